@@ -1,0 +1,228 @@
+"""Overhead camera model: pinhole with two-term radial distortion, field <-> pixel.
+
+Shared by the simulator (which renders through it) and vision (which measures through it), so
+there is one model and one set of parameters (``configs/cameras.yaml``).
+
+Camera frame: x along the image u axis (columns), y along v (rows), z along the optical axis.
+With ``yaw_rad = 0`` and no tilt, the camera looks straight down, u runs along the field's +x
+and v along the field's -y. Pixel (u, v) is measured from the top-left corner of the top-left
+pixel, so the centre of pixel (i, j) is (j + 0.5, i + 0.5).
+
+Distortion, as OpenCV's first two radial terms: with normalised coordinates (x, y) and
+``r^2 = x^2 + y^2``, the distorted coordinates are ``(x, y) * (1 + k1 r^2 + k2 r^4)``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from cmdragons.config import setting
+from cmdragons.geometry import Field, LeagueParams
+
+__all__ = ["AutoLayout", "CameraModel", "CameraParams", "CamerasParams", "cameras_from_config"]
+
+
+@dataclass(frozen=True)
+class CameraParams:
+    """One camera's intrinsic and extrinsic parameters."""
+
+    id: int = setting(0, lo=0, hi=63)
+    position_m: tuple[float, float, float] = (0.0, 0.0, 4.0)  # optical centre in the field frame
+    yaw_rad: float = setting(0.0, lo=-2 * math.pi, hi=2 * math.pi)  # image u axis vs field +x
+    tilt_x_rad: float = setting(0.0, lo=-0.5, hi=0.5)  # rotation about the camera x axis
+    tilt_y_rad: float = setting(0.0, lo=-0.5, hi=0.5)  # rotation about the camera y axis
+    focal_px: float = setting(600.0, lo=10.0, hi=100000.0)
+    principal_point_px: tuple[float, float] = (512.0, 384.0)
+    k1: float = setting(0.0, lo=-1.0, hi=1.0)
+    k2: float = setting(0.0, lo=-1.0, hi=1.0)
+    resolution_px: tuple[int, int] = (1024, 768)  # width, height
+
+    def __post_init__(self) -> None:
+        if self.position_m[2] <= 0.3:
+            raise ValueError("a camera must hang above the field: position_m[2] > 0.3")
+        if min(self.resolution_px) < 16:
+            raise ValueError("resolution_px must be at least 16 x 16")
+
+
+@dataclass(frozen=True)
+class AutoLayout:
+    """Cameras derived from the field: a grid of downward cameras, each seeing its cell plus the
+    overlap with its neighbours and a margin past the field lines, at robot-top height."""
+
+    grid: tuple[int, int] = (2, 1)  # cameras along x, along y
+    height_m: float = setting(4.0, lo=0.5, hi=20.0)
+    overlap_m: float = setting(0.4, lo=0.0, hi=5.0)  # width of the strip two neighbours both see
+    margin_x_m: float = setting(0.25, lo=0.0, hi=2.0)  # past the goal lines
+    margin_y_m: float = setting(0.2, lo=0.0, hi=2.0)  # past the touch lines
+    resolution_px: tuple[int, int] = (1024, 768)
+    long_axis: Literal["x", "y"] = "y"  # field axis along the image width
+    k1: float = setting(-0.02, lo=-0.5, hi=0.5)
+    k2: float = setting(0.0, lo=-0.5, hi=0.5)
+
+
+@dataclass(frozen=True)
+class CamerasParams:
+    """configs/cameras.yaml."""
+
+    layout: Literal["auto", "list"] = "auto"
+    auto: AutoLayout = AutoLayout()
+    cameras: tuple[CameraParams, ...] = ()
+
+    def __post_init__(self) -> None:
+        if self.layout == "list" and not self.cameras:
+            raise ValueError("layout 'list' needs at least one entry under cameras")
+        ids = [c.id for c in self.cameras]
+        if len(set(ids)) != len(ids):
+            raise ValueError("camera ids must be distinct")
+
+
+class CameraModel:
+    """Projection between the field frame (metres) and one camera's pixels."""
+
+    def __init__(self, params: CameraParams) -> None:
+        self.params = params
+        self.id = params.id
+        self.width, self.height = params.resolution_px
+        self.f = params.focal_px
+        self.cx, self.cy = params.principal_point_px
+        self.k1, self.k2 = params.k1, params.k2
+        self.center = np.asarray(params.position_m, dtype=np.float64)
+        c, s = math.cos(params.yaw_rad), math.sin(params.yaw_rad)
+        # camera axes in the field frame, before tilt: x = u, y = v, z = optical axis (down)
+        base = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, -1.0]])  # columns: x_c, y_c, z_c
+        base[:, 1] = np.cross(base[:, 2], base[:, 0])
+        tx, ty = params.tilt_x_rad, params.tilt_y_rad
+        rx = np.array([[1, 0, 0], [0, math.cos(tx), -math.sin(tx)], [0, math.sin(tx), math.cos(tx)]])
+        ry = np.array([[math.cos(ty), 0, math.sin(ty)], [0, 1, 0], [-math.sin(ty), 0, math.cos(ty)]])
+        self.R_cam_to_field: NDArray[np.float64] = base @ rx @ ry
+
+    # --- distortion on normalised coordinates ------------------------------------------------
+    def distort(self, xy: NDArray[np.float64]) -> NDArray[np.float64]:
+        r2 = np.sum(xy * xy, axis=-1, keepdims=True)
+        out: NDArray[np.float64] = xy * (1.0 + self.k1 * r2 + self.k2 * r2 * r2)
+        return out
+
+    def undistort(self, xy_d: NDArray[np.float64], iterations: int = 20) -> NDArray[np.float64]:
+        """Inverse of :meth:`distort` by Newton's method on the radius (exact to ~1e-12)."""
+        rd = np.sqrt(np.sum(xy_d * xy_d, axis=-1))
+        r = rd.copy()
+        for _ in range(iterations):
+            r2 = r * r
+            g = r * (1.0 + self.k1 * r2 + self.k2 * r2 * r2) - rd
+            dg = 1.0 + 3.0 * self.k1 * r2 + 5.0 * self.k2 * r2 * r2
+            r = r - g / np.where(np.abs(dg) < 1e-9, 1e-9, dg)
+        scale = np.where(rd > 1e-15, r / np.where(rd > 1e-15, rd, 1.0), 1.0)
+        return xy_d * scale[..., None]
+
+    # --- projection ----------------------------------------------------------------------------
+    def project(self, points: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Field points (..., 3) in metres -> pixels (..., 2). Points behind the camera give NaN."""
+        p = np.asarray(points, dtype=np.float64)
+        pc = (p - self.center) @ self.R_cam_to_field
+        z = pc[..., 2:3]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            xy = np.where(z > 1e-9, pc[..., :2] / z, np.nan)
+        xy = self.distort(xy)
+        return np.stack([self.f * xy[..., 0] + self.cx, self.f * xy[..., 1] + self.cy], axis=-1)
+
+    def project_xy(self, xy: NDArray[np.float64], z: float) -> NDArray[np.float64]:
+        """Field points (..., 2) on the plane at height ``z`` -> pixels (..., 2)."""
+        xy = np.asarray(xy, dtype=np.float64)
+        pts = np.concatenate([xy, np.full(xy.shape[:-1] + (1,), z)], axis=-1)
+        return self.project(pts)
+
+    def rays(self, pixels: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Pixels (..., 2) -> ray directions (..., 3) in the field frame, scaled to dz = -1."""
+        px = np.asarray(pixels, dtype=np.float64)
+        xy_d = np.stack([(px[..., 0] - self.cx) / self.f, (px[..., 1] - self.cy) / self.f], axis=-1)
+        xy = self.undistort(xy_d)
+        d_cam = np.concatenate([xy, np.ones(xy.shape[:-1] + (1,))], axis=-1)
+        d: NDArray[np.float64] = d_cam @ self.R_cam_to_field.T
+        return d / (-d[..., 2:3])
+
+    def unproject(self, pixels: NDArray[np.float64], z: float) -> NDArray[np.float64]:
+        """Pixels (..., 2) -> field points (..., 2) on the plane at height ``z`` metres."""
+        d = self.rays(pixels)
+        t = self.center[2] - z
+        out: NDArray[np.float64] = self.center[:2] + d[..., :2] * t
+        return out
+
+    def pixel_rays_grid(self) -> NDArray[np.float32]:
+        """Ray (dx, dy) per pixel centre, shape (height, width, 2): the field point seen at
+        height z is ``center_xy + (center_z - z) * (dx, dy)``."""
+        u = np.arange(self.width, dtype=np.float64) + 0.5
+        v = np.arange(self.height, dtype=np.float64) + 0.5
+        grid = np.stack(np.meshgrid(u, v), axis=-1)
+        return self.rays(grid)[..., :2].astype(np.float32)
+
+    def in_image(self, pixels: NDArray[np.float64], margin: float = 0.0) -> NDArray[np.bool_]:
+        px = np.asarray(pixels)
+        with np.errstate(invalid="ignore"):
+            return (
+                (px[..., 0] >= margin)
+                & (px[..., 0] <= self.width - margin)
+                & (px[..., 1] >= margin)
+                & (px[..., 1] <= self.height - margin)
+            )
+
+    def pixels_per_metre(self, xy: tuple[float, float], z: float) -> float:
+        """Local image scale (pixels per metre) at a field point on the plane at height ``z``."""
+        h = 1e-3
+        pts = np.array([[xy[0] - h, xy[1]], [xy[0] + h, xy[1]], [xy[0], xy[1] - h], [xy[0], xy[1] + h]])
+        px = self.project_xy(pts, z)
+        sx = np.linalg.norm(px[1] - px[0]) / (2 * h)
+        sy = np.linalg.norm(px[3] - px[2]) / (2 * h)
+        return float(min(sx, sy))
+
+
+def _auto_camera(cam_id: int, center: tuple[float, float], half: tuple[float, float], lay: AutoLayout,
+                 robot_height: float) -> CameraParams:
+    w, h = lay.resolution_px
+    yaw = 0.0 if lay.long_axis == "x" else -math.pi / 2.0
+    # the covered rectangle at robot-top height, in camera-frame half extents (u, v)
+    hu, hv = (half[0], half[1]) if lay.long_axis == "x" else (half[1], half[0])
+    dist = lay.height_m - robot_height
+    corner = np.array([hu / dist, hv / dist])
+
+    def fits(f: float) -> bool:
+        r2 = float(corner @ corner)
+        d = corner * (1.0 + lay.k1 * r2 + lay.k2 * r2 * r2) * f
+        return bool(d[0] <= w / 2.0 and d[1] <= h / 2.0)
+
+    lo, hi = 1.0, 100000.0  # the largest focal length whose image still holds the rectangle
+    for _ in range(80):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if fits(mid) else (lo, mid)
+    return CameraParams(
+        id=cam_id, position_m=(center[0], center[1], lay.height_m), yaw_rad=yaw, focal_px=lo,
+        principal_point_px=(w / 2.0, h / 2.0), k1=lay.k1, k2=lay.k2, resolution_px=(w, h),
+    )  # fmt: skip
+
+
+def cameras_from_config(params: CamerasParams, league: LeagueParams) -> list[CameraModel]:
+    """The camera models in force: the explicit list, or the auto layout over the field."""
+    if params.layout == "list":
+        return [CameraModel(p) for p in params.cameras]
+    lay = params.auto
+    f = Field(league)
+    x0, x1 = -f.half_length - lay.margin_x_m, f.half_length + lay.margin_x_m
+    y0, y1 = -f.half_width - lay.margin_y_m, f.half_width + lay.margin_y_m
+    nx, ny = lay.grid
+    cx_w, cy_w = (x1 - x0) / nx, (y1 - y0) / ny
+    models = []
+    for j in range(ny):
+        for i in range(nx):
+            # each camera sees its cell, plus half the overlap toward every neighbour
+            lo_x = x0 + i * cx_w - (lay.overlap_m / 2.0 if i > 0 else 0.0)
+            hi_x = x0 + (i + 1) * cx_w + (lay.overlap_m / 2.0 if i < nx - 1 else 0.0)
+            lo_y = y0 + j * cy_w - (lay.overlap_m / 2.0 if j > 0 else 0.0)
+            hi_y = y0 + (j + 1) * cy_w + (lay.overlap_m / 2.0 if j < ny - 1 else 0.0)
+            centre = ((lo_x + hi_x) / 2.0, (lo_y + hi_y) / 2.0)
+            half = ((hi_x - lo_x) / 2.0, (hi_y - lo_y) / 2.0)
+            models.append(CameraModel(_auto_camera(j * nx + i, centre, half, lay, league.robot.height_m)))
+    return models

@@ -1,0 +1,297 @@
+"""YAML configuration -> frozen, typed dataclasses.
+
+Every tunable number of the system lives in ``configs/<concern>.yaml``. Each concern is parsed
+into a frozen dataclass declared beside the code that uses it. This module holds only the
+generic machinery, so it imports nothing else of the project:
+
+* :func:`load_yaml` reads one file and reports a missing file or malformed YAML (with its line);
+* :func:`parse` turns a mapping into a dataclass, checking unknown keys, types, ranges and choices,
+  and naming the file, the key and what is allowed when something is wrong;
+* :func:`apply_override` applies one ``--set concern.key.path=value`` to the raw mappings.
+
+Ranges and choices are declared on the dataclass fields with :func:`setting`::
+
+    @dataclass(frozen=True)
+    class MotorParams:
+        max_speed_m_s: float = setting(3.0, lo=0.0, hi=10.0)
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import types
+import typing
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any, Literal, TypeVar, Union, get_args, get_origin, get_type_hints
+
+import yaml
+
+__all__ = [
+    "ConfigError",
+    "apply_override",
+    "default_config_dir",
+    "load_yaml",
+    "parse",
+    "setting",
+    "to_plain",
+]
+
+T = TypeVar("T")
+
+
+class ConfigError(ValueError):
+    """A configuration problem, naming the file, the key and what is allowed."""
+
+    def __init__(self, file: str | Path, key: str, message: str) -> None:
+        self.file = str(file)
+        self.key = key
+        self.message = message
+        where = f"{self.file}: {key}" if key else self.file
+        super().__init__(f"{where}: {message}")
+
+
+def setting(
+    default: Any = dataclasses.MISSING,
+    *,
+    lo: float | None = None,
+    hi: float | None = None,
+    choices: tuple[Any, ...] | None = None,
+    default_factory: Any = dataclasses.MISSING,
+) -> Any:
+    """A dataclass field with an allowed closed range ``[lo, hi]`` or a set of choices."""
+    meta = {"lo": lo, "hi": hi, "choices": choices}
+    if default_factory is not dataclasses.MISSING:
+        return dataclasses.field(default_factory=default_factory, metadata=meta)
+    return dataclasses.field(default=default, metadata=meta)
+
+
+def default_config_dir() -> Path:
+    """``./configs`` when the working directory has one, else the configs beside the package."""
+    here = Path.cwd() / "configs"
+    if here.is_dir():
+        return here
+    return Path(__file__).resolve().parent.parent / "configs"
+
+
+def load_yaml(path: str | Path) -> dict[str, Any]:
+    """Read one YAML mapping; a missing file or malformed YAML raises :class:`ConfigError`."""
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(path, "", "file not found")
+    try:
+        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark
+        line = f"line {mark.line + 1}, column {mark.column + 1}: " if mark is not None else ""
+        raise ConfigError(path, "", f"malformed YAML at {line}{exc.problem}") from None
+    except yaml.YAMLError as exc:
+        raise ConfigError(path, "", f"malformed YAML: {exc}") from None
+    except UnicodeDecodeError as exc:
+        raise ConfigError(path, "", f"not UTF-8 text: {exc}") from None
+    if data is None:
+        return {}
+    if not isinstance(data, dict):
+        raise ConfigError(path, "", f"the top level must be a mapping of keys, not {type(data).__name__}")
+    return data
+
+
+def apply_override(raw: dict[str, dict[str, Any]], assignment: str) -> None:
+    """Apply ``concern.key.path=value`` to the raw mappings of all concerns, in place.
+
+    The value is read as a YAML scalar or flow collection (``3``, ``true``, ``[1, 2]``).
+    """
+    origin = f"--set {assignment}"
+    if "=" not in assignment:
+        raise ConfigError(origin, "", "expected concern.key.path=value")
+    path, _, text = assignment.partition("=")
+    parts = [p for p in path.strip().split(".") if p]
+    if len(parts) < 2:
+        raise ConfigError(origin, path, "expected at least concern.key (for example sim.physics.substeps=8)")
+    concern = parts[0]
+    if concern not in raw:
+        raise ConfigError(origin, concern, f"unknown concern; allowed: {', '.join(sorted(raw))}")
+    try:
+        value = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        raise ConfigError(origin, path, f"value is not valid YAML: {exc}") from None
+    node: Any = raw[concern]
+    for i, key in enumerate(parts[1:-1], start=1):
+        if isinstance(node, list):
+            node = _list_item(node, key, origin, ".".join(parts[: i + 1]))
+            continue
+        if not isinstance(node, dict):
+            raise ConfigError(origin, ".".join(parts[: i + 1]), "cannot descend into a scalar value")
+        node = node.setdefault(key, {})
+    last = parts[-1]
+    if isinstance(node, list):
+        index = int(last) if last.lstrip("-").isdigit() else None
+        if index is None or not -len(node) <= index < len(node):
+            raise ConfigError(origin, path, f"list index out of range 0..{len(node) - 1}")
+        node[index] = value
+    elif isinstance(node, dict):
+        node[last] = value
+    else:
+        raise ConfigError(origin, path, "cannot descend into a scalar value")
+
+
+def _list_item(node: list[Any], key: str, origin: str, where: str) -> Any:
+    if not key.lstrip("-").isdigit() or not -len(node) <= int(key) < len(node):
+        raise ConfigError(origin, where, f"list index out of range 0..{len(node) - 1}")
+    return node[int(key)]
+
+
+def parse(cls: type[T], data: Any, *, file: str | Path, key: str = "") -> T:
+    """Build dataclass ``cls`` from ``data``; every problem raises :class:`ConfigError`.
+
+    Missing keys take the dataclass defaults; unknown keys, wrong types, values out of range or
+    outside the declared choices are errors. ``__post_init__`` may raise ``ValueError`` for checks
+    that involve several fields; its message is reported with the file and key.
+    """
+    return typing.cast(T, _convert(cls, data, str(file), key))
+
+
+def to_plain(obj: Any) -> Any:
+    """A dataclass (tree) as plain dicts, lists and scalars, ready for YAML or JSON."""
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return {f.name: to_plain(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
+    if isinstance(obj, Mapping):
+        return {str(k): to_plain(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [to_plain(v) for v in obj]
+    return obj
+
+
+def _join(key: str, sub: str | int) -> str:
+    if isinstance(sub, int):
+        return f"{key}[{sub}]"
+    return f"{key}.{sub}" if key else sub
+
+
+def _type_name(tp: Any) -> str:
+    if tp is float:
+        return "a number"
+    if tp is int:
+        return "an integer"
+    if tp is bool:
+        return "true or false"
+    if tp is str:
+        return "a string"
+    if dataclasses.is_dataclass(tp):
+        return "a mapping"
+    return str(tp).replace("typing.", "")
+
+
+def _convert(tp: Any, value: Any, file: str, key: str) -> Any:
+    origin = get_origin(tp)
+    if dataclasses.is_dataclass(tp) and isinstance(tp, type):
+        return _convert_dataclass(tp, value, file, key)
+    if tp is Any:
+        return value
+    if origin is Literal:
+        allowed = get_args(tp)
+        if value not in allowed or isinstance(value, bool) != isinstance(allowed[0], bool):
+            raise ConfigError(file, key, f"{value!r} is not allowed; allowed: {', '.join(map(repr, allowed))}")
+        return value
+    if origin in (Union, types.UnionType):
+        args = get_args(tp)
+        if value is None and type(None) in args:
+            return None
+        errors = []
+        for arg in args:
+            if arg is type(None):
+                continue
+            try:
+                return _convert(arg, value, file, key)
+            except ConfigError as exc:
+                errors.append(exc.message)
+        raise ConfigError(file, key, " or ".join(errors))
+    if origin is tuple:
+        args = get_args(tp)
+        if not isinstance(value, list | tuple):
+            raise ConfigError(file, key, f"expected a list, got {value!r}")
+        if len(args) == 2 and args[1] is Ellipsis:
+            return tuple(_convert(args[0], v, file, _join(key, i)) for i, v in enumerate(value))
+        if len(value) != len(args):
+            raise ConfigError(file, key, f"expected a list of {len(args)} values, got {len(value)}")
+        return tuple(_convert(a, v, file, _join(key, i)) for i, (a, v) in enumerate(zip(args, value, strict=True)))
+    if origin in (dict, Mapping):
+        key_t, val_t = get_args(tp)
+        if not isinstance(value, dict):
+            raise ConfigError(file, key, f"expected a mapping, got {value!r}")
+        out = {}
+        for k, v in value.items():
+            out[_convert(key_t, k, file, _join(key, str(k)))] = _convert(val_t, v, file, _join(key, str(k)))
+        return types.MappingProxyType(out)
+    if tp is bool:
+        if not isinstance(value, bool):
+            raise ConfigError(file, key, f"expected true or false, got {value!r}")
+        return value
+    if tp is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise ConfigError(file, key, f"expected an integer, got {value!r}")
+        return value
+    if tp is float:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise ConfigError(file, key, f"expected a number, got {value!r}")
+        if not math.isfinite(value):
+            raise ConfigError(file, key, f"expected a finite number, got {value!r}")
+        return float(value)
+    if tp is str:
+        if not isinstance(value, str):
+            raise ConfigError(file, key, f"expected a string, got {value!r}")
+        return value
+    raise TypeError(f"config type {tp!r} at {key} is not supported")
+
+
+def _convert_dataclass(cls: type, value: Any, file: str, key: str) -> Any:
+    if isinstance(value, cls):
+        return value
+    if value is None:
+        value = {}
+    if not isinstance(value, dict):
+        raise ConfigError(file, key, f"expected a mapping, got {value!r}")
+    hints = get_type_hints(cls)
+    fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
+    unknown = [k for k in value if k not in fields]
+    if unknown:
+        raise ConfigError(
+            file, _join(key, str(unknown[0])), f"unknown key; allowed keys: {', '.join(sorted(fields))}"
+        )
+    kwargs = {}
+    for name, f in fields.items():
+        sub = _join(key, name)
+        if name not in value:
+            if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
+                raise ConfigError(file, sub, "missing required key")
+            continue
+        converted = _convert(hints[name], value[name], file, sub)
+        _check_limits(f, converted, file, sub)
+        kwargs[name] = converted
+    try:
+        return cls(**kwargs)
+    except ConfigError:
+        raise
+    except (ValueError, TypeError) as exc:
+        raise ConfigError(file, key, str(exc)) from None
+
+
+def _check_limits(f: dataclasses.Field[Any], value: Any, file: str, key: str) -> None:
+    lo, hi, choices = f.metadata.get("lo"), f.metadata.get("hi"), f.metadata.get("choices")
+    items = value if isinstance(value, tuple) else (value,)
+    for i, item in enumerate(items):
+        where = _join(key, i) if isinstance(value, tuple) else key
+        if choices is not None and item not in choices:
+            raise ConfigError(file, where, f"{item!r} is not allowed; allowed: {', '.join(map(repr, choices))}")
+        if isinstance(item, int | float) and not isinstance(item, bool):
+            if (lo is not None and item < lo) or (hi is not None and item > hi):
+                raise ConfigError(file, where, f"{item!r} is out of range; allowed: {_range(lo, hi)}")
+
+
+def _range(lo: float | None, hi: float | None) -> str:
+    if lo is not None and hi is not None:
+        return f"{lo} to {hi}"
+    if lo is not None:
+        return f">= {lo}"
+    return f"<= {hi}"

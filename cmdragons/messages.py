@@ -1,0 +1,541 @@
+"""What crosses stage and process boundaries.
+
+Every message is a frozen dataclass with ``to_dict``/``from_dict`` (the JSONL forms of DESIGN.md:
+metres, radians, team as "blue"/"yellow") and ``encode``/``decode``, a compact binary form for the
+bus: a fixed little-endian header followed by packed rows (numpy structured arrays).
+"""
+
+from __future__ import annotations
+
+import math
+import struct
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any, ClassVar, Self
+
+import numpy as np
+from numpy.typing import NDArray
+
+from cmdragons.geometry import TEAMS, Team
+
+__all__ = [
+    "BallDetection",
+    "BallState",
+    "BallTruth",
+    "DetectionFrame",
+    "GameState",
+    "GroundTruth",
+    "MessageError",
+    "RobotCommand",
+    "RobotDetection",
+    "RobotState",
+    "RobotTruth",
+    "WorldState",
+]
+
+
+class MessageError(ValueError):
+    """A message that cannot be decoded or read from its dict form."""
+
+
+def _team_code(team: str) -> int:
+    try:
+        return TEAMS.index(team)  # type: ignore[arg-type,unused-ignore]
+    except ValueError:
+        raise MessageError(f"team must be 'blue' or 'yellow', got {team!r}") from None
+
+
+def _team(team: Any) -> Team:
+    if team not in TEAMS:
+        raise MessageError(f"team must be 'blue' or 'yellow', got {team!r}")
+    return team  # type: ignore[no-any-return]
+
+
+def _f(d: Mapping[str, Any], key: str, default: float | None = None) -> float:
+    try:
+        value = d[key]
+    except KeyError:
+        if default is None:
+            raise MessageError(f"missing key {key!r}") from None
+        return default
+    if value is None:
+        return math.nan
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise MessageError(f"{key!r} must be a number, got {value!r}") from None
+
+
+def _pixel(value: Any) -> tuple[float, float]:
+    if value is None:
+        return (math.nan, math.nan)
+    try:
+        u, v = value
+        return (float(u), float(v))
+    except (TypeError, ValueError):
+        raise MessageError(f"pixel must be [u, v], got {value!r}") from None
+
+
+def _num(x: float) -> float | None:
+    """JSON has no NaN: unknown numbers are written as null."""
+    return None if math.isnan(x) else x
+
+
+class _Codec:
+    """Header struct + one structured array per list field."""
+
+    def __init__(self, header: str, *rows: np.dtype[Any]) -> None:
+        self.header = struct.Struct("<" + header)
+        self.rows = rows
+
+    def pack(self, head: Sequence[Any], *tables: NDArray[Any]) -> bytes:
+        parts = [self.header.pack(*head)]
+        for table in tables:
+            parts.append(struct.pack("<I", len(table)))
+            parts.append(table.tobytes())
+        return b"".join(parts)
+
+    def unpack(self, data: bytes | bytearray | memoryview) -> tuple[tuple[Any, ...], list[NDArray[Any]]]:
+        buf = memoryview(data).cast("B")
+        try:
+            head = self.header.unpack_from(buf, 0)
+            off = self.header.size
+            tables = []
+            for dt in self.rows:
+                (n,) = struct.unpack_from("<I", buf, off)
+                off += 4
+                size = n * dt.itemsize
+                if off + size > len(buf):
+                    raise MessageError("message is truncated")
+                tables.append(np.frombuffer(buf[off : off + size], dtype=dt).copy())
+                off += size
+        except struct.error as exc:
+            raise MessageError(f"message is truncated or corrupt: {exc}") from None
+        if off != len(buf):
+            raise MessageError(f"message has {len(buf) - off} trailing bytes")
+        return head, tables
+
+
+# --- detections ------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class BallDetection:
+    x: float
+    y: float
+    confidence: float
+    pixel: tuple[float, float]
+
+
+@dataclass(frozen=True)
+class RobotDetection:
+    team: Team
+    id: int
+    x: float
+    y: float
+    theta: float
+    confidence: float
+    pixel: tuple[float, float]
+
+
+_BALL_DET = np.dtype([("x", "<f8"), ("y", "<f8"), ("confidence", "<f4"), ("u", "<f4"), ("v", "<f4")])
+_ROBOT_DET = np.dtype(
+    [("team", "u1"), ("id", "u1"), ("x", "<f8"), ("y", "<f8"), ("theta", "<f4"),
+     ("confidence", "<f4"), ("u", "<f4"), ("v", "<f4")]
+)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class DetectionFrame:
+    """One camera frame's detections: the content of an SSL-Vision detection packet."""
+
+    camera_id: int
+    frame_number: int
+    t_capture: float
+    t_sent: float
+    balls: tuple[BallDetection, ...] = ()
+    robots: tuple[RobotDetection, ...] = ()
+
+    _codec: ClassVar[_Codec] = _Codec("Hqdd", _BALL_DET, _ROBOT_DET)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "camera_id": self.camera_id,
+            "frame_number": self.frame_number,
+            "t_capture": self.t_capture,
+            "t_sent": self.t_sent,
+            "balls": [
+                {"x": b.x, "y": b.y, "confidence": b.confidence, "pixel": [b.pixel[0], b.pixel[1]]}
+                for b in self.balls
+            ],
+            "robots": [
+                {"team": r.team, "id": r.id, "x": r.x, "y": r.y, "theta": r.theta,
+                 "confidence": r.confidence, "pixel": [r.pixel[0], r.pixel[1]]}
+                for r in self.robots
+            ],
+        }  # fmt: skip
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Self:
+        try:
+            return cls(
+                camera_id=int(d["camera_id"]),
+                frame_number=int(d["frame_number"]),
+                t_capture=_f(d, "t_capture"),
+                t_sent=_f(d, "t_sent", default=_f(d, "t_capture")),
+                balls=tuple(
+                    BallDetection(_f(b, "x"), _f(b, "y"), _f(b, "confidence", 1.0), _pixel(b.get("pixel")))
+                    for b in d.get("balls", ())
+                ),
+                robots=tuple(
+                    RobotDetection(_team(r["team"]), int(r["id"]), _f(r, "x"), _f(r, "y"), _f(r, "theta"),
+                                   _f(r, "confidence", 1.0), _pixel(r.get("pixel")))
+                    for r in d.get("robots", ())
+                ),  # fmt: skip
+            )
+        except (KeyError, TypeError, AttributeError) as exc:
+            raise MessageError(f"bad detection frame: {exc!r}") from None
+
+    def encode(self) -> bytes:
+        balls = np.array([(b.x, b.y, b.confidence, *b.pixel) for b in self.balls], dtype=_BALL_DET)
+        robots = np.array(
+            [(_team_code(r.team), r.id, r.x, r.y, r.theta, r.confidence, *r.pixel) for r in self.robots],
+            dtype=_ROBOT_DET,
+        )
+        return self._codec.pack((self.camera_id, self.frame_number, self.t_capture, self.t_sent), balls, robots)
+
+    @classmethod
+    def decode(cls, data: bytes | bytearray | memoryview) -> Self:
+        (cam, frame, t_capture, t_sent), (balls, robots) = cls._codec.unpack(data)
+        return cls(
+            cam, frame, t_capture, t_sent,
+            tuple(BallDetection(float(b["x"]), float(b["y"]), float(b["confidence"]), (float(b["u"]), float(b["v"])))
+                  for b in balls),
+            tuple(RobotDetection(TEAMS[int(r["team"]) & 1], int(r["id"]), float(r["x"]), float(r["y"]),
+                                 float(r["theta"]), float(r["confidence"]), (float(r["u"]), float(r["v"])))
+                  for r in robots),
+        )  # fmt: skip
+
+
+# --- tracked world state ----------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class BallState:
+    x: float
+    y: float
+    vx: float
+    vy: float
+    visible: bool = True
+    covariance: NDArray[np.float64] | None = field(default=None, compare=False, repr=False)  # in memory only
+
+
+@dataclass(frozen=True)
+class RobotState:
+    team: Team
+    id: int
+    x: float
+    y: float
+    theta: float
+    vx: float = 0.0
+    vy: float = 0.0
+    omega: float = 0.0
+    visible: bool = True
+
+
+_BALL_STATE = np.dtype([("x", "<f8"), ("y", "<f8"), ("vx", "<f4"), ("vy", "<f4"), ("visible", "u1")])
+_ROBOT_STATE = np.dtype(
+    [("team", "u1"), ("id", "u1"), ("visible", "u1"), ("x", "<f8"), ("y", "<f8"), ("theta", "<f4"),
+     ("vx", "<f4"), ("vy", "<f4"), ("omega", "<f4")]
+)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class WorldState:
+    """The tracker's estimate at time ``t`` (s); ``ball`` is None until a ball was ever seen."""
+
+    t: float
+    ball: BallState | None
+    robots: tuple[RobotState, ...] = ()
+
+    _codec: ClassVar[_Codec] = _Codec("d", _BALL_STATE, _ROBOT_STATE)
+
+    def robot(self, team: Team, robot_id: int) -> RobotState | None:
+        for r in self.robots:
+            if r.team == team and r.id == robot_id:
+                return r
+        return None
+
+    def to_dict(self) -> dict[str, Any]:
+        b = self.ball
+        return {
+            "t": self.t,
+            "ball": None if b is None else {"x": b.x, "y": b.y, "vx": b.vx, "vy": b.vy, "visible": b.visible},
+            "robots": [
+                {"team": r.team, "id": r.id, "x": r.x, "y": r.y, "theta": r.theta, "vx": r.vx, "vy": r.vy,
+                 "omega": r.omega, "visible": r.visible}
+                for r in self.robots
+            ],
+        }  # fmt: skip
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Self:
+        try:
+            b = d.get("ball")
+            ball = None if b is None else BallState(_f(b, "x"), _f(b, "y"), _f(b, "vx", 0.0), _f(b, "vy", 0.0),
+                                                     bool(b.get("visible", True)))  # fmt: skip
+            robots = tuple(
+                RobotState(_team(r["team"]), int(r["id"]), _f(r, "x"), _f(r, "y"), _f(r, "theta"),
+                           _f(r, "vx", 0.0), _f(r, "vy", 0.0), _f(r, "omega", 0.0), bool(r.get("visible", True)))
+                for r in d.get("robots", ())
+            )  # fmt: skip
+            return cls(_f(d, "t"), ball, robots)
+        except (KeyError, TypeError, AttributeError) as exc:
+            raise MessageError(f"bad world state: {exc!r}") from None
+
+    def encode(self) -> bytes:
+        b = self.ball
+        balls = np.array([] if b is None else [(b.x, b.y, b.vx, b.vy, b.visible)], dtype=_BALL_STATE)
+        robots = np.array(
+            [(_team_code(r.team), r.id, r.visible, r.x, r.y, r.theta, r.vx, r.vy, r.omega) for r in self.robots],
+            dtype=_ROBOT_STATE,
+        )
+        return self._codec.pack((self.t,), balls, robots)
+
+    @classmethod
+    def decode(cls, data: bytes | bytearray | memoryview) -> Self:
+        (t,), (balls, robots) = cls._codec.unpack(data)
+        ball = None
+        if len(balls):
+            b = balls[0]
+            ball = BallState(float(b["x"]), float(b["y"]), float(b["vx"]), float(b["vy"]), bool(b["visible"]))
+        return cls(
+            float(t), ball,
+            tuple(RobotState(TEAMS[int(r["team"]) & 1], int(r["id"]), float(r["x"]), float(r["y"]),
+                             float(r["theta"]), float(r["vx"]), float(r["vy"]), float(r["omega"]),
+                             bool(r["visible"])) for r in robots),
+        )  # fmt: skip
+
+
+# --- commands ----------------------------------------------------------------------------------
+
+
+_COMMAND = np.dtype(
+    [("team", "u1"), ("id", "u1"), ("chip", "u1"), ("dribbler", "<f4"), ("vx", "<f4"), ("vy", "<f4"),
+     ("omega", "<f4"), ("kick_speed", "<f4")]
+)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class RobotCommand:
+    """Velocity command for one robot: vx, vy in the field frame (m/s), omega (rad/s); a kick of
+    ``kick_speed`` m/s fires when the ball touches the front (0 = kicker off); ``dribbler`` is the
+    dribbler power from 0 (off) to 1."""
+
+    team: Team
+    id: int
+    vx: float = 0.0
+    vy: float = 0.0
+    omega: float = 0.0
+    kick_speed: float = 0.0
+    chip: bool = False
+    dribbler: float = 0.0
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"team": self.team, "id": self.id, "vx": _num(self.vx), "vy": _num(self.vy),
+                "omega": _num(self.omega), "kick_speed": _num(self.kick_speed), "chip": self.chip,
+                "dribbler": _num(self.dribbler)}  # fmt: skip
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Self:
+        try:
+            return cls(_team(d["team"]), int(d["id"]), _f(d, "vx", 0.0), _f(d, "vy", 0.0), _f(d, "omega", 0.0),
+                       _f(d, "kick_speed", 0.0), bool(d.get("chip", False)), _f(d, "dribbler", 0.0))  # fmt: skip
+        except (KeyError, TypeError, AttributeError) as exc:
+            raise MessageError(f"bad robot command: {exc!r}") from None
+
+    @staticmethod
+    def encode_many(commands: Sequence[RobotCommand]) -> bytes:
+        table = np.array(
+            [(_team_code(c.team), c.id, c.chip, c.dribbler, c.vx, c.vy, c.omega, c.kick_speed) for c in commands],
+            dtype=_COMMAND,
+        )
+        return _COMMANDS_CODEC.pack((), table)
+
+    @classmethod
+    def decode_many(cls, data: bytes | bytearray | memoryview) -> list[RobotCommand]:
+        _, (table,) = _COMMANDS_CODEC.unpack(data)
+        return [
+            cls(TEAMS[int(r["team"]) & 1], int(r["id"]), float(r["vx"]), float(r["vy"]), float(r["omega"]),
+                float(r["kick_speed"]), bool(r["chip"]), float(r["dribbler"]))
+            for r in table
+        ]  # fmt: skip
+
+
+_COMMANDS_CODEC = _Codec("", _COMMAND)
+
+
+# --- ground truth (simulator only) -----------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class BallTruth:
+    x: float
+    y: float
+    z: float
+    vx: float
+    vy: float
+    vz: float = 0.0
+    # per camera id: (u, v) of the ball centre and the fraction of its silhouette not occluded
+    pixels: Mapping[int, tuple[float, float, float]] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class RobotTruth:
+    team: Team
+    id: int
+    x: float
+    y: float
+    theta: float
+    vx: float
+    vy: float
+    omega: float
+    # per camera id: (u, v) of the centre of the robot's top, for cameras whose image holds the whole top
+    pixels: Mapping[int, tuple[float, float]] = field(default_factory=dict)
+
+
+_BALL_TRUTH = np.dtype([("x", "<f8"), ("y", "<f8"), ("z", "<f8"), ("vx", "<f8"), ("vy", "<f8"), ("vz", "<f8")])
+_ROBOT_TRUTH = np.dtype(
+    [("team", "u1"), ("id", "u1"), ("x", "<f8"), ("y", "<f8"), ("theta", "<f8"), ("vx", "<f8"),
+     ("vy", "<f8"), ("omega", "<f8")]
+)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class GroundTruth:
+    """The simulator's true state for one camera frame (what vision, tracking and safety are
+    scored against)."""
+
+    frame_number: int
+    t: float
+    ball: BallTruth
+    robots: tuple[RobotTruth, ...] = ()
+
+    _codec: ClassVar[_Codec] = _Codec("qd", _BALL_TRUTH, _ROBOT_TRUTH)
+
+    def to_dict(self) -> dict[str, Any]:
+        b = self.ball
+        ball: dict[str, Any] = {"x": b.x, "y": b.y, "z": b.z, "vx": b.vx, "vy": b.vy, "vz": b.vz}
+        if b.pixels:
+            ball["cameras"] = {str(k): {"pixel": [u, v], "visible_fraction": f} for k, (u, v, f) in b.pixels.items()}
+        robots = []
+        for r in self.robots:
+            rd: dict[str, Any] = {"team": r.team, "id": r.id, "x": r.x, "y": r.y, "theta": r.theta, "vx": r.vx,
+                                  "vy": r.vy, "omega": r.omega}  # fmt: skip
+            if r.pixels:
+                rd["cameras"] = {str(k): {"pixel": [u, v]} for k, (u, v) in r.pixels.items()}
+            robots.append(rd)
+        return {"frame_number": self.frame_number, "t": self.t, "ball": ball, "robots": robots}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Self:
+        try:
+            b = d["ball"]
+            ball = BallTruth(
+                _f(b, "x"), _f(b, "y"), _f(b, "z", 0.0), _f(b, "vx", 0.0), _f(b, "vy", 0.0), _f(b, "vz", 0.0),
+                {int(k): (*_pixel(c["pixel"]), float(c.get("visible_fraction", 1.0)))
+                 for k, c in b.get("cameras", {}).items()},
+            )  # fmt: skip
+            robots = tuple(
+                RobotTruth(_team(r["team"]), int(r["id"]), _f(r, "x"), _f(r, "y"), _f(r, "theta"),
+                           _f(r, "vx", 0.0), _f(r, "vy", 0.0), _f(r, "omega", 0.0),
+                           {int(k): _pixel(c["pixel"]) for k, c in r.get("cameras", {}).items()})
+                for r in d.get("robots", ())
+            )  # fmt: skip
+            return cls(int(d["frame_number"]), _f(d, "t"), ball, robots)
+        except (KeyError, TypeError, AttributeError, ValueError) as exc:
+            raise MessageError(f"bad ground truth: {exc!r}") from None
+
+    def encode(self) -> bytes:
+        """The state only (pixel truth stays in the JSONL and MCAP logs)."""
+        b = self.ball
+        balls = np.array([(b.x, b.y, b.z, b.vx, b.vy, b.vz)], dtype=_BALL_TRUTH)
+        robots = np.array(
+            [(_team_code(r.team), r.id, r.x, r.y, r.theta, r.vx, r.vy, r.omega) for r in self.robots],
+            dtype=_ROBOT_TRUTH,
+        )
+        return self._codec.pack((self.frame_number, self.t), balls, robots)
+
+    @classmethod
+    def decode(cls, data: bytes | bytearray | memoryview) -> Self:
+        (frame, t), (balls, robots) = cls._codec.unpack(data)
+        if len(balls) != 1:
+            raise MessageError("ground truth must hold exactly one ball")
+        b = balls[0]
+        return cls(
+            int(frame), float(t),
+            BallTruth(float(b["x"]), float(b["y"]), float(b["z"]), float(b["vx"]), float(b["vy"]), float(b["vz"])),
+            tuple(RobotTruth(TEAMS[int(r["team"]) & 1], int(r["id"]), float(r["x"]), float(r["y"]),
+                             float(r["theta"]), float(r["vx"]), float(r["vy"]), float(r["omega"])) for r in robots),
+        )  # fmt: skip
+
+
+# --- referee ------------------------------------------------------------------------------------
+
+_COMMANDS = ("halt", "stop", "kickoff", "free_kick", "normal")
+_GAME = struct.Struct("<dBbHHBdd")
+
+
+@dataclass(frozen=True)
+class GameState:
+    """The referee's word at time ``t``: the command in force and for which team, the score, which
+    goal blue defends, and where the ball is (to be) placed for a restart."""
+
+    t: float
+    command: str = "normal"  # one of halt, stop, kickoff, free_kick, normal
+    for_team: Team | None = None  # the team that takes the kickoff or free kick
+    score_blue: int = 0
+    score_yellow: int = 0
+    blue_defends_negative_x: bool = True
+    placement: tuple[float, float] | None = None
+
+    def __post_init__(self) -> None:
+        if self.command not in _COMMANDS:
+            raise MessageError(f"game command must be one of {', '.join(_COMMANDS)}, got {self.command!r}")
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"t": self.t, "command": self.command, "for_team": self.for_team,
+                "score": {"blue": self.score_blue, "yellow": self.score_yellow},
+                "blue_defends": "negative_x" if self.blue_defends_negative_x else "positive_x",
+                "placement": None if self.placement is None else list(self.placement)}  # fmt: skip
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Self:
+        try:
+            team = d.get("for_team")
+            placement = d.get("placement")
+            return cls(
+                _f(d, "t"), str(d.get("command", "normal")), None if team is None else _team(team),
+                int(d.get("score", {}).get("blue", 0)), int(d.get("score", {}).get("yellow", 0)),
+                d.get("blue_defends", "negative_x") == "negative_x",
+                None if placement is None else (float(placement[0]), float(placement[1])),
+            )  # fmt: skip
+        except (KeyError, TypeError, AttributeError, ValueError, IndexError) as exc:
+            raise MessageError(f"bad game state: {exc!r}") from None
+
+    def encode(self) -> bytes:
+        px, py = self.placement if self.placement is not None else (math.nan, math.nan)
+        team = -1 if self.for_team is None else _team_code(self.for_team)
+        return _GAME.pack(self.t, _COMMANDS.index(self.command), team, self.score_blue, self.score_yellow,
+                          self.blue_defends_negative_x, px, py)  # fmt: skip
+
+    @classmethod
+    def decode(cls, data: bytes | bytearray | memoryview) -> Self:
+        try:
+            t, cmd, team, sb, sy, blue_neg, px, py = _GAME.unpack(bytes(data))
+        except struct.error as exc:
+            raise MessageError(f"game state is truncated or corrupt: {exc}") from None
+        if cmd >= len(_COMMANDS):
+            raise MessageError(f"unknown game command code {cmd}")
+        placement = None if math.isnan(px) else (px, py)
+        return cls(t, _COMMANDS[cmd], None if team < 0 else TEAMS[team & 1], sb, sy, bool(blue_neg), placement)

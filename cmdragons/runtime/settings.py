@@ -1,0 +1,67 @@
+"""All configuration concerns of a run, loaded together from one config folder.
+
+``configs/<concern>.yaml`` for each concern below; a file left out takes its defaults, an unknown
+file in the folder is an error (most likely a typo in its name).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from cmdragons.camera import CameraModel, CamerasParams, cameras_from_config
+from cmdragons.config import ConfigError, apply_override, default_config_dir, load_yaml, parse
+from cmdragons.geometry import Field, LeagueParams
+from sim.params import SimParams
+
+__all__ = ["CONCERNS", "Settings", "load_settings"]
+
+CONCERNS: dict[str, type] = {
+    "field": LeagueParams,
+    "cameras": CamerasParams,
+    "sim": SimParams,
+}
+
+
+@dataclass(frozen=True)
+class Settings:
+    config_dir: Path
+    field: LeagueParams
+    cameras: CamerasParams
+    sim: SimParams
+
+    def field_geometry(self) -> Field:
+        return Field(self.field)
+
+    def camera_models(self) -> list[CameraModel]:
+        return cameras_from_config(self.cameras, self.field)
+
+
+def load_settings(config_dir: str | Path | None = None, overrides: Sequence[str] = ()) -> Settings:
+    """Load every concern from ``config_dir`` (default: see :func:`default_config_dir`) and apply
+    ``--set`` overrides. Raises :class:`ConfigError` naming the file and key of any problem."""
+    folder = Path(config_dir) if config_dir is not None else default_config_dir()
+    if not folder.is_dir():
+        raise ConfigError(folder, "", "config folder not found")
+    for path in sorted(folder.glob("*.yaml")):
+        if path.stem not in CONCERNS:
+            raise ConfigError(path, "", f"unknown config file; allowed: {', '.join(f'{c}.yaml' for c in CONCERNS)}")
+    raw: dict[str, dict[str, Any]] = {}
+    files: dict[str, str] = {}
+    for name in CONCERNS:
+        path = folder / f"{name}.yaml"
+        raw[name] = load_yaml(path) if path.exists() else {}
+        files[name] = str(path)
+    touched: dict[str, list[str]] = {}
+    for assignment in overrides:
+        apply_override(raw, assignment)
+        touched.setdefault(assignment.partition(".")[0], []).append(assignment)
+    parsed = {}
+    for name, cls in CONCERNS.items():
+        origin = files[name]
+        if name in touched:
+            origin += " (with --set " + ", ".join(touched[name]) + ")"
+        parsed[name] = parse(cls, raw[name], file=origin)
+    return Settings(config_dir=folder, **parsed)

@@ -1,0 +1,35 @@
+"""configs/sim.yaml: everything the simulator is tuned by."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+from cmdragons.config import setting
+from cmdragons.geometry import Team
+from sim.referee import RefereeParams
+from sim.render import RenderParams
+from sim.script import ScriptParams
+from sim.world import BallParams, DribblerParams, KickerParams, PhysicsParams, RobotParams
+
+__all__ = ["SimParams"]
+
+
+@dataclass(frozen=True)
+class SimParams:
+    seed: int = setting(1, lo=0, hi=2**63 - 1)  # every random choice of the simulator derives from it
+    # robots per team; a team left out gets its division's count (configs/field.yaml)
+    robots_per_team: Mapping[Team, int] = field(default_factory=dict)
+    physics: PhysicsParams = PhysicsParams()
+    robot: RobotParams = RobotParams()
+    ball: BallParams = BallParams()
+    kicker: KickerParams = KickerParams()
+    dribbler: DribblerParams = DribblerParams()
+    referee: RefereeParams = RefereeParams()
+    script: ScriptParams = ScriptParams()
+    render: RenderParams = RenderParams()
+
+    def __post_init__(self) -> None:
+        for team, n in self.robots_per_team.items():
+            if not 0 <= n <= 16:
+                raise ValueError(f"robots_per_team.{team} must be 0 to 16 (the pattern has 16 ids), got {n}")

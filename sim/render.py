@@ -1,0 +1,362 @@
+"""Overhead camera renderer: what one ceiling camera would see of the field, robots and ball.
+
+Geometry through :class:`cmdragons.camera.CameraModel` (pinhole + radial distortion), so a pixel
+sees exactly what vision's inverse of the same model expects. Objects are drawn at their real
+heights: robot tops (with the league's standard pattern) at ``robot.height_m``, their sides where
+the ray passes through the body below the top, the ball as a sphere; this gives the parallax and
+occlusions of a real overhead camera (SSL-Vision's setting, Bruce's thesis §2).
+
+Cost model: the static scene (carpet, lines, goals in 3D, lighting) is drawn once per camera;
+a frame is a noisy copy of it plus the dynamic objects inside their projected bounding boxes,
+all in one parallel numba pass (:mod:`sim._kernels`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+from numpy.typing import NDArray
+
+from cmdragons.camera import CameraModel
+from cmdragons.config import setting
+from cmdragons.geometry import Field, LeagueParams
+from sim import _kernels as kern
+from sim.snapshot import Snapshot
+
+__all__ = ["CameraRenderer", "CameraTruth", "RenderParams"]
+
+BGR = tuple[int, int, int]
+
+
+@dataclass(frozen=True)
+class RenderParams:
+    """configs/sim.yaml ``render``: the camera's sensor and the colours of the scene.
+
+    Colours are BGR grey levels (0..255) under full light, chosen far apart in YUV so a colour
+    segmenter can separate them; the id-dot green is brighter and more saturated than the carpet.
+    """
+
+    noise_sigma_grey: float = setting(2.5, lo=0.0, hi=40.0)  # per channel, grey levels; 0: off
+    noise_bank_frames: int = setting(4, lo=1, hi=64)  # pre-generated noise frames (seeded)
+    vignetting_fraction: float = setting(0.12, lo=0.0, hi=0.9)  # light lost at the image corners
+    gradient_fraction: float = setting(0.08, lo=0.0, hi=0.9)  # light change from -x to +x goal line
+    exposure_s: float = setting(0.002, lo=0.0, hi=0.05)  # motion blur; 0: off
+    max_blur_samples: int = setting(8, lo=1, hi=64)  # time samples per moving object, at most
+    blur_step_px: float = setting(0.5, lo=0.05, hi=10.0)  # samples at most this far apart (px)
+    static_supersampling: int = setting(4, lo=1, hi=8)  # per axis, for the goals' edges (once)
+    ball_ambient_fraction: float = setting(0.6, lo=0.0, hi=1.0)  # ball rim brightness vs its top
+
+    carpet_bgr: BGR = setting((40, 110, 40), lo=0, hi=255)
+    line_bgr: BGR = setting((235, 235, 235), lo=0, hi=255)
+    goal_bgr: BGR = setting((150, 150, 155), lo=0, hi=255)  # goal wall tops; their sides are darker
+    boundary_bgr: BGR = setting((60, 75, 65), lo=0, hi=255)  # outside the boundary
+    ball_bgr: BGR = setting((20, 115, 250), lo=0, hi=255)  # orange
+    blue_bgr: BGR = setting((230, 120, 20), lo=0, hi=255)
+    yellow_bgr: BGR = setting((20, 220, 240), lo=0, hi=255)
+    pink_bgr: BGR = setting((200, 80, 255), lo=0, hi=255)
+    green_bgr: BGR = setting((60, 235, 60), lo=0, hi=255)  # id dots
+    cover_bgr: BGR = setting((28, 28, 28), lo=0, hi=255)  # matte-black robot top
+    side_bgr: BGR = setting((85, 85, 90), lo=0, hi=255)  # robot body seen from the side
+
+    def __post_init__(self) -> None:
+        # the ranges are checked here too, so that code building params directly is held to them
+        for f in dataclasses.fields(self):
+            lo, hi = f.metadata.get("lo"), f.metadata.get("hi")
+            value = getattr(self, f.name)
+            items = value if isinstance(value, tuple) else (value,)
+            if f.name.endswith("_bgr") and len(items) != 3:
+                raise ValueError(f"{f.name} must be three grey levels (B, G, R), got {value!r}")
+            for item in items:
+                if (lo is not None and item < lo) or (hi is not None and item > hi):
+                    raise ValueError(f"{f.name} = {value!r} is out of range {lo} to {hi}")
+
+
+@dataclass(frozen=True)
+class CameraTruth:
+    """What the image shows, projected exactly: for scoring vision against ground truth.
+
+    ``ball``: (u, v) px of the ball centre and the visible fraction of its silhouette (0..1),
+    None when the centre is outside the image. ``robots``: (team 0 blue / 1 yellow, id) ->
+    (u, v) px of the centre of the robot's top, for robots whose whole top is in the image.
+    """
+
+    camera_id: int
+    frame_number: int
+    t_capture: float
+    ball: tuple[float, float, float] | None
+    robots: dict[tuple[int, int], tuple[float, float]]
+
+
+class CameraRenderer:
+    """Renders one camera's BGR image of a :class:`~sim.snapshot.Snapshot`.
+
+    Deterministic: the noise comes from a bank generated from ``seed`` and the camera id, and each
+    frame's pick from the same generator, so the same seed and snapshots give identical bytes.
+    """
+
+    def __init__(self, model: CameraModel, league: LeagueParams, params: RenderParams, seed: int) -> None:
+        self.model, self.league, self.params = model, league, params
+        self.field = Field(league)
+        self.rng = np.random.default_rng([seed, model.id])
+        h, w = model.height, model.width
+        self.shape_hw = (h, w)
+
+        self.rays = np.ascontiguousarray(model.pixel_rays_grid())  # (h, w, 2) per metre of descent
+        self.foot = _footprints(self.rays)
+        ground = model.center[:2] + model.center[2] * self.rays.astype(np.float64)
+        self.gain = _lighting_gain(model, ground, self.field.dims.length_m, params)
+        self.background = _static_background(model, self.field, params, self.rays, self.foot, self.gain)
+
+        robot, pattern = league.robot, league.pattern
+        self.cam = kern.camera_vector(model)
+        self.shape = np.zeros(kern.SHAPE_SIZE)
+        self.shape[kern.SHAPE_ROBOT_RADIUS] = robot.radius_m
+        self.shape[kern.SHAPE_ROBOT_HEIGHT] = robot.height_m
+        self.shape[kern.SHAPE_ROBOT_FRONT] = robot.front_distance_m
+        self.shape[kern.SHAPE_BALL_RADIUS] = league.ball.radius_m
+        self.shape[kern.SHAPE_CENTER_DOT_RADIUS] = pattern.center_dot_diameter_m / 2.0
+        self.shape[kern.SHAPE_ID_DOT_RADIUS] = pattern.id_dot_diameter_m / 2.0
+        self.shape[kern.SHAPE_BALL_AMBIENT] = params.ball_ambient_fraction
+        self.dots = np.array(pattern.dot_positions_m, dtype=np.float64).reshape(-1, 2)
+        self.pink = np.array([pattern.dot_is_pink(i) for i in range(len(pattern.ids))], dtype=np.bool_)
+        palette = np.zeros((kern.PAL_SIZE, 3), dtype=np.float32)
+        palette[kern.PAL_COVER] = params.cover_bgr
+        palette[kern.PAL_SIDE] = params.side_bgr
+        palette[kern.PAL_BALL] = params.ball_bgr
+        palette[kern.PAL_BLUE] = params.blue_bgr
+        palette[kern.PAL_YELLOW] = params.yellow_bgr
+        palette[kern.PAL_PINK] = params.pink_bgr
+        palette[kern.PAL_GREEN] = params.green_bgr
+        self.palette = palette
+
+        self.bank = _noise_bank(self.rng, h * w * 3, params.noise_bank_frames, params.noise_sigma_grey)
+        self._plan = kern.ObjectPlan(32, params.max_blur_samples)
+        self._row_ball = np.zeros((h, 2))
+        self._n_chunks = max(1, numba.get_num_threads())
+
+    # --- per frame ---------------------------------------------------------------------------
+    def render(self, snapshot: Snapshot) -> tuple[NDArray[np.uint8], CameraTruth]:
+        """The camera image (height, width, 3) BGR uint8 of ``snapshot`` and its truth."""
+        out = np.empty((self.model.height, self.model.width, 3), dtype=np.uint8)
+        return out, self.render_into(snapshot, out)
+
+    def render_into(self, snapshot: Snapshot, out: NDArray[np.uint8]) -> CameraTruth:
+        """Render ``snapshot`` into ``out`` (height, width, 3) BGR uint8, C-contiguous."""
+        if out.shape != (*self.shape_hw, 3) or out.dtype != np.uint8 or not out.flags.c_contiguous:
+            raise ValueError(f"out must be a C-contiguous uint8 array of shape {(*self.shape_hw, 3)}")
+        robots = np.ascontiguousarray(snapshot.robots, dtype=np.float64).reshape(-1, 8)
+        ball = np.ascontiguousarray(snapshot.ball, dtype=np.float64)
+        if robots.shape[0] > self._plan.rob_k.shape[0]:
+            self._plan = kern.ObjectPlan(robots.shape[0], self.params.max_blur_samples)
+        plan = kern.plan_objects(self._plan, robots, ball, self.cam, self.shape, self.pink, self.dots,
+                                 self.palette, self.params.exposure_s, self.params.blur_step_px)  # fmt: skip
+        noise_start = None
+        if self.params.noise_sigma_grey > 0.0:
+            # one bank frame at a random offset: a fresh-looking field of noise for one add
+            size = self.background.size
+            frame = int(self.rng.integers(self.params.noise_bank_frames))
+            noise_start = frame * size + int(self.rng.integers(size))
+        vis, sil = kern.render_frame(out, self.background, self.bank, noise_start, self.rays, self.foot, self.gain,
+                                     self.cam, self.shape, self.dots, self.palette, plan, self._row_ball,
+                                     self._n_chunks)  # fmt: skip
+        return self._truth(snapshot, robots, plan, vis, sil)
+
+    def _truth(self, snapshot: Snapshot, robots: NDArray[np.float64], plan: kern.ObjectPlan, vis: float,
+               sil: float) -> CameraTruth:  # fmt: skip
+        bt = plan.ball_truth
+        ball = None
+        if bt[2] > 0.0:
+            ball = (float(bt[0]), float(bt[1]), min(1.0, vis / sil) if sil > 0.0 else 0.0)
+        seen: dict[tuple[int, int], tuple[float, float]] = {}
+        for k in np.flatnonzero(plan.rob_truth[:, 2] > 0.0):
+            seen[(int(robots[k, 0]), int(robots[k, 1]))] = (float(plan.rob_truth[k, 0]), float(plan.rob_truth[k, 1]))
+        return CameraTruth(self.model.id, snapshot.frame_number, snapshot.t, ball, seen)
+
+
+# --- the static scene, once per camera ---------------------------------------------------------------
+
+
+def _footprints(rays: NDArray[np.float32]) -> NDArray[np.float32]:
+    """Per pixel, the side (m) of the square of equal area that the pixel covers on a horizontal
+    plane one metre below the camera: the finite-difference Jacobian of the rays."""
+    r = rays.astype(np.float64)
+    du = np.gradient(r, axis=1)
+    dv = np.gradient(r, axis=0)
+    area = np.abs(du[..., 0] * dv[..., 1] - du[..., 1] * dv[..., 0])
+    return np.sqrt(area).astype(np.float32)
+
+
+def _lighting_gain(model: CameraModel, ground: NDArray[np.float64], field_length_m: float,
+                   params: RenderParams) -> NDArray[np.float32]:  # fmt: skip
+    """Per-pixel light gain: vignetting (quadratic in the distance from the principal point,
+    ``1 - vignetting`` at the farthest corner) times a linear gradient along the field's x
+    (``1 +- gradient/2`` at the goal lines)."""
+    v, u = np.mgrid[0 : model.height, 0 : model.width].astype(np.float64) + 0.5
+    r2 = (u - model.cx) ** 2 + (v - model.cy) ** 2
+    corners = [(0.0, 0.0), (model.width, 0.0), (0.0, model.height), (model.width, model.height)]
+    r2_max = max((cu - model.cx) ** 2 + (cv - model.cy) ** 2 for cu, cv in corners)
+    gain = (1.0 - params.vignetting_fraction * r2 / r2_max) * (
+        1.0 + params.gradient_fraction * ground[..., 0] / field_length_m
+    )
+    return np.clip(gain, 0.0, None).astype(np.float32)
+
+
+def _coverage(sd: NDArray[np.float64], pix: NDArray[np.float64]) -> NDArray[np.float64]:
+    return np.clip(0.5 - sd / pix, 0.0, 1.0)
+
+
+def _segment_distance(px: NDArray[np.float64], py: NDArray[np.float64], a: tuple[float, float],
+                      b: tuple[float, float]) -> NDArray[np.float64]:  # fmt: skip
+    ax, ay = a
+    dx, dy = b[0] - ax, b[1] - ay
+    t = np.clip(((px - ax) * dx + (py - ay) * dy) / max(dx * dx + dy * dy, 1e-18), 0.0, 1.0)
+    return np.hypot(px - ax - t * dx, py - ay - t * dy)
+
+
+def _goal_hits(center: NDArray[np.float64], d: NDArray[np.float64], boxes: list[tuple[float, float, float, float]],
+               height_m: float) -> tuple[NDArray[np.bool_], NDArray[np.int64]]:  # fmt: skip
+    """Rays ``center + t (dx, dy, -1)`` against vertical boxes (x0, y0, x1, y1) of ``height_m``:
+    hit mask and the face the nearest hit enters (0 top, 1 an x face, 2 a y face)."""
+    best_t = np.full(d.shape[:-1], np.inf)
+    face = np.zeros(d.shape[:-1], dtype=np.int64)
+    cx, cy, cz = center
+    for x0, y0, x1, y1 in boxes:
+        enter = [np.full(best_t.shape, cz - height_m)]
+        leave = [np.full(best_t.shape, cz)]
+        for lo, hi, c, dc in ((x0, x1, cx, d[..., 0]), (y0, y1, cy, d[..., 1])):
+            # rays parallel to a slab never cross it: a tiny slope stands in, giving +-huge t
+            safe = np.where(np.abs(dc) < 1e-12, 1e-12, dc)
+            ta, tb = (lo - c) / safe, (hi - c) / safe
+            enter.append(np.minimum(ta, tb))
+            leave.append(np.maximum(ta, tb))
+        t_in = np.max(enter, axis=0)
+        t_out = np.min(leave, axis=0)
+        hit = (t_in <= t_out) & (t_in < best_t)
+        best_t = np.where(hit, t_in, best_t)
+        face = np.where(hit, np.argmax(enter, axis=0), face)
+    return np.isfinite(best_t), face
+
+
+def _static_background(model: CameraModel, field: Field, params: RenderParams, rays: NDArray[np.float32],
+                       foot: NDArray[np.float32], gain: NDArray[np.float32]) -> NDArray[np.uint8]:  # fmt: skip
+    """The field without robots and ball, lit: carpet, painted lines (anti-aliased by coverage),
+    the boundary, and the goals as 3D walls seen with parallax (supersampled at their edges)."""
+    d = rays.astype(np.float64)
+    cz = model.center[2]
+    gx = model.center[0] + cz * d[..., 0]
+    gy = model.center[1] + cz * d[..., 1]
+    pix = cz * foot.astype(np.float64)
+    carpet = np.array(params.carpet_bgr, dtype=np.float64)
+
+    out_sd = np.maximum(np.abs(gx) - field.boundary_half_length, np.abs(gy) - field.boundary_half_width)
+    a_out = _coverage(-out_sd, pix)[..., None]
+    img = carpet + a_out * (np.array(params.boundary_bgr, dtype=np.float64) - carpet)
+
+    half_w = field.dims.line_width_m / 2.0
+    radius = field.dims.center_circle_radius_m
+    a_line = np.zeros(gx.shape)
+    ring = np.linspace(0.0, 2.0 * np.pi, 65)
+    win = _window(model, np.stack([radius * np.cos(ring), radius * np.sin(ring), 0.0 * ring], 1))
+    if win is not None:
+        a_line[win] = _coverage(np.abs(np.hypot(gx[win], gy[win]) - radius) - half_w, pix[win])
+    for seg in field.line_segments():
+        along = np.linspace(0.0, 1.0, 33)[:, None]
+        pts = np.array(seg.a) + along * (np.array(seg.b) - np.array(seg.a))
+        win = _window(model, np.concatenate([pts, np.zeros((33, 1))], 1))
+        if win is not None:
+            a = _coverage(_segment_distance(gx[win], gy[win], seg.a, seg.b) - half_w, pix[win])
+            a_line[win] = np.maximum(a_line[win], a)
+    img += a_line[..., None] * (np.array(params.line_bgr, dtype=np.float64) - img)
+
+    gh = field.dims.goal_height_m
+    face_gain = np.array([1.0, 0.8, 0.68])  # top, x-facing, y-facing: light from above, off-axis
+    goal = np.array(params.goal_bgr, dtype=np.float64)
+    for side in (1.0, -1.0):
+        boxes = field.goal_walls(side)
+        corners = np.array([(x, y, z) for x0, y0, x1, y1 in boxes for x in (x0, x1) for y in (y0, y1)
+                            for z in (0.0, gh)])  # fmt: skip
+        win = _window(model, corners)
+        if win is not None:
+            img[win] = _draw_goal(model, boxes, gh, d[win], img[win], win, params.static_supersampling,
+                                  face_gain, goal)  # fmt: skip
+
+    img *= gain[..., None]
+    return np.clip(np.floor(img + 0.5), 0, 255).astype(np.uint8)
+
+
+def _window(model: CameraModel, points: NDArray[np.float64], margin_px: int = 3) -> tuple[slice, slice] | None:
+    """Image rows and columns holding the projection of ``points`` (n, 3), field frame, m,
+    widened by ``margin_px``; None when it misses the image. The points sample a shape densely
+    enough that distortion cannot bow its image out of the window."""
+    px = model.project(points)
+    px = px[np.isfinite(px).all(axis=1)]
+    if px.size == 0:
+        return None
+    j0 = max(0, int(np.floor(px[:, 0].min())) - margin_px)
+    j1 = min(model.width, int(np.ceil(px[:, 0].max())) + margin_px)
+    i0 = max(0, int(np.floor(px[:, 1].min())) - margin_px)
+    i1 = min(model.height, int(np.ceil(px[:, 1].max())) + margin_px)
+    if i0 >= i1 or j0 >= j1:
+        return None
+    return slice(i0, i1), slice(j0, j1)
+
+
+def _draw_goal(model: CameraModel, boxes: list[tuple[float, float, float, float]], height_m: float,
+               d: NDArray[np.float64], img: NDArray[np.float64], win: tuple[slice, slice], s: int,
+               face_gain: NDArray[np.float64], goal: NDArray[np.float64]) -> NDArray[np.float64]:  # fmt: skip
+    """One goal's walls over the window ``img`` (rays ``d``): pixels near a wall are
+    supersampled s x s, since the walls are only a few pixels thick in the image."""
+    img = img.copy()
+    hit, _ = _goal_hits(model.center, d, boxes, height_m)
+    near = hit.copy()  # dilated by one pixel: edge pixels whose centre misses the wall
+    near[1:] |= hit[:-1]
+    near[:-1] |= hit[1:]
+    near[:, 1:] |= near[:, :-1].copy()
+    near[:, :-1] |= near[:, 1:].copy()
+    ii, jj = np.nonzero(near)
+    if ii.size == 0:
+        return img
+    offs = (np.arange(s) + 0.5) / s
+    sub_u = (win[1].start + jj[:, None, None] + offs[None, None, :]).repeat(s, axis=1)
+    sub_v = (win[0].start + ii[:, None, None] + offs[None, :, None]).repeat(s, axis=2)
+    sub_d = model.rays(np.stack([sub_u, sub_v], axis=-1))[..., :2]  # (n, s, s, 2)
+    sub_hit, sub_face = _goal_hits(model.center, sub_d, boxes, height_m)
+    wall = np.where(sub_hit[..., None], face_gain[sub_face][..., None] * goal, img[ii, jj][:, None, None, :])
+    img[ii, jj] = wall.mean(axis=(1, 2))
+    return img
+    # supersample every pixel near a wall (dilated by one pixel): the walls are thin in the image
+    near = hit.copy()
+    near[1:] |= hit[:-1]
+    near[:-1] |= hit[1:]
+    near[:, 1:] |= near[:, :-1].copy()
+    near[:, :-1] |= near[:, 1:].copy()
+    ii, jj = np.nonzero(near)
+    if ii.size:
+        s = params.static_supersampling
+        offs = (np.arange(s) + 0.5) / s
+        sub_u = (jj[:, None, None] + offs[None, None, :]).repeat(s, axis=1)
+        sub_v = (ii[:, None, None] + offs[None, :, None]).repeat(s, axis=2)
+        sub_d = model.rays(np.stack([sub_u, sub_v], axis=-1))[..., :2]  # (n, s, s, 2)
+        sub_hit, sub_face = _goal_hits(model.center, sub_d, boxes, gh)
+        wall = np.where(sub_hit[..., None], face_gain[sub_face][..., None] * goal, img[ii, jj][:, None, None, :])
+        img[ii, jj] = wall.mean(axis=(1, 2))
+
+    img *= gain[..., None]
+    return np.clip(np.floor(img + 0.5), 0, 255).astype(np.uint8)
+
+
+def _noise_bank(rng: np.random.Generator, frame_size: int, frames: int, sigma: float) -> NDArray[np.int8]:
+    """``frames`` frames of Gaussian sensor noise (grey levels, int8), back to back, followed by a
+    copy of the start so that a frame read from any offset is contiguous."""
+    if sigma <= 0.0:
+        return np.zeros(1, dtype=np.int8)
+    bank = np.empty(frames * frame_size + frame_size, dtype=np.int8)
+    for k in range(frames):  # a frame at a time: bounded temporary memory
+        noise = rng.standard_normal(frame_size, dtype=np.float32) * np.float32(sigma)
+        bank[k * frame_size : (k + 1) * frame_size] = np.clip(np.rint(noise), -127, 127).astype(np.int8)
+    bank[frames * frame_size :] = bank[:frame_size]
+    return bank
+

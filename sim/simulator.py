@@ -1,0 +1,126 @@
+"""The simulator as one object: physics, referee and overhead cameras, frame by frame.
+
+``capture()`` renders every camera at the current instant and returns the images with their
+ground truth; ``advance(commands)`` sends commands at that instant and steps one camera frame.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from cmdragons.camera import CameraModel
+from cmdragons.geometry import TEAMS, LeagueParams, Team
+from cmdragons.messages import GameState, GroundTruth, RobotCommand
+from sim.params import SimParams
+from sim.referee import Referee
+from sim.render import CameraRenderer
+from sim.world import BallOut, Contact, Goal, Kick, World
+
+__all__ = ["Frame", "Simulator"]
+
+
+@dataclass(frozen=True)
+class Frame:
+    """One camera frame: an image per camera id (BGR uint8) and the truth at capture time."""
+
+    t_capture: float
+    frame_number: int
+    images: dict[int, NDArray[np.uint8]]
+    truth: GroundTruth
+    game: GameState
+
+
+@dataclass
+class StageTimes:
+    """Wall-clock milliseconds per call, for summaries and benchmarks."""
+
+    physics_ms: list[float] = field(default_factory=list)
+    render_ms: list[float] = field(default_factory=list)
+
+
+class Simulator:
+    def __init__(
+        self,
+        league: LeagueParams,
+        cameras: Sequence[CameraModel],
+        params: SimParams,
+        *,
+        seed: int | None = None,
+        render: bool = True,
+    ) -> None:
+        self.league, self.params = league, params
+        self.seed = params.seed if seed is None else seed
+        counts = {t: params.robots_per_team.get(t, league.dims.robots_per_team) for t in TEAMS}
+        self.world = World(league, params.physics, params.robot, params.ball, params.kicker, params.dribbler,
+                           robots_per_team=counts)  # fmt: skip
+        self.referee = Referee(self.world, params.referee)
+        self.referee.kickoff_setup("blue")
+        self.cameras = list(cameras)
+        seeds = np.random.SeedSequence(self.seed).spawn(len(self.cameras) + 1)
+        self.rng = np.random.default_rng(seeds[0])  # for scripted play and anything else of the sim
+        self.renderers = (
+            [CameraRenderer(m, league, params.render, seed=int(s.generate_state(1)[0]))
+             for m, s in zip(self.cameras, seeds[1:], strict=True)]
+            if render else []
+        )  # fmt: skip
+        self.times = StageTimes()
+
+    @property
+    def t(self) -> float:
+        return self.world.t
+
+    @property
+    def frame_dt(self) -> float:
+        return self.world.frame_dt
+
+    def capture(self) -> Frame:
+        """Render all cameras at the current instant."""
+        snap = self.world.snapshot()
+        images: dict[int, NDArray[np.uint8]] = {}
+        ball_px: dict[int, tuple[float, float, float]] = {}
+        robot_px: dict[tuple[Team, int], dict[int, tuple[float, float]]] = {}
+        t0 = time.perf_counter()
+        for renderer in self.renderers:
+            cam = renderer.model.id
+            image, truth = renderer.render(snap)
+            images[cam] = image
+            if truth.ball is not None:
+                ball_px[cam] = truth.ball
+            for (team, rid), px in truth.robots.items():
+                robot_px.setdefault((TEAMS[team], rid), {})[cam] = px
+        if self.renderers:
+            self.times.render_ms.append((time.perf_counter() - t0) * 1e3)
+        gt = self.world.ground_truth(snap, ball_px, robot_px)
+        return Frame(snap.t, snap.frame_number, images, gt, self.referee.state())
+
+    def advance(self, commands: Iterable[RobotCommand] = ()) -> list[Goal | BallOut | Kick | Contact]:
+        """Send ``commands`` now and step one camera frame; returns the frame's events."""
+        t0 = time.perf_counter()
+        events = self.world.step_frame(commands)
+        self.referee.observe(events)
+        self.times.physics_ms.append((time.perf_counter() - t0) * 1e3)
+        return events
+
+    def summary(self) -> dict[str, object]:
+        """Facts of the run so far, for summary.json."""
+        contacts = self.referee.contacts + self.world.open_contacts()
+        return {
+            "seconds": round(self.world.t, 6),
+            "frames": self.world.frame_number,
+            "seed": self.seed,
+            "score": dict(self.referee.score),
+            "kicks": self.referee.kicks,
+            "balls_out": self.referee.balls_out,
+            "robot_contacts": {
+                "count": len(contacts),
+                "max_depth_m": max((c.max_depth_m for c in contacts), default=0.0),
+                "max_relative_speed_m_s": max((c.relative_speed_m_s for c in contacts), default=0.0),
+                "total_duration_s": sum(c.duration_s for c in contacts),
+            },
+            "command_faults": self.world.faults.as_dict(),
+        }

@@ -1,0 +1,114 @@
+"""Config loading: every kind of mistake gets a message naming the file, the key and what is allowed."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+
+from cmdragons.camera import CamerasParams
+from cmdragons.config import ConfigError
+from cmdragons.geometry import LeagueParams
+from cmdragons.runtime.settings import CONCERNS, load_settings
+from sim.params import SimParams
+
+REPO_CONFIGS = Path(__file__).resolve().parents[2] / "configs"
+
+
+@pytest.fixture()
+def configs(tmp_path: Path) -> Path:
+    folder = tmp_path / "configs"
+    shutil.copytree(REPO_CONFIGS, folder)
+    return folder
+
+
+def test_shipped_configs_equal_the_dataclass_defaults() -> None:
+    # the YAML files show every default; they must not drift from the code's defaults
+    s = load_settings(REPO_CONFIGS)
+    assert s.field == LeagueParams()
+    assert s.cameras == CamerasParams()
+    assert s.sim == SimParams()
+    assert sorted(p.stem for p in REPO_CONFIGS.glob("*.yaml")) == sorted(CONCERNS)
+
+
+@pytest.mark.parametrize(
+    ("file", "text", "key", "fragment"),
+    [
+        ("sim.yaml", "physics:\n  substepz: 4\n", "physics.substepz", "unknown key; allowed keys:"),
+        ("sim.yaml", "physics:\n  substeps: fast\n", "physics.substeps", "expected an integer"),
+        ("sim.yaml", "physics:\n  substeps: 0\n", "physics.substeps", "out of range; allowed: 1 to 100"),
+        ("sim.yaml", "robot:\n  max_speed_m_s: -1.0\n", "robot.max_speed_m_s", "allowed: 0.0 to 10.0"),
+        ("field.yaml", "division: C\n", "division", "allowed: 'A', 'B'"),
+        ("sim.yaml", "physics:\n  wall_elasticity: .nan\n", "physics.wall_elasticity", "finite"),
+        ("cameras.yaml", "auto:\n  grid: [2]\n", "auto.grid", "a list of 2 values"),
+        ("field.yaml", "robot:\n  front_distance_m: 0.2\n", "robot", "smaller than radius_m"),
+    ],
+)
+def test_bad_values_name_file_key_and_allowed(configs: Path, file: str, text: str, key: str, fragment: str) -> None:
+    (configs / file).write_text(text)
+    with pytest.raises(ConfigError) as err:
+        load_settings(configs)
+    assert err.value.file.endswith(file)
+    assert err.value.key == key
+    assert fragment in str(err.value)
+
+
+def test_malformed_yaml_names_its_line(configs: Path) -> None:
+    (configs / "sim.yaml").write_text("seed: 1\nphysics:\n  substeps: [1, 2\n  frame_rate_hz: 60\n")
+    with pytest.raises(ConfigError) as err:
+        load_settings(configs)
+    assert err.value.file.endswith("sim.yaml")
+    assert "malformed YAML at line" in str(err.value)
+
+
+def test_missing_folder_and_unknown_file(tmp_path: Path, configs: Path) -> None:
+    with pytest.raises(ConfigError, match="config folder not found"):
+        load_settings(tmp_path / "nowhere")
+    (configs / "simm.yaml").write_text("seed: 2\n")
+    with pytest.raises(ConfigError, match="unknown config file; allowed: field.yaml, cameras.yaml, sim.yaml"):
+        load_settings(configs)
+
+
+def test_missing_file_takes_defaults_and_missing_yaml_file_is_reported(configs: Path, tmp_path: Path) -> None:
+    (configs / "sim.yaml").unlink()
+    assert load_settings(configs).sim == SimParams()
+    from cmdragons.config import load_yaml
+
+    with pytest.raises(ConfigError, match="file not found"):
+        load_yaml(tmp_path / "absent.yaml")
+
+
+def test_set_overrides(configs: Path) -> None:
+    s = load_settings(configs, ["sim.physics.substeps=8", "field.division=A", "sim.robots_per_team={blue: 3}"])
+    assert s.sim.physics.substeps == 8
+    assert s.field.dims.length_m == 12.0
+    assert s.sim.robots_per_team == {"blue": 3}
+    s = load_settings(configs, ["field.pattern.dot_positions_m.0=[0.03, 0.05]"])
+    assert s.field.pattern.dot_positions_m[0] == (0.03, 0.05)
+
+
+@pytest.mark.parametrize(
+    ("assignment", "fragment"),
+    [
+        ("sim.physics.substeps=-3", "out of range"),
+        ("sim.physics.nope=3", "unknown key"),
+        ("simm.seed=3", "unknown concern; allowed: cameras, field, sim"),
+        ("sim.seed", "expected concern.key.path=value"),
+        ("seed=3", "expected at least concern.key"),
+    ],
+)
+def test_bad_overrides(configs: Path, assignment: str, fragment: str) -> None:
+    with pytest.raises(ConfigError) as err:
+        load_settings(configs, [assignment])
+    assert fragment in str(err.value)
+    assert "--set" in err.value.file
+
+
+def test_cli_reports_config_errors(configs: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from cmdragons.cli import main
+
+    (configs / "sim.yaml").write_text("physics:\n  substeps: 0\n")
+    assert main(["sim", "--config", str(configs), "--seconds", "0.1", "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert "sim.yaml: physics.substeps: 0 is out of range; allowed: 1 to 100" in err

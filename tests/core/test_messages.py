@@ -1,0 +1,126 @@
+"""Messages: dict and binary round trips, the JSONL forms of DESIGN.md, clear errors on bad input."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from cmdragons.messages import (
+    BallDetection,
+    BallState,
+    BallTruth,
+    DetectionFrame,
+    GameState,
+    GroundTruth,
+    MessageError,
+    RobotCommand,
+    RobotDetection,
+    RobotState,
+    RobotTruth,
+    WorldState,
+)
+
+DET = DetectionFrame(
+    camera_id=1, frame_number=42, t_capture=0.7, t_sent=0.702,
+    balls=(BallDetection(0.5, -0.25, 0.9, (100.5, 200.25)),),
+    robots=(RobotDetection("blue", 3, 1.0, 2.0, 0.5, 0.99, (10.0, 20.0)),
+            RobotDetection("yellow", 15, -1.0, -2.0, -3.0, 0.5, (30.0, 40.0))),
+)  # fmt: skip
+WORLD = WorldState(
+    t=1.5, ball=BallState(0.1, 0.2, 1.0, -1.0, True),
+    robots=(RobotState("blue", 0, 1.0, 1.0, 0.1, 0.5, 0.25, 1.0, True), RobotState("yellow", 7, -1.0, 0.0, 3.0)),
+)  # fmt: skip
+TRUTH = GroundTruth(
+    frame_number=9, t=0.15, ball=BallTruth(0.0, 0.1, 0.0215, 1.0, 0.0, 0.0, {0: (10.0, 20.0, 0.75)}),
+    robots=(RobotTruth("blue", 1, 1.0, 2.0, 0.3, 0.1, 0.2, 0.3, {0: (5.0, 6.0), 1: (7.0, 8.0)}),),
+)  # fmt: skip
+COMMAND = RobotCommand("yellow", 4, 1.0, -0.5, 2.0, 3.5, True, 0.5)
+GAME = GameState(3.0, "free_kick", "yellow", 2, 1, False, (1.0, -2.8))
+
+
+@pytest.mark.parametrize("msg", [DET, WORLD, TRUTH, COMMAND, GAME], ids=lambda m: type(m).__name__)
+def test_dict_round_trip_through_json(msg: object) -> None:
+    d = json.loads(json.dumps(msg.to_dict()))  # type: ignore[attr-defined]
+    assert type(msg).from_dict(d) == msg  # type: ignore[attr-defined]
+
+
+@pytest.mark.parametrize("msg", [DET, WORLD, GAME], ids=lambda m: type(m).__name__)
+def test_binary_round_trip(msg: object) -> None:
+    back = type(msg).decode(msg.encode())  # type: ignore[attr-defined]
+    assert _close(back.to_dict(), msg.to_dict())  # type: ignore[attr-defined]
+
+
+def _close(a: object, b: object) -> bool:
+    if isinstance(a, dict) and isinstance(b, dict):
+        assert a.keys() == b.keys()
+        return all(_close(a[k], b[k]) for k in a)
+    if isinstance(a, list) and isinstance(b, list):
+        assert len(a) == len(b)
+        return all(_close(x, y) for x, y in zip(a, b, strict=True))
+    if isinstance(a, float) or isinstance(b, float):
+        assert a == pytest.approx(b, rel=1e-6, abs=1e-6)
+        return True
+    assert a == b
+    return True
+
+
+def test_binary_round_trip_truth_and_commands() -> None:
+    back = GroundTruth.decode(TRUTH.encode())
+    assert back.ball.x == TRUTH.ball.x and back.robots[0].theta == TRUTH.robots[0].theta
+    cmds = RobotCommand.decode_many(RobotCommand.encode_many([COMMAND, RobotCommand("blue", 0)]))
+    assert cmds[1] == RobotCommand("blue", 0)
+    assert _close(cmds[0].to_dict(), COMMAND.to_dict())
+
+
+def test_jsonl_forms_match_the_design() -> None:
+    d = DET.to_dict()
+    assert set(d) == {"camera_id", "frame_number", "t_capture", "t_sent", "balls", "robots"}
+    assert set(d["balls"][0]) == {"x", "y", "confidence", "pixel"}
+    assert set(d["robots"][0]) == {"team", "id", "x", "y", "theta", "confidence", "pixel"}
+    t = TRUTH.to_dict()
+    assert {"frame_number", "t", "ball", "robots"} <= set(t)
+    assert {"x", "y", "z", "vx", "vy"} <= set(t["ball"])
+    assert {"team", "id", "x", "y", "theta", "vx", "vy", "omega"} <= set(t["robots"][0])
+    w = WORLD.to_dict()
+    assert set(w["ball"]) == {"x", "y", "vx", "vy", "visible"}
+    assert set(w["robots"][0]) == {"team", "id", "x", "y", "theta", "vx", "vy", "omega", "visible"}
+
+
+def test_nan_survives_json_as_null() -> None:
+    c = RobotCommand("blue", 1, vx=math.nan)
+    d = json.loads(json.dumps(c.to_dict(), allow_nan=False))
+    assert math.isnan(RobotCommand.from_dict(d).vx)
+
+
+@pytest.mark.parametrize(
+    "bad",
+    [
+        {"camera_id": 0, "frame_number": 1, "t_capture": 0.0, "robots": [{"team": "red", "id": 1, "x": 0, "y": 0,
+                                                                           "theta": 0}]},
+        {"camera_id": 0, "t_capture": 0.0},
+        {"camera_id": 0, "frame_number": 1, "t_capture": "soon"},
+    ],
+)  # fmt: skip
+def test_bad_dicts_raise_message_error(bad: dict[str, object]) -> None:
+    with pytest.raises(MessageError):
+        DetectionFrame.from_dict(bad)
+
+
+def test_corrupt_binary_raises_message_error() -> None:
+    data = DET.encode()
+    with pytest.raises(MessageError):
+        DetectionFrame.decode(data[:-3])
+    with pytest.raises(MessageError):
+        DetectionFrame.decode(data + b"\x00")
+    with pytest.raises(MessageError):
+        WorldState.decode(b"\x01\x02")
+    with pytest.raises(MessageError):
+        GameState("t", "dance")  # type: ignore[arg-type]
+
+
+def test_covariance_is_kept_in_memory_only() -> None:
+    b = BallState(0.0, 0.0, 0.0, 0.0, True, covariance=np.eye(4))
+    assert "covariance" not in WorldState(0.0, b).to_dict()["ball"]

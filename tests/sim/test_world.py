@@ -1,0 +1,272 @@
+"""Physics against known values: kicks, the two-phase ball, motor limits, walls, goals, contacts."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from cmdragons.geometry import LeagueParams
+from cmdragons.messages import RobotCommand
+from sim.referee import Referee, RefereeParams
+from sim.world import (
+    BallOut,
+    BallParams,
+    Contact,
+    DribblerParams,
+    Goal,
+    Kick,
+    KickerParams,
+    PhysicsParams,
+    RobotParams,
+    World,
+)
+
+LEAGUE = LeagueParams()
+FRONT = LEAGUE.robot.front_distance_m + LEAGUE.ball.radius_m
+
+
+def make_world(blue: int = 1, yellow: int = 0, robot: RobotParams | None = None) -> World:
+    w = World(LEAGUE, PhysicsParams(), robot or RobotParams(), BallParams(), KickerParams(), DribblerParams(),
+              robots_per_team={"blue": blue, "yellow": yellow})  # fmt: skip
+    for i, (team, rid) in enumerate(w.robot_keys()):
+        w.place_robot(team, rid, -3.5 + 1.0 * i, -2.5, 0.0)  # parked apart, out of the way
+    w.place_ball(0.0, 1.5)
+    return w
+
+
+def run(w: World, seconds: float, commands: list[RobotCommand] | None = None) -> list[object]:
+    events: list[object] = []
+    for _ in range(round(seconds * 60)):
+        events += w.step_frame(commands or [])
+    return events
+
+
+def ball_speed(w: World) -> float:
+    return float(w.ball_body.velocity.length)
+
+
+@pytest.mark.parametrize("kick", [2.0, 4.0, 6.5])
+def test_kick_speed(kick: float) -> None:
+    w = make_world()
+    w.place_robot("blue", 0, 0.0, 0.0, 0.0)
+    w.place_ball(FRONT + 0.01, 0.0)
+    speeds = []
+    kicked = None
+    for _ in range(60):
+        events = w.step_frame([RobotCommand("blue", 0, vx=0.3, kick_speed=kick)])
+        kicked = kicked or next((e for e in events if isinstance(e, Kick)), None)
+        if kicked:
+            speeds.append(ball_speed(w))
+            break
+    assert kicked is not None and kicked.speed_m_s == kick
+    # within one frame of sliding friction of the kick speed, along the robot's heading
+    assert speeds[0] == pytest.approx(kick, abs=BallParams().acc_slide_m_s2 / 60 + 1e-6)
+    assert abs(w.ball_body.velocity.y) < 1e-6
+
+
+def test_kick_is_clamped_to_the_kicker_limit() -> None:
+    w = make_world()
+    cmd = w.sanitize(RobotCommand("blue", 0, kick_speed=20.0))
+    assert cmd is not None and cmd.kick_speed == KickerParams().max_speed_m_s
+    assert w.faults.clamped == 1
+
+
+def model_distance(v0: float, p: BallParams) -> float:
+    vs = p.slide_to_roll_fraction * v0
+    return (v0**2 - vs**2) / (2 * p.acc_slide_m_s2) + vs**2 / (2 * p.acc_roll_m_s2)
+
+
+@pytest.mark.parametrize("v0", [0.5, 1.5, 3.0])
+def test_rolling_distance_matches_two_phase_model(v0: float) -> None:
+    w = make_world(blue=0)
+    w.place_ball(-3.0, 0.0, vx=v0)
+    run(w, 12.0)
+    assert ball_speed(w) == 0.0
+    travelled = w.ball_body.position.x + 3.0
+    assert travelled == pytest.approx(model_distance(v0, BallParams()), rel=0.05)
+
+
+def test_robots_never_exceed_their_limits() -> None:
+    p = RobotParams()
+    w = make_world(blue=3, yellow=3, robot=p)
+    for i, (team, rid) in enumerate(w.robot_keys()):
+        w.place_robot(team, rid, -3.0 + 1.2 * i, 0.0, 0.0)
+    rng = np.random.default_rng(7)
+    prev = None
+    dt = 1.0 / 60
+    worst_acc = worst_speed = worst_omega = 0.0
+    for k in range(600):
+        cmds = []
+        for team, rid in w.robot_keys():
+            # wild commands, including far out of limits; robots keep apart (each in its lane)
+            vx, vy = rng.normal(0, 4, size=2) if k % 30 < 20 else (0.0, 0.0)
+            cmds.append(RobotCommand(team, rid, vx * 0.1, vy, rng.normal(0, 30)))
+        w.step_frame(cmds)
+        snap = w.snapshot().robots
+        vel = snap[:, 5:7]
+        worst_speed = max(worst_speed, float(np.max(np.hypot(vel[:, 0], vel[:, 1]))))
+        worst_omega = max(worst_omega, float(np.max(np.abs(snap[:, 7]))))
+        if prev is not None:
+            worst_acc = max(worst_acc, float(np.max(np.hypot(*(vel - prev).T))) / dt)
+        prev = vel.copy()
+        # keep them inside their lanes
+        for i, (team, rid) in enumerate(w.robot_keys()):
+            x, y = snap[i, 2], snap[i, 3]
+            if abs(y) > 2.0 or abs(x - (-3.0 + 1.2 * i)) > 0.45:
+                w.place_robot(team, rid, -3.0 + 1.2 * i, 0.0, snap[i, 4])
+                prev = None
+    assert worst_speed <= p.max_speed_m_s * 1.001
+    assert worst_omega <= p.max_omega_rad_s * 1.001
+    assert worst_acc <= p.max_brake_m_s2 * 1.02
+    assert w.faults.clamped > 0
+
+
+def test_acceleration_and_braking_limits() -> None:
+    p = RobotParams()
+    w = make_world(robot=p)
+    w.place_robot("blue", 0, -3.0, 0.0, 0.0)
+    speeds = []
+    for _ in range(120):  # 2 s at full speed forward
+        w.step_frame([RobotCommand("blue", 0, vx=p.max_speed_m_s)])
+        speeds.append(w.snapshot().robots[0, 5])
+    # reaches 3 m/s after 1 s (+ latency) accelerating at 3 m/s^2
+    t_reach = next(i for i, s in enumerate(speeds) if s >= p.max_speed_m_s - 1e-6) / 60
+    assert t_reach == pytest.approx(p.max_speed_m_s / p.max_accel_m_s2 + p.command_latency_s, abs=2 / 60)
+    stop = []
+    for _ in range(60):
+        w.step_frame([RobotCommand("blue", 0)])
+        stop.append(w.snapshot().robots[0, 5])
+    t_stop = next(i for i, s in enumerate(stop) if s <= 1e-6) / 60
+    assert t_stop == pytest.approx(p.max_speed_m_s / p.max_brake_m_s2 + p.command_latency_s, abs=2 / 60)
+
+
+def test_command_latency() -> None:
+    p = RobotParams(command_latency_s=0.1)
+    w = make_world(robot=p)
+    moved_at = None
+    for k in range(30):
+        w.step_frame([RobotCommand("blue", 0, vx=1.0)] if k == 0 else [RobotCommand("blue", 0, vx=1.0)])
+        if moved_at is None and w.snapshot().robots[0, 5] > 1e-6:
+            moved_at = w.t
+    assert moved_at is not None and 0.1 <= moved_at <= 0.1 + 2 / 60
+
+
+@pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf])
+def test_non_finite_commands_brake_and_are_counted(bad: float) -> None:
+    w = make_world()
+    run(w, 1.0, [RobotCommand("blue", 0, vx=1.0)])
+    assert w.snapshot().robots[0, 5] == pytest.approx(1.0)
+    run(w, 1.0, [RobotCommand("blue", 0, vx=bad, vy=0.5)])
+    assert abs(w.snapshot().robots[0, 5]) < 1e-9 and abs(w.snapshot().robots[0, 6]) < 1e-9
+    assert w.faults.non_finite == 60
+    run(w, 0.1, [RobotCommand("yellow", 9, vx=1.0)])
+    assert w.faults.unknown_robot == 6
+
+
+def test_robot_without_commands_brakes_after_timeout() -> None:
+    w = make_world()
+    run(w, 1.0, [RobotCommand("blue", 0, vx=1.0)])
+    run(w, 1.0)
+    assert w.snapshot().robots[0, 5] == 0.0
+    assert w.faults.timed_out == 1
+
+
+def test_ball_kicked_into_a_wall_comes_back() -> None:
+    w = make_world(blue=0)
+    w.place_ball(0.0, 2.0, vx=0.0, vy=3.0)
+    run(w, 1.0)
+    vy = w.ball_body.velocity.y
+    assert vy < 0.0  # bounced off the boundary wall at y = 3.3
+    assert w.ball_body.position.y < LEAGUE.dims.width_m / 2 + LEAGUE.dims.boundary_width_m
+
+
+def test_goal_counted_and_kickoff_restart() -> None:
+    w = make_world(blue=1, yellow=1)
+    ref = Referee(w, RefereeParams())
+    w.place_ball(3.5, 0.1, vx=4.0)
+    events = []
+    for _ in range(120):
+        ev = w.step_frame()
+        ref.observe(ev)
+        events += ev
+    goals = [e for e in events if isinstance(e, Goal)]
+    assert len(goals) == 1 and goals[0].scoring_team == "blue"  # blue attacks the goal at +x
+    assert ref.score == {"blue": 1, "yellow": 0}
+    # after the restart delay: ball on the centre spot, yellow kicks off
+    assert tuple(w.ball_body.position) == pytest.approx((0.0, 0.0))
+    assert ref.command == "kickoff" and ref.for_team == "yellow"
+
+
+def test_ball_out_gives_a_free_kick_at_a_legal_spot() -> None:
+    w = make_world(blue=1, yellow=1)
+    ref = Referee(w, RefereeParams())
+    w.place_robot("yellow", 0, 1.0, 2.0, math.pi / 2)
+    w.place_ball(1.0, 2.0 + FRONT + 0.005)
+    events = []
+    for k in range(120):
+        ev = w.step_frame([RobotCommand("yellow", 0, vy=0.3, kick_speed=3.0)] if k < 10 else [])
+        ref.observe(ev)
+        events += ev
+    outs = [e for e in events if isinstance(e, BallOut)]
+    assert len(outs) == 1 and outs[0].last_touch == "yellow"
+    x, y = w.ball_body.position
+    assert (x, y) == pytest.approx((1.0, 3.0 - 0.2), abs=1e-6)
+    assert ref.command == "free_kick" and ref.for_team == "blue"
+
+
+def test_robot_contacts_are_reported() -> None:
+    w = make_world(blue=1, yellow=1)
+    w.place_robot("blue", 0, -1.0, 0.0, 0.0)
+    w.place_robot("yellow", 0, 1.0, 0.0, math.pi)
+    events = run(w, 1.5, [RobotCommand("blue", 0, vx=2.0), RobotCommand("yellow", 0, vx=-2.0)])
+    events += run(w, 1.0, [RobotCommand("blue", 0, vx=-1.0), RobotCommand("yellow", 0, vx=1.0)])
+    contacts = [e for e in events if isinstance(e, Contact)]
+    assert len(contacts) >= 1
+    c = contacts[0]
+    assert {c.a, c.b} == {("blue", 0), ("yellow", 0)}
+    assert c.relative_speed_m_s == pytest.approx(4.0, rel=0.1)
+    assert c.duration_s > 0.0 and c.max_depth_m >= 0.0
+
+
+def test_dribbler_holds_the_ball_while_turning() -> None:
+    w = make_world()
+    w.place_robot("blue", 0, 0.0, 0.0, 0.0)
+    w.place_ball(FRONT + 0.003, 0.0)
+    run(w, 0.2, [RobotCommand("blue", 0, dribbler=1.0)])
+    assert w.holding("blue", 0)
+    run(w, 1.0, [RobotCommand("blue", 0, vx=0.5, omega=1.0, dribbler=1.0)])
+    r = w.snapshot().robots[0]
+    rel = np.array(w.ball_body.position) - r[2:4]
+    heading = np.array([math.cos(r[4]), math.sin(r[4])])
+    assert np.linalg.norm(rel) == pytest.approx(FRONT, abs=0.01)
+    assert rel @ heading / np.linalg.norm(rel) > 0.95
+    run(w, 0.2, [RobotCommand("blue", 0)])
+    assert not w.holding("blue", 0)
+
+
+def test_chip_flies_over_robots() -> None:
+    w = make_world(blue=2)
+    w.place_robot("blue", 0, 0.0, 0.0, 0.0)
+    w.place_robot("blue", 1, 0.6, 0.0, 0.0)  # in the way of a flat kick
+    w.place_ball(FRONT + 0.005, 0.0)
+    heights = []
+    for _ in range(90):
+        w.step_frame([RobotCommand("blue", 0, kick_speed=4.0, chip=True)])
+        heights.append(w.snapshot().ball[2])
+    assert max(heights) > LEAGUE.robot.height_m + 0.1
+    assert w.ball_body.position.x > 1.0  # passed robot 1
+    assert heights[-1] == pytest.approx(LEAGUE.ball.radius_m)
+
+
+def test_same_seedless_physics_is_deterministic() -> None:
+    def trace() -> np.ndarray:
+        w = make_world(blue=3, yellow=3)
+        w.place_ball(0.0, 0.0, 2.0, 1.0)
+        for k in range(120):
+            w.step_frame([RobotCommand(t, i, math.sin(k / 10 + i), math.cos(k / 7), 1.0) for t, i in w.robot_keys()])
+        s = w.snapshot()
+        return np.concatenate([s.ball, s.robots.ravel()])
+
+    assert np.array_equal(trace(), trace())

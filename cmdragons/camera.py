@@ -21,14 +21,14 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from cmdragons.config import setting
+from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, LeagueParams
 
 __all__ = ["AutoLayout", "CameraModel", "CameraParams", "CamerasParams", "cameras_from_config"]
 
 
 @dataclass(frozen=True)
-class CameraParams:
+class CameraParams(Validated):
     """One camera's intrinsic and extrinsic parameters."""
 
     id: int = setting(0, lo=0, hi=63)
@@ -43,6 +43,7 @@ class CameraParams:
     resolution_px: tuple[int, int] = (1024, 768)  # width, height
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         if self.position_m[2] <= 0.3:
             raise ValueError("a camera must hang above the field: position_m[2] > 0.3")
         if min(self.resolution_px) < 16:
@@ -50,7 +51,7 @@ class CameraParams:
 
 
 @dataclass(frozen=True)
-class AutoLayout:
+class AutoLayout(Validated):
     """Cameras derived from the field: a grid of downward cameras, each seeing its cell plus the
     overlap with its neighbours and a margin past the field lines, at robot-top height."""
 
@@ -66,7 +67,7 @@ class AutoLayout:
 
 
 @dataclass(frozen=True)
-class CamerasParams:
+class CamerasParams(Validated):
     """configs/cameras.yaml."""
 
     layout: Literal["auto", "list"] = "auto"
@@ -74,6 +75,7 @@ class CamerasParams:
     cameras: tuple[CameraParams, ...] = ()
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         if self.layout == "list" and not self.cameras:
             raise ValueError("layout 'list' needs at least one entry under cameras")
         ids = [c.id for c in self.cameras]
@@ -111,11 +113,15 @@ class CameraModel:
         """Inverse of :meth:`distort` by Newton's method on the radius (exact to ~1e-12)."""
         rd = np.sqrt(np.sum(xy_d * xy_d, axis=-1))
         r = rd.copy()
-        for _ in range(iterations):
-            r2 = r * r
-            g = r * (1.0 + self.k1 * r2 + self.k2 * r2 * r2) - rd
-            dg = 1.0 + 3.0 * self.k1 * r2 + 5.0 * self.k2 * r2 * r2
-            r = r - g / np.where(np.abs(dg) < 1e-9, 1e-9, dg)
+        if self.k1 != 0.0 or self.k2 != 0.0:
+            for _ in range(iterations):
+                r2 = r * r
+                g = r * (1.0 + self.k1 * r2 + self.k2 * r2 * r2) - rd
+                dg = 1.0 + 3.0 * self.k1 * r2 + 5.0 * self.k2 * r2 * r2
+                step = g / np.where(np.abs(dg) < 1e-9, 1e-9, dg)
+                r = r - step
+                if float(np.max(np.abs(step), initial=0.0)) < 1e-14:
+                    break
         scale = np.where(rd > 1e-15, r / np.where(rd > 1e-15, rd, 1.0), 1.0)
         return xy_d * scale[..., None]
 

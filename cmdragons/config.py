@@ -30,7 +30,9 @@ import yaml
 
 __all__ = [
     "ConfigError",
+    "Validated",
     "apply_override",
+    "check_ranges",
     "default_config_dir",
     "load_yaml",
     "parse",
@@ -275,6 +277,23 @@ def _convert_dataclass(cls: type, value: Any, file: str, key: str) -> Any:
         raise
     except (ValueError, TypeError) as exc:
         raise ConfigError(file, key, str(exc)) from None
+
+
+def check_ranges(obj: Any) -> None:
+    """Check every :func:`setting` field of dataclass ``obj`` against its range and choices;
+    raises ``ValueError`` naming the field (the loader adds the file)."""
+    for f in dataclasses.fields(obj):
+        try:
+            _check_limits(f, getattr(obj, f.name), "", f.name)
+        except ConfigError as exc:
+            raise ValueError(f"{exc.key}: {exc.message}") from None
+
+
+class Validated:
+    """Mixin for parameter dataclasses: ranges are checked however the object is built."""
+
+    def __post_init__(self) -> None:
+        check_ranges(self)
 
 
 def _check_limits(f: dataclasses.Field[Any], value: Any, file: str, key: str) -> None:

@@ -15,7 +15,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from cmdragons.config import setting
+from cmdragons.config import Validated, setting
 
 __all__ = [
     "BallShape",
@@ -48,7 +48,7 @@ def rotate(v: NDArray[np.float64], theta: float) -> NDArray[np.float64]:
 
 
 @dataclass(frozen=True)
-class FieldDims:
+class FieldDims(Validated):
     """One division's field dimensions (SSL rules), metres."""
 
     length_m: float = setting(9.0, lo=1.0, hi=30.0)  # goal line to goal line
@@ -65,6 +65,7 @@ class FieldDims:
     robots_per_team: int = setting(6, lo=0, hi=16)  # the league's count for this division
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         if self.goal_width_m >= self.width_m:
             raise ValueError("goal_width_m must be smaller than width_m")
         if self.defense_width_m >= self.width_m or 2 * self.defense_depth_m >= self.length_m:
@@ -72,7 +73,7 @@ class FieldDims:
 
 
 @dataclass(frozen=True)
-class RobotShape:
+class RobotShape(Validated):
     """A robot's body: a cylinder cut flat at the front (the dribbler and kicker side)."""
 
     radius_m: float = setting(0.09, lo=0.02, hi=0.5)
@@ -80,6 +81,7 @@ class RobotShape:
     front_distance_m: float = setting(0.07, lo=0.01, hi=0.5)  # centre to the flat front face
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         if self.front_distance_m >= self.radius_m:
             raise ValueError("front_distance_m must be smaller than radius_m")
 
@@ -96,7 +98,7 @@ class RobotShape:
 
 
 @dataclass(frozen=True)
-class BallShape:
+class BallShape(Validated):
     radius_m: float = setting(0.0215, lo=0.005, hi=0.2)
 
 
@@ -108,7 +110,7 @@ _DEFAULT_IDS = (
 
 
 @dataclass(frozen=True)
-class PatternGeometry:
+class PatternGeometry(Validated):
     """The league's standard robot top pattern (2010): robot frame, metres.
 
     ``ids[i]`` lists the colours of the id dots in the order of ``dot_positions_m``
@@ -121,6 +123,7 @@ class PatternGeometry:
     ids: tuple[str, ...] = _DEFAULT_IDS
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         for code in self.ids:
             if len(code) != len(self.dot_positions_m) or set(code) - {"P", "G"}:
                 raise ValueError(
@@ -134,7 +137,7 @@ class PatternGeometry:
 
 
 @dataclass(frozen=True)
-class LeagueParams:
+class LeagueParams(Validated):
     """configs/field.yaml: the division in force and the league's fixed shapes."""
 
     division: Literal["A", "B"] = "B"
@@ -152,6 +155,7 @@ class LeagueParams:
     pattern: PatternGeometry = PatternGeometry()
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         if self.division not in self.divisions:
             raise ValueError(f"division {self.division!r} has no entry under divisions")
 

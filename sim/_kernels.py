@@ -32,6 +32,7 @@ __all__ = [
     "CAM_SIZE",
     "PAL_SIZE",
     "SHAPE_SIZE",
+    "ObjectPlan",
     "add_noise_reference",
     "camera_vector",
     "plan_objects",
@@ -91,7 +92,7 @@ def camera_vector(model: CameraModel) -> NDArray[np.float64]:
 # =================================================================================================
 
 
-@njit(cache=True)  # type: ignore[misc]
+@njit(cache=True)
 def _project(cam: NDArray[np.float64], x: float, y: float, z: float) -> tuple[float, float]:
     """Field point (m) -> pixel (u, v), the same model as ``CameraModel.project``; NaN behind."""
     px, py, pz = x - cam[0], y - cam[1], z - cam[2]
@@ -106,7 +107,7 @@ def _project(cam: NDArray[np.float64], x: float, y: float, z: float) -> tuple[fl
     return cam[CAM_FOCAL] * xn * k + cam[CAM_PP], cam[CAM_FOCAL] * yn * k + cam[CAM_PP + 1]
 
 
-@njit(cache=True)  # type: ignore[misc]
+@njit(cache=True)
 def _project_points_kernel(cam: NDArray[np.float64], pts: NDArray[np.float64], out: NDArray[np.float64]) -> None:
     for k in range(pts.shape[0]):
         out[k, 0], out[k, 1] = _project(cam, pts[k, 0], pts[k, 1], pts[k, 2])
@@ -120,7 +121,7 @@ def project_points(cam: NDArray[np.float64], pts: NDArray[np.float64]) -> NDArra
     return out
 
 
-@njit(cache=True)  # type: ignore[misc]
+@njit(cache=True)
 def _bbox(cam: NDArray[np.float64], x: float, y: float, ext: float, z0: float, z1: float,
           out: NDArray[np.int32]) -> None:  # fmt: skip
     """Pixel rows/columns [i0, i1) x [j0, j1) holding the projection of the axis-aligned box
@@ -146,7 +147,7 @@ def _bbox(cam: NDArray[np.float64], x: float, y: float, ext: float, z0: float, z
         out[0], out[1], out[2], out[3] = int(i0), int(i1), int(j0), int(j1)
 
 
-@njit(cache=True)  # type: ignore[misc]
+@njit(cache=True)
 def _sample_count(motion_px: float, blur_step_px: float, max_samples: int) -> int:
     """Time samples across the exposure: sharp below one step, else at most a step apart."""
     if motion_px <= blur_step_px:
@@ -154,7 +155,7 @@ def _sample_count(motion_px: float, blur_step_px: float, max_samples: int) -> in
     return min(max_samples, int(math.ceil(motion_px / blur_step_px)) + 1)
 
 
-@njit(cache=True)  # type: ignore[misc]
+@njit(cache=True)
 def _plan_objects_kernel(
     robots: NDArray[np.float64], ball: NDArray[np.float64], cam: NDArray[np.float64],
     shape: NDArray[np.float64], pink: NDArray[np.bool_], dots: NDArray[np.float64],
@@ -187,7 +188,7 @@ def _plan_objects_kernel(
         _bbox(cam, x, y, r + 0.5 * speed * exposure_s, 0.0, h, rob_bbox[k])
         for c in range(3):
             rob_colors[k, 0, c] = palette[PAL_BLUE + min(max(team, 0), 1), c]
-            for d in range(4):
+            for d in range(dots.shape[0]):
                 rob_colors[k, 1 + d, c] = palette[PAL_PINK if pink[rid % n_ids, d] else PAL_GREEN, c]
         u, v = _project(cam, x, y, h)
         rob_truth[k, 0], rob_truth[k, 1] = u, v
@@ -217,17 +218,17 @@ def _plan_objects_kernel(
 
 
 class ObjectPlan:
-    """Per-frame, per-object drawing plan (blur samples, boxes, colours) and projected truth.
+    """One frame's drawing plan (blur samples, boxes, colours) and projected truth per object.
 
-    Arrays are sized for ``capacity`` robots and reused across frames.
+    Robot arrays have ``capacity`` rows, reused across frames; the first ``n`` are in use.
     """
 
-    def __init__(self, capacity: int, max_samples: int) -> None:
+    def __init__(self, capacity: int, max_samples: int, n_dots: int = 4) -> None:
         self.max_samples = max_samples
         self.rob_samples = np.zeros((capacity, max_samples, 4))  # x m, y m, cos, sin per sample
         self.rob_k = np.zeros(capacity, dtype=np.int64)  # samples in use
         self.rob_bbox = np.zeros((capacity, 4), dtype=np.int32)  # i0, i1, j0, j1 (px, half-open)
-        self.rob_colors = np.zeros((capacity, 5, 3), dtype=np.float32)  # centre dot, 4 id dots, BGR
+        self.rob_colors = np.zeros((capacity, 1 + n_dots, 3), dtype=np.float32)  # centre, id dots; BGR
         self.rob_truth = np.zeros((capacity, 3))  # u, v px of the top centre; 1 if the top is inside
         self.ball_samples = np.zeros((max_samples, 3))  # x, y, z m
         self.ball_k = 1
@@ -235,47 +236,44 @@ class ObjectPlan:
         self.ball_truth = np.zeros(3)  # u, v px of the centre; 1 if inside the image
         self.n = 0
 
-    def view(self, n: int) -> ObjectPlan:
-        """This plan restricted to the first ``n`` robots (views, no copies)."""
-        out = ObjectPlan.__new__(ObjectPlan)
-        out.__dict__.update(self.__dict__)
-        out.rob_samples, out.rob_k = self.rob_samples[:n], self.rob_k[:n]
-        out.rob_bbox, out.rob_colors, out.rob_truth = self.rob_bbox[:n], self.rob_colors[:n], self.rob_truth[:n]
-        out.n = n
-        return out
+    @property
+    def capacity(self) -> int:
+        return int(self.rob_k.shape[0])
 
 
 def plan_objects(
     plan: ObjectPlan, robots: NDArray[np.float64], ball: NDArray[np.float64], cam: NDArray[np.float64],
     shape: NDArray[np.float64], pink: NDArray[np.bool_], dots: NDArray[np.float64],
     palette: NDArray[np.float32], exposure_s: float, blur_step_px: float,
-) -> ObjectPlan:  # fmt: skip
+) -> None:  # fmt: skip
     """Fill ``plan`` for the snapshot's robots (n, 8: team, id, x, y, theta, vx, vy, omega) and
-    ball (6: x, y, z, vx, vy, vz), field frame, SI units; returns the plan cut to n robots.
+    ball (6: x, y, z, vx, vy, vz), field frame, SI units. The plan must hold n robots.
 
     Motion blur: an object whose image moves more than ``blur_step_px`` during the exposure
     (``exposure_s``, centred on the snapshot's instant) gets samples at most that far apart.
     """
     n = robots.shape[0]
-    p = plan.view(n)
-    p.ball_k = _plan_objects_kernel(
+    if n > plan.capacity or plan.rob_colors.shape[1] != 1 + dots.shape[0]:
+        raise ValueError(f"the plan holds {plan.capacity} robots of {plan.rob_colors.shape[1] - 1} id dots")
+    plan.n = n
+    plan.ball_k = _plan_objects_kernel(
         robots, ball, cam, shape, pink, dots, palette, exposure_s, plan.max_samples, blur_step_px,
-        p.rob_samples, p.rob_k, p.rob_bbox, p.rob_colors, p.rob_truth, p.ball_samples, p.ball_bbox, p.ball_truth,
+        plan.rob_samples[:n], plan.rob_k[:n], plan.rob_bbox[:n], plan.rob_colors[:n], plan.rob_truth[:n],
+        plan.ball_samples, plan.ball_bbox, plan.ball_truth,
     )  # fmt: skip
-    return p
 
 
 # --- per-pixel shading ---------------------------------------------------------------------------
 
 
-@njit(cache=True, fastmath=True)  # type: ignore[misc]
+@njit(cache=True, fastmath=True, inline="always")
 def _shape_sd(x: float, y: float, r: float, front: float) -> float:
     """Signed distance (m) of robot-frame point (x, y) to the top outline: a disc cut flat at the
     front (max of the two distances: exact inside and along the edges, low only near the corners)."""
     return max(math.sqrt(x * x + y * y) - r, x - front)
 
 
-@njit(cache=True, fastmath=True)  # type: ignore[misc]
+@njit(cache=True, fastmath=True, inline="always")
 def _segment_sd(ax: float, ay: float, bx: float, by: float, r: float, front: float) -> tuple[float, float]:
     """Smallest :func:`_shape_sd` along the robot-frame segment A -> B and the parameter t in [0, 1]
     where it occurs. The function is convex along the segment, so its minimum is at an end, at the
@@ -314,74 +312,81 @@ def _segment_sd(ax: float, ay: float, bx: float, by: float, r: float, front: flo
     return best, bt
 
 
-@njit(cache=True, fastmath=True)  # type: ignore[misc]
+@njit(cache=True, fastmath=True, inline="always")
 def _coverage(sd: float, pix: float) -> float:
     return min(max(0.5 - sd / pix, 0.0), 1.0)
 
 
-@njit(cache=True, fastmath=True)  # type: ignore[misc]
-def _body_coverage(samples: NDArray[np.float64], n: int, shape: NDArray[np.float64],
+@njit(cache=True, fastmath=True, inline="always")
+def _body_coverage(samples: NDArray[np.float64], k: int, n: int, shape: NDArray[np.float64],
                    ax_w: float, ay_w: float, bx_w: float, by_w: float, z_a: float, z_b: float,
                    cam_z: float, foot: float) -> float:  # fmt: skip
-    """Coverage of a robot body (averaged over its blur samples) along the part of a pixel's
+    """Coverage of robot k's body (averaged over its n blur samples) along the part of a pixel's
     ray between heights z_a > z_b, whose field points are A_w and B_w: the ray passes through the
     body's vertical prism there when the segment A -> B meets the top outline."""
     r, front = shape[SHAPE_ROBOT_RADIUS], shape[SHAPE_ROBOT_FRONT]
-    pix_a = (cam_z - z_a) * foot
-    pix_far = cam_z * foot  # the largest footprint along the ray: a cheap, safe reject bound
+    half_a = 0.5 * (cam_z - z_a) * foot
+    # the outline lies inside the disc: a segment farther than half the largest footprint along
+    # the ray from the disc cannot touch it (the common case in a bounding box: no square root)
+    reach = r + 0.5 * cam_z * foot
+    inner = r - half_a
     acc = 0.0
     for m in range(n):
-        px, py, co, si = samples[m, 0], samples[m, 1], samples[m, 2], samples[m, 3]
+        px, py, co, si = samples[k, m, 0], samples[k, m, 1], samples[k, m, 2], samples[k, m, 3]
         ex, ey = ax_w - px, ay_w - py
         ax, ay = co * ex + si * ey, co * ey - si * ex
-        if _shape_sd(ax, ay, r, front) <= -0.5 * pix_a:
-            acc += 1.0  # enters through the top: fully inside
-            continue
         ex, ey = bx_w - px, by_w - py
         bx, by = co * ex + si * ey, co * ey - si * ex
-        # the outline lies inside the disc: a segment far from the disc cannot touch it
         dx, dy = bx - ax, by - ay
         dd = dx * dx + dy * dy
         t = min(max(-(ax * dx + ay * dy) / dd, 0.0), 1.0) if dd > 1e-18 else 0.0
         qx, qy = ax + t * dx, ay + t * dy
-        if math.sqrt(qx * qx + qy * qy) - r >= 0.5 * pix_far:
+        if qx * qx + qy * qy >= reach * reach:
+            continue
+        if inner > 0.0 and ax * ax + ay * ay <= inner * inner and ax - front <= -half_a:
+            acc += 1.0  # enters through the top, away from its rim: inside
             continue
         sd, t = _segment_sd(ax, ay, bx, by, r, front)
         acc += _coverage(sd, (cam_z - (z_a + t * (z_b - z_a))) * foot)
     return acc / n
 
 
-@njit(cache=True, fastmath=True)  # type: ignore[misc]
-def _top_colour(samples: NDArray[np.float64], n: int, shape: NDArray[np.float64], dots: NDArray[np.float64],
+@njit(cache=True, fastmath=True, inline="always")
+def _top_colour(samples: NDArray[np.float64], k: int, n: int, shape: NDArray[np.float64], dots: NDArray[np.float64],
                 colors: NDArray[np.float32], cover: NDArray[np.float32], qx_w: float, qy_w: float,
                 pix: float, acc: NDArray[np.float64]) -> float:  # fmt: skip
-    """Premultiplied colour of a robot top (cover with its pattern) at the field point Q_w on
-    the plane of the top, averaged over the blur samples, into ``acc``; returns the coverage."""
+    """Premultiplied colour of robot k's top (cover with its pattern) at the field point Q_w on
+    the plane of the top, averaged over the blur samples, into ``acc``; returns the coverage.
+    Squared distances reject what a shape's coverage ramp cannot reach before any square root."""
     r, front = shape[SHAPE_ROBOT_RADIUS], shape[SHAPE_ROBOT_FRONT]
     rc, ri = shape[SHAPE_CENTER_DOT_RADIUS], shape[SHAPE_ID_DOT_RADIUS]
+    half = 0.5 * pix
+    reach2, reach_c2, reach_i2 = (r + half) ** 2, (rc + half) ** 2, (ri + half) ** 2
     acc[0] = acc[1] = acc[2] = 0.0
     a_sum = 0.0
     for m in range(n):
-        ex, ey = qx_w - samples[m, 0], qy_w - samples[m, 1]
-        co, si = samples[m, 2], samples[m, 3]
+        ex, ey = qx_w - samples[k, m, 0], qy_w - samples[k, m, 1]
+        co, si = samples[k, m, 2], samples[k, m, 3]
         qx, qy = co * ex + si * ey, co * ey - si * ex
-        rq = math.sqrt(qx * qx + qy * qy)
-        a = _coverage(max(rq - r, qx - front), pix)
-        if a <= 0.0:
+        r2 = qx * qx + qy * qy
+        if r2 >= reach2 or qx - front >= half:
             continue
+        rq = math.sqrt(r2)
+        a = _coverage(max(rq - r, qx - front), pix)
         c0, c1, c2 = cover[0], cover[1], cover[2]
-        ad = _coverage(rq - rc, pix)
-        if ad > 0.0:
-            c0 += ad * (colors[0, 0] - c0)
-            c1 += ad * (colors[0, 1] - c1)
-            c2 += ad * (colors[0, 2] - c2)
+        if r2 < reach_c2:
+            ad = _coverage(rq - rc, pix)
+            c0 += ad * (colors[k, 0, 0] - c0)
+            c1 += ad * (colors[k, 0, 1] - c1)
+            c2 += ad * (colors[k, 0, 2] - c2)
         for d in range(dots.shape[0]):
             ux, uy = qx - dots[d, 0], qy - dots[d, 1]
-            ad = _coverage(math.sqrt(ux * ux + uy * uy) - ri, pix)
-            if ad > 0.0:
-                c0 += ad * (colors[1 + d, 0] - c0)
-                c1 += ad * (colors[1 + d, 1] - c1)
-                c2 += ad * (colors[1 + d, 2] - c2)
+            u2 = ux * ux + uy * uy
+            if u2 < reach_i2:
+                ad = _coverage(math.sqrt(u2) - ri, pix)
+                c0 += ad * (colors[k, 1 + d, 0] - c0)
+                c1 += ad * (colors[k, 1 + d, 1] - c1)
+                c2 += ad * (colors[k, 1 + d, 2] - c2)
         acc[0] += a * c0
         acc[1] += a * c1
         acc[2] += a * c2
@@ -392,7 +397,7 @@ def _top_colour(samples: NDArray[np.float64], n: int, shape: NDArray[np.float64]
     return a_sum / n
 
 
-@njit(cache=True, fastmath=True)  # type: ignore[misc]
+@njit(cache=True, fastmath=True, inline="always")
 def _ball_sample(cam: NDArray[np.float64], rdx: float, rdy: float, foot: float, bx: float, by: float,
                  bz: float, rb: float, ambient: float) -> tuple[float, float, float]:  # fmt: skip
     """Ray (dx, dy, -1) from the optical centre against the ball sphere at B: (coverage, shade,
@@ -419,17 +424,17 @@ def _ball_sample(cam: NDArray[np.float64], rdx: float, rdy: float, foot: float, 
     return a, shade, cam[2] - t
 
 
-@njit(cache=True, fastmath=True)  # type: ignore[misc]
+@njit(cache=True, fastmath=True, inline="always")
 def _write_span(o: NDArray[np.uint8], scratch: NDArray[np.float32], nz: NDArray[np.int8], noise_on: bool,
                 q0: int, q1: int) -> None:  # fmt: skip
     for q in range(q0, q1):
-        v = int(math.floor(scratch[q] + 0.5))
+        v = int(scratch[q] + 0.5)  # colours are never negative: truncation rounds
         if noise_on:
             v += nz[q]
         o[q] = min(max(v, 0), 255)
 
 
-@njit(cache=True, parallel=True, fastmath=True)  # type: ignore[misc]
+@njit(cache=True, parallel=True, fastmath=True)
 def _render_frame_kernel(
     out2: NDArray[np.uint8], bg2: NDArray[np.uint8], bank: NDArray[np.int8], noise_start: int, noise_on: bool,
     rays: NDArray[np.float32], foot: NDArray[np.float32], gain: NDArray[np.float32], cam: NDArray[np.float64],
@@ -478,7 +483,7 @@ def _render_frame_kernel(
                 k = active[a]
                 for j in range(rob_bbox[k, 2], rob_bbox[k, 3]):
                     rdx, rdy, fp = rays[i, j, 0], rays[i, j, 1], foot[i, j]
-                    al = _body_coverage(rob_samples[k], rob_k[k], shape, cx + (cz - h) * rdx, cy + (cz - h) * rdy,
+                    al = _body_coverage(rob_samples, k, rob_k[k], shape, cx + (cz - h) * rdx, cy + (cz - h) * rdy,
                                         cx + cz * rdx, cy + cz * rdy, h, 0.0, cz, fp)  # fmt: skip
                     if al > 0.0:
                         g = gain[i, j]
@@ -489,7 +494,7 @@ def _render_frame_kernel(
                 k = active[a]
                 for j in range(rob_bbox[k, 2], rob_bbox[k, 3]):
                     rdx, rdy = rays[i, j, 0], rays[i, j, 1]
-                    al = _top_colour(rob_samples[k], rob_k[k], shape, dots, rob_colors[k], cover,
+                    al = _top_colour(rob_samples, k, rob_k[k], shape, dots, rob_colors, cover,
                                      cx + (cz - h) * rdx, cy + (cz - h) * rdy, (cz - h) * foot[i, j], acc)  # fmt: skip
                     if al > 0.0:
                         g = gain[i, j]
@@ -515,7 +520,7 @@ def _render_frame_kernel(
                             for a in range(n_act):
                                 k = active[a]
                                 if rob_bbox[k, 2] <= j < rob_bbox[k, 3]:
-                                    occ = _body_coverage(rob_samples[k], rob_k[k], shape, cx + (cz - h) * rdx,
+                                    occ = _body_coverage(rob_samples, k, rob_k[k], shape, cx + (cz - h) * rdx,
                                                          cy + (cz - h) * rdy, cx + (cz - zb) * rdx,
                                                          cy + (cz - zb) * rdy, h, zb, cz, fp)  # fmt: skip
                                     vis *= 1.0 - occ
@@ -557,13 +562,23 @@ def render_frame(
     start = noise_start if noise_start is not None else 0
     if noise_on and start + h_img * w_img * 3 > bank.shape[0]:
         raise ValueError("noise_start runs past the end of the noise bank")
+    n = plan.n
     _render_frame_kernel(
         out.reshape(h_img, w_img * 3), background.reshape(h_img, w_img * 3), bank, start, noise_on,
-        rays, foot, gain, cam, shape, dots, palette, plan.rob_samples, plan.rob_k, plan.rob_bbox,
-        plan.rob_colors, plan.ball_samples, plan.ball_k, plan.ball_bbox, row_ball, n_chunks,
+        rays, foot, gain, cam, shape, dots, palette, plan.rob_samples[:n], plan.rob_k[:n], plan.rob_bbox[:n],
+        plan.rob_colors[:n], plan.ball_samples, plan.ball_k, plan.ball_bbox, row_ball, n_chunks,
     )  # fmt: skip
-    vis, sil = row_ball.sum(axis=0)
-    return float(vis), float(sil)
+    return _ball_rows_sum(row_ball, int(plan.ball_bbox[0]), int(plan.ball_bbox[1]))
+
+
+@njit(cache=True)
+def _ball_rows_sum(row_ball: NDArray[np.float64], i0: int, i1: int) -> tuple[float, float]:
+    # in a fixed order, so the visible fraction does not depend on the thread count
+    vis, sil = 0.0, 0.0
+    for i in range(i0, i1):
+        vis += row_ball[i, 0]
+        sil += row_ball[i, 1]
+    return vis, sil
 
 
 # =================================================================================================
@@ -574,15 +589,16 @@ def render_frame(
 def add_noise_reference(background: NDArray[np.uint8], bank: NDArray[np.int8], start: int) -> NDArray[np.uint8]:
     """The background plus the bank's noise from ``start``, saturated to 0..255."""
     noise = bank[start : start + background.size].reshape(background.shape)
-    return np.clip(background.astype(np.int16) + noise, 0, 255).astype(np.uint8)
+    out: NDArray[np.uint8] = np.clip(background.astype(np.int16) + noise, 0, 255).astype(np.uint8)
+    return out
 
 
 def plan_objects_reference(
     model: CameraModel, robots: NDArray[np.float64], ball: NDArray[np.float64], shape: NDArray[np.float64],
     pink: NDArray[np.bool_], palette: NDArray[np.float32], exposure_s: float, max_samples: int,
     blur_step_px: float,
-) -> dict[str, object]:  # fmt: skip
-    """:func:`plan_objects` with ``CameraModel.project``: a dict of the same quantities."""
+) -> ObjectPlan:  # fmt: skip
+    """:func:`plan_objects` computed with ``CameraModel.project``, robot by robot."""
     r, h, rb = shape[SHAPE_ROBOT_RADIUS], shape[SHAPE_ROBOT_HEIGHT], shape[SHAPE_BALL_RADIUS]
 
     def count(motion_px: float) -> int:
@@ -603,21 +619,21 @@ def plan_objects_reference(
             return np.zeros(4, dtype=np.int32)
         return np.array([i0, i1, j0, j1], dtype=np.int32)
 
-    out: dict[str, list[object]] = {"rob_k": [], "rob_samples": [], "rob_bbox": [], "rob_colors": [], "rob_truth": []}
-    for row in robots:
+    plan = ObjectPlan(robots.shape[0], max_samples, pink.shape[1])
+    for k, row in enumerate(robots):
         team, rid, x, y, th, vx, vy, om = row
         speed = math.hypot(vx, vy)
         n = count((speed + abs(om) * r) * exposure_s * model.f / (model.center[2] - h))
         tm = ((np.arange(n) + 0.5) / n - 0.5) * exposure_s
-        out["rob_k"].append(n)
-        out["rob_samples"].append(np.stack([x + vx * tm, y + vy * tm, np.cos(th + om * tm), np.sin(th + om * tm)], 1))
-        out["rob_bbox"].append(bbox(x, y, r + 0.5 * speed * exposure_s, 0.0, h))
+        plan.rob_k[k] = n
+        plan.rob_samples[k, :n] = np.stack([x + vx * tm, y + vy * tm, np.cos(th + om * tm), np.sin(th + om * tm)], 1)
+        plan.rob_bbox[k] = bbox(x, y, r + 0.5 * speed * exposure_s, 0.0, h)
         ids = [PAL_PINK if p else PAL_GREEN for p in pink[int(rid) % pink.shape[0]]]
-        out["rob_colors"].append(palette[[PAL_BLUE + int(team)] + ids])
+        plan.rob_colors[k] = palette[[PAL_BLUE + int(team), *ids]]
         ang = 2.0 * np.pi * np.arange(N_OUTLINE) / N_OUTLINE
         rim = model.project_xy(np.stack([x + r * np.cos(ang), y + r * np.sin(ang)], 1), h)
         uv = model.project_xy(np.array([x, y]), h)
-        out["rob_truth"].append(np.array([uv[0], uv[1], float(model.in_image(rim).all())]))
+        plan.rob_truth[k] = (uv[0], uv[1], float(model.in_image(rim).all()))
     bx, by, bz, bvx, bvy, bvz = ball
     speed = math.sqrt(bvx * bvx + bvy * bvy + bvz * bvz)
     n = count(speed * exposure_s * model.f / (model.center[2] - bz))
@@ -625,13 +641,12 @@ def plan_objects_reference(
     ext = rb + 0.5 * speed * exposure_s
     uv = model.project(np.array([bx, by, bz]))
     inside = 0.0 <= uv[0] < model.width and 0.0 <= uv[1] < model.height
-    return {
-        **out,
-        "ball_k": n,
-        "ball_samples": np.stack([bx + bvx * tm, by + bvy * tm, bz + bvz * tm], 1),
-        "ball_bbox": bbox(bx, by, ext, bz - ext, bz + ext),
-        "ball_truth": np.array([uv[0], uv[1], float(inside)]),
-    }
+    plan.ball_k = n
+    plan.ball_samples[:n] = np.stack([bx + bvx * tm, by + bvy * tm, bz + bvz * tm], 1)
+    plan.ball_bbox[:] = bbox(bx, by, ext, bz - ext, bz + ext)
+    plan.ball_truth[:] = (uv[0], uv[1], float(inside))
+    plan.n = robots.shape[0]
+    return plan
 
 
 def _shape_sd_np(x: NDArray[np.float64], y: NDArray[np.float64], r: float, front: float) -> NDArray[np.float64]:
@@ -641,8 +656,7 @@ def _shape_sd_np(x: NDArray[np.float64], y: NDArray[np.float64], r: float, front
 def _segment_sd_np(ax: NDArray[np.float64], ay: NDArray[np.float64], bx: NDArray[np.float64],
                    by: NDArray[np.float64], r: float, front: float,
                    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:  # fmt: skip
-    """Vectorised :func:`_segment_sd`: the candidates are evaluated on a fine grid of t as well,
-    which can only confirm the exact candidates (the function is convex along the segment)."""
+    """Vectorised :func:`_segment_sd` (the same candidate points of t)."""
     dx, dy = bx - ax, by - ay
     dd = dx * dx + dy * dy
     safe = np.where(dd < 1e-18, 1.0, dd)
@@ -688,7 +702,8 @@ def render_frame_reference(
     r, h, front = shape[SHAPE_ROBOT_RADIUS], shape[SHAPE_ROBOT_HEIGHT], shape[SHAPE_ROBOT_FRONT]
     rc, ri, rb = shape[SHAPE_CENTER_DOT_RADIUS], shape[SHAPE_ID_DOT_RADIUS], shape[SHAPE_BALL_RADIUS]
     clean = background.astype(np.float32)
-    boxes = [tuple(b) for b in plan.rob_bbox] + [tuple(plan.ball_bbox)]
+    rob_bbox = plan.rob_bbox[: plan.n]
+    boxes = [tuple(b) for b in rob_bbox] + [tuple(plan.ball_bbox)]
 
     def region(box: tuple[int, ...]) -> tuple[slice, slice]:
         return slice(box[0], box[1]), slice(box[2], box[3])
@@ -698,13 +713,13 @@ def render_frame_reference(
         depth = cz - np.asarray(z)
         return np.stack([cx + depth * d[..., 0], cy + depth * d[..., 1]], -1)
 
-    for k, box in enumerate(plan.rob_bbox):
+    for k, box in enumerate(rob_bbox):
         sl = region(tuple(box))
         samples = plan.rob_samples[k, : plan.rob_k[k]]
         al = _body_coverage_np(samples, shape, plane_points(sl, h), plane_points(sl, 0.0), h, 0.0, cz,
                                foot[sl].astype(np.float64))[..., None]  # fmt: skip
         clean[sl] = clean[sl] + al * (palette[PAL_SIDE] * gain[sl][..., None] - clean[sl])
-    for k, box in enumerate(plan.rob_bbox):
+    for k, box in enumerate(rob_bbox):
         sl = region(tuple(box))
         q_w = plane_points(sl, h)
         pix = (cz - h) * foot[sl].astype(np.float64)
@@ -716,9 +731,9 @@ def render_frame_reference(
             a = np.clip(0.5 - _shape_sd_np(qx, qy, r, front) / pix, 0.0, 1.0)
             col = np.broadcast_to(palette[PAL_COVER].astype(np.float64), pix.shape + (3,)).copy()
             centres = [(0.0, 0.0, rc)] + [(dx, dy, ri) for dx, dy in dots]
-            for d, (ux, uy, rad) in enumerate(centres):
+            for e, (ux, uy, rad) in enumerate(centres):
                 ad = np.clip(0.5 - (np.hypot(qx - ux, qy - uy) - rad) / pix, 0.0, 1.0)[..., None]
-                col += ad * (plan.rob_colors[k, d] - col)
+                col += ad * (plan.rob_colors[k, e] - col)
             acc += a[..., None] * col
             a_sum += a
         n = len(samples)
@@ -730,19 +745,19 @@ def render_frame_reference(
     dd = d[..., 0] ** 2 + d[..., 1] ** 2 + 1.0
     a_tot, c_tot, sil_tot = np.zeros(fp.shape), np.zeros(fp.shape), np.zeros(fp.shape)
     for bx, by, bz in plan.ball_samples[: plan.ball_k]:
-        w = np.array([bx - cx, by - cy, bz - cz])
-        tc = (w[0] * d[..., 0] + w[1] * d[..., 1] - w[2]) / dd
-        dist2 = np.maximum(w @ w - tc * tc * dd, 0.0)
+        wv = np.array([bx - cx, by - cy, bz - cz])
+        tc = (wv[0] * d[..., 0] + wv[1] * d[..., 1] - wv[2]) / dd
+        dist2 = np.maximum(wv @ wv - tc * tc * dd, 0.0)
         a = np.clip(0.5 - (np.sqrt(dist2) - rb) / (fp * tc / dd**0.25), 0.0, 1.0)
         t = np.where(dist2 < rb * rb, tc - np.sqrt(np.maximum(rb * rb - dist2, 0.0) / dd), tc)
-        nrm = np.stack([d[..., 0] * t - w[0], d[..., 1] * t - w[1], -t - w[2]], -1)
+        nrm = np.stack([d[..., 0] * t - wv[0], d[..., 1] * t - wv[1], -t - wv[2]], -1)
         up = nrm[..., 2] / np.maximum(np.linalg.norm(nrm, axis=-1), 1e-12)
         amb = shape[SHAPE_BALL_AMBIENT]
         shade = amb + (1.0 - amb) * np.maximum(up, 0.0)
         z_hit = cz - t
         zb = np.maximum(z_hit, 0.0)
         vis = np.ones(fp.shape)
-        for k, box in enumerate(plan.rob_bbox):
+        for k, box in enumerate(rob_bbox):
             i0, i1, j0, j1 = box
             b_i0, b_i1, b_j0, b_j1 = plan.ball_bbox
             inside = np.zeros(fp.shape, dtype=bool)
@@ -753,15 +768,15 @@ def render_frame_reference(
         a_tot += a * vis
         c_tot += a * vis * shade
         sil_tot += a
-    n = plan.ball_k
-    a_tot, c_tot, sil_tot = a_tot / n, c_tot / n, sil_tot / n
+    n_b = plan.ball_k
+    a_tot, c_tot, sil_tot = a_tot / n_b, c_tot / n_b, sil_tot / n_b
     clean[sl] = clean[sl] * (1.0 - a_tot[..., None]) + (c_tot * gain[sl])[..., None] * palette[PAL_BALL]
 
     out = background.copy() if noise_start is None else add_noise_reference(background, bank, noise_start)
     noisy = np.floor(clean + 0.5).astype(np.int32)
     if noise_start is not None:
         noisy += bank[noise_start : noise_start + background.size].reshape(background.shape)
-    for box in boxes:
-        sl = region(box)
+    for b_box in boxes:
+        sl = region(b_box)
         out[sl] = np.clip(noisy[sl], 0, 255)
     return out, float(a_tot.sum()), float(sil_tot.sum())

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
-from cmdragons.config import setting
+from cmdragons.config import Validated, setting
 from cmdragons.geometry import Team
 from sim.referee import RefereeParams
 from sim.render import RenderParams
@@ -16,7 +16,7 @@ __all__ = ["SimParams"]
 
 
 @dataclass(frozen=True)
-class SimParams:
+class SimParams(Validated):
     seed: int = setting(1, lo=0, hi=2**63 - 1)  # every random choice of the simulator derives from it
     # robots per team; a team left out gets its division's count (configs/field.yaml)
     robots_per_team: Mapping[Team, int] = field(default_factory=dict)
@@ -30,6 +30,7 @@ class SimParams:
     render: RenderParams = RenderParams()
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         for team, n in self.robots_per_team.items():
             if not 0 <= n <= 16:
                 raise ValueError(f"robots_per_team.{team} must be 0 to 16 (the pattern has 16 ids), got {n}")

@@ -13,7 +13,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Literal
 
-from cmdragons.config import setting
+from cmdragons.config import Validated, setting
 from cmdragons.geometry import TEAMS, Team
 from cmdragons.messages import GameState
 from sim.world import BallOut, Contact, Goal, Kick, World
@@ -31,7 +31,7 @@ _DEFAULT_FORMATIONS: dict[Literal["A", "B"], tuple[_Pose, ...]] = {
 
 
 @dataclass(frozen=True)
-class RefereeParams:
+class RefereeParams(Validated):
     enabled: bool = True  # off: no restarts, the ball bounces off the boundary walls
     blue_defends: Literal["negative_x", "positive_x"] = "negative_x"
     restart_delay_s: float = setting(1.0, lo=0.0, hi=30.0)  # goal or out -> ball placed

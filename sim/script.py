@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cmdragons.config import setting
+from cmdragons.config import Validated, setting
 from cmdragons.geometry import TEAMS, Field, wrap_angle
 from cmdragons.messages import RobotCommand
 from sim.snapshot import Snapshot
@@ -21,7 +21,7 @@ __all__ = ["ScriptParams", "ScriptedPlay"]
 
 
 @dataclass(frozen=True)
-class ScriptParams:
+class ScriptParams(Validated):
     cruise_speed_m_s: float = setting(1.5, lo=0.0, hi=10.0)
     position_gain_1_s: float = setting(2.5, lo=0.0, hi=100.0)  # speed command per metre of error
     heading_gain_1_s: float = setting(6.0, lo=0.0, hi=100.0)

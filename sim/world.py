@@ -29,7 +29,7 @@ import numpy as np
 import pymunk
 from numpy.typing import NDArray
 
-from cmdragons.config import setting
+from cmdragons.config import Validated, setting
 from cmdragons.geometry import TEAMS, Field, LeagueParams, Team
 from cmdragons.messages import BallTruth, GroundTruth, RobotCommand, RobotTruth
 from sim.snapshot import Snapshot
@@ -56,7 +56,7 @@ _GRAVITY = 9.81
 
 
 @dataclass(frozen=True)
-class PhysicsParams:
+class PhysicsParams(Validated):
     frame_rate_hz: float = setting(60.0, lo=1.0, hi=1000.0)  # camera frames per second
     substeps: int = setting(6, lo=1, hi=100)  # physics steps per camera frame
     collision_slop_m: float = setting(0.0005, lo=0.0, hi=0.01)  # allowed overlap before correction
@@ -64,7 +64,7 @@ class PhysicsParams:
 
 
 @dataclass(frozen=True)
-class RobotParams:
+class RobotParams(Validated):
     mass_kg: float = setting(2.5, lo=0.1, hi=50.0)
     max_speed_m_s: float = setting(3.0, lo=0.0, hi=10.0)
     max_accel_m_s2: float = setting(3.0, lo=0.0, hi=50.0)  # speeding up or turning the velocity
@@ -78,7 +78,7 @@ class RobotParams:
 
 
 @dataclass(frozen=True)
-class BallParams:
+class BallParams(Validated):
     mass_kg: float = setting(0.046, lo=0.001, hi=1.0)
     acc_slide_m_s2: float = setting(3.0, lo=0.0, hi=50.0)  # deceleration while sliding
     acc_roll_m_s2: float = setting(0.26, lo=0.0, hi=10.0)  # deceleration while rolling
@@ -90,7 +90,7 @@ class BallParams:
 
 
 @dataclass(frozen=True)
-class KickerParams:
+class KickerParams(Validated):
     max_speed_m_s: float = setting(6.5, lo=0.0, hi=20.0)
     recharge_s: float = setting(0.3, lo=0.0, hi=10.0)  # time between two kicks of one robot
     touch_tolerance_m: float = setting(0.006, lo=0.0, hi=0.05)  # ball surface to the front face
@@ -98,7 +98,7 @@ class KickerParams:
 
 
 @dataclass(frozen=True)
-class DribblerParams:
+class DribblerParams(Validated):
     grip_force_n: float = setting(1.0, lo=0.0, hi=50.0)  # at full dribbler power
     pull_speed_m_s: float = setting(0.5, lo=0.0, hi=5.0)  # how fast the grip re-centres the ball
     release_distance_m: float = setting(0.03, lo=0.001, hi=0.5)  # ball torn this far away: released

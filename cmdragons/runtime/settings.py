@@ -58,7 +58,7 @@ def load_settings(config_dir: str | Path | None = None, overrides: Sequence[str]
     for assignment in overrides:
         apply_override(raw, assignment)
         touched.setdefault(assignment.partition(".")[0], []).append(assignment)
-    parsed = {}
+    parsed: dict[str, Any] = {}
     for name, cls in CONCERNS.items():
         origin = files[name]
         if name in touched:

@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, LeagueParams
 
-__all__ = ["AutoLayout", "CameraModel", "CameraParams", "CamerasParams", "cameras_from_config"]
+__all__ = ["AutoLayout", "CameraModel", "CameraParams", "CamerasParams", "cameras_from_config", "smallest_ball_px"]
 
 
 @dataclass(frozen=True)
@@ -53,17 +53,27 @@ class CameraParams(Validated):
 @dataclass(frozen=True)
 class AutoLayout(Validated):
     """Cameras derived from the field: a grid of downward cameras, each seeing its cell plus the
-    overlap with its neighbours and a margin past the field lines, at robot-top height."""
+    overlap with its neighbours and a margin past the field lines, at robot-top height.
 
-    grid: tuple[int, int] = (2, 1)  # cameras along x, along y
+    ``grid: auto`` takes the fewest cameras for which the ball is at least ``min_ball_px`` across
+    everywhere on the field; ``long_axis: auto`` lays each image's width along its cell's longer side.
+    """
+
+    grid: tuple[int, int] | Literal["auto"] = "auto"  # cameras along x, along y
+    min_ball_px: float = setting(6.0, lo=1.0, hi=100.0)  # ball diameter in pixels that grid auto ensures
     height_m: float = setting(4.0, lo=0.5, hi=20.0)
     overlap_m: float = setting(0.4, lo=0.0, hi=5.0)  # width of the strip two neighbours both see
     margin_x_m: float = setting(0.25, lo=0.0, hi=2.0)  # past the goal lines
     margin_y_m: float = setting(0.2, lo=0.0, hi=2.0)  # past the touch lines
     resolution_px: tuple[int, int] = (1024, 768)
-    long_axis: Literal["x", "y"] = "y"  # field axis along the image width
+    long_axis: Literal["x", "y", "auto"] = "auto"  # field axis along the image width
     k1: float = setting(-0.02, lo=-0.5, hi=0.5)
     k2: float = setting(0.0, lo=-0.5, hi=0.5)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.grid != "auto" and not (1 <= self.grid[0] <= 16 and 1 <= self.grid[1] <= 16):
+            raise ValueError("grid must be 'auto' or [nx, ny] with 1 to 16 cameras along each axis")
 
 
 @dataclass(frozen=True)
@@ -187,11 +197,12 @@ class CameraModel:
 
 
 def _auto_camera(cam_id: int, center: tuple[float, float], half: tuple[float, float], lay: AutoLayout,
-                 robot_height: float) -> CameraParams:
+                 robot_height: float) -> CameraParams:  # fmt: skip
     w, h = lay.resolution_px
-    yaw = 0.0 if lay.long_axis == "x" else -math.pi / 2.0
+    long_axis = lay.long_axis if lay.long_axis != "auto" else ("x" if half[0] >= half[1] else "y")
+    yaw = 0.0 if long_axis == "x" else -math.pi / 2.0
     # the covered rectangle at robot-top height, in camera-frame half extents (u, v)
-    hu, hv = (half[0], half[1]) if lay.long_axis == "x" else (half[1], half[0])
+    hu, hv = (half[0], half[1]) if long_axis == "x" else (half[1], half[0])
     dist = lay.height_m - robot_height
     corner = np.array([hu / dist, hv / dist])
 
@@ -210,15 +221,11 @@ def _auto_camera(cam_id: int, center: tuple[float, float], half: tuple[float, fl
     )  # fmt: skip
 
 
-def cameras_from_config(params: CamerasParams, league: LeagueParams) -> list[CameraModel]:
-    """The camera models in force: the explicit list, or the auto layout over the field."""
-    if params.layout == "list":
-        return [CameraModel(p) for p in params.cameras]
-    lay = params.auto
+def _grid_cameras(grid: tuple[int, int], lay: AutoLayout, league: LeagueParams) -> list[CameraModel]:
     f = Field(league)
     x0, x1 = -f.half_length - lay.margin_x_m, f.half_length + lay.margin_x_m
     y0, y1 = -f.half_width - lay.margin_y_m, f.half_width + lay.margin_y_m
-    nx, ny = lay.grid
+    nx, ny = grid
     cx_w, cy_w = (x1 - x0) / nx, (y1 - y0) / ny
     models = []
     for j in range(ny):
@@ -231,4 +238,38 @@ def cameras_from_config(params: CamerasParams, league: LeagueParams) -> list[Cam
             centre = ((lo_x + hi_x) / 2.0, (lo_y + hi_y) / 2.0)
             half = ((hi_x - lo_x) / 2.0, (hi_y - lo_y) / 2.0)
             models.append(CameraModel(_auto_camera(j * nx + i, centre, half, lay, league.robot.height_m)))
+    return models
+
+
+def smallest_ball_px(models: list[CameraModel], league: LeagueParams, samples: int = 15) -> float:
+    """The ball's smallest diameter in pixels over the playing area, each point taken in the camera
+    that sees it largest; 0 where no camera sees a point."""
+    f = Field(league)
+    z = league.ball.radius_m
+    worst = math.inf
+    for x in np.linspace(-f.half_length, f.half_length, samples):
+        for y in np.linspace(-f.half_width, f.half_width, samples):
+            p = np.array([x, y])
+            best = max(
+                (m.pixels_per_metre((float(x), float(y)), z) for m in models if m.in_image(m.project_xy(p, z))),
+                default=0.0,
+            )
+            worst = min(worst, best * 2.0 * z)
+    return worst
+
+
+_GRIDS = ((1, 1), (2, 1), (1, 2), (2, 2), (3, 2), (2, 3), (3, 3), (4, 2), (4, 3), (3, 4), (4, 4), (6, 4), (8, 4))
+
+
+def cameras_from_config(params: CamerasParams, league: LeagueParams) -> list[CameraModel]:
+    """The camera models in force: the explicit list, or the auto layout over the field."""
+    if params.layout == "list":
+        return [CameraModel(p) for p in params.cameras]
+    lay = params.auto
+    if lay.grid != "auto":
+        return _grid_cameras(lay.grid, lay, league)
+    for grid in _GRIDS:
+        models = _grid_cameras(grid, lay, league)
+        if smallest_ball_px(models, league) >= lay.min_ball_px:
+            return models
     return models

@@ -7,7 +7,14 @@ import math
 import numpy as np
 import pytest
 
-from cmdragons.camera import CameraModel, CameraParams, CamerasParams, cameras_from_config
+from cmdragons.camera import (
+    AutoLayout,
+    CameraModel,
+    CameraParams,
+    CamerasParams,
+    cameras_from_config,
+    smallest_ball_px,
+)
 from cmdragons.geometry import Field, LeagueParams
 
 
@@ -78,10 +85,17 @@ def test_default_cameras_cover_the_field_with_overlap_and_ball_size() -> None:
         s = strip + [dx, 0.0]
         assert all(c.in_image(c.project_xy(s, league.robot.height_m)).all() for c in cams)
     # the ball is at least 6 px across anywhere on the field in the camera that sees it best
-    for p in pts[::7]:
-        best = max(c.pixels_per_metre((p[0], p[1]), league.ball.radius_m) for c in cams
-                   if c.in_image(c.project_xy(p, league.ball.radius_m)))  # fmt: skip
-        assert best * 2 * league.ball.radius_m >= 6.0
+    assert smallest_ball_px(cams, league, samples=31) >= 6.0
+
+
+def test_auto_grid_gives_division_a_enough_cameras() -> None:
+    league = LeagueParams(division="A")
+    cams = cameras_from_config(CamerasParams(), league)
+    assert len(cams) == 4
+    assert smallest_ball_px(cams, league, samples=31) >= 6.0
+    # a fixed grid is taken as given
+    fixed = cameras_from_config(CamerasParams(auto=AutoLayout(grid=(2, 1))), league)
+    assert len(fixed) == 2 and smallest_ball_px(fixed, league) < 6.0
 
 
 def test_camera_params_validation() -> None:

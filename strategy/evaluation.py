@@ -25,7 +25,15 @@ from numpy.typing import NDArray
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field
 
-__all__ = ["PassEvaluation", "PassParams", "best_shot", "lane_open_angle", "open_goal_angle", "pass_values"]
+__all__ = [
+    "PassEvaluation",
+    "PassParams",
+    "best_shot",
+    "clearest_direction",
+    "lane_open_angle",
+    "open_goal_angle",
+    "pass_values",
+]
 
 Array = NDArray[np.float64]
 
@@ -176,3 +184,16 @@ def pass_values(ball: Array, points: Array, field: Field, goal_sign: float, obst
     values = (f_len**params.weight_length * f_lane**params.weight_lane * f_open**params.weight_shot_open
               * f_dist**params.weight_shot_distance * f_redirect**params.weight_redirect)  # fmt: skip
     return PassEvaluation(points, values, aims)
+
+
+def clearest_direction(ball: Array, toward: float, obstacles: Array, radius: float, reach_m: float = 1.5,
+                       spread_rad: float = math.pi / 2, samples: int = 13) -> tuple[float, float]:  # fmt: skip
+    """Among directions within ``spread_rad`` of ``toward``, the one whose lane of length
+    ``reach_m`` from the ball is most open, preferring directions near ``toward`` on ties.
+    Returns (angle, open angle)."""
+    angles = toward + np.linspace(-spread_rad, spread_rad, samples)
+    targets = ball + reach_m * np.stack([np.cos(angles), np.sin(angles)], axis=1)
+    open_ = lane_open_angle(ball, targets, obstacles, radius, 0.6)
+    score = open_ - 0.05 * np.abs(angles - toward)
+    k = int(np.argmax(score))
+    return float(angles[k]), float(open_[k])

@@ -64,7 +64,7 @@ class ERRTParams:
     waypoint_cache: bool = True  # keep and use the waypoint cache
     waypoint_cache_size: int = setting(64, lo=1, hi=10000)  # cached points
     waypoint_replacement: Literal["random", "fifo"] = setting("random", choices=("random", "fifo"))
-    waypoint_spacing_m: float = setting(0.3, lo=0.01, hi=10.0)  # points cached along a plan
+    waypoint_spacing_m: float = setting(0.3, lo=0.01, hi=10.0)  # spacing of the points cached along a plan
     bidirectional: bool = True  # grow trees from both ends (multi-bridge ERRT, §4.3.4)
     max_bridges: int = setting(4, lo=1, hi=64)  # bridges to collect before choosing the shortest
     extra_iterations: int = setting(24, lo=0, hi=100000)  # more iterations after the first bridge
@@ -94,15 +94,19 @@ class WaypointCache:
 
     def add(self, pts: FloatArray) -> None:
         size = len(self.points)
-        for p in pts:
-            if self.count < size:
-                self.points[self.count] = p
-                self.count += 1
-            elif self._replacement == "fifo":
-                self.points[self._next] = p
-                self._next = (self._next + 1) % size
-            else:
-                self.points[int(self._rng.integers(size))] = p
+        pts = pts[-size:]  # more than the cache holds: the last ones would win anyway
+        room = min(size - self.count, len(pts))
+        self.points[self.count : self.count + room] = pts[:room]
+        self.count += room
+        rest = pts[room:]
+        if len(rest) == 0:
+            return
+        if self._replacement == "fifo":
+            idx = (self._next + np.arange(len(rest))) % size
+            self._next = int((self._next + len(rest)) % size)
+        else:
+            idx = (self._rng.random(len(rest)) * size).astype(np.int64)  # integers() costs 10x more
+        self.points[idx] = rest
 
     def view(self) -> FloatArray:
         return self.points[: self.count]
@@ -110,16 +114,6 @@ class WaypointCache:
     def clear(self) -> None:
         self.count = 0
         self._next = 0
-
-
-def resample(path: FloatArray, spacing_m: float) -> FloatArray:
-    """The vertices of a polyline plus points every ``spacing_m`` along its segments."""
-    out = [path[:1]]
-    for a, b in zip(path[:-1], path[1:], strict=True):
-        n = max(1, int(np.ceil(np.hypot(*(b - a)) / spacing_m)))
-        f = np.arange(1, n + 1)[:, None] / n
-        out.append(a + f * (b - a))
-    return np.vstack(out)
 
 
 class ERRTPlanner:
@@ -189,7 +183,7 @@ class ERRTPlanner:
         raw = np.vstack([self._branch(a0)[::-1], self._branch(a1)])
         stats["raw_length_m"] = float(np.hypot(*np.diff(raw, axis=0).T).sum())
         path = smooth(cw, raw, self.params.smoothing)
-        return self._done(ends, path, PlanStatus.SOLVED, stats, t0)
+        return self._done(ends, path, PlanStatus.SOLVED, stats, t0, cache_points=raw)
 
     # --- steps ----------------------------------------------------------------------------------
     def _reuse(self, cw: CompiledWorld, ends: RobustEnds) -> FloatArray | None:
@@ -269,9 +263,14 @@ class ERRTPlanner:
         stats: dict[str, object],
         t0: float,
         cache: bool = True,
+        cache_points: FloatArray | None = None,
     ) -> PlanResult:
+        """Remember the plan and feed the waypoint cache with points every ``waypoint_spacing_m`` along
+        the tree's own path (Bruce 2006 §4.3), which keeps some clearance, rather than along the
+        smoothed path that touches the obstacles and is the first to be blocked when they move."""
         if cache and self.params.waypoint_cache:
-            self.cache.add(resample(path, self.params.waypoint_spacing_m)[1:-1])
+            along = cache_points if cache_points is not None else path
+            self.cache.add(K.resample(along, self.params.waypoint_spacing_m)[1:-1])
         self.last_path = path
         self.last_goal = ends.goal
         stats["ms"] = (time.perf_counter() - t0) * 1e3

@@ -121,36 +121,12 @@ class CompiledWorld:
         self.radius_m = radius_m
         self.window_s = (t0_s, t1_s)
         self.params = params
-        c, v, b = world.circles, world.velocities, world.boxes
-        obs = np.empty((len(c) + len(b), 6))
-        obs[: len(c), 0] = 0.0
-        obs[: len(c), 1:3] = c[:, :2] + v * t0_s
-        obs[: len(c), 3:5] = c[:, :2] + v * t1_s
-        obs[: len(c), 5] = c[:, 2] + radius_m
-        obs[len(c) :, 0] = 1.0
-        obs[len(c) :, 1:5] = b
-        obs[len(c) :, 5] = radius_m
-        core = np.empty((len(obs), 4))
-        core[:, 0] = np.minimum(obs[:, 1], obs[:, 3])
-        core[:, 1] = np.minimum(obs[:, 2], obs[:, 4])
-        core[:, 2] = np.maximum(obs[:, 1], obs[:, 3])
-        core[:, 3] = np.maximum(obs[:, 2], obs[:, 4])
-        aabb = core + obs[:, 5:6] * np.array([-1.0, -1.0, 1.0, 1.0])
-        x0, y0, x1, y1 = world.bounds
-        inner = np.array([x0 + radius_m, y0 + radius_m, x1 - radius_m, y1 - radius_m])
-        self.obs, self.aabb, self.inner = obs, aabb, inner
+        bounds = np.array(world.bounds)
         mode = BROAD_PHASES[params.broad_phase]
-        nb = params.mask_bins
-        grid = np.array([x0, y0, nb / (x1 - x0), nb / (y1 - y0)])
-        if mode == K.MODE_MASKS:
-            xm, ym = K.build_masks(aabb, grid, nb)
-        else:
-            xm = ym = np.zeros((1, 1), dtype=np.uint64)
-        if mode == K.MODE_AABB_TREE:
-            tbox, tchild, tleaf = K.build_aabb_tree(aabb)
-        else:
-            tbox, tchild, tleaf = np.zeros((1, 4)), -np.ones((1, 2), dtype=np.int32), -np.ones(1, dtype=np.int32)
-        self.cw: tuple[Any, ...] = (obs, aabb, inner, mode, grid, xm, ym, tbox, tchild, tleaf)
+        self.cw: tuple[Any, ...] = K.build_world(
+            world.circles, world.velocities, world.boxes, bounds, radius_m, t0_s, t1_s, mode, params.mask_bins
+        )
+        self.obs, self.aabb, self.inner = self.cw[0], self.cw[1], self.cw[2]
 
     # --- queries (field frame, metres) ------------------------------------------------------------
     def point_free(self, x: float, y: float) -> bool:
@@ -159,9 +135,7 @@ class CompiledWorld:
 
     def segment_free(self, a: ArrayLike, b: ArrayLike) -> bool:
         """Swept-circle query: the robot's disc moving straight from a to b touches nothing."""
-        ax, ay = (float(v) for v in np.asarray(a, dtype=np.float64)[:2])
-        bx, by = (float(v) for v in np.asarray(b, dtype=np.float64)[:2])
-        return bool(K.segment_free(self.cw, ax, ay, bx, by))
+        return bool(K.segment_free(self.cw, float(a[0]), float(a[1]), float(b[0]), float(b[1])))  # type: ignore[index]
 
     def segments_free(self, segments: ArrayLike) -> NDArray[np.bool_]:
         """:meth:`segment_free` for each row (ax, ay, bx, by)."""

@@ -71,7 +71,8 @@ def test_missing_folder_and_unknown_file(tmp_path: Path, configs: Path) -> None:
     with pytest.raises(ConfigError, match="config folder not found"):
         load_settings(tmp_path / "nowhere")
     (configs / "simm.yaml").write_text("seed: 2\n")
-    with pytest.raises(ConfigError, match="unknown config file; allowed: field.yaml, cameras.yaml, sim.yaml, planner.yaml"):
+    allowed = "unknown config file; allowed: field.yaml, cameras.yaml, sim.yaml, planner.yaml"
+    with pytest.raises(ConfigError, match=allowed):
         load_settings(configs)
 
 

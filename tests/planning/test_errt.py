@@ -20,7 +20,9 @@ def planner(**kw: object) -> ERRTPlanner:
 def test_waypoint_cache_replacement_strategies() -> None:
     fifo = WaypointCache(3, "fifo", np.random.default_rng(0))
     fifo.add(np.arange(10.0).reshape(5, 2))
-    np.testing.assert_array_equal(fifo.view(), [[6, 7], [8, 9], [4, 5]])  # the oldest went first
+    np.testing.assert_array_equal(fifo.view(), [[4, 5], [6, 7], [8, 9]])  # the last three stay
+    fifo.add(np.array([[10.0, 11.0]]))
+    np.testing.assert_array_equal(fifo.view(), [[10, 11], [6, 7], [8, 9]])  # the oldest went first
     rand = WaypointCache(3, "random", np.random.default_rng(0))
     rand.add(np.arange(20.0).reshape(10, 2))
     assert rand.count == 3 and len({tuple(p) for p in rand.view()}) == 3

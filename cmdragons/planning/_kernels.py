@@ -138,7 +138,7 @@ def _hits_segment(obs: np.ndarray, j: int, ax: float, ay: float, bx: float, by: 
         d2 = segment_segment_dist2(ax, ay, bx, by, obs[j, 1], obs[j, 2], obs[j, 3], obs[j, 4])
     else:
         d2 = segment_box_dist2(ax, ay, bx, by, obs[j, 1], obs[j, 2], obs[j, 3], obs[j, 4])
-    return d2 < r * r
+    return bool(d2 < r * r)
 
 
 @njit(cache=True)
@@ -148,12 +148,12 @@ def obstacle_clearance(obs: np.ndarray, j: int, px: float, py: float) -> float:
         d2 = point_segment_dist2(px, py, obs[j, 1], obs[j, 2], obs[j, 3], obs[j, 4])
     else:
         d2 = point_box_dist2(px, py, obs[j, 1], obs[j, 2], obs[j, 3], obs[j, 4])
-    return math.sqrt(d2) - obs[j, 5]
+    return float(math.sqrt(d2) - obs[j, 5])
 
 
 @njit(cache=True)
 def _in_inner(inner: np.ndarray, px: float, py: float) -> bool:
-    return inner[0] - EPS_M <= px <= inner[2] + EPS_M and inner[1] - EPS_M <= py <= inner[3] + EPS_M
+    return bool(inner[0] - EPS_M <= px <= inner[2] + EPS_M and inner[1] - EPS_M <= py <= inner[3] + EPS_M)
 
 
 # --- broad phase ------------------------------------------------------------------------------------
@@ -286,7 +286,7 @@ def build_world(
 
 @njit(cache=True)
 def _box_overlap(b: np.ndarray, i: int, x0: float, y0: float, x1: float, y1: float) -> bool:
-    return b[i, 0] <= x1 and x0 <= b[i, 2] and b[i, 1] <= y1 and y0 <= b[i, 3]
+    return bool(b[i, 0] <= x1 and x0 <= b[i, 2] and b[i, 1] <= y1 and y0 <= b[i, 3])
 
 
 @njit(cache=True)

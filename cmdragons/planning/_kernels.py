@@ -559,7 +559,8 @@ def errt_grow(
 
     ``fparams = (p_goal, p_waypoint, step_m, connect_radius_m)``,
     ``iparams = (max_extensions, bidirectional, max_bridges, extra_iterations, nn_kind)``,
-    ``state = (n_nodes, n_bridges, iterations, first_bridge_iteration)``. Returns a GROW_* code.
+    ``state = (n_nodes, n_bridges, iterations, first_bridge_iteration, waypoint_targets)``, the last
+    counting the iterations that aimed at a cached waypoint. Returns a GROW_* code.
     """
     p_goal, p_way, step, connect_r = fparams[0], fparams[1], fparams[2], fparams[3]
     max_ext, bidir, max_br, extra, nn = iparams[0], iparams[1], iparams[2], iparams[3], iparams[4]
@@ -582,6 +583,7 @@ def errt_grow(
             tx, ty = nodes[other, 0], nodes[other, 1]
         elif u < p_goal + p_way and n_way > 0:
             w = min(n_way - 1, int(rand[r, 1] * n_way))
+            state[4] += 1
             tx, ty = waypoints[w, 0], waypoints[w, 1]
         else:
             tx = inner[0] + rand[r, 1] * (inner[2] - inner[0])
@@ -658,6 +660,28 @@ def resample(path: np.ndarray, spacing_m: float) -> np.ndarray:
             out[m, 1] = path[i, 1] + f * (path[i + 1, 1] - path[i, 1])
             m += 1
     return out
+
+
+@njit(cache=True)
+def cache_add(points: np.ndarray, meta: np.ndarray, pts: np.ndarray, u: np.ndarray, fifo: bool) -> int:
+    """Store ``pts`` (k, 2) in the waypoint cache ``points`` (size, 2) (Bruce 2006 §4.3.3):
+    ``meta = (count, next)``; while there is room a point takes the next free slot, then it replaces
+    the oldest (``fifo``) or a random slot picked by the next uniform of ``u``. Returns how many
+    uniforms it used."""
+    size = points.shape[0]
+    used = 0
+    for i in range(max(0, pts.shape[0] - size), pts.shape[0]):
+        if meta[0] < size:
+            k = meta[0]
+            meta[0] += 1
+        elif fifo:
+            k = meta[1]
+            meta[1] = (k + 1) % size
+        else:
+            k = min(size - 1, int(u[used] * size))
+            used += 1
+        points[k, 0], points[k, 1] = pts[i, 0], pts[i, 1]
+    return used
 
 
 # --- smoothing --------------------------------------------------------------------------------------

@@ -138,7 +138,7 @@ def _hits_segment(obs: np.ndarray, j: int, ax: float, ay: float, bx: float, by: 
         d2 = segment_segment_dist2(ax, ay, bx, by, obs[j, 1], obs[j, 2], obs[j, 3], obs[j, 4])
     else:
         d2 = segment_box_dist2(ax, ay, bx, by, obs[j, 1], obs[j, 2], obs[j, 3], obs[j, 4])
-    return d2 < r * r
+    return bool(d2 < r * r)
 
 
 @njit(cache=True)
@@ -148,12 +148,12 @@ def obstacle_clearance(obs: np.ndarray, j: int, px: float, py: float) -> float:
         d2 = point_segment_dist2(px, py, obs[j, 1], obs[j, 2], obs[j, 3], obs[j, 4])
     else:
         d2 = point_box_dist2(px, py, obs[j, 1], obs[j, 2], obs[j, 3], obs[j, 4])
-    return math.sqrt(d2) - obs[j, 5]
+    return float(math.sqrt(d2) - obs[j, 5])
 
 
 @njit(cache=True)
 def _in_inner(inner: np.ndarray, px: float, py: float) -> bool:
-    return inner[0] - EPS_M <= px <= inner[2] + EPS_M and inner[1] - EPS_M <= py <= inner[3] + EPS_M
+    return bool(inner[0] - EPS_M <= px <= inner[2] + EPS_M and inner[1] - EPS_M <= py <= inner[3] + EPS_M)
 
 
 # --- broad phase ------------------------------------------------------------------------------------
@@ -286,7 +286,7 @@ def build_world(
 
 @njit(cache=True)
 def _box_overlap(b: np.ndarray, i: int, x0: float, y0: float, x1: float, y1: float) -> bool:
-    return b[i, 0] <= x1 and x0 <= b[i, 2] and b[i, 1] <= y1 and y0 <= b[i, 3]
+    return bool(b[i, 0] <= x1 and x0 <= b[i, 2] and b[i, 1] <= y1 and y0 <= b[i, 3])
 
 
 @njit(cache=True)
@@ -559,7 +559,8 @@ def errt_grow(
 
     ``fparams = (p_goal, p_waypoint, step_m, connect_radius_m)``,
     ``iparams = (max_extensions, bidirectional, max_bridges, extra_iterations, nn_kind)``,
-    ``state = (n_nodes, n_bridges, iterations, first_bridge_iteration)``. Returns a GROW_* code.
+    ``state = (n_nodes, n_bridges, iterations, first_bridge_iteration, waypoint_targets)``, the last
+    counting the iterations that aimed at a cached waypoint. Returns a GROW_* code.
     """
     p_goal, p_way, step, connect_r = fparams[0], fparams[1], fparams[2], fparams[3]
     max_ext, bidir, max_br, extra, nn = iparams[0], iparams[1], iparams[2], iparams[3], iparams[4]
@@ -582,6 +583,7 @@ def errt_grow(
             tx, ty = nodes[other, 0], nodes[other, 1]
         elif u < p_goal + p_way and n_way > 0:
             w = min(n_way - 1, int(rand[r, 1] * n_way))
+            state[4] += 1
             tx, ty = waypoints[w, 0], waypoints[w, 1]
         else:
             tx = inner[0] + rand[r, 1] * (inner[2] - inner[0])
@@ -658,6 +660,28 @@ def resample(path: np.ndarray, spacing_m: float) -> np.ndarray:
             out[m, 1] = path[i, 1] + f * (path[i + 1, 1] - path[i, 1])
             m += 1
     return out
+
+
+@njit(cache=True)
+def cache_add(points: np.ndarray, meta: np.ndarray, pts: np.ndarray, u: np.ndarray, fifo: bool) -> int:
+    """Store ``pts`` (k, 2) in the waypoint cache ``points`` (size, 2) (Bruce 2006 §4.3.3):
+    ``meta = (count, next)``; while there is room a point takes the next free slot, then it replaces
+    the oldest (``fifo``) or a random slot picked by the next uniform of ``u``. Returns how many
+    uniforms it used."""
+    size = points.shape[0]
+    used = 0
+    for i in range(max(0, pts.shape[0] - size), pts.shape[0]):
+        if meta[0] < size:
+            k = meta[0]
+            meta[0] += 1
+        elif fifo:
+            k = meta[1]
+            meta[1] = (k + 1) % size
+        else:
+            k = min(size - 1, int(u[used] * size))
+            used += 1
+        points[k, 0], points[k, 1] = pts[i, 0], pts[i, 1]
+    return used
 
 
 # --- smoothing --------------------------------------------------------------------------------------

@@ -16,6 +16,7 @@ straight moves (the swept-circle segment query). The compiled world carries its 
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -32,6 +33,7 @@ BroadPhase = Literal["linear", "masks", "aabb_tree"]
 BROAD_PHASES: dict[str, int] = {"linear": K.MODE_LINEAR, "masks": K.MODE_MASKS, "aabb_tree": K.MODE_AABB_TREE}
 
 FloatArray = NDArray[np.float64]
+Point = Sequence[float] | FloatArray  # (x, y), metres
 
 
 @dataclass(frozen=True)
@@ -133,9 +135,9 @@ class CompiledWorld:
         """The robot's disc at (x, y) touches no obstacle and lies inside the field boundary."""
         return bool(K.point_free(self.cw, float(x), float(y)))
 
-    def segment_free(self, a: ArrayLike, b: ArrayLike) -> bool:
+    def segment_free(self, a: Point, b: Point) -> bool:
         """Swept-circle query: the robot's disc moving straight from a to b touches nothing."""
-        return bool(K.segment_free(self.cw, float(a[0]), float(a[1]), float(b[0]), float(b[1])))  # type: ignore[index]
+        return bool(K.segment_free(self.cw, float(a[0]), float(a[1]), float(b[0]), float(b[1])))
 
     def segments_free(self, segments: ArrayLike) -> NDArray[np.bool_]:
         """:meth:`segment_free` for each row (ax, ay, bx, by)."""
@@ -165,14 +167,17 @@ def field_world(
     velocities: ArrayLike | None = None,
     robot_radius_m: float | None = None,
     *,
-    defense_areas: bool = True,
+    defense_areas: bool | Literal[-1, 1] = True,
     goal_walls: bool = True,
     extra_circles: ArrayLike | None = None,
 ) -> CollisionWorld:
     """The collision world of a small-size field: the boundary walls, the defense areas (when the
     robot must stay out of them) and the goal walls as boxes, ``robots`` (n, 2) as circles of the
     league's robot radius moving at ``velocities`` (n, 2), plus ``extra_circles`` (x, y, r) such as
-    the ball."""
+    the ball.
+
+    ``defense_areas``: True both, False neither, -1 or +1 only the one at x < 0 or x > 0 (a goalie
+    may enter its own defense area but not the opponent's: pass the opponent's side)."""
     r = field.league.robot.radius_m if robot_radius_m is None else robot_radius_m
     pos = _as_rows(robots, 2, "robots")
     circles = np.column_stack([pos, np.full(len(pos), r)]) if len(pos) else np.zeros((0, 3))
@@ -182,8 +187,14 @@ def field_world(
     vel = np.vstack([vel, np.zeros((len(extra), 2))])
     boxes: list[tuple[float, float, float, float]] = []
     hl, dw, dd = field.half_length, field.dims.defense_width_m / 2.0, field.dims.defense_depth_m
-    if defense_areas:
-        boxes += [(hl - dd, -dw, hl, dw), (-hl, -dw, -hl + dd, dw)]
+    if isinstance(defense_areas, bool):
+        sides: tuple[float, ...] = (1.0, -1.0) if defense_areas else ()
+    elif defense_areas in (-1, 1):
+        sides = (float(defense_areas),)
+    else:
+        raise ValueError(f"defense_areas must be True, False, -1 or 1, not {defense_areas!r}")
+    for side in sides:
+        boxes.append((hl - dd, -dw, hl, dw) if side > 0 else (-hl, -dw, -hl + dd, dw))
     if goal_walls:
         boxes += field.goal_walls(1.0) + field.goal_walls(-1.0)
     bounds = (

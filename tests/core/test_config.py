@@ -10,6 +10,7 @@ import pytest
 from cmdragons.camera import CamerasParams
 from cmdragons.config import ConfigError
 from cmdragons.geometry import LeagueParams
+from cmdragons.planning.registry import PlannerParams
 from cmdragons.runtime.settings import CONCERNS, load_settings
 from sim.params import SimParams
 
@@ -29,6 +30,7 @@ def test_shipped_configs_equal_the_dataclass_defaults() -> None:
     assert s.field == LeagueParams()
     assert s.cameras == CamerasParams()
     assert s.sim == SimParams()
+    assert s.planner == PlannerParams()
     assert sorted(p.stem for p in REPO_CONFIGS.glob("*.yaml")) == sorted(CONCERNS)
 
 
@@ -43,6 +45,9 @@ def test_shipped_configs_equal_the_dataclass_defaults() -> None:
         ("sim.yaml", "physics:\n  wall_elasticity: .nan\n", "physics.wall_elasticity", "finite"),
         ("cameras.yaml", "auto:\n  grid: [2]\n", "auto.grid", "a list of 2 values"),
         ("field.yaml", "robot:\n  front_distance_m: 0.2\n", "robot", "smaller than radius_m"),
+        ("planner.yaml", "planner: astar\n", "planner", "allowed: 'errt', 'prm', 'visgraph'"),
+        ("planner.yaml", "errt:\n  p_goal: 0.6\n  p_waypoint: 0.6\n", "errt", "p_goal + p_waypoint"),
+        ("planner.yaml", "errt:\n  nearest: octree\n", "errt.nearest", "allowed: 'brute', 'kdtree'"),
     ],
 )
 def test_bad_values_name_file_key_and_allowed(configs: Path, file: str, text: str, key: str, fragment: str) -> None:
@@ -66,7 +71,7 @@ def test_missing_folder_and_unknown_file(tmp_path: Path, configs: Path) -> None:
     with pytest.raises(ConfigError, match="config folder not found"):
         load_settings(tmp_path / "nowhere")
     (configs / "simm.yaml").write_text("seed: 2\n")
-    with pytest.raises(ConfigError, match="unknown config file; allowed: field.yaml, cameras.yaml, sim.yaml"):
+    with pytest.raises(ConfigError, match="unknown config file; allowed: field.yaml, cameras.yaml, sim.yaml, planner.yaml"):
         load_settings(configs)
 
 
@@ -93,7 +98,7 @@ def test_set_overrides(configs: Path) -> None:
     [
         ("sim.physics.substeps=-3", "out of range"),
         ("sim.physics.nope=3", "unknown key"),
-        ("simm.seed=3", "unknown concern; allowed: cameras, field, sim"),
+        ("simm.seed=3", "unknown concern; allowed: cameras, field, planner, sim"),
         ("sim.seed", "expected concern.key.path=value"),
         ("seed=3", "expected at least concern.key"),
     ],

@@ -1,0 +1,50 @@
+"""Planner registry and the ``planner`` config concern (configs/planner.yaml).
+
+A new algorithm is one module plus one line in :data:`PLANNERS` (and its params beside it here).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from cmdragons.config import setting
+from cmdragons.planning.errt import ERRTParams, ERRTPlanner
+from cmdragons.planning.prm import DynamicPRMParams, DynamicPRMPlanner
+from cmdragons.planning.problem import Planner
+from cmdragons.planning.visgraph import VisGraphParams, VisibilityGraphPlanner
+from cmdragons.planning.world import CollisionParams
+
+__all__ = ["PLANNERS", "PlannerParams", "make_planner"]
+
+
+PLANNERS: dict[str, Callable[[PlannerParams, np.random.Generator], Planner]] = {
+    "errt": lambda p, rng: ERRTPlanner(p.errt, rng),
+    "prm": lambda p, rng: DynamicPRMPlanner(p.prm, rng),
+    "visgraph": lambda p, rng: VisibilityGraphPlanner(p.visgraph, rng),
+}
+
+
+@dataclass(frozen=True)
+class PlannerParams:
+    """configs/planner.yaml: which global planner drives the robots and how each one is tuned."""
+
+    planner: str = setting("errt", choices=tuple(PLANNERS))  # which of PLANNERS drives the robots
+    seed: int = setting(1, lo=0, hi=2**63 - 1)  # each robot's planner draws from (seed, robot id)
+    budget_ms: float = setting(1.0, lo=0.01, hi=10000.0)  # planning time per robot and frame
+    horizon_s: float = setting(0.0, lo=0.0, hi=10.0)  # moving robots are avoided over [0, horizon]
+    collision: CollisionParams = CollisionParams()
+    errt: ERRTParams = ERRTParams()
+    prm: DynamicPRMParams = DynamicPRMParams()
+    visgraph: VisGraphParams = VisGraphParams()
+
+
+def make_planner(params: PlannerParams, robot_id: int = 0, name: str | None = None) -> Planner:
+    """A fresh planner for one robot: ``name`` (default ``params.planner``) seeded from
+    (``params.seed``, ``robot_id``)."""
+    key = name or params.planner
+    if key not in PLANNERS:
+        raise KeyError(f"unknown planner {key!r}; known: {', '.join(sorted(PLANNERS))}")
+    return PLANNERS[key](params, np.random.default_rng([params.seed, robot_id]))

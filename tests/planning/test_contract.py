@@ -1,0 +1,137 @@
+"""The planner contract (after OMPL's PlannerTest): every registered planner on the same scenes.
+
+Checked for each: the path is collision-free under the swept-circle check and inside the field,
+runs from the start to the goal, its cost is its length; solvable scenes are solved; impossible
+ones end in a clean NO_PATH; a start in an obstacle is left by the shortest way; a blocked goal
+gives the nearest free one; the deadline is kept; the same seed gives the same path.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from cmdragons.geometry import Field
+from cmdragons.planning import (
+    PLANNERS,
+    PlannerParams,
+    PlanProblem,
+    PlanStatus,
+    deadline_in,
+    field_world,
+    make_planner,
+    path_length,
+)
+from cmdragons.planning.scenes import random_scene
+from tests.planning.conftest import RADIUS_M, problem, ring, wall_with_gap
+
+NAMES = sorted(PLANNERS)
+GENEROUS_S = 5.0  # deadline for scenes that must be solved: far beyond any planner's need
+
+
+def check_path(prob: PlanProblem, path: np.ndarray, from_index: int = 0) -> None:
+    cw = prob.compiled()
+    assert path.ndim == 2 and path.shape[1] == 2 and len(path) >= 2
+    assert cw.path_free(path[from_index:]), "path collides (swept-circle check)"
+    x0, y0, x1, y1 = prob.world.bounds
+    inside = (path[:, 0] >= x0 + RADIUS_M - 1e-9) & (path[:, 0] <= x1 - RADIUS_M + 1e-9)
+    inside &= (path[:, 1] >= y0 + RADIUS_M - 1e-9) & (path[:, 1] <= y1 - RADIUS_M + 1e-9)
+    assert inside[from_index:].all(), "path leaves the field"
+
+
+def solvable_scenes(field: Field) -> list[PlanProblem]:
+    rng = np.random.default_rng(2024)
+    scenes = [random_scene(field, rng).problem(field) for _ in range(12)]
+    return scenes + [problem(wall_with_gap(field), (-3.0, -1.0), (3.0, -1.0))]
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_solvable_scenes_are_solved_with_valid_paths(name: str, field: Field) -> None:
+    planner = make_planner(PlannerParams(), name=name)
+    for prob in solvable_scenes(field):
+        planner.reset()
+        result = planner.solve(prob, deadline_in(GENEROUS_S))
+        assert result.status is PlanStatus.SOLVED, (name, prob.start, prob.goal, result.stats)
+        check_path(prob, result.path)
+        assert tuple(result.path[0]) == prob.start and tuple(result.path[-1]) == prob.goal
+        assert result.cost == pytest.approx(path_length(result.path), rel=2e-3)  # visgraph: exact arcs
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_straight_line_when_free(name: str, field: Field) -> None:
+    prob = problem(field_world(field), (-2.0, 1.0), (2.5, -1.0))
+    result = make_planner(PlannerParams(), name=name).solve(prob, deadline_in(GENEROUS_S))
+    assert result.status is PlanStatus.SOLVED
+    np.testing.assert_allclose(result.path, [prob.start, prob.goal])
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_unreachable_goal_is_a_clean_no_path(name: str, field: Field) -> None:
+    # the goal is free but walled in by a ring of touching robots
+    world = field_world(field, ring((1.0, 0.5), 0.45, 16))
+    prob = problem(world, (-3.0, -1.0), (1.0, 0.5))
+    assert prob.compiled().point_free(1.0, 0.5)
+    result = make_planner(PlannerParams(), name=name).solve(prob, deadline_in(GENEROUS_S))
+    assert result.status is PlanStatus.NO_PATH
+    assert result.cost == float("inf")
+    assert tuple(result.path[0]) == prob.start
+    check_path(prob, result.path) if len(result.path) > 1 else None
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_start_inside_an_obstacle_leaves_by_the_shortest_way(name: str, field: Field) -> None:
+    world = field_world(field, [[0.0, 0.0], [1.0, 0.4], [1.0, -0.4]])
+    prob = problem(world, (0.05, 0.0), (3.0, 0.0))  # 5 cm from a robot's centre: deep inside
+    result = make_planner(PlannerParams(), name=name).solve(prob, deadline_in(GENEROUS_S))
+    assert result.status is PlanStatus.SOLVED and result.stats["escaped_start"]
+    assert tuple(result.path[0]) == prob.start
+    np.testing.assert_allclose(result.path[1], [0.18, 0.0], atol=1e-4)  # straight out, radially
+    check_path(prob, result.path, from_index=1)
+    assert tuple(result.path[-1]) == prob.goal
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_goal_inside_an_obstacle_gives_the_nearest_free_goal(name: str, field: Field) -> None:
+    prob = problem(field_world(field, [[1.0, 1.0]]), (-2.0, 0.0), (1.0, 1.1))
+    result = make_planner(PlannerParams(), name=name).solve(prob, deadline_in(GENEROUS_S))
+    assert result.status is PlanStatus.APPROXIMATE and result.stats["goal_moved"]
+    np.testing.assert_allclose(result.path[-1], [1.0, 1.18], atol=1e-4)
+    check_path(prob, result.path)
+    prob = problem(field_world(field), (0.0, 0.0), (4.0, 0.5))  # in the defense area: out of its front
+    result = make_planner(PlannerParams(), name=name).solve(prob, deadline_in(GENEROUS_S))
+    assert result.status is PlanStatus.APPROXIMATE
+    np.testing.assert_allclose(result.path[-1], [3.5 - RADIUS_M, 0.5], atol=1e-4)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_invalid_start_is_a_status(name: str, field: Field) -> None:
+    prob = problem(field_world(field), (float("nan"), 0.0), (1.0, 0.0))
+    result = make_planner(PlannerParams(), name=name).solve(prob, deadline_in(GENEROUS_S))
+    assert result.status is PlanStatus.INVALID_START
+
+
+@pytest.mark.parametrize("name", [n for n in NAMES if n != "visgraph"])  # visgraph: one uninterruptible kernel call
+def test_deadline_is_kept(name: str, field: Field) -> None:
+    # a hard scene (a wall with a narrow gap) and a huge work budget: only the deadline stops it
+    params = PlannerParams()
+    params = type(params)(errt=type(params.errt)(max_nodes=10**6, bidirectional=False),
+                          prm=type(params.prm)(n_nodes=50, max_nodes=10**6, grow_nodes=5))  # fmt: skip
+    world = field_world(field, ring((1.0, 0.5), 0.45, 16))
+    prob = problem(world, (-3.0, -1.0), (1.0, 0.5))
+    planner = make_planner(params, name=name)
+    planner.solve(prob, deadline_in(0.001))  # compile and build roadmaps outside the timed call
+    for budget_s in (0.002, 0.02):
+        t0 = time.perf_counter()
+        result = planner.solve(prob, t0 + budget_s)
+        elapsed = time.perf_counter() - t0
+        assert result.status is PlanStatus.TIMEOUT
+        assert elapsed < budget_s + 0.015, f"{name} overran its deadline by {elapsed - budget_s:.4f} s"
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_same_seed_same_path(name: str, field: Field) -> None:
+    prob = solvable_scenes(field)[3]
+    paths = [make_planner(PlannerParams(seed=9), name=name).solve(prob, deadline_in(GENEROUS_S)).path for _ in range(2)]
+    np.testing.assert_array_equal(paths[0], paths[1])

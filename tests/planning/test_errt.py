@@ -1,0 +1,99 @@
+"""ERRT specifics (Bruce 2006 §4.3): waypoint cache, plan reuse, variants, smoothing."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from cmdragons.geometry import Field
+from cmdragons.planning import ERRTParams, ERRTPlanner, PlanStatus, deadline_in, field_world, path_length
+from cmdragons.planning.errt import SmoothingParams, WaypointCache, smooth
+from tests.planning.conftest import problem, wall_with_gap
+
+
+def planner(**kw: object) -> ERRTPlanner:
+    return ERRTPlanner(ERRTParams(**kw), np.random.default_rng(5))  # type: ignore[arg-type]
+
+
+def test_waypoint_cache_replacement_strategies() -> None:
+    fifo = WaypointCache(3, "fifo", np.random.default_rng(0))
+    fifo.add(np.arange(10.0).reshape(5, 2))
+    np.testing.assert_array_equal(fifo.view(), [[6, 7], [8, 9], [4, 5]])  # the oldest went first
+    rand = WaypointCache(3, "random", np.random.default_rng(0))
+    rand.add(np.arange(20.0).reshape(10, 2))
+    assert rand.count == 3 and len({tuple(p) for p in rand.view()}) == 3
+    fifo.clear()
+    assert fifo.view().shape == (0, 2)
+
+
+def test_a_plan_fills_the_cache_and_is_reused_while_valid(field: Field) -> None:
+    world = wall_with_gap(field)
+    prob = problem(world, (-3.0, -1.0), (3.0, -1.0))
+    errt = planner(waypoint_cache_size=200)
+    first = errt.solve(prob, deadline_in(1.0))
+    assert first.status is PlanStatus.SOLVED and not first.stats["reused"]
+    assert errt.cache.count > 10
+    # through the gap at y = 1.5: the cached points lie along that route
+    assert np.any(np.abs(errt.cache.view()[:, 0]) < 0.2)
+    # the robot moved along its path: the remainder is reused, joined from the new start
+    here = tuple(first.path[0] + 0.4 * (first.path[1] - first.path[0]))
+    moved = problem(world, here, (3.0, -1.0))  # type: ignore[arg-type]
+    again = errt.solve(moved, deadline_in(1.0))
+    assert again.stats["reused"] and again.status is PlanStatus.SOLVED
+    assert moved.compiled().path_free(again.path)
+    np.testing.assert_array_equal(again.path[-1], (3.0, -1.0))
+    # a robot parks in the gap: the old plan is no longer valid and a new one goes around the wall
+    blocked = field_world(field, np.vstack([world.circles[:, :2], [[0.0, 1.5]]]))
+    third = errt.solve(problem(blocked, here, (3.0, -1.0)), deadline_in(1.0))  # type: ignore[arg-type]
+    assert not third.stats["reused"]
+    assert third.status is not PlanStatus.SOLVED or problem(blocked, here, (3.0, -1.0)).compiled().path_free(third.path)  # type: ignore[arg-type]
+
+
+def test_a_new_goal_is_planned_afresh(field: Field) -> None:
+    world = wall_with_gap(field)
+    errt = planner()
+    errt.solve(problem(world, (-3.0, -1.0), (3.0, -1.0)), deadline_in(1.0))
+    other = errt.solve(problem(world, (-3.0, -1.0), (3.0, 2.0)), deadline_in(1.0))
+    assert not other.stats["reused"]
+    np.testing.assert_array_equal(other.path[-1], (3.0, 2.0))
+
+
+@pytest.mark.parametrize(
+    "variant",
+    [
+        {"bidirectional": False},
+        {"nearest": "kdtree"},
+        {"waypoint_cache": False},
+        {"waypoint_replacement": "fifo"},
+        {"max_bridges": 1, "extra_iterations": 0},
+        {"max_extensions": 1},
+    ],
+    ids=lambda v: ",".join(f"{k}={x}" for k, x in v.items()),
+)
+def test_variants_find_valid_paths(variant: dict[str, object], field: Field) -> None:
+    prob = problem(wall_with_gap(field), (-3.0, -1.0), (3.0, -1.0))
+    result = planner(**variant).solve(prob, deadline_in(2.0))
+    assert result.status is PlanStatus.SOLVED
+    assert prob.compiled().path_free(result.path)
+
+
+def test_smoothing_keeps_paths_free_and_never_longer(field: Field) -> None:
+    prob = problem(wall_with_gap(field), (-3.0, -1.0), (3.0, -1.0))
+    raw = planner(smoothing=SmoothingParams(passes=0)).solve(prob, deadline_in(1.0))
+    cw = prob.compiled()
+    for passes in (0, 1, 3, 6):
+        out = smooth(cw, raw.path, SmoothingParams(passes=passes))
+        assert cw.path_free(out)
+        assert path_length(out) <= path_length(raw.path) + 1e-9
+        np.testing.assert_array_equal(out[[0, -1]], raw.path[[0, -1]])
+    # through the gap at (0, 1.5): the shortest way is about |(-3,-1)->(0,1.5)| + |(0,1.5)->(3,-1)|
+    best = 2 * np.hypot(3.0, 2.5)
+    assert path_length(smooth(cw, raw.path, SmoothingParams(passes=6))) < 1.03 * best
+
+
+def test_params_are_validated() -> None:
+    with pytest.raises(ValueError, match="p_goal"):
+        ERRTParams(p_goal=0.7, p_waypoint=0.5)
+    assert dataclasses.replace(ERRTParams(), p_goal=0.5).p_goal == 0.5

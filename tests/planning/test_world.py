@@ -1,0 +1,80 @@
+"""The collision world: field obstacles, clearance as robot radius, time windows, nearest free point."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from cmdragons.geometry import Field
+from cmdragons.planning import CollisionWorld, field_world
+
+R = 0.09
+
+
+def test_field_world_blocks_defense_areas_goal_walls_and_boundary(field: Field) -> None:
+    cw = field_world(field).compile(R)
+    assert cw.point_free(0.0, 0.0)
+    assert not cw.point_free(4.0, 0.0)  # inside the defense area at +x
+    assert not cw.point_free(-3.5 + 0.05, 0.9)  # within a robot radius of the -x defense area
+    assert cw.point_free(-3.5 + 0.1, 0.9)
+    assert not cw.point_free(4.71, 0.0)  # the back wall of the goal
+    assert not cw.point_free(4.8 - 0.05, 2.0)  # the disc would cross the boundary wall
+    assert cw.point_free(4.8 - 0.1, 2.0)  # robots may leave the field lines, not the walls
+    assert cw.segment_free((-3.0, 0.0), (3.0, 0.2))  # the open field
+    assert not cw.segment_free((3.45, -2.0), (3.45, 2.0))  # grazes the defense area's front
+    assert cw.segment_free((3.4, -2.0), (3.4, 2.0))
+
+
+def test_robot_radius_is_the_clearance(field: Field) -> None:
+    world = field_world(field, [[0.0, 0.0]])
+    cw = world.compile(R)
+    assert cw.point_free(0.1801, 0.0) and not cw.point_free(0.1799, 0.0)
+    # a segment passing at 0.17 m from the robot's centre is blocked, at 0.19 m it is free
+    assert not cw.segment_free((-1.0, 0.17), (1.0, 0.17))
+    assert cw.segment_free((-1.0, 0.19), (1.0, 0.19))
+    assert world.compile(0.0).point_free(0.1, 0.0)
+    assert cw.clearance(0.5, 0.0) == pytest.approx(0.5 - 0.18)
+
+
+def test_moving_robots_are_swept_over_the_time_window(field: Field) -> None:
+    world = field_world(field, [[0.0, -1.0]], velocities=[[0.0, 2.0]])
+    now, later = world.compile(R), world.compile(R, 0.0, 0.5)
+    seg = ((-1.0, 0.0), (1.0, 0.0))
+    assert now.segment_free(*seg)  # the robot is still a metre away
+    assert not later.segment_free(*seg)  # within half a second it crosses the line
+    assert world.compile(R, 0.6, 1.0).segment_free(*seg)  # and by then it has passed
+    assert world.compile(R) is now  # compiled worlds are shared per radius and window
+
+
+def test_nearest_free_point_leaves_by_the_shortest_way(field: Field) -> None:
+    cw = field_world(field, [[0.0, 0.0]]).compile(R)
+    x, y = cw.nearest_free(0.05, 0.0)  # type: ignore[misc]
+    assert (x, y) == pytest.approx((0.18, 0.0), abs=1e-4)
+    x, y = cw.nearest_free(3.9, 0.2)  # type: ignore[misc]  # deep in the defense area: out of its front
+    assert (x, y) == pytest.approx((3.5 - R, 0.2), abs=1e-4)
+    x, y = cw.nearest_free(0.0, 3.25)  # type: ignore[misc]  # against the wall: back inside
+    assert (x, y) == pytest.approx((0.0, 3.3 - R), abs=1e-4)
+
+
+def test_nearest_free_point_between_two_robots(field: Field) -> None:
+    # pushed out of one robot straight into the other: the ring search finds the way out
+    cw = field_world(field, [[0.0, 0.0], [0.3, 0.0]]).compile(R)
+    x, y = cw.nearest_free(0.15, 0.0)  # type: ignore[misc]
+    assert cw.point_free(x, y)
+    assert np.hypot(x - 0.15, y) < 0.2
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "fragment"),
+    [
+        ({"bounds": (1.0, 0.0, 0.0, 1.0)}, "bounds"),
+        ({"circles": [[0.0, 0.0, -1.0]]}, "radii"),
+        ({"circles": [[0.0, 0.0, 0.1]], "velocities": [[0.0, 0.0], [1.0, 1.0]]}, "velocities"),
+        ({"boxes": [[1.0, 0.0, 0.0, 1.0]]}, "boxes"),
+        ({"circles": [[np.nan, 0.0, 0.1]]}, "finite"),
+    ],
+)
+def test_bad_worlds_are_refused(kwargs: dict[str, object], fragment: str) -> None:
+    args = {"bounds": (-1.0, -1.0, 1.0, 1.0), **kwargs}
+    with pytest.raises(ValueError, match=fragment):
+        CollisionWorld(**args)  # type: ignore[arg-type]

@@ -13,6 +13,7 @@ from typing import Any
 
 from cmdragons.camera import CameraModel, CamerasParams, cameras_from_config
 from cmdragons.config import ConfigError, apply_override, default_config_dir, load_yaml, parse
+from cmdragons.control.motion import ControlParams
 from cmdragons.geometry import Field, LeagueParams
 from cmdragons.planning.registry import PlannerParams
 from sim.params import SimParams
@@ -24,6 +25,7 @@ CONCERNS: dict[str, type] = {
     "cameras": CamerasParams,
     "sim": SimParams,
     "planner": PlannerParams,
+    "control": ControlParams,
 }
 
 
@@ -34,6 +36,7 @@ class Settings:
     cameras: CamerasParams
     sim: SimParams
     planner: PlannerParams
+    control: ControlParams
 
     def field_geometry(self) -> Field:
         return Field(self.field)

@@ -16,6 +16,7 @@ from cmdragons.config import ConfigError, apply_override, default_config_dir, lo
 from cmdragons.control.motion import ControlParams
 from cmdragons.geometry import Field, LeagueParams
 from cmdragons.planning.registry import PlannerParams
+from cmdragons.safety.registry import SafetyParams
 from sim.params import SimParams
 
 __all__ = ["CONCERNS", "Settings", "load_settings"]
@@ -26,6 +27,7 @@ CONCERNS: dict[str, type] = {
     "sim": SimParams,
     "planner": PlannerParams,
     "control": ControlParams,
+    "safety": SafetyParams,
 }
 
 
@@ -37,6 +39,7 @@ class Settings:
     sim: SimParams
     planner: PlannerParams
     control: ControlParams
+    safety: SafetyParams
 
     def field_geometry(self) -> Field:
         return Field(self.field)

@@ -24,7 +24,13 @@ def _sim(settings: Settings, quick: bool) -> list[Row]:
     return run(settings, quick)
 
 
-SUITES: dict[str, Callable[[Settings, bool], list[Row]]] = {"sim": _sim}
+def _safety(settings: Settings, quick: bool) -> list[Row]:
+    from cmdragons.bench.safety import run
+
+    return run(settings, quick)
+
+
+SUITES: dict[str, Callable[[Settings, bool], list[Row]]] = {"sim": _sim, "safety": _safety}
 
 
 def print_table(suite: str, rows: list[Row]) -> None:

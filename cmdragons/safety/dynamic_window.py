@@ -36,8 +36,8 @@ class DynamicWindowParams(Validated):
     margin_m: float = setting(0.03, lo=0.0, hi=1.0)  # kept between robot bodies
     static_margin_m: float = setting(0.01, lo=0.0, hi=1.0)  # kept from walls and static obstacles
     static_step_m: float = setting(0.02, lo=0.001, hi=0.5)  # sample spacing of the static check
-    speed_levels: int = setting(4, lo=1, hi=50)  # rings of the velocity window
-    directions: int = setting(16, lo=3, hi=360)  # directions per ring
+    speed_levels: int = setting(3, lo=1, hi=50)  # rings of the velocity window
+    directions: int = setting(12, lo=3, hi=360)  # directions per ring
     clearance_weight_1_s: float = setting(0.5, lo=0.0, hi=100.0)  # m/s of score per metre of clearance
     clearance_cap_m: float = setting(0.5, lo=0.0, hi=10.0)  # clearance beyond this earns nothing
 

@@ -13,8 +13,10 @@ from typing import Any
 
 from cmdragons.camera import CameraModel, CamerasParams, cameras_from_config
 from cmdragons.config import ConfigError, apply_override, default_config_dir, load_yaml, parse
+from cmdragons.control.motion import ControlParams
 from cmdragons.geometry import Field, LeagueParams
 from cmdragons.planning.registry import PlannerParams
+from cmdragons.safety.registry import SafetyParams
 from sim.params import SimParams
 
 __all__ = ["CONCERNS", "Settings", "load_settings"]
@@ -24,6 +26,8 @@ CONCERNS: dict[str, type] = {
     "cameras": CamerasParams,
     "sim": SimParams,
     "planner": PlannerParams,
+    "control": ControlParams,
+    "safety": SafetyParams,
 }
 
 
@@ -34,6 +38,8 @@ class Settings:
     cameras: CamerasParams
     sim: SimParams
     planner: PlannerParams
+    control: ControlParams
+    safety: SafetyParams
 
     def field_geometry(self) -> Field:
         return Field(self.field)

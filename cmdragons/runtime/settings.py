@@ -14,6 +14,7 @@ from typing import Any
 from cmdragons.camera import CameraModel, CamerasParams, cameras_from_config
 from cmdragons.config import ConfigError, apply_override, default_config_dir, load_yaml, parse
 from cmdragons.geometry import Field, LeagueParams
+from cmdragons.tracking.tracker import TrackerParams
 from sim.params import SimParams
 
 __all__ = ["CONCERNS", "Settings", "load_settings"]
@@ -22,6 +23,7 @@ CONCERNS: dict[str, type] = {
     "field": LeagueParams,
     "cameras": CamerasParams,
     "sim": SimParams,
+    "tracker": TrackerParams,
 }
 
 
@@ -31,6 +33,7 @@ class Settings:
     field: LeagueParams
     cameras: CamerasParams
     sim: SimParams
+    tracker: TrackerParams
 
     def field_geometry(self) -> Field:
         return Field(self.field)

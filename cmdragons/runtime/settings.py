@@ -17,6 +17,7 @@ from cmdragons.control.motion import ControlParams
 from cmdragons.geometry import Field, LeagueParams
 from cmdragons.planning.registry import PlannerParams
 from cmdragons.safety.registry import SafetyParams
+from cmdragons.tracking.tracker import TrackerParams
 from sim.params import SimParams
 
 __all__ = ["CONCERNS", "Settings", "load_settings"]
@@ -28,6 +29,7 @@ CONCERNS: dict[str, type] = {
     "planner": PlannerParams,
     "control": ControlParams,
     "safety": SafetyParams,
+    "tracker": TrackerParams,
 }
 
 
@@ -40,6 +42,7 @@ class Settings:
     planner: PlannerParams
     control: ControlParams
     safety: SafetyParams
+    tracker: TrackerParams
 
     def field_geometry(self) -> Field:
         return Field(self.field)

@@ -106,7 +106,8 @@ class Strategy:
             intents = keep_away(intents, ball, self.field, own_sign, self.p, game.command == "kickoff",
                                 game.command == "stop")
         if game.command == "kickoff" and ours:
-            intents = self._own_half(intents, own_sign, keep=self._attacker(intents))
+            attacker = next((rid for rid, role in self.roles.roles.items() if role == "attacker"), None)
+            intents = self._own_half(intents, own_sign, keep=attacker)
         return intents
 
     # --- normal play ----------------------------------------------------------------------------
@@ -241,13 +242,6 @@ class Strategy:
         return chosen
 
     # --- game states ----------------------------------------------------------------------------
-    @staticmethod
-    def _attacker(intents: dict[int, Intent]) -> int | None:
-        for rid, it in intents.items():
-            if it.kick_speed > 0 or not it.avoid_ball:
-                return rid
-        return None
-
     def _own_half(self, intents: dict[int, Intent], own_sign: float, keep: int | None) -> dict[int, Intent]:
         """At our kickoff everyone but the kicker stays in our half, outside the centre circle."""
         out = {}

@@ -17,8 +17,10 @@ from cmdragons.control.motion import ControlParams
 from cmdragons.geometry import Field, LeagueParams
 from cmdragons.planning.registry import PlannerParams
 from cmdragons.safety.registry import SafetyParams
+from cmdragons.team import TeamParams
 from cmdragons.tracking.tracker import TrackerParams
 from sim.params import SimParams
+from strategy.plays import StrategyParams
 
 __all__ = ["CONCERNS", "Settings", "load_settings"]
 
@@ -30,6 +32,8 @@ CONCERNS: dict[str, type] = {
     "control": ControlParams,
     "safety": SafetyParams,
     "tracker": TrackerParams,
+    "strategy": StrategyParams,
+    "team": TeamParams,
 }
 
 
@@ -43,6 +47,8 @@ class Settings:
     control: ControlParams
     safety: SafetyParams
     tracker: TrackerParams
+    strategy: StrategyParams
+    team: TeamParams
 
     def field_geometry(self) -> Field:
         return Field(self.field)

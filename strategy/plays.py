@@ -52,6 +52,7 @@ class StrategyParams(Validated):
     stop_distance_m: float = setting(0.65, lo=0.5, hi=3.0)  # rule: 0.5 m from the ball in a stop, plus margin
     stop_speed_m_s: float = setting(1.2, lo=0.1, hi=5.0)  # rule: 1.5 m/s in a stop, minus margin
     center_circle_margin_m: float = setting(0.15, lo=0.0, hi=2.0)  # kept outside the centre circle at their kickoff
+    ball_room_m: float = setting(0.35, lo=0.0, hi=3.0)  # team-mates leave the ball handler this much room
 
 
 @dataclass
@@ -162,6 +163,9 @@ class Strategy:
         for rid, r in own.items():  # robots without a role (more robots than objectives): mark or hold
             if rid not in out:
                 out[rid] = mark(opp[rid % len(opp)], f, own_sign, p.skills) if opp else Intent(r.x, r.y, r.theta)
+        # everyone but the goalie and the robot playing the ball leaves it room
+        others = {rid: it for rid, it in out.items() if roles.get(rid) not in ("goalie", "attacker", "receiver")}
+        out.update(keep_away(others, ball, f, own_sign, p, kickoff=False, slow=False, distance_m=p.ball_room_m))
         return out
 
     def _goalie(self, r: RobotState, ball: BallState, own_sign: float) -> Intent:
@@ -219,6 +223,7 @@ class Strategy:
             *to_point)
         if not ps.kicked and heading_there:
             ps.kicked = True
+            ps.t_start = t  # the timeout runs from the kick
         elif ps.kicked and (speed < 0.2 or not heading_there):
             receiver = own[ps.receiver]
             if math.hypot(receiver.x - ball.x, receiver.y - ball.y) < 0.3 or speed < 0.2:
@@ -269,12 +274,13 @@ class Strategy:
 
 
 def keep_away(intents: dict[int, Intent], ball: BallState, pitch: Field, own_sign: float, p: StrategyParams,
-              kickoff: bool, slow: bool) -> dict[int, Intent]:  # fmt: skip
-    """Every target at least ``stop_distance_m`` from the ball (the rules' 0.5 m plus a margin);
-    at their kickoff also in our half and outside the centre circle; slow in a stop."""
+              kickoff: bool, slow: bool, distance_m: float | None = None) -> dict[int, Intent]:  # fmt: skip
+    """Every target at least ``distance_m`` (default ``stop_distance_m``: the rules' 0.5 m plus a
+    margin) from the ball; at their kickoff also in our half and outside the centre circle; slow in
+    a stop."""
     out = {}
     radius = p.skills.robot_radius_m
-    d_min = p.stop_distance_m + radius
+    d_min = (p.stop_distance_m if distance_m is None else distance_m) + radius
     r_c = pitch.dims.center_circle_radius_m + p.center_circle_margin_m + radius
     for rid, it in intents.items():
         x, y = it.x, it.y

@@ -81,6 +81,7 @@ class Strategy:
         self.roles = RoleAssigner(params.roles)
         self.grid = candidate_grid(pitch, params.passing)
         self.mem = _Memory()
+        self.last_action: dict[int, str] = {}  # robot id -> "shot", "pass" or "clear": what its kick is for
         self.obstacle_radius = params.skills.robot_radius_m + params.skills.ball_radius_m
 
     # --- geometry of our side -----------------------------------------------------------------
@@ -175,6 +176,7 @@ class Strategy:
             # clear the ball out of our area toward the opponent half, away from the middle
             target = (-own_sign * f.half_length * 0.5, math.copysign(f.half_width * 0.6, ball.y or 1.0))
             intent = kick_to(r, ball, target, 4.0, self.p.skills)
+            self.last_action[r.id] = "clear"
             return Intent(intent.x, intent.y, intent.theta, intent.kick_speed, intent.chip, intent.dribbler,
                           intent.avoid_ball, True, intent.max_speed_m_s, intent.final_speed_m_s)  # fmt: skip
         return goalie_block(ball, f, own_sign, self.p.skills)
@@ -185,6 +187,7 @@ class Strategy:
         ball_xy = np.array([ball.x, ball.y])
         _, aim, shot_value = best_shot(ball_xy, f, attack_sign, opp_xy, self.obstacle_radius, p.passing)
         if shot_value >= p.shoot_value:
+            self.last_action[r.id] = "shot"
             return kick_to(r, ball, aim, p.skills.max_kick_m_s, p.skills)
         receivers = [(role, rid) for role, rid in by_role.items() if role.startswith("supporter")]
         if receivers:
@@ -199,14 +202,16 @@ class Strategy:
                     shoot_at = shot_aim if value_there >= p.one_touch_value else None
                     self.mem.passing = _Pass(r.id, rid, point, t, shoot_at=shoot_at)
                 dist = math.hypot(point[0] - ball.x, point[1] - ball.y)
+                self.last_action[r.id] = "pass"
                 return kick_to(r, ball, point, pass_speed(dist, p.skills), p.skills)
         # nothing good: play the ball forward through the most open lane (around a blocker)
         self.mem.passing = None
         toward = math.atan2(aim[1] - ball.y, aim[0] - ball.x)
         angle, _ = clearest_direction(ball_xy, toward, opp_xy, self.obstacle_radius)
         target = (ball.x + 1.5 * math.cos(angle), ball.y + 1.5 * math.sin(angle))
-        speed = p.skills.max_kick_m_s if (ball.x * attack_sign) > 0 and abs(angle - toward) < 0.2 else 3.0
-        return kick_to(r, ball, target, speed, p.skills)
+        shooting = (ball.x * attack_sign) > 0 and abs(angle - toward) < 0.2
+        self.last_action[r.id] = "shot" if shooting else "clear"
+        return kick_to(r, ball, target, p.skills.max_kick_m_s if shooting else 3.0, p.skills)
 
     def _update_pass(self, t: float, own: dict[int, RobotState], ball: BallState) -> _Pass | None:
         """Follow a pass: kicked once the ball runs toward the receiver; over when received, lost

@@ -226,8 +226,8 @@ def _cmd_play(args: argparse.Namespace) -> int:
                 if args.video and frame.images:
                     drawn = {m.id: draw_overlays(frame.images[m.id], m, match.last_world, match.brain,
                                                  match.last_commands, height) for m in models}  # fmt: skip
-                    tiled = tile_cameras(drawn, models)
-                    tiled = cv2.resize(tiled, (tiled.shape[1] // 2, tiled.shape[0] // 2), interpolation=cv2.INTER_AREA)
+                    full = tile_cameras(drawn, models)
+                    tiled = cv2.resize(full, (full.shape[1] // 2, full.shape[0] // 2), interpolation=cv2.INTER_AREA)
                     if video is None:
                         video = cv2.VideoWriter(str(folder / "match.mp4"), cv2.VideoWriter.fourcc(*"mp4v"), fps,
                                                 (tiled.shape[1], tiled.shape[0]))  # fmt: skip

@@ -4,7 +4,8 @@ For a candidate receiving point p the pass evaluation looks at two arcs: arc a f
 and arc b from p to the opponent goal. Each arc has a radius (its length) and an open angle (the
 free angular width around its centre line, between the nearest obstacles on either side); the
 third input is the angle between the two centre lines, the deflection a one-touch shot at p must
-make. Each input goes through a simple saturating function, and the factors are combined as a
+make (a kicker can turn the ball by well under a right angle, so a bigger turn means trapping the
+ball first). Each input goes through a simple saturating function, and the factors are combined as a
 weighted product (weights as exponents), so any hopeless factor makes the whole pass hopeless.
 
 Shot evaluation: the widest free part of the goal mouth seen from a point, with the obstacles'
@@ -31,6 +32,7 @@ __all__ = [
     "best_shot",
     "clearest_direction",
     "lane_open_angle",
+    "one_touch_turn",
     "open_goal_angle",
     "pass_values",
 ]
@@ -48,7 +50,10 @@ class PassParams(Validated):
     lane_open_angle_rad: float = setting(0.35, lo=0.01, hi=3.0)  # a pass lane this wide is fully open
     shot_open_angle_rad: float = setting(0.2, lo=0.01, hi=3.0)  # a goal gap this wide is fully open
     shot_distance_scale_m: float = setting(3.0, lo=0.1, hi=20.0)  # shots decay as exp(-distance / scale)
-    max_redirect_rad: float = setting(1.4, lo=0.1, hi=3.14)  # one-touch deflection worth nothing beyond
+    # one-touch: the ball turns from "back toward the passer" to "toward the goal"; a kicker can do
+    # that only while the turn is well under a right angle (the ball must meet the front face)
+    max_turn_rad: float = setting(1.3, lo=0.1, hi=3.14)
+    trap_factor: float = setting(0.5, lo=0.0, hi=1.0)  # value kept when the receiver must trap, not one-touch
     goal_samples: int = setting(24, lo=3, hi=256)  # angular samples across the goal mouth
     weight_length: float = setting(1.0, lo=0.0, hi=10.0)  # exponents of the factors
     weight_lane: float = setting(2.0, lo=0.0, hi=10.0)
@@ -150,6 +155,15 @@ class PassEvaluation:
         return self.points[i], float(self.values[i])
 
 
+def one_touch_turn(ball: Array, points: Array, aims: Array) -> Array:
+    """At each receiving point, the angle between the way back to the passer and the way to the aim:
+    0 sends the ball straight back, pi lets it run on (no kicker can do that)."""
+    back = ball - points
+    out = np.atleast_2d(aims) - points
+    turn: Array = np.abs(_wrap(np.arctan2(out[:, 1], out[:, 0]) - np.arctan2(back[:, 1], back[:, 0])))
+    return turn
+
+
 def candidate_grid(field: Field, params: PassParams) -> Array:
     """Receiving points on a regular grid inside the field, off both defense areas."""
     m = params.field_margin_m
@@ -173,14 +187,14 @@ def pass_values(ball: Array, points: Array, field: Field, goal_sign: float, obst
     aims = np.stack([np.full(len(points), goal_sign * field.half_length), aim_y], axis=1)
     to_goal = aims - points
     len_b = np.hypot(to_goal[:, 0], to_goal[:, 1])
-    redirect = np.abs(_wrap(np.arctan2(to_goal[:, 1], to_goal[:, 0]) - np.arctan2(to_p[:, 1], to_p[:, 0])))
+    turn = one_touch_turn(ball, points, aims)
 
     lo, hi = params.min_pass_m, params.max_pass_m
     f_len = np.clip(len_a / max(lo, 1e-9), 0.0, 1.0) * np.clip((1.2 * hi - len_a) / (0.2 * hi), 0.0, 1.0)
     f_lane = np.clip(open_a / (2.0 * params.lane_open_angle_rad), 0.0, 1.0)
     f_open = np.clip(open_b / params.shot_open_angle_rad, 0.0, 1.0)
     f_dist = np.exp(-len_b / params.shot_distance_scale_m)
-    f_redirect = np.clip(1.0 - redirect / params.max_redirect_rad, 0.0, 1.0)
+    f_redirect = np.where(turn <= params.max_turn_rad, 1.0, params.trap_factor)
     values = (f_len**params.weight_length * f_lane**params.weight_lane * f_open**params.weight_shot_open
               * f_dist**params.weight_shot_distance * f_redirect**params.weight_redirect)  # fmt: skip
     return PassEvaluation(points, values, aims)

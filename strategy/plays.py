@@ -26,6 +26,7 @@ from strategy.evaluation import (
     best_shot,
     candidate_grid,
     clearest_direction,
+    one_touch_turn,
     pass_values,
 )
 from strategy.roles import Objective, RoleAssigner, RoleParams
@@ -198,8 +199,10 @@ class Strategy:
                 rid = receivers[k][1]
                 point = (float(pts[k, 0]), float(pts[k, 1]))
                 _, shot_aim, value_there = best_shot(pts[k], f, attack_sign, opp_xy, self.obstacle_radius, p.passing)
+                turn = float(one_touch_turn(ball_xy, pts[k : k + 1], np.array([shot_aim]))[0])
                 if self.mem.passing is None or self.mem.passing.receiver != rid:
-                    shoot_at = shot_aim if value_there >= p.one_touch_value else None
+                    one_touch = value_there >= p.one_touch_value and turn <= p.passing.max_turn_rad
+                    shoot_at = shot_aim if one_touch else None
                     self.mem.passing = _Pass(r.id, rid, point, t, shoot_at=shoot_at)
                 dist = math.hypot(point[0] - ball.x, point[1] - ball.y)
                 self.last_action[r.id] = "pass"

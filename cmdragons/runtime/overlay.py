@@ -40,9 +40,9 @@ def draw_overlays(image: NDArray[np.uint8], model: CameraModel, world: WorldStat
             if v > 0.02 * vmax:
                 level = int(255 * v / vmax)
                 cv2.circle(out, (int(x), int(y)), 3 * 16, (0, level, 255 - level), -1, cv2.LINE_AA, 4)
-    for plan in brain.plans.values():
-        if len(plan.path) >= 2:
-            pts = _px(model, plan.path, 0.0)
+    for robot_plan in brain.plans.values():
+        if len(robot_plan.path) >= 2:
+            pts = _px(model, robot_plan.path, 0.0)
             cv2.polylines(out, [pts.reshape(-1, 1, 2)], False, _PATH, 1, cv2.LINE_AA, 4)
     if world is not None:
         scale = 0.25  # metres of arrow per m/s

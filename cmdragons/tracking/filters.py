@@ -15,6 +15,7 @@ expectation: the velocity covariance is then inflated so the next detections re-
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import cast
 
@@ -199,15 +200,32 @@ class RobotFilter:
         a_ang = min(max((self.command[2] - state[5]) / dt, -self.p.max_alpha_rad_s2), self.p.max_alpha_rad_s2)
         return np.array([a_lin[0], a_lin[1], a_ang])
 
-    def predicted_state(self, t: float) -> Vec:
-        """State at time ``t`` (no change to the filter; robots hand on no covariance)."""
-        dt = t - self.t
-        if dt <= 0.0:
-            return cast(Vec, self.kf.x.copy())
-        f, b, _ = self.cache.get(dt)
-        x: Vec = f @ self.kf.x + b @ self._accel(self.kf.x, dt)
-        x[2] = _wrap(x[2])
+    def predicted_state(self, t: float,
+                        commands: Sequence[tuple[float, tuple[float, float, float]]] = ()) -> Vec:  # fmt: skip
+        """State at time ``t`` (no change to the filter; robots hand on no covariance). ``commands``
+        (time they take effect, (vx, vy, omega)), in time order, are followed as they come into force
+        between now and ``t``: the look-ahead must see the commands already sent."""
+        x = cast(Vec, self.kf.x.copy())
+        now, command = self.t, self.command
+        for t_effect, cmd in commands:
+            if t_effect <= now:
+                command = cmd
+                continue
+            if t_effect >= t:
+                break
+            x = self._advance(x, t_effect - now, command)
+            now, command = t_effect, cmd
+        if t > now:
+            x = self._advance(x, t - now, command)
         return x
+
+    def _advance(self, x: Vec, dt: float, command: tuple[float, float, float] | None) -> Vec:
+        f, b, _ = self.cache.get(dt)
+        saved, self.command = self.command, command
+        out: Vec = f @ x + b @ self._accel(x, dt)
+        self.command = saved
+        out[2] = _wrap(out[2])
+        return out
 
     def predict(self, t: float) -> None:
         dt = t - self.t

@@ -240,7 +240,7 @@ class Tracker:
             if track.hits < self.p.robot_confirm_detections:
                 continue
             track.filter.command = self._command_at((team, rid), track.filter.t)
-            x = track.filter.predicted_state(t)
+            x = track.filter.predicted_state(t, self._commands.get((team, rid), ()))
             robots.append(RobotState(team, rid, float(x[0]), float(x[1]), float(x[2]), float(x[3]), float(x[4]),
                                      float(x[5]), track.last_seen == self.t))  # fmt: skip
         return WorldState(t, ball, tuple(robots))

@@ -16,6 +16,7 @@ from cmdragons.config import ConfigError, apply_override, default_config_dir, lo
 from cmdragons.geometry import Field, LeagueParams
 from cmdragons.planning.registry import PlannerParams
 from sim.params import SimParams
+from vision.pipeline import VisionParams
 
 __all__ = ["CONCERNS", "Settings", "load_settings"]
 
@@ -24,6 +25,7 @@ CONCERNS: dict[str, type] = {
     "cameras": CamerasParams,
     "sim": SimParams,
     "planner": PlannerParams,
+    "vision": VisionParams,
 }
 
 
@@ -34,6 +36,7 @@ class Settings:
     cameras: CamerasParams
     sim: SimParams
     planner: PlannerParams
+    vision: VisionParams
 
     def field_geometry(self) -> Field:
         return Field(self.field)

@@ -13,6 +13,7 @@ from cmdragons.geometry import LeagueParams
 from cmdragons.planning.registry import PlannerParams
 from cmdragons.runtime.settings import CONCERNS, load_settings
 from sim.params import SimParams
+from vision.pipeline import VisionParams
 
 REPO_CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 
@@ -31,6 +32,7 @@ def test_shipped_configs_equal_the_dataclass_defaults() -> None:
     assert s.cameras == CamerasParams()
     assert s.sim == SimParams()
     assert s.planner == PlannerParams()
+    assert s.vision == VisionParams()
     assert sorted(p.stem for p in REPO_CONFIGS.glob("*.yaml")) == sorted(CONCERNS)
 
 
@@ -71,7 +73,7 @@ def test_missing_folder_and_unknown_file(tmp_path: Path, configs: Path) -> None:
     with pytest.raises(ConfigError, match="config folder not found"):
         load_settings(tmp_path / "nowhere")
     (configs / "simm.yaml").write_text("seed: 2\n")
-    allowed = "unknown config file; allowed: field.yaml, cameras.yaml, sim.yaml, planner.yaml"
+    allowed = "unknown config file; allowed: field.yaml, cameras.yaml, sim.yaml, planner.yaml, vision.yaml"
     with pytest.raises(ConfigError, match=allowed):
         load_settings(configs)
 
@@ -99,7 +101,7 @@ def test_set_overrides(configs: Path) -> None:
     [
         ("sim.physics.substeps=-3", "out of range"),
         ("sim.physics.nope=3", "unknown key"),
-        ("simm.seed=3", "unknown concern; allowed: cameras, field, planner, sim"),
+        ("simm.seed=3", "unknown concern; allowed: cameras, field, planner, sim, vision"),
         ("sim.seed", "expected concern.key.path=value"),
         ("seed=3", "expected at least concern.key"),
     ],

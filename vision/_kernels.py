@@ -240,3 +240,137 @@ def merge_regions(stats: np.ndarray, max_gap_px: float, min_density: float) -> n
             stats[i, R_U0], stats[i, R_U1], stats[i, R_V0], stats[i, R_V1] = u0, u1, v0, v1
             alive[j] = False
     return alive
+
+
+@numba.njit(cache=True)
+def region_rays(grid: np.ndarray, pixels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Ray (dx, dy) per metre of descent at each pixel position (n, 2), bilinear in the camera's
+    per-pixel ray grid (H, W, 2) sampled at pixel centres; and the area (m^2 per px, per metre of
+    descent squared) that one pixel covers there, from the grid's local Jacobian."""
+    h, w = grid.shape[0], grid.shape[1]
+    n = pixels.shape[0]
+    rays = np.empty((n, 2))
+    area = np.empty(n)
+    for k in range(n):
+        fu = min(max(pixels[k, 0] - 0.5, 0.0), w - 1.000001)
+        fv = min(max(pixels[k, 1] - 0.5, 0.0), h - 1.000001)
+        j, i = int(fu), int(fv)
+        a, b = fu - j, fv - i
+        for c in range(2):
+            top = (1.0 - a) * grid[i, j, c] + a * grid[i, j + 1, c]
+            bottom = (1.0 - a) * grid[i + 1, j, c] + a * grid[i + 1, j + 1, c]
+            rays[k, c] = (1.0 - b) * top + b * bottom
+        # derivatives along u and v over this grid cell
+        du0 = (1.0 - b) * (grid[i, j + 1, 0] - grid[i, j, 0]) + b * (grid[i + 1, j + 1, 0] - grid[i + 1, j, 0])
+        du1 = (1.0 - b) * (grid[i, j + 1, 1] - grid[i, j, 1]) + b * (grid[i + 1, j + 1, 1] - grid[i + 1, j, 1])
+        dv0 = (1.0 - a) * (grid[i + 1, j, 0] - grid[i, j, 0]) + a * (grid[i + 1, j + 1, 0] - grid[i, j + 1, 0])
+        dv1 = (1.0 - a) * (grid[i + 1, j, 1] - grid[i, j, 1]) + a * (grid[i + 1, j + 1, 1] - grid[i, j + 1, 1])
+        area[k] = abs(du0 * dv1 - du1 * dv0)
+    return rays, area
+
+
+@numba.njit(cache=True)
+def fit_pattern(centre: np.ndarray, w_centre: float, obs: np.ndarray, w_obs: np.ndarray,
+                slots: np.ndarray) -> tuple[float, float, float, float]:  # fmt: skip
+    """Weighted least-squares rigid fit (2D Procrustes) of a pattern whose centre dot sits at the
+    template origin and whose k id dots sit at ``slots`` (k, 2), to the observed centre and dots
+    ``obs`` (k, 2). Returns heading, x, y and the weighted RMS residual (m)."""
+    k = obs.shape[0]
+    wsum = w_centre
+    mox, moy = w_centre * centre[0], w_centre * centre[1]
+    mtx, mty = 0.0, 0.0
+    for i in range(k):
+        wsum += w_obs[i]
+        mox += w_obs[i] * obs[i, 0]
+        moy += w_obs[i] * obs[i, 1]
+        mtx += w_obs[i] * slots[i, 0]
+        mty += w_obs[i] * slots[i, 1]
+    mox, moy, mtx, mty = mox / wsum, moy / wsum, mtx / wsum, mty / wsum
+    # the centre dot: template (0, 0) against the observed centre
+    cross = w_centre * ((-mtx) * (centre[1] - moy) - (-mty) * (centre[0] - mox))
+    dot = w_centre * ((-mtx) * (centre[0] - mox) + (-mty) * (centre[1] - moy))
+    for i in range(k):
+        tx, ty = slots[i, 0] - mtx, slots[i, 1] - mty
+        ox, oy = obs[i, 0] - mox, obs[i, 1] - moy
+        cross += w_obs[i] * (tx * oy - ty * ox)
+        dot += w_obs[i] * (tx * ox + ty * oy)
+    theta = np.arctan2(cross, dot)
+    c, s = np.cos(theta), np.sin(theta)
+    px, py = mox - (c * mtx - s * mty), moy - (s * mtx + c * mty)
+    err = w_centre * ((px - centre[0]) ** 2 + (py - centre[1]) ** 2)
+    for i in range(k):
+        ex = c * slots[i, 0] - s * slots[i, 1] + px - obs[i, 0]
+        ey = s * slots[i, 0] + c * slots[i, 1] + py - obs[i, 1]
+        err += w_obs[i] * (ex * ex + ey * ey)
+    return theta, px, py, np.sqrt(err / wsum)
+
+
+# pattern match table columns, filled by `match_patterns`
+M_OK, M_X, M_Y, M_THETA, M_RES, M_PINK, M_MISSING, M_DOTS, M_AREA = range(9)
+M_COLS = 9
+
+
+@numba.njit(cache=True)
+def match_patterns(cxy: np.ndarray, cw: np.ndarray, dxy: np.ndarray, dw: np.ndarray, dpink: np.ndarray,
+                   dgood: np.ndarray, slots: np.ndarray, assign: np.ndarray, search_r: float,
+                   min_dots: int) -> np.ndarray:  # fmt: skip
+    """For each centre dot (field xy (n, 2), area weight (n,)), the id dots within ``search_r``
+    (at most as many as the pattern has slots, those nearest the pattern's ring), fitted to the
+    template under every assignment of dots to slots (``assign`` (m, k_max): slot per observed
+    dot; rows for fewer dots use the leading columns). Thesis A.2.2-A.2.3.
+
+    Row per centre: ok, x, y, theta, residual, pink slots as bits, the slot left empty (or -1),
+    dots used, the smallest area weight among the dots (1 = as expected).
+    """
+    n_c, k_max = cxy.shape[0], slots.shape[0]
+    out = np.zeros((n_c, M_COLS))
+    ring = 0.0
+    for s in range(k_max):
+        ring += np.sqrt(slots[s, 0] ** 2 + slots[s, 1] ** 2) / k_max
+    near = np.empty(dxy.shape[0], np.int64)
+    off = np.empty(dxy.shape[0])
+    obs = np.empty((k_max, 2))
+    w_obs = np.empty(k_max)
+    t = np.empty((k_max, 2))
+    for c in range(n_c):
+        m = 0
+        for d in range(dxy.shape[0]):
+            r = np.sqrt((dxy[d, 0] - cxy[c, 0]) ** 2 + (dxy[d, 1] - cxy[c, 1]) ** 2)
+            if dgood[d] and r <= search_r:
+                near[m] = d
+                off[m] = abs(r - ring)
+                m += 1
+        if m < min_dots:
+            continue
+        order = np.argsort(off[:m])[:k_max]
+        k = order.shape[0]
+        min_w = cw[c]
+        for i in range(k):
+            obs[i, 0] = dxy[near[order[i]], 0]
+            obs[i, 1] = dxy[near[order[i]], 1]
+            w_obs[i] = dw[near[order[i]]]
+            min_w = min(min_w, w_obs[i])
+        best_res, best = np.inf, -1
+        bt, bx, by = 0.0, 0.0, 0.0
+        for a in range(assign.shape[0]):
+            # an assignment of k dots: its first k slots distinct (rows repeat for k < k_max)
+            for i in range(k):
+                t[i, 0] = slots[assign[a, i], 0]
+                t[i, 1] = slots[assign[a, i], 1]
+            theta, x, y, res = fit_pattern(cxy[c], cw[c], obs[:k], w_obs[:k], t[:k])
+            if res < best_res:
+                best_res, best, bt, bx, by = res, a, theta, x, y
+        pink = 0
+        used = 0
+        for i in range(k):
+            used |= 1 << assign[best, i]
+            if dpink[near[order[i]]]:
+                pink |= 1 << assign[best, i]
+        missing = -1
+        for s in range(k_max):
+            if not (used >> s) & 1:
+                missing = s
+        out[c, M_OK] = 1.0
+        out[c, M_X], out[c, M_Y], out[c, M_THETA], out[c, M_RES] = bx, by, bt, best_res
+        out[c, M_PINK], out[c, M_MISSING], out[c, M_DOTS], out[c, M_AREA] = pink, missing, k, min_w
+    return out

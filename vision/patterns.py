@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,9 +27,12 @@ from cmdragons.camera import CameraModel
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import TEAMS, PatternGeometry, Team
 from cmdragons.messages import BallDetection, RobotDetection
+from vision import _kernels as kern
 from vision.cmvision import Regions
 
-__all__ = ["BallParams", "PatternParams", "detect_ball", "detect_robots", "field_regions"]
+F64 = NDArray[np.float64]
+
+__all__ = ["BallParams", "PatternMatcher", "PatternParams", "RegionGeometry", "detect_ball", "fit_reference"]
 
 
 @dataclass(frozen=True)
@@ -57,43 +61,32 @@ class BallParams(Validated):
     min_confidence: float = setting(0.1, lo=0.0, hi=1.0)
 
 
-@dataclass(frozen=True)
-class FieldRegions:
-    """Regions placed on a horizontal plane: field position (n, 2) m and area (n,) m^2."""
+class RegionGeometry:
+    """Where the regions of one image lie on the field: each centroid's ray (dx, dy per metre of
+    descent) from the camera's per-pixel ray grid, and the field area of one pixel per metre of
+    descent squared. A plane at height z is then ``centre_xy + (centre_z - z) * ray``."""
 
-    xy: NDArray[np.float64]
-    area_m2: NDArray[np.float64]
-    pixel: NDArray[np.float64]
+    def __init__(self, regions: Regions, camera: CameraModel, grid: NDArray[np.float32]) -> None:
+        self.regions = regions
+        self.camera = camera
+        self.rays, self.pixel_area = kern.region_rays(grid, regions.centroid)
 
+    def xy(self, idx: NDArray[np.int64], z: float) -> NDArray[np.float64]:
+        """Field points (n, 2) of regions ``idx`` on the plane at height ``z`` (m)."""
+        out: NDArray[np.float64] = self.camera.center[:2] + (self.camera.center[2] - z) * self.rays[idx]
+        return out
 
-def field_regions(regions: Regions, idx: NDArray[np.int64], camera: CameraModel, z: float) -> FieldRegions:
-    """Regions ``idx`` projected to the field plane at height ``z`` (m): centroid through the
-    camera model, pixel area through the local Jacobian of the pixel -> field map."""
-    px = regions.centroid[idx]
-    if idx.size == 0:
-        return FieldRegions(np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2)))
-    pts = np.concatenate([px, px + [1.0, 0.0], px + [0.0, 1.0]], axis=0)
-    xy = camera.unproject(pts, z)
-    n = idx.size
-    du, dv = xy[n : 2 * n] - xy[:n], xy[2 * n :] - xy[:n]
-    jac = np.abs(du[:, 0] * dv[:, 1] - du[:, 1] * dv[:, 0])
-    return FieldRegions(xy[:n], regions.area[idx] * jac, px)
+    def area_m2(self, idx: NDArray[np.int64], z: float) -> NDArray[np.float64]:
+        """Field areas (n,) m^2 of regions ``idx`` on the plane at height ``z``."""
+        out: NDArray[np.float64] = self.regions.area[idx] * self.pixel_area[idx] * (self.camera.center[2] - z) ** 2
+        return out
 
 
-def _templates(pattern: PatternGeometry) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
-    slots = np.array(pattern.dot_positions_m, dtype=np.float64)
-    perms = np.array(list(itertools.permutations(range(len(slots)))), dtype=np.int64)
-    return slots, perms
-
-
-F64 = NDArray[np.float64]
-
-
-def _fit(centre: F64, w_centre: float, obs: F64, w_obs: F64, slots: F64) -> tuple[F64, F64, F64]:
+def fit_reference(centre: F64, w_centre: float, obs: F64, w_obs: F64, slots: F64) -> tuple[F64, F64, F64]:
     """Weighted least-squares rigid fits (2D Procrustes) of the pattern to the observed dots, for
-    every row of ``slots`` (m, k, 2): the template positions the k observed dots are assigned to.
-    The centre dot sits at the template origin. Returns heading (m,), position (m, 2) and the
-    weighted RMS residual (m,)."""
+    every row of ``slots`` (m, k, 2): the template positions the k observed dots are assigned to;
+    the centre dot sits at the template origin. Returns heading (m,), position (m, 2) and the
+    weighted RMS residual (m,). The plain-numpy reference of :func:`vision._kernels.fit_pattern`."""
     m = slots.shape[0]
     w_all = np.concatenate([[w_centre], w_obs])
     wsum = w_all.sum()
@@ -115,102 +108,111 @@ def _fit(centre: F64, w_centre: float, obs: F64, w_obs: F64, slots: F64) -> tupl
     return theta, pos, res
 
 
-@dataclass(frozen=True)
-class _Dots:
-    xy: NDArray[np.float64]
-    area_m2: NDArray[np.float64]
-    pink: NDArray[np.bool_]
+class PatternMatcher:
+    """The standard pattern of one league, ready to match (templates, id table, expected areas)."""
 
+    def __init__(self, pattern: PatternGeometry, params: PatternParams) -> None:
+        self.pattern, self.params = pattern, params
+        self.slots = np.array(pattern.dot_positions_m, dtype=np.float64)
+        self.assign = np.array(list(itertools.permutations(range(len(self.slots)))), dtype=np.int64)
+        self.code_to_id = {
+            sum(1 << s for s, ch in enumerate(code) if ch == "P"): i for i, code in enumerate(pattern.ids)
+        }
+        self.centre_area = math.pi * (pattern.center_dot_diameter_m / 2.0) ** 2
+        self.dot_area = math.pi * (pattern.id_dot_diameter_m / 2.0) ** 2
 
-def detect_robots(regions: Regions, classes: dict[str, int], camera: CameraModel, pattern: PatternGeometry,
-                  height_m: dict[Team, float], params: PatternParams) -> list[RobotDetection]:  # fmt: skip
-    """Robots of both teams from the regions of one image; ``classes`` maps the roles blue,
-    yellow, pink, green to class indices. Duplicates (one robot found twice) are merged."""
-    slots, perms = _templates(pattern)
-    code_to_id = {code: i for i, code in enumerate(pattern.ids)}
-    centre_area = math.pi * (pattern.center_dot_diameter_m / 2.0) ** 2
-    dot_area = math.pi * (pattern.id_dot_diameter_m / 2.0) ** 2
-    lo, hi = params.min_area_fraction, params.max_area_fraction
-    found: list[RobotDetection] = []
-    for team in TEAMS:
-        z = height_m[team]
-        centres = field_regions(regions, regions.of_class(classes[team]), camera, z)
-        ok = (centres.area_m2 >= lo * centre_area) & (centres.area_m2 <= hi * centre_area)
-        if not ok.any():
-            continue
-        pink = field_regions(regions, regions.of_class(classes["pink"]), camera, z)
-        green = field_regions(regions, regions.of_class(classes["green"]), camera, z)
-        dots = _Dots(
-            np.concatenate([pink.xy, green.xy]), np.concatenate([pink.area_m2, green.area_m2]),
-            np.concatenate([np.ones(len(pink.xy), bool), np.zeros(len(green.xy), bool)]),
-        )  # fmt: skip
-        good = (dots.area_m2 >= lo * dot_area) & (dots.area_m2 <= hi * dot_area)
-        for k in np.flatnonzero(ok):
-            det = _match(team, centres.xy[k], centres.area_m2[k], centres.pixel[k], dots, good, slots, perms,
-                         code_to_id, centre_area, dot_area, params)  # fmt: skip
-            if det is not None:
-                found.append(det)
-    return merge_duplicates(found, params.duplicate_distance_m)
+    def detect(self, geo: RegionGeometry, classes: dict[str, int], height_m: dict[Team, float],
+               is_pink: Callable[[NDArray[np.float64]], bool | None]) -> list[RobotDetection]:  # fmt: skip
+        """Robots of both teams; ``classes`` maps the roles blue, yellow, pink, green to class
+        indices; ``is_pink(pixel)`` reads an id dot's colour at a pixel where no region was found
+        (None: neither colour). Duplicates (one robot found twice) are merged."""
+        regions, params = geo.regions, self.params
+        lo, hi = params.min_area_fraction, params.max_area_fraction
+        pink_idx, green_idx = regions.of_class(classes["pink"]), regions.of_class(classes["green"])
+        dot_idx = np.concatenate([pink_idx, green_idx])
+        dpink = np.arange(dot_idx.size) < pink_idx.size
+        found: list[RobotDetection] = []
+        for team in TEAMS:
+            z = height_m[team]
+            c_idx = regions.of_class(classes[team])
+            cw = geo.area_m2(c_idx, z) / self.centre_area
+            ok = (cw >= lo) & (cw <= hi)
+            if not ok.any() or dot_idx.size < params.min_dots:
+                continue
+            c_idx, cw = c_idx[ok], cw[ok]
+            dw = geo.area_m2(dot_idx, z) / self.dot_area
+            table = kern.match_patterns(geo.xy(c_idx, z), cw, geo.xy(dot_idx, z), dw, dpink, (dw >= lo) & (dw <= hi),
+                                        self.slots, self.assign, params.search_radius_m, params.min_dots)  # fmt: skip
+            for row, k in zip(table, c_idx, strict=True):
+                det = self._robot(team, row, regions.centroid[k], z, geo.camera, is_pink)
+                if det is not None:
+                    found.append(det)
+        return merge_duplicates(found, params.duplicate_distance_m)
 
-
-def _match(team: str, centre: NDArray[np.float64], centre_a: float, pixel: NDArray[np.float64], dots: _Dots,
-           good: NDArray[np.bool_], slots: NDArray[np.float64], perms: NDArray[np.int64], code_to_id: dict[str, int],
-           centre_area: float, dot_area: float, params: PatternParams) -> RobotDetection | None:  # fmt: skip
-    d = np.hypot(dots.xy[:, 0] - centre[0], dots.xy[:, 1] - centre[1])
-    near = np.flatnonzero(good & (d <= params.search_radius_m))
-    if near.size < params.min_dots:
-        return None
-    ring = float(np.mean(np.hypot(slots[:, 0], slots[:, 1])))
-    if near.size > len(slots):  # the dots nearest the pattern's ring
-        near = near[np.argsort(np.abs(d[near] - ring))[: len(slots)]]
-    k = near.size
-    # each assignment of the k observed dots to k distinct template slots
-    assign = np.unique(perms[:, :k], axis=0)
-    w_obs = dots.area_m2[near] / dot_area
-    theta, pos, res = _fit(centre, centre_a / centre_area, dots.xy[near], w_obs, slots[assign])
-    best = int(np.argmin(res))
-    if res[best] > params.max_residual_m:
-        return None
-    if k < len(slots):
-        return None  # TODO(min_dots=3): read the missing slot's colour from the image
-    code = ["?"] * len(slots)
-    for obs_i, slot in enumerate(assign[best]):
-        code[slot] = "P" if dots.pink[near[obs_i]] else "G"
-    rid = code_to_id.get("".join(code))
-    if rid is None:
-        return None
-    areas = np.concatenate([[centre_a / centre_area], w_obs])
-    area_conf = float(np.clip(np.min(np.minimum(areas, 1.0 / np.maximum(areas, 1e-9))) / 0.5, 0.0, 1.0))
-    conf = math.exp(-0.5 * (float(res[best]) / params.residual_scale_m) ** 2) * area_conf
-    if conf < params.min_confidence:
-        return None
-    return RobotDetection(team, rid, float(pos[best, 0]), float(pos[best, 1]),  # type: ignore[arg-type]
-                          math.remainder(float(theta[best]), 2.0 * math.pi), conf,
-                          (float(pixel[0]), float(pixel[1])))  # fmt: skip
+    def _robot(self, team: Team, row: NDArray[np.float64], pixel: NDArray[np.float64], z: float, camera: CameraModel,
+               is_pink: Callable[[NDArray[np.float64]], bool | None]) -> RobotDetection | None:  # fmt: skip
+        if row[kern.M_OK] == 0.0 or row[kern.M_RES] > self.params.max_residual_m:
+            return None
+        pink = int(row[kern.M_PINK])
+        missing = int(row[kern.M_MISSING])
+        if missing >= 0:
+            # a dot the regions missed (glare, a dark corner): read its colour where the fit puts it
+            c, s = math.cos(row[kern.M_THETA]), math.sin(row[kern.M_THETA])
+            sx, sy = self.slots[missing]
+            at = camera.project_xy(np.array([row[kern.M_X] + c * sx - s * sy, row[kern.M_Y] + s * sx + c * sy]), z)
+            colour = is_pink(at)
+            if colour is None:
+                return None
+            pink |= int(colour) << missing
+        rid = self.code_to_id.get(pink)
+        if rid is None:
+            return None
+        # confidence: the fit residual against the pattern noise, and how far the smallest dot
+        # falls short of its expected area (half the area or less: no trust)
+        area_conf = min(1.0, max(0.0, (row[kern.M_AREA] - 0.5) / 0.4))
+        conf = math.exp(-0.5 * (row[kern.M_RES] / self.params.residual_scale_m) ** 2) * area_conf
+        if missing >= 0:
+            conf *= 0.5
+        if conf < self.params.min_confidence:
+            return None
+        return RobotDetection(team, rid, float(row[kern.M_X]), float(row[kern.M_Y]),
+                              math.remainder(float(row[kern.M_THETA]), 2.0 * math.pi), conf,
+                              (float(pixel[0]), float(pixel[1])))  # fmt: skip
 
 
 def merge_duplicates(robots: list[RobotDetection], distance_m: float) -> list[RobotDetection]:
     """Most confident first; a detection of a (team, id) already reported, or closer than
     ``distance_m`` to a reported robot, is the same robot seen twice and is dropped."""
-    kept: list[RobotDetection] = []
-    for r in sorted(robots, key=lambda r: -r.confidence):
-        if any((k.team == r.team and k.id == r.id) or math.hypot(k.x - r.x, k.y - r.y) < distance_m for k in kept):
+    ranked = sorted(robots, key=lambda r: -r.confidence)
+    xy = np.array([[r.x, r.y] for r in ranked]).reshape(-1, 2)
+    kept: list[int] = []
+    seen: set[tuple[str, int]] = set()
+    for k, r in enumerate(ranked):
+        if (r.team, r.id) in seen:
             continue
-        kept.append(r)
-    return kept
+        if kept and float(np.min(np.hypot(*(xy[kept] - xy[k]).T))) < distance_m:
+            continue
+        kept.append(k)
+        seen.add((r.team, r.id))
+    return [ranked[k] for k in kept]
 
 
-def detect_ball(regions: Regions, orange: int, camera: CameraModel, ball_radius_m: float,
-                robots: list[RobotDetection], robot_height_m: dict[Team, float], pattern_radius_m: float,
-                params: BallParams) -> list[BallDetection]:  # fmt: skip
+def detect_ball(
+    geo: RegionGeometry,
+    orange: int,
+    ball_radius_m: float,
+    robots: list[RobotDetection],
+    robot_height_m: dict[Team, float],
+    pattern_radius_m: float,
+    params: BallParams,
+) -> list[BallDetection]:
     """Ball candidates: orange regions of the ball's size and shape, not inside a detected
     robot's pattern, on the plane of the ball centre; most confident first."""
+    regions = geo.regions
     idx = regions.of_class(orange)
     if idx.size == 0 or params.max_balls == 0:
         return []
-    reg = field_regions(regions, idx, camera, ball_radius_m)
-    expected = math.pi * ball_radius_m**2
-    ratio = reg.area_m2 / expected
+    ratio = geo.area_m2(idx, ball_radius_m) / (math.pi * ball_radius_m**2)
     mom = regions.moments[idx]
     tr, det = mom[:, 0] + mom[:, 1], mom[:, 0] * mom[:, 1] - mom[:, 2] ** 2
     disc = np.sqrt(np.maximum(tr * tr / 4.0 - det, 0.0))
@@ -218,24 +220,23 @@ def detect_ball(regions: Regions, orange: int, camera: CameraModel, ball_radius_
     box = regions.bbox[idx]
     fill = regions.area[idx] / ((box[:, 2] - box[:, 0] + 1.0) * (box[:, 3] - box[:, 1] + 1.0))
     keep = (
-        (ratio >= params.min_area_fraction) & (ratio <= params.max_area_fraction)
-        & (elong <= params.max_elongation) & (fill >= params.min_fill)
-    )  # fmt: skip
-    if robots:
+        (ratio >= params.min_area_fraction)
+        & (ratio <= params.max_area_fraction)
+        & (elong <= params.max_elongation)
+        & (fill >= params.min_fill)
+    )
+    for r in robots:
         # a pattern holds no orange: an orange spot inside one is a misread marker
-        tops = np.array([[r.x, r.y] for r in robots])
-        heights = np.array([robot_height_m[r.team] for r in robots])
-        for j in np.flatnonzero(keep):
-            at_top = np.stack([camera.unproject(reg.pixel[j], float(h)) for h in heights])
-            if np.any(np.hypot(*(at_top - tops).T) < pattern_radius_m):
-                keep[j] = False
+        at_top = geo.xy(idx, robot_height_m[r.team])
+        keep &= np.hypot(at_top[:, 0] - r.x, at_top[:, 1] - r.y) >= pattern_radius_m
+    xy = geo.xy(idx, ball_radius_m)
     out = []
     for j in np.flatnonzero(keep):
         size_conf = min(ratio[j], 1.0 / ratio[j])
         shape_conf = min(1.0, 1.5 / elong[j])
         conf = float(np.clip(size_conf * shape_conf / 0.6, 0.0, 1.0))
         if conf >= params.min_confidence:
-            out.append(BallDetection(float(reg.xy[j, 0]), float(reg.xy[j, 1]), conf,
-                                     (float(reg.pixel[j, 0]), float(reg.pixel[j, 1]))))  # fmt: skip
+            px = regions.centroid[idx[j]]
+            out.append(BallDetection(float(xy[j, 0]), float(xy[j, 1]), conf, (float(px[0]), float(px[1]))))
     out.sort(key=lambda b: -b.confidence)
     return out[: params.max_balls]

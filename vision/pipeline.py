@@ -18,8 +18,16 @@ from cmdragons.camera import CameraModel
 from cmdragons.config import Validated
 from cmdragons.geometry import TEAMS, LeagueParams, Team
 from cmdragons.messages import DetectionFrame
-from vision.cmvision import MAX_CLASSES, ColourClass, ColourSpace, RegionParams, Regions, Segmenter
-from vision.patterns import BallParams, PatternParams, detect_ball, detect_robots
+from vision.cmvision import (
+    MAX_CLASSES,
+    ColourClass,
+    ColourSpace,
+    RegionParams,
+    Regions,
+    Segmenter,
+    classify_reference,
+)
+from vision.patterns import BallParams, PatternMatcher, PatternParams, RegionGeometry, detect_ball
 
 __all__ = ["ColourRoles", "VisionParams", "VisionPipeline", "default_colours"]
 
@@ -85,6 +93,8 @@ class VisionPipeline:
         self.classes = {role: self.segmenter.index(getattr(roles, role)) for role in ("ball", "blue", "yellow",
                                                                                        "pink", "green")}  # fmt: skip
         self.heights: dict[Team, float] = {t: params.robot_height_m.get(t, league.robot.height_m) for t in TEAMS}
+        self.matcher = PatternMatcher(league.pattern, params.patterns)
+        self.grid = camera.pixel_rays_grid()
         dots = np.array(league.pattern.dot_positions_m)
         self.pattern_radius_m = float(np.max(np.hypot(dots[:, 0], dots[:, 1]))) + league.pattern.id_dot_diameter_m / 2
         self.last_regions: Regions | None = None
@@ -104,13 +114,28 @@ class VisionPipeline:
                              f"got {image.dtype} {image.shape}")  # fmt: skip
         regions = self.segmenter.regions(image)
         self.last_regions = regions
-        robots = detect_robots(regions, self.classes, self.camera, self.league.pattern, self.heights,
-                               self.params.patterns)  # fmt: skip
-        balls = detect_ball(regions, self.classes["ball"], self.camera, self.league.ball.radius_m, robots,
-                            self.heights, self.pattern_radius_m * 0.8, self.params.ball)  # fmt: skip
+        geo = RegionGeometry(regions, self.camera, self.grid)
+        robots = self.matcher.detect(geo, self.classes, self.heights, lambda px: self._is_pink(image, px))
+        # a ball seen beside a robot lies outside its top: only a misread marker is well inside
+        balls = detect_ball(geo, self.classes["ball"], self.league.ball.radius_m, robots, self.heights,
+                            self.pattern_radius_m * 0.8, self.params.ball)  # fmt: skip
         # no wall clock here: the frame is "sent" at its capture time (latency is the runtime's)
         return DetectionFrame(self.camera.id, frame_number, t_capture, t_capture, tuple(balls),
                               tuple(sorted(robots, key=lambda r: (r.team, r.id))))  # fmt: skip
+
+    def _is_pink(self, image: NDArray[np.uint8], pixel: NDArray[np.float64]) -> bool | None:
+        """The id-dot colour at ``pixel`` (u, v): the majority class of the 3 x 3 pixels around it."""
+        if not np.all(np.isfinite(pixel)):
+            return None
+        j, i = int(pixel[0]), int(pixel[1])
+        if not (1 <= i < image.shape[0] - 1 and 1 <= j < image.shape[1] - 1):
+            return None
+        bits = classify_reference(image[i - 1 : i + 2, j - 1 : j + 2], self.segmenter.classes, self.params.colour_space)
+        pink = int(np.count_nonzero(bits & np.uint32(1 << self.classes["pink"])))
+        green = int(np.count_nonzero(bits & np.uint32(1 << self.classes["green"])))
+        if max(pink, green) < 3:
+            return None
+        return pink > green
 
 
 def angle_error(a: float, b: float) -> float:

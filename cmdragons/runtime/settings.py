@@ -21,6 +21,7 @@ from cmdragons.team import TeamParams
 from cmdragons.tracking.tracker import TrackerParams
 from sim.params import SimParams
 from strategy.plays import StrategyParams
+from vision.pipeline import VisionParams
 
 __all__ = ["CONCERNS", "Settings", "load_settings"]
 
@@ -34,6 +35,7 @@ CONCERNS: dict[str, type] = {
     "tracker": TrackerParams,
     "strategy": StrategyParams,
     "team": TeamParams,
+    "vision": VisionParams,
 }
 
 
@@ -49,6 +51,7 @@ class Settings:
     tracker: TrackerParams
     strategy: StrategyParams
     team: TeamParams
+    vision: VisionParams
 
     def field_geometry(self) -> Field:
         return Field(self.field)

@@ -33,6 +33,7 @@ SUITES: dict[str, Callable[[Settings, bool], list[Row]]] = {
     "sim": _lazy("cmdragons.bench.sim"),
     "planning": _lazy("cmdragons.bench.planning"),
     "safety": _lazy("cmdragons.bench.safety"),
+    "tracking": _lazy("cmdragons.bench.tracking"),
 }
 
 

@@ -32,21 +32,25 @@ Vec = NDArray[np.float64]
 
 @dataclass(frozen=True)
 class BallModelParams(Validated):
-    measurement_sigma_m: float = setting(0.003, lo=1e-5, hi=1.0)  # vision's position noise
-    accel_sigma_m_s2: float = setting(1.5, lo=0.0, hi=100.0)  # white-noise acceleration (model error)
+    measurement_sigma_m: float = setting(0.0016, lo=1e-5, hi=1.0)  # vision's position noise
+    accel_sigma_m_s2: float = setting(0.5, lo=0.0, hi=100.0)  # white-noise acceleration (model error)
     acc_slide_m_s2: float = setting(3.0, lo=0.0, hi=50.0)
     acc_roll_m_s2: float = setting(0.26, lo=0.0, hi=10.0)
     slide_to_roll_fraction: float = setting(0.64, lo=0.0, hi=1.0)
     initial_speed_sigma_m_s: float = setting(3.0, lo=0.01, hi=50.0)  # velocity uncertainty of a new track
     kick_gate_chi2: float = setting(25.0, lo=1.0, hi=1e6)  # innovation (2 dof) beyond this: kick or bounce
     kick_speed_sigma_m_s: float = setting(4.0, lo=0.01, hi=50.0)  # velocity uncertainty after a kick
+    # next to a robot the ball may be pushed, dribbled or kicked at any moment: far less predictable
+    near_robot_accel_sigma_m_s2: float = setting(8.0, lo=0.0, hi=500.0)
+    near_robot_m: float = setting(0.15, lo=0.0, hi=2.0)  # ball centre to robot centre counted as next to it
+    switch_band: float = setting(0.12, lo=0.0, hi=1.0)  # +- share of the switch speed where the phase is unsure
 
 
 @dataclass(frozen=True)
 class RobotModelParams(Validated):
-    measurement_sigma_m: float = setting(0.003, lo=1e-5, hi=1.0)
-    measurement_sigma_rad: float = setting(0.02, lo=1e-5, hi=3.0)
-    accel_sigma_m_s2: float = setting(2.0, lo=0.0, hi=100.0)  # model error around the commanded motion
+    measurement_sigma_m: float = setting(0.0005, lo=1e-5, hi=1.0)  # vision's robot position noise
+    measurement_sigma_rad: float = setting(0.01, lo=1e-5, hi=3.0)
+    accel_sigma_m_s2: float = setting(8.0, lo=0.0, hi=100.0)  # model error around the commanded motion
     alpha_sigma_rad_s2: float = setting(20.0, lo=0.0, hi=1000.0)
     max_accel_m_s2: float = setting(3.0, lo=0.0, hi=50.0)  # what our commands can ask of the motors
     max_alpha_rad_s2: float = setting(60.0, lo=0.0, hi=1000.0)
@@ -102,8 +106,10 @@ class BallFilter:
         self.kf = kf
         self.t = t
         self.cache = _Cache(2, (p.accel_sigma_m_s2, p.accel_sigma_m_s2))
+        self.near_cache = _Cache(2, (p.near_robot_accel_sigma_m_s2, p.near_robot_accel_sigma_m_s2))
         # a ball first seen may have just been kicked: sliding until its speed is known (as after a kick)
         self.slide_start_speed = math.inf
+        self.t_kick = t
         self.kicked = False
 
     def _decel(self, v: Vec, dt: float) -> Vec:
@@ -124,11 +130,17 @@ class BallFilter:
         x = f @ self.kf.x + b @ self._decel(self.kf.x[2:], dt)
         return x, f @ self.kf.P @ f.T + q
 
-    def predict(self, t: float) -> None:
+    def predict(self, t: float, near_robot: bool = False) -> None:
+        """Advance to ``t``; ``near_robot``: a robot is next to the ball and may move it."""
         dt = t - self.t
         if dt <= 0.0:
             return
-        f, b, q = self.cache.get(dt)
+        # the slide-to-roll switch is only known to within the slide's start speed: around it, the
+        # filter follows the detections rather than the model
+        speed = math.hypot(self.kf.x[2], self.kf.x[3])
+        switch = self.p.slide_to_roll_fraction * self.slide_start_speed
+        near_switch = math.isfinite(switch) and abs(speed - switch) < self.p.switch_band * switch
+        f, b, q = (self.near_cache if near_robot or near_switch else self.cache).get(dt)
         self.kf.predict(u=self._decel(self.kf.x[2:], dt), B=b, F=f, Q=q)
         self.t = t
 
@@ -148,9 +160,12 @@ class BallFilter:
             self.kf.P[2:, 2:] = np.eye(2) * self.p.kick_speed_sigma_m_s**2
             self.kf.P[:2, :2] += np.eye(2) * float(np.sum((z - self.kf.x[:2]) ** 2))
             self.slide_start_speed = math.inf  # sliding until the new speed is known
+            self.t_kick = self.t
         self.kf.update(z)
         if self.slide_start_speed == math.inf and self.kf.P[2, 2] < 0.25:
-            self.slide_start_speed = math.hypot(self.kf.x[2], self.kf.x[3])
+            # the speed is known now, some frames after the kick: the slide began faster than that
+            speed = math.hypot(self.kf.x[2], self.kf.x[3])
+            self.slide_start_speed = speed + self.p.acc_slide_m_s2 * max(0.0, self.t - self.t_kick)
         self.kicked = kicked
         return kicked
 

@@ -136,8 +136,11 @@ class Tracker:
         for key, track in self.robots.items():
             track.filter.command = self._command_at(key, track.filter.t)
             track.filter.predict(t)
+        near = self.p.ball.near_robot_m
+        robots_xy = np.array([r.filter.kf.x[:2] for r in self.robots.values()]).reshape(-1, 2)
         for ball in self.balls:
-            ball.filter.predict(t)
+            d = np.hypot(*(robots_xy - ball.filter.position).T) if len(robots_xy) else np.zeros(0)
+            ball.filter.predict(t, near_robot=bool(len(d) and float(d.min()) < near))
         for det in frame.robots:
             self.stats.detections += 1
             z = np.array([det.x, det.y, det.theta])

@@ -10,6 +10,7 @@ import pytest
 from cmdragons.geometry import TEAMS, LeagueParams
 from cmdragons.messages import BallDetection, DetectionFrame, RobotCommand, RobotDetection, WorldState
 from cmdragons.tracking import Tracker, TrackerParams
+from cmdragons.tracking.filters import BallModelParams, RobotModelParams
 from sim.snapshot import Snapshot
 from sim.world import BallParams, DribblerParams, KickerParams, PhysicsParams, RobotParams, World
 
@@ -41,7 +42,12 @@ def detect(snap: Snapshot, rng: np.random.Generator, camera: int = 0, ball: bool
 
 
 def params(latency: float = 0.0) -> TrackerParams:
-    return TrackerParams(latency_s=latency)
+    """The tracker told the noise these synthetic detections carry."""
+    return TrackerParams(
+        latency_s=latency,
+        ball=BallModelParams(measurement_sigma_m=SIGMA),
+        robot=RobotModelParams(measurement_sigma_m=SIGMA, measurement_sigma_rad=0.02),
+    )
 
 
 def ball_error(ws: WorldState, snap: Snapshot) -> tuple[float, float]:

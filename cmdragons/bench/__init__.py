@@ -30,7 +30,13 @@ def _planning(settings: Settings, quick: bool) -> list[Row]:
     return run(settings, quick)
 
 
-SUITES: dict[str, Callable[[Settings, bool], list[Row]]] = {"sim": _sim, "planning": _planning}
+def _vision(settings: Settings, quick: bool) -> list[Row]:
+    from cmdragons.bench.vision import run
+
+    return run(settings, quick)
+
+
+SUITES: dict[str, Callable[[Settings, bool], list[Row]]] = {"sim": _sim, "planning": _planning, "vision": _vision}
 
 
 def print_table(suite: str, rows: list[Row]) -> None:

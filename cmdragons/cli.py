@@ -1,4 +1,4 @@
-"""``cmdragons`` command line: play | sim | bench.
+"""``cmdragons`` command line: play | sim | vision | bench.
 
 Every command takes ``--config DIR`` (default ``./configs``) and repeatable
 ``--set concern.key.path=value`` overrides.
@@ -57,6 +57,18 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=None, help="override sim.seed")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
+    p = sub.add_parser(
+        "vision", help="detect ball and robots in camera frames (also: vision calibrate ..., vision tune ...)",
+        description="SOURCE: a recording folder, a video file, an image folder or a glob (one per camera). "
+        "`cmdragons vision calibrate -h` and `cmdragons vision tune -h` for the other two commands.",
+    )  # fmt: skip
+    _common(p)
+    p.add_argument("source", nargs="+", metavar="SOURCE")
+    p.add_argument("--out", metavar="DIR", default=None, help="output folder (default logs/<time>-vision)")
+    p.add_argument("--video", action="store_true", help="also write an annotated video per camera")
+    p.add_argument("--fps", type=float, default=None, help="frames per second for t_capture (default: sim's)")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+
     p = sub.add_parser("bench", help="run a benchmark suite and print its table")
     _common(p)
     p.add_argument("suite", help="suite name (see `cmdragons bench --help`: sim, planning, safety, ...)")
@@ -66,6 +78,15 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if len(argv) >= 2 and argv[0] == "vision" and argv[1] in ("calibrate", "tune"):
+        from cmdragons.cli_vision import main as vision_command
+
+        try:
+            return vision_command(argv[1], argv[2:], _common)
+        except ConfigError as exc:
+            print(f"cmdragons: config error: {exc}", file=sys.stderr)
+            return 2
     args = build_parser().parse_args(argv)
     try:
         if args.command == "sim":
@@ -74,6 +95,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _cmd_bench(args)
         if args.command == "play":
             return _cmd_play(args)
+        if args.command == "vision":
+            return _cmd_vision(args)
     except ConfigError as exc:
         print(f"cmdragons: config error: {exc}", file=sys.stderr)
         return 2
@@ -260,6 +283,40 @@ def _event_dict(e: object) -> dict[str, object]:
     import dataclasses
 
     return {k: v for k, v in dataclasses.asdict(e).items()} if dataclasses.is_dataclass(e) else {}  # type: ignore[arg-type]
+
+
+def _cmd_vision(args: argparse.Namespace) -> int:
+    from cmdragons.runtime.log import run_folder
+    from cmdragons.runtime.settings import load_settings
+    from vision.run import run_vision
+    from vision.sources import SourceError, open_sources
+
+    settings = load_settings(args.config, args.set)
+    try:
+        sources, recording = open_sources(args.source)
+    except SourceError as exc:
+        print(f"cmdragons vision: {exc}", file=sys.stderr)
+        return 2
+    folder = run_folder("vision", args.out)
+    fps = args.fps or settings.sim.physics.frame_rate_hz
+    total = sum(len(s.paths) for s in sources if s.kind == "images") or None
+    with _progress(not args.no_progress) as progress:
+        task = progress.add_task("vision", total=total, info="")
+        summary = run_vision(sources, {m.id: m for m in settings.camera_models()}, settings.vision, settings.field,
+                             folder, args.video, fps, recording, lambda n: progress.advance(task, n))  # fmt: skip
+    d = summary.as_dict()
+    bad = summary.unreadable + summary.empty + summary.wrong_size
+    ms = d["ms_per_frame"]["median"]
+    print(f"vision: {summary.frames} frames from {len(sources)} camera(s), {d['robots_per_frame']:.2f} robots and "
+          f"{d['balls_per_frame']:.2f} balls per frame, " + (f"{ms:.2f} ms per frame (median)" if ms else "no frame")
+          + f" -> {folder}")  # fmt: skip
+    for name, frames in d["bad_frames"].items():
+        if frames:
+            print(f"vision: {len(frames)} {name.replace('_', ' ')} frame(s): {', '.join(frames[:20])}"
+                  + (" ..." if len(frames) > 20 else ""))  # fmt: skip
+    if summary.score:
+        print("vision: against truth: " + ", ".join(f"{k} {v:.4g}" for k, v in summary.score.items()))
+    return 0 if len(bad) < summary.frames else 1
 
 
 def _cmd_bench(args: argparse.Namespace) -> int:

@@ -33,14 +33,14 @@ __all__ = ["ColourRoles", "VisionParams", "VisionPipeline", "default_colours"]
 
 
 def default_colours() -> dict[str, ColourClass]:
-    """Boxes (YUV) for the simulator's default colours, derived by ``cmdragons vision tune``
-    from rendered frames with truth."""
+    """Boxes (YUV) for the simulator's default colours, derived by ``cmdragons vision tune`` (margin
+    16) from 2 s recordings with truth at the bench's low, default and high noise levels."""
     return {
-        "orange": ColourClass(lo=(70, 30, 165), hi=(210, 100, 235), min_area_px=6),
-        "blue": ColourClass(lo=(40, 160, 40), hi=(170, 235, 100), min_area_px=6),
-        "yellow": ColourClass(lo=(110, 0, 130), hi=(250, 70, 162), min_area_px=6),
-        "pink": ColourClass(lo=(70, 135, 165), hi=(210, 185, 230), min_area_px=6),
-        "green": ColourClass(lo=(90, 45, 30), hi=(225, 95, 82), min_area_px=6),
+        "orange": ColourClass(lo=(87, 40, 161), hi=(160, 98, 222), min_area_px=6),
+        "blue": ColourClass(lo=(67, 168, 46), hi=(124, 222, 101), min_area_px=6),
+        "yellow": ColourClass(lo=(164, 0, 127), hi=(236, 56, 180), min_area_px=6),
+        "pink": ColourClass(lo=(107, 131, 173), hi=(172, 185, 227), min_area_px=6),
+        "green": ColourClass(lo=(123, 43, 27), hi=(192, 100, 86), min_area_px=6),
     }
 
 

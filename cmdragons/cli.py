@@ -67,6 +67,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", metavar="DIR", default=None, help="output folder (default logs/<time>-vision)")
     p.add_argument("--video", action="store_true", help="also write an annotated video per camera")
     p.add_argument("--fps", type=float, default=None, help="frames per second for t_capture (default: sim's)")
+    p.add_argument("--track", action="store_true", help="also track the detections and write tracks.jsonl")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
     p = sub.add_parser("bench", help="run a benchmark suite and print its table")
@@ -316,6 +317,12 @@ def _cmd_vision(args: argparse.Namespace) -> int:
                   + (" ..." if len(frames) > 20 else ""))  # fmt: skip
     if summary.score:
         print("vision: against truth: " + ", ".join(f"{k} {v:.4g}" for k, v in summary.score.items()))
+    if args.track:
+        from cmdragons.runtime.tracks import track_detections
+
+        counts = track_detections(folder / "detections.jsonl", folder / "tracks.jsonl", settings.tracker)
+        print(f"vision: tracked {counts['frames']} frames -> {folder / 'tracks.jsonl'}"
+              + (f" ({counts['bad_lines']} unreadable detection lines skipped)" if counts["bad_lines"] else ""))
     return 0 if len(bad) < summary.frames else 1
 
 

@@ -121,12 +121,15 @@ def _timing(settings: Settings, frames: int) -> dict[str, Any]:
     from cmdragons.messages import BallDetection, RobotDetection
 
     times = []
+    # detections as noisy as the tracker is configured to expect from vision
+    sb, sr, sa = (settings.tracker.ball.measurement_sigma_m, settings.tracker.robot.measurement_sigma_m,
+                  settings.tracker.robot.measurement_sigma_rad)  # fmt: skip
     for k in range(frames + 30):
         s = sim.world.snapshot()
-        ball = (BallDetection(float(s.ball[0] + rng.normal(0, 0.003)), float(s.ball[1] + rng.normal(0, 0.003)), 1.0,
+        ball = (BallDetection(float(s.ball[0] + rng.normal(0, sb)), float(s.ball[1] + rng.normal(0, sb)), 1.0,
                               (0.0, 0.0)),)  # fmt: skip
-        robots = tuple(RobotDetection(TEAMS[int(r[0])], int(r[1]), float(r[2] + rng.normal(0, 0.003)),
-                                      float(r[3] + rng.normal(0, 0.003)), float(r[4] + rng.normal(0, 0.02)), 1.0,
+        robots = tuple(RobotDetection(TEAMS[int(r[0])], int(r[1]), float(r[2] + rng.normal(0, sr)),
+                                      float(r[3] + rng.normal(0, sr)), float(r[4] + rng.normal(0, sa)), 1.0,
                                       (0.0, 0.0)) for r in s.robots)  # fmt: skip
         det = DetectionFrame(0, s.frame_number, s.t, s.t, ball, robots)
         t0 = time.perf_counter()

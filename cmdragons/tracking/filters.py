@@ -198,6 +198,7 @@ class RobotFilter:
         self.cache = _Cache(3, (p.accel_sigma_m_s2, p.accel_sigma_m_s2, p.alpha_sigma_rad_s2))
         self.command: tuple[float, float, float] | None = None  # (vx, vy, omega) in force
         self._steady: Vec | None = None  # inverse innovation covariance while in steady-state mode
+        self._steady_list: list[float] = []  # the same, row by row, as floats
         self._steady_dt = 0.0
         self._dt = 0.0
         self._regular = 0  # consecutive regular frames
@@ -205,22 +206,27 @@ class RobotFilter:
 
     def _accel(self, state: Vec, dt: float) -> Vec:
         """Accelerations toward the commanded velocity, as far as the motors allow in ``dt``."""
-        if self.command is None or dt <= 0.0:
-            return np.zeros(3)
-        dv = np.array([self.command[0] - state[3], self.command[1] - state[4]])
-        a_lin = dv / dt
-        norm = math.hypot(a_lin[0], a_lin[1])
+        return np.array(self._accel_tuple(float(state[3]), float(state[4]), float(state[5]), dt, self.command))
+
+    def _accel_tuple(self, vx: float, vy: float, w: float, dt: float,
+                     command: tuple[float, float, float] | None) -> tuple[float, float, float]:  # fmt: skip
+        if command is None or dt <= 0.0:
+            return (0.0, 0.0, 0.0)
+        ax, ay = (command[0] - vx) / dt, (command[1] - vy) / dt
+        norm = math.hypot(ax, ay)
         if norm > self.p.max_accel_m_s2:
-            a_lin *= self.p.max_accel_m_s2 / norm
-        a_ang = min(max((self.command[2] - state[5]) / dt, -self.p.max_alpha_rad_s2), self.p.max_alpha_rad_s2)
-        return np.array([a_lin[0], a_lin[1], a_ang])
+            ax, ay = ax * self.p.max_accel_m_s2 / norm, ay * self.p.max_accel_m_s2 / norm
+        a_ang = min(max((command[2] - w) / dt, -self.p.max_alpha_rad_s2), self.p.max_alpha_rad_s2)
+        return (ax, ay, a_ang)
 
     def predicted_state(self, t: float,
                         commands: Sequence[tuple[float, tuple[float, float, float]]] = ()) -> Vec:  # fmt: skip
         """State at time ``t`` (no change to the filter; robots hand on no covariance). ``commands``
         (time they take effect, (vx, vy, omega)), in time order, are followed as they come into force
         between now and ``t``: the look-ahead must see the commands already sent."""
-        x = cast(Vec, self.kf.x.copy())
+        # plain floats: this runs for every robot every frame, and numpy's per-call cost on
+        # 6-vectors would dominate it
+        x = [float(v) for v in self.kf.x]
         now, command = self.t, self.command
         for t_effect, cmd in commands:
             if t_effect <= now:
@@ -232,15 +238,15 @@ class RobotFilter:
             now, command = t_effect, cmd
         if t > now:
             x = self._advance(x, t - now, command)
-        return x
+        x[2] = _wrap(x[2])
+        return np.array(x)
 
-    def _advance(self, x: Vec, dt: float, command: tuple[float, float, float] | None) -> Vec:
-        f, b, _ = self.cache.get(dt)
-        saved, self.command = self.command, command
-        out: Vec = f @ x + b @ self._accel(x, dt)
-        self.command = saved
-        out[2] = _wrap(out[2])
-        return out
+    def _advance(self, x: list[float], dt: float, command: tuple[float, float, float] | None) -> list[float]:
+        """Constant acceleration toward ``command`` for ``dt`` seconds (the filter's motion model)."""
+        a = self._accel_tuple(x[3], x[4], x[5], dt, command)
+        h = 0.5 * dt * dt
+        return [x[0] + x[3] * dt + a[0] * h, x[1] + x[4] * dt + a[1] * h, x[2] + x[5] * dt + a[2] * h,
+                x[3] + a[0] * dt, x[4] + a[1] * dt, x[5] + a[2] * dt]  # fmt: skip
 
     def predict(self, t: float) -> None:
         dt = t - self.t
@@ -265,9 +271,14 @@ class RobotFilter:
         return y
 
     def nis(self, z: Vec) -> float:
-        y = self.innovation(z)
         if self._steady is not None and self._pending_update:
-            return float(y @ self._steady @ y)
+            # the settled gate: y' S^-1 y in plain floats (called for every detection, every frame)
+            x = self.kf.x
+            y0, y1, y2 = float(z[0] - x[0]), float(z[1] - x[1]), _wrap(float(z[2] - x[2]))
+            si = self._steady_list
+            return (y0 * (si[0] * y0 + si[1] * y1 + si[2] * y2) + y1 * (si[3] * y0 + si[4] * y1 + si[5] * y2)
+                    + y2 * (si[6] * y0 + si[7] * y1 + si[8] * y2))  # fmt: skip
+        y = self.innovation(z)
         s = self.kf.P[:3, :3] + self.kf.R
         return float(y @ np.linalg.solve(s, y))
 
@@ -296,6 +307,7 @@ class RobotFilter:
         f, _, q = self.cache.get(self._dt)
         prior = f @ self.kf.P @ f.T + q
         self._steady = np.linalg.inv(prior[:3, :3] + self.kf.R)
+        self._steady_list = [float(v) for v in self._steady.ravel()]
         self._steady_dt = self._dt
 
     def _leave_steady(self) -> None:

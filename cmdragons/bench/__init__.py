@@ -34,6 +34,7 @@ SUITES: dict[str, Callable[[Settings, bool], list[Row]]] = {
     "planning": _lazy("cmdragons.bench.planning"),
     "safety": _lazy("cmdragons.bench.safety"),
     "tracking": _lazy("cmdragons.bench.tracking"),
+    "play": _lazy("cmdragons.bench.play"),
     "vision": _lazy("cmdragons.bench.vision"),
 }
 

@@ -14,6 +14,7 @@ Distortion, as OpenCV's first two radial terms: with normalised coordinates (x, 
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import Literal
@@ -24,7 +25,16 @@ from numpy.typing import NDArray
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, LeagueParams
 
-__all__ = ["AutoLayout", "CameraModel", "CameraParams", "CamerasParams", "cameras_from_config", "smallest_ball_px"]
+__all__ = [
+    "AutoLayout",
+    "CameraModel",
+    "CameraParams",
+    "CamerasParams",
+    "cameras_from_config",
+    "opencv_extrinsics",
+    "params_from_opencv",
+    "smallest_ball_px",
+]
 
 
 @dataclass(frozen=True)
@@ -194,6 +204,44 @@ class CameraModel:
         sx = np.linalg.norm(px[1] - px[0]) / (2 * h)
         sy = np.linalg.norm(px[3] - px[2]) / (2 * h)
         return float(min(sx, sy))
+
+
+def opencv_extrinsics(model: CameraModel) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """OpenCV's (rvec, tvec) of a camera: ``x_cam = R(rvec) p + tvec`` for field points p (m).
+    The camera axes are the same (x along u, y along v, z along the optical axis); OpenCV's
+    intrinsics differ only in measuring pixels from the centre of the top-left pixel (cx - 0.5)."""
+    import cv2
+
+    r_world_to_cam = model.R_cam_to_field.T
+    rvec, _ = cv2.Rodrigues(r_world_to_cam)
+    tvec: NDArray[np.float64] = -r_world_to_cam @ model.center
+    return np.asarray(rvec, dtype=np.float64).ravel(), tvec
+
+
+def params_from_opencv(rvec: NDArray[np.float64], tvec: NDArray[np.float64], base: CameraParams) -> CameraParams:
+    """``base`` with the pose of OpenCV's (rvec, tvec): the inverse of :func:`opencv_extrinsics`.
+
+    With R = base(yaw) @ Rx(tilt_x) @ Ry(tilt_y) (the model's convention), base(yaw) is symmetric,
+    so base(yaw) @ R has a zero in row 0, column 1: that fixes yaw up to a half turn, and the
+    small tilts (cos(tilt_y) > 0) fix the half turn.
+    """
+    import cv2
+
+    rot, _ = cv2.Rodrigues(np.asarray(rvec, dtype=np.float64))
+    r = rot.T  # camera -> field
+    center = -r @ np.asarray(tvec, dtype=np.float64)
+    yaw = math.atan2(-r[0, 1], r[1, 1])
+    c, s = math.cos(yaw), math.sin(yaw)
+    if c * r[0, 0] + s * r[1, 0] < 0.0:
+        yaw += math.pi
+        c, s = -c, -s
+    base_yaw = np.array([[c, s, 0.0], [s, -c, 0.0], [0.0, 0.0, -1.0]])
+    m = base_yaw @ r
+    return dataclasses.replace(
+        base, position_m=(float(center[0]), float(center[1]), float(center[2])),
+        yaw_rad=math.remainder(yaw, 2.0 * math.pi), tilt_x_rad=math.atan2(m[2, 1], m[1, 1]),
+        tilt_y_rad=math.atan2(m[0, 2], m[0, 0]),
+    )  # fmt: skip
 
 
 def _auto_camera(cam_id: int, center: tuple[float, float], half: tuple[float, float], lay: AutoLayout,

@@ -38,6 +38,7 @@ class RefereeParams(Validated):
     place_robots_on_goal: bool = True  # put both teams in their kickoff formation after a goal
     free_kick_distance_m: float = setting(0.2, lo=0.0, hi=2.0)  # from the lines and defense areas
     kickoff_clearance_m: float = setting(0.5, lo=0.0, hi=3.0)  # own robots around the ball in a stop
+    restart_timeout_s: float = setting(10.0, lo=0.1, hi=600.0)  # a restart not taken by then: play on
     # start poses (x m, y m, theta rad) of the team defending -x, per division; mirrored for the other
     formations: Mapping[Literal["A", "B"], tuple[tuple[float, float, float], ...]] = field(
         default_factory=lambda: dict(_DEFAULT_FORMATIONS)
@@ -60,6 +61,7 @@ class Referee:
         self.for_team: Team | None = "blue"
         self._restart: tuple[float, str, Team, tuple[float, float]] | None = None
         self._restart_ball: tuple[float, float] | None = (0.0, 0.0)
+        self._restart_t = 0.0  # when the restart in force was given
 
     def formation(self, team: Team) -> list[tuple[float, float, float]]:
         """Kickoff poses of ``team``'s robots in the field frame."""
@@ -88,6 +90,7 @@ class Referee:
         self.world.place_ball(0.0, 0.0)
         self.command, self.for_team = "kickoff", kicking_team
         self._restart_ball = (0.0, 0.0)
+        self._restart_t = self.world.t
 
     def observe(self, events: list[Goal | BallOut | Kick | Contact]) -> None:
         """Take one frame's events; carry out a due restart."""
@@ -123,10 +126,12 @@ class Referee:
                 self.world.place_ball(*spot)
                 self.command, self.for_team = ("kickoff" if kind == "kickoff" else "free_kick"), team
                 self._restart_ball = spot
-        # a restart is taken once the ball moved: normal play
+                self._restart_t = t
+        # a restart is taken once the ball moved: normal play; not taken in time, play goes on anyway
         if self.command in ("kickoff", "free_kick") and self._restart_ball is not None:
             bx, by = self.world.ball_body.position
-            if math.hypot(bx - self._restart_ball[0], by - self._restart_ball[1]) > 0.05:
+            moved = math.hypot(bx - self._restart_ball[0], by - self._restart_ball[1]) > 0.05
+            if moved or t - self._restart_t > self.params.restart_timeout_s:
                 self.command, self.for_team, self._restart_ball = "normal", None, None
 
     def state(self) -> GameState:

@@ -6,6 +6,7 @@ with the unit in each metric's name. Baselines run side by side in the same proc
 
 from __future__ import annotations
 
+import importlib
 import json
 from collections.abc import Callable
 from pathlib import Path
@@ -18,19 +19,24 @@ __all__ = ["SUITES", "print_table", "write_json"]
 Row = dict[str, Any]
 
 
-def _sim(settings: Settings, quick: bool) -> list[Row]:
-    from cmdragons.bench.sim import run
+def _lazy(module: str) -> Callable[[Settings, bool], list[Row]]:
+    """A suite's ``run`` imported on first use (a suite may pull in heavy or optional packages)."""
 
-    return run(settings, quick)
+    def run(settings: Settings, quick: bool) -> list[Row]:
+        rows: list[Row] = importlib.import_module(module).run(settings, quick)
+        return rows
 
-
-def _planning(settings: Settings, quick: bool) -> list[Row]:
-    from cmdragons.bench.planning import run
-
-    return run(settings, quick)
+    return run
 
 
-SUITES: dict[str, Callable[[Settings, bool], list[Row]]] = {"sim": _sim, "planning": _planning}
+SUITES: dict[str, Callable[[Settings, bool], list[Row]]] = {
+    "sim": _lazy("cmdragons.bench.sim"),
+    "planning": _lazy("cmdragons.bench.planning"),
+    "safety": _lazy("cmdragons.bench.safety"),
+    "tracking": _lazy("cmdragons.bench.tracking"),
+    "play": _lazy("cmdragons.bench.play"),
+    "vision": _lazy("cmdragons.bench.vision"),
+}
 
 
 def print_table(suite: str, rows: list[Row]) -> None:

@@ -13,9 +13,15 @@ from typing import Any
 
 from cmdragons.camera import CameraModel, CamerasParams, cameras_from_config
 from cmdragons.config import ConfigError, apply_override, default_config_dir, load_yaml, parse
+from cmdragons.control.motion import ControlParams
 from cmdragons.geometry import Field, LeagueParams
 from cmdragons.planning.registry import PlannerParams
+from cmdragons.safety.registry import SafetyParams
+from cmdragons.team import TeamParams
+from cmdragons.tracking.tracker import TrackerParams
 from sim.params import SimParams
+from strategy.plays import StrategyParams
+from vision.pipeline import VisionParams
 
 __all__ = ["CONCERNS", "Settings", "load_settings"]
 
@@ -24,6 +30,12 @@ CONCERNS: dict[str, type] = {
     "cameras": CamerasParams,
     "sim": SimParams,
     "planner": PlannerParams,
+    "control": ControlParams,
+    "safety": SafetyParams,
+    "tracker": TrackerParams,
+    "strategy": StrategyParams,
+    "team": TeamParams,
+    "vision": VisionParams,
 }
 
 
@@ -34,6 +46,12 @@ class Settings:
     cameras: CamerasParams
     sim: SimParams
     planner: PlannerParams
+    control: ControlParams
+    safety: SafetyParams
+    tracker: TrackerParams
+    strategy: StrategyParams
+    team: TeamParams
+    vision: VisionParams
 
     def field_geometry(self) -> Field:
         return Field(self.field)

@@ -7,10 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from cmdragons.camera import CamerasParams
 from cmdragons.config import ConfigError
-from cmdragons.geometry import LeagueParams
-from cmdragons.planning.registry import PlannerParams
 from cmdragons.runtime.settings import CONCERNS, load_settings
 from sim.params import SimParams
 
@@ -27,10 +24,8 @@ def configs(tmp_path: Path) -> Path:
 def test_shipped_configs_equal_the_dataclass_defaults() -> None:
     # the YAML files show every default; they must not drift from the code's defaults
     s = load_settings(REPO_CONFIGS)
-    assert s.field == LeagueParams()
-    assert s.cameras == CamerasParams()
-    assert s.sim == SimParams()
-    assert s.planner == PlannerParams()
+    for name, cls in CONCERNS.items():
+        assert getattr(s, name) == cls(), name
     assert sorted(p.stem for p in REPO_CONFIGS.glob("*.yaml")) == sorted(CONCERNS)
 
 
@@ -46,6 +41,8 @@ def test_shipped_configs_equal_the_dataclass_defaults() -> None:
         ("cameras.yaml", "auto:\n  grid: [2]\n", "auto.grid", "a list of 2 values"),
         ("field.yaml", "robot:\n  front_distance_m: 0.2\n", "robot", "smaller than radius_m"),
         ("planner.yaml", "planner: astar\n", "planner", "allowed: 'errt', 'prm', 'visgraph'"),
+        ("safety.yaml", "method: magic\n", "method", "allowed: 'none', 'dss', 'dynamic_window'"),
+        ("safety.yaml", "dss:\n  own_margin_m: -0.1\n", "dss.own_margin_m", "allowed: 0.0 to 1.0"),
         ("planner.yaml", "errt:\n  p_goal: 0.6\n  p_waypoint: 0.6\n", "errt", "p_goal + p_waypoint"),
         ("planner.yaml", "errt:\n  nearest: octree\n", "errt.nearest", "allowed: 'brute', 'kdtree'"),
     ],
@@ -71,8 +68,8 @@ def test_missing_folder_and_unknown_file(tmp_path: Path, configs: Path) -> None:
     with pytest.raises(ConfigError, match="config folder not found"):
         load_settings(tmp_path / "nowhere")
     (configs / "simm.yaml").write_text("seed: 2\n")
-    allowed = "unknown config file; allowed: field.yaml, cameras.yaml, sim.yaml, planner.yaml"
-    with pytest.raises(ConfigError, match=allowed):
+    allowed = ", ".join(f"{c}.yaml" for c in CONCERNS)
+    with pytest.raises(ConfigError, match=f"unknown config file; allowed: {allowed}"):
         load_settings(configs)
 
 
@@ -99,7 +96,7 @@ def test_set_overrides(configs: Path) -> None:
     [
         ("sim.physics.substeps=-3", "out of range"),
         ("sim.physics.nope=3", "unknown key"),
-        ("simm.seed=3", "unknown concern; allowed: cameras, field, planner, sim"),
+        ("simm.seed=3", "unknown concern; allowed: " + ", ".join(sorted(CONCERNS))),
         ("sim.seed", "expected concern.key.path=value"),
         ("seed=3", "expected at least concern.key"),
     ],

@@ -1,0 +1,212 @@
+"""``cmdragons bench safety``: the safety experiment of Bruce 2006 §5.6.1 in the simulator.
+
+N robots of one team (2, 4, 6, 8, 11, 22) cross the field at once: half start near the left goal
+line and drive to the right one, half the other way, at random lateral positions (seeded), so that
+paths cross head-on and diagonally. Each frame the robots' true state plus Gaussian noise (what a
+tracker would hand over) goes through latency compensation, the trapezoid motion controller and the
+safety stage under test (none, DSS, the dynamic window), and the commands drive the pymunk world
+(sim.world.World directly, no rendering). A trial ends when every robot has come within
+``ARRIVED_M`` of its goal, or at ``TIMEOUT_S``. Instead of the global planner, a keep-right rule
+(:func:`keep_right_targets`) routes each robot past a robot in its way, the same for every method.
+
+Metrics per N, method and noise level: ``collisions`` (robot-robot contacts, summed over the
+trials), ``collisions_above_1_5_m_s`` (those closing faster than 1.5 m/s), ``penetration_mm_s``
+(depth x duration of the contacts, mean per trial), ``completion_s`` (mean time until the last robot arrived;
+a timed-out trial counts its timeout), ``completion_ratio_to_none``, ``ms_per_frame`` (controller
+and safety stage together, mean) and ``ms_per_agent``.
+"""
+
+from __future__ import annotations
+
+import math
+import multiprocessing
+import os
+import time
+from collections.abc import Sequence
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from cmdragons.control import ControlParams, LatencyCompensator, follow_path, motion_commands
+from cmdragons.messages import RobotCommand
+from cmdragons.planning.world import field_world
+from cmdragons.runtime.settings import Settings
+from cmdragons.safety.registry import make_safety
+from sim.world import Contact, World
+
+__all__ = ["NOISE", "TrialResult", "run", "run_trial"]
+
+# Gaussian noise on the observed state: (position sigma m, velocity sigma m/s, heading sigma rad)
+NOISE: dict[str, tuple[float, float, float]] = {"default": (0.002, 0.02, 0.01), "high": (0.01, 0.1, 0.05)}
+METHODS = ("none", "dss", "dynamic_window")
+ROBOTS = (2, 4, 6, 8, 11, 22)
+QUICK_ROBOTS = (2, 6, 11)
+TRIALS, QUICK_TRIALS = 100, 3
+ARRIVED_M = 0.05  # a robot this close to its goal has arrived
+TIMEOUT_S = 10.0
+FAST_M_S = 1.5  # collisions closing faster than this are reported apart
+LINE_OFFSET_M = 0.4  # starts and goals lie this far inside the goal lines
+# navigation stand-in (the planner's job in the team): keep right of a robot in the way
+LOOKAHEAD_M = 1.0  # robots this far ahead on the way to the goal count as in the way
+CORRIDOR_M = 0.25  # ... when their centre is this close to the straight line
+PASS_M = 0.45  # the detour waypoint lies this far to the right of the robot in the way
+
+
+@dataclass(frozen=True)
+class TrialResult:
+    n: int
+    method: str
+    noise: str
+    collisions: int
+    fast_collisions: int
+    penetration_mm_s: float
+    completion_s: float
+    completed: bool
+    brain_ms: float  # mean per frame: latency compensation, controller and safety
+
+
+def _layout(settings: Settings, n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """Starts and goals (n, 2): even robots on the left, odd on the right, lateral slots shuffled."""
+    f = settings.field_geometry()
+    x = f.half_length - LINE_OFFSET_M
+    side = np.where(np.arange(n) % 2 == 0, -1.0, 1.0)
+    k = (n + 1) // 2
+    slots = np.linspace(-f.half_width + 0.4, f.half_width - 0.4, k) if k > 1 else np.zeros(1)
+    jitter = (slots[1] - slots[0]) * 0.25 if k > 1 else 0.5
+    starts = np.empty((n, 2))
+    goals = np.empty((n, 2))
+    for s in (-1.0, 1.0):
+        idx = np.flatnonzero(side == s)
+        starts[idx, 0] = s * x
+        starts[idx, 1] = rng.permutation(slots)[: len(idx)] + rng.uniform(-jitter, jitter, len(idx))
+        goals[idx, 0] = -s * x
+        goals[idx, 1] = rng.permutation(slots)[: len(idx)] + rng.uniform(-jitter, jitter, len(idx))
+    return starts, goals
+
+
+def keep_right_targets(
+    state: np.ndarray, goals: np.ndarray, headings: np.ndarray, control: ControlParams
+) -> np.ndarray:
+    """Targets (n, 5) for the controller: straight to the goal, or, when another robot stands in the
+    way within ``LOOKAHEAD_M``, along a path through a waypoint ``PASS_M`` to the right of it.
+
+    A stand-in for the global planner, which the team runs but this benchmark does not (it costs more
+    than the whole rest of the frame): a shared keep-right rule lets crossing robots pass each other
+    instead of meeting head-on; every safety method runs behind the same rule."""
+    pos = state[:, :2]
+    n = len(pos)
+    to_goal = goals - pos
+    dist = np.hypot(to_goal[:, 0], to_goal[:, 1])
+    unit = to_goal / np.maximum(dist, 1e-9)[:, None]
+    rel = pos[None, :, :] - pos[:, None, :]  # rel[i, j] = pos_j - pos_i
+    along = np.einsum("ijk,ik->ij", rel, unit)
+    across = unit[:, None, 0] * rel[:, :, 1] - unit[:, None, 1] * rel[:, :, 0]
+    ahead = (along > 0) & (along < np.minimum(LOOKAHEAD_M, dist[:, None])) & (np.abs(across) < CORRIDOR_M)
+    ahead[np.arange(n), np.arange(n)] = False
+    targets = np.column_stack([goals, np.zeros((n, 2)), headings])
+    for i in np.flatnonzero(ahead.any(axis=1)):
+        j = int(np.argmin(np.where(ahead[i], along[i], np.inf)))
+        right = np.array([unit[i, 1], -unit[i, 0]])
+        path = np.array([pos[i], pos[j] + right * PASS_M, goals[i]])
+        t = follow_path((float(pos[i, 0]), float(pos[i, 1])), path, float(headings[i]), control)
+        targets[i] = (t.x, t.y, t.vx, t.vy, t.theta)
+    return targets
+
+
+def run_trial(settings: Settings, n: int, method: str, noise: str, seed: int) -> TrialResult:
+    """One traversal of ``n`` robots with safety ``method`` under ``noise``; same seed, same layout
+    and noise for every method."""
+    sp = settings.sim
+    world = World(settings.field, sp.physics, sp.robot, sp.ball, sp.kicker, sp.dribbler,
+                  robots_per_team={"blue": n, "yellow": 0})  # fmt: skip
+    f = settings.field_geometry()
+    world.place_ball(0.0, f.half_width + 0.15)  # in the boundary strip, out of the way
+    layout_rng = np.random.default_rng([seed, n])
+    starts, goals = _layout(settings, n, layout_rng)
+    headings = np.where(goals[:, 0] > starts[:, 0], 0.0, math.pi)
+    for i in range(n):
+        world.place_robot("blue", i, float(starts[i, 0]), float(starts[i, 1]), float(headings[i]))
+    noise_rng = np.random.default_rng([seed, n, 7])
+    sigma = np.array([NOISE[noise][0]] * 2 + [NOISE[noise][2]] + [NOISE[noise][1]] * 2 + [NOISE[noise][2]])
+    radius = settings.field.robot.radius_m
+    static = field_world(f, defense_areas=False)
+    safety = make_safety(settings.safety, settings.control, radius, static, method, stream=seed)
+    lat = LatencyCompensator(settings.control.motion)
+    ids = np.arange(n)
+    no_opponents = np.zeros((0, 4))
+    contacts: list[Contact] = []
+    brain = 0.0
+    frames = round(TIMEOUT_S * sp.physics.frame_rate_hz)
+    arrived = np.full(n, np.nan)
+    steps = 0
+    for _ in range(frames):
+        steps += 1
+        rows = world.snapshot().robots
+        truth = rows[:, 2:8]
+        observed = truth + noise_rng.normal(0.0, 1.0, truth.shape) * sigma
+        t0 = time.perf_counter()
+        state = lat.predict(world.t, ids, observed)
+        targets = keep_right_targets(state, goals, headings, settings.control)
+        cmd = motion_commands(state, targets, settings.control)
+        safe = safety.filter(state[:, [0, 1, 3, 4]], cmd[:, :2], no_opponents)
+        cmd[:, :2] = safe.velocities
+        brain += time.perf_counter() - t0
+        lat.record(world.t, ids, cmd)
+        commands = [RobotCommand("blue", i, float(c[0]), float(c[1]), float(c[2])) for i, c in enumerate(cmd)]
+        contacts += [e for e in world.step_frame(commands) if isinstance(e, Contact)]
+        after = world.snapshot().robots
+        near = np.hypot(after[:, 2] - goals[:, 0], after[:, 3] - goals[:, 1]) < ARRIVED_M
+        arrived[near & np.isnan(arrived)] = world.t
+        if not np.isnan(arrived).any():
+            break
+    done = not np.isnan(arrived).any()
+    completion = float(np.max(arrived)) if done else TIMEOUT_S
+    contacts += world.open_contacts()
+    return TrialResult(
+        n, method, noise, len(contacts), sum(c.relative_speed_m_s > FAST_M_S for c in contacts),
+        sum(c.max_depth_m * 1e3 * c.duration_s for c in contacts), completion, done, brain * 1e3 / steps,
+    )  # fmt: skip
+
+
+_SETTINGS: list[Settings] = []  # handed to the forked workers (settings hold mapping proxies that do not pickle)
+
+
+def _cell(args: tuple[int, str, str, Sequence[int]]) -> list[TrialResult]:
+    n, method, noise, seeds = args
+    return [run_trial(_SETTINGS[0], n, method, noise, s) for s in seeds]
+
+
+def run(settings: Settings, quick: bool) -> list[dict[str, Any]]:
+    robots = QUICK_ROBOTS if quick else ROBOTS
+    trials = QUICK_TRIALS if quick else TRIALS
+    seeds = list(range(trials))
+    # chunks of trials, so that two processes share the work evenly (the machine has 2 cores)
+    chunk = max(1, trials // 4)
+    jobs = [(n, m, z, seeds[i : i + chunk]) for n in robots for z in NOISE for m in METHODS
+            for i in range(0, trials, chunk)]  # fmt: skip
+    workers = max(1, min(2, os.cpu_count() or 1))
+    results: list[TrialResult] = []
+    _SETTINGS[:] = [settings]
+    with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("fork")) as pool:
+        for part in pool.map(_cell, jobs):
+            results += part
+    rows: list[dict[str, Any]] = []
+    for n in robots:
+        for z in NOISE:
+            base = float(np.mean([r.completion_s for r in results if (r.n, r.method, r.noise) == (n, "none", z)]))
+            for m in METHODS:
+                rs = [r for r in results if (r.n, r.method, r.noise) == (n, m, z)]
+                completion = float(np.mean([r.completion_s for r in rs]))
+                ms = float(np.mean([r.brain_ms for r in rs]))
+                rows.append({
+                    "name": f"{m} n={n} noise={z}", "robots": n, "trials": len(rs),
+                    "collisions": sum(r.collisions for r in rs),
+                    "collisions_above_1_5_m_s": sum(r.fast_collisions for r in rs),
+                    "penetration_mm_s": float(np.mean([r.penetration_mm_s for r in rs])),
+                    "completion_s": completion, "completion_ratio_to_none": completion / base,
+                    "incomplete": sum(not r.completed for r in rs),
+                    "ms_per_frame": ms, "ms_per_agent": ms / n,
+                })  # fmt: skip
+    return rows

@@ -1,0 +1,138 @@
+"""Per-robot motion control: the velocity command for the next frame period (Bruce 2006 appendix B.4).
+
+Field frame, metres, seconds, radians. The robot's translation follows the 2D trapezoidal profile
+toward a target position and velocity; its heading follows a 1D profile toward a target angle. The
+command is the profile's velocity at the end of the next control period, held to the robot's
+limits (speed, and the acceleration model A(v) of §5.1), because the robot's motors track a
+commanded velocity as fast as their limits allow.
+
+Path following: the target is the next waypoint of a planned path; the robot arrives there with
+a speed that still lets it stop at the end of the path and turn into the next leg without drifting
+more than ``corner_overshoot_m`` past the corner.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from cmdragons.config import Validated, setting
+from cmdragons.control import _kernels as K
+from cmdragons.control.trapezoid import TrapezoidParams
+from cmdragons.messages import RobotCommand, RobotState
+
+__all__ = [
+    "ControlParams",
+    "MotionParams",
+    "MotionTarget",
+    "PathParams",
+    "follow_path",
+    "motion_command",
+    "motion_commands",
+]
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class MotionParams(Validated):
+    """The robot model the controller and the safety search assume (defaults: the simulator's
+    robots) and the control period."""
+
+    max_speed_m_s: float = setting(3.0, lo=0.01, hi=10.0)
+    max_accel_m_s2: float = setting(3.0, lo=0.01, hi=50.0)  # speeding up or turning the velocity
+    max_brake_m_s2: float = setting(6.0, lo=0.01, hi=50.0)  # slowing down
+    max_omega_rad_s: float = setting(20.0, lo=0.01, hi=100.0)
+    max_alpha_rad_s2: float = setting(60.0, lo=0.01, hi=1000.0)  # angular acceleration and braking
+    frame_rate_hz: float = setting(60.0, lo=1.0, hi=1000.0)  # one command per camera frame
+    latency_s: float = setting(0.03, lo=0.0, hi=1.0)  # command sent -> wheels act on it
+
+    @property
+    def period_s(self) -> float:
+        """The control period: one command holds for this long."""
+        return 1.0 / self.frame_rate_hz
+
+    def limits(self) -> FloatArray:
+        """(vmax, accel, brake, omega_max, alpha_max) for the kernels."""
+        return np.array([self.max_speed_m_s, self.max_accel_m_s2, self.max_brake_m_s2,
+                         self.max_omega_rad_s, self.max_alpha_rad_s2])  # fmt: skip
+
+
+@dataclass(frozen=True)
+class PathParams(Validated):
+    """configs/control.yaml ``path``: following a planned path."""
+
+    waypoint_reached_m: float = setting(0.05, lo=0.0, hi=1.0)  # a waypoint this close counts as passed
+    corner_overshoot_m: float = setting(0.03, lo=0.001, hi=1.0)  # drift past a corner while turning
+
+
+@dataclass(frozen=True)
+class ControlParams:
+    """configs/control.yaml: motion control (Bruce 2006 B.4)."""
+
+    motion: MotionParams = MotionParams()
+    trapezoid: TrapezoidParams = TrapezoidParams()
+    path: PathParams = PathParams()
+
+
+@dataclass(frozen=True)
+class MotionTarget:
+    """Where a robot should be next: position (m), velocity on arrival (m/s), heading (rad); field
+    frame."""
+
+    x: float
+    y: float
+    vx: float = 0.0
+    vy: float = 0.0
+    theta: float = 0.0
+
+
+def motion_commands(states: ArrayLike, targets: ArrayLike, params: ControlParams) -> FloatArray:
+    """Commands (n, 3) vx, vy (field frame, m/s), omega (rad/s) for robots ``states`` (n, 6: x, y,
+    theta, vx, vy, omega) toward ``targets`` (n, 5: x, y, vx, vy, theta), one frame period ahead."""
+    s = np.ascontiguousarray(states, dtype=np.float64).reshape(-1, 6)
+    t = np.ascontiguousarray(targets, dtype=np.float64).reshape(-1, 5)
+    m = params.motion
+    return np.asarray(K.motion_commands(s, t, m.limits(), m.period_s, params.trapezoid.split_iterations))
+
+
+def motion_command(robot: RobotState, target: MotionTarget, params: ControlParams) -> RobotCommand:
+    """The command of one robot toward ``target`` for the next frame period (Bruce 2006 B.4)."""
+    state = np.array([[robot.x, robot.y, robot.theta, robot.vx, robot.vy, robot.omega]])
+    goal = np.array([[target.x, target.y, target.vx, target.vy, target.theta]])
+    vx, vy, omega = motion_commands(state, goal, params)[0]
+    return RobotCommand(robot.team, robot.id, float(vx), float(vy), float(omega))
+
+
+def follow_path(position: tuple[float, float], path: ArrayLike, theta: float, params: ControlParams) -> MotionTarget:
+    """The target on a planned ``path`` (k, 2) for a robot at ``position``: the first waypoint not yet
+    reached, to arrive at with the fastest speed that still lets the robot stop at the path's end and
+    turn into the next leg within ``corner_overshoot_m``; at the last point, stop (Bruce 2006 B.4)."""
+    pts = np.asarray(path, dtype=np.float64).reshape(-1, 2)
+    p = np.asarray(position, dtype=np.float64)
+    if len(pts) == 0:
+        return MotionTarget(float(p[0]), float(p[1]), theta=theta)
+    # the first point is where the path started; skip it and every waypoint already reached (but
+    # never the last point)
+    k = min(1, len(pts) - 1)
+    while k < len(pts) - 1 and math.dist(p, pts[k]) <= params.path.waypoint_reached_m:
+        k += 1
+    if k == len(pts) - 1:
+        return MotionTarget(float(pts[k, 0]), float(pts[k, 1]), theta=theta)
+    w, nxt = pts[k], pts[k + 1]
+    incoming, outgoing = w - p, nxt - w
+    n_in, n_out = float(np.hypot(*incoming)), float(np.hypot(*outgoing))
+    if n_in <= 1e-9 or n_out <= 1e-9:
+        return MotionTarget(float(w[0]), float(w[1]), theta=theta)
+    m = params.motion
+    rest = n_out + float(np.hypot(*np.diff(pts[k + 1 :], axis=0).T).sum()) if k + 2 < len(pts) else n_out
+    cos_turn = float(incoming @ outgoing) / (n_in * n_out)
+    # the velocity across the next leg (all of it when turning back) is cancelled at max_accel
+    across = math.sqrt(max(0.0, 1.0 - cos_turn * cos_turn)) if cos_turn > 0.0 else 1.0
+    turn_speed = math.sqrt(2.0 * m.max_accel_m_s2 * params.path.corner_overshoot_m) / max(across, 1e-9)
+    speed = min(m.max_speed_m_s, math.sqrt(2.0 * m.max_brake_m_s2 * rest), turn_speed)
+    u = incoming / n_in
+    return MotionTarget(float(w[0]), float(w[1]), float(u[0] * speed), float(u[1] * speed), theta)

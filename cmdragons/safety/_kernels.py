@@ -1,0 +1,461 @@
+"""numba kernels of Dynamics Safety Search (Bruce 2006 ch. 5) and of the dynamic window (§5.2).
+
+Field frame, metres, seconds. A robot's command is modelled as one control period ``dt`` of
+acceleration ``a`` (the velocity command v + a dt, reached as fast as the motors can and then held)
+followed by braking at the maximum deceleration ``brake`` along its velocity until it rests (§5.1,
+§5.3). Such a trajectory is a short list of parabolic segments, stored as rows
+``(t0, t1, px, py, vx, vy, ax, ay)``: position ``p + v (t - t0) + a (t - t0)^2 / 2`` for
+``t0 <= t <= t1``; the last row rests forever (``t1 = inf``).
+
+Two trajectories collide when their centres come closer than ``R`` (two radii plus a margin) at
+the same time. On each time interval where both are single parabolas the squared distance minus
+``R(t)^2`` is a quartic in time; its minimum over the interval is at an end or at a root of the
+cubic derivative, found by bisection inside the monotone pieces between the cubic's turning points.
+An opponent is a disc moving at its current velocity whose radius grows by ``accel t^2 / 2``: every
+place it can reach by accelerating at most ``accel`` in any direction.
+
+A pair already closer than ``R`` at the start (noise, a push) counts as safe while the distance
+does not shrink below its starting value: otherwise no command, not even the stop, could pass and
+the pair would freeze in contact.
+
+Plain-numpy references of these kernels live in :mod:`cmdragons.safety._reference`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from cmdragons.control._kernels import clip_accel, limit_velocity
+
+N_SEG = 4  # reaching the command, holding it to the period's end, braking, rest
+_BISECT = 40
+
+# statuses of a robot after the search
+KEPT = 0  # its own command was safe
+CHANGED = 1  # the safe sample nearest its command
+STOPPED = 2  # nothing else was safe: the stop
+STOP_ASKED = 3  # it asked to stop (always accepted)
+
+
+@njit(cache=True)
+def _put(tr: np.ndarray, k: int, t0: float, t1: float, px: float, py: float, vx: float, vy: float,
+         ax: float, ay: float) -> tuple[float, float, float, float]:  # fmt: skip
+    # write segment k and return the position and velocity at its end
+    tr[k, 0], tr[k, 1], tr[k, 2], tr[k, 3], tr[k, 4], tr[k, 5], tr[k, 6], tr[k, 7] = t0, t1, px, py, vx, vy, ax, ay
+    h = t1 - t0
+    return px + vx * h + 0.5 * ax * h * h, py + vy * h + 0.5 * ay * h * h, vx + ax * h, vy + ay * h
+
+
+@njit(cache=True)
+def trajectory(
+    px: float, py: float, vx: float, vy: float, ax: float, ay: float, dt: float, accel: float, brake: float
+) -> np.ndarray:
+    """Segments (N_SEG, 8) of the command v + a dt held for one period ``dt``, then braking at
+    ``brake`` to rest. The motors reach a commanded velocity as fast as they can (at ``brake`` when
+    it slows the robot against its motion, else at ``accel``) and then hold it, as the simulator's
+    motor model does; the stop command (a = -v / dt) thus brakes at full strength."""
+    tr = np.zeros((N_SEG, 8))
+    cx, cy = vx + ax * dt, vy + ay * dt
+    dvx, dvy = cx - vx, cy - vy
+    dv = math.hypot(dvx, dvy)
+    slowing = dvx * vx + dvy * vy < 0.0 and cx * cx + cy * cy < vx * vx + vy * vy
+    rate = brake if slowing else accel
+    t_reach = min(dv / rate, dt) if rate > 0.0 and dv > 0.0 else 0.0
+    ux, uy = (dvx / dv * rate, dvy / dv * rate) if dv > 0.0 and rate > 0.0 else (0.0, 0.0)
+    qx, qy, wx, wy = _put(tr, 0, 0.0, t_reach, px, py, vx, vy, ux, uy)
+    qx, qy, wx, wy = _put(tr, 1, t_reach, dt, qx, qy, wx, wy, 0.0, 0.0)
+    w = math.hypot(wx, wy)
+    t_brake = w / brake if brake > 0.0 else 0.0
+    bx, by = (-brake * wx / w, -brake * wy / w) if w > 0.0 else (0.0, 0.0)
+    qx, qy, _, _ = _put(tr, 2, dt, dt + t_brake, qx, qy, wx, wy, bx, by)
+    _put(tr, 3, dt + t_brake, math.inf, qx, qy, 0.0, 0.0, 0.0, 0.0)
+    return tr
+
+
+@njit(cache=True)
+def stop_accel(vx: float, vy: float, dt: float) -> tuple[float, float]:
+    """The acceleration that names the stop command (velocity zero): the motors brake at full
+    strength until the robot rests (see :func:`trajectory`)."""
+    return -vx / dt, -vy / dt
+
+
+@njit(cache=True)
+def _seg_at(tr: np.ndarray, k: int, t: float) -> tuple[float, float, float, float]:
+    # position and velocity of segment k at absolute time t (inside the segment)
+    h = t - tr[k, 0]
+    return (tr[k, 2] + tr[k, 4] * h + 0.5 * tr[k, 6] * h * h, tr[k, 3] + tr[k, 5] * h + 0.5 * tr[k, 7] * h * h,
+            tr[k, 4] + tr[k, 6] * h, tr[k, 5] + tr[k, 7] * h)  # fmt: skip
+
+
+@njit(cache=True)
+def _poly(c: np.ndarray, t: float) -> float:
+    return float((((c[4] * t + c[3]) * t + c[2]) * t + c[1]) * t + c[0])
+
+
+@njit(cache=True)
+def _dpoly(c: np.ndarray, t: float) -> float:
+    return float(((4.0 * c[4] * t + 3.0 * c[3]) * t + 2.0 * c[2]) * t + c[1])
+
+
+@njit(cache=True)
+def quartic_min(c: np.ndarray, T: float) -> float:
+    """Minimum of c0 + c1 t + ... + c4 t^4 over [0, T]."""
+    best = min(_poly(c, 0.0), _poly(c, T))
+    # turning points of the cubic derivative: roots of 12 c4 t^2 + 6 c3 t + 2 c2
+    cuts = np.empty(4)
+    cuts[0] = 0.0
+    m = 1
+    qa, qb, qc = 12.0 * c[4], 6.0 * c[3], 2.0 * c[2]
+    if abs(qa) > 1e-15:
+        disc = qb * qb - 4.0 * qa * qc
+        if disc > 0.0:
+            s = math.sqrt(disc)
+            r1, r2 = (-qb - s) / (2.0 * qa), (-qb + s) / (2.0 * qa)
+            if r1 > r2:
+                r1, r2 = r2, r1
+            for r in (r1, r2):
+                if 0.0 < r < T:
+                    cuts[m] = r
+                    m += 1
+    elif abs(qb) > 1e-15:
+        r = -qc / qb
+        if 0.0 < r < T:
+            cuts[m] = r
+            m += 1
+    cuts[m] = T
+    m += 1
+    for i in range(m - 1):
+        lo, hi = cuts[i], cuts[i + 1]
+        flo, fhi = _dpoly(c, lo), _dpoly(c, hi)
+        if flo < 0.0 < fhi:  # the quartic falls then rises: a minimum inside
+            for _ in range(_BISECT):
+                mid = 0.5 * (lo + hi)
+                if _dpoly(c, mid) < 0.0:
+                    lo = mid
+                else:
+                    hi = mid
+            best = min(best, _poly(c, 0.5 * (lo + hi)))
+    return best
+
+
+@njit(cache=True)
+def _gap_coeffs(
+    d0x: float, d0y: float, d1x: float, d1y: float, ex: float, ey: float, r0: float, r1: float, r2: float
+) -> np.ndarray:
+    # |d0 + d1 t + e t^2|^2 - (r0 + r1 t + r2 t^2)^2 as quartic coefficients
+    c = np.empty(5)
+    c[0] = d0x * d0x + d0y * d0y - r0 * r0
+    c[1] = 2.0 * (d0x * d1x + d0y * d1y) - 2.0 * r0 * r1
+    c[2] = d1x * d1x + d1y * d1y + 2.0 * (d0x * ex + d0y * ey) - (r1 * r1 + 2.0 * r0 * r2)
+    c[3] = 2.0 * (d1x * ex + d1y * ey) - 2.0 * r1 * r2
+    c[4] = ex * ex + ey * ey - r2 * r2
+    return c
+
+
+@njit(cache=True)
+def _interval_hits(
+    d0x: float, d0y: float, d1x: float, d1y: float, ex: float, ey: float,
+    r0: float, r1: float, r2: float, T: float,
+) -> bool:  # fmt: skip
+    """Does |d0 + d1 t + e t^2| fall below r0 + r1 t + r2 t^2 (r's >= 0) for some t in [0, T]?"""
+    # cheap rejection: the distance cannot shrink faster than its derivative bounds allow
+    lower = math.hypot(d0x, d0y) - math.hypot(d1x, d1y) * T - math.hypot(ex, ey) * T * T
+    if lower > r0 + r1 * T + r2 * T * T:
+        return False
+    return quartic_min(_gap_coeffs(d0x, d0y, d1x, d1y, ex, ey, r0, r1, r2), T) < 0.0
+
+
+@njit(cache=True)
+def _reach(tr: np.ndarray) -> float:
+    # a bound on how far the trajectory strays from its start: the path length of its segments
+    total = 0.0
+    for k in range(N_SEG - 1):
+        h = tr[k, 1] - tr[k, 0]
+        total += math.hypot(tr[k, 4], tr[k, 5]) * h + 0.5 * math.hypot(tr[k, 6], tr[k, 7]) * h * h
+    return total
+
+
+@njit(cache=True)
+def pair_hits(ta: np.ndarray, tb: np.ndarray, radius: float) -> bool:
+    """Do two trajectories bring their centres closer than ``radius`` at the same time? (A pair
+    closer than that at the start only fails when it gets closer still.)"""
+    dx0, dy0 = ta[0, 2] - tb[0, 2], ta[0, 3] - tb[0, 3]
+    d0 = math.hypot(dx0, dy0)
+    if d0 > _reach(ta) + _reach(tb) + radius:
+        return False
+    r = min(radius, d0 * (1.0 - 1e-9))
+    # the breakpoints of both: [0, dt] share one segment each, then the two braking ends
+    times = np.empty(N_SEG * 2 + 1)
+    n = 0
+    for k in range(N_SEG):
+        times[n], times[n + 1] = ta[k, 0], tb[k, 0]
+        n += 2
+    times[n] = max(ta[N_SEG - 1, 0], tb[N_SEG - 1, 0])
+    times = np.sort(times[: n + 1])
+    ka, kb = 0, 0
+    for i in range(n):
+        t0, t1 = times[i], times[i + 1]
+        if t1 - t0 <= 1e-12:
+            continue
+        while ka < N_SEG - 1 and ta[ka, 1] <= t0 + 1e-12:
+            ka += 1
+        while kb < N_SEG - 1 and tb[kb, 1] <= t0 + 1e-12:
+            kb += 1
+        ax, ay, avx, avy = _seg_at(ta, ka, t0)
+        bx, by, bvx, bvy = _seg_at(tb, kb, t0)
+        ex, ey = 0.5 * (ta[ka, 6] - tb[kb, 6]), 0.5 * (ta[ka, 7] - tb[kb, 7])
+        if _interval_hits(ax - bx, ay - by, avx - bvx, avy - bvy, ex, ey, r, 0.0, 0.0, t1 - t0):
+            return True
+    # both at rest after the last breakpoint
+    ax, ay = ta[N_SEG - 1, 2], ta[N_SEG - 1, 3]
+    bx, by = tb[N_SEG - 1, 2], tb[N_SEG - 1, 3]
+    return math.hypot(ax - bx, ay - by) < r
+
+
+@njit(cache=True)
+def opponent_hits(tr: np.ndarray, ox: float, oy: float, ovx: float, ovy: float, radius: float, accel: float) -> bool:
+    """Can an opponent at (ox, oy) moving at (ovx, ovy), accelerating at most ``accel`` in any
+    direction, come closer than ``radius`` to the trajectory before it rests?"""
+    dx0, dy0 = tr[0, 2] - ox, tr[0, 3] - oy
+    d0 = math.hypot(dx0, dy0)
+    r = min(radius, d0 * (1.0 - 1e-9))
+    t_rest = tr[N_SEG - 1, 0]
+    far = _reach(tr) + math.hypot(ovx, ovy) * t_rest + r + 0.5 * accel * t_rest * t_rest
+    if d0 > far:
+        return False
+    for k in range(N_SEG - 1):
+        t0, t1 = tr[k, 0], tr[k, 1]
+        if t1 - t0 <= 1e-12:
+            continue
+        qx, qy = ox + ovx * t0, oy + ovy * t0
+        # the opponent's reach grows as accel (t0 + h)^2 / 2 = r0 + r1 h + r2 h^2
+        g0, g1, g2 = r + 0.5 * accel * t0 * t0, accel * t0, 0.5 * accel
+        if _interval_hits(tr[k, 2] - qx, tr[k, 3] - qy, tr[k, 4] - ovx, tr[k, 5] - ovy, 0.5 * tr[k, 6],
+                          0.5 * tr[k, 7], g0, g1, g2, t1 - t0):  # fmt: skip
+            return True
+    return False
+
+
+@njit(cache=True)
+def static_clearance(px: float, py: float, inner: np.ndarray, boxes: np.ndarray, circles: np.ndarray) -> float:
+    """Clearance (m) of a robot centre from the walls (``inner``: x0, y0, x1, y1 the centre must stay
+    in), the boxes (x0, y0, x1, y1, already grown by the robot radius as a clearance) and circles
+    (x, y, r, grown likewise); < 0 in collision."""
+    c = min(px - inner[0], inner[2] - px, py - inner[1], inner[3] - py)
+    for j in range(boxes.shape[0]):
+        ex = max(boxes[j, 0] - px, 0.0, px - boxes[j, 2])
+        ey = max(boxes[j, 1] - py, 0.0, py - boxes[j, 3])
+        c = min(c, math.hypot(ex, ey) - boxes[j, 4])
+    for j in range(circles.shape[0]):
+        c = min(c, math.hypot(px - circles[j, 0], py - circles[j, 1]) - circles[j, 2])
+    return float(c)
+
+
+@njit(cache=True)
+def static_hits(tr: np.ndarray, inner: np.ndarray, boxes: np.ndarray, circles: np.ndarray, margin: float,
+                step: float) -> bool:  # fmt: skip
+    """Does the trajectory come within ``margin`` of a static obstacle? Sampled so that consecutive
+    samples lie at most ``step`` apart along the path, each held to ``margin + step / 2`` (every
+    point of the path is within step / 2 of a sample). A start already closer only fails deeper."""
+    c0 = static_clearance(tr[0, 2], tr[0, 3], inner, boxes, circles)
+    need = min(margin + 0.5 * step, c0 - 1e-9)
+    for k in range(N_SEG - 1):
+        t0, t1 = tr[k, 0], tr[k, 1]
+        if t1 - t0 <= 0.0:
+            continue
+        vmax = max(math.hypot(tr[k, 4], tr[k, 5]), math.hypot(tr[k, 4] + tr[k, 6] * (t1 - t0),
+                                                              tr[k, 5] + tr[k, 7] * (t1 - t0)))  # fmt: skip
+        n = max(1, int(math.ceil(vmax * (t1 - t0) / step)))
+        for i in range(1, n + 1):
+            px, py, _, _ = _seg_at(tr, k, t0 + (t1 - t0) * i / n)
+            if static_clearance(px, py, inner, boxes, circles) < need:
+                return True
+    return False
+
+
+@njit(cache=True)
+def _trajectory_hits(
+    i: int, tr: np.ndarray, trs: np.ndarray, opp: np.ndarray, inner: np.ndarray, boxes: np.ndarray,
+    circles: np.ndarray, cfg: np.ndarray,
+) -> bool:  # fmt: skip
+    # cfg: dt, accel, brake, own radius sum, opponent radius sum, opponent accel, static margin, step
+    for j in range(trs.shape[0]):
+        if j != i and pair_hits(tr, trs[j], cfg[3]):
+            return True
+    for j in range(opp.shape[0]):
+        if opponent_hits(tr, opp[j, 0], opp[j, 1], opp[j, 2], opp[j, 3], cfg[4], cfg[5]):
+            return True
+    return static_hits(tr, inner, boxes, circles, cfg[6], cfg[7])
+
+
+@njit(cache=True)
+def _feasible(vx: float, vy: float, ax: float, ay: float, lim: np.ndarray, dt: float) -> tuple[float, float]:
+    # the acceleration held to A(v) and the speed limit for one period; lim: vmax, accel, brake
+    cx, cy = limit_velocity(vx, vy, vx + ax * dt, vy + ay * dt, lim[0], lim[1], lim[2], dt)
+    return (cx - vx) / dt, (cy - vy) / dt
+
+
+@njit(cache=True)
+def dss(
+    states: np.ndarray, desired: np.ndarray, stop_asked: np.ndarray, opp: np.ndarray, inner: np.ndarray,
+    boxes: np.ndarray, circles: np.ndarray, lim: np.ndarray, cfg: np.ndarray, unit_samples: np.ndarray,
+    heuristics: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """Cooperative Dynamics Safety Search (Bruce 2006 §5.3) over the own robots in turn.
+
+    ``states`` (n, 4) x, y, vx, vy; ``desired`` (n, 2) each robot's commanded acceleration;
+    ``stop_asked`` (n,) robots that asked to stop; ``opp`` (m, 4) opponents; ``unit_samples``
+    (n, k, 2) random points of the unit disc (mapped into each robot's A(v)); ``heuristics`` (h, 3):
+    (scale, rotation rad, 1 = from the A(v) boundary) variants of the desired acceleration.
+    Every robot starts on its stop trajectory; in turn, each keeps its command if safe against all
+    others' current trajectories, else takes the safe candidate nearest its command, else stops.
+    Returns the accelerations (n, 2) and each robot's status (KEPT, CHANGED, STOPPED, STOP_ASKED)."""
+    n = states.shape[0]
+    dt, accel, brake = cfg[0], cfg[1], cfg[2]
+    trs = np.empty((n, N_SEG, 8))
+    acc = np.empty((n, 2))
+    status = np.full(n, STOPPED, dtype=np.int64)
+    for i in range(n):
+        sx, sy = stop_accel(states[i, 2], states[i, 3], dt)
+        acc[i, 0], acc[i, 1] = sx, sy
+        trs[i] = trajectory(states[i, 0], states[i, 1], states[i, 2], states[i, 3], sx, sy, dt, accel, brake)
+    k_rand = unit_samples.shape[1]
+    n_h = heuristics.shape[0]
+    cand = np.empty((1 + n_h + k_rand + 1, 2))
+    cost = np.empty(cand.shape[0])
+    for i in range(n):
+        if stop_asked[i]:
+            status[i] = STOP_ASKED
+            continue
+        px, py, vx, vy = states[i, 0], states[i, 1], states[i, 2], states[i, 3]
+        dx, dy = _feasible(vx, vy, desired[i, 0], desired[i, 1], lim, dt)
+        tr = trajectory(px, py, vx, vy, dx, dy, dt, accel, brake)
+        if not _trajectory_hits(i, tr, trs, opp, inner, boxes, circles, cfg):
+            trs[i] = tr
+            acc[i, 0], acc[i, 1] = dx, dy
+            status[i] = KEPT
+            continue
+        # candidates: variants of the command, coasting, random points of A(v)
+        m = 0
+        dn = math.hypot(dx, dy)
+        for h in range(n_h):
+            c, s = math.cos(heuristics[h, 1]), math.sin(heuristics[h, 1])
+            ux, uy = c * dx - s * dy, s * dx + c * dy
+            if heuristics[h, 2] > 0.0 and dn > 0.0:
+                bx, by = clip_accel(vx, vy, ux * 1e6 / dn, uy * 1e6 / dn, lim[1], lim[2])
+                ux, uy = bx, by
+            cand[m, 0], cand[m, 1] = heuristics[h, 0] * ux, heuristics[h, 0] * uy
+            m += 1
+        cand[m, 0], cand[m, 1] = 0.0, 0.0
+        m += 1
+        for r in range(k_rand):
+            ux, uy = unit_samples[i, r, 0], unit_samples[i, r, 1]
+            un = math.hypot(ux, uy)
+            if un > 0.0:
+                bx, by = clip_accel(vx, vy, ux * 1e6 / un, uy * 1e6 / un, lim[1], lim[2])
+                cand[m, 0], cand[m, 1] = bx * un, by * un
+            else:
+                cand[m, 0], cand[m, 1] = 0.0, 0.0
+            m += 1
+        for r in range(m):
+            fx, fy = _feasible(vx, vy, cand[r, 0], cand[r, 1], lim, dt)
+            cand[r, 0], cand[r, 1] = fx, fy
+            cost[r] = math.hypot(fx - dx, fy - dy)
+        order = np.argsort(cost[:m])
+        for r in order:
+            tr = trajectory(px, py, vx, vy, cand[r, 0], cand[r, 1], dt, accel, brake)
+            if not _trajectory_hits(i, tr, trs, opp, inner, boxes, circles, cfg):
+                trs[i] = tr
+                acc[i, 0], acc[i, 1] = cand[r, 0], cand[r, 1]
+                status[i] = CHANGED
+                break
+    return acc, status
+
+
+@njit(cache=True)
+def trajectories_clear(
+    states: np.ndarray, acc: np.ndarray, opp: np.ndarray, inner: np.ndarray, boxes: np.ndarray,
+    circles: np.ndarray, cfg: np.ndarray,
+) -> np.ndarray:  # fmt: skip
+    """For each robot: is its trajectory under ``acc`` clear of every other's, the opponents and the
+    static obstacles? (The check a finished search must pass.)"""
+    n = states.shape[0]
+    trs = np.empty((n, N_SEG, 8))
+    for i in range(n):
+        trs[i] = trajectory(states[i, 0], states[i, 1], states[i, 2], states[i, 3], acc[i, 0], acc[i, 1],
+                            cfg[0], cfg[1], cfg[2])  # fmt: skip
+    out = np.empty(n, dtype=np.bool_)
+    for i in range(n):
+        out[i] = not _trajectory_hits(i, trs[i], trs, opp, inner, boxes, circles, cfg)
+    return out
+
+
+# --- the dynamic window, Bruce 2006 §5.2 (after Fox, Burgard and Thrun 1997) ---------------------------
+@njit(cache=True)
+def dynamic_window(
+    states: np.ndarray, desired: np.ndarray, others: np.ndarray, inner: np.ndarray, boxes: np.ndarray,
+    circles: np.ndarray, lim: np.ndarray, cfg: np.ndarray, window: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """The dynamic window for each own robot on its own (not cooperative).
+
+    ``states`` (n, 4) own robots x, y, vx, vy; ``desired`` (n, 2) commanded velocities; ``others``
+    (m, 4) every robot it must avoid, own ones included (row i of the own robots is skipped by
+    position); ``window`` (k, 2) points of the unit disc that span the velocities reachable in one
+    period (mapped into A(v)). A velocity is admissible when the robot, moving at it and then braking
+    at full strength, stops short of every obstacle as it stands now (the other robots are taken as
+    standing still, as in the classic method) and of the static obstacles. Among admissible
+    velocities the one maximising -|v - desired| + clearance_weight * min(clearance, cap) is taken;
+    with none admissible, the stop. cfg: dt, accel, brake, radius sum, static margin, static step,
+    clearance weight (1/s), clearance cap (m). Returns velocities (n, 2) and statuses."""
+    n = states.shape[0]
+    dt, accel, brake, radius = cfg[0], cfg[1], cfg[2], cfg[3]
+    out = np.zeros((n, 2))
+    status = np.full(n, STOPPED, dtype=np.int64)
+    rest = np.zeros((N_SEG, 8))
+    for i in range(n):
+        px, py, vx, vy = states[i, 0], states[i, 1], states[i, 2], states[i, 3]
+        dx, dy = desired[i, 0], desired[i, 1]
+        if dx == 0.0 and dy == 0.0:
+            status[i] = STOP_ASKED
+            continue
+        best, best_score = -1, -math.inf
+        bvx, bvy = 0.0, 0.0
+        for r in range(window.shape[0] + 1):
+            if r == window.shape[0]:  # the command itself, held to the limits
+                ax, ay = _feasible(vx, vy, (dx - vx) / dt, (dy - vy) / dt, lim, dt)
+            else:
+                ux, uy = window[r, 0], window[r, 1]
+                un = math.hypot(ux, uy)
+                ax, ay = 0.0, 0.0
+                if un > 0.0:
+                    ex, ey = clip_accel(vx, vy, ux * 1e6 / un, uy * 1e6 / un, lim[1], lim[2])
+                    ax, ay = _feasible(vx, vy, ex * un, ey * un, lim, dt)
+            cx, cy = vx + ax * dt, vy + ay * dt
+            # moving at (cx, cy) from now on, then braking
+            tr = trajectory(px, py, cx, cy, 0.0, 0.0, dt, accel, brake)
+            clear = cfg[7]
+            hit = False
+            for j in range(others.shape[0]):
+                qx, qy = others[j, 0], others[j, 1]
+                if qx == px and qy == py:
+                    continue  # this robot itself
+                rest[N_SEG - 1, 2], rest[N_SEG - 1, 3] = qx, qy
+                for k in range(N_SEG - 1):
+                    rest[k, 0], rest[k, 1], rest[k, 2], rest[k, 3] = tr[k, 0], tr[k, 1], qx, qy
+                rest[N_SEG - 1, 0], rest[N_SEG - 1, 1] = tr[N_SEG - 1, 0], math.inf
+                if pair_hits(tr, rest, radius):
+                    hit = True
+                    break
+                clear = min(clear, math.hypot(tr[N_SEG - 1, 2] - qx, tr[N_SEG - 1, 3] - qy) - radius)
+            if hit or static_hits(tr, inner, boxes, circles, cfg[4], cfg[5]):
+                continue
+            score = -math.hypot(cx - dx, cy - dy) + cfg[6] * max(clear, 0.0)
+            if score > best_score:
+                best, best_score, bvx, bvy = r, score, cx, cy
+        if best >= 0:
+            out[i, 0], out[i, 1] = bvx, bvy
+            status[i] = KEPT if best == window.shape[0] else CHANGED
+    return out, status

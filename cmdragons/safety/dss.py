@@ -1,0 +1,118 @@
+"""Dynamics Safety Search (DSS, Bruce 2006 ch. 5): cooperative safety for a team of robots.
+
+Field frame, metres, seconds. Each robot's command is modelled as one control period of constant
+acceleration followed by braking at the maximum deceleration until it rests (§5.1, §5.3); a command
+is safe when that braking trajectory keeps clear of every other own robot's current trajectory, of
+every opponent (whose future motion is bounded by a disc that grows as it could accelerate, at its
+current velocity) and of the static obstacles. All robots start on their stop trajectories, which
+the previous frame made safe (§5.4); in turn, each keeps its command when it is safe, or searches
+random and heuristic samples of its acceleration set A(v) for the safe one closest to it, with the
+stop as the fallback that is always accepted. Margins come from configs/safety.yaml.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from cmdragons.config import Validated, setting
+from cmdragons.control.motion import MotionParams
+from cmdragons.planning.world import CollisionWorld
+from cmdragons.safety import _kernels as K
+from cmdragons.safety.base import ArraySafety, SafetyResult, StaticObstacles
+
+__all__ = ["DSSParams", "DynamicsSafetySearch", "heuristic_table"]
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class DSSParams(Validated):
+    """configs/safety.yaml ``dss``: margins and the search (Bruce 2006 §5.3, §5.5)."""
+
+    own_margin_m: float = setting(0.03, lo=0.0, hi=1.0)  # kept between two own robots' bodies
+    opponent_margin_m: float = setting(0.05, lo=0.0, hi=1.0)  # kept from an opponent's reachable disc
+    opponent_accel_m_s2: float = setting(3.0, lo=0.0, hi=50.0)  # bound on how opponents may accelerate
+    static_margin_m: float = setting(0.01, lo=0.0, hi=1.0)  # kept from walls and static obstacles
+    static_step_m: float = setting(0.02, lo=0.001, hi=0.5)  # sample spacing of the static check
+    random_samples: int = setting(40, lo=0, hi=1000)  # random points of A(v) per searching robot
+    scales: tuple[float, ...] = setting((0.75, 0.5, 0.25), lo=0.0, hi=1.0)  # shorter versions of the command
+    rotations_deg: tuple[float, ...] = setting((20.0, 45.0, 90.0, 135.0), lo=0.0, hi=180.0)  # turned both ways
+
+
+def heuristic_table(params: DSSParams) -> FloatArray:
+    """Rows (scale, rotation rad, from the A(v) boundary) of the heuristic samples: the command
+    shortened, and turned both ways at full strength (§5.5)."""
+    rows = [(s, 0.0, 0.0) for s in params.scales]
+    for deg in params.rotations_deg:
+        rows += [(1.0, math.radians(deg), 1.0), (1.0, -math.radians(deg), 1.0)]
+    return np.array(rows, dtype=np.float64).reshape(-1, 3)
+
+
+class DynamicsSafetySearch(ArraySafety):
+    """DSS for one team (Bruce 2006 §5.3). Holds the random generator that draws the samples."""
+
+    def __init__(
+        self,
+        params: DSSParams,
+        motion: MotionParams,
+        robot_radius_m: float,
+        static: CollisionWorld | None,
+        rng: np.random.Generator,
+    ) -> None:
+        self.params = params
+        self.motion = motion
+        self.rng = rng
+        self.static = StaticObstacles.from_world(static, robot_radius_m)
+        self.limits = np.array([motion.max_speed_m_s, motion.max_accel_m_s2, motion.max_brake_m_s2])
+        self.cfg = np.array([
+            motion.period_s, motion.max_accel_m_s2, motion.max_brake_m_s2, 2.0 * robot_radius_m + params.own_margin_m,
+            2.0 * robot_radius_m + params.opponent_margin_m, params.opponent_accel_m_s2,
+            params.static_margin_m, params.static_step_m,
+        ])  # fmt: skip
+        self.heuristics = heuristic_table(params)
+
+    def unit_samples(self, n: int) -> FloatArray:
+        """(n, random_samples, 2) points uniform in the unit disc, one set per robot."""
+        k = self.params.random_samples
+        r = np.sqrt(self.rng.random((n, k)))
+        phi = self.rng.uniform(-math.pi, math.pi, (n, k))
+        return np.stack([r * np.cos(phi), r * np.sin(phi)], axis=2)
+
+    def search(
+        self, states: ArrayLike, velocities: ArrayLike, opponents: ArrayLike
+    ) -> tuple[FloatArray, NDArray[np.int64]]:
+        """The accelerations (n, 2) DSS picks and each robot's status; inputs as :meth:`filter`."""
+        s = np.ascontiguousarray(states, dtype=np.float64).reshape(-1, 4)
+        v = np.ascontiguousarray(velocities, dtype=np.float64).reshape(-1, 2)
+        opp = np.ascontiguousarray(opponents, dtype=np.float64).reshape(-1, 4)
+        dt = self.motion.period_s
+        desired = (v - s[:, 2:4]) / dt
+        stop_asked = np.all(v == 0.0, axis=1)
+        st = self.static
+        acc, status = K.dss(s, desired, stop_asked, opp, st.inner, st.boxes, st.circles, self.limits, self.cfg,
+                            self.unit_samples(len(s)), self.heuristics)  # fmt: skip
+        return np.asarray(acc), np.asarray(status)
+
+    def filter(self, states: ArrayLike, velocities: ArrayLike, opponents: ArrayLike) -> SafetyResult:
+        """Safe velocities: the command where it is safe, the stop (zero) where nothing else is,
+        else the velocity one period of the chosen acceleration reaches."""
+        s = np.asarray(states, dtype=np.float64).reshape(-1, 4)
+        v = np.asarray(velocities, dtype=np.float64).reshape(-1, 2)
+        acc, status = self.search(s, v, opponents)
+        out = s[:, 2:4] + acc * self.motion.period_s
+        out[status == K.KEPT] = v[status == K.KEPT]
+        out[(status == K.STOPPED) | (status == K.STOP_ASKED)] = 0.0
+        return SafetyResult(out, status)
+
+    def clear(self, states: ArrayLike, accelerations: ArrayLike, opponents: ArrayLike) -> NDArray[np.bool_]:
+        """Per robot: is the trajectory of ``accelerations`` clear of all others, opponents and
+        static obstacles (the property every search result has)?"""
+        s = np.ascontiguousarray(states, dtype=np.float64).reshape(-1, 4)
+        a = np.ascontiguousarray(accelerations, dtype=np.float64).reshape(-1, 2)
+        opp = np.ascontiguousarray(opponents, dtype=np.float64).reshape(-1, 4)
+        st = self.static
+        return np.asarray(K.trajectories_clear(s, a, opp, st.inner, st.boxes, st.circles, self.cfg))

@@ -1,0 +1,316 @@
+"""Kalman filters for the ball and for robots (filterpy), in the field frame, SI units.
+
+Both are linear: the ball's state is (x, y, vx, vy) and a robot's (x, y, theta, vx, vy, omega) with
+velocities in the field frame, the frame our commands use too, so no extended or unscented filter
+is needed; the only non-linearity, the heading's wrap-around, is handled by measuring the heading
+relative to the prediction. Known accelerations (the ball's rolling or sliding deceleration, a
+robot's acceleration toward its last command) enter as control inputs.
+
+Ball model (the simulator's, after the CMDragons thesis): after a kick or a bounce the ball slides
+at ``acc_slide`` until its speed falls to ``slide_to_roll_fraction`` of the speed the slide began
+with, then rolls at ``acc_roll``. Kicks and bounces show as innovations far outside the filter's
+expectation: the velocity covariance is then inflated so the next detections re-acquire it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import cast
+
+import numpy as np
+from filterpy.kalman import KalmanFilter
+from numpy.typing import NDArray
+
+from cmdragons.config import Validated, setting
+
+__all__ = ["BallFilter", "BallModelParams", "RobotFilter", "RobotModelParams"]
+
+Vec = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class BallModelParams(Validated):
+    measurement_sigma_m: float = setting(0.0016, lo=1e-5, hi=1.0)  # vision's position noise
+    accel_sigma_m_s2: float = setting(0.5, lo=0.0, hi=100.0)  # white-noise acceleration (model error)
+    acc_slide_m_s2: float = setting(3.0, lo=0.0, hi=50.0)
+    acc_roll_m_s2: float = setting(0.26, lo=0.0, hi=10.0)
+    slide_to_roll_fraction: float = setting(0.64, lo=0.0, hi=1.0)
+    initial_speed_sigma_m_s: float = setting(3.0, lo=0.01, hi=50.0)  # velocity uncertainty of a new track
+    kick_gate_chi2: float = setting(25.0, lo=1.0, hi=1e6)  # innovation (2 dof) beyond this: kick or bounce
+    kick_speed_sigma_m_s: float = setting(4.0, lo=0.01, hi=50.0)  # velocity uncertainty after a kick
+    # next to a robot the ball may be pushed, dribbled or kicked at any moment: far less predictable
+    near_robot_accel_sigma_m_s2: float = setting(8.0, lo=0.0, hi=500.0)
+    near_robot_m: float = setting(0.15, lo=0.0, hi=2.0)  # ball centre to robot centre counted as next to it
+    switch_band: float = setting(0.12, lo=0.0, hi=1.0)  # +- share of the switch speed where the phase is unsure
+
+
+@dataclass(frozen=True)
+class RobotModelParams(Validated):
+    measurement_sigma_m: float = setting(0.0005, lo=1e-5, hi=1.0)  # vision's robot position noise
+    measurement_sigma_rad: float = setting(0.01, lo=1e-5, hi=3.0)
+    accel_sigma_m_s2: float = setting(8.0, lo=0.0, hi=100.0)  # model error around the commanded motion
+    alpha_sigma_rad_s2: float = setting(20.0, lo=0.0, hi=1000.0)
+    max_accel_m_s2: float = setting(3.0, lo=0.0, hi=50.0)  # what our commands can ask of the motors
+    max_alpha_rad_s2: float = setting(60.0, lo=0.0, hi=1000.0)
+    initial_speed_sigma_m_s: float = setting(1.0, lo=0.01, hi=20.0)
+    # after this many regular frames (one detection each, the same time step) the gain has settled
+    # and the filter runs in filterpy's steady-state mode (a third of the cost) until a frame differs
+    steady_after_updates: int = setting(30, lo=1, hi=100000)
+
+
+def _cv_matrices(n: int, dt: float, sigmas: tuple[float, ...]) -> tuple[Vec, Vec, Vec]:
+    """Constant-velocity F, control B (accelerations) and white-noise-acceleration Q for ``n``
+    position coordinates followed by their ``n`` velocities."""
+    eye = np.eye(n)
+    zero = np.zeros((n, n))
+    f = np.block([[eye, dt * eye], [zero, eye]])
+    b = np.vstack([0.5 * dt * dt * eye, dt * eye])
+    q = np.zeros((2 * n, 2 * n))
+    for i, s in enumerate(sigmas):
+        s2 = s * s
+        q[i, i] = s2 * dt**4 / 4.0
+        q[i, n + i] = q[n + i, i] = s2 * dt**3 / 2.0
+        q[n + i, n + i] = s2 * dt * dt
+    return f, b, q
+
+
+class _Cache:
+    """F, B, Q per time step: frames come at a few fixed intervals, so these repeat."""
+
+    def __init__(self, n: int, sigmas: tuple[float, ...]) -> None:
+        self.n, self.sigmas = n, sigmas
+        self._by_dt: dict[float, tuple[Vec, Vec, Vec]] = {}
+
+    def get(self, dt: float) -> tuple[Vec, Vec, Vec]:
+        key = round(dt, 7)
+        m = self._by_dt.get(key)
+        if m is None:
+            if len(self._by_dt) > 64:
+                self._by_dt.clear()
+            m = self._by_dt[key] = _cv_matrices(self.n, key, self.sigmas)
+        return m
+
+
+class BallFilter:
+    """One ball hypothesis: (x, y, vx, vy) with the two-phase deceleration as control input."""
+
+    def __init__(self, p: BallModelParams, x: float, y: float, t: float) -> None:
+        self.p = p
+        kf = KalmanFilter(dim_x=4, dim_z=2)
+        kf.x = np.array([x, y, 0.0, 0.0])
+        kf.P = np.diag([p.measurement_sigma_m**2] * 2 + [p.initial_speed_sigma_m_s**2] * 2)
+        kf.H = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0]])
+        kf.R = np.eye(2) * p.measurement_sigma_m**2
+        self.kf = kf
+        self.t = t
+        self.cache = _Cache(2, (p.accel_sigma_m_s2, p.accel_sigma_m_s2))
+        self.near_cache = _Cache(2, (p.near_robot_accel_sigma_m_s2, p.near_robot_accel_sigma_m_s2))
+        # a ball first seen may have just been kicked: sliding until its speed is known (as after a kick)
+        self.slide_start_speed = math.inf
+        self.t_kick = t
+        self.kicked = False
+
+    def _decel(self, v: Vec, dt: float) -> Vec:
+        speed = math.hypot(v[0], v[1])
+        if speed < 1e-6 or dt <= 0.0:
+            return np.zeros(2)
+        sliding = speed > self.p.slide_to_roll_fraction * self.slide_start_speed
+        a = self.p.acc_slide_m_s2 if sliding else self.p.acc_roll_m_s2
+        a = min(a, speed / dt)  # friction stops the ball; it never reverses it
+        return -a * v[:2] / speed
+
+    def predicted(self, t: float) -> tuple[Vec, Vec]:
+        """State and covariance at time ``t`` (no change to the filter)."""
+        dt = t - self.t
+        if dt <= 0.0:
+            return self.kf.x.copy(), self.kf.P.copy()
+        f, b, q = self.cache.get(dt)
+        x = f @ self.kf.x + b @ self._decel(self.kf.x[2:], dt)
+        return x, f @ self.kf.P @ f.T + q
+
+    def predict(self, t: float, near_robot: bool = False) -> None:
+        """Advance to ``t``; ``near_robot``: a robot is next to the ball and may move it."""
+        dt = t - self.t
+        if dt <= 0.0:
+            return
+        # the slide-to-roll switch is only known to within the slide's start speed: around it, the
+        # filter follows the detections rather than the model
+        speed = math.hypot(self.kf.x[2], self.kf.x[3])
+        switch = self.p.slide_to_roll_fraction * self.slide_start_speed
+        near_switch = math.isfinite(switch) and abs(speed - switch) < self.p.switch_band * switch
+        f, b, q = (self.near_cache if near_robot or near_switch else self.cache).get(dt)
+        self.kf.predict(u=self._decel(self.kf.x[2:], dt), B=b, F=f, Q=q)
+        self.t = t
+
+    def nis(self, z: Vec) -> float:
+        """Normalised innovation squared of a detection against the current prediction."""
+        y = z - self.kf.x[:2]
+        s = self.kf.P[:2, :2] + self.kf.R
+        return float(y @ np.linalg.solve(s, y))
+
+    def update(self, z: Vec) -> bool:
+        """Take a detection; returns True when it looked like a kick or bounce."""
+        kicked = self.nis(z) > self.p.kick_gate_chi2
+        if kicked:
+            # the velocity is unknown after a kick: forget it, keep the position's certainty
+            self.kf.P[2:, :] = 0.0
+            self.kf.P[:, 2:] = 0.0
+            self.kf.P[2:, 2:] = np.eye(2) * self.p.kick_speed_sigma_m_s**2
+            self.kf.P[:2, :2] += np.eye(2) * float(np.sum((z - self.kf.x[:2]) ** 2))
+            self.slide_start_speed = math.inf  # sliding until the new speed is known
+            self.t_kick = self.t
+        self.kf.update(z)
+        if self.slide_start_speed == math.inf and self.kf.P[2, 2] < 0.25:
+            # the speed is known now, some frames after the kick: the slide began faster than that
+            speed = math.hypot(self.kf.x[2], self.kf.x[3])
+            self.slide_start_speed = speed + self.p.acc_slide_m_s2 * max(0.0, self.t - self.t_kick)
+        self.kicked = kicked
+        return kicked
+
+    @property
+    def position(self) -> Vec:
+        return cast(Vec, self.kf.x[:2])
+
+    @property
+    def velocity(self) -> Vec:
+        return cast(Vec, self.kf.x[2:])
+
+
+def _wrap(a: float) -> float:
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+class RobotFilter:
+    """One robot: (x, y, theta, vx, vy, omega); the last command in force is the control input."""
+
+    def __init__(self, p: RobotModelParams, x: float, y: float, theta: float, t: float) -> None:
+        self.p = p
+        kf = KalmanFilter(dim_x=6, dim_z=3)
+        kf.x = np.array([x, y, theta, 0.0, 0.0, 0.0])
+        kf.P = np.diag([p.measurement_sigma_m**2] * 2 + [p.measurement_sigma_rad**2]
+                       + [p.initial_speed_sigma_m_s**2] * 2 + [(4 * p.initial_speed_sigma_m_s) ** 2])  # fmt: skip
+        kf.H = np.hstack([np.eye(3), np.zeros((3, 3))])
+        kf.R = np.diag([p.measurement_sigma_m**2] * 2 + [p.measurement_sigma_rad**2])
+        self.kf = kf
+        self.t = t
+        self.cache = _Cache(3, (p.accel_sigma_m_s2, p.accel_sigma_m_s2, p.alpha_sigma_rad_s2))
+        self.command: tuple[float, float, float] | None = None  # (vx, vy, omega) in force
+        self._steady: Vec | None = None  # inverse innovation covariance while in steady-state mode
+        self._steady_list: list[float] = []  # the same, row by row, as floats
+        self._steady_dt = 0.0
+        self._dt = 0.0
+        self._regular = 0  # consecutive regular frames
+        self._pending_update = False  # predicted, not yet updated at this time
+
+    def _accel(self, state: Vec, dt: float) -> Vec:
+        """Accelerations toward the commanded velocity, as far as the motors allow in ``dt``."""
+        return np.array(self._accel_tuple(float(state[3]), float(state[4]), float(state[5]), dt, self.command))
+
+    def _accel_tuple(self, vx: float, vy: float, w: float, dt: float,
+                     command: tuple[float, float, float] | None) -> tuple[float, float, float]:  # fmt: skip
+        if command is None or dt <= 0.0:
+            return (0.0, 0.0, 0.0)
+        ax, ay = (command[0] - vx) / dt, (command[1] - vy) / dt
+        norm = math.hypot(ax, ay)
+        if norm > self.p.max_accel_m_s2:
+            ax, ay = ax * self.p.max_accel_m_s2 / norm, ay * self.p.max_accel_m_s2 / norm
+        a_ang = min(max((command[2] - w) / dt, -self.p.max_alpha_rad_s2), self.p.max_alpha_rad_s2)
+        return (ax, ay, a_ang)
+
+    def predicted_state(self, t: float,
+                        commands: Sequence[tuple[float, tuple[float, float, float]]] = ()) -> Vec:  # fmt: skip
+        """State at time ``t`` (no change to the filter; robots hand on no covariance). ``commands``
+        (time they take effect, (vx, vy, omega)), in time order, are followed as they come into force
+        between now and ``t``: the look-ahead must see the commands already sent."""
+        # plain floats: this runs for every robot every frame, and numpy's per-call cost on
+        # 6-vectors would dominate it
+        x = [float(v) for v in self.kf.x]
+        now, command = self.t, self.command
+        for t_effect, cmd in commands:
+            if t_effect <= now:
+                command = cmd
+                continue
+            if t_effect >= t:
+                break
+            x = self._advance(x, t_effect - now, command)
+            now, command = t_effect, cmd
+        if t > now:
+            x = self._advance(x, t - now, command)
+        x[2] = _wrap(x[2])
+        return np.array(x)
+
+    def _advance(self, x: list[float], dt: float, command: tuple[float, float, float] | None) -> list[float]:
+        """Constant acceleration toward ``command`` for ``dt`` seconds (the filter's motion model)."""
+        a = self._accel_tuple(x[3], x[4], x[5], dt, command)
+        h = 0.5 * dt * dt
+        return [x[0] + x[3] * dt + a[0] * h, x[1] + x[4] * dt + a[1] * h, x[2] + x[5] * dt + a[2] * h,
+                x[3] + a[0] * dt, x[4] + a[1] * dt, x[5] + a[2] * dt]  # fmt: skip
+
+    def predict(self, t: float) -> None:
+        dt = t - self.t
+        if dt <= 0.0:
+            return
+        f, b, q = self.cache.get(dt)
+        u = self._accel(self.kf.x, dt)
+        if self._steady is not None and abs(dt - self._steady_dt) < 1e-6 and not self._pending_update:
+            self.kf.F = f
+            self.kf.predict_steadystate(u=u, B=b)
+        else:
+            self._leave_steady()
+            self.kf.predict(u=u, B=b, F=f, Q=q)
+            self._dt = dt
+        self.kf.x[2] = _wrap(self.kf.x[2])
+        self.t = t
+        self._pending_update = True
+
+    def innovation(self, z: Vec) -> Vec:
+        y = cast(Vec, z - self.kf.x[:3])
+        y[2] = _wrap(y[2])
+        return y
+
+    def nis(self, z: Vec) -> float:
+        if self._steady is not None and self._pending_update:
+            # the settled gate: y' S^-1 y in plain floats (called for every detection, every frame)
+            x = self.kf.x
+            y0, y1, y2 = float(z[0] - x[0]), float(z[1] - x[1]), _wrap(float(z[2] - x[2]))
+            si = self._steady_list
+            return (y0 * (si[0] * y0 + si[1] * y1 + si[2] * y2) + y1 * (si[3] * y0 + si[4] * y1 + si[5] * y2)
+                    + y2 * (si[6] * y0 + si[7] * y1 + si[8] * y2))  # fmt: skip
+        y = self.innovation(z)
+        s = self.kf.P[:3, :3] + self.kf.R
+        return float(y @ np.linalg.solve(s, y))
+
+    def update(self, z: Vec) -> None:
+        # the heading measured next to the prediction, so the filter never sees the wrap
+        zz = self.kf.x[:3] + self.innovation(z)
+        if self._steady is not None and self._pending_update:
+            self.kf.update_steadystate(zz)
+        else:
+            self._leave_steady()  # a second view in the same frame: the settled gain does not apply
+            self.kf.update(zz)
+            self._regular = self._regular + 1 if self._pending_update else 0
+            if self._regular >= self.p.steady_after_updates:
+                self._enter_steady()
+        self.kf.x[2] = _wrap(self.kf.x[2])
+        self._pending_update = False
+
+    def miss(self) -> None:
+        """No detection this frame: the settled gain no longer holds."""
+        self._leave_steady()
+        self._regular = 0
+
+    def _enter_steady(self) -> None:
+        # filterpy's last full update left the settled gain in kf.K and the settled posterior in kf.P;
+        # the gate needs the innovation covariance of the settled prior
+        f, _, q = self.cache.get(self._dt)
+        prior = f @ self.kf.P @ f.T + q
+        self._steady = np.linalg.inv(prior[:3, :3] + self.kf.R)
+        self._steady_list = [float(v) for v in self._steady.ravel()]
+        self._steady_dt = self._dt
+
+    def _leave_steady(self) -> None:
+        if self._steady is not None:
+            self._steady = None
+            self._regular = 0

@@ -1,0 +1,249 @@
+"""Multi-camera tracking of the ball and all robots: association, track life, latency compensation.
+
+Per set of camera frames the tracker predicts every track to each frame's capture time and takes
+that camera's detections, so detections of one object from overlapping cameras fuse as
+sequential measurements of one track. Robots are associated by team and id, and a detection whose
+Mahalanobis distance to its track is implausible (a wrong id, a reflection) is rejected; a robot
+that was really moved (placed by the referee) shows as a run of consistent rejected detections and
+its track starts again there. The ball keeps several hypotheses while more than one orange region
+is plausible, and reports the most credible. Tracks are confirmed after a few detections, predicted
+through occlusion with growing covariance and ``visible = False``, and dropped after a timeout.
+
+The world state handed to the team is predicted ahead to the moment its next command takes effect
+(``latency_s``), as the CMDragons tracker did (Bruce 2006, ch. 2).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from cmdragons.config import Validated, setting
+from cmdragons.geometry import Team
+from cmdragons.messages import BallState, DetectionFrame, RobotCommand, RobotState, WorldState
+from cmdragons.tracking.filters import BallFilter, BallModelParams, RobotFilter, RobotModelParams
+
+__all__ = ["Tracker", "TrackerParams", "TrackerStats"]
+
+
+@dataclass(frozen=True)
+class TrackerParams(Validated):
+    """configs/tracker.yaml."""
+
+    latency_s: float = setting(0.03, lo=0.0, hi=1.0)  # capture -> our next command takes effect
+    min_confidence: float = setting(0.1, lo=0.0, hi=1.0)  # detections below are ignored
+    ball: BallModelParams = BallModelParams()
+    robot: RobotModelParams = RobotModelParams()
+    max_ball_speed_m_s: float = setting(10.0, lo=0.1, hi=50.0)  # farther jumps are other objects
+    ball_jump_margin_m: float = setting(0.05, lo=0.0, hi=2.0)  # plus this, for noise and bounces
+    ball_hypotheses: int = setting(4, lo=1, hi=32)  # kept at once, at most
+    ball_confirm_detections: int = setting(2, lo=1, hi=100)
+    ball_timeout_s: float = setting(1.0, lo=0.0, hi=60.0)  # unseen this long: hypothesis dropped
+    robot_gate_chi2: float = setting(60.0, lo=1.0, hi=1e6)  # Mahalanobis^2 (3 dof) for a detection
+    robot_reinit_detections: int = setting(6, lo=1, hi=1000)  # consistent rejected detections -> restart
+    robot_reinit_spread_m: float = setting(0.05, lo=0.0, hi=5.0)  # ... within this of each other
+    robot_confirm_detections: int = setting(3, lo=1, hi=100)
+    robot_timeout_s: float = setting(1.0, lo=0.0, hi=60.0)
+
+
+@dataclass
+class TrackerStats:
+    """What the tracker refused or repaired, for run summaries."""
+
+    frames: int = 0
+    detections: int = 0
+    non_finite: int = 0  # NaN or infinite coordinates
+    low_confidence: int = 0
+    robot_gated: int = 0  # implausible for their track (wrong id, reflection, outlier)
+    robot_restarts: int = 0  # a robot really moved far: track started again
+    ball_kicks: int = 0  # velocity re-acquired after a kick or bounce
+    stale_frames: int = 0  # frames older than what the tracker already took
+
+    def as_dict(self) -> dict[str, int]:
+        return dict(self.__dict__)
+
+
+@dataclass
+class _RobotTrack:
+    filter: RobotFilter
+    hits: int = 1
+    last_seen: float = 0.0
+    rejected: deque[tuple[float, float, float]] = field(default_factory=lambda: deque(maxlen=64))
+
+
+@dataclass
+class _BallTrack:
+    filter: BallFilter
+    born: float
+    hits: int = 1
+    last_seen: float = 0.0
+
+
+class Tracker:
+    """Detections of every camera in, one :class:`WorldState` per frame out."""
+
+    def __init__(self, params: TrackerParams) -> None:
+        self.p = params
+        self.robots: dict[tuple[Team, int], _RobotTrack] = {}
+        self.balls: list[_BallTrack] = []
+        self.stats = TrackerStats()
+        self.t = -math.inf  # capture time of the newest frame taken
+        self._commands: dict[tuple[Team, int], deque[tuple[float, tuple[float, float, float]]]] = {}
+
+    # --- input --------------------------------------------------------------------------------
+    def command_sent(self, commands: Iterable[RobotCommand], t_sent: float) -> None:
+        """Our own commands, sent at ``t_sent``: the robots' control input once the latency passed."""
+        for c in commands:
+            if all(math.isfinite(v) for v in (c.vx, c.vy, c.omega)):
+                self._commands.setdefault((c.team, c.id), deque(maxlen=32)).append(
+                    (t_sent + self.p.latency_s, (c.vx, c.vy, c.omega))
+                )
+
+    def _command_at(self, key: tuple[Team, int], t: float) -> tuple[float, float, float] | None:
+        history = self._commands.get(key)
+        if not history:
+            return None
+        current = None
+        for t_effect, cmd in history:
+            if t_effect <= t + 1e-9:
+                current = cmd
+            else:
+                break
+        return current
+
+    def step(self, frames: Sequence[DetectionFrame]) -> WorldState:
+        """Take one set of camera frames (any order, any cameras) and return the world state
+        predicted to the newest capture time plus ``latency_s``."""
+        for frame in sorted(frames, key=lambda f: f.t_capture):
+            if frame.t_capture < self.t - 1e-9 or not math.isfinite(frame.t_capture):
+                self.stats.stale_frames += 1
+                continue
+            self._take(frame)
+        self.stats.frames += 1
+        for track in self.robots.values():
+            if track.last_seen != self.t:
+                track.filter.miss()
+        self._drop_stale()
+        return self.world_state(self.t + self.p.latency_s)
+
+    def _take(self, frame: DetectionFrame) -> None:
+        t = frame.t_capture
+        self.t = t
+        for key, track in self.robots.items():
+            track.filter.command = self._command_at(key, track.filter.t)
+            track.filter.predict(t)
+        near = self.p.ball.near_robot_m
+        robots_xy = np.array([r.filter.kf.x[:2] for r in self.robots.values()]).reshape(-1, 2)
+        for ball in self.balls:
+            d = np.hypot(*(robots_xy - ball.filter.position).T) if len(robots_xy) else np.zeros(0)
+            ball.filter.predict(t, near_robot=bool(len(d) and float(d.min()) < near))
+        for det in frame.robots:
+            self.stats.detections += 1
+            z = np.array([det.x, det.y, det.theta])
+            if not np.all(np.isfinite(z)):
+                self.stats.non_finite += 1
+                continue
+            if det.confidence < self.p.min_confidence:
+                self.stats.low_confidence += 1
+                continue
+            self._take_robot((det.team, det.id), z, t)
+        balls = []
+        for bd in frame.balls:
+            self.stats.detections += 1
+            z = np.array([bd.x, bd.y])
+            if not np.all(np.isfinite(z)):
+                self.stats.non_finite += 1
+            elif bd.confidence < self.p.min_confidence:
+                self.stats.low_confidence += 1
+            else:
+                balls.append(z)
+        self._take_balls(balls, t)
+
+    # --- robots -------------------------------------------------------------------------------
+    def _take_robot(self, key: tuple[Team, int], z: np.ndarray, t: float) -> None:
+        track = self.robots.get(key)
+        if track is None:
+            self.robots[key] = _RobotTrack(RobotFilter(self.p.robot, z[0], z[1], z[2], t), last_seen=t)
+            return
+        if track.filter.nis(z) <= self.p.robot_gate_chi2:
+            track.filter.update(z)
+            track.hits += 1
+            track.last_seen = t
+            track.rejected.clear()
+            return
+        self.stats.robot_gated += 1
+        track.filter.miss()
+        track.rejected.append((t, z[0], z[1]))
+        recent = [r for r in track.rejected if t - r[0] <= 0.5]
+        if len(recent) >= self.p.robot_reinit_detections:
+            pts = np.array([(x, y) for _, x, y in recent[-self.p.robot_reinit_detections :]])
+            if float(np.max(np.linalg.norm(pts - pts[-1], axis=1))) <= self.p.robot_reinit_spread_m:
+                self.robots[key] = _RobotTrack(RobotFilter(self.p.robot, z[0], z[1], z[2], t), last_seen=t,
+                                               hits=self.p.robot_confirm_detections)  # fmt: skip
+                self.stats.robot_restarts += 1
+
+    # --- ball ---------------------------------------------------------------------------------
+    def _take_balls(self, detections: list[np.ndarray], t: float) -> None:
+        if not detections:
+            return
+        pairs = []
+        for i, track in enumerate(self.balls):
+            reach = self.p.max_ball_speed_m_s * max(t - track.last_seen, 1e-3) + self.p.ball_jump_margin_m
+            for j, z in enumerate(detections):
+                d = float(np.linalg.norm(z - track.filter.position))
+                if d <= reach:
+                    pairs.append((track.filter.nis(z), d, i, j))
+        pairs.sort()
+        used_tracks: set[int] = set()
+        used_dets: set[int] = set()
+        for _, _, i, j in pairs:
+            if i in used_tracks or j in used_dets:
+                continue
+            used_tracks.add(i)
+            used_dets.add(j)
+            track = self.balls[i]
+            if track.filter.update(detections[j]):
+                self.stats.ball_kicks += 1
+            track.hits += 1
+            track.last_seen = t
+        for j, z in enumerate(detections):
+            if j not in used_dets:
+                self.balls.append(_BallTrack(BallFilter(self.p.ball, z[0], z[1], t), born=t, last_seen=t))
+        if len(self.balls) > self.p.ball_hypotheses:
+            self.balls.sort(key=self._ball_rank, reverse=True)
+            del self.balls[self.p.ball_hypotheses :]
+
+    def _ball_rank(self, track: _BallTrack) -> tuple[bool, float, int]:
+        confirmed = track.hits >= self.p.ball_confirm_detections
+        return (confirmed, track.last_seen, track.hits)
+
+    def _drop_stale(self) -> None:
+        t = self.t
+        self.robots = {k: r for k, r in self.robots.items() if t - r.last_seen <= self.p.robot_timeout_s}
+        self.balls = [b for b in self.balls if t - b.last_seen <= self.p.ball_timeout_s]
+
+    # --- output -------------------------------------------------------------------------------
+    def best_ball(self) -> _BallTrack | None:
+        confirmed = [b for b in self.balls if b.hits >= self.p.ball_confirm_detections]
+        return max(confirmed, key=self._ball_rank) if confirmed else None
+
+    def world_state(self, t: float) -> WorldState:
+        """All confirmed tracks predicted to time ``t``; ``visible`` means seen in the newest frame."""
+        ball = None
+        best = self.best_ball()
+        if best is not None:
+            x, cov = best.filter.predicted(t)
+            ball = BallState(float(x[0]), float(x[1]), float(x[2]), float(x[3]), best.last_seen == self.t, cov)
+        robots = []
+        for (team, rid), track in sorted(self.robots.items()):
+            if track.hits < self.p.robot_confirm_detections:
+                continue
+            track.filter.command = self._command_at((team, rid), track.filter.t)
+            x = track.filter.predicted_state(t, self._commands.get((team, rid), ()))
+            robots.append(RobotState(team, rid, float(x[0]), float(x[1]), float(x[2]), float(x[3]), float(x[4]),
+                                     float(x[5]), track.last_seen == self.t))  # fmt: skip
+        return WorldState(t, ball, tuple(robots))

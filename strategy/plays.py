@@ -1,0 +1,308 @@
+"""The team's play: game state and roles -> one :class:`~strategy.skills.Intent` per robot.
+
+Roles in priority order (Bruce 2006, B.5): goalie, attacker (at the ball), defenders on the edge of
+our defense area, supporters at the best receiving points of the pass evaluation, spread apart.
+The attacker shoots when the open goal angle is good, passes to the best supporter when the pass
+evaluation there is good, and otherwise shoots or clears forward. A supporter a pass is played to
+meets the ball, with a one-touch shot when its point sees the goal well (B.6).
+
+Game states: kickoff and free kick (ours: the attacker takes it; theirs: keep away), stop (every
+robot at least ``stop_distance_m`` from the ball and slow), halt, normal play.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from cmdragons.config import Validated, setting
+from cmdragons.geometry import Field, Team
+from cmdragons.messages import BallState, GameState, RobotState, WorldState
+from strategy.evaluation import (
+    PassEvaluation,
+    PassParams,
+    best_shot,
+    candidate_grid,
+    clearest_direction,
+    one_touch_turn,
+    pass_values,
+)
+from strategy.roles import Objective, RoleAssigner, RoleParams
+from strategy.skills import Intent, SkillParams, defend, goalie_block, kick_to, mark, pass_speed, receive
+
+__all__ = ["Strategy", "StrategyParams", "keep_away"]
+
+
+@dataclass(frozen=True)
+class StrategyParams(Validated):
+    """configs/strategy.yaml."""
+
+    skills: SkillParams = SkillParams()
+    passing: PassParams = PassParams()
+    roles: RoleParams = RoleParams()
+    defenders: int = setting(2, lo=0, hi=10)
+    shoot_value: float = setting(0.15, lo=0.0, hi=1.0)  # shot evaluation worth shooting at
+    pass_value: float = setting(0.05, lo=0.0, hi=1.0)  # pass evaluation worth passing at
+    one_touch_value: float = setting(0.1, lo=0.0, hi=1.0)  # shot value at the receiving point for a one-touch
+    pass_timeout_s: float = setting(3.0, lo=0.1, hi=30.0)  # a pass not received by then is over
+    pass_eval_every_frames: int = setting(6, lo=1, hi=600)  # the pass grid is re-evaluated this often
+    supporter_spacing_m: float = setting(1.2, lo=0.0, hi=10.0)  # supporters' points at least this far apart
+    supporter_min_ball_distance_m: float = setting(1.0, lo=0.0, hi=10.0)
+    stop_distance_m: float = setting(0.65, lo=0.5, hi=3.0)  # rule: 0.5 m from the ball in a stop, plus margin
+    stop_speed_m_s: float = setting(1.2, lo=0.1, hi=5.0)  # rule: 1.5 m/s in a stop, minus margin
+    center_circle_margin_m: float = setting(0.15, lo=0.0, hi=2.0)  # kept outside the centre circle at their kickoff
+    ball_room_m: float = setting(0.35, lo=0.0, hi=3.0)  # team-mates leave the ball handler this much room
+
+
+@dataclass
+class _Pass:
+    passer: int
+    receiver: int
+    point: tuple[float, float]
+    t_start: float
+    kicked: bool = False
+    shoot_at: tuple[float, float] | None = None
+
+
+@dataclass
+class _Memory:
+    frame: int = 0
+    evaluation: PassEvaluation | None = None
+    support_points: list[tuple[float, float]] = field(default_factory=list)
+    passing: _Pass | None = None
+
+
+class Strategy:
+    """One team's decisions, frame by frame."""
+
+    def __init__(self, team: Team, pitch: Field, params: StrategyParams) -> None:
+        self.team, self.field, self.p = team, pitch, params
+        self.roles = RoleAssigner(params.roles)
+        self.grid = candidate_grid(pitch, params.passing)
+        self.mem = _Memory()
+        self.last_action: dict[int, str] = {}  # robot id -> "shot", "pass" or "clear": what its kick is for
+        self.obstacle_radius = params.skills.robot_radius_m + params.skills.ball_radius_m
+
+    # --- geometry of our side -----------------------------------------------------------------
+    def own_sign(self, game: GameState) -> float:
+        blue_neg = game.blue_defends_negative_x
+        return -1.0 if (self.team == "blue") == blue_neg else 1.0
+
+    def decide(self, world: WorldState, game: GameState) -> dict[int, Intent]:
+        """An intent for each of our robots in ``world``."""
+        self.mem.frame += 1
+        own = {r.id: r for r in world.robots if r.team == self.team}
+        opp = [r for r in world.robots if r.team != self.team]
+        if not own:
+            return {}
+        own_sign = self.own_sign(game)
+        ball = world.ball
+        if game.command == "halt":
+            return {rid: Intent(r.x, r.y, r.theta, max_speed_m_s=0.0) for rid, r in own.items()}
+        if ball is None:
+            return self._hold(own, own_sign)
+        intents = self._normal(world.t, own, opp, ball, own_sign, game)
+        ours = game.for_team == self.team
+        if game.command == "stop" or (game.command in ("kickoff", "free_kick") and not ours):
+            intents = keep_away(intents, ball, self.field, own_sign, self.p, game.command == "kickoff",
+                                game.command == "stop")
+        if game.command == "kickoff" and ours:
+            attacker = next((rid for rid, role in self.roles.roles.items() if role == "attacker"), None)
+            intents = self._own_half(intents, own_sign, keep=attacker)
+        return intents
+
+    # --- normal play ----------------------------------------------------------------------------
+    def _normal(self, t: float, own: dict[int, RobotState], opp: list[RobotState], ball: BallState,
+                own_sign: float, game: GameState) -> dict[int, Intent]:  # fmt: skip
+        p, f = self.p, self.field
+        attack_sign = -own_sign
+        opp_xy = np.array([[r.x, r.y] for r in opp]) if opp else np.zeros((0, 2))
+        ball_xy = np.array([ball.x, ball.y])
+        if self.mem.evaluation is None or self.mem.frame % p.pass_eval_every_frames == 0:
+            self.mem.evaluation = pass_values(ball_xy, self.grid, f, attack_sign, opp_xy, self.obstacle_radius,
+                                              p.passing)  # fmt: skip
+            self.mem.support_points = self._spread_points(self.mem.evaluation, ball_xy, len(own))
+
+        goalie_id = p.roles.goalie_id if p.roles.goalie_id in own else None
+        goal_x = own_sign * f.half_length
+        objectives = [Objective("goalie", goal_x, 0.0, fixed_robot=goalie_id)]
+        passing = self._update_pass(t, own, ball)
+        if passing is not None and passing.kicked:
+            objectives.append(Objective("receiver", *passing.point, fixed_robot=passing.receiver))
+        else:
+            objectives.append(Objective("attacker", ball.x, ball.y))
+        slots = [0.0] if p.defenders == 1 else list(np.linspace(-0.12 * (p.defenders - 1), 0.12 * (p.defenders - 1),
+                                                                 p.defenders))  # fmt: skip
+        defenders = {}
+        for k, slot in enumerate(slots):
+            intent = defend(ball, f, own_sign, float(slot), p.skills)
+            defenders[f"defender{k}"] = intent
+            objectives.append(Objective(f"defender{k}", intent.x, intent.y))
+        for k, (x, y) in enumerate(self.mem.support_points):
+            objectives.append(Objective(f"supporter{k}", x, y))
+        roles = self.roles.assign({rid: (r.x, r.y) for rid, r in own.items()}, objectives)
+        by_role = {role: rid for rid, role in roles.items()}
+
+        out: dict[int, Intent] = {}
+        for rid, role in roles.items():
+            r = own[rid]
+            if role == "goalie":
+                out[rid] = self._goalie(r, ball, own_sign)
+            elif role == "attacker":
+                out[rid] = self._attack(t, r, own, opp_xy, ball, by_role, attack_sign)
+            elif role == "receiver":
+                assert passing is not None
+                out[rid] = receive(r, ball, passing.point, p.skills, passing.shoot_at,
+                                   p.skills.max_kick_m_s if passing.shoot_at else 0.0)  # fmt: skip
+            elif role.startswith("defender"):
+                out[rid] = defenders[role]
+            else:
+                k = int(role[len("supporter"):])
+                x, y = self.mem.support_points[k]
+                out[rid] = Intent(x, y, math.atan2(ball.y - y, ball.x - x))
+        for rid, r in own.items():  # robots without a role (more robots than objectives): mark or hold
+            if rid not in out:
+                out[rid] = mark(opp[rid % len(opp)], f, own_sign, p.skills) if opp else Intent(r.x, r.y, r.theta)
+        # everyone but the goalie and the robot playing the ball leaves it room
+        others = {rid: it for rid, it in out.items() if roles.get(rid) not in ("goalie", "attacker", "receiver")}
+        out.update(keep_away(others, ball, f, own_sign, p, kickoff=False, slow=False, distance_m=p.ball_room_m))
+        return out
+
+    def _goalie(self, r: RobotState, ball: BallState, own_sign: float) -> Intent:
+        f = self.field
+        inside = f.in_defense_area(ball.x, ball.y) == int(own_sign)
+        if inside and math.hypot(ball.vx, ball.vy) < 0.5:
+            # clear the ball out of our area toward the opponent half, away from the middle
+            target = (-own_sign * f.half_length * 0.5, math.copysign(f.half_width * 0.6, ball.y or 1.0))
+            intent = kick_to(r, ball, target, 4.0, self.p.skills)
+            self.last_action[r.id] = "clear"
+            return Intent(intent.x, intent.y, intent.theta, intent.kick_speed, intent.chip, intent.dribbler,
+                          intent.avoid_ball, True, intent.max_speed_m_s, intent.final_speed_m_s)  # fmt: skip
+        return goalie_block(ball, f, own_sign, self.p.skills)
+
+    def _attack(self, t: float, r: RobotState, own: dict[int, RobotState], opp_xy: np.ndarray, ball: BallState,
+                by_role: dict[str, int], attack_sign: float) -> Intent:  # fmt: skip
+        p, f = self.p, self.field
+        ball_xy = np.array([ball.x, ball.y])
+        _, aim, shot_value = best_shot(ball_xy, f, attack_sign, opp_xy, self.obstacle_radius, p.passing)
+        if shot_value >= p.shoot_value:
+            self.last_action[r.id] = "shot"
+            return kick_to(r, ball, aim, p.skills.max_kick_m_s, p.skills)
+        receivers = [(role, rid) for role, rid in by_role.items() if role.startswith("supporter")]
+        if receivers:
+            pts = np.array([[own[rid].x, own[rid].y] for _, rid in receivers])
+            ev = pass_values(ball_xy, pts, f, attack_sign, opp_xy, self.obstacle_radius, p.passing)
+            k = int(np.argmax(ev.values))
+            if ev.values[k] >= p.pass_value:
+                rid = receivers[k][1]
+                point = (float(pts[k, 0]), float(pts[k, 1]))
+                _, shot_aim, value_there = best_shot(pts[k], f, attack_sign, opp_xy, self.obstacle_radius, p.passing)
+                turn = float(one_touch_turn(ball_xy, pts[k : k + 1], np.array([shot_aim]))[0])
+                if self.mem.passing is None or self.mem.passing.receiver != rid:
+                    one_touch = value_there >= p.one_touch_value and turn <= p.passing.max_turn_rad
+                    shoot_at = shot_aim if one_touch else None
+                    self.mem.passing = _Pass(r.id, rid, point, t, shoot_at=shoot_at)
+                dist = math.hypot(point[0] - ball.x, point[1] - ball.y)
+                self.last_action[r.id] = "pass"
+                return kick_to(r, ball, point, pass_speed(dist, p.skills), p.skills)
+        # nothing good: play the ball forward through the most open lane (around a blocker)
+        self.mem.passing = None
+        toward = math.atan2(aim[1] - ball.y, aim[0] - ball.x)
+        angle, _ = clearest_direction(ball_xy, toward, opp_xy, self.obstacle_radius)
+        target = (ball.x + 1.5 * math.cos(angle), ball.y + 1.5 * math.sin(angle))
+        shooting = (ball.x * attack_sign) > 0 and abs(angle - toward) < 0.2
+        self.last_action[r.id] = "shot" if shooting else "clear"
+        return kick_to(r, ball, target, p.skills.max_kick_m_s if shooting else 3.0, p.skills)
+
+    def _update_pass(self, t: float, own: dict[int, RobotState], ball: BallState) -> _Pass | None:
+        """Follow a pass: kicked once the ball runs toward the receiver; over when received, lost
+        or timed out."""
+        ps = self.mem.passing
+        if ps is None:
+            return None
+        if ps.receiver not in own or t - ps.t_start > self.p.pass_timeout_s:
+            self.mem.passing = None
+            return None
+        speed = math.hypot(ball.vx, ball.vy)
+        to_point = (ps.point[0] - ball.x, ps.point[1] - ball.y)
+        heading_there = speed > 0.5 and (ball.vx * to_point[0] + ball.vy * to_point[1]) > 0.8 * speed * math.hypot(
+            *to_point)
+        if not ps.kicked and heading_there:
+            ps.kicked = True
+            ps.t_start = t  # the timeout runs from the kick
+        elif ps.kicked and (speed < 0.2 or not heading_there):
+            receiver = own[ps.receiver]
+            if math.hypot(receiver.x - ball.x, receiver.y - ball.y) < 0.3 or speed < 0.2:
+                self.mem.passing = None  # received (or died): the new attacker takes over
+                return None
+        return ps
+
+    def _spread_points(self, ev: PassEvaluation, ball: np.ndarray, n_robots: int) -> list[tuple[float, float]]:
+        """The best receiving points, at least ``supporter_spacing_m`` apart and off the ball."""
+        k = max(0, n_robots - 2 - self.p.defenders)
+        order = np.argsort(-ev.values)
+        chosen: list[tuple[float, float]] = []
+        for i in order:
+            if len(chosen) >= k:
+                break
+            x, y = float(ev.points[i, 0]), float(ev.points[i, 1])
+            if math.hypot(x - ball[0], y - ball[1]) < self.p.supporter_min_ball_distance_m:
+                continue
+            if all(math.hypot(x - a, y - b) >= self.p.supporter_spacing_m for a, b in chosen):
+                chosen.append((x, y))
+        return chosen
+
+    # --- game states ----------------------------------------------------------------------------
+    def _own_half(self, intents: dict[int, Intent], own_sign: float, keep: int | None) -> dict[int, Intent]:
+        """At our kickoff everyone but the kicker stays in our half, outside the centre circle."""
+        out = {}
+        r_c = self.field.dims.center_circle_radius_m + self.p.center_circle_margin_m + self.p.skills.robot_radius_m
+        for rid, it in intents.items():
+            if rid == keep:
+                out[rid] = it
+                continue
+            x = own_sign * max(own_sign * it.x, self.p.skills.robot_radius_m + 0.05)
+            y = it.y
+            if math.hypot(x, y) < r_c:
+                y = math.copysign(r_c, y if y != 0 else 1.0)
+            out[rid] = Intent(x, y, it.theta, it.kick_speed, it.chip, it.dribbler, it.avoid_ball,
+                              it.allow_own_defense, it.max_speed_m_s, it.final_speed_m_s)  # fmt: skip
+        return out
+
+    def _hold(self, own: dict[int, RobotState], own_sign: float) -> dict[int, Intent]:
+        """No ball seen yet: hold a defensive shape in our half."""
+        out = {}
+        for k, rid in enumerate(sorted(own)):
+            x = own_sign * (self.field.half_length * 0.3 + 0.4 * (k % 3))
+            y = (k - len(own) / 2) * 0.6
+            out[rid] = Intent(x, y, 0.0 if own_sign < 0 else math.pi)
+        return out
+
+
+def keep_away(intents: dict[int, Intent], ball: BallState, pitch: Field, own_sign: float, p: StrategyParams,
+              kickoff: bool, slow: bool, distance_m: float | None = None) -> dict[int, Intent]:  # fmt: skip
+    """Every target at least ``distance_m`` (default ``stop_distance_m``: the rules' 0.5 m plus a
+    margin) from the ball; at their kickoff also in our half and outside the centre circle; slow in
+    a stop."""
+    out = {}
+    radius = p.skills.robot_radius_m
+    d_min = (p.stop_distance_m if distance_m is None else distance_m) + radius
+    r_c = pitch.dims.center_circle_radius_m + p.center_circle_margin_m + radius
+    for rid, it in intents.items():
+        x, y = it.x, it.y
+        if kickoff:
+            x = own_sign * max(own_sign * x, radius + 0.05)
+            if math.hypot(x, y) < r_c:
+                ang = math.atan2(y, x) if math.hypot(x, y) > 1e-6 else (0.0 if own_sign > 0 else math.pi)
+                x, y = r_c * math.cos(ang), r_c * math.sin(ang)
+        dx, dy = x - ball.x, y - ball.y
+        d = math.hypot(dx, dy)
+        if d < d_min:
+            if d < 1e-6:
+                dx, dy, d = own_sign, 0.0, 1.0
+            x, y = ball.x + dx / d * d_min, ball.y + dy / d * d_min
+        out[rid] = Intent(x, y, it.theta, dribbler=0.0, avoid_ball=True, allow_own_defense=it.allow_own_defense,
+                          max_speed_m_s=p.stop_speed_m_s if slow else it.max_speed_m_s)  # fmt: skip
+    return out

@@ -1,0 +1,65 @@
+"""Objective assignment (Bruce 2006, appendix B.5): roles in priority order, each taken by the
+free robot that reaches its objective at the lowest cost, with hysteresis against flicker.
+
+A role's cost for a robot is the distance from the robot to the role's objective point; the robot
+holding the role since the last frame gets ``hysteresis_m`` off its cost, so two robots at nearly
+the same distance do not swap roles frame after frame.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+from cmdragons.config import Validated, setting
+
+__all__ = ["Objective", "RoleAssigner", "RoleParams"]
+
+
+@dataclass(frozen=True)
+class RoleParams(Validated):
+    hysteresis_m: float = setting(0.5, lo=0.0, hi=10.0)  # cost bonus of the robot already in the role
+    goalie_id: int = setting(0, lo=-1, hi=15)  # -1: whoever is nearest the goal when play starts
+
+
+@dataclass(frozen=True)
+class Objective:
+    role: str
+    x: float
+    y: float
+    fixed_robot: int | None = None  # a role only this robot may take (the goalie)
+
+
+class RoleAssigner:
+    """Keeps the roles of one team from frame to frame."""
+
+    def __init__(self, params: RoleParams) -> None:
+        self.params = params
+        self.roles: dict[int, str] = {}  # robot id -> role
+
+    def assign(self, robots: Mapping[int, tuple[float, float]], objectives: Sequence[Objective]) -> dict[int, str]:
+        """``objectives`` in priority order; robots left over get no role."""
+        free = dict(robots)
+        previous = {role: rid for rid, role in self.roles.items()}
+        out: dict[int, str] = {}
+        for obj in objectives:
+            if not free:
+                break
+            if obj.fixed_robot is not None:
+                if obj.fixed_robot in free:
+                    out[obj.fixed_robot] = obj.role
+                    del free[obj.fixed_robot]
+                    continue
+            best, best_cost = None, math.inf
+            for rid, (x, y) in free.items():
+                cost = math.hypot(x - obj.x, y - obj.y)
+                if previous.get(obj.role) == rid:
+                    cost -= self.params.hysteresis_m
+                if cost < best_cost or (cost == best_cost and best is not None and rid < best):
+                    best, best_cost = rid, cost
+            assert best is not None
+            out[best] = obj.role
+            del free[best]
+        self.roles = out
+        return out

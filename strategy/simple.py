@@ -1,0 +1,76 @@
+"""The built-in simple opponent: plays on the true state with plain steering, no planning.
+
+Its lowest id keeps goal, the robot nearest the ball goes behind it and shoots at the goal's centre,
+the others hold a shape in their half that follows the ball sideways. It keeps the rules' distance
+in a stop and at our restarts. A sparring partner for matches and benchmarks, not a team.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from cmdragons.config import Validated, setting
+from cmdragons.geometry import Field, Team
+from cmdragons.messages import GameState, RobotCommand, WorldState
+from strategy.evaluation import clearest_direction
+from strategy.plays import StrategyParams, keep_away
+from strategy.skills import Intent, goalie_block, kick_to
+
+__all__ = ["SimpleTeam", "SimpleTeamParams", "steer"]
+
+
+@dataclass(frozen=True)
+class SimpleTeamParams(Validated):
+    max_speed_m_s: float = setting(2.0, lo=0.0, hi=10.0)
+    position_gain_1_s: float = setting(3.0, lo=0.0, hi=100.0)  # speed per metre of position error
+    heading_gain_1_s: float = setting(5.0, lo=0.0, hi=100.0)
+    max_omega_rad_s: float = setting(8.0, lo=0.0, hi=100.0)
+    shot_speed_m_s: float = setting(5.0, lo=0.0, hi=10.0)
+
+
+def steer(team: Team, rid: int, x: float, y: float, theta: float, it: Intent, p: SimpleTeamParams) -> RobotCommand:
+    """Proportional steering toward an intent, field frame; no obstacle avoidance."""
+    dx, dy = it.x - x, it.y - y
+    d = math.hypot(dx, dy)
+    cap = p.max_speed_m_s if it.max_speed_m_s is None else min(p.max_speed_m_s, it.max_speed_m_s)
+    v = min(cap, p.position_gain_1_s * d + it.final_speed_m_s)
+    vx, vy = (dx / d * v, dy / d * v) if d > 1e-6 else (0.0, 0.0)
+    omega = max(-p.max_omega_rad_s, min(p.max_omega_rad_s, p.heading_gain_1_s * math.remainder(it.theta - theta,
+                                                                                                 2 * math.pi)))
+    return RobotCommand(team, rid, vx, vy, omega, it.kick_speed, it.chip, it.dribbler)
+
+
+class SimpleTeam:
+    def __init__(self, team: Team, pitch: Field, params: SimpleTeamParams, strategy: StrategyParams) -> None:
+        self.team, self.field, self.p, self.sp = team, pitch, params, strategy
+
+    def commands(self, world: WorldState, game: GameState) -> list[RobotCommand]:
+        own = sorted((r for r in world.robots if r.team == self.team), key=lambda r: r.id)
+        ball = world.ball
+        if not own or ball is None or game.command == "halt":
+            return [RobotCommand(self.team, r.id) for r in own]
+        own_sign = -1.0 if (self.team == "blue") == game.blue_defends_negative_x else 1.0
+        f = self.field
+        goal = (-own_sign * f.half_length, 0.0)
+        intents: dict[int, Intent] = {own[0].id: goalie_block(ball, f, own_sign, self.sp.skills)}
+        field_players = own[1:]
+        if field_players:
+            chaser = min(field_players, key=lambda r: math.hypot(r.x - ball.x, r.y - ball.y))
+            others_xy = np.array([[r.x, r.y] for r in world.robots if r.team != self.team]).reshape(-1, 2)
+            toward = math.atan2(goal[1] - ball.y, goal[0] - ball.x)
+            radius = self.sp.skills.robot_radius_m + self.sp.skills.ball_radius_m
+            angle, _ = clearest_direction(np.array([ball.x, ball.y]), toward, others_xy, radius)
+            target = (ball.x + 2.0 * math.cos(angle), ball.y + 2.0 * math.sin(angle))
+            intents[chaser.id] = kick_to(chaser, ball, target, self.p.shot_speed_m_s, self.sp.skills)
+            others = [r for r in field_players if r.id != chaser.id]
+            for k, r in enumerate(others):
+                x = own_sign * f.half_length * (0.55 - 0.3 * (k % 2))
+                y = ball.y * 0.4 + (k - (len(others) - 1) / 2) * 1.2
+                intents[r.id] = Intent(x, y, math.atan2(ball.y - y, ball.x - x))
+        ours = game.for_team == self.team
+        if game.command == "stop" or (game.command in ("kickoff", "free_kick") and not ours):
+            intents = keep_away(intents, ball, f, own_sign, self.sp, game.command == "kickoff", game.command == "stop")
+        return [steer(self.team, r.id, r.x, r.y, r.theta, intents[r.id], self.p) for r in own]

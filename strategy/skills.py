@@ -1,0 +1,200 @@
+"""Skills: what one robot does this frame, as an :class:`Intent` for navigation.
+
+A skill looks at the world (field frame, metres, radians) and says where the robot should be, how
+it should face, and what its kicker and dribbler do; planning, motion control and safety make it
+happen. Skills keep no state; plays and roles (``strategy.plays``) choose them.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from cmdragons.config import Validated, setting
+from cmdragons.geometry import Field
+from cmdragons.messages import BallState, RobotState
+from strategy.onetouch import aim_heading
+
+__all__ = [
+    "Intent",
+    "SkillParams",
+    "defend",
+    "go_to_pose",
+    "goalie_block",
+    "kick_to",
+    "mark",
+    "pass_speed",
+    "receive",
+]
+
+
+@dataclass(frozen=True)
+class SkillParams(Validated):
+    robot_radius_m: float = setting(0.09, lo=0.02, hi=0.5)
+    ball_radius_m: float = setting(0.0215, lo=0.005, hi=0.2)
+    front_distance_m: float = setting(0.07, lo=0.01, hi=0.5)  # centre to the kicker face
+    approach_distance_m: float = setting(0.12, lo=0.0, hi=1.0)  # wait this far behind the ball, lined up
+    lined_up_rad: float = setting(0.08, lo=0.001, hi=1.0)  # heading error allowed before driving through
+    lined_up_m: float = setting(0.03, lo=0.001, hi=0.5)  # lateral error allowed before driving through
+    push_speed_m_s: float = setting(0.8, lo=0.05, hi=5.0)  # speed of the last approach onto the ball
+    max_kick_m_s: float = setting(6.0, lo=0.1, hi=10.0)  # shots
+    pass_arrival_m_s: float = setting(1.5, lo=0.1, hi=6.0)  # the speed a pass should arrive with
+    pass_min_m_s: float = setting(1.5, lo=0.1, hi=10.0)
+    pass_max_m_s: float = setting(5.0, lo=0.1, hi=10.0)
+    acc_slide_m_s2: float = setting(3.0, lo=0.0, hi=50.0)  # the ball model, for pass speeds and intercepts
+    acc_roll_m_s2: float = setting(0.26, lo=0.0, hi=10.0)
+    slide_to_roll_fraction: float = setting(0.64, lo=0.0, hi=1.0)
+    kicker_retention: float = setting(0.3, lo=0.0, hi=1.0)  # ball velocity across the heading a kick keeps
+    goalie_depth_m: float = setting(0.15, lo=0.0, hi=2.0)  # goalie stands this far in front of the goal line
+    defense_margin_m: float = setting(0.15, lo=0.0, hi=2.0)  # defenders stand this far outside the area
+    mark_distance_m: float = setting(0.45, lo=0.2, hi=3.0)  # marker between its opponent and our goal
+
+
+@dataclass(frozen=True)
+class Intent:
+    """Where a robot should go and how it should face, plus kicker and dribbler."""
+
+    x: float
+    y: float
+    theta: float
+    kick_speed: float = 0.0
+    chip: bool = False
+    dribbler: float = 0.0
+    avoid_ball: bool = True  # the ball is an obstacle for planning
+    allow_own_defense: bool = False  # the goalie may enter our defense area
+    max_speed_m_s: float | None = None  # None: the robot's limit
+    final_speed_m_s: float = 0.0  # arrive moving (driving through the ball)
+
+
+def _angle(dx: float, dy: float) -> float:
+    return math.atan2(dy, dx)
+
+
+def go_to_pose(x: float, y: float, theta: float, max_speed: float | None = None) -> Intent:
+    return Intent(x, y, theta, max_speed_m_s=max_speed)
+
+
+def kick_to(robot: RobotState, ball: BallState, target: tuple[float, float], speed: float, p: SkillParams,
+            chip: bool = False) -> Intent:  # fmt: skip
+    """Get behind the ball on the line to ``target``, then drive through it with the kicker armed."""
+    aim = _angle(target[0] - ball.x, target[1] - ball.y)
+    c, s = math.cos(aim), math.sin(aim)
+    rx, ry = robot.x - ball.x, robot.y - ball.y
+    along, across = rx * c + ry * s, -rx * s + ry * c
+    contact = p.front_distance_m + p.ball_radius_m
+    heading_error = abs(math.remainder(aim - robot.theta, 2 * math.pi))
+    lined_up = along < -contact + 0.02 and abs(across) < p.lined_up_m and heading_error < p.lined_up_rad
+    if lined_up or (along < 0 and along > -contact - 0.03 and abs(across) < 0.5 * p.lined_up_m):
+        # drive through the ball; the kicker fires when it touches the front
+        return Intent(ball.x + c * 0.05, ball.y + s * 0.05, aim, kick_speed=speed, chip=chip, avoid_ball=False,
+                      max_speed_m_s=p.push_speed_m_s, final_speed_m_s=p.push_speed_m_s, dribbler=0.3)  # fmt: skip
+    behind = contact + p.approach_distance_m
+    px, py = ball.x - c * behind, ball.y - s * behind
+    if along > -contact and abs(across) < behind:
+        # on the wrong side of the ball: swing around it at a safe distance first
+        side = 1.0 if across >= 0 else -1.0
+        px = ball.x - c * 0.5 * behind - s * side * behind * 1.2
+        py = ball.y - s * 0.5 * behind + c * side * behind * 1.2
+    return Intent(px, py, aim, avoid_ball=True)
+
+
+def ball_travel(speed: float, p: SkillParams) -> float:
+    """Distance a ball kicked at ``speed`` rolls until it stops (two-phase model)."""
+    v_roll = p.slide_to_roll_fraction * speed
+    slide = (speed**2 - v_roll**2) / (2 * max(p.acc_slide_m_s2, 1e-9))
+    return slide + v_roll**2 / (2 * max(p.acc_roll_m_s2, 1e-9))
+
+
+def speed_after(speed: float, distance: float, p: SkillParams) -> float:
+    """Ball speed after rolling ``distance`` from a kick at ``speed`` (0 if it stops before)."""
+    v_roll = p.slide_to_roll_fraction * speed
+    slide = (speed**2 - v_roll**2) / (2 * max(p.acc_slide_m_s2, 1e-9))
+    if distance <= slide:
+        return math.sqrt(max(speed**2 - 2 * p.acc_slide_m_s2 * distance, 0.0))
+    return math.sqrt(max(v_roll**2 - 2 * p.acc_roll_m_s2 * (distance - slide), 0.0))
+
+
+def pass_speed(distance: float, p: SkillParams) -> float:
+    """Kick speed so the ball arrives at ``distance`` with about ``pass_arrival_m_s`` (bisection)."""
+    lo, hi = 0.0, p.pass_max_m_s
+    for _ in range(40):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if speed_after(mid, distance, p) < p.pass_arrival_m_s else (lo, mid)
+    return min(max(hi, p.pass_min_m_s), p.pass_max_m_s)
+
+
+def receive(robot: RobotState, ball: BallState, wait_at: tuple[float, float], p: SkillParams,
+            shoot_at: tuple[float, float] | None = None, shot_speed: float = 0.0) -> Intent:  # fmt: skip
+    """Meet the moving ball on its path near ``wait_at``; with ``shoot_at``, a one-touch shot
+    aimed with the kick model (B.6), else stop it with the dribbler facing it."""
+    speed = math.hypot(ball.vx, ball.vy)
+    px, py = wait_at
+    if speed > 0.3:
+        # the point of the ball's path nearest the waiting point
+        ux, uy = ball.vx / speed, ball.vy / speed
+        t = max(0.0, (px - ball.x) * ux + (py - ball.y) * uy)
+        px, py = ball.x + ux * t, ball.y + uy * t
+    toward_ball = _angle(ball.x - px, ball.y - py)
+    contact = p.front_distance_m + p.ball_radius_m
+    if shoot_at is not None and speed > 0.3:
+        target = _angle(shoot_at[0] - px, shoot_at[1] - py)
+        v_in = (ball.vx - robot.vx, ball.vy - robot.vy)
+        heading = aim_heading(target, v_in, shot_speed, p.kicker_retention)
+        # stand so the ball meets the middle of the kicker face
+        cx, cy = px - math.cos(heading) * contact, py - math.sin(heading) * contact
+        return Intent(cx, cy, heading, kick_speed=shot_speed, avoid_ball=False, dribbler=0.0)
+    cx, cy = px - math.cos(toward_ball) * contact, py - math.sin(toward_ball) * contact
+    return Intent(cx, cy, toward_ball, dribbler=1.0, avoid_ball=False)
+
+
+def goalie_block(ball: BallState, field: Field, own_sign: float, p: SkillParams) -> Intent:
+    """Stand between the ball and our goal; meet a ball heading for the goal on its line."""
+    gx = own_sign * field.half_length
+    x = gx - own_sign * p.goalie_depth_m
+    half = field.goal_half_width - p.robot_radius_m * 0.5
+    speed = math.hypot(ball.vx, ball.vy)
+    y = ball.y * 0.5  # default: shade toward the ball
+    if speed > 0.5 and (ball.vx * own_sign) > 0.2:
+        t = (x - ball.x) / ball.vx
+        if t > 0:
+            y = ball.y + ball.vy * t
+    else:
+        # on the line from the ball to the goal centre
+        dx = gx - ball.x
+        if abs(dx) > 1e-6:
+            y = ball.y + (0.0 - ball.y) * (x - ball.x) / dx
+    y = min(max(y, -half), half)
+    face = _angle(ball.x - x, ball.y - y)
+    return Intent(x, y, face, allow_own_defense=True, avoid_ball=False)
+
+
+def defend(ball: BallState, field: Field, own_sign: float, slot: float, p: SkillParams) -> Intent:
+    """Stand on the edge of our defense area (plus a margin) on the line from the goal centre to the
+    ball, shifted sideways by ``slot`` metres (two defenders use -0.12 and +0.12)."""
+    gx = own_sign * field.half_length
+    depth = field.dims.defense_depth_m + p.defense_margin_m + p.robot_radius_m
+    half_w = field.dims.defense_width_m / 2 + p.defense_margin_m + p.robot_radius_m
+    dx, dy = ball.x - gx, ball.y
+    ang = math.atan2(dy, -own_sign * abs(dx) if abs(dx) > 1e-6 else -own_sign)
+    ux, uy = math.cos(ang), math.sin(ang)
+    # where the ray from the goal centre leaves the grown defense rectangle
+    t_front = depth / max(abs(ux), 1e-9)
+    t_side = half_w / max(abs(uy), 1e-9)
+    t = min(t_front, t_side)
+    x, y = gx + ux * t, uy * t
+    x += -uy * slot * (1 if own_sign < 0 else -1)
+    y += ux * slot * (1 if own_sign < 0 else -1)
+    y = float(np.clip(y, -field.half_width + p.robot_radius_m, field.half_width - p.robot_radius_m))
+    return Intent(x, y, _angle(ball.x - x, ball.y - y))
+
+
+def mark(opponent: RobotState, field: Field, own_sign: float, p: SkillParams) -> Intent:
+    """Stand between an opponent and our goal centre, ``mark_distance_m`` from the opponent."""
+    gx = own_sign * field.half_length
+    dx, dy = gx - opponent.x, 0.0 - opponent.y
+    d = math.hypot(dx, dy)
+    k = min(p.mark_distance_m, d * 0.5) / max(d, 1e-9)
+    x, y = opponent.x + dx * k, opponent.y + dy * k
+    return Intent(x, y, _angle(opponent.x - x, opponent.y - y))

@@ -1,0 +1,178 @@
+"""Dynamics Safety Search (Bruce 2006 ch. 5): safety as a property over random scenes, the stop always
+accepted, commands kept when safe, limits kept, the WorldState interface."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
+
+from cmdragons.control import MotionParams
+from cmdragons.control import _reference as CR
+from cmdragons.geometry import Field, LeagueParams
+from cmdragons.messages import RobotCommand, RobotState, WorldState
+from cmdragons.planning.world import field_world
+from cmdragons.safety import _kernels as K
+from cmdragons.safety import _reference as R
+from cmdragons.safety.base import CHANGED, KEPT, STOP_ASKED, STOPPED
+from cmdragons.safety.dss import DSSParams, DynamicsSafetySearch
+
+MOTION = MotionParams()
+RADIUS = 0.09
+FIELD = Field(LeagueParams())
+WORLD = field_world(FIELD, defense_areas=False)
+DT = MOTION.period_s
+
+
+def make_dss(seed: int = 0, **kw: float) -> DynamicsSafetySearch:
+    return DynamicsSafetySearch(DSSParams(**kw), MOTION, RADIUS, WORLD, np.random.default_rng(seed))  # type: ignore[arg-type]
+
+
+def stop_accels(states: np.ndarray) -> np.ndarray:
+    return np.array([K.stop_accel(s[2], s[3], DT) for s in states]).reshape(-1, 2)
+
+
+def trajectories(states: np.ndarray, acc: np.ndarray) -> list[np.ndarray]:
+    m = MOTION
+    return [K.trajectory(*s, *a, DT, m.max_accel_m_s2, m.max_brake_m_s2) for s, a in zip(states, acc, strict=True)]
+
+
+def scene(seed: int, n: int, spread: float) -> tuple[np.ndarray, np.ndarray]:
+    """n robots converging on the centre at random speeds, commanded to speed up in random ways."""
+    rng = np.random.default_rng(seed)
+    p = rng.uniform(-spread, spread, (n, 2))
+    v = -p / np.linalg.norm(p, axis=1)[:, None] * rng.uniform(0.0, 2.5, (n, 1)) + rng.normal(0.0, 0.5, (n, 2))
+    states = np.column_stack([p, v])
+    commands = states[:, 2:4] + rng.normal(0.0, 0.2, (n, 2))  # mostly at full acceleration
+    return states, commands
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(2, 6), st.floats(0.3, 1.5))
+def test_dss_never_returns_intersecting_braking_trajectories(seed: int, n: int, spread: float) -> None:
+    states, commands = scene(seed, n, spread)
+    limit = 2 * RADIUS + DSSParams().own_margin_m
+    # only valid starts: the robots' stop trajectories keep clear of each other (what the previous
+    # frame's search guarantees); keep the robots that fit, in order
+    stops = trajectories(states, stop_accels(states))
+    keep: list[int] = []
+    for i in range(n):
+        if all(R.pair_min_distance(stops[i], stops[j], n=801) >= limit + 2e-3 for j in keep):
+            keep.append(i)
+    assume(len(keep) >= 2)
+    states, commands = states[keep], commands[keep]
+    acc, status = make_dss(seed).search(states, commands, np.zeros((0, 4)))
+    trs = trajectories(states, acc)
+    for i in range(len(keep)):
+        for j in range(i):
+            # checked independently, by dense sampling in time
+            assert R.pair_min_distance(trs[i], trs[j], n=2001) >= limit - 1e-3, (i, j, status)
+
+
+def test_stop_is_always_accepted_even_in_contact() -> None:
+    states = np.array([[0.0, 0.0, 1.0, 0.0], [0.15, 0.0, -1.0, 0.0], [0.0, 0.15, 0.0, -2.0]])
+    result = make_dss().filter(states, np.zeros((3, 2)), np.zeros((0, 4)))
+    assert list(result.status) == [STOP_ASKED] * 3
+    np.testing.assert_array_equal(result.velocities, 0.0)
+
+
+def test_safe_commands_are_kept_unsafe_ones_changed_or_stopped() -> None:
+    # two robots far apart, driving parallel: both keep their commands exactly
+    states = np.array([[-2.0, -1.0, 1.0, 0.0], [-2.0, 1.0, 1.0, 0.0]])
+    commands = np.array([[1.05, 0.0], [1.0, 0.05]])
+    r = make_dss().filter(states, commands, np.zeros((0, 4)))
+    assert list(r.status) == [KEPT, KEPT]
+    np.testing.assert_array_equal(r.velocities, commands)
+    # head-on at 2.5 m/s, 1.3 m apart, still speeding up: safe to stop (2 x 0.52 m of braking plus
+    # 0.21 m), not safe to go on: the first robot must give way
+    states = np.array([[-0.65, 0.0, 2.5, 0.0], [0.65, 0.0, -2.5, 0.0]])
+    r = make_dss().filter(states, np.array([[2.55, 0.0], [-2.55, 0.0]]), np.zeros((0, 4)))
+    assert r.status[0] in (CHANGED, STOPPED)
+    acc, status = make_dss().search(states, np.array([[2.55, 0.0], [-2.55, 0.0]]), np.zeros((0, 4)))
+    assert make_dss().clear(states, acc, np.zeros((0, 4))).all()
+
+
+def test_chosen_commands_keep_the_robot_limits() -> None:
+    rng = np.random.default_rng(5)
+    for seed in range(20):
+        states, _ = scene(seed, 8, 1.5)
+        speed = np.hypot(states[:, 2], states[:, 3])
+        states[:, 2:4] *= np.minimum(1.0, MOTION.max_speed_m_s / speed)[:, None]
+        commands = rng.normal(0.0, 3.0, (8, 2))
+        acc, status = make_dss(seed).search(states, commands, np.zeros((0, 4)))
+        # every acceleration lies in A(v) and keeps the speed limit; the stop is velocity zero
+        go = status != STOPPED
+        np.testing.assert_allclose(CR.clip_accel(states[go, 2:4], acc[go], 3.0, 6.0), acc[go], atol=1e-6)
+        assert np.all(np.hypot(*(states[:, 2:4] + acc * DT).T) <= MOTION.max_speed_m_s + 1e-9)
+        np.testing.assert_allclose(states[~go, 2:4] + acc[~go] * DT, 0.0, atol=1e-12)
+
+
+def test_walls_and_opponents_are_avoided() -> None:
+    hl = FIELD.boundary_half_length
+    # driving at a wall at 3 m/s from 0.6 m away: braking takes 0.75 m, so not the command
+    states = np.array([[hl - 0.6 - RADIUS, 0.0, 3.0, 0.0]])
+    r = make_dss().filter(states, np.array([[3.0, 0.0]]), np.zeros((0, 4)))
+    assert r.status[0] != KEPT and r.velocities[0, 0] < 3.0
+    # an opponent standing 0.5 m ahead: a robot at 2 m/s may not keep going
+    states = np.array([[0.0, 0.0, 2.0, 0.0]])
+    r = make_dss().filter(states, np.array([[2.0, 0.0]]), np.array([[0.5, 0.0, 0.0, 0.0]]))
+    assert r.status[0] != KEPT
+    # the same opponent 3 m away: keep
+    r = make_dss().filter(states, np.array([[2.0, 0.0]]), np.array([[3.0, 0.0, 0.0, 0.0]]))
+    assert r.status[0] == KEPT
+
+
+def test_make_safe_on_world_state_keeps_everything_but_the_velocity() -> None:
+    robots = (
+        RobotState("blue", 1, -0.65, 0.0, 0.0, 2.5, 0.0),
+        RobotState("blue", 4, 0.65, 0.0, 3.1, -2.5, 0.0),
+        RobotState("yellow", 0, 2.0, 2.0, 0.0),
+    )
+    world = WorldState(0.0, None, robots)
+    commands = [RobotCommand("blue", 1, 2.55, 0.0, 1.0, kick_speed=3.0), RobotCommand("blue", 4, -2.55, 0.0)]
+    out = make_dss().make_safe(commands, world)
+    assert [(c.team, c.id, c.omega, c.kick_speed) for c in out] == [("blue", 1, 1.0, 3.0), ("blue", 4, 0.0, 0.0)]
+    assert out[0].vx < 2.55 or out[1].vx > -2.55
+    assert make_dss().make_safe([], world) == []
+
+
+@pytest.mark.parametrize("n", [2, 11])
+def test_search_is_deterministic_for_a_seed(n: int) -> None:
+    states, commands = scene(7, n, 1.0)
+    a = make_dss(3).search(states, commands, np.zeros((0, 4)))
+    b = make_dss(3).search(states, commands, np.zeros((0, 4)))
+    np.testing.assert_array_equal(a[0], b[0])
+    np.testing.assert_array_equal(a[1], b[1])
+
+
+def test_closed_loop_with_the_exact_model_never_brings_robots_too_close() -> None:
+    """§5.4: with the model exact, a start on safe stop trajectories stays safe forever. Six robots
+    cross the field from both sides at once, each commanded straight at its goal by the trapezoid
+    controller; their motion follows the motor model under the commands DSS picks."""
+    from cmdragons.control import ControlParams, motion_commands
+
+    n = 6
+    ys = np.array([-2.0, -1.0, 0.0, 0.6, 1.5, 2.4])
+    pos = np.column_stack([np.where(np.arange(n) % 2 == 0, -3.5, 3.5), ys])
+    goals = np.column_stack([-pos[:, 0], ys[[3, 0, 5, 1, 2, 4]]])
+    vel = np.zeros((n, 2))
+    dss = make_dss(1)
+    limit = 2 * RADIUS + DSSParams().own_margin_m
+    statuses: list[int] = []
+    closest = np.inf
+    for _ in range(480):
+        states6 = np.column_stack([pos, np.zeros(n), vel, np.zeros(n)])
+        targets = np.column_stack([goals, np.zeros((n, 3))])
+        cmd = motion_commands(states6, targets, ControlParams())[:, :2]
+        acc, status = dss.search(np.column_stack([pos, vel]), cmd, np.zeros((0, 4)))
+        statuses += status.tolist()
+        # the motors' motion over one period (reach the command, hold it)
+        trs = trajectories(np.column_stack([pos, vel]), acc)
+        pos = np.array([R.positions(tr, np.array([DT]))[0] for tr in trs])
+        vel = np.array([tr[2, 4:6] for tr in trs])
+        d = np.linalg.norm(pos[:, None] - pos[None], axis=2) + np.eye(n) * 1e9
+        closest = min(closest, float(d.min()))
+    assert closest >= limit - 1e-6
+    assert statuses.count(CHANGED) > 20  # the search did real work
+    assert np.linalg.norm(pos - goals, axis=1).max() < 0.05  # and everyone got through

@@ -1,0 +1,67 @@
+"""Pass and shot evaluation in constructed scenes, against closed forms."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from cmdragons.geometry import Field, LeagueParams
+from strategy.evaluation import PassParams, best_shot, candidate_grid, lane_open_angle, open_goal_angle, pass_values
+
+FIELD = Field(LeagueParams())
+R = 0.09 + 0.0215  # robot radius plus ball radius
+P = PassParams()
+NONE = np.zeros((0, 2))
+
+
+def test_open_goal_angle_without_obstacles_is_the_goal_mouth() -> None:
+    d = 2.0
+    width, aim = open_goal_angle(np.array([[FIELD.half_length - d, 0.0]]), FIELD, 1.0, NONE, R, samples=101)
+    gw = FIELD.goal_half_width - R * 0.5
+    assert width[0] == pytest.approx(2 * math.atan(gw / d), rel=1e-3)
+    assert aim[0] == pytest.approx(0.0, abs=1e-9)
+
+
+def test_goalkeeper_shadow_moves_the_aim() -> None:
+    keeper = np.array([[FIELD.half_length - 0.1, 0.25]])  # covering the left half of the goal
+    width, aim = open_goal_angle(np.array([[2.5, 0.0]]), FIELD, 1.0, keeper, R, samples=101)
+    free_width, _ = open_goal_angle(np.array([[2.5, 0.0]]), FIELD, 1.0, NONE, R, samples=101)
+    assert 0 < width[0] < free_width[0]
+    assert aim[0] < 0.0  # aim at the open right side
+    _, target, value = best_shot(np.array([2.5, 0.0]), FIELD, 1.0, keeper, R, P)
+    assert target[1] < 0.0 and 0 < value <= 1
+
+
+def test_lane_blocked_by_an_obstacle_on_the_line_but_not_beyond_the_receiver() -> None:
+    ball = np.array([0.0, 0.0])
+    target = np.array([[2.0, 0.0]])
+    assert lane_open_angle(ball, target, np.array([[1.0, 0.0]]), R, 0.5)[0] == 0.0
+    assert lane_open_angle(ball, target, np.array([[3.0, 0.0]]), R, 0.5)[0] == pytest.approx(1.0)
+    # an obstacle beside the lane narrows it on its side only
+    side = lane_open_angle(ball, target, np.array([[1.0, 0.5]]), R, 0.5)[0]
+    expected = math.atan2(0.5, 1.0) - math.asin(R / math.hypot(1.0, 0.5)) + 0.5
+    assert side == pytest.approx(expected, rel=1e-9)
+
+
+def test_pass_evaluation_prefers_the_open_receiver() -> None:
+    ball = np.array([-1.0, 0.0])
+    open_receiver = np.array([1.5, 1.5])
+    marked_receiver = np.array([1.5, -1.5])
+    opponents = np.array([[0.25, -0.75], [3.5, 0.0]])  # one in the lane to the marked receiver
+    ev = pass_values(ball, np.stack([open_receiver, marked_receiver]), FIELD, 1.0, opponents, R, P)
+    assert ev.values[0] > 0.05 and ev.values[1] == 0.0
+
+
+def test_grid_best_point_is_open_and_legal() -> None:
+    ball = np.array([-2.0, 1.0])
+    rng = np.random.default_rng(3)
+    opponents = rng.uniform([-1, -3], [4.5, 3], size=(6, 2))
+    pts = candidate_grid(FIELD, P)
+    assert all(FIELD.in_defense_area(x, y) == 0 for x, y in pts)
+    ev = pass_values(ball, pts, FIELD, 1.0, opponents, R, P)
+    best, value = ev.best()
+    assert value > 0
+    assert lane_open_angle(ball, best[None, :], opponents, R, 1.0)[0] > 0
+    assert FIELD.in_field(*best, margin=P.field_margin_m - 1e-9)

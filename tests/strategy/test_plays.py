@@ -1,0 +1,72 @@
+"""Plays against the rules and the roles' promises, over many seeded random situations."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from cmdragons.geometry import Field, LeagueParams
+from cmdragons.messages import BallState, GameState, RobotState, WorldState
+from strategy.plays import Strategy, StrategyParams
+
+FIELD = Field(LeagueParams())
+
+
+def random_world(rng: np.random.Generator, n_own: int, n_opp: int) -> WorldState:
+    def robot(team: str, rid: int) -> RobotState:
+        x, y = rng.uniform([-4.3, -2.8], [4.3, 2.8])
+        return RobotState(team, rid, float(x), float(y), float(rng.uniform(-math.pi, math.pi)))  # type: ignore[arg-type]
+
+    bx, by = rng.uniform([-4.3, -2.8], [4.3, 2.8])
+    bv = rng.normal(0, 1.0, 2) * (rng.random() < 0.5)
+    robots = tuple(robot("blue", i) for i in range(n_own)) + tuple(robot("yellow", i) for i in range(n_opp))
+    return WorldState(0.0, BallState(float(bx), float(by), float(bv[0]), float(bv[1])), robots)
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_goal_never_left_without_a_goalie(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    n_own = int(rng.integers(1, 7))
+    world = random_world(rng, n_own, int(rng.integers(0, 7)))
+    strategy = Strategy("blue", FIELD, StrategyParams())
+    game = GameState(0.0, "normal", blue_defends_negative_x=bool(seed % 2))
+    strategy.decide(world, game)
+    assert "goalie" in strategy.roles.roles.values()
+    own_sign = strategy.own_sign(game)
+    goalie = next(rid for rid, role in strategy.roles.roles.items() if role == "goalie")
+    intent = strategy.decide(world, game)[goalie]
+    assert abs(intent.x - own_sign * FIELD.half_length) < 1.2  # at our goal, whatever else happens
+
+
+@pytest.mark.parametrize("seed", range(20))
+@pytest.mark.parametrize("command", ["stop", "free_kick"])
+def test_distance_to_the_ball_when_the_rules_ask(seed: int, command: str) -> None:
+    rng = np.random.default_rng(100 + seed)
+    world = random_world(rng, 6, 6)
+    assert world.ball is not None
+    p = StrategyParams()
+    game = GameState(0.0, command, for_team="yellow" if command == "free_kick" else None)
+    for rid, it in Strategy("blue", FIELD, p).decide(world, game).items():
+        assert math.hypot(it.x - world.ball.x, it.y - world.ball.y) >= 0.5 + p.skills.robot_radius_m, rid
+        if command == "stop":
+            assert it.max_speed_m_s is not None and it.max_speed_m_s <= 1.5
+        assert it.kick_speed == 0.0
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_their_kickoff_keeps_us_in_our_half_outside_the_circle(seed: int) -> None:
+    rng = np.random.default_rng(200 + seed)
+    world = random_world(rng, 6, 6)
+    world = WorldState(0.0, BallState(0.0, 0.0, 0.0, 0.0), world.robots)
+    game = GameState(0.0, "kickoff", for_team="yellow", blue_defends_negative_x=True)
+    for it in Strategy("blue", FIELD, StrategyParams()).decide(world, game).values():
+        assert it.x < 0.0
+        assert math.hypot(it.x, it.y) >= FIELD.dims.center_circle_radius_m
+
+
+def test_halt_stops_everyone() -> None:
+    world = random_world(np.random.default_rng(1), 6, 0)
+    intents = Strategy("blue", FIELD, StrategyParams()).decide(world, GameState(0.0, "halt"))
+    assert all(it.max_speed_m_s == 0.0 for it in intents.values())

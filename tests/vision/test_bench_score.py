@@ -1,0 +1,52 @@
+"""Scoring detections against truth, and ``cmdragons bench vision`` end to end on a tiny run."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from cmdragons.bench import SUITES
+from cmdragons.messages import BallDetection, BallTruth, DetectionFrame, GroundTruth, RobotDetection, RobotTruth
+from cmdragons.runtime.settings import load_settings
+
+CONFIGS = Path(__file__).resolve().parents[2] / "configs"
+
+
+def test_score_counts_found_false_and_wrong_ids() -> None:
+    from vision.score import Score
+
+    truth = GroundTruth(
+        3, 0.05, BallTruth(1.0, 1.0, 0.02, 0.0, 0.0, pixels={0: (10.0, 10.0, 0.9)}),
+        (RobotTruth("blue", 1, 0.0, 0.0, 0.5, 0, 0, 0, pixels={0: (1.0, 1.0)}),
+         RobotTruth("yellow", 2, 2.0, 0.0, 0.0, 0, 0, 0, pixels={0: (2.0, 2.0)}),
+         RobotTruth("yellow", 3, 3.0, 0.0, 0.0, 0, 0, 0, pixels={1: (2.0, 2.0)})),
+    )  # fmt: skip
+    det = DetectionFrame(
+        0, 3, 0.05, 0.05, (BallDetection(1.003, 1.004, 1.0, (0, 0)), BallDetection(-2.0, 0.0, 0.5, (0, 0))),
+        (RobotDetection("blue", 1, 0.002, 0.0, 0.5 + math.radians(1.0), 1.0, (0, 0)),
+         RobotDetection("yellow", 7, 2.0, 0.01, 0.0, 1.0, (0, 0)),
+         RobotDetection("blue", 4, -1.0, -1.0, 0.0, 1.0, (0, 0))),
+    )  # fmt: skip
+    score = Score()
+    score.add(det, truth)
+    s = score.summary()
+    assert s["robot_detection_rate"] == 1.0  # both robots camera 0 sees are found (one with a wrong id)
+    assert s["id_accuracy"] == 0.5
+    assert math.isclose(s["robot_rms_mm"], 2.0) and math.isclose(s["heading_rms_deg"], 1.0)
+    assert math.isclose(s["ball_rms_mm"], 5.0) and s["ball_detection_rate"] == 1.0
+    assert s["false_per_frame"] == 2.0  # the blue robot at (-1, -1) and the second ball
+
+
+def test_tiny_vision_bench_meets_the_quality_targets() -> None:
+    from cmdragons.bench.vision import run
+
+    assert "vision" in SUITES
+    rows = {r["name"]: r for r in run(load_settings(CONFIGS), True, frames=3)}
+    for level in ("low", "default", "high"):
+        row = rows[f"vision {level}"]
+        assert row["camera_frames"] == 6
+        assert row["robot_rms_mm"] <= 5.0 and row["heading_rms_deg"] <= 2.0
+        assert row["id_accuracy"] == 1.0 and row["robot_detection_rate"] == 1.0
+        assert row["false_per_frame"] == 0.0
+    timing = [r for r in rows.values() if "median_ms" in r]
+    assert len(timing) == 3 and all(r["median_ms"] > 0 for r in timing)

@@ -1,0 +1,80 @@
+"""The vision pipeline against the renderer's truth: every id of both teams at several headings,
+the ball, and bad input.
+
+Tolerances (default noise, lighting and blur of configs/sim.yaml): robot centre within 3 mm,
+heading within 1.5 degrees, ball within 3 mm; ids exact; nothing reported that is not there.
+"""
+
+from __future__ import annotations
+
+import math
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from cmdragons.camera import CameraModel
+from cmdragons.config import ConfigError
+from cmdragons.geometry import TEAMS
+from cmdragons.runtime.settings import load_settings
+from sim.render import RenderParams
+from vision.pipeline import VisionParams, VisionPipeline
+
+from .conftest import LEAGUE, grid_of_robots, render, snapshot
+
+REPO_CONFIGS = Path(__file__).resolve().parents[2] / "configs"
+
+
+@pytest.mark.parametrize("camera_index", [0, 1])
+@pytest.mark.parametrize("heading", [0.0, 2.9, -1.3])
+def test_every_id_and_pose_match_truth(cameras: list[CameraModel], camera_index: int, heading: float) -> None:
+    model = cameras[camera_index]
+    robots = grid_of_robots(model, [heading])  # each (team, id) once, headings heading + 0.37 id
+    ball = model.unproject(np.array([[model.width * 0.31, model.height * 0.93]]), LEAGUE.ball.radius_m)[0]
+    image, truth = render(model, snapshot(robots, ball=(ball[0], ball[1], LEAGUE.ball.radius_m)), seed=camera_index)
+    det = VisionPipeline(VisionParams(), LEAGUE, model).process(image, 7, 0.25)
+    assert (det.camera_id, det.frame_number, det.t_capture) == (model.id, 7, 0.25)
+    assert len(truth.robots) == 32
+    expected = {(TEAMS[int(r[0])], int(r[1])): r for r in robots}
+    assert sorted((r.team, r.id) for r in det.robots) == sorted(expected)
+    for r in det.robots:
+        _, _, x, y, theta = expected[(r.team, r.id)]
+        assert math.hypot(r.x - x, r.y - y) < 0.003, (r, x, y)
+        assert abs(math.degrees(math.remainder(r.theta - theta, 2 * math.pi))) < 1.5, (r, theta)
+        assert 0.5 < r.confidence <= 1.0
+        np.testing.assert_allclose(r.pixel, truth.robots[(TEAMS.index(r.team), r.id)], atol=1.0)
+    assert len(det.balls) == 1
+    assert math.hypot(det.balls[0].x - ball[0], det.balls[0].y - ball[1]) < 0.003
+
+
+def test_empty_field_gives_no_detections(cameras: list[CameraModel]) -> None:
+    image, _ = render(cameras[0], snapshot([]), RenderParams(noise_sigma_grey=6.0))
+    det = VisionPipeline(VisionParams(), LEAGUE, cameras[0]).process(image, 0, 0.0)
+    assert det.robots == () and det.balls == ()
+
+
+@pytest.mark.parametrize("shape", [(100, 100, 3), (768, 1024), (768, 1024, 4)])
+def test_wrong_size_frame_is_a_clear_error(cameras: list[CameraModel], shape: tuple[int, ...]) -> None:
+    with pytest.raises(ValueError, match="expected a uint8 image of shape"):
+        VisionPipeline(VisionParams(), LEAGUE, cameras[0]).process(np.zeros(shape, np.uint8), 0, 0.0)
+
+
+@pytest.mark.parametrize(
+    ("text", "fragment"),
+    [
+        ("roles:\n  ball: red\n", "roles.ball: unknown colour 'red'; colours defined: orange, blue"),
+        ("colours:\n  orange: {lo: [0, 0, 0], hi: [255, 255, 300]}\n", "colours.orange.hi[2]"),
+        ("colours:\n  orange: {lo: [10, 0, 0], hi: [5, 255, 255]}\n", "must not exceed hi"),
+        ("colour_space: hsv\n", "allowed: 'yuv', 'bgr'"),
+        ("regions:\n  connectivity: 6\n", "allowed: 4, 8"),
+    ],
+)
+def test_bad_vision_config_names_the_problem(tmp_path: Path, text: str, fragment: str) -> None:
+    folder = tmp_path / "configs"
+    shutil.copytree(REPO_CONFIGS, folder)
+    (folder / "vision.yaml").write_text(text)
+    with pytest.raises(ConfigError) as err:
+        load_settings(folder)
+    assert err.value.file.endswith("vision.yaml")
+    assert fragment in str(err.value)

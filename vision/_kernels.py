@@ -1,0 +1,376 @@
+"""numba kernels of CMVision (Bruce's thesis, appendix A.1): classify, run-length encode,
+connect runs into regions, region statistics and density-based merging.
+
+Every kernel has a plain-numpy reference in :mod:`vision.cmvision` and a test that both agree.
+Pixel coordinates are (u, v) = (column, row) of the pixel's top-left corner; centroids are
+reported at pixel centres (+0.5) by the wrappers, not here.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+from numba import prange
+
+# region table columns (float64), filled by `region_stats` and `merge_regions`
+R_CLASS, R_AREA, R_SUM_U, R_SUM_V, R_SUM_UU, R_SUM_VV, R_SUM_UV, R_U0, R_V0, R_U1, R_V1 = range(11)
+R_COLS = 11
+
+
+@numba.njit(cache=True, inline="always")
+def _convert_row(src: np.ndarray, conv: np.ndarray, c0: np.ndarray, c1: np.ndarray, c2: np.ndarray) -> None:
+    """One row, interleaved (b, g, r) bytes, into three planes of the colour space: a fixed point
+    (x 256) linear map per channel, plus an offset, clamped to 0..255. A loop of its own so that
+    it vectorises; the table look-ups come in a second loop."""
+    a00, a01, a02, a03 = conv[0, 0], conv[0, 1], conv[0, 2], conv[0, 3]
+    a10, a11, a12, a13 = conv[1, 0], conv[1, 1], conv[1, 2], conv[1, 3]
+    a20, a21, a22, a23 = conv[2, 0], conv[2, 1], conv[2, 2], conv[2, 3]
+    for j in range(c0.shape[0]):
+        b, g, r = np.int32(src[3 * j]), np.int32(src[3 * j + 1]), np.int32(src[3 * j + 2])
+        c0[j] = min(max(((a00 * b + a01 * g + a02 * r + 128) >> 8) + a03, 0), 255)
+        c1[j] = min(max(((a10 * b + a11 * g + a12 * r + 128) >> 8) + a13, 0), 255)
+        c2[j] = min(max(((a20 * b + a21 * g + a22 * r + 128) >> 8) + a23, 0), 255)
+
+
+@numba.njit(cache=True, inline="always")
+def _lookup_row(c0: np.ndarray, c1: np.ndarray, c2: np.ndarray, l0: np.ndarray, l1: np.ndarray, l2: np.ndarray,
+                out: np.ndarray) -> None:  # fmt: skip
+    # each table holds one bit per class: a class holds the pixel iff all three channels do
+    for j in range(out.shape[0]):
+        out[j] = l0[c0[j]] & l1[c1[j]] & l2[c2[j]]
+
+
+@numba.njit(cache=True, inline="always")
+def _lowest_bit(m: np.uint32) -> int:
+    k = 0
+    while (m & np.uint32(1)) == 0:
+        m >>= np.uint32(1)
+        k += 1
+    return k
+
+
+@numba.njit(cache=True, inline="always")
+def _encode_row(bits: np.ndarray, runs: np.ndarray) -> int:
+    """Runs of one class in a row of class bit sets; a pixel takes its lowest class (config order
+    is priority). Returns the number of runs written (at most ``runs.shape[0]``)."""
+    w = bits.shape[0]
+    cap = runs.shape[0]
+    n = 0
+    cur = -1
+    start = 0
+    for j in range(w):
+        m = bits[j]
+        if m == 0 and cur < 0:
+            continue  # the common case: background
+        cls = -1 if m == 0 else _lowest_bit(m)
+        if cls != cur:
+            if cur >= 0 and n < cap:
+                runs[n, 0] = start
+                runs[n, 1] = j - 1
+                runs[n, 2] = cur
+                n += 1
+            cur = cls
+            start = j
+    if cur >= 0 and n < cap:
+        runs[n, 0] = start
+        runs[n, 1] = w - 1
+        runs[n, 2] = cur
+        n += 1
+    return n
+
+
+@numba.njit(cache=True, parallel=True)
+def classify(image: np.ndarray, conv: np.ndarray, lut: np.ndarray, bits: np.ndarray, runs: np.ndarray,
+             counts: np.ndarray, n_chunks: int) -> None:  # fmt: skip
+    """Classification (thesis A.1.3) and run-length encoding in one pass over the image, in
+    parallel over ``n_chunks`` blocks of rows.
+
+    Per pixel, one colour-space conversion, three table look-ups and two ANDs give the bit set of
+    the classes whose threshold box holds it; written to ``bits`` (H, W) when it has H rows (else
+    ``bits`` is unused). When ``runs`` has H rows, ``runs[row, k] = (u_start, u_end inclusive,
+    class)`` and ``counts[row]`` runs: pixels of no class make no runs; a row with more runs than
+    ``runs.shape[1]`` keeps the first.
+    """
+    h, w = image.shape[0], image.shape[1]
+    flat = image.reshape(h, w * 3)
+    l0, l1, l2 = lut[0].copy(), lut[1].copy(), lut[2].copy()
+    keep_bits, encode = bits.shape[0] == h, runs.shape[0] == h
+    n_chunks = max(1, min(h, n_chunks))
+    for chunk in prange(n_chunks):
+        c0, c1, c2 = np.empty(w, np.int32), np.empty(w, np.int32), np.empty(w, np.int32)
+        row = np.empty(w, np.uint32)
+        for i in range(chunk * h // n_chunks, (chunk + 1) * h // n_chunks):
+            out = bits[i] if keep_bits else row
+            _convert_row(flat[i], conv, c0, c1, c2)
+            _lookup_row(c0, c1, c2, l0, l1, l2, out)
+            if encode:
+                counts[i] = _encode_row(out, runs[i])
+
+
+@numba.njit(cache=True)
+def _find(parent: np.ndarray, a: int) -> int:
+    root = a
+    while parent[root] != root:
+        root = parent[root]
+    while parent[a] != root:  # path compression
+        nxt = parent[a]
+        parent[a] = root
+        a = nxt
+    return root
+
+
+@numba.njit(cache=True)
+def connect_runs(runs: np.ndarray, counts: np.ndarray, eight: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Flatten the per-row runs and join runs of one class that touch across neighbouring rows
+    (4- or 8-connectivity) by union-find (thesis A.1.4).
+
+    Returns ``flat`` (n, 4): row, u_start, u_end, class; ``label`` (n,): region index of each run,
+    regions numbered in order of their first run (raster order); ``n_regions`` as a 1-array.
+    """
+    h = counts.shape[0]
+    offsets = np.zeros(h + 1, dtype=np.int64)
+    for i in range(h):
+        offsets[i + 1] = offsets[i] + counts[i]
+    n = offsets[h]
+    flat = np.empty((n, 4), dtype=np.int32)
+    for i in range(h):
+        for k in range(counts[i]):
+            idx = offsets[i] + k
+            flat[idx, 0] = i
+            flat[idx, 1] = runs[i, k, 0]
+            flat[idx, 2] = runs[i, k, 1]
+            flat[idx, 3] = runs[i, k, 2]
+    parent = np.arange(np.int64(n))
+    slack = 1 if eight else 0
+    for i in range(1, h):
+        q = offsets[i - 1]
+        q_end = offsets[i]
+        for p in range(offsets[i], offsets[i + 1]):
+            ps, pe = flat[p, 1], flat[p, 2]
+            # runs of the row above that end before this one starts can touch no later run
+            while q < q_end and flat[q, 2] < ps - slack:
+                q += 1
+            qq = q
+            while qq < q_end and flat[qq, 1] <= pe + slack:
+                if flat[qq, 3] == flat[p, 3]:
+                    ra, rb = _find(parent, p), _find(parent, qq)
+                    if ra != rb:
+                        if ra < rb:
+                            parent[rb] = ra
+                        else:
+                            parent[ra] = rb
+                qq += 1
+    label = np.empty(n, dtype=np.int64)
+    region_of_root = np.full(n, -1, dtype=np.int64)
+    count = 0
+    for p in range(n):
+        root = _find(parent, p)
+        if region_of_root[root] < 0:
+            region_of_root[root] = count
+            count += 1
+        label[p] = region_of_root[root]
+    n_regions = np.array([count], dtype=np.int64)
+    return flat, label, n_regions
+
+
+@numba.njit(cache=True)
+def region_stats(flat: np.ndarray, label: np.ndarray, n_regions: int) -> np.ndarray:
+    """Per region: class, area, sums of u, v, u^2, v^2, uv and the bounding box (thesis A.1.5),
+    from the runs in closed form (sums of integer ranges), u and v at pixel corners."""
+    out = np.zeros((n_regions, R_COLS), dtype=np.float64)
+    for k in range(n_regions):
+        out[k, R_U0] = 1e18
+        out[k, R_V0] = 1e18
+        out[k, R_U1] = -1.0
+        out[k, R_V1] = -1.0
+    for p in range(flat.shape[0]):
+        k = label[p]
+        v = float(flat[p, 0])
+        s = float(flat[p, 1])
+        e = float(flat[p, 2])
+        n = e - s + 1.0
+        su = n * (s + e) / 2.0
+        suu = (e * (e + 1.0) * (2.0 * e + 1.0) - (s - 1.0) * s * (2.0 * s - 1.0)) / 6.0
+        out[k, R_CLASS] = flat[p, 3]
+        out[k, R_AREA] += n
+        out[k, R_SUM_U] += su
+        out[k, R_SUM_V] += n * v
+        out[k, R_SUM_UU] += suu
+        out[k, R_SUM_VV] += n * v * v
+        out[k, R_SUM_UV] += su * v
+        out[k, R_U0] = min(out[k, R_U0], s)
+        out[k, R_U1] = max(out[k, R_U1], e)
+        out[k, R_V0] = min(out[k, R_V0], v)
+        out[k, R_V1] = max(out[k, R_V1], v)
+    return out
+
+
+@numba.njit(cache=True)
+def merge_regions(stats: np.ndarray, max_gap_px: float, min_density: float) -> np.ndarray:
+    """Density-based merging (thesis A.1.6): two regions of one class whose bounding boxes are at
+    most ``max_gap_px`` apart are joined when the joined region still fills at least
+    ``min_density`` of its bounding box. Larger regions absorb smaller ones, in one greedy pass.
+
+    Merges ``stats`` in place and returns a mask of the regions that survive.
+    """
+    n = stats.shape[0]
+    alive = np.ones(n, dtype=np.bool_)
+    order = np.argsort(-stats[:, R_AREA], kind="mergesort")
+    for a in range(n):
+        i = order[a]
+        if not alive[i]:
+            continue
+        for b in range(a + 1, n):
+            j = order[b]
+            if not alive[j] or stats[j, R_CLASS] != stats[i, R_CLASS]:
+                continue
+            gap_u = max(stats[j, R_U0] - stats[i, R_U1], stats[i, R_U0] - stats[j, R_U1]) - 1.0
+            gap_v = max(stats[j, R_V0] - stats[i, R_V1], stats[i, R_V0] - stats[j, R_V1]) - 1.0
+            if gap_u > max_gap_px or gap_v > max_gap_px:
+                continue
+            u0 = min(stats[i, R_U0], stats[j, R_U0])
+            u1 = max(stats[i, R_U1], stats[j, R_U1])
+            v0 = min(stats[i, R_V0], stats[j, R_V0])
+            v1 = max(stats[i, R_V1], stats[j, R_V1])
+            box = (u1 - u0 + 1.0) * (v1 - v0 + 1.0)
+            if (stats[i, R_AREA] + stats[j, R_AREA]) < min_density * box:
+                continue
+            for c in range(R_AREA, R_SUM_UV + 1):
+                stats[i, c] += stats[j, c]
+            stats[i, R_U0], stats[i, R_U1], stats[i, R_V0], stats[i, R_V1] = u0, u1, v0, v1
+            alive[j] = False
+    return alive
+
+
+@numba.njit(cache=True)
+def region_rays(grid: np.ndarray, pixels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Ray (dx, dy) per metre of descent at each pixel position (n, 2), bilinear in the camera's
+    per-pixel ray grid (H, W, 2) sampled at pixel centres; and the area (m^2 per px, per metre of
+    descent squared) that one pixel covers there, from the grid's local Jacobian."""
+    h, w = grid.shape[0], grid.shape[1]
+    n = pixels.shape[0]
+    rays = np.empty((n, 2))
+    area = np.empty(n)
+    for k in range(n):
+        fu = min(max(pixels[k, 0] - 0.5, 0.0), w - 1.000001)
+        fv = min(max(pixels[k, 1] - 0.5, 0.0), h - 1.000001)
+        j, i = int(fu), int(fv)
+        a, b = fu - j, fv - i
+        for c in range(2):
+            top = (1.0 - a) * grid[i, j, c] + a * grid[i, j + 1, c]
+            bottom = (1.0 - a) * grid[i + 1, j, c] + a * grid[i + 1, j + 1, c]
+            rays[k, c] = (1.0 - b) * top + b * bottom
+        # derivatives along u and v over this grid cell
+        du0 = (1.0 - b) * (grid[i, j + 1, 0] - grid[i, j, 0]) + b * (grid[i + 1, j + 1, 0] - grid[i + 1, j, 0])
+        du1 = (1.0 - b) * (grid[i, j + 1, 1] - grid[i, j, 1]) + b * (grid[i + 1, j + 1, 1] - grid[i + 1, j, 1])
+        dv0 = (1.0 - a) * (grid[i + 1, j, 0] - grid[i, j, 0]) + a * (grid[i + 1, j + 1, 0] - grid[i, j + 1, 0])
+        dv1 = (1.0 - a) * (grid[i + 1, j, 1] - grid[i, j, 1]) + a * (grid[i + 1, j + 1, 1] - grid[i, j + 1, 1])
+        area[k] = abs(du0 * dv1 - du1 * dv0)
+    return rays, area
+
+
+@numba.njit(cache=True)
+def fit_pattern(centre: np.ndarray, w_centre: float, obs: np.ndarray, w_obs: np.ndarray,
+                slots: np.ndarray) -> tuple[float, float, float, float]:  # fmt: skip
+    """Weighted least-squares rigid fit (2D Procrustes) of a pattern whose centre dot sits at the
+    template origin and whose k id dots sit at ``slots`` (k, 2), to the observed centre and dots
+    ``obs`` (k, 2). Returns heading, x, y and the weighted RMS residual (m)."""
+    k = obs.shape[0]
+    wsum = w_centre
+    mox, moy = w_centre * centre[0], w_centre * centre[1]
+    mtx, mty = 0.0, 0.0
+    for i in range(k):
+        wsum += w_obs[i]
+        mox += w_obs[i] * obs[i, 0]
+        moy += w_obs[i] * obs[i, 1]
+        mtx += w_obs[i] * slots[i, 0]
+        mty += w_obs[i] * slots[i, 1]
+    mox, moy, mtx, mty = mox / wsum, moy / wsum, mtx / wsum, mty / wsum
+    # the centre dot: template (0, 0) against the observed centre
+    cross = w_centre * ((-mtx) * (centre[1] - moy) - (-mty) * (centre[0] - mox))
+    dot = w_centre * ((-mtx) * (centre[0] - mox) + (-mty) * (centre[1] - moy))
+    for i in range(k):
+        tx, ty = slots[i, 0] - mtx, slots[i, 1] - mty
+        ox, oy = obs[i, 0] - mox, obs[i, 1] - moy
+        cross += w_obs[i] * (tx * oy - ty * ox)
+        dot += w_obs[i] * (tx * ox + ty * oy)
+    theta = np.arctan2(cross, dot)
+    c, s = np.cos(theta), np.sin(theta)
+    px, py = mox - (c * mtx - s * mty), moy - (s * mtx + c * mty)
+    err = w_centre * ((px - centre[0]) ** 2 + (py - centre[1]) ** 2)
+    for i in range(k):
+        ex = c * slots[i, 0] - s * slots[i, 1] + px - obs[i, 0]
+        ey = s * slots[i, 0] + c * slots[i, 1] + py - obs[i, 1]
+        err += w_obs[i] * (ex * ex + ey * ey)
+    return theta, px, py, np.sqrt(err / wsum)
+
+
+# pattern match table columns, filled by `match_patterns`
+M_OK, M_X, M_Y, M_THETA, M_RES, M_PINK, M_MISSING, M_DOTS, M_AREA = range(9)
+M_COLS = 9
+
+
+@numba.njit(cache=True)
+def match_patterns(cxy: np.ndarray, cw: np.ndarray, dxy: np.ndarray, dw: np.ndarray, dpink: np.ndarray,
+                   dgood: np.ndarray, slots: np.ndarray, assign: np.ndarray, search_r: float,
+                   min_dots: int) -> np.ndarray:  # fmt: skip
+    """For each centre dot (field xy (n, 2), area weight (n,)), the id dots within ``search_r``
+    (at most as many as the pattern has slots, those nearest the pattern's ring), fitted to the
+    template under every assignment of dots to slots (``assign`` (m, k_max): slot per observed
+    dot; rows for fewer dots use the leading columns). Thesis A.2.2-A.2.3.
+
+    Row per centre: ok, x, y, theta, residual, pink slots as bits, the slot left empty (or -1),
+    dots used, the smallest area weight among the dots (1 = as expected).
+    """
+    n_c, k_max = cxy.shape[0], slots.shape[0]
+    out = np.zeros((n_c, M_COLS))
+    ring = 0.0
+    for s in range(k_max):
+        ring += np.sqrt(slots[s, 0] ** 2 + slots[s, 1] ** 2) / k_max
+    near = np.empty(dxy.shape[0], np.int64)
+    off = np.empty(dxy.shape[0])
+    obs = np.empty((k_max, 2))
+    w_obs = np.empty(k_max)
+    t = np.empty((k_max, 2))
+    for c in range(n_c):
+        m = 0
+        for d in range(dxy.shape[0]):
+            r = np.sqrt((dxy[d, 0] - cxy[c, 0]) ** 2 + (dxy[d, 1] - cxy[c, 1]) ** 2)
+            if dgood[d] and r <= search_r:
+                near[m] = d
+                off[m] = abs(r - ring)
+                m += 1
+        if m < min_dots:
+            continue
+        order = np.argsort(off[:m])[:k_max]
+        k = order.shape[0]
+        min_w = cw[c]
+        for i in range(k):
+            obs[i, 0] = dxy[near[order[i]], 0]
+            obs[i, 1] = dxy[near[order[i]], 1]
+            w_obs[i] = dw[near[order[i]]]
+            min_w = min(min_w, w_obs[i])
+        best_res, best = np.inf, -1
+        bt, bx, by = 0.0, 0.0, 0.0
+        for a in range(assign.shape[0]):
+            # an assignment of k dots: its first k slots distinct (rows repeat for k < k_max)
+            for i in range(k):
+                t[i, 0] = slots[assign[a, i], 0]
+                t[i, 1] = slots[assign[a, i], 1]
+            theta, x, y, res = fit_pattern(cxy[c], cw[c], obs[:k], w_obs[:k], t[:k])
+            if res < best_res:
+                best_res, best, bt, bx, by = res, a, theta, x, y
+        pink = 0
+        used = 0
+        for i in range(k):
+            used |= 1 << assign[best, i]
+            if dpink[near[order[i]]]:
+                pink |= 1 << assign[best, i]
+        missing = -1
+        for s in range(k_max):
+            if not (used >> s) & 1:
+                missing = s
+        out[c, M_OK] = 1.0
+        out[c, M_X], out[c, M_Y], out[c, M_THETA], out[c, M_RES] = bx, by, bt, best_res
+        out[c, M_PINK], out[c, M_MISSING], out[c, M_DOTS], out[c, M_AREA] = pink, missing, k, min_w
+    return out

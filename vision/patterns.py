@@ -1,0 +1,242 @@
+"""Robot pattern and ball detection from colour regions (Bruce's thesis, appendix A.2).
+
+Robots carry the league's standard pattern (:class:`cmdragons.geometry.PatternGeometry`): a
+team-colour centre dot and four pink/green id dots. Each centre region is projected to the field
+on the plane of the robot tops; the pink and green regions around it are gathered and the dot
+arrangement is fitted to the template by weighted least squares over position and heading, for
+every assignment of dots to template slots (A.2.2-A.2.3). The best fit gives the slots' colours,
+hence the id, the centre and the heading; its residual and the regions' areas give a confidence.
+
+The ball is the orange region of the right size and shape, on the plane of the ball centre,
+that is not inside a detected robot's pattern.
+
+Field frame, metres, radians; pixels as in :mod:`vision.cmvision`.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from cmdragons.camera import CameraModel
+from cmdragons.config import Validated, setting
+from cmdragons.geometry import TEAMS, PatternGeometry, Team
+from cmdragons.messages import BallDetection, RobotDetection
+from vision import _kernels as kern
+from vision.cmvision import Regions
+
+F64 = NDArray[np.float64]
+
+__all__ = ["BallParams", "PatternMatcher", "PatternParams", "RegionGeometry", "detect_ball", "fit_reference"]
+
+
+@dataclass(frozen=True)
+class PatternParams(Validated):
+    """configs/vision.yaml ``patterns``: matching the standard robot pattern."""
+
+    search_radius_m: float = setting(0.1, lo=0.02, hi=0.5)  # id dots this far from the centre dot, at most
+    max_residual_m: float = setting(0.02, lo=0.001, hi=0.2)  # RMS fit residual above which no robot is reported
+    residual_scale_m: float = setting(0.006, lo=0.0005, hi=0.1)  # confidence exp(-(res/scale)^2 / 2)
+    min_area_fraction: float = setting(0.3, lo=0.0, hi=1.0)  # of a dot's expected area, for centre and id dots
+    max_area_fraction: float = setting(2.5, lo=1.0, hi=20.0)
+    min_dots: int = setting(4, lo=3, hi=4)  # id dots needed; with 3 the missing slot's colour is read from the image
+    duplicate_distance_m: float = setting(0.12, lo=0.0, hi=1.0)  # closer robots are one robot seen twice
+    min_confidence: float = setting(0.1, lo=0.0, hi=1.0)
+
+
+@dataclass(frozen=True)
+class BallParams(Validated):
+    """configs/vision.yaml ``ball``: which orange regions are balls."""
+
+    min_area_fraction: float = setting(0.3, lo=0.0, hi=1.0)  # of the ball's expected area in the image
+    max_area_fraction: float = setting(3.0, lo=1.0, hi=50.0)  # motion blur stretches a fast ball
+    max_elongation: float = setting(3.0, lo=1.0, hi=50.0)  # ratio of the second moments' axes
+    min_fill: float = setting(0.4, lo=0.0, hi=1.0)  # area / bounding-box area
+    max_balls: int = setting(1, lo=0, hi=16)  # per camera frame, most confident first
+    min_confidence: float = setting(0.1, lo=0.0, hi=1.0)
+
+
+class RegionGeometry:
+    """Where the regions of one image lie on the field: each centroid's ray (dx, dy per metre of
+    descent) from the camera's per-pixel ray grid, and the field area of one pixel per metre of
+    descent squared. A plane at height z is then ``centre_xy + (centre_z - z) * ray``."""
+
+    def __init__(self, regions: Regions, camera: CameraModel, grid: NDArray[np.float32]) -> None:
+        self.regions = regions
+        self.camera = camera
+        self.rays, self.pixel_area = kern.region_rays(grid, regions.centroid)
+
+    def xy(self, idx: NDArray[np.int64], z: float) -> NDArray[np.float64]:
+        """Field points (n, 2) of regions ``idx`` on the plane at height ``z`` (m)."""
+        out: NDArray[np.float64] = self.camera.center[:2] + (self.camera.center[2] - z) * self.rays[idx]
+        return out
+
+    def area_m2(self, idx: NDArray[np.int64], z: float) -> NDArray[np.float64]:
+        """Field areas (n,) m^2 of regions ``idx`` on the plane at height ``z``."""
+        out: NDArray[np.float64] = self.regions.area[idx] * self.pixel_area[idx] * (self.camera.center[2] - z) ** 2
+        return out
+
+
+def fit_reference(centre: F64, w_centre: float, obs: F64, w_obs: F64, slots: F64) -> tuple[F64, F64, F64]:
+    """Weighted least-squares rigid fits (2D Procrustes) of the pattern to the observed dots, for
+    every row of ``slots`` (m, k, 2): the template positions the k observed dots are assigned to;
+    the centre dot sits at the template origin. Returns heading (m,), position (m, 2) and the
+    weighted RMS residual (m,). The plain-numpy reference of :func:`vision._kernels.fit_pattern`."""
+    m = slots.shape[0]
+    w_all = np.concatenate([[w_centre], w_obs])
+    wsum = w_all.sum()
+    o = np.concatenate([centre[None], obs], axis=0)  # (k+1, 2)
+    t = np.concatenate([np.zeros((m, 1, 2)), slots], axis=1)  # (m, k+1, 2)
+    mo = (w_all[:, None] * o).sum(axis=0) / wsum
+    mt = (w_all[None, :, None] * t).sum(axis=1) / wsum  # (m, 2)
+    oc = o[None] - mo
+    tc = t - mt[:, None]
+    cross = (w_all * (tc[..., 0] * oc[..., 1] - tc[..., 1] * oc[..., 0])).sum(axis=1)
+    dot = (w_all * (tc[..., 0] * oc[..., 0] + tc[..., 1] * oc[..., 1])).sum(axis=1)
+    theta = np.arctan2(cross, dot)
+    c, s = np.cos(theta), np.sin(theta)
+    pos = mo - np.stack([c * mt[:, 0] - s * mt[:, 1], s * mt[:, 0] + c * mt[:, 1]], axis=1)
+    rx = c[:, None] * t[..., 0] - s[:, None] * t[..., 1] + pos[:, 0:1]
+    ry = s[:, None] * t[..., 0] + c[:, None] * t[..., 1] + pos[:, 1:2]
+    err2 = (rx - o[None, :, 0]) ** 2 + (ry - o[None, :, 1]) ** 2
+    res = np.sqrt((w_all * err2).sum(axis=1) / wsum)
+    return theta, pos, res
+
+
+class PatternMatcher:
+    """The standard pattern of one league, ready to match (templates, id table, expected areas)."""
+
+    def __init__(self, pattern: PatternGeometry, params: PatternParams) -> None:
+        self.pattern, self.params = pattern, params
+        self.slots = np.array(pattern.dot_positions_m, dtype=np.float64)
+        self.assign = np.array(list(itertools.permutations(range(len(self.slots)))), dtype=np.int64)
+        self.code_to_id = {
+            sum(1 << s for s, ch in enumerate(code) if ch == "P"): i for i, code in enumerate(pattern.ids)
+        }
+        self.centre_area = math.pi * (pattern.center_dot_diameter_m / 2.0) ** 2
+        self.dot_area = math.pi * (pattern.id_dot_diameter_m / 2.0) ** 2
+
+    def detect(self, geo: RegionGeometry, classes: dict[str, int], height_m: dict[Team, float],
+               is_pink: Callable[[NDArray[np.float64]], bool | None]) -> list[RobotDetection]:  # fmt: skip
+        """Robots of both teams; ``classes`` maps the roles blue, yellow, pink, green to class
+        indices; ``is_pink(pixel)`` reads an id dot's colour at a pixel where no region was found
+        (None: neither colour). Duplicates (one robot found twice) are merged."""
+        regions, params = geo.regions, self.params
+        lo, hi = params.min_area_fraction, params.max_area_fraction
+        pink_idx, green_idx = regions.of_class(classes["pink"]), regions.of_class(classes["green"])
+        dot_idx = np.concatenate([pink_idx, green_idx])
+        dpink = np.arange(dot_idx.size) < pink_idx.size
+        found: list[RobotDetection] = []
+        for team in TEAMS:
+            z = height_m[team]
+            c_idx = regions.of_class(classes[team])
+            cw = geo.area_m2(c_idx, z) / self.centre_area
+            ok = (cw >= lo) & (cw <= hi)
+            if not ok.any() or dot_idx.size < params.min_dots:
+                continue
+            c_idx, cw = c_idx[ok], cw[ok]
+            dw = geo.area_m2(dot_idx, z) / self.dot_area
+            table = kern.match_patterns(geo.xy(c_idx, z), cw, geo.xy(dot_idx, z), dw, dpink, (dw >= lo) & (dw <= hi),
+                                        self.slots, self.assign, params.search_radius_m, params.min_dots)  # fmt: skip
+            for row, k in zip(table, c_idx, strict=True):
+                det = self._robot(team, row, regions.centroid[k], z, geo.camera, is_pink)
+                if det is not None:
+                    found.append(det)
+        return merge_duplicates(found, params.duplicate_distance_m)
+
+    def _robot(self, team: Team, row: NDArray[np.float64], pixel: NDArray[np.float64], z: float, camera: CameraModel,
+               is_pink: Callable[[NDArray[np.float64]], bool | None]) -> RobotDetection | None:  # fmt: skip
+        if row[kern.M_OK] == 0.0 or row[kern.M_RES] > self.params.max_residual_m:
+            return None
+        pink = int(row[kern.M_PINK])
+        missing = int(row[kern.M_MISSING])
+        if missing >= 0:
+            # a dot the regions missed (glare, a dark corner): read its colour where the fit puts it
+            c, s = math.cos(row[kern.M_THETA]), math.sin(row[kern.M_THETA])
+            sx, sy = self.slots[missing]
+            at = camera.project_xy(np.array([row[kern.M_X] + c * sx - s * sy, row[kern.M_Y] + s * sx + c * sy]), z)
+            colour = is_pink(at)
+            if colour is None:
+                return None
+            pink |= int(colour) << missing
+        rid = self.code_to_id.get(pink)
+        if rid is None:
+            return None
+        # confidence: the fit residual against the pattern noise, and how far the smallest dot
+        # falls short of its expected area (half the area or less: no trust)
+        area_conf = min(1.0, max(0.0, (row[kern.M_AREA] - 0.5) / 0.4))
+        conf = math.exp(-0.5 * (row[kern.M_RES] / self.params.residual_scale_m) ** 2) * area_conf
+        if missing >= 0:
+            conf *= 0.5
+        if conf < self.params.min_confidence:
+            return None
+        return RobotDetection(team, rid, float(row[kern.M_X]), float(row[kern.M_Y]),
+                              math.remainder(float(row[kern.M_THETA]), 2.0 * math.pi), conf,
+                              (float(pixel[0]), float(pixel[1])))  # fmt: skip
+
+
+def merge_duplicates(robots: list[RobotDetection], distance_m: float) -> list[RobotDetection]:
+    """Most confident first; a detection of a (team, id) already reported, or closer than
+    ``distance_m`` to a reported robot, is the same robot seen twice and is dropped."""
+    ranked = sorted(robots, key=lambda r: -r.confidence)
+    xy = np.array([[r.x, r.y] for r in ranked]).reshape(-1, 2)
+    kept: list[int] = []
+    seen: set[tuple[str, int]] = set()
+    for k, r in enumerate(ranked):
+        if (r.team, r.id) in seen:
+            continue
+        if kept and float(np.min(np.hypot(*(xy[kept] - xy[k]).T))) < distance_m:
+            continue
+        kept.append(k)
+        seen.add((r.team, r.id))
+    return [ranked[k] for k in kept]
+
+
+def detect_ball(
+    geo: RegionGeometry,
+    orange: int,
+    ball_radius_m: float,
+    robots: list[RobotDetection],
+    robot_height_m: dict[Team, float],
+    pattern_radius_m: float,
+    params: BallParams,
+) -> list[BallDetection]:
+    """Ball candidates: orange regions of the ball's size and shape, not inside a detected
+    robot's pattern, on the plane of the ball centre; most confident first."""
+    regions = geo.regions
+    idx = regions.of_class(orange)
+    if idx.size == 0 or params.max_balls == 0:
+        return []
+    ratio = geo.area_m2(idx, ball_radius_m) / (math.pi * ball_radius_m**2)
+    mom = regions.moments[idx]
+    tr, det = mom[:, 0] + mom[:, 1], mom[:, 0] * mom[:, 1] - mom[:, 2] ** 2
+    disc = np.sqrt(np.maximum(tr * tr / 4.0 - det, 0.0))
+    elong = np.sqrt((tr / 2.0 + disc) / np.maximum(tr / 2.0 - disc, 1e-6))
+    box = regions.bbox[idx]
+    fill = regions.area[idx] / ((box[:, 2] - box[:, 0] + 1.0) * (box[:, 3] - box[:, 1] + 1.0))
+    keep = (
+        (ratio >= params.min_area_fraction)
+        & (ratio <= params.max_area_fraction)
+        & (elong <= params.max_elongation)
+        & (fill >= params.min_fill)
+    )
+    for r in robots:
+        # a pattern holds no orange: an orange spot inside one is a misread marker
+        at_top = geo.xy(idx, robot_height_m[r.team])
+        keep &= np.hypot(at_top[:, 0] - r.x, at_top[:, 1] - r.y) >= pattern_radius_m
+    xy = geo.xy(idx, ball_radius_m)
+    out = []
+    for j in np.flatnonzero(keep):
+        size_conf = min(ratio[j], 1.0 / ratio[j])
+        shape_conf = min(1.0, 1.5 / elong[j])
+        conf = float(np.clip(size_conf * shape_conf / 0.6, 0.0, 1.0))
+        if conf >= params.min_confidence:
+            px = regions.centroid[idx[j]]
+            out.append(BallDetection(float(xy[j, 0]), float(xy[j, 1]), conf, (float(px[0]), float(px[1]))))
+    out.sort(key=lambda b: -b.confidence)
+    return out[: params.max_balls]

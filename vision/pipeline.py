@@ -1,0 +1,143 @@
+"""One camera image -> one :class:`~cmdragons.messages.DetectionFrame`: CMVision regions, then
+robot patterns and the ball (Bruce's thesis, appendix A).
+
+:class:`VisionParams` is ``configs/vision.yaml``: the colour space, the colour classes (threshold
+boxes), which class plays which role, and the region, pattern and ball parameters.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from cmdragons.camera import CameraModel
+from cmdragons.config import Validated
+from cmdragons.geometry import TEAMS, LeagueParams, Team
+from cmdragons.messages import DetectionFrame
+from vision.cmvision import (
+    MAX_CLASSES,
+    ColourClass,
+    ColourSpace,
+    RegionParams,
+    Regions,
+    Segmenter,
+    classify_reference,
+)
+from vision.patterns import BallParams, PatternMatcher, PatternParams, RegionGeometry, detect_ball
+
+__all__ = ["ColourRoles", "VisionParams", "VisionPipeline", "default_colours"]
+
+
+def default_colours() -> dict[str, ColourClass]:
+    """Boxes (YUV) for the simulator's default colours, derived by ``cmdragons vision tune`` (margin
+    16) from 2 s recordings with truth at the bench's low, default and high noise levels."""
+    return {
+        "orange": ColourClass(lo=(87, 40, 161), hi=(160, 98, 222), min_area_px=6),
+        "blue": ColourClass(lo=(67, 168, 46), hi=(124, 222, 101), min_area_px=6),
+        "yellow": ColourClass(lo=(164, 0, 127), hi=(236, 56, 180), min_area_px=6),
+        "pink": ColourClass(lo=(107, 131, 173), hi=(172, 185, 227), min_area_px=6),
+        "green": ColourClass(lo=(123, 43, 27), hi=(192, 100, 86), min_area_px=6),
+    }
+
+
+@dataclass(frozen=True)
+class ColourRoles(Validated):
+    """Which colour class is which part of the scene (names under ``colours``)."""
+
+    ball: str = "orange"
+    blue: str = "blue"  # team colour of the blue team's centre dot
+    yellow: str = "yellow"
+    pink: str = "pink"  # id dots
+    green: str = "green"
+
+
+@dataclass(frozen=True)
+class VisionParams(Validated):
+    """configs/vision.yaml."""
+
+    colour_space: ColourSpace = "yuv"  # the space the colour boxes are given in
+    colours: Mapping[str, ColourClass] = field(default_factory=default_colours)  # at most 32; order is priority
+    roles: ColourRoles = ColourRoles()
+    regions: RegionParams = RegionParams()
+    patterns: PatternParams = PatternParams()
+    ball: BallParams = BallParams()
+    # height of the pattern plane per team, m; a team left out: the robot height of configs/field.yaml
+    robot_height_m: Mapping[Team, float] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if len(self.colours) > MAX_CLASSES:
+            raise ValueError(f"colours: at most {MAX_CLASSES} colour classes, got {len(self.colours)}")
+        for role in ("ball", "blue", "yellow", "pink", "green"):
+            name = getattr(self.roles, role)
+            if name not in self.colours:
+                raise ValueError(
+                    f"roles.{role}: unknown colour {name!r}; colours defined: {', '.join(self.colours) or 'none'}"
+                )
+        for team, h in self.robot_height_m.items():
+            if not 0.01 <= h <= 1.0:
+                raise ValueError(f"robot_height_m.{team} must be 0.01 to 1.0 m, got {h}")
+
+
+class VisionPipeline:
+    """Detections of one camera: construct once per camera, then :meth:`process` each frame."""
+
+    def __init__(self, params: VisionParams, league: LeagueParams, camera: CameraModel) -> None:
+        self.params, self.league, self.camera = params, league, camera
+        self.segmenter = Segmenter(params.colours, params.colour_space, params.regions)
+        roles = params.roles
+        self.classes = {role: self.segmenter.index(getattr(roles, role)) for role in ("ball", "blue", "yellow",
+                                                                                       "pink", "green")}  # fmt: skip
+        self.heights: dict[Team, float] = {t: params.robot_height_m.get(t, league.robot.height_m) for t in TEAMS}
+        self.matcher = PatternMatcher(league.pattern, params.patterns)
+        self.grid = camera.pixel_rays_grid()
+        dots = np.array(league.pattern.dot_positions_m)
+        self.pattern_radius_m = float(np.max(np.hypot(dots[:, 0], dots[:, 1]))) + league.pattern.id_dot_diameter_m / 2
+        self.last_regions: Regions | None = None
+
+    @property
+    def shape(self) -> tuple[int, int, int]:
+        return (self.camera.height, self.camera.width, 3)
+
+    def process(self, image: NDArray[np.uint8], frame_number: int, t_capture: float) -> DetectionFrame:
+        """Ball and robots (field frame, m, rad) in ``image`` (H, W, 3) BGR uint8 of this camera.
+
+        Raises ValueError for an image of the wrong shape or type (callers that read frames from
+        disk check first and count such frames).
+        """
+        if image.shape != self.shape or image.dtype != np.uint8:
+            raise ValueError(f"camera {self.camera.id}: expected a uint8 image of shape {self.shape}, "
+                             f"got {image.dtype} {image.shape}")  # fmt: skip
+        regions = self.segmenter.regions(image)
+        self.last_regions = regions
+        geo = RegionGeometry(regions, self.camera, self.grid)
+        robots = self.matcher.detect(geo, self.classes, self.heights, lambda px: self._is_pink(image, px))
+        # a ball seen beside a robot lies outside its top: only a misread marker is well inside
+        balls = detect_ball(geo, self.classes["ball"], self.league.ball.radius_m, robots, self.heights,
+                            self.pattern_radius_m * 0.8, self.params.ball)  # fmt: skip
+        # no wall clock here: the frame is "sent" at its capture time (latency is the runtime's)
+        return DetectionFrame(self.camera.id, frame_number, t_capture, t_capture, tuple(balls),
+                              tuple(sorted(robots, key=lambda r: (r.team, r.id))))  # fmt: skip
+
+    def _is_pink(self, image: NDArray[np.uint8], pixel: NDArray[np.float64]) -> bool | None:
+        """The id-dot colour at ``pixel`` (u, v): the majority class of the 3 x 3 pixels around it."""
+        if not np.all(np.isfinite(pixel)):
+            return None
+        j, i = int(pixel[0]), int(pixel[1])
+        if not (1 <= i < image.shape[0] - 1 and 1 <= j < image.shape[1] - 1):
+            return None
+        bits = classify_reference(image[i - 1 : i + 2, j - 1 : j + 2], self.segmenter.classes, self.params.colour_space)
+        pink = int(np.count_nonzero(bits & np.uint32(1 << self.classes["pink"])))
+        green = int(np.count_nonzero(bits & np.uint32(1 << self.classes["green"])))
+        if max(pink, green) < 3:
+            return None
+        return pink > green
+
+
+def angle_error(a: float, b: float) -> float:
+    """Smallest signed difference a - b of two angles, radians."""
+    return math.remainder(a - b, 2.0 * math.pi)

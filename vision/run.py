@@ -1,0 +1,139 @@
+"""``cmdragons vision SOURCE...``: every camera frame of the sources through the pipeline, into
+detections.jsonl (DESIGN.md), an optional annotated video per camera, and a summary.
+
+A frame that cannot be read, is empty or has the wrong size is counted and reported by number; it
+never stops the run.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+from numpy.typing import NDArray
+
+from cmdragons.camera import CameraModel
+from cmdragons.geometry import LeagueParams
+from cmdragons.messages import DetectionFrame, GroundTruth
+from cmdragons.recording import RecordingReader
+from vision.pipeline import VisionParams, VisionPipeline
+from vision.score import Score
+from vision.sources import FrameSource
+
+__all__ = ["RunSummary", "annotate", "run_vision"]
+
+
+@dataclass
+class RunSummary:
+    frames: int = 0
+    unreadable: list[str] = field(default_factory=list)  # "<source>#<frame>"
+    empty: list[str] = field(default_factory=list)
+    wrong_size: list[str] = field(default_factory=list)
+    robots: int = 0
+    balls: int = 0
+    ms: list[float] = field(default_factory=list)
+    score: dict[str, float] | None = None
+
+    def as_dict(self) -> dict[str, Any]:
+        n = max(1, self.frames)
+        return {
+            "frames": self.frames,
+            "bad_frames": {"unreadable": self.unreadable, "empty": self.empty, "wrong_size": self.wrong_size},
+            "robots_per_frame": self.robots / n,
+            "balls_per_frame": self.balls / n,
+            "ms_per_frame": {
+                "median": float(np.median(self.ms)) if self.ms else None,
+                "p95": float(np.percentile(self.ms, 95)) if self.ms else None,
+            },  # fmt: skip
+            "score": self.score,
+        }
+
+
+COLOURS_BGR = {"blue": (255, 160, 0), "yellow": (0, 230, 255), "ball": (0, 140, 255)}
+
+
+def annotate(image: NDArray[np.uint8], pipe: VisionPipeline, det: DetectionFrame) -> NDArray[np.uint8]:
+    """A copy of ``image`` with the regions' boxes, each robot's pattern circle, heading and id,
+    and the ball."""
+    out = image.copy()
+    regions = pipe.last_regions
+    if regions is not None:
+        for k in range(len(regions)):
+            u0, v0, u1, v1 = (int(x) for x in regions.bbox[k])
+            cv2.rectangle(out, (u0 - 1, v0 - 1), (u1 + 1, v1 + 1), (200, 200, 200), 1)
+    cam, league = pipe.camera, pipe.league
+    for r in det.robots:
+        z = pipe.heights[r.team]
+        c = cam.project_xy(np.array([r.x, r.y]), z)
+        tip = cam.project_xy(np.array([r.x + 0.12 * np.cos(r.theta), r.y + 0.12 * np.sin(r.theta)]), z)
+        radius = int(round(league.robot.radius_m * cam.pixels_per_metre((r.x, r.y), z)))
+        colour = COLOURS_BGR[r.team]
+        cv2.circle(out, (int(c[0]), int(c[1])), radius, colour, 1, cv2.LINE_AA)
+        cv2.line(out, (int(c[0]), int(c[1])), (int(tip[0]), int(tip[1])), colour, 1, cv2.LINE_AA)
+        cv2.putText(out, str(r.id), (int(c[0]) + radius, int(c[1]) - radius), cv2.FONT_HERSHEY_SIMPLEX, 0.5, colour,
+                    1, cv2.LINE_AA)  # fmt: skip
+    for b in det.balls:
+        cv2.circle(out, (int(b.pixel[0]), int(b.pixel[1])), 8, COLOURS_BGR["ball"], 1, cv2.LINE_AA)
+    return out
+
+
+def run_vision(sources: Sequence[FrameSource], cameras: dict[int, CameraModel], params: VisionParams,
+               league: LeagueParams, out: Path, video: bool, fps: float, recording: Path | None = None,
+               progress: Callable[[int], None] | None = None) -> RunSummary:  # fmt: skip
+    """Process every frame of every source; ``cameras`` gives the model of a source that brings
+    none (by its camera id). Writes ``out/detections.jsonl`` and, with ``video``,
+    ``out/annotated_camera_<id>.mp4``. With a recording's truth, the detections are scored."""
+    out.mkdir(parents=True, exist_ok=True)
+    summary = RunSummary()
+    truth: dict[int, GroundTruth] = {}
+    if recording is not None:
+        truth = {t.frame_number: t for t in RecordingReader(recording).truth()}
+    score = Score() if truth else None
+    with open(out / "detections.jsonl", "w", encoding="utf-8") as jsonl:
+        for src in sources:
+            model = src.camera or cameras.get(src.camera_id)
+            if model is None:
+                raise ValueError(f"{src.name}: no camera model for camera id {src.camera_id} (see --config cameras)")
+            pipe = VisionPipeline(params, league, model)
+            writer: cv2.VideoWriter | None = None
+            for k, image in src.frames():
+                where = f"{src.name}#{k}"
+                summary.frames += 1
+                if progress is not None:
+                    progress(1)
+                if image is None:
+                    summary.unreadable.append(where)
+                    continue
+                if image.size == 0:
+                    summary.empty.append(where)
+                    continue
+                if image.shape != pipe.shape:
+                    summary.wrong_size.append(where)
+                    continue
+                t_capture = k / fps
+                t0 = time.perf_counter()
+                det = pipe.process(image, k, t_capture)
+                summary.ms.append((time.perf_counter() - t0) * 1e3)
+                summary.robots += len(det.robots)
+                summary.balls += len(det.balls)
+                jsonl.write(json.dumps(det.to_dict(), separators=(",", ":")) + "\n")
+                if score is not None and k in truth:
+                    score.add(det, truth[k])
+                if video:
+                    if writer is None:
+                        path = out / f"annotated_camera_{src.camera_id}.mp4"
+                        writer = cv2.VideoWriter(str(path), cv2.VideoWriter.fourcc(*"mp4v"), fps,
+                                                 (model.width, model.height))  # fmt: skip
+                    writer.write(annotate(image, pipe, det))
+            if writer is not None:
+                writer.release()
+    if score is not None:
+        summary.score = score.summary()
+    (out / "summary.json").write_text(json.dumps(summary.as_dict(), indent=2) + "\n", encoding="utf-8")
+    return summary

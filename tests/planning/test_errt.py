@@ -123,5 +123,6 @@ def test_cached_waypoints_are_aimed_at_with_the_configured_probability(field: Fi
     before = errt.cache.view().copy()
     boxed = field_world(field, np.vstack([world.circles[:, :2], ring((3.0, -1.0), 0.5, 12)]))
     failed = errt.solve(problem(boxed, (-3.0, -1.0), (3.0, -1.0)), deadline_in(1.0))
-    assert failed.status is PlanStatus.NO_PATH
+    # exhausting the nodes gives NO_PATH; on a loaded machine the deadline may come first: a failure too
+    assert failed.status in (PlanStatus.NO_PATH, PlanStatus.TIMEOUT)
     np.testing.assert_array_equal(errt.cache.view(), before)

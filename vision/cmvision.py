@@ -5,6 +5,8 @@ An image (H, W, 3) BGR uint8 becomes colour regions in four steps:
 1. Thresholding (A.1.3): each colour class is a box ``lo <= c <= hi`` in a colour space (YUV by
    default, A.1.2). The boxes are compiled into three tables of 256 bit masks, one per channel,
    so one pass classifies every pixel into up to 32 classes with three look-ups and two ANDs.
+   U is computed first, alone, and screened against the U table: most of a field (carpet, lines,
+   the robots' black covers) fails on U, so Y and V are computed only where it passes.
 2. Run-length encoding: runs of one class along each row.
 3. Connected regions (A.1.4): runs that touch across rows are joined by union-find.
 4. Region statistics (A.1.5): area, centroid, bounding box, second moments; density-based merging
@@ -20,7 +22,6 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Literal
 
-import numba
 import numpy as np
 from numpy.typing import NDArray
 
@@ -101,6 +102,16 @@ def build_lut(classes: Sequence[ColourClass]) -> NDArray[np.uint32]:
     return lut
 
 
+def _screen_intervals(table: NDArray[np.uint32]) -> NDArray[np.uint8]:
+    """The values whose entry in one channel's table is non-zero, as intervals: rows
+    ``(lo, width)`` uint8 for ``[lo, lo + width]``, in increasing order. The kernel screens pixels
+    on channel 1 with these (a vectorised compare per interval instead of a table look-up)."""
+    inside = np.concatenate([[False], table != 0, [False]])
+    edges = np.flatnonzero(np.diff(inside.astype(np.int8)))
+    starts, ends = edges[0::2], edges[1::2] - 1
+    return np.stack([starts, ends - starts], axis=1).astype(np.uint8).reshape(-1, 2)
+
+
 def classify_reference(
     image: NDArray[np.uint8], classes: Sequence[ColourClass], space: ColourSpace
 ) -> NDArray[np.uint32]:
@@ -165,14 +176,13 @@ class Segmenter:
         self.space = space
         self.params = params
         self.lut = build_lut(self.classes)
+        self._screen = _screen_intervals(self.lut[1])
         self.conv = _CONVERSIONS[space]
         self.min_area = np.array([c.min_area_px for c in self.classes], dtype=np.float64)
         self._runs: NDArray[np.int32] = np.zeros((0, 0, 3), dtype=np.int32)
         self._counts: NDArray[np.int64] = np.zeros(0, dtype=np.int64)
         self._no_runs = np.zeros((0, 1, 3), dtype=np.int32)  # "keep no runs" for the kernel
         self._no_bits = np.zeros((0, 1), dtype=np.uint32)
-        # a few blocks of rows per thread: balance without scheduling cost
-        self._chunks = 4 * numba.get_num_threads()
 
     def index(self, name: str) -> int:
         return self.names.index(name)
@@ -180,7 +190,7 @@ class Segmenter:
     def classify(self, image: NDArray[np.uint8]) -> NDArray[np.uint32]:
         """Per pixel, the bit set of classes (bit k: class k) whose box holds it."""
         out = np.empty(image.shape[:2], dtype=np.uint32)
-        kern.classify(np.ascontiguousarray(image), self.conv, self.lut, out, self._no_runs, self._counts, self._chunks)
+        kern.classify(np.ascontiguousarray(image), self.conv, self.lut, self._screen, out, self._no_runs, self._counts)
         return out
 
     def runs(self, image: NDArray[np.uint8]) -> tuple[NDArray[np.int32], NDArray[np.int64]]:
@@ -191,7 +201,7 @@ class Segmenter:
             self._runs = np.zeros((h, self.params.max_runs_per_row, 3), dtype=np.int32)
             self._counts = np.zeros(h, dtype=np.int64)
         image = np.ascontiguousarray(image)
-        kern.classify(image, self.conv, self.lut, self._no_bits, self._runs, self._counts, self._chunks)
+        kern.classify(image, self.conv, self.lut, self._screen, self._no_bits, self._runs, self._counts)
         return self._runs, self._counts
 
     def regions(self, image: NDArray[np.uint8], merge: bool = True) -> Regions:

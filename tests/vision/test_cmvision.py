@@ -15,6 +15,7 @@ from vision.cmvision import (
     ColourClass,
     RegionParams,
     Segmenter,
+    _screen_intervals,
     build_lut,
     classify_reference,
     merge_reference,
@@ -59,6 +60,46 @@ def test_lut_classification_equals_direct_thresholds(space: str, seed: int, scen
     for image, classes in ((random_image(seed), wide_classes()), (scene, CLASSES)):
         seg = Segmenter(classes, space, RegionParams())  # type: ignore[arg-type]
         np.testing.assert_array_equal(seg.classify(image), classify_reference(image, list(classes.values()), space))  # type: ignore[arg-type]
+
+
+def every_colour(step: int = 3) -> NDArray[np.uint8]:
+    """One pixel per (b, g, r) on a grid of ``step`` levels per channel, 0 and 255 included."""
+    v = np.unique(np.r_[np.arange(0, 256, step), 255]).astype(np.uint8)
+    b, g, r = np.meshgrid(v, v, v, indexing="ij")
+    return np.stack([b, g, r], axis=-1).reshape(len(v) * len(v), len(v), 3)
+
+
+@pytest.mark.parametrize("space", ["yuv", "bgr"])
+@pytest.mark.parametrize("classes", [CLASSES, wide_classes()], ids=["default", "wide"])
+def test_screened_classification_equals_direct_thresholds_over_colour_space(
+    space: str, classes: dict[str, ColourClass]
+) -> None:
+    # the default boxes screen most colours out on channel 1; the wide ones (channel 1 all of
+    # 0..255) let every pixel through the screen
+    image = every_colour()
+    seg = Segmenter(classes, space, RegionParams())  # type: ignore[arg-type]
+    bits = classify_reference(image, list(classes.values()), space)  # type: ignore[arg-type]
+    np.testing.assert_array_equal(seg.classify(image), bits)
+    runs, counts = seg.runs(image)
+    got = [[tuple(int(x) for x in runs[i, k]) for k in range(counts[i])] for i in range(image.shape[0])]
+    assert got == runs_reference(bits)
+
+
+@pytest.mark.parametrize(
+    "ranges", [[], [(0, 255)], [(0, 0)], [(255, 255)], [(0, 100), (131, 222)], [(5, 9), (10, 20), (40, 40)]]
+)
+def test_screen_intervals_cover_exactly_the_nonzero_entries(ranges: list[tuple[int, int]]) -> None:
+    table = np.zeros(256, np.uint32)
+    for k, (lo, hi) in enumerate(ranges):
+        table[lo : hi + 1] |= np.uint32(1 << k)
+    got = _screen_intervals(table)
+    assert got.dtype == np.uint8 and got.shape[1] == 2
+    covered = np.zeros(256, bool)
+    for lo, width in got.astype(int):
+        covered[lo : lo + width + 1] = True
+    np.testing.assert_array_equal(covered, table != 0)
+    ends = got[:, 0].astype(int) + got[:, 1]
+    assert np.all(got[1:, 0] > ends[:-1] + 1), "sorted, apart, adjacent ranges joined"
 
 
 def test_yuv_matches_opencv_within_one_level() -> None:

@@ -46,7 +46,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("bench", help="run a benchmark suite and print its table")
     _common(p)
-    p.add_argument("suite", help="suite name (sim, safety)")
+    p.add_argument("suite", help="suite name (sim, planning, safety)")
     p.add_argument("--quick", action="store_true", help="a reduced suite, well under a minute")
     p.add_argument("--json", metavar="PATH", default=None, help="also write the rows as JSON")
     return parser

@@ -95,6 +95,9 @@ class KickerParams(Validated):
     recharge_s: float = setting(0.3, lo=0.0, hi=10.0)  # time between two kicks of one robot
     touch_tolerance_m: float = setting(0.006, lo=0.0, hi=0.05)  # ball surface to the front face
     chip_angle_rad: float = setting(0.7854, lo=0.05, hi=1.5)  # elevation of a chip kick
+    # fraction of the ball's velocity across the robot's heading that survives a kick: the kicker
+    # pushes along the heading only, so a one-touch redirection must aim off the target to compensate
+    tangential_retention: float = setting(0.3, lo=0.0, hi=1.0)
 
 
 @dataclass(frozen=True)
@@ -470,15 +473,19 @@ class World:
                 continue
             self._release(r)
             hx, hy = math.cos(r.body.angle), math.sin(r.body.angle)
+            # the ball's velocity relative to the robot, across the heading, partly survives the kick
+            rel = self.ball_body.velocity - r.body.velocity
+            across = (-hy * rel.x + hx * rel.y) * self.p_kicker.tangential_retention
+            tx, ty = -hy * across, hx * across
             if r.command.chip:
                 a = self.p_kicker.chip_angle_rad
-                self.ball_body.velocity = (hx * speed * math.cos(a), hy * speed * math.cos(a))
+                self.ball_body.velocity = (hx * speed * math.cos(a) + tx, hy * speed * math.cos(a) + ty)
                 self._ball.vz = speed * math.sin(a)
                 self._ball.z = 1e-6
                 self.ball_shape.filter = pymunk.ShapeFilter(categories=_CAT_BALL, mask=_CAT_WALL)
             else:
-                self.ball_body.velocity = (hx * speed, hy * speed)
-                self._start_slide(speed)
+                self.ball_body.velocity = (hx * speed + tx, hy * speed + ty)
+                self._start_slide(self.ball_body.velocity.length)
             r.kick_ready_t = self.t + self.p_kicker.recharge_s
             self._ball.last_touch = r.team
             self.events.append(Kick(self.t, r.team, r.id, speed, bool(r.command.chip)))

@@ -24,16 +24,34 @@ def _sim(settings: Settings, quick: bool) -> list[Row]:
     return run(settings, quick)
 
 
+def _planning(settings: Settings, quick: bool) -> list[Row]:
+    from cmdragons.bench.planning import run
+
+    return run(settings, quick)
+
+
 def _safety(settings: Settings, quick: bool) -> list[Row]:
     from cmdragons.bench.safety import run
 
     return run(settings, quick)
 
 
-SUITES: dict[str, Callable[[Settings, bool], list[Row]]] = {"sim": _sim, "safety": _safety}
+SUITES: dict[str, Callable[[Settings, bool], list[Row]]] = {"sim": _sim, "planning": _planning, "safety": _safety}
 
 
 def print_table(suite: str, rows: list[Row]) -> None:
+    """One table per run of consecutive rows that share their metrics."""
+    groups: list[list[Row]] = []
+    for row in rows:
+        if groups and set(groups[-1][0]) == set(row):
+            groups[-1].append(row)
+        else:
+            groups.append([row])
+    for group in groups:
+        _print_group(suite, group)
+
+
+def _print_group(suite: str, rows: list[Row]) -> None:
     from rich.console import Console
     from rich.table import Table
 

@@ -138,7 +138,7 @@ def _hits_segment(obs: np.ndarray, j: int, ax: float, ay: float, bx: float, by: 
         d2 = segment_segment_dist2(ax, ay, bx, by, obs[j, 1], obs[j, 2], obs[j, 3], obs[j, 4])
     else:
         d2 = segment_box_dist2(ax, ay, bx, by, obs[j, 1], obs[j, 2], obs[j, 3], obs[j, 4])
-    return d2 < r * r
+    return bool(d2 < r * r)
 
 
 @njit(cache=True)
@@ -148,12 +148,12 @@ def obstacle_clearance(obs: np.ndarray, j: int, px: float, py: float) -> float:
         d2 = point_segment_dist2(px, py, obs[j, 1], obs[j, 2], obs[j, 3], obs[j, 4])
     else:
         d2 = point_box_dist2(px, py, obs[j, 1], obs[j, 2], obs[j, 3], obs[j, 4])
-    return math.sqrt(d2) - obs[j, 5]
+    return float(math.sqrt(d2) - obs[j, 5])
 
 
 @njit(cache=True)
 def _in_inner(inner: np.ndarray, px: float, py: float) -> bool:
-    return inner[0] - EPS_M <= px <= inner[2] + EPS_M and inner[1] - EPS_M <= py <= inner[3] + EPS_M
+    return bool(inner[0] - EPS_M <= px <= inner[2] + EPS_M and inner[1] - EPS_M <= py <= inner[3] + EPS_M)
 
 
 # --- broad phase ------------------------------------------------------------------------------------
@@ -244,8 +244,49 @@ def _range_area(aabb: np.ndarray, order: np.ndarray, lo: int, hi: int) -> float:
 
 
 @njit(cache=True)
+def build_world(
+    circles: np.ndarray, vel: np.ndarray, boxes: np.ndarray, bounds: np.ndarray, radius: float,
+    t0: float, t1: float, mode: int, n_bins: int,
+) -> tuple[Any, ...]:  # fmt: skip
+    """The compiled world tuple (see the module docstring) for a robot of ``radius`` over the time
+    window [t0, t1]: circles (x, y, r) moving at ``vel`` become capsules, boxes get the radius as
+    clearance, and the chosen broad phase is built."""
+    nc, nb = circles.shape[0], boxes.shape[0]
+    k = nc + nb
+    obs = np.empty((k, 6))
+    aabb = np.empty((k, 4))
+    for j in range(nc):
+        obs[j, 0] = 0.0
+        obs[j, 1], obs[j, 2] = circles[j, 0] + vel[j, 0] * t0, circles[j, 1] + vel[j, 1] * t0
+        obs[j, 3], obs[j, 4] = circles[j, 0] + vel[j, 0] * t1, circles[j, 1] + vel[j, 1] * t1
+        obs[j, 5] = circles[j, 2] + radius
+    for i in range(nb):
+        j = nc + i
+        obs[j, 0] = 1.0
+        obs[j, 1], obs[j, 2], obs[j, 3], obs[j, 4] = boxes[i, 0], boxes[i, 1], boxes[i, 2], boxes[i, 3]
+        obs[j, 5] = radius
+    for j in range(k):
+        r = obs[j, 5]
+        aabb[j, 0], aabb[j, 2] = min(obs[j, 1], obs[j, 3]) - r, max(obs[j, 1], obs[j, 3]) + r
+        aabb[j, 1], aabb[j, 3] = min(obs[j, 2], obs[j, 4]) - r, max(obs[j, 2], obs[j, 4]) + r
+    x0, y0, x1, y1 = bounds[0], bounds[1], bounds[2], bounds[3]
+    inner = np.array([x0 + radius, y0 + radius, x1 - radius, y1 - radius])
+    grid = np.array([x0, y0, n_bins / (x1 - x0), n_bins / (y1 - y0)])
+    if mode == MODE_MASKS:
+        xm, ym = build_masks(aabb, grid, n_bins)
+    else:
+        xm = np.zeros((1, 1), dtype=np.uint64)
+        ym = np.zeros((1, 1), dtype=np.uint64)
+    if mode == MODE_AABB_TREE:
+        tbox, tchild, tleaf = build_aabb_tree(aabb)
+    else:
+        tbox, tchild, tleaf = np.zeros((1, 4)), -np.ones((1, 2), dtype=np.int32), -np.ones(1, dtype=np.int32)
+    return (obs, aabb, inner, mode, grid, xm, ym, tbox, tchild, tleaf)
+
+
+@njit(cache=True)
 def _box_overlap(b: np.ndarray, i: int, x0: float, y0: float, x1: float, y1: float) -> bool:
-    return b[i, 0] <= x1 and x0 <= b[i, 2] and b[i, 1] <= y1 and y0 <= b[i, 3]
+    return bool(b[i, 0] <= x1 and x0 <= b[i, 2] and b[i, 1] <= y1 and y0 <= b[i, 3])
 
 
 @njit(cache=True)
@@ -472,6 +513,19 @@ def _nearest(
     return nearest_brute(nodes, tree, n, t, qx, qy)
 
 
+@njit(cache=True)
+def nearest_batch(nodes: np.ndarray, q: np.ndarray, nn: int, kdc: np.ndarray, kdd: np.ndarray) -> np.ndarray:
+    """Nearest node (all in tree 0, KD root 0) for each query row; for measuring the two searches."""
+    n = nodes.shape[0]
+    tree = np.zeros(n, dtype=np.int8)
+    roots = np.zeros(2, dtype=np.int32)
+    stack = np.zeros((n, 2))
+    out = np.empty(q.shape[0], dtype=np.int64)
+    for i in range(q.shape[0]):
+        out[i] = _nearest(nodes, tree, n, 0, q[i, 0], q[i, 1], nn, kdc, kdd, roots, stack)
+    return out
+
+
 # --- ERRT -------------------------------------------------------------------------------------------
 @njit(cache=True)
 def errt_grow(
@@ -505,7 +559,8 @@ def errt_grow(
 
     ``fparams = (p_goal, p_waypoint, step_m, connect_radius_m)``,
     ``iparams = (max_extensions, bidirectional, max_bridges, extra_iterations, nn_kind)``,
-    ``state = (n_nodes, n_bridges, iterations, first_bridge_iteration)``. Returns a GROW_* code.
+    ``state = (n_nodes, n_bridges, iterations, first_bridge_iteration, waypoint_targets)``, the last
+    counting the iterations that aimed at a cached waypoint. Returns a GROW_* code.
     """
     p_goal, p_way, step, connect_r = fparams[0], fparams[1], fparams[2], fparams[3]
     max_ext, bidir, max_br, extra, nn = iparams[0], iparams[1], iparams[2], iparams[3], iparams[4]
@@ -528,6 +583,7 @@ def errt_grow(
             tx, ty = nodes[other, 0], nodes[other, 1]
         elif u < p_goal + p_way and n_way > 0:
             w = min(n_way - 1, int(rand[r, 1] * n_way))
+            state[4] += 1
             tx, ty = waypoints[w, 0], waypoints[w, 1]
         else:
             tx = inner[0] + rand[r, 1] * (inner[2] - inner[0])
@@ -573,6 +629,59 @@ def errt_grow(
     if state[1] >= max_br or (state[1] > 0 and state[2] - state[3] > extra):
         return GROW_DONE
     return GROW_RUNNING
+
+
+@njit(cache=True)
+def polyline_length(path: np.ndarray) -> float:
+    """Length of the polyline (n, 2), metres."""
+    total = 0.0
+    for i in range(path.shape[0] - 1):
+        total += math.hypot(path[i + 1, 0] - path[i, 0], path[i + 1, 1] - path[i, 1])
+    return total
+
+
+@njit(cache=True)
+def resample(path: np.ndarray, spacing_m: float) -> np.ndarray:
+    """The polyline's vertices plus points at most ``spacing_m`` apart along each segment."""
+    n = path.shape[0]
+    total = 1
+    for i in range(n - 1):
+        seg = math.hypot(path[i + 1, 0] - path[i, 0], path[i + 1, 1] - path[i, 1])
+        total += max(1, int(math.ceil(seg / spacing_m)))
+    out = np.empty((total, 2))
+    out[0, 0], out[0, 1] = path[0, 0], path[0, 1]
+    m = 1
+    for i in range(n - 1):
+        seg = math.hypot(path[i + 1, 0] - path[i, 0], path[i + 1, 1] - path[i, 1])
+        parts = max(1, int(math.ceil(seg / spacing_m)))
+        for p in range(1, parts + 1):
+            f = p / parts
+            out[m, 0] = path[i, 0] + f * (path[i + 1, 0] - path[i, 0])
+            out[m, 1] = path[i, 1] + f * (path[i + 1, 1] - path[i, 1])
+            m += 1
+    return out
+
+
+@njit(cache=True)
+def cache_add(points: np.ndarray, meta: np.ndarray, pts: np.ndarray, u: np.ndarray, fifo: bool) -> int:
+    """Store ``pts`` (k, 2) in the waypoint cache ``points`` (size, 2) (Bruce 2006 §4.3.3):
+    ``meta = (count, next)``; while there is room a point takes the next free slot, then it replaces
+    the oldest (``fifo``) or a random slot picked by the next uniform of ``u``. Returns how many
+    uniforms it used."""
+    size = points.shape[0]
+    used = 0
+    for i in range(max(0, pts.shape[0] - size), pts.shape[0]):
+        if meta[0] < size:
+            k = meta[0]
+            meta[0] += 1
+        elif fifo:
+            k = meta[1]
+            meta[1] = (k + 1) % size
+        else:
+            k = min(size - 1, int(u[used] * size))
+            used += 1
+        points[k, 0], points[k, 1] = pts[i, 0], pts[i, 1]
+    return used
 
 
 # --- smoothing --------------------------------------------------------------------------------------

@@ -20,14 +20,16 @@ def point_segment_dist(p: FloatArray, a: FloatArray, b: FloatArray) -> FloatArra
     den = np.einsum("ij,ij->i", d, d)
     t = np.where(den > 0, np.einsum("ij,ij->i", p - a, d) / np.where(den > 0, den, 1.0), 0.0)
     t = np.clip(t, 0.0, 1.0)
-    return np.hypot(*(a + t[:, None] * d - p).T)
+    out: FloatArray = np.hypot(*(a + t[:, None] * d - p).T)
+    return out
 
 
 def point_box_dist(p: FloatArray, box: FloatArray) -> FloatArray:
     """Distances from points p (n, 2) to boxes (n, 4) x0, y0, x1, y1."""
     ex = np.maximum.reduce([box[:, 0] - p[:, 0], np.zeros(len(p)), p[:, 0] - box[:, 2]])
     ey = np.maximum.reduce([box[:, 1] - p[:, 1], np.zeros(len(p)), p[:, 1] - box[:, 3]])
-    return np.hypot(ex, ey)
+    out: FloatArray = np.hypot(ex, ey)
+    return out
 
 
 def sampled_segment_dist(a: FloatArray, b: FloatArray, dist_to_point, samples: int = 4001) -> float:  # type: ignore[no-untyped-def]
@@ -68,3 +70,24 @@ def segment_free(obs: FloatArray, inner: FloatArray, a: FloatArray, b: FloatArra
 def nearest(nodes: FloatArray, q: FloatArray) -> int:
     """Index of the row of ``nodes`` nearest to q."""
     return int(np.argmin(np.hypot(*(nodes - q).T)))
+
+
+def cache_add(points: FloatArray, count: int, nxt: int, pts: FloatArray, u: FloatArray, fifo: bool) -> tuple[int, int]:
+    """The waypoint cache's replacement with numpy slices: fill the free slots, then overwrite the
+    oldest (fifo) or the slots ``u * size`` picks. Returns the new (count, next)."""
+    size = len(points)
+    pts = pts[-size:]
+    room = min(size - count, len(pts))
+    points[count : count + room] = pts[:room]
+    count += room
+    rest = pts[room:]
+    if len(rest) == 0:
+        return count, nxt
+    if fifo:
+        idx = (nxt + np.arange(len(rest))) % size
+        nxt = int((nxt + len(rest)) % size)
+    else:
+        idx = np.minimum(size - 1, (u[: len(rest)] * size).astype(np.int64))
+    for i, k in zip(idx, rest, strict=True):  # in order: a later point wins a slot drawn twice
+        points[i] = k
+    return count, nxt

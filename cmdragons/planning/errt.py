@@ -64,7 +64,7 @@ class ERRTParams:
     waypoint_cache: bool = True  # keep and use the waypoint cache
     waypoint_cache_size: int = setting(64, lo=1, hi=10000)  # cached points
     waypoint_replacement: Literal["random", "fifo"] = setting("random", choices=("random", "fifo"))
-    waypoint_spacing_m: float = setting(0.3, lo=0.01, hi=10.0)  # points cached along a plan
+    waypoint_spacing_m: float = setting(0.3, lo=0.01, hi=10.0)  # spacing of the points cached along a plan
     bidirectional: bool = True  # grow trees from both ends (multi-bridge ERRT, §4.3.4)
     max_bridges: int = setting(4, lo=1, hi=64)  # bridges to collect before choosing the shortest
     extra_iterations: int = setting(24, lo=0, hi=100000)  # more iterations after the first bridge
@@ -83,43 +83,31 @@ class ERRTParams:
 
 class WaypointCache:
     """Points of earlier plans (Bruce 2006 §4.3): a fixed-size store with random or FIFO replacement
-    (§4.3.3); the planner's own rng picks the victims, so runs repeat exactly."""
+    (§4.3.3), filled by the numba kernel :func:`_kernels.cache_add` (a microsecond a plan); the
+    planner's own rng picks the victims, so runs repeat exactly."""
 
     def __init__(self, size: int, replacement: str, rng: np.random.Generator) -> None:
         self.points = np.zeros((size, 2))
-        self.count = 0
-        self._next = 0
-        self._replacement = replacement
+        self._meta = np.zeros(2, dtype=np.int64)  # count, next (FIFO)
+        self._fifo = replacement == "fifo"
         self._rng = rng
+        self._u = np.zeros(0)
+        self._u_next = 0
+
+    @property
+    def count(self) -> int:
+        return int(self._meta[0])
 
     def add(self, pts: FloatArray) -> None:
-        size = len(self.points)
-        for p in pts:
-            if self.count < size:
-                self.points[self.count] = p
-                self.count += 1
-            elif self._replacement == "fifo":
-                self.points[self._next] = p
-                self._next = (self._next + 1) % size
-            else:
-                self.points[int(self._rng.integers(size))] = p
+        if len(self._u) - self._u_next < len(pts):
+            self._u, self._u_next = self._rng.random(max(1024, len(pts))), 0
+        self._u_next += K.cache_add(self.points, self._meta, pts, self._u[self._u_next :], self._fifo)
 
     def view(self) -> FloatArray:
         return self.points[: self.count]
 
     def clear(self) -> None:
-        self.count = 0
-        self._next = 0
-
-
-def resample(path: FloatArray, spacing_m: float) -> FloatArray:
-    """The vertices of a polyline plus points every ``spacing_m`` along its segments."""
-    out = [path[:1]]
-    for a, b in zip(path[:-1], path[1:], strict=True):
-        n = max(1, int(np.ceil(np.hypot(*(b - a)) / spacing_m)))
-        f = np.arange(1, n + 1)[:, None] / n
-        out.append(a + f * (b - a))
-    return np.vstack(out)
+        self._meta[:] = 0
 
 
 class ERRTPlanner:
@@ -143,7 +131,7 @@ class ERRTPlanner:
         self._kdd = np.zeros(cap, dtype=np.int32)
         self._roots = np.array([0, 1], dtype=np.int32)
         self._stack = np.zeros((cap, 2))
-        self._state = np.zeros(4, dtype=np.int64)
+        self._state = np.zeros(5, dtype=np.int64)
         self._bridges = np.zeros((p.max_bridges, 3))
         p_way = p.p_waypoint if p.waypoint_cache else 0.0
         self._f = np.array([p.p_goal, p_way, p.step_m, p.connect_radius_m])
@@ -156,6 +144,7 @@ class ERRTPlanner:
                              self._stack, self._state, self._bridges)  # fmt: skip
         self._rand = np.zeros((0, 3))
         self._rand_next = 0
+        self._t_search = 0.0
 
     def reset(self) -> None:
         self.cache.clear()
@@ -168,6 +157,7 @@ class ERRTPlanner:
         cw, ends = prepare(problem)
         if ends.failure is not None:
             return ends.fail(t0)
+        self._t_search = time.perf_counter()  # the search alone, without compiling the world
         reused = self._reuse(cw, ends)
         if reused is not None:
             return self._done(ends, reused, PlanStatus.SOLVED, {"reused": True, "iterations": 0}, t0, cache=False)
@@ -175,13 +165,16 @@ class ERRTPlanner:
         if cw.segment_free(s, g):
             path = np.array([s, g], dtype=np.float64)
             return self._done(ends, path, PlanStatus.SOLVED, {"reused": False, "iterations": 0}, t0)
-        code, timed_out = self._grow(cw, s, g, deadline)
+        waypoints = self.cache.view() if self.params.waypoint_cache else self._no_waypoints
+        code, timed_out = self._grow(cw, s, g, waypoints, deadline)
         n_nodes, n_bridges, iterations = (int(v) for v in self._state[:3])
-        stats: dict[str, object] = {"reused": False, "iterations": iterations, "nodes": n_nodes, "bridges": n_bridges}
+        stats: dict[str, object] = {"reused": False, "iterations": iterations, "nodes": n_nodes, "bridges": n_bridges,
+                                    "waypoint_targets": int(self._state[4]), "cached": len(waypoints)}  # fmt: skip
         if n_bridges == 0:
             self.last_path = None
             status = PlanStatus.TIMEOUT if timed_out else PlanStatus.NO_PATH
             partial = self._branch(self._closest_to(g))[::-1]
+            stats["search_ms"] = (time.perf_counter() - self._t_search) * 1e3
             stats["ms"] = (time.perf_counter() - t0) * 1e3
             return ends.finish(partial, status, stats)
         b = int(np.argmin(self._bridges[:n_bridges, 2]))
@@ -189,7 +182,7 @@ class ERRTPlanner:
         raw = np.vstack([self._branch(a0)[::-1], self._branch(a1)])
         stats["raw_length_m"] = float(np.hypot(*np.diff(raw, axis=0).T).sum())
         path = smooth(cw, raw, self.params.smoothing)
-        return self._done(ends, path, PlanStatus.SOLVED, stats, t0)
+        return self._done(ends, path, PlanStatus.SOLVED, stats, t0, cache_points=raw)
 
     # --- steps ----------------------------------------------------------------------------------
     def _reuse(self, cw: CompiledWorld, ends: RobustEnds) -> FloatArray | None:
@@ -209,7 +202,7 @@ class ERRTPlanner:
         return None
 
     def _grow(
-        self, cw: CompiledWorld, s: tuple[float, float], g: tuple[float, float], deadline: float
+        self, cw: CompiledWorld, s: tuple[float, float], g: tuple[float, float], waypoints: FloatArray, deadline: float
     ) -> tuple[int, bool]:
         """Run the ERRT kernel in chunks until it finishes, runs out of nodes or the deadline passes."""
         self._nodes[0], self._nodes[1] = s, g
@@ -218,8 +211,7 @@ class ERRTPlanner:
         self._cost[:2] = 0.0
         self._kdc[:2] = -1
         self._kdd[:2] = 0
-        self._state[:] = (2, 0, 0, 0)
-        waypoints = self.cache.view() if self.params.waypoint_cache else self._no_waypoints
+        self._state[:] = (2, 0, 0, 0, 0)
         chunk = self.params.chunk_iterations
         while True:
             rand = self._random_rows(chunk)
@@ -269,10 +261,17 @@ class ERRTPlanner:
         stats: dict[str, object],
         t0: float,
         cache: bool = True,
+        cache_points: FloatArray | None = None,
     ) -> PlanResult:
+        """Remember the plan and feed the waypoint cache with points every ``waypoint_spacing_m`` along
+        the tree's own path (Bruce 2006 §4.3), which keeps some clearance, rather than along the
+        smoothed path that touches the obstacles and is the first to be blocked when they move."""
         if cache and self.params.waypoint_cache:
-            self.cache.add(resample(path, self.params.waypoint_spacing_m)[1:-1])
+            along = cache_points if cache_points is not None else path
+            self.cache.add(K.resample(along, self.params.waypoint_spacing_m)[1:-1])
         self.last_path = path
         self.last_goal = ends.goal
-        stats["ms"] = (time.perf_counter() - t0) * 1e3
+        now = time.perf_counter()
+        stats["search_ms"] = (now - self._t_search) * 1e3
+        stats["ms"] = (now - t0) * 1e3
         return ends.finish(path, status, stats)

@@ -121,7 +121,7 @@ class DynamicPRMPlanner:
             pts, start, adj, w = rm.csr(np.array([s, g]))
             src, dst = len(pts) - 2, len(pts) - 1
             cost, prev = K.astar(cw.cw, pts, start, adj, w, src, dst, np.zeros(len(adj), dtype=np.int8))
-            route = K.route_to(prev, dst) if np.isfinite(cost[dst]) else []
+            route: NDArray[np.int64] = K.route_to(prev, dst) if np.isfinite(cost[dst]) else np.zeros(0, np.int64)
             searches += 1
             stats: dict[str, object] = {"searches": searches, "roadmap_nodes": len(rm.pts)}
             if len(route):

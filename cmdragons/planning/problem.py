@@ -17,6 +17,7 @@ inside an obstacle is replaced by the nearest free goal (status APPROXIMATE).
 from __future__ import annotations
 
 import enum
+import math
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -25,6 +26,7 @@ from typing import Any, Protocol
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from cmdragons.planning import _kernels as K
 from cmdragons.planning.world import CollisionParams, CollisionWorld, CompiledWorld
 
 __all__ = [
@@ -33,6 +35,7 @@ __all__ = [
     "PlanStatus",
     "Planner",
     "RobustEnds",
+    "Stateless",
     "deadline_in",
     "path_length",
     "prepare",
@@ -101,6 +104,13 @@ class Planner(Protocol):
         """Forget everything learnt from earlier frames."""
 
 
+class Stateless:
+    """For planners that keep nothing across frames."""
+
+    def reset(self) -> None:
+        """Nothing to forget."""
+
+
 def deadline_in(budget_s: float) -> float:
     """The absolute ``time.perf_counter()`` deadline ``budget_s`` seconds from now."""
     return time.perf_counter() + budget_s
@@ -108,8 +118,7 @@ def deadline_in(budget_s: float) -> float:
 
 def path_length(path: ArrayLike) -> float:
     """Length of a polyline (k, 2), metres."""
-    p = np.asarray(path, dtype=np.float64).reshape(-1, 2)
-    return float(np.hypot(*np.diff(p, axis=0).T).sum()) if len(p) > 1 else 0.0
+    return float(K.polyline_length(np.ascontiguousarray(path, dtype=np.float64).reshape(-1, 2)))
 
 
 @dataclass(frozen=True)
@@ -151,12 +160,12 @@ def prepare(problem: PlanProblem) -> tuple[CompiledWorld, RobustEnds]:
 def robust_ends(cw: CompiledWorld, start: tuple[float, float], goal: tuple[float, float]) -> RobustEnds:
     """Robust planning (Bruce 2006 §4.6.2): where to plan from and to when the start or the goal lies
     in an obstacle or outside the field."""
-    s = np.array(start, dtype=np.float64)
-    if not (np.all(np.isfinite(s)) and np.all(np.isfinite(goal))):
-        bad = PlanStatus.INVALID_START if not np.all(np.isfinite(s)) else PlanStatus.INVALID_GOAL
-        return RobustEnds(start, goal, s[None, :], False, False, bad)
+    prefix = np.array([start], dtype=np.float64)
+    start_ok = math.isfinite(start[0]) and math.isfinite(start[1])
+    if not (start_ok and math.isfinite(goal[0]) and math.isfinite(goal[1])):
+        bad = PlanStatus.INVALID_GOAL if start_ok else PlanStatus.INVALID_START
+        return RobustEnds(start, goal, prefix, False, False, bad)
     escaped = False
-    prefix = s[None, :]
     if not cw.point_free(*start):
         out = cw.nearest_free(*start)
         if out is None:

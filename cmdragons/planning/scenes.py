@@ -95,3 +95,73 @@ class MovingScene:
             speed = self.rng.uniform(0.0, self.max_speed, k)
             heading = self.rng.uniform(-np.pi, np.pi, k)
             self.vel[turn] = np.column_stack([speed * np.cos(heading), speed * np.sin(heading)])
+
+
+class CrowdScene:
+    """Hard replanning (Bruce 2006 §4.3.1): two crowds of robots, each a ring around a free pocket
+    with one narrow gap, drift and turn about the field, one in each half; our robot shuttles
+    between the pockets (its goal is the centre of the pocket it is not in). The straight line is
+    blocked by both rings, and a tree has to find the gap out of one pocket and into the other,
+    which takes an ERRT without a waypoint cache hundreds of iterations. The remaining robots
+    (up to 21 in all) wander as in :class:`MovingScene`.
+
+    ``ring_m``: ring radius (robot centres); ``gap_m``: the free width of the gap for the robot's
+    centre (0.0 would close it); robots on the ring are ``spacing_m`` apart (a closed wall when
+    under two grown radii, 0.36 m)."""
+
+    def __init__(self, field: Field, rng: np.random.Generator, n_robots: int = 21, ring_m: float = 0.55,
+                 gap_m: float = 0.12, spacing_m: float = 0.3, max_speed_m_s: float = 0.8,
+                 max_turn_rad_s: float = 0.5) -> None:  # fmt: skip
+        self.field = field
+        self.rng = rng
+        r = field.league.robot.radius_m
+        block = 4.0 * r  # centre distance of two robots that touch when grown by the robot's radius
+        # angles of the ring's robots: the gap is between the last and the first
+        gap_angle = 2.0 * np.arcsin(min(1.0, (block + gap_m) / (2.0 * ring_m)))
+        step = 2.0 * np.arcsin(min(1.0, spacing_m / (2.0 * ring_m)))
+        n_ring = int((2.0 * np.pi - gap_angle) // step) + 1
+        self.ring_angles = np.arange(n_ring) * (2.0 * np.pi - gap_angle) / (n_ring - 1)
+        self.ring_m = ring_m
+        # each crowd roams one half, clear of the defense areas
+        x_lim = field.half_length - field.dims.defense_depth_m - ring_m - 2 * r
+        y_lim = field.half_width - ring_m - 2 * r
+        self.box = np.array([[-x_lim, -y_lim, -ring_m - 2 * r, y_lim], [ring_m + 2 * r, -y_lim, x_lim, y_lim]])
+        self.centre = np.column_stack([rng.uniform(self.box[:, 0], self.box[:, 2]),
+                                       rng.uniform(self.box[:, 1], self.box[:, 3])])  # fmt: skip
+        speed = rng.uniform(0.2, max_speed_m_s, 2)
+        heading = rng.uniform(-np.pi, np.pi, 2)
+        self.vel = np.column_stack([speed * np.cos(heading), speed * np.sin(heading)])
+        # the gaps start facing away from each other (the straight line hits both rings)
+        self.theta = np.array([np.pi, 0.0]) + rng.uniform(-0.5, 0.5, 2) + gap_angle / 2.0
+        self.omega = rng.uniform(-max_turn_rad_s, max_turn_rad_s, 2)
+        n_free = max(0, n_robots - 2 * n_ring)
+        others = random_scene(field, rng, max_robots=max(1, n_free), max_speed_m_s=max_speed_m_s)
+        self.wander = MovingScene(field, Scene(others.robots[:n_free], others.velocities[:n_free],
+                                               (0.0, 0.0), (0.0, 0.0)), rng, max_speed_m_s)  # fmt: skip
+        self.target = 1  # the pocket our robot heads for
+
+    @property
+    def robots(self) -> FloatArray:
+        return np.vstack([self._ring(0)[0], self._ring(1)[0], self.wander.pos])
+
+    @property
+    def velocities(self) -> FloatArray:
+        return np.vstack([self._ring(0)[1], self._ring(1)[1], self.wander.vel])
+
+    def _ring(self, k: int) -> tuple[FloatArray, FloatArray]:
+        a = self.ring_angles + self.theta[k]
+        off = self.ring_m * np.column_stack([np.cos(a), np.sin(a)])
+        vel = self.vel[k] + self.omega[k] * np.column_stack([-off[:, 1], off[:, 0]])
+        return self.centre[k] + off, vel
+
+    def pocket(self, k: int) -> tuple[float, float]:
+        return float(self.centre[k, 0]), float(self.centre[k, 1])
+
+    def step(self, dt_s: float) -> None:
+        self.centre += self.vel * dt_s
+        self.theta += self.omega * dt_s
+        lo, hi = self.box[:, :2], self.box[:, 2:]
+        out = (self.centre < lo) | (self.centre > hi)
+        self.vel[out] *= -1.0
+        self.centre = np.clip(self.centre, lo, hi)
+        self.wander.step(dt_s)

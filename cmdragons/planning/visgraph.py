@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 
 from cmdragons.config import setting
 from cmdragons.planning import _kernels as K
-from cmdragons.planning.problem import PlanProblem, PlanResult, PlanStatus, path_length, prepare
+from cmdragons.planning.problem import PlanProblem, PlanResult, PlanStatus, Stateless, path_length, prepare
 
 __all__ = ["VisGraphParams", "VisibilityGraphPlanner"]
 
@@ -35,7 +35,7 @@ class VisGraphParams:
     arc_polyline_step_deg: float = setting(10.0, lo=0.1, hi=90.0)  # segments of the polyline around an arc
 
 
-class VisibilityGraphPlanner:
+class VisibilityGraphPlanner(Stateless):
     """Exact shortest paths among discs and boxes. Stateless; it does not stop at the deadline
     because one graph is a single kernel call (a few milliseconds with 20 robots)."""
 
@@ -43,9 +43,6 @@ class VisibilityGraphPlanner:
 
     def __init__(self, params: VisGraphParams, rng: np.random.Generator | None = None) -> None:
         self.params = params
-
-    def reset(self) -> None:
-        pass
 
     def solve(self, problem: PlanProblem, deadline: float) -> PlanResult:
         t0 = time.perf_counter()

@@ -16,6 +16,7 @@ straight moves (the swept-circle segment query). The compiled world carries its 
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -32,6 +33,7 @@ BroadPhase = Literal["linear", "masks", "aabb_tree"]
 BROAD_PHASES: dict[str, int] = {"linear": K.MODE_LINEAR, "masks": K.MODE_MASKS, "aabb_tree": K.MODE_AABB_TREE}
 
 FloatArray = NDArray[np.float64]
+Point = Sequence[float] | FloatArray  # (x, y), metres
 
 
 @dataclass(frozen=True)
@@ -121,47 +123,21 @@ class CompiledWorld:
         self.radius_m = radius_m
         self.window_s = (t0_s, t1_s)
         self.params = params
-        c, v, b = world.circles, world.velocities, world.boxes
-        obs = np.empty((len(c) + len(b), 6))
-        obs[: len(c), 0] = 0.0
-        obs[: len(c), 1:3] = c[:, :2] + v * t0_s
-        obs[: len(c), 3:5] = c[:, :2] + v * t1_s
-        obs[: len(c), 5] = c[:, 2] + radius_m
-        obs[len(c) :, 0] = 1.0
-        obs[len(c) :, 1:5] = b
-        obs[len(c) :, 5] = radius_m
-        core = np.empty((len(obs), 4))
-        core[:, 0] = np.minimum(obs[:, 1], obs[:, 3])
-        core[:, 1] = np.minimum(obs[:, 2], obs[:, 4])
-        core[:, 2] = np.maximum(obs[:, 1], obs[:, 3])
-        core[:, 3] = np.maximum(obs[:, 2], obs[:, 4])
-        aabb = core + obs[:, 5:6] * np.array([-1.0, -1.0, 1.0, 1.0])
-        x0, y0, x1, y1 = world.bounds
-        inner = np.array([x0 + radius_m, y0 + radius_m, x1 - radius_m, y1 - radius_m])
-        self.obs, self.aabb, self.inner = obs, aabb, inner
+        bounds = np.array(world.bounds)
         mode = BROAD_PHASES[params.broad_phase]
-        nb = params.mask_bins
-        grid = np.array([x0, y0, nb / (x1 - x0), nb / (y1 - y0)])
-        if mode == K.MODE_MASKS:
-            xm, ym = K.build_masks(aabb, grid, nb)
-        else:
-            xm = ym = np.zeros((1, 1), dtype=np.uint64)
-        if mode == K.MODE_AABB_TREE:
-            tbox, tchild, tleaf = K.build_aabb_tree(aabb)
-        else:
-            tbox, tchild, tleaf = np.zeros((1, 4)), -np.ones((1, 2), dtype=np.int32), -np.ones(1, dtype=np.int32)
-        self.cw: tuple[Any, ...] = (obs, aabb, inner, mode, grid, xm, ym, tbox, tchild, tleaf)
+        self.cw: tuple[Any, ...] = K.build_world(
+            world.circles, world.velocities, world.boxes, bounds, radius_m, t0_s, t1_s, mode, params.mask_bins
+        )
+        self.obs, self.aabb, self.inner = self.cw[0], self.cw[1], self.cw[2]
 
     # --- queries (field frame, metres) ------------------------------------------------------------
     def point_free(self, x: float, y: float) -> bool:
         """The robot's disc at (x, y) touches no obstacle and lies inside the field boundary."""
         return bool(K.point_free(self.cw, float(x), float(y)))
 
-    def segment_free(self, a: ArrayLike, b: ArrayLike) -> bool:
+    def segment_free(self, a: Point, b: Point) -> bool:
         """Swept-circle query: the robot's disc moving straight from a to b touches nothing."""
-        ax, ay = (float(v) for v in np.asarray(a, dtype=np.float64)[:2])
-        bx, by = (float(v) for v in np.asarray(b, dtype=np.float64)[:2])
-        return bool(K.segment_free(self.cw, ax, ay, bx, by))
+        return bool(K.segment_free(self.cw, float(a[0]), float(a[1]), float(b[0]), float(b[1])))
 
     def segments_free(self, segments: ArrayLike) -> NDArray[np.bool_]:
         """:meth:`segment_free` for each row (ax, ay, bx, by)."""
@@ -191,14 +167,17 @@ def field_world(
     velocities: ArrayLike | None = None,
     robot_radius_m: float | None = None,
     *,
-    defense_areas: bool = True,
+    defense_areas: bool | Literal[-1, 1] = True,
     goal_walls: bool = True,
     extra_circles: ArrayLike | None = None,
 ) -> CollisionWorld:
     """The collision world of a small-size field: the boundary walls, the defense areas (when the
     robot must stay out of them) and the goal walls as boxes, ``robots`` (n, 2) as circles of the
     league's robot radius moving at ``velocities`` (n, 2), plus ``extra_circles`` (x, y, r) such as
-    the ball."""
+    the ball.
+
+    ``defense_areas``: True both, False neither, -1 or +1 only the one at x < 0 or x > 0 (a goalie
+    may enter its own defense area but not the opponent's: pass the opponent's side)."""
     r = field.league.robot.radius_m if robot_radius_m is None else robot_radius_m
     pos = _as_rows(robots, 2, "robots")
     circles = np.column_stack([pos, np.full(len(pos), r)]) if len(pos) else np.zeros((0, 3))
@@ -208,8 +187,14 @@ def field_world(
     vel = np.vstack([vel, np.zeros((len(extra), 2))])
     boxes: list[tuple[float, float, float, float]] = []
     hl, dw, dd = field.half_length, field.dims.defense_width_m / 2.0, field.dims.defense_depth_m
-    if defense_areas:
-        boxes += [(hl - dd, -dw, hl, dw), (-hl, -dw, -hl + dd, dw)]
+    if isinstance(defense_areas, bool):
+        sides: tuple[float, ...] = (1.0, -1.0) if defense_areas else ()
+    elif defense_areas in (-1, 1):
+        sides = (float(defense_areas),)
+    else:
+        raise ValueError(f"defense_areas must be True, False, -1 or 1, not {defense_areas!r}")
+    for side in sides:
+        boxes.append((hl - dd, -dw, hl, dw) if side > 0 else (-hl, -dw, -hl + dd, dw))
     if goal_walls:
         boxes += field.goal_walls(1.0) + field.goal_walls(-1.0)
     bounds = (

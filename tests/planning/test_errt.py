@@ -10,7 +10,7 @@ import pytest
 from cmdragons.geometry import Field
 from cmdragons.planning import ERRTParams, ERRTPlanner, PlanStatus, deadline_in, field_world, path_length
 from cmdragons.planning.errt import SmoothingParams, WaypointCache, smooth
-from tests.planning.conftest import problem, wall_with_gap
+from tests.planning.conftest import problem, ring, wall_with_gap
 
 
 def planner(**kw: object) -> ERRTPlanner:
@@ -20,7 +20,9 @@ def planner(**kw: object) -> ERRTPlanner:
 def test_waypoint_cache_replacement_strategies() -> None:
     fifo = WaypointCache(3, "fifo", np.random.default_rng(0))
     fifo.add(np.arange(10.0).reshape(5, 2))
-    np.testing.assert_array_equal(fifo.view(), [[6, 7], [8, 9], [4, 5]])  # the oldest went first
+    np.testing.assert_array_equal(fifo.view(), [[4, 5], [6, 7], [8, 9]])  # the last three stay
+    fifo.add(np.array([[10.0, 11.0]]))
+    np.testing.assert_array_equal(fifo.view(), [[10, 11], [6, 7], [8, 9]])  # the oldest went first
     rand = WaypointCache(3, "random", np.random.default_rng(0))
     rand.add(np.arange(20.0).reshape(10, 2))
     assert rand.count == 3 and len({tuple(p) for p in rand.view()}) == 3
@@ -97,3 +99,29 @@ def test_params_are_validated() -> None:
     with pytest.raises(ValueError, match="p_goal"):
         ERRTParams(p_goal=0.7, p_waypoint=0.5)
     assert dataclasses.replace(ERRTParams(), p_goal=0.5).p_goal == 0.5
+
+
+def test_cached_waypoints_are_aimed_at_with_the_configured_probability(field: Field) -> None:
+    # the cache is fed from the last successful plan, and a search draws its targets from it
+    # with probability p_waypoint (Bruce 2006 §4.3)
+    world = wall_with_gap(field)
+    prob = problem(world, (-3.0, -1.0), (3.0, -1.0))
+    errt = planner(p_waypoint=0.4, reuse_last_plan=False, extra_iterations=2000, max_bridges=64, max_nodes=20000)
+    first = errt.solve(prob, deadline_in(1.0))
+    assert first.stats["cached"] == 0 and first.stats["waypoint_targets"] == 0
+    cached = errt.cache.view().copy()
+    assert len(cached) > 10
+    second = errt.solve(prob, deadline_in(1.0))
+    assert second.stats["cached"] == len(cached)
+    iterations, hits = 0, 0
+    for _ in range(8):
+        res = errt.solve(prob, deadline_in(1.0))
+        iterations, hits = iterations + res.stats["iterations"], hits + res.stats["waypoint_targets"]
+    assert iterations > 1000
+    assert abs(hits / iterations - 0.4) < 4 * np.sqrt(0.4 * 0.6 / iterations)
+    # a failed search adds nothing: the cache holds the last successful plans only
+    before = errt.cache.view().copy()
+    boxed = field_world(field, np.vstack([world.circles[:, :2], ring((3.0, -1.0), 0.5, 12)]))
+    failed = errt.solve(problem(boxed, (-3.0, -1.0), (3.0, -1.0)), deadline_in(1.0))
+    assert failed.status is PlanStatus.NO_PATH
+    np.testing.assert_array_equal(errt.cache.view(), before)

@@ -112,7 +112,7 @@ def test_errt_tree_edges_are_collision_free() -> None:
     parent = np.full(cap, -1, dtype=np.int32)
     tree = np.zeros(cap, dtype=np.int8)
     tree[1] = 1
-    state = np.array([2, 0, 0, 0], dtype=np.int64)
+    state = np.array([2, 0, 0, 0, 0], dtype=np.int64)
     bridges = np.zeros((4, 3))
     kd = (np.full((cap, 2), -1, dtype=np.int32), np.zeros(cap, dtype=np.int32), np.array([0, 1], dtype=np.int32))
     fparams = np.array([0.1, 0.0, 0.3, 20.0])  # p_goal, p_waypoint, step_m, connect_radius_m
@@ -130,3 +130,18 @@ def test_errt_tree_edges_are_collision_free() -> None:
         assert tree[int(a0)] == 0 and tree[int(a1)] == 1
         assert R.segment_free(cw.obs, cw.inner, nodes[int(a0)], nodes[int(a1)])
         assert length > 0
+
+
+@pytest.mark.parametrize("fifo", [False, True])
+@pytest.mark.parametrize(("size", "batches"), [(5, [3, 4, 9]), (64, [20, 20, 20, 20, 1]), (1, [2, 1])])
+def test_waypoint_cache_add_agrees(fifo: bool, size: int, batches: list[int]) -> None:
+    rng = np.random.default_rng(size)
+    got, ref = np.zeros((size, 2)), np.zeros((size, 2))
+    meta, count, nxt = np.zeros(2, dtype=np.int64), 0, 0
+    for k in batches:
+        pts, u = rng.uniform(-4, 4, (k, 2)), rng.random(k)
+        replaced = 0 if fifo else max(0, min(k, size) - (size - count))  # one uniform per random victim
+        assert K.cache_add(got, meta, pts, u, fifo) == replaced
+        count, nxt = R.cache_add(ref, count, nxt, pts, u, fifo)
+        assert (int(meta[0]), int(meta[1])) == (count, nxt)
+        np.testing.assert_array_equal(got, ref)

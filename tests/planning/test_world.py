@@ -25,6 +25,27 @@ def test_field_world_blocks_defense_areas_goal_walls_and_boundary(field: Field) 
     assert cw.segment_free((3.4, -2.0), (3.4, 2.0))
 
 
+@pytest.mark.parametrize(
+    ("defense_areas", "blocked_plus_x", "blocked_minus_x"),
+    [(True, True, True), (False, False, False), (1, True, False), (-1, False, True)],
+)
+def test_defense_areas_on_one_side_only(
+    field: Field, defense_areas: bool, blocked_plus_x: bool, blocked_minus_x: bool
+) -> None:
+    # a goalie at -x may enter its own defense area but never the opponent's at +x
+    cw = field_world(field, defense_areas=defense_areas).compile(R)  # type: ignore[arg-type]
+    assert cw.point_free(4.0, 0.5) is not blocked_plus_x
+    assert cw.point_free(-4.0, -0.5) is not blocked_minus_x
+    assert not cw.point_free(4.71, 0.0) and not cw.point_free(-4.71, 0.0)  # goal walls stay
+    assert cw.point_free(0.0, 0.0)
+
+
+@pytest.mark.parametrize("bad", [0, 2, -2, 0.5])
+def test_defense_areas_refuses_other_values(field: Field, bad: object) -> None:
+    with pytest.raises(ValueError, match="defense_areas"):
+        field_world(field, defense_areas=bad)  # type: ignore[arg-type]
+
+
 def test_robot_radius_is_the_clearance(field: Field) -> None:
     world = field_world(field, [[0.0, 0.0]])
     cw = world.compile(R)

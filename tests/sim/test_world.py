@@ -270,3 +270,22 @@ def test_same_seedless_physics_is_deterministic() -> None:
         return np.concatenate([s.ball, s.robots.ravel()])
 
     assert np.array_equal(trace(), trace())
+
+
+def test_kick_keeps_part_of_the_velocity_across_the_heading() -> None:
+    # a ball rolling across the robot's mouth leaves along heading * kick + retention * across
+    w = make_world()
+    w.place_robot("blue", 0, 0.0, 0.0, 0.0)
+    w.place_ball(FRONT + 0.002, -0.04, vy=1.0)
+    before = None
+    for _ in range(10):
+        vy_before = w.ball_body.velocity.y
+        events = w.step_frame([RobotCommand("blue", 0, kick_speed=4.0)])
+        if any(isinstance(e, Kick) for e in events):
+            before = vy_before
+            break
+    assert before is not None
+    retention = KickerParams().tangential_retention
+    vx, vy = w.ball_body.velocity
+    assert vx == pytest.approx(4.0, abs=0.1)
+    assert vy == pytest.approx(retention * before, abs=0.05)

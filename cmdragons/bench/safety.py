@@ -45,7 +45,7 @@ ROBOTS = (2, 4, 6, 8, 11, 22)
 QUICK_ROBOTS = (2, 6, 11)
 TRIALS, QUICK_TRIALS = 100, 3
 ARRIVED_M = 0.05  # a robot this close to its goal has arrived
-TIMEOUT_S = 10.0
+TIMEOUT_S = 15.0
 FAST_M_S = 1.5  # collisions closing faster than this are reported apart
 LINE_OFFSET_M = 0.4  # starts and goals lie this far inside the goal lines
 # navigation stand-in (the planner's job in the team): keep right of a robot in the way
@@ -73,16 +73,20 @@ def _layout(settings: Settings, n: int, rng: np.random.Generator) -> tuple[np.nd
     x = f.half_length - LINE_OFFSET_M
     side = np.where(np.arange(n) % 2 == 0, -1.0, 1.0)
     k = (n + 1) // 2
-    slots = np.linspace(-f.half_width + 0.4, f.half_width - 0.4, k) if k > 1 else np.zeros(1)
-    jitter = (slots[1] - slots[0]) * 0.25 if k > 1 else 0.5
+    edge = f.half_width - 0.4
+    slots = np.linspace(-edge, edge, k) if k > 1 else np.zeros(1)
+    jitter = min((slots[1] - slots[0]) * 0.25, 0.3) if k > 1 else 0.3
     starts = np.empty((n, 2))
     goals = np.empty((n, 2))
     for s in (-1.0, 1.0):
         idx = np.flatnonzero(side == s)
         starts[idx, 0] = s * x
-        starts[idx, 1] = rng.permutation(slots)[: len(idx)] + rng.uniform(-jitter, jitter, len(idx))
+        # lateral slots, jittered but kept on the field (0.1 m from the touch lines at the most)
+        starts[idx, 1] = np.clip(rng.permutation(slots)[: len(idx)] + rng.uniform(-jitter, jitter, len(idx)),
+                                 -edge - 0.3, edge + 0.3)  # fmt: skip
         goals[idx, 0] = -s * x
-        goals[idx, 1] = rng.permutation(slots)[: len(idx)] + rng.uniform(-jitter, jitter, len(idx))
+        goals[idx, 1] = np.clip(rng.permutation(slots)[: len(idx)] + rng.uniform(-jitter, jitter, len(idx)),
+                                -edge - 0.3, edge + 0.3)  # fmt: skip
     return starts, goals
 
 

@@ -15,10 +15,14 @@ from cmdragons.runtime.settings import load_settings
 SETTINGS = load_settings(Path(__file__).resolve().parents[2] / "configs")
 
 
-def test_layout_crosses_the_field_from_both_sides() -> None:
-    starts, goals = _layout(SETTINGS, 6, np.random.default_rng(0))
-    assert np.all(np.sign(starts[:, 0]) == -np.sign(goals[:, 0]))
-    assert sorted(np.sign(starts[:, 0])) == [-1, -1, -1, 1, 1, 1]
+@pytest.mark.parametrize("n", [2, 4, 6, 11, 22])
+def test_layout_crosses_the_field_from_both_sides_on_the_field(n: int) -> None:
+    half_width = SETTINGS.field_geometry().half_width
+    for seed in range(20):
+        starts, goals = _layout(SETTINGS, n, np.random.default_rng(seed))
+        assert np.all(np.sign(starts[:, 0]) == -np.sign(goals[:, 0]))
+        assert sorted(np.sign(starts[:, 0])) == sorted([-1.0] * ((n + 1) // 2) + [1.0] * (n // 2))
+        assert np.abs(np.vstack([starts, goals])[:, 1]).max() <= half_width - 0.1
 
 
 @pytest.mark.parametrize("seed", [0, 1])

@@ -127,7 +127,8 @@ def test_deadline_is_kept(name: str, field: Field) -> None:
         result = planner.solve(prob, t0 + budget_s)
         elapsed = time.perf_counter() - t0
         assert result.status is PlanStatus.TIMEOUT
-        assert elapsed < budget_s + 0.015, f"{name} overran its deadline by {elapsed - budget_s:.4f} s"
+        # the work budget alone would keep it busy for seconds; 0.1 s of slack absorbs a loaded machine
+        assert elapsed < budget_s + 0.1, f"{name} overran its deadline by {elapsed - budget_s:.4f} s"
 
 
 @pytest.mark.parametrize("name", NAMES)

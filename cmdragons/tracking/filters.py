@@ -58,6 +58,11 @@ class RobotModelParams(Validated):
     # after this many regular frames (one detection each, the same time step) the gain has settled
     # and the filter runs in filterpy's steady-state mode (a third of the cost) until a frame differs
     steady_after_updates: int = setting(30, lo=1, hi=100000)
+    # the gate's floor: robots pushing each other move a few centimetres outside the model, and
+    # vision is so precise that the filter's own covariance would reject that; a wrong id is at
+    # least a robot diameter (0.18 m) away and stays rejected
+    gate_floor_m: float = setting(0.03, lo=0.0, hi=1.0)
+    gate_floor_rad: float = setting(0.2, lo=0.0, hi=3.2)
 
 
 def _cv_matrices(n: int, dt: float, sigmas: tuple[float, ...]) -> tuple[Vec, Vec, Vec]:
@@ -199,6 +204,7 @@ class RobotFilter:
         self.command: tuple[float, float, float] | None = None  # (vx, vy, omega) in force
         self._steady: Vec | None = None  # inverse innovation covariance while in steady-state mode
         self._steady_list: list[float] = []  # the same, row by row, as floats
+        self._gate_floor = np.diag([p.gate_floor_m**2, p.gate_floor_m**2, p.gate_floor_rad**2])
         self._steady_dt = 0.0
         self._dt = 0.0
         self._regular = 0  # consecutive regular frames
@@ -279,7 +285,7 @@ class RobotFilter:
             return (y0 * (si[0] * y0 + si[1] * y1 + si[2] * y2) + y1 * (si[3] * y0 + si[4] * y1 + si[5] * y2)
                     + y2 * (si[6] * y0 + si[7] * y1 + si[8] * y2))  # fmt: skip
         y = self.innovation(z)
-        s = self.kf.P[:3, :3] + self.kf.R
+        s = self.kf.P[:3, :3] + self.kf.R + self._gate_floor
         return float(y @ np.linalg.solve(s, y))
 
     def update(self, z: Vec) -> None:
@@ -306,7 +312,7 @@ class RobotFilter:
         # the gate needs the innovation covariance of the settled prior
         f, _, q = self.cache.get(self._dt)
         prior = f @ self.kf.P @ f.T + q
-        self._steady = np.linalg.inv(prior[:3, :3] + self.kf.R)
+        self._steady = np.linalg.inv(prior[:3, :3] + self.kf.R + self._gate_floor)
         self._steady_list = [float(v) for v in self._steady.ravel()]
         self._steady_dt = self._dt
 

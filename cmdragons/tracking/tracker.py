@@ -44,7 +44,7 @@ class TrackerParams(Validated):
     ball_confirm_detections: int = setting(2, lo=1, hi=100)
     ball_timeout_s: float = setting(1.0, lo=0.0, hi=60.0)  # unseen this long: hypothesis dropped
     robot_gate_chi2: float = setting(60.0, lo=1.0, hi=1e6)  # Mahalanobis^2 (3 dof) for a detection
-    robot_reinit_detections: int = setting(6, lo=1, hi=1000)  # consistent rejected detections -> restart
+    robot_reinit_detections: int = setting(3, lo=1, hi=1000)  # consistent rejected detections -> restart
     robot_reinit_spread_m: float = setting(0.05, lo=0.0, hi=5.0)  # ... within this of each other
     robot_confirm_detections: int = setting(3, lo=1, hi=100)
     robot_timeout_s: float = setting(1.0, lo=0.0, hi=60.0)

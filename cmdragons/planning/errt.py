@@ -71,7 +71,7 @@ class ERRTParams:
     connect_radius_m: float = setting(20.0, lo=0.0, hi=100.0)  # longest straight bridge tried
     nearest: Literal["brute", "kdtree"] = setting("brute", choices=("brute", "kdtree"))  # measured: brute wins
     max_nodes: int = setting(2000, lo=16, hi=1000000)  # node budget; spent without a path: NO_PATH
-    chunk_iterations: int = setting(64, lo=1, hi=100000)  # iterations between deadline checks
+    chunk_iterations: int = setting(256, lo=1, hi=100000)  # iterations between deadline checks (fixed)
     reuse_last_plan: bool = True  # keep the last plan while it stays valid and the goal stays
     goal_tolerance_m: float = setting(0.01, lo=0.0, hi=1.0)  # goal moves less than this: same goal
     smoothing: SmoothingParams = SmoothingParams()
@@ -215,18 +215,15 @@ class ERRTPlanner:
         chunk = self.params.chunk_iterations
         while True:
             rand = self._random_rows(chunk)
-            t_chunk = time.perf_counter()
             before = int(self._state[2])
             code = K.errt_grow(cw.cw, *self._tree_arrays, rand, waypoints, self._f, self._i)
             self._rand_next += int(self._state[2]) - before
             if code != K.GROW_RUNNING:
                 return int(code), False
-            now = time.perf_counter()
-            if now >= deadline:
+            if time.perf_counter() >= deadline:
                 return int(code), True
-            # size the next chunk to end well before the deadline (iterations slow down as trees grow)
-            per_iteration = max((now - t_chunk) / chunk, 1e-8)
-            chunk = int(min(4 * chunk, max(1.0, 0.5 * (deadline - now) / per_iteration)))
+            # chunks keep a fixed size: the search's result must not depend on the machine's speed
+            # (where the chunks end shows in the result), only a deadline that is hit may cut it
 
     def _random_rows(self, n: int) -> FloatArray:
         """The next ``n`` rows of the planner's stream of uniforms (three per iteration). Only the rows

@@ -60,9 +60,9 @@ class RobotModelParams(Validated):
     steady_after_updates: int = setting(30, lo=1, hi=100000)
     # the gate's floor: robots pushing each other move a few centimetres outside the model, and
     # vision is so precise that the filter's own covariance would reject that; a wrong id is at
-    # least a robot diameter (0.18 m) away and stays rejected
-    gate_floor_m: float = setting(0.03, lo=0.0, hi=1.0)
-    gate_floor_rad: float = setting(0.2, lo=0.0, hi=3.2)
+    # least a robot diameter (0.18 m) away and stays rejected (sqrt(robot_gate_chi2) x floor = 7.7 cm)
+    gate_floor_m: float = setting(0.01, lo=0.0, hi=1.0)
+    gate_floor_rad: float = setting(0.1, lo=0.0, hi=3.2)
 
 
 def _cv_matrices(n: int, dt: float, sigmas: tuple[float, ...]) -> tuple[Vec, Vec, Vec]:

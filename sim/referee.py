@@ -39,6 +39,7 @@ class RefereeParams(Validated):
     free_kick_distance_m: float = setting(0.2, lo=0.0, hi=2.0)  # from the lines and defense areas
     kickoff_clearance_m: float = setting(0.5, lo=0.0, hi=3.0)  # own robots around the ball in a stop
     restart_timeout_s: float = setting(10.0, lo=0.1, hi=600.0)  # a restart not taken by then: play on
+    keeper_held_ball_s: float = setting(10.0, lo=0.1, hi=600.0)  # ball this long in a defense area: free kick
     # start poses (x m, y m, theta rad) of the team defending -x, per division; mirrored for the other
     formations: Mapping[Literal["A", "B"], tuple[tuple[float, float, float], ...]] = field(
         default_factory=lambda: dict(_DEFAULT_FORMATIONS)
@@ -62,6 +63,8 @@ class Referee:
         self._restart: tuple[float, str, Team, tuple[float, float]] | None = None
         self._restart_ball: tuple[float, float] | None = (0.0, 0.0)
         self._restart_t = 0.0  # when the restart in force was given
+        self._in_area_since: float | None = None  # normal play with the ball in a defense area since
+        self.keeper_held_ball = 0
 
     def formation(self, team: Team) -> list[tuple[float, float, float]]:
         """Kickoff poses of ``team``'s robots in the field frame."""
@@ -117,6 +120,7 @@ class Referee:
                 spot = self.world.field.free_kick_spot(e.x, e.y, self.params.free_kick_distance_m)
                 self.command, self.for_team = "stop", None
                 self._restart = (t + self.params.restart_delay_s, "free_kick", taker, spot)
+        self._check_keeper_held_ball(t)
         if self._restart is not None and t >= self._restart[0]:
             _, kind, team, spot = self._restart
             self._restart = None
@@ -133,6 +137,24 @@ class Referee:
             moved = math.hypot(bx - self._restart_ball[0], by - self._restart_ball[1]) > 0.05
             if moved or t - self._restart_t > self.params.restart_timeout_s:
                 self.command, self.for_team, self._restart_ball = "normal", None, None
+
+    def _check_keeper_held_ball(self, t: float) -> None:
+        """Rules (keeper held ball): the ball in a defense area for ``keeper_held_ball_s`` of normal
+        play gives the other team a free kick at the nearest legal spot."""
+        bx, by = self.world.ball_body.position
+        side = self.world.field.in_defense_area(bx, by)
+        if self.command != "normal" or self._restart is not None or not side:
+            self._in_area_since = None
+            return
+        if self._in_area_since is None:
+            self._in_area_since = t
+        elif t - self._in_area_since >= self.params.keeper_held_ball_s:
+            self._in_area_since = None
+            self.keeper_held_ball += 1
+            taker: Team = "yellow" if side == self.blue_sign else "blue"
+            spot = self.world.field.free_kick_spot(bx, by, self.params.free_kick_distance_m)
+            self.command, self.for_team = "stop", None
+            self._restart = (t + self.params.restart_delay_s, "free_kick", taker, spot)
 
     def state(self) -> GameState:
         return GameState(

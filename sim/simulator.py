@@ -116,6 +116,7 @@ class Simulator:
             "score": dict(self.referee.score),
             "kicks": self.referee.kicks,
             "balls_out": self.referee.balls_out,
+            "keeper_held_ball": self.referee.keeper_held_ball,
             "robot_contacts": {
                 "count": len(contacts),
                 "max_depth_m": max((c.max_depth_m for c in contacts), default=0.0),

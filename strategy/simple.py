@@ -1,6 +1,6 @@
 """The built-in simple opponent: plays on the true state with plain steering, no planning.
 
-Its lowest id keeps goal, the robot nearest the ball goes behind it and shoots at the goal's centre,
+Its lowest id keeps goal (and clears a ball at rest in its area), the robot nearest the ball goes behind it and shoots at the goal's centre,
 the others hold a shape in their half that follows the ball sideways. It keeps the rules' distance
 in a stop and at our restarts. A sparring partner for matches and benchmarks, not a team.
 """
@@ -55,7 +55,12 @@ class SimpleTeam:
         own_sign = -1.0 if (self.team == "blue") == game.blue_defends_negative_x else 1.0
         f = self.field
         goal = (-own_sign * f.half_length, 0.0)
-        intents: dict[int, Intent] = {own[0].id: goalie_block(ball, f, own_sign, self.sp.skills)}
+        goalie = own[0]
+        intents: dict[int, Intent] = {goalie.id: goalie_block(ball, f, own_sign, self.sp.skills)}
+        if f.in_defense_area(ball.x, ball.y) == int(own_sign) and math.hypot(ball.vx, ball.vy) < 0.5:
+            # the ball at rest in its own area: the goalie clears it up the field, away from the middle
+            clear_to = (-own_sign * f.half_length * 0.5, math.copysign(f.half_width * 0.6, ball.y or 1.0))
+            intents[goalie.id] = kick_to(goalie, ball, clear_to, self.p.shot_speed_m_s, self.sp.skills)
         field_players = own[1:]
         if field_players:
             chaser = min(field_players, key=lambda r: math.hypot(r.x - ball.x, r.y - ball.y))

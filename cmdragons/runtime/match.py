@@ -74,6 +74,9 @@ class _Eyes:
         self.perception = perception
         self.tracker = Tracker(settings.tracker)
         self.rng = np.random.default_rng(seed)
+        # truth perception: detections with the noise vision measures (the tracker's measurement model)
+        t = settings.tracker
+        self.noise = (t.ball.measurement_sigma_m, t.robot.measurement_sigma_m, t.robot.measurement_sigma_rad)
         self.pipelines: dict[int, Any] = {}
         if perception == "vision":
             from vision.pipeline import VisionPipeline  # imported here: truth runs need no vision
@@ -85,8 +88,9 @@ class _Eyes:
             return [self.pipelines[cam].process(img, frame.frame_number, frame.t_capture)
                     for cam, img in sorted(frame.images.items())]  # fmt: skip
         gt, n = frame.truth, self.rng.normal
-        ball = (BallDetection(gt.ball.x + n(0, 0.003), gt.ball.y + n(0, 0.003), 1.0, (0.0, 0.0)),)
-        robots = tuple(RobotDetection(r.team, r.id, r.x + n(0, 0.003), r.y + n(0, 0.003), r.theta + n(0, 0.02), 1.0,
+        s_ball, s_xy, s_theta = self.noise
+        ball = (BallDetection(gt.ball.x + n(0, s_ball), gt.ball.y + n(0, s_ball), 1.0, (0.0, 0.0)),)
+        robots = tuple(RobotDetection(r.team, r.id, r.x + n(0, s_xy), r.y + n(0, s_xy), r.theta + n(0, s_theta), 1.0,
                                       (0.0, 0.0)) for r in gt.robots)  # fmt: skip
         return [DetectionFrame(0, frame.frame_number, frame.t_capture, frame.t_capture, ball, robots)]
 

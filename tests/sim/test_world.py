@@ -216,6 +216,23 @@ def test_ball_out_gives_a_free_kick_at_a_legal_spot() -> None:
     assert ref.command == "free_kick" and ref.for_team == "blue"
 
 
+def test_ball_held_in_a_defense_area_gives_the_other_team_a_free_kick() -> None:
+    w = make_world(blue=1, yellow=1)
+    ref = Referee(w, RefereeParams(keeper_held_ball_s=2.0, restart_delay_s=0.5))
+    ref.command, ref.for_team = "normal", None
+    w.place_ball(4.2, 0.3)  # at rest in the defense area at +x: yellow defends it
+    for _ in range(round(1.9 * 60)):
+        ref.observe(w.step_frame())
+    assert ref.command == "normal"  # not yet
+    for _ in range(round(0.7 * 60)):
+        ref.observe(w.step_frame())
+    assert ref.keeper_held_ball == 1
+    assert ref.command == "free_kick" and ref.for_team == "blue"
+    x, y = w.ball_body.position
+    assert w.field.in_defense_area(x, y, margin=0.2 - 1e-6) == 0  # placed outside the area, at the rules' distance
+    assert math.hypot(x - 4.2, y - 0.3) < 1.0
+
+
 def test_robot_contacts_are_reported() -> None:
     w = make_world(blue=1, yellow=1)
     w.place_robot("blue", 0, -1.0, 0.0, 0.0)

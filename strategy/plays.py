@@ -26,11 +26,11 @@ from strategy.evaluation import (
     best_shot,
     candidate_grid,
     clearest_direction,
-    one_touch_turn,
+        one_touch_turn,
     pass_values,
 )
 from strategy.roles import Objective, RoleAssigner, RoleParams
-from strategy.skills import Intent, SkillParams, defend, goalie_block, kick_to, mark, pass_speed, receive
+from strategy.skills import Intent, SkillParams, defend, goalie_block, intercept, kick_to, mark, pass_speed, receive
 
 __all__ = ["Strategy", "StrategyParams", "keep_away"]
 
@@ -54,6 +54,10 @@ class StrategyParams(Validated):
     stop_speed_m_s: float = setting(1.2, lo=0.1, hi=5.0)  # rule: 1.5 m/s in a stop, minus margin
     center_circle_margin_m: float = setting(0.15, lo=0.0, hi=2.0)  # kept outside the centre circle at their kickoff
     ball_room_m: float = setting(0.35, lo=0.0, hi=3.0)  # team-mates leave the ball handler this much room
+    max_back_pass_m: float = setting(0.5, lo=0.0, hi=20.0)  # passes go at most this far back toward our goal
+    meet_speed_m_s: float = setting(0.8, lo=0.0, hi=10.0)  # a ball this fast coming at the attacker is met on its path
+    meet_cos: float = setting(0.7, lo=-1.0, hi=1.0)  # ... when its direction is this close to the attacker's
+    clear_speed_m_s: float = setting(3.0, lo=0.1, hi=10.0)  # the ball played forward when nothing is good
 
 
 @dataclass
@@ -63,6 +67,20 @@ class _Pass:
     point: tuple[float, float]
     t_start: float
     kicked: bool = False
+    shoot_at: tuple[float, float] | None = None
+
+
+@dataclass
+class _Kick:
+    """The attacker's decided kick: what for, where to, how hard, since when."""
+
+    robot: int
+    kind: str  # "shot", "pass" or "clear"
+    target: tuple[float, float]
+    speed: float
+    t: float
+    value: float
+    receiver: int | None = None
     shoot_at: tuple[float, float] | None = None
 
 
@@ -132,7 +150,10 @@ class Strategy:
         if passing is not None and passing.kicked:
             objectives.append(Objective("receiver", *passing.point, fixed_robot=passing.receiver))
         else:
-            objectives.append(Objective("attacker", ball.x, ball.y))
+            # the attacker's cost: the way to where each robot can meet the (moving) ball
+            meet = {rid: intercept(r, ball, p.skills, f) for rid, r in own.items()}
+            costs = {rid: math.hypot(m.x - own[rid].x, m.y - own[rid].y) for rid, m in meet.items()}
+            objectives.append(Objective("attacker", ball.x, ball.y, costs=costs))
         slots = [0.0] if p.defenders == 1 else list(np.linspace(-0.12 * (p.defenders - 1), 0.12 * (p.defenders - 1),
                                                                  p.defenders))  # fmt: skip
         defenders = {}
@@ -184,13 +205,40 @@ class Strategy:
 
     def _attack(self, t: float, r: RobotState, own: dict[int, RobotState], opp_xy: np.ndarray, ball: BallState,
                 by_role: dict[str, int], attack_sign: float) -> Intent:  # fmt: skip
+        """Play the ball where the attacker can meet it: shoot, pass or play it forward."""
+        p = self.p
+        met = intercept(r, ball, p.skills, self.field)
+        kick = self._decide_kick(t, r, own, opp_xy, met, by_role, attack_sign)
+        if kick.kind == "pass" and kick.receiver is not None:
+            if self.mem.passing is None or self.mem.passing.receiver != kick.receiver:
+                self.mem.passing = _Pass(r.id, kick.receiver, kick.target, t, shoot_at=kick.shoot_at)
+        else:
+            self.mem.passing = None
+        self.last_action[r.id] = kick.kind
+        speed = math.hypot(ball.vx, ball.vy)
+        toward = ((r.x - ball.x) * ball.vx + (r.y - ball.y) * ball.vy) / max(speed * math.hypot(r.x - ball.x, r.y - ball.y),
+                                                                          1e-9)  # fmt: skip
+        if speed > p.meet_speed_m_s and toward > p.meet_cos:
+            # the ball comes at the attacker: meet it on its path, redirecting it at the target when the
+            # turn allows a one-touch kick, else stopping it with the dribbler
+            turn = float(one_touch_turn(np.array([ball.x, ball.y]), np.array([[met.x, met.y]]),
+                                        np.array([kick.target]))[0])  # fmt: skip
+            if turn <= p.passing.max_turn_rad:
+                return receive(r, ball, (met.x, met.y), p.skills, kick.target, kick.speed)
+            return receive(r, ball, (met.x, met.y), p.skills)
+        return kick_to(r, met, kick.target, kick.speed, p.skills)
+
+    def _decide_kick(self, t: float, r: RobotState, own: dict[int, RobotState], opp_xy: np.ndarray,
+                     ball: BallState, by_role: dict[str, int], attack_sign: float) -> _Kick:  # fmt: skip
+        """Shoot when the open goal angle is good, else pass to the best supporter when its pass is
+        good, else play the ball forward through the most open lane."""
         p, f = self.p, self.field
         ball_xy = np.array([ball.x, ball.y])
         _, aim, shot_value = best_shot(ball_xy, f, attack_sign, opp_xy, self.obstacle_radius, p.passing)
         if shot_value >= p.shoot_value:
-            self.last_action[r.id] = "shot"
-            return kick_to(r, ball, aim, p.skills.max_kick_m_s, p.skills)
-        receivers = [(role, rid) for role, rid in by_role.items() if role.startswith("supporter")]
+            return _Kick(r.id, "shot", aim, p.skills.max_kick_m_s, t, shot_value)
+        receivers = [(role, rid) for role, rid in by_role.items() if role.startswith("supporter")
+                     and (own[rid].x - ball.x) * attack_sign > -p.max_back_pass_m]  # fmt: skip
         if receivers:
             pts = np.array([[own[rid].x, own[rid].y] for _, rid in receivers])
             ev = pass_values(ball_xy, pts, f, attack_sign, opp_xy, self.obstacle_radius, p.passing)
@@ -200,21 +248,18 @@ class Strategy:
                 point = (float(pts[k, 0]), float(pts[k, 1]))
                 _, shot_aim, value_there = best_shot(pts[k], f, attack_sign, opp_xy, self.obstacle_radius, p.passing)
                 turn = float(one_touch_turn(ball_xy, pts[k : k + 1], np.array([shot_aim]))[0])
-                if self.mem.passing is None or self.mem.passing.receiver != rid:
-                    one_touch = value_there >= p.one_touch_value and turn <= p.passing.max_turn_rad
-                    shoot_at = shot_aim if one_touch else None
-                    self.mem.passing = _Pass(r.id, rid, point, t, shoot_at=shoot_at)
+                one_touch = value_there >= p.one_touch_value and turn <= p.passing.max_turn_rad
                 dist = math.hypot(point[0] - ball.x, point[1] - ball.y)
-                self.last_action[r.id] = "pass"
-                return kick_to(r, ball, point, pass_speed(dist, p.skills), p.skills)
+                return _Kick(r.id, "pass", point, pass_speed(dist, p.skills), t, float(ev.values[k]), rid,
+                             shot_aim if one_touch else None)  # fmt: skip
         # nothing good: play the ball forward through the most open lane (around a blocker)
-        self.mem.passing = None
         toward = math.atan2(aim[1] - ball.y, aim[0] - ball.x)
         angle, _ = clearest_direction(ball_xy, toward, opp_xy, self.obstacle_radius)
         target = (ball.x + 1.5 * math.cos(angle), ball.y + 1.5 * math.sin(angle))
         shooting = (ball.x * attack_sign) > 0 and abs(angle - toward) < 0.2
-        self.last_action[r.id] = "shot" if shooting else "clear"
-        return kick_to(r, ball, target, p.skills.max_kick_m_s if shooting else 3.0, p.skills)
+        if shooting:
+            return _Kick(r.id, "shot", target, p.skills.max_kick_m_s, t, shot_value)
+        return _Kick(r.id, "clear", target, p.clear_speed_m_s, t, 0.0)
 
     def _update_pass(self, t: float, own: dict[int, RobotState], ball: BallState) -> _Pass | None:
         """Follow a pass: kicked once the ball runs toward the receiver; over when received, lost

@@ -29,6 +29,7 @@ class Objective:
     x: float
     y: float
     fixed_robot: int | None = None  # a role only this robot may take (the goalie)
+    costs: Mapping[int, float] | None = None  # per robot, instead of the distance to (x, y)
 
 
 class RoleAssigner:
@@ -53,7 +54,7 @@ class RoleAssigner:
                     continue
             best, best_cost = None, math.inf
             for rid, (x, y) in free.items():
-                cost = math.hypot(x - obj.x, y - obj.y)
+                cost = obj.costs[rid] if obj.costs is not None and rid in obj.costs else math.hypot(x - obj.x, y - obj.y)
                 if previous.get(obj.role) == rid:
                     cost -= self.params.hysteresis_m
                 if cost < best_cost or (cost == best_cost and best is not None and rid < best):

@@ -23,6 +23,7 @@ __all__ = [
     "defend",
     "go_to_pose",
     "goalie_block",
+    "intercept",
     "kick_to",
     "mark",
     "pass_speed",
@@ -39,6 +40,9 @@ class SkillParams(Validated):
     lined_up_rad: float = setting(0.08, lo=0.001, hi=1.0)  # heading error allowed before driving through
     lined_up_m: float = setting(0.03, lo=0.001, hi=0.5)  # lateral error allowed before driving through
     push_speed_m_s: float = setting(0.8, lo=0.05, hi=5.0)  # speed of the last approach onto the ball
+    cone_reach_m: float = setting(0.2, lo=0.0, hi=2.0)  # the approach cone reaches this far past the waiting point
+    cone_slope: float = setting(0.25, lo=0.0, hi=2.0)  # lateral error allowed per metre from the ball
+    cone_heading_rad_m: float = setting(1.0, lo=0.0, hi=20.0)  # heading error allowed per metre from the ball
     max_kick_m_s: float = setting(6.0, lo=0.1, hi=10.0)  # shots
     pass_arrival_m_s: float = setting(1.5, lo=0.1, hi=6.0)  # the speed a pass should arrive with
     pass_min_m_s: float = setting(1.5, lo=0.1, hi=10.0)
@@ -50,6 +54,8 @@ class SkillParams(Validated):
     goalie_depth_m: float = setting(0.15, lo=0.0, hi=2.0)  # goalie stands this far in front of the goal line
     defense_margin_m: float = setting(0.15, lo=0.0, hi=2.0)  # defenders stand this far outside the area
     mark_distance_m: float = setting(0.45, lo=0.2, hi=3.0)  # marker between its opponent and our goal
+    intercept_speed_m_s: float = setting(1.8, lo=0.1, hi=10.0)  # robot's average speed when meeting a moving ball
+    intercept_horizon_s: float = setting(3.0, lo=0.0, hi=20.0)  # the moving ball is predicted this far ahead
 
 
 @dataclass(frozen=True)
@@ -85,7 +91,13 @@ def kick_to(robot: RobotState, ball: BallState, target: tuple[float, float], spe
     along, across = rx * c + ry * s, -rx * s + ry * c
     contact = p.front_distance_m + p.ball_radius_m
     heading_error = abs(math.remainder(aim - robot.theta, 2 * math.pi))
-    lined_up = along < -contact + 0.02 and abs(across) < p.lined_up_m and heading_error < p.lined_up_rad
+    # behind the ball, inside a cone around the kick line that narrows to lined_up_m at contact: driving
+    # straight through the ball closes the lateral error on the way (heading likewise)
+    gap = max(0.0, -along - contact)
+    in_cone = (-along < contact + p.approach_distance_m + p.cone_reach_m
+               and abs(across) < p.lined_up_m + p.cone_slope * gap
+               and heading_error < p.lined_up_rad + p.cone_heading_rad_m * gap)  # fmt: skip
+    lined_up = along < -contact + 0.02 and in_cone
     if lined_up or (along < 0 and along > -contact - 0.03 and abs(across) < 0.5 * p.lined_up_m):
         # drive through the ball; the kicker fires when it touches the front
         return Intent(ball.x + c * 0.05, ball.y + s * 0.05, aim, kick_speed=speed, chip=chip, avoid_ball=False,
@@ -123,6 +135,34 @@ def pass_speed(distance: float, p: SkillParams) -> float:
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if speed_after(mid, distance, p) < p.pass_arrival_m_s else (lo, mid)
     return min(max(hi, p.pass_min_m_s), p.pass_max_m_s)
+
+
+def intercept(robot: RobotState, ball: BallState, p: SkillParams, field: Field | None = None,
+              step_s: float = 0.05) -> BallState:  # fmt: skip
+    """The moving ball where ``robot`` can meet it: the first point of its predicted path (rolling
+    deceleration, stopping at the field's edge) the robot reaches in time at ``intercept_speed_m_s``.
+    A ball at rest is returned as it is."""
+    speed = math.hypot(ball.vx, ball.vy)
+    if speed < 0.1:
+        return ball
+    ux, uy = ball.vx / speed, ball.vy / speed
+    t_stop = speed / max(p.acc_roll_m_s2, 1e-9)
+    limit_x = field.half_length if field is not None else math.inf
+    limit_y = field.half_width if field is not None else math.inf
+    x, y, v = ball.x, ball.y, speed
+    t = 0.0
+    while t <= min(p.intercept_horizon_s, t_stop):
+        v = speed - p.acc_roll_m_s2 * t
+        d = speed * t - 0.5 * p.acc_roll_m_s2 * t * t
+        nx, ny = ball.x + ux * d, ball.y + uy * d
+        if abs(nx) > limit_x or abs(ny) > limit_y:
+            break  # the ball leaves the field (or bounces) here: meet it before
+        x, y = nx, ny
+        if math.hypot(x - robot.x, y - robot.y) <= p.intercept_speed_m_s * t:
+            break
+        t += step_s
+    v = max(v, 0.0)
+    return BallState(x, y, ux * v, uy * v, ball.visible)
 
 
 def receive(robot: RobotState, ball: BallState, wait_at: tuple[float, float], p: SkillParams,

@@ -34,6 +34,9 @@ class DSSParams(Validated):
     """configs/safety.yaml ``dss``: margins and the search (Bruce 2006 §5.3, §5.5)."""
 
     own_margin_m: float = setting(0.03, lo=0.0, hi=1.0)  # kept between two own robots' bodies
+    # how far an own robot's velocity estimate may be off (m/s): the distance kept between two own
+    # robots grows by twice this per second of their braking trajectories
+    velocity_error_m_s: float = setting(0.1, lo=0.0, hi=5.0)
     opponent_margin_m: float = setting(0.05, lo=0.0, hi=1.0)  # kept from an opponent's reachable disc
     opponent_accel_m_s2: float = setting(3.0, lo=0.0, hi=50.0)  # bound on how opponents may accelerate
     static_margin_m: float = setting(0.01, lo=0.0, hi=1.0)  # kept from walls and static obstacles
@@ -71,7 +74,7 @@ class DynamicsSafetySearch(ArraySafety):
         self.cfg = np.array([
             motion.period_s, motion.max_accel_m_s2, motion.max_brake_m_s2, 2.0 * robot_radius_m + params.own_margin_m,
             2.0 * robot_radius_m + params.opponent_margin_m, params.opponent_accel_m_s2,
-            params.static_margin_m, params.static_step_m,
+            params.static_margin_m, params.static_step_m, 2.0 * params.velocity_error_m_s,
         ])  # fmt: skip
         self.heuristics = heuristic_table(params)
 

@@ -84,9 +84,10 @@ def test_safe_commands_are_kept_unsafe_ones_changed_or_stopped() -> None:
     r = make_dss().filter(states, commands, np.zeros((0, 4)))
     assert list(r.status) == [KEPT, KEPT]
     np.testing.assert_array_equal(r.velocities, commands)
-    # head-on at 2.5 m/s, 1.3 m apart, still speeding up: safe to stop (2 x 0.52 m of braking plus
-    # 0.21 m), not safe to go on: the first robot must give way
-    states = np.array([[-0.65, 0.0, 2.5, 0.0], [0.65, 0.0, -2.5, 0.0]])
+    # head-on at 2.5 m/s, 1.4 m apart, still speeding up: safe to stop (2 x 0.52 m of braking plus
+    # 0.21 m, grown by 2 x 0.1 m/s over the 0.42 s of braking), not safe to go on: the first robot
+    # must give way
+    states = np.array([[-0.7, 0.0, 2.5, 0.0], [0.7, 0.0, -2.5, 0.0]])
     r = make_dss().filter(states, np.array([[2.55, 0.0], [-2.55, 0.0]]), np.zeros((0, 4)))
     assert r.status[0] in (CHANGED, STOPPED)
     acc, status = make_dss().search(states, np.array([[2.55, 0.0], [-2.55, 0.0]]), np.zeros((0, 4)))

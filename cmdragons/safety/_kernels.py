@@ -292,14 +292,29 @@ def static_hits(tr: np.ndarray, inner: np.ndarray, boxes: np.ndarray, circles: n
 
 
 @njit(cache=True)
+def exposed(states: np.ndarray, opp: np.ndarray, reach: float) -> np.ndarray:
+    """Per own robot: is an opponent's centre within ``reach`` of its centre, near enough to push it
+    into a team-mate before anyone can react?"""
+    out = np.zeros(states.shape[0], dtype=np.bool_)
+    for i in range(states.shape[0]):
+        for j in range(opp.shape[0]):
+            if math.hypot(states[i, 0] - opp[j, 0], states[i, 1] - opp[j, 1]) < reach:
+                out[i] = True
+                break
+    return out
+
+
+@njit(cache=True)
 def _trajectory_hits(
-    i: int, tr: np.ndarray, trs: np.ndarray, opp: np.ndarray, inner: np.ndarray, boxes: np.ndarray,
-    circles: np.ndarray, cfg: np.ndarray,
+    i: int, tr: np.ndarray, trs: np.ndarray, pushed: np.ndarray, opp: np.ndarray, inner: np.ndarray,
+    boxes: np.ndarray, circles: np.ndarray, cfg: np.ndarray,
 ) -> bool:  # fmt: skip
     # cfg: dt, accel, brake, own radius sum, opponent radius sum, opponent accel, static margin, step,
-    # growth of the own radius sum (m/s)
+    # growth of the own radius sum (m/s), own radius sum where an opponent may push one of the two,
+    # the opponent reach that counts as that
     for j in range(trs.shape[0]):
-        if j != i and pair_hits(tr, trs[j], cfg[3], cfg[8]):
+        radius = cfg[9] if pushed[i] or pushed[j] else cfg[3]
+        if j != i and pair_hits(tr, trs[j], radius, cfg[8]):
             return True
     for j in range(opp.shape[0]):
         if opponent_hits(tr, opp[j, 0], opp[j, 1], opp[j, 2], opp[j, 3], cfg[4], cfg[5]):
@@ -331,6 +346,7 @@ def dss(
     Returns the accelerations (n, 2) and each robot's status (KEPT, CHANGED, STOPPED, STOP_ASKED)."""
     n = states.shape[0]
     dt, accel, brake = cfg[0], cfg[1], cfg[2]
+    pushed = exposed(states, opp, cfg[10])
     trs = np.empty((n, N_SEG, 8))
     acc = np.empty((n, 2))
     status = np.full(n, STOPPED, dtype=np.int64)
@@ -349,7 +365,7 @@ def dss(
         px, py, vx, vy = states[i, 0], states[i, 1], states[i, 2], states[i, 3]
         dx, dy = _feasible(vx, vy, desired[i, 0], desired[i, 1], lim, dt)
         tr = trajectory(px, py, vx, vy, dx, dy, dt, accel, brake)
-        if not _trajectory_hits(i, tr, trs, opp, inner, boxes, circles, cfg):
+        if not _trajectory_hits(i, tr, trs, pushed, opp, inner, boxes, circles, cfg):
             trs[i] = tr
             acc[i, 0], acc[i, 1] = dx, dy
             status[i] = KEPT
@@ -383,7 +399,7 @@ def dss(
         order = np.argsort(cost[:m])
         for r in order:
             tr = trajectory(px, py, vx, vy, cand[r, 0], cand[r, 1], dt, accel, brake)
-            if not _trajectory_hits(i, tr, trs, opp, inner, boxes, circles, cfg):
+            if not _trajectory_hits(i, tr, trs, pushed, opp, inner, boxes, circles, cfg):
                 trs[i] = tr
                 acc[i, 0], acc[i, 1] = cand[r, 0], cand[r, 1]
                 status[i] = CHANGED
@@ -404,8 +420,9 @@ def trajectories_clear(
         trs[i] = trajectory(states[i, 0], states[i, 1], states[i, 2], states[i, 3], acc[i, 0], acc[i, 1],
                             cfg[0], cfg[1], cfg[2])  # fmt: skip
     out = np.empty(n, dtype=np.bool_)
+    pushed = exposed(states, opp, cfg[10])
     for i in range(n):
-        out[i] = not _trajectory_hits(i, trs[i], trs, opp, inner, boxes, circles, cfg)
+        out[i] = not _trajectory_hits(i, trs[i], trs, pushed, opp, inner, boxes, circles, cfg)
     return out
 
 

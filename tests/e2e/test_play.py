@@ -31,8 +31,6 @@ def test_against_the_simple_opponent_runs(against_simple: dict[str, Any]) -> Non
     assert against_simple["command_faults"]["non_finite"] == 0
 
 
-@pytest.mark.xfail(strict=True, reason="issue 7 is open: one brush between two of our robots in this match "
-                   "(22 ms, 0.14 mm deep, 0.14 m/s); strict, so the suite fails once it passes")  # fmt: skip
 def test_against_the_simple_opponent_no_own_collision(against_simple: dict[str, Any]) -> None:
     assert against_simple["collisions"]["own"] == 0
 

@@ -124,6 +124,20 @@ def test_walls_and_opponents_are_avoided() -> None:
     assert r.status[0] == KEPT
 
 
+def test_own_robots_keep_farther_apart_where_an_opponent_may_push_one() -> None:
+    # a robot creeps at 0.3 m/s toward a team-mate at rest 8 cm away: it may go on, braking short
+    # of the 3 cm margin; with an opponent 0.22 m from the team-mate's body it may not
+    states = np.array([[0.0, 0.0, 0.0, 0.0], [0.26, 0.0, -0.3, 0.0]])
+    commands = np.array([[0.0, 0.0], [-0.3, 0.0]])
+    alone = make_dss().filter(states, commands, np.zeros((0, 4)))
+    assert alone.status[1] == KEPT
+    near = make_dss().filter(states, commands, np.array([[-0.4, 0.0, 0.0, 0.0]]))
+    assert near.status[1] != KEPT and near.velocities[1, 0] > -0.3
+    # the opponent farther than push_range_m: the usual margin again
+    far = make_dss().filter(states, commands, np.array([[-0.6, 0.0, 0.0, 0.0]]))
+    assert far.status[1] == KEPT
+
+
 def test_make_safe_on_world_state_keeps_everything_but_the_velocity() -> None:
     robots = (
         RobotState("blue", 1, -0.65, 0.0, 0.0, 2.5, 0.0),

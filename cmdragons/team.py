@@ -80,6 +80,7 @@ class Brain:
         self.times: dict[str, list[float]] = defaultdict(list)
         self.plans: dict[int, RobotPlan] = {}
         self._control_cache: dict[float, ControlParams] = {}
+        self._last_seen: dict[int, tuple[float, RobotState]] = {}  # own robots as the world last showed them
 
     def _planner(self, rid: int) -> Planner:
         planner = self.planners.get(rid)
@@ -105,13 +106,40 @@ class Brain:
         own = {r.id: r for r in world.robots if r.team == self.team}
         commands = [self._navigate(own[rid], intent, world, game) for rid, intent in sorted(intents.items())]
         t2 = time.perf_counter()
-        safe = self.safety.make_safe(commands, world) if commands else []
+        if commands:
+            lost = self._lost_robots(world)
+            stops = [RobotCommand(self.team, r.id) for r in lost]
+            safe = self.safety.make_safe(commands + stops, dataclasses.replace(world, robots=world.robots + lost))
+        else:
+            safe = []
         t3 = time.perf_counter()
         self.times["strategy"].append((t1 - t0) * 1e3)
         self.times["planning_control"].append((t2 - t1) * 1e3)
         self.times["safety"].append((t3 - t2) * 1e3)
         self.times["brain"].append((t3 - t0) * 1e3)
         return safe
+
+    def _lost_robots(self, world: WorldState) -> tuple[RobotState, ...]:
+        """Own robots the world no longer shows (the tracker lost them, e.g. off the cameras' view).
+        Each is told to stop, and the safety search keeps it as a robot that stops: braking at full
+        strength from the state the world last showed, so that team-mates do not drive into a robot
+        nobody sees (field frame, m, s)."""
+        shown = {r.id for r in world.robots if r.team == self.team}
+        for r in world.robots:
+            if r.team == self.team:
+                self._last_seen[r.id] = (world.t, r)
+        brake = self.settings.control.motion.max_brake_m_s2
+        lost = []
+        for rid, (t_seen, r) in sorted(self._last_seen.items()):
+            if rid in shown:
+                continue
+            speed = math.hypot(r.vx, r.vy)
+            tau = min(max(world.t - t_seen, 0.0), speed / brake)
+            k = (speed - 0.5 * brake * tau) * tau / speed if speed > 0.0 else 0.0  # distance / speed
+            f = (speed - brake * tau) / speed if speed > 0.0 else 0.0
+            lost.append(dataclasses.replace(r, x=r.x + r.vx * k, y=r.y + r.vy * k, vx=r.vx * f, vy=r.vy * f,
+                                            omega=0.0, visible=False))  # fmt: skip
+        return tuple(lost)
 
     def _navigate(self, robot: RobotState, it: Intent, world: WorldState, game: GameState) -> RobotCommand:
         if it.max_speed_m_s == 0.0:

@@ -6,7 +6,7 @@ paths cross head-on and diagonally. Each frame the robots' true state plus Gauss
 tracker would hand over) goes through latency compensation, the trapezoid motion controller and the
 safety stage under test (none, DSS, the dynamic window), and the commands drive the pymunk world
 (sim.world.World directly, no rendering). A trial ends when every robot has come within
-``ARRIVED_M`` of its goal, or at ``TIMEOUT_S``. Instead of the global planner, a keep-right rule
+``ARRIVED_M`` of its goal, or at ``TIMEOUT_S``. Instead of the global planner, a passing rule
 (:func:`keep_right_targets`) routes each robot past a robot in its way, the same for every method.
 
 Metrics per N, method and noise level: ``collisions`` (robot-robot contacts, summed over the
@@ -51,7 +51,8 @@ LINE_OFFSET_M = 0.4  # starts and goals lie this far inside the goal lines
 # navigation stand-in (the planner's job in the team): keep right of a robot in the way
 LOOKAHEAD_M = 1.0  # robots this far ahead on the way to the goal count as in the way
 CORRIDOR_M = 0.25  # ... when their centre is this close to the straight line
-PASS_M = 0.45  # the detour waypoint lies this far to the right of the robot in the way
+PASS_M = 0.45  # the detour waypoint lies this far beside the robot in the way
+EDGE_M = 0.12  # ... and at least this far inside the touch and goal lines (a robot radius and a little)
 
 
 @dataclass(frozen=True)
@@ -91,14 +92,18 @@ def _layout(settings: Settings, n: int, rng: np.random.Generator) -> tuple[np.nd
 
 
 def keep_right_targets(
-    state: np.ndarray, goals: np.ndarray, headings: np.ndarray, control: ControlParams
-) -> np.ndarray:
+    state: np.ndarray, goals: np.ndarray, headings: np.ndarray, control: ControlParams,
+    half_size: tuple[float, float] = (math.inf, math.inf),
+) -> np.ndarray:  # fmt: skip
     """Targets (n, 5) for the controller: straight to the goal, or, when another robot stands in the
-    way within ``LOOKAHEAD_M``, along a path through a waypoint ``PASS_M`` to the right of it.
+    way within ``LOOKAHEAD_M``, along a path through a waypoint ``PASS_M`` beside it.
 
     A stand-in for the global planner, which the team runs but this benchmark does not (it costs more
-    than the whole rest of the frame): a shared keep-right rule lets crossing robots pass each other
-    instead of meeting head-on; every safety method runs behind the same rule."""
+    than the whole rest of the frame). The robot passes on the side of the other robot it is already
+    on, and keeps right when the other robot lies dead ahead: for two robots heading at each other
+    this is the same side for both, so they pass instead of stepping into each other. The waypoint
+    stays ``EDGE_M`` inside the touch and goal lines (``half_size``: half length and half width of
+    the field, m), where a planner would keep it. Every safety method runs behind the same rule."""
     pos = state[:, :2]
     n = len(pos)
     to_goal = goals - pos
@@ -110,10 +115,12 @@ def keep_right_targets(
     ahead = (along > 0) & (along < np.minimum(LOOKAHEAD_M, dist[:, None])) & (np.abs(across) < CORRIDOR_M)
     ahead[np.arange(n), np.arange(n)] = False
     targets = np.column_stack([goals, np.zeros((n, 2)), headings])
+    lim = np.array([half_size[0] - EDGE_M, half_size[1] - EDGE_M])
     for i in np.flatnonzero(ahead.any(axis=1)):
         j = int(np.argmin(np.where(ahead[i], along[i], np.inf)))
         right = np.array([unit[i, 1], -unit[i, 0]])
-        path = np.array([pos[i], pos[j] + right * PASS_M, goals[i]])
+        side = 1.0 if across[i, j] >= 0.0 else -1.0  # the other robot on the left (or ahead): pass right
+        path = np.array([pos[i], np.clip(pos[j] + side * right * PASS_M, -lim, lim), goals[i]])
         t = follow_path((float(pos[i, 0]), float(pos[i, 1])), path, float(headings[i]), control)
         targets[i] = (t.x, t.y, t.vx, t.vy, t.theta)
     return targets
@@ -152,7 +159,7 @@ def run_trial(settings: Settings, n: int, method: str, noise: str, seed: int) ->
         observed = truth + noise_rng.normal(0.0, 1.0, truth.shape) * sigma
         t0 = time.perf_counter()
         state = lat.predict(world.t, ids, observed)
-        targets = keep_right_targets(state, goals, headings, settings.control)
+        targets = keep_right_targets(state, goals, headings, settings.control, (f.half_length, f.half_width))
         cmd = motion_commands(state, targets, settings.control)
         safe = safety.filter(state[:, [0, 1, 3, 4]], cmd[:, :2], no_opponents)
         cmd[:, :2] = safe.velocities

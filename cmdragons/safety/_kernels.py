@@ -179,22 +179,33 @@ def _reach(tr: np.ndarray) -> float:
 
 
 @njit(cache=True)
-def pair_hits(ta: np.ndarray, tb: np.ndarray, radius: float) -> bool:
-    """Do two trajectories bring their centres closer than ``radius`` at the same time? (A pair
-    closer than that at the start only fails when it gets closer still.)"""
+def pair_hits(ta: np.ndarray, tb: np.ndarray, radius: float, growth: float) -> bool:
+    """Do two trajectories bring their centres closer than ``radius + growth t`` at the same time t?
+
+    ``growth`` (m/s) covers errors in the two velocities the trajectories start from: braking at
+    the same deceleration, a velocity off by dv puts the robot dv t away from its model until it
+    rests. The kept distance never exceeds the starting one (a pair that starts closer than the
+    grown distance only fails when it gets closer still, as a pair already closer than
+    ``radius`` does)."""
     dx0, dy0 = ta[0, 2] - tb[0, 2], ta[0, 3] - tb[0, 3]
     d0 = math.hypot(dx0, dy0)
-    if d0 > _reach(ta) + _reach(tb) + radius:
+    t_end = max(ta[N_SEG - 1, 0], tb[N_SEG - 1, 0])
+    if d0 > _reach(ta) + _reach(tb) + radius + growth * t_end:
         return False
-    r = min(radius, d0 * (1.0 - 1e-9))
-    # the breakpoints of both: [0, dt] share one segment each, then the two braking ends
-    times = np.empty(N_SEG * 2 + 1)
+    cap = d0 * (1.0 - 1e-9)
+    r = min(radius, cap)
+    # until t_cap the kept distance grows; from then on it is the starting distance
+    t_cap = (cap - r) / growth if growth > 0.0 else math.inf
+    # the breakpoints of both: [0, dt] share one segment each, then the two braking ends, and t_cap
+    times = np.empty(N_SEG * 2 + 2)
     n = 0
     for k in range(N_SEG):
         times[n], times[n + 1] = ta[k, 0], tb[k, 0]
         n += 2
-    times[n] = max(ta[N_SEG - 1, 0], tb[N_SEG - 1, 0])
-    times = np.sort(times[: n + 1])
+    times[n] = t_end
+    times[n + 1] = min(t_cap, t_end)
+    times = np.sort(times[: n + 2])
+    n += 1
     ka, kb = 0, 0
     for i in range(n):
         t0, t1 = times[i], times[i + 1]
@@ -207,12 +218,16 @@ def pair_hits(ta: np.ndarray, tb: np.ndarray, radius: float) -> bool:
         ax, ay, avx, avy = _seg_at(ta, ka, t0)
         bx, by, bvx, bvy = _seg_at(tb, kb, t0)
         ex, ey = 0.5 * (ta[ka, 6] - tb[kb, 6]), 0.5 * (ta[ka, 7] - tb[kb, 7])
-        if _interval_hits(ax - bx, ay - by, avx - bvx, avy - bvy, ex, ey, r, 0.0, 0.0, t1 - t0):
+        if t0 < t_cap - 1e-12:
+            r0, r1 = r + growth * t0, growth
+        else:
+            r0, r1 = cap, 0.0
+        if _interval_hits(ax - bx, ay - by, avx - bvx, avy - bvy, ex, ey, r0, r1, 0.0, t1 - t0):
             return True
     # both at rest after the last breakpoint
     ax, ay = ta[N_SEG - 1, 2], ta[N_SEG - 1, 3]
     bx, by = tb[N_SEG - 1, 2], tb[N_SEG - 1, 3]
-    return math.hypot(ax - bx, ay - by) < r
+    return bool(math.hypot(ax - bx, ay - by) < min(r + growth * t_end, cap))
 
 
 @njit(cache=True)
@@ -277,13 +292,29 @@ def static_hits(tr: np.ndarray, inner: np.ndarray, boxes: np.ndarray, circles: n
 
 
 @njit(cache=True)
+def exposed(states: np.ndarray, opp: np.ndarray, reach: float) -> np.ndarray:
+    """Per own robot: is an opponent's centre within ``reach`` of its centre, near enough to push it
+    into a team-mate before anyone can react?"""
+    out = np.zeros(states.shape[0], dtype=np.bool_)
+    for i in range(states.shape[0]):
+        for j in range(opp.shape[0]):
+            if math.hypot(states[i, 0] - opp[j, 0], states[i, 1] - opp[j, 1]) < reach:
+                out[i] = True
+                break
+    return out
+
+
+@njit(cache=True)
 def _trajectory_hits(
-    i: int, tr: np.ndarray, trs: np.ndarray, opp: np.ndarray, inner: np.ndarray, boxes: np.ndarray,
-    circles: np.ndarray, cfg: np.ndarray,
+    i: int, tr: np.ndarray, trs: np.ndarray, pushed: np.ndarray, opp: np.ndarray, inner: np.ndarray,
+    boxes: np.ndarray, circles: np.ndarray, cfg: np.ndarray,
 ) -> bool:  # fmt: skip
-    # cfg: dt, accel, brake, own radius sum, opponent radius sum, opponent accel, static margin, step
+    # cfg: dt, accel, brake, own radius sum, opponent radius sum, opponent accel, static margin, step,
+    # growth of the own radius sum (m/s), own radius sum where an opponent may push one of the two,
+    # the opponent reach that counts as that
     for j in range(trs.shape[0]):
-        if j != i and pair_hits(tr, trs[j], cfg[3]):
+        radius = cfg[9] if pushed[i] or pushed[j] else cfg[3]
+        if j != i and pair_hits(tr, trs[j], radius, cfg[8]):
             return True
     for j in range(opp.shape[0]):
         if opponent_hits(tr, opp[j, 0], opp[j, 1], opp[j, 2], opp[j, 3], cfg[4], cfg[5]):
@@ -315,6 +346,7 @@ def dss(
     Returns the accelerations (n, 2) and each robot's status (KEPT, CHANGED, STOPPED, STOP_ASKED)."""
     n = states.shape[0]
     dt, accel, brake = cfg[0], cfg[1], cfg[2]
+    pushed = exposed(states, opp, cfg[10])
     trs = np.empty((n, N_SEG, 8))
     acc = np.empty((n, 2))
     status = np.full(n, STOPPED, dtype=np.int64)
@@ -333,7 +365,7 @@ def dss(
         px, py, vx, vy = states[i, 0], states[i, 1], states[i, 2], states[i, 3]
         dx, dy = _feasible(vx, vy, desired[i, 0], desired[i, 1], lim, dt)
         tr = trajectory(px, py, vx, vy, dx, dy, dt, accel, brake)
-        if not _trajectory_hits(i, tr, trs, opp, inner, boxes, circles, cfg):
+        if not _trajectory_hits(i, tr, trs, pushed, opp, inner, boxes, circles, cfg):
             trs[i] = tr
             acc[i, 0], acc[i, 1] = dx, dy
             status[i] = KEPT
@@ -367,7 +399,7 @@ def dss(
         order = np.argsort(cost[:m])
         for r in order:
             tr = trajectory(px, py, vx, vy, cand[r, 0], cand[r, 1], dt, accel, brake)
-            if not _trajectory_hits(i, tr, trs, opp, inner, boxes, circles, cfg):
+            if not _trajectory_hits(i, tr, trs, pushed, opp, inner, boxes, circles, cfg):
                 trs[i] = tr
                 acc[i, 0], acc[i, 1] = cand[r, 0], cand[r, 1]
                 status[i] = CHANGED
@@ -388,8 +420,9 @@ def trajectories_clear(
         trs[i] = trajectory(states[i, 0], states[i, 1], states[i, 2], states[i, 3], acc[i, 0], acc[i, 1],
                             cfg[0], cfg[1], cfg[2])  # fmt: skip
     out = np.empty(n, dtype=np.bool_)
+    pushed = exposed(states, opp, cfg[10])
     for i in range(n):
-        out[i] = not _trajectory_hits(i, trs[i], trs, opp, inner, boxes, circles, cfg)
+        out[i] = not _trajectory_hits(i, trs[i], trs, pushed, opp, inner, boxes, circles, cfg)
     return out
 
 
@@ -446,7 +479,7 @@ def dynamic_window(
                 for k in range(N_SEG - 1):
                     rest[k, 0], rest[k, 1], rest[k, 2], rest[k, 3] = tr[k, 0], tr[k, 1], qx, qy
                 rest[N_SEG - 1, 0], rest[N_SEG - 1, 1] = tr[N_SEG - 1, 0], math.inf
-                if pair_hits(tr, rest, radius):
+                if pair_hits(tr, rest, radius, 0.0):
                     hit = True
                     break
                 clear = min(clear, math.hypot(tr[N_SEG - 1, 2] - qx, tr[N_SEG - 1, 3] - qy) - radius)

@@ -39,6 +39,16 @@ def pair_min_distance(ta: FloatArray, tb: FloatArray, n: int = 4001) -> float:
     return float(np.min(np.linalg.norm(positions(ta, t) - positions(tb, t), axis=1)))
 
 
+def pair_min_gap(ta: FloatArray, tb: FloatArray, radius: float, growth: float, n: int = 4001) -> float:
+    """The least of |pa(t) - pb(t)| minus the kept distance min(radius + growth t, start distance),
+    the growth stopping once both rest; by dense sampling."""
+    t = sample_times(ta, tb, n=n)
+    d = np.linalg.norm(positions(ta, t) - positions(tb, t), axis=1)
+    rest = max(float(ta[-1, 0]), float(tb[-1, 0]))
+    kept = np.minimum(radius + growth * np.minimum(t, rest), d[0])
+    return float(np.min(d - kept))
+
+
 def opponent_min_gap(tr: FloatArray, opponent: FloatArray, accel: float, n: int = 4001) -> float:
     """The least of |p(t) - (o + w t)| - accel t^2 / 2 until the trajectory rests, by sampling."""
     t = np.linspace(0.0, float(tr[-1, 0]), n)

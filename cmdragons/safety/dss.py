@@ -8,6 +8,11 @@ current velocity) and of the static obstacles. All robots start on their stop tr
 the previous frame made safe (§5.4); in turn, each keeps its command when it is safe, or searches
 random and heuristic samples of its acceleration set A(v) for the safe one closest to it, with the
 stop as the fallback that is always accepted. Margins come from configs/safety.yaml.
+
+Two allowances for what the model does not know: the distance kept between two own robots grows
+over their braking trajectories by their velocity error (a robot whose speed is misjudged by dv
+brakes dv t away from its model), and it widens to ``pushed_margin_m`` while an opponent is near
+enough to push one of them into the other.
 """
 
 from __future__ import annotations
@@ -34,6 +39,13 @@ class DSSParams(Validated):
     """configs/safety.yaml ``dss``: margins and the search (Bruce 2006 §5.3, §5.5)."""
 
     own_margin_m: float = setting(0.03, lo=0.0, hi=1.0)  # kept between two own robots' bodies
+    # how far an own robot's velocity estimate may be off (m/s): the distance kept between two own
+    # robots grows by twice this per second of their braking trajectories
+    velocity_error_m_s: float = setting(0.1, lo=0.0, hi=5.0)
+    # kept between two own robots instead of own_margin_m while an opponent is within push_range_m
+    # of either: a push at walking pace moves a robot several centimetres before it can brake
+    pushed_margin_m: float = setting(0.1, lo=0.0, hi=1.0)
+    push_range_m: float = setting(0.3, lo=0.0, hi=5.0)  # opponent body to own robot body
     opponent_margin_m: float = setting(0.05, lo=0.0, hi=1.0)  # kept from an opponent's reachable disc
     opponent_accel_m_s2: float = setting(3.0, lo=0.0, hi=50.0)  # bound on how opponents may accelerate
     static_margin_m: float = setting(0.01, lo=0.0, hi=1.0)  # kept from walls and static obstacles
@@ -71,7 +83,9 @@ class DynamicsSafetySearch(ArraySafety):
         self.cfg = np.array([
             motion.period_s, motion.max_accel_m_s2, motion.max_brake_m_s2, 2.0 * robot_radius_m + params.own_margin_m,
             2.0 * robot_radius_m + params.opponent_margin_m, params.opponent_accel_m_s2,
-            params.static_margin_m, params.static_step_m,
+            params.static_margin_m, params.static_step_m, 2.0 * params.velocity_error_m_s,
+            2.0 * robot_radius_m + max(params.own_margin_m, params.pushed_margin_m),
+            2.0 * robot_radius_m + params.push_range_m,
         ])  # fmt: skip
         self.heuristics = heuristic_table(params)
 

@@ -84,9 +84,10 @@ def test_safe_commands_are_kept_unsafe_ones_changed_or_stopped() -> None:
     r = make_dss().filter(states, commands, np.zeros((0, 4)))
     assert list(r.status) == [KEPT, KEPT]
     np.testing.assert_array_equal(r.velocities, commands)
-    # head-on at 2.5 m/s, 1.3 m apart, still speeding up: safe to stop (2 x 0.52 m of braking plus
-    # 0.21 m), not safe to go on: the first robot must give way
-    states = np.array([[-0.65, 0.0, 2.5, 0.0], [0.65, 0.0, -2.5, 0.0]])
+    # head-on at 2.5 m/s, 1.4 m apart, still speeding up: safe to stop (2 x 0.52 m of braking plus
+    # 0.21 m, grown by 2 x 0.1 m/s over the 0.42 s of braking), not safe to go on: the first robot
+    # must give way
+    states = np.array([[-0.7, 0.0, 2.5, 0.0], [0.7, 0.0, -2.5, 0.0]])
     r = make_dss().filter(states, np.array([[2.55, 0.0], [-2.55, 0.0]]), np.zeros((0, 4)))
     assert r.status[0] in (CHANGED, STOPPED)
     acc, status = make_dss().search(states, np.array([[2.55, 0.0], [-2.55, 0.0]]), np.zeros((0, 4)))
@@ -121,6 +122,20 @@ def test_walls_and_opponents_are_avoided() -> None:
     # the same opponent 3 m away: keep
     r = make_dss().filter(states, np.array([[2.0, 0.0]]), np.array([[3.0, 0.0, 0.0, 0.0]]))
     assert r.status[0] == KEPT
+
+
+def test_own_robots_keep_farther_apart_where_an_opponent_may_push_one() -> None:
+    # a robot creeps at 0.3 m/s toward a team-mate at rest 8 cm away: it may go on, braking short
+    # of the 3 cm margin; with an opponent 0.22 m from the team-mate's body it may not
+    states = np.array([[0.0, 0.0, 0.0, 0.0], [0.26, 0.0, -0.3, 0.0]])
+    commands = np.array([[0.0, 0.0], [-0.3, 0.0]])
+    alone = make_dss().filter(states, commands, np.zeros((0, 4)))
+    assert alone.status[1] == KEPT
+    near = make_dss().filter(states, commands, np.array([[-0.4, 0.0, 0.0, 0.0]]))
+    assert near.status[1] != KEPT and near.velocities[1, 0] > -0.3
+    # the opponent farther than push_range_m: the usual margin again
+    far = make_dss().filter(states, commands, np.array([[-0.6, 0.0, 0.0, 0.0]]))
+    assert far.status[1] == KEPT
 
 
 def test_make_safe_on_world_state_keeps_everything_but_the_velocity() -> None:

@@ -44,18 +44,19 @@ def test_quartic_minimum_agrees_with_polynomial_roots() -> None:
         assert K.quartic_min(c, T) == pytest.approx(R.quartic_min(c, T), abs=1e-9)
 
 
-def test_pair_check_agrees_with_dense_sampling() -> None:
+@pytest.mark.parametrize("growth", [0.0, 0.3])
+def test_pair_check_agrees_with_dense_sampling(growth: float) -> None:
     rng = np.random.default_rng(1)
     checked = 0
     for _ in range(600):
         ta, tb = random_trajectory(rng), random_trajectory(rng)
         radius = 0.21
-        start = float(np.hypot(*(ta[0, 2:4] - tb[0, 2:4])))
-        limit = min(radius, start)  # a pair already closer only fails when it gets closer still
-        ref = R.pair_min_distance(ta, tb)
-        if abs(ref - limit) < 2e-3:
+        # a pair already closer only fails when it gets closer still; the kept distance grows at
+        # ``growth`` until both rest, but never beyond the starting distance
+        gap = R.pair_min_gap(ta, tb, radius, growth)
+        if abs(gap) < 2e-3:
             continue  # sampling cannot decide grazing contacts
-        assert K.pair_hits(ta, tb, radius) == (ref < limit), (ref, limit)
+        assert K.pair_hits(ta, tb, radius, growth) == (gap < 0.0), gap
         checked += 1
     assert checked > 500
 

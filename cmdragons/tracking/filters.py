@@ -8,12 +8,15 @@ robot's acceleration toward its last command) enter as control inputs.
 
 Ball model (the simulator's, after the CMDragons thesis): after a kick or a bounce the ball slides
 at ``acc_slide`` until its speed falls to ``slide_to_roll_fraction`` of the speed the slide began
-with, then rolls at ``acc_roll``. Kicks and bounces show as innovations far outside the filter's
-expectation: the velocity covariance is then inflated so the next detections re-acquire it.
+with, then rolls at ``acc_roll``; every touch of a robot starts a new slide. Kicks and bounces show
+as innovations far outside the filter's expectation: the velocity covariance is then inflated so
+the next detections re-acquire it, and the filter as it was is kept until the next detection: if
+that one fits it, the odd detection was not a kick and the motion goes on as before.
 """
 
 from __future__ import annotations
 
+import copy
 import itertools
 import math
 from collections.abc import Sequence
@@ -126,6 +129,10 @@ class BallFilter:
         self.slide_start_speed = math.inf
         self.t_kick = t
         self.kicked = False
+        # after a detection far outside the expectation, the filter as it was before it, kept until
+        # the next detection tells a kick (which it does not fit) from a single bad detection (which
+        # it does: a ball seen at the edge of a camera, a reflection)
+        self.held: BallFilter | None = None
 
     def _decel(self, v: Vec, dt: float) -> Vec:
         speed = math.hypot(v[0], v[1])
@@ -158,6 +165,12 @@ class BallFilter:
         f, b, q = (self.near_cache if near_robot or near_switch else self.cache).get(dt)
         self.kf.predict(u=self._decel(self.kf.x[2:], dt), B=b, F=f, Q=q)
         self.t = t
+        if near_robot:
+            # every touch of a robot starts a new slide (as a kick does) from the speed it leaves with
+            self.slide_start_speed = math.inf
+            self.t_kick = t
+        if self.held is not None:
+            self.held.predict(t, near_robot)
 
     def nis(self, z: Vec) -> float:
         """Normalised innovation squared of a detection against the current prediction."""
@@ -168,8 +181,15 @@ class BallFilter:
     def update(self, z: Vec, nis: float | None = None) -> bool:
         """Take a detection (``nis``: its :meth:`nis`, when already known); returns True when it
         looked like a kick or bounce."""
+        if self.held is not None:
+            held, self.held = self.held, None
+            if held.nis(z) <= self.p.kick_gate_chi2:
+                # the motion goes on as before the odd detection: that one was not a kick
+                self.kf, self.slide_start_speed, self.t_kick = held.kf, held.slide_start_speed, held.t_kick
+                nis = None
         kicked = (self.nis(z) if nis is None else nis) > self.p.kick_gate_chi2
         if kicked:
+            self.held = copy.deepcopy(self)
             # the velocity is unknown after a kick: forget it, keep the position's certainty
             self.kf.P[2:, :] = 0.0
             self.kf.P[:, 2:] = 0.0

@@ -57,6 +57,9 @@ class BallModelParams(Validated):
     near_robot_accel_sigma_m_s2: float = setting(8.0, lo=0.0, hi=500.0)
     near_robot_m: float = setting(0.15, lo=0.0, hi=2.0)  # ball centre to robot centre counted as next to it
     switch_band: float = setting(0.12, lo=0.0, hi=1.0)  # +- share of the switch speed where the phase is unsure
+    # after this many regular frames with the same model (time step, process noise) the gain has
+    # settled and the filter runs in filterpy's steady-state mode until a frame differs
+    steady_after_updates: int = setting(30, lo=1, hi=100000)
 
 
 @dataclass(frozen=True)
@@ -124,7 +127,11 @@ class BallFilter:
         self.kf = kf
         self.t = t
         self.cache = _Cache(2, (p.accel_sigma_m_s2, p.accel_sigma_m_s2))
-        self.near_cache = _Cache(2, (p.near_robot_accel_sigma_m_s2, p.near_robot_accel_sigma_m_s2))
+        # process noise by what may move the ball besides the model: nothing, the slide-to-roll
+        # switch (one deceleration for the other), a robot next to it
+        switch_sigma = max(p.accel_sigma_m_s2, abs(p.acc_slide_m_s2 - p.acc_roll_m_s2))
+        self.caches = (self.cache, _Cache(2, (switch_sigma, switch_sigma)),
+                       _Cache(2, (p.near_robot_accel_sigma_m_s2, p.near_robot_accel_sigma_m_s2)))  # fmt: skip
         # a ball first seen may have just been kicked: sliding until its speed is known (as after a kick)
         self.slide_start_speed = math.inf
         self.t_kick = t
@@ -133,6 +140,10 @@ class BallFilter:
         # the next detection tells a kick (which it does not fit) from a single bad detection (which
         # it does: a ball seen at the edge of a camera, a reflection)
         self.held: BallFilter | None = None
+        self._model: tuple[float, int] = (0.0, 0)  # time step and noise (index in caches) of the last prediction
+        self._regular = 0  # consecutive regular frames with that model
+        self._steady: list[float] | None = None  # settled inverse innovation covariance, row by row
+        self._pending_update = False  # predicted, not yet updated at this time
 
     def _decel(self, v: Vec, dt: float) -> Vec:
         speed = math.hypot(v[0], v[1])
@@ -162,8 +173,18 @@ class BallFilter:
         speed = math.hypot(self.kf.x[2], self.kf.x[3])
         switch = self.p.slide_to_roll_fraction * self.slide_start_speed
         near_switch = math.isfinite(switch) and abs(speed - switch) < self.p.switch_band * switch
-        f, b, q = (self.near_cache if near_robot or near_switch else self.cache).get(dt)
-        self.kf.predict(u=self._decel(self.kf.x[2:], dt), B=b, F=f, Q=q)
+        model = (round(dt, 7), 2 if near_robot else 1 if near_switch else 0)
+        f, b, q = self.caches[model[1]].get(dt)
+        u = self._decel(self.kf.x[2:], dt)
+        if self._steady is not None and model == self._model and not self._pending_update:
+            self.kf.F = f
+            self.kf.predict_steadystate(u=u, B=b)
+        else:
+            self._steady = None
+            self._regular = self._regular if model == self._model and not self._pending_update else 0
+            self.kf.predict(u=u, B=b, F=f, Q=q)
+        self._model = model
+        self._pending_update = True
         self.t = t
         if near_robot:
             # every touch of a robot starts a new slide (as a kick does) from the speed it leaves with
@@ -174,9 +195,14 @@ class BallFilter:
 
     def nis(self, z: Vec) -> float:
         """Normalised innovation squared of a detection against the current prediction."""
-        y = z - self.kf.x[:2]
-        s = self.kf.P[:2, :2] + self.kf.R
-        return float(y @ np.linalg.solve(s, y))
+        # 2 x 2, in plain floats: numpy's per-call cost would be most of it
+        x0, x1 = cast(list[float], self.kf.x[:2].tolist())
+        y0, y1 = float(z[0]) - x0, float(z[1]) - x1
+        if self._steady is not None and self._pending_update:
+            si = self._steady
+            return y0 * (si[0] * y0 + si[1] * y1) + y1 * (si[2] * y0 + si[3] * y1)
+        (a, b), (c, d) = cast(list[list[float]], (self.kf.P[:2, :2] + self.kf.R).tolist())
+        return (d * y0 * y0 - (b + c) * y0 * y1 + a * y1 * y1) / (a * d - b * c)
 
     def update(self, z: Vec, nis: float | None = None) -> bool:
         """Take a detection (``nis``: its :meth:`nis`, when already known); returns True when it
@@ -185,11 +211,13 @@ class BallFilter:
             held, self.held = self.held, None
             if held.nis(z) <= self.p.kick_gate_chi2:
                 # the motion goes on as before the odd detection: that one was not a kick
-                self.kf, self.slide_start_speed, self.t_kick = held.kf, held.slide_start_speed, held.t_kick
+                vars(self).update(vars(held))
                 nis = None
         kicked = (self.nis(z) if nis is None else nis) > self.p.kick_gate_chi2
         if kicked:
             self.held = copy.deepcopy(self)
+            self._steady = None
+            self._regular = 0
             # the velocity is unknown after a kick: forget it, keep the position's certainty
             self.kf.P[2:, :] = 0.0
             self.kf.P[:, 2:] = 0.0
@@ -197,7 +225,19 @@ class BallFilter:
             self.kf.P[:2, :2] += np.eye(2) * float(np.sum((z - self.kf.x[:2]) ** 2))
             self.slide_start_speed = math.inf  # sliding until the new speed is known
             self.t_kick = self.t
-        self.kf.update(z)
+        if self._steady is not None and self._pending_update:
+            self.kf.update_steadystate(z)
+        else:
+            self._steady = None  # a second view in the same frame: the settled gain does not apply
+            self.kf.update(z)
+            self._regular = self._regular + 1 if self._pending_update else 0
+            if self._regular >= self.p.steady_after_updates:
+                # filterpy's last full update left the settled gain in kf.K; the gate needs the
+                # innovation covariance of the settled prior
+                f, _, q = self.caches[self._model[1]].get(self._model[0])
+                prior = f @ self.kf.P @ f.T + q
+                self._steady = [float(v) for v in np.linalg.inv(prior[:2, :2] + self.kf.R).ravel()]
+        self._pending_update = False
         if self.slide_start_speed == math.inf and self.kf.P[2, 2] < 0.25:
             # the speed is known now, some frames after the kick: the slide began faster than that
             speed = math.hypot(self.kf.x[2], self.kf.x[3])

@@ -95,6 +95,7 @@ class Tracker:
         self.t = -math.inf  # capture time of the newest frame taken
         self._commands: dict[tuple[Team, int], deque[tuple[float, tuple[float, float, float]]]] = {}
         self._steady_updates = filters.SteadyUpdates()
+        self._robots_sorted = True  # self.robots in key order
 
     # --- input --------------------------------------------------------------------------------
     def command_sent(self, commands: Iterable[RobotCommand], t_sent: float) -> None:
@@ -117,6 +118,14 @@ class Tracker:
                 break
         return current
 
+    def _apply_commands(self) -> None:
+        """Each robot filter's control input: our command in force at the filter's time (robots we
+        sent nothing, the opponents, keep none)."""
+        for key in self._commands:
+            track = self.robots.get(key)
+            if track is not None:
+                track.filter.command = self._command_at(key, track.filter.t)
+
     def step(self, frames: Sequence[DetectionFrame]) -> WorldState:
         """Take one set of camera frames (any order, any cameras) and return the world state
         predicted to the newest capture time plus ``latency_s``."""
@@ -135,8 +144,7 @@ class Tracker:
     def _take(self, frame: DetectionFrame) -> None:
         t = frame.t_capture
         self.t = t
-        for key, track in self.robots.items():
-            track.filter.command = self._command_at(key, track.filter.t)
+        self._apply_commands()
         filters.predict_robots([track.filter for track in self.robots.values()], t)
         near = self.p.ball.near_robot_m
         robots_xy = np.array([r.filter.kf.x[:2] for r in self.robots.values()]).reshape(-1, 2)
@@ -193,6 +201,7 @@ class Tracker:
         track = self.robots.get(key)
         if track is None:
             self.robots[key] = _RobotTrack(RobotFilter(self.p.robot, z[0], z[1], z[2], t), last_seen=t)
+            self._robots_sorted = False
             return
         if track.filter.nis(z) <= self.p.robot_gate_chi2:
             track.filter.update(z)
@@ -264,10 +273,12 @@ class Tracker:
         if best is not None:
             x, cov = best.filter.predicted(t)
             ball = BallState(float(x[0]), float(x[1]), float(x[2]), float(x[3]), best.last_seen == self.t, cov)
-        confirmed = [(key, track) for key, track in sorted(self.robots.items())
+        if not self._robots_sorted:  # by team and id; the order only changes when a track is born
+            self.robots = dict(sorted(self.robots.items()))
+            self._robots_sorted = True
+        confirmed = [(key, track) for key, track in self.robots.items()
                      if track.hits >= self.p.robot_confirm_detections]  # fmt: skip
-        for key, track in confirmed:
-            track.filter.command = self._command_at(key, track.filter.t)
+        self._apply_commands()
         states = filters.predicted_states([track.filter for _, track in confirmed], t,
                                   [self._commands.get(key, ()) for key, _ in confirmed])  # fmt: skip
         robots = tuple(RobotState(team, rid, x[0], x[1], x[2], x[3], x[4], x[5], track.last_seen == self.t)

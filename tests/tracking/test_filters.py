@@ -7,6 +7,8 @@ import math
 import numpy as np
 
 from cmdragons.tracking.filters import (
+    BallFilter,
+    BallModelParams,
     RobotFilter,
     RobotModelParams,
     SteadyUpdates,
@@ -72,3 +74,23 @@ def test_batched_gate_rejects_as_one_robot_does() -> None:
     taken = SteadyUpdates().take(filters, z, gate)
     assert taken.tolist() == expected
     assert not filters[0].steady_pending and filters[1].steady_pending and filters[2].steady_pending
+
+
+def test_ball_steady_state_mode_agrees_with_full_updates() -> None:
+    # once the gain has settled, filterpy's steady-state mode gives the full filter's estimates
+    settled = BallFilter(BallModelParams(steady_after_updates=30), -2.0, 0.0, t=0.0)
+    full = BallFilter(BallModelParams(steady_after_updates=100000), -2.0, 0.0, t=0.0)
+    rng = np.random.default_rng(4)
+    entered = False
+    for k in range(1, 150):
+        t = k * DT
+        # kicked at 2 m/s at t = 0: the two-phase model, sliding at 3 m/s^2 down to 0.64 x 2 m/s, then rolling
+        x = -2.0 + 2.0 * t - 1.5 * t * t if t < 0.24 else -1.6064 + 1.28 * (t - 0.24) - 0.13 * (t - 0.24) ** 2
+        z = np.array([x, 0.0]) + rng.normal(0.0, 0.0016, 2)
+        for f in (settled, full):
+            f.predict(t, near_robot=20 <= k < 25)  # a robot passes by: a different model for 5 frames
+            f.update(z)
+        entered |= settled._steady is not None
+        assert np.allclose(settled.position, full.position, rtol=0.0, atol=1e-6)
+        assert np.allclose(settled.velocity, full.velocity, rtol=0.0, atol=1e-4)
+    assert entered and full._steady is None

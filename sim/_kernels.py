@@ -34,12 +34,14 @@ __all__ = [
     "SHAPE_SIZE",
     "ObjectPlan",
     "add_noise_reference",
+    "noise_pool",
     "camera_vector",
     "plan_objects",
     "plan_objects_reference",
     "project_points",
     "render_frame",
     "render_frame_reference",
+    "sensor_noise_reference",
 ]
 
 # --- packed layouts -----------------------------------------------------------------------------
@@ -424,6 +426,57 @@ def _ball_sample(cam: NDArray[np.float64], rdx: float, rdy: float, foot: float, 
     return a, shade, cam[2] - t
 
 
+# --- sensor noise: fresh every frame ------------------------------------------------------------
+# A pool of Gaussian noise values (one frame's worth plus a row, drawn once per camera) is read
+# each frame at a fresh offset per row, and every value's sign is flipped by a fresh bit: row i of
+# the frame with key K starts at r % (len(pool) - W3) with r = splitmix64(K + (i + 1) * GOLDEN), and
+# value q's sign is bit q % 64 of splitmix64(r + (q // 64 + 1) * GOLDEN). A pixel's noise in one
+# frame is thus independent of its noise in the next (and of its neighbours'), as a real sensor's,
+# at the cost of a copy: no per-value generator, which would double the time of a frame. No
+# state is carried between rows or frames: rows run on any thread in any order, same bytes.
+_GOLDEN = np.uint64(0x9E3779B97F4A7C15)
+_MIX1 = np.uint64(0xBF58476D1CE4E5B9)
+_MIX2 = np.uint64(0x94D049BB133111EB)
+
+
+def noise_pool(rng: np.random.Generator, frame_size: int, row_size: int, sigma_grey: float) -> NDArray[np.int8]:
+    """``frame_size + row_size`` values of N(0, sigma) sensor noise rounded to grey levels and
+    saturated to -127..127 (int8); a single zero when ``sigma_grey`` is 0 (no noise)."""
+    if sigma_grey <= 0.0:
+        return np.zeros(1, dtype=np.int8)
+    pool = np.empty(frame_size + row_size, dtype=np.int8)
+    chunk = 1 << 20  # bounded temporary memory
+    for k in range(0, pool.shape[0], chunk):
+        n = min(chunk, pool.shape[0] - k)
+        noise = rng.standard_normal(n, dtype=np.float32) * np.float32(sigma_grey)
+        pool[k : k + n] = np.clip(np.rint(noise), -127, 127).astype(np.int8)
+    return pool
+
+
+@njit(cache=True, inline="always")
+def _splitmix64(z: np.uint64) -> np.uint64:
+    z = (z ^ (z >> np.uint64(30))) * _MIX1
+    z = (z ^ (z >> np.uint64(27))) * _MIX2
+    return z ^ (z >> np.uint64(31))
+
+
+@njit(cache=True, inline="always")
+def _noise_row(nz: NDArray[np.int8], pool: NDArray[np.int8], key: np.uint64, row: int) -> None:
+    """Row ``row``'s sensor noise of the frame with ``key`` into ``nz`` (length 3 * image width)."""
+    w3 = nz.shape[0]
+    r = _splitmix64(key + np.uint64(row + 1) * _GOLDEN)
+    off = np.int64(r % np.uint64(pool.shape[0] - w3))
+    src = pool[off : off + w3]
+    for blk in range((w3 + 63) // 64):
+        z = _splitmix64(r + np.uint64(blk + 1) * _GOLDEN)
+        base = 64 * blk
+        for t in range(min(64, w3 - base)):
+            # branch-free, in int32: the loop vectorises (8x faster than a conditional negation)
+            flip = np.int32(z >> np.uint64(t)) & np.int32(1)
+            v = np.int32(src[base + t])
+            nz[base + t] = v - 2 * flip * v
+
+
 @njit(cache=True, fastmath=True, inline="always")
 def _write_span(o: NDArray[np.uint8], scratch: NDArray[np.float32], nz: NDArray[np.int8], noise_on: bool,
                 q0: int, q1: int) -> None:  # fmt: skip
@@ -436,7 +489,7 @@ def _write_span(o: NDArray[np.uint8], scratch: NDArray[np.float32], nz: NDArray[
 
 @njit(cache=True, parallel=True, fastmath=True)
 def _render_frame_kernel(
-    out2: NDArray[np.uint8], bg2: NDArray[np.uint8], bank: NDArray[np.int8], noise_start: int, noise_on: bool,
+    out2: NDArray[np.uint8], bg2: NDArray[np.uint8], pool: NDArray[np.int8], noise_key: np.uint64, noise_on: bool,
     rays: NDArray[np.float32], foot: NDArray[np.float32], gain: NDArray[np.float32], cam: NDArray[np.float64],
     shape: NDArray[np.float64], dots: NDArray[np.float64], palette: NDArray[np.float32],
     rob_samples: NDArray[np.float64], rob_k: NDArray[np.int64], rob_bbox: NDArray[np.int32],
@@ -451,12 +504,13 @@ def _render_frame_kernel(
     # rows are dealt out round-robin so that both threads share the rows holding objects
     for chunk in prange(n_chunks):
         scratch = np.empty(w3, dtype=np.float32)  # the row's clean (noise-free) colours
+        nz = np.empty(w3, dtype=np.int8)  # the row's sensor noise
         active = np.empty(n_rob, dtype=np.int64)
         acc = np.empty(3)
         for i in range(chunk, h_img, n_chunks):
             o, b = out2[i], bg2[i]
-            nz = bank[noise_start + i * w3 : noise_start + (i + 1) * w3]
             if noise_on:
+                _noise_row(nz, pool, noise_key, i)
                 for q in range(w3):
                     o[q] = min(max(np.int32(b[q]) + np.int32(nz[q]), 0), 255)
             else:
@@ -546,25 +600,26 @@ def _render_frame_kernel(
 
 
 def render_frame(
-    out: NDArray[np.uint8], background: NDArray[np.uint8], bank: NDArray[np.int8], noise_start: int | None,
+    out: NDArray[np.uint8], background: NDArray[np.uint8], pool: NDArray[np.int8], noise_key: int | None,
     rays: NDArray[np.float32], foot: NDArray[np.float32], gain: NDArray[np.float32], cam: NDArray[np.float64],
     shape: NDArray[np.float64], dots: NDArray[np.float64], palette: NDArray[np.float32], plan: ObjectPlan,
     row_ball: NDArray[np.float64], n_chunks: int = 2,
 ) -> tuple[float, float]:  # fmt: skip
     """Compose one frame into ``out`` (H, W, 3 BGR uint8): the static ``background``, the planned
     robots (sides, then tops) and ball, lighting ``gain`` on object colours, then sensor noise
-    ``bank[noise_start + (i*W + j)*3 + c]`` added with saturation (``noise_start`` None: no noise).
+    drawn from ``pool`` (:func:`noise_pool`) by the frame's ``noise_key`` (0 .. 2**64 - 1) and
+    added with saturation (``noise_key`` None: no noise).
 
     ``row_ball`` (H, 2) is scratch. Returns the ball's (visible, silhouette) coverage in pixels.
     """
     h_img, w_img = out.shape[:2]
-    noise_on = noise_start is not None
-    start = noise_start if noise_start is not None else 0
-    if noise_on and start + h_img * w_img * 3 > bank.shape[0]:
-        raise ValueError("noise_start runs past the end of the noise bank")
+    noise_on = noise_key is not None
+    if noise_on and pool.shape[0] <= w_img * 3:
+        raise ValueError(f"the noise pool ({pool.shape[0]} values) must be longer than a row ({w_img * 3})")
     n = plan.n
     _render_frame_kernel(
-        out.reshape(h_img, w_img * 3), background.reshape(h_img, w_img * 3), bank, start, noise_on,
+        out.reshape(h_img, w_img * 3), background.reshape(h_img, w_img * 3), pool,
+        np.uint64(noise_key if noise_key is not None else 0), noise_on,
         rays, foot, gain, cam, shape, dots, palette, plan.rob_samples[:n], plan.rob_k[:n], plan.rob_bbox[:n],
         plan.rob_colors[:n], plan.ball_samples, plan.ball_k, plan.ball_bbox, row_ball, n_chunks,
     )  # fmt: skip
@@ -586,9 +641,30 @@ def _ball_rows_sum(row_ball: NDArray[np.float64], i0: int, i1: int) -> tuple[flo
 # =================================================================================================
 
 
-def add_noise_reference(background: NDArray[np.uint8], bank: NDArray[np.int8], start: int) -> NDArray[np.uint8]:
-    """The background plus the bank's noise from ``start``, saturated to 0..255."""
-    noise = bank[start : start + background.size].reshape(background.shape)
+def sensor_noise_reference(pool: NDArray[np.int8], key: int, shape: tuple[int, ...]) -> NDArray[np.int8]:
+    """The sensor noise of the frame with ``key`` for an image of ``shape`` (H, W, 3), all rows at once."""
+    h, w3 = shape[0], int(np.prod(shape[1:]))
+    q = np.arange(w3)
+
+    def mix(z: NDArray[np.uint64]) -> NDArray[np.uint64]:
+        z = (z ^ (z >> np.uint64(30))) * _MIX1
+        z = (z ^ (z >> np.uint64(27))) * _MIX2
+        out: NDArray[np.uint64] = z ^ (z >> np.uint64(31))
+        return out
+
+    with np.errstate(over="ignore"):  # uint64 arithmetic wraps, as in the kernel
+        r = mix(np.uint64(key) + (np.arange(h, dtype=np.uint64) + np.uint64(1)) * _GOLDEN)
+        off = (r % np.uint64(pool.shape[0] - w3)).astype(np.int64)
+        words = mix(r[:, None] + (q // 64 + 1).astype(np.uint64)[None, :] * _GOLDEN)
+    flip = ((words >> (q % 64).astype(np.uint64)[None, :]) & np.uint64(1)).astype(bool)
+    values = pool[off[:, None] + q[None, :]]
+    noise: NDArray[np.int8] = np.where(flip, -values, values).astype(np.int8)
+    return noise.reshape(shape)
+
+
+def add_noise_reference(background: NDArray[np.uint8], pool: NDArray[np.int8], key: int) -> NDArray[np.uint8]:
+    """The background plus the sensor noise of the frame with ``key``, saturated to 0..255."""
+    noise = sensor_noise_reference(pool, key, background.shape)
     out: NDArray[np.uint8] = np.clip(background.astype(np.int16) + noise, 0, 255).astype(np.uint8)
     return out
 
@@ -693,7 +769,7 @@ def _body_coverage_np(samples: NDArray[np.float64], shape: NDArray[np.float64], 
 
 
 def render_frame_reference(
-    background: NDArray[np.uint8], bank: NDArray[np.int8], noise_start: int | None, rays: NDArray[np.float32],
+    background: NDArray[np.uint8], pool: NDArray[np.int8], noise_key: int | None, rays: NDArray[np.float32],
     foot: NDArray[np.float32], gain: NDArray[np.float32], cam: NDArray[np.float64], shape: NDArray[np.float64],
     dots: NDArray[np.float64], palette: NDArray[np.float32], plan: ObjectPlan,
 ) -> tuple[NDArray[np.uint8], float, float]:  # fmt: skip
@@ -772,10 +848,10 @@ def render_frame_reference(
     a_tot, c_tot, sil_tot = a_tot / n_b, c_tot / n_b, sil_tot / n_b
     clean[sl] = clean[sl] * (1.0 - a_tot[..., None]) + (c_tot * gain[sl])[..., None] * palette[PAL_BALL]
 
-    out = background.copy() if noise_start is None else add_noise_reference(background, bank, noise_start)
+    out = background.copy() if noise_key is None else add_noise_reference(background, pool, noise_key)
     noisy = np.floor(clean + 0.5).astype(np.int32)
-    if noise_start is not None:
-        noisy += bank[noise_start : noise_start + background.size].reshape(background.shape)
+    if noise_key is not None:
+        noisy += sensor_noise_reference(pool, noise_key, background.shape)
     for b_box in boxes:
         sl = region(b_box)
         out[sl] = np.clip(noisy[sl], 0, 255)

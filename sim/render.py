@@ -40,7 +40,6 @@ class RenderParams(Validated):
     """
 
     noise_sigma_grey: float = setting(2.5, lo=0.0, hi=40.0)  # per channel, grey levels; 0: off
-    noise_bank_frames: int = setting(4, lo=1, hi=64)  # pre-generated noise frames (seeded)
     vignetting_fraction: float = setting(0.12, lo=0.0, hi=0.9)  # light lost at the image corners
     gradient_fraction: float = setting(0.08, lo=0.0, hi=0.9)  # light change from -x to +x goal line
     exposure_s: float = setting(0.002, lo=0.0, hi=0.05)  # motion blur; 0: off
@@ -81,8 +80,10 @@ class CameraTruth:
 class CameraRenderer:
     """Renders one camera's BGR image of a :class:`~sim.snapshot.Snapshot`.
 
-    Deterministic: the noise comes from a bank generated from ``seed`` and the camera id, and each
-    frame's pick from the same generator, so the same seed and snapshots give identical bytes.
+    Sensor noise is fresh every frame, as a real sensor's: each frame draws a 64-bit key from a
+    generator seeded by ``seed`` and the camera id, and the key picks every row's values from a
+    pool of Gaussian noise and flips their signs (:mod:`sim._kernels`, sensor noise). The same
+    seed and snapshots give identical bytes.
     """
 
     def __init__(self, model: CameraModel, league: LeagueParams, params: RenderParams, seed: int) -> None:
@@ -120,7 +121,7 @@ class CameraRenderer:
         palette[kern.PAL_GREEN] = params.green_bgr
         self.palette = palette
 
-        self.bank = _noise_bank(self.rng, h * w * 3, params.noise_bank_frames, params.noise_sigma_grey)
+        self.noise = kern.noise_pool(self.rng, h * w * 3, w * 3, params.noise_sigma_grey)
         self._plan = kern.ObjectPlan(32, params.max_blur_samples, len(self.dots))
         self._row_ball = np.zeros((h, 2))
         self._n_chunks = max(1, numba.get_num_threads())
@@ -151,13 +152,10 @@ class CameraRenderer:
             plan = self._plan = kern.ObjectPlan(robots.shape[0], self.params.max_blur_samples, len(self.dots))
         kern.plan_objects(plan, robots, ball, self.cam, self.shape, self.pink, self.dots, self.palette,
                           self.params.exposure_s, self.params.blur_step_px)  # fmt: skip
-        noise_start = None
+        noise_key = None
         if self.params.noise_sigma_grey > 0.0:
-            # one bank frame at a random offset: a fresh-looking field of noise for one add
-            size = self.background.size
-            frame = int(self.rng.integers(self.params.noise_bank_frames))
-            noise_start = frame * size + int(self.rng.integers(size))
-        vis, sil = kern.render_frame(out, self.background, self.bank, noise_start, self.rays, self.foot, self.gain,
+            noise_key = int(self.rng.integers(2**64, dtype=np.uint64))
+        vis, sil = kern.render_frame(out, self.background, self.noise, noise_key, self.rays, self.foot, self.gain,
                                      self.cam, self.shape, self.dots, self.palette, plan, self._row_ball,
                                      self._n_chunks)  # fmt: skip
         return self._truth(snapshot, robots, plan, vis, sil)
@@ -327,16 +325,3 @@ def _draw_goal(model: CameraModel, boxes: list[tuple[float, float, float, float]
     wall = np.where(sub_hit[..., None], face_gain[sub_face][..., None] * goal, img[ii, jj][:, None, None, :])
     img[ii, jj] = wall.mean(axis=(1, 2))
     return img
-
-
-def _noise_bank(rng: np.random.Generator, frame_size: int, frames: int, sigma: float) -> NDArray[np.int8]:
-    """``frames`` frames of Gaussian sensor noise (grey levels, int8), back to back, followed by a
-    copy of the start so that a frame read from any offset is contiguous."""
-    if sigma <= 0.0:
-        return np.zeros(1, dtype=np.int8)
-    bank = np.empty(frames * frame_size + frame_size, dtype=np.int8)
-    for k in range(frames):  # a frame at a time: bounded temporary memory
-        noise = rng.standard_normal(frame_size, dtype=np.float32) * np.float32(sigma)
-        bank[k * frame_size : (k + 1) * frame_size] = np.clip(np.rint(noise), -127, 127).astype(np.int8)
-    bank[frames * frame_size :] = bank[:frame_size]
-    return bank

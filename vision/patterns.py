@@ -7,8 +7,8 @@ arrangement is fitted to the template by weighted least squares over position an
 every assignment of dots to template slots (A.2.2-A.2.3). The best fit gives the slots' colours,
 hence the id, the centre and the heading; its residual and the regions' areas give a confidence.
 
-The ball is the orange region of the right size and shape, on the plane of the ball centre,
-that is not inside a detected robot's pattern.
+The ball is the orange region of the right size and shape, on the plane of the blob's centroid
+(a calibrated height above the ball centre), that is not inside a detected robot's pattern.
 
 Field frame, metres, radians; pixels as in :mod:`vision.cmvision`.
 """
@@ -59,6 +59,9 @@ class BallParams(Validated):
     min_fill: float = setting(0.4, lo=0.0, hi=1.0)  # area / bounding-box area
     max_balls: int = setting(1, lo=0, hi=16)  # per camera frame, most confident first
     min_confidence: float = setting(0.1, lo=0.0, hi=1.0)
+    # the orange blob's centroid sits this far above the ball's centre, as seen from the camera:
+    # the shaded lower rim falls out of the orange class (vision.score.ball_height_bias_m measures it)
+    blob_height_above_centre_m: float = setting(0.0027, lo=-0.05, hi=0.05)
 
 
 class RegionGeometry:
@@ -207,7 +210,8 @@ def detect_ball(
     params: BallParams,
 ) -> list[BallDetection]:
     """Ball candidates: orange regions of the ball's size and shape, not inside a detected
-    robot's pattern, on the plane of the ball centre; most confident first."""
+    robot's pattern, on the plane of the blob's centroid (the ball centre's height plus
+    ``params.blob_height_above_centre_m``); most confident first."""
     regions = geo.regions
     idx = regions.of_class(orange)
     if idx.size == 0 or params.max_balls == 0:
@@ -229,7 +233,7 @@ def detect_ball(
         # a pattern holds no orange: an orange spot inside one is a misread marker
         at_top = geo.xy(idx, robot_height_m[r.team])
         keep &= np.hypot(at_top[:, 0] - r.x, at_top[:, 1] - r.y) >= pattern_radius_m
-    xy = geo.xy(idx, ball_radius_m)
+    xy = geo.xy(idx, ball_radius_m + params.blob_height_above_centre_m)
     out = []
     for j in np.flatnonzero(keep):
         size_conf = min(ratio[j], 1.0 / ratio[j])

@@ -11,13 +11,15 @@ over robots found with the right team and id.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import NDArray
 
 from cmdragons.messages import DetectionFrame, GroundTruth
 
-__all__ = ["Score"]
+__all__ = ["Score", "ball_height_bias_m"]
 
 
 @dataclass
@@ -38,6 +40,8 @@ class Score:
     robot_err_m: list[float] = field(default_factory=list)
     heading_err_rad: list[float] = field(default_factory=list)
     ball_err_m: list[float] = field(default_factory=list)
+    # per ball found: camera id, detection (x, y), truth (x, y, z)
+    ball_pairs: list[tuple[int, float, float, float, float, float]] = field(default_factory=list)
 
     def add(self, det: DetectionFrame, truth: GroundTruth) -> None:
         """Score one camera's detections against the truth of the same instant."""
@@ -73,6 +77,7 @@ class Score:
             elif not hit:
                 hit = True
                 self.ball_err_m.append(d)
+                self.ball_pairs.append((cam, bd.x, bd.y, b.x, b.y, b.z))
         self.ball_found += int(hit and ball_visible)
 
     def summary(self) -> dict[str, float]:
@@ -94,3 +99,27 @@ class Score:
             "false_per_frame": rate(self.false_robots + self.false_balls, self.frames),
             "camera_frames": float(self.frames),
         }
+
+
+def ball_height_bias_m(
+    score: Score, centres: Mapping[int, NDArray[np.float64]], projected_above_centre_m: float
+) -> float:
+    """How much higher than vision projected them the ball's blobs should have been projected to
+    meet the truth: least squares over the balls found (m; 0: no radial bias left).
+
+    A detection is ``C + (C_z - z_p) * ray`` with C the optical centre (``centres`` by camera id,
+    field frame) and z_p the true centre's height plus ``projected_above_centre_m``; the blob's
+    ray meets the truth best at the true centre's height plus the fitted h. The result is
+    ``h - projected_above_centre_m``: a bias outward from each camera's nadir, growing with the
+    distance from it, shows as a positive height.
+    """
+    if not score.ball_pairs:
+        return math.nan
+    pairs = np.array(score.ball_pairs)
+    c = np.array([centres[int(k)] for k in pairs[:, 0]])
+    det, true_xy, true_z = pairs[:, 1:3], pairs[:, 3:5], pairs[:, 5]
+    ray = (det - c[:, :2]) / (c[:, 2] - true_z - projected_above_centre_m)[:, None]
+    # truth = C + (C_z - z - h) * ray  =>  a + h * ray = 0 with a = truth - C - (C_z - z) * ray
+    a = true_xy - c[:, :2] - (c[:, 2] - true_z)[:, None] * ray
+    h = -float(np.sum(a * ray) / np.sum(ray * ray))
+    return h - projected_above_centre_m

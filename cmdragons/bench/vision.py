@@ -12,6 +12,10 @@ default    configs/sim.yaml render (2.5, 0.12, 0.08, 2 ms)
 high       6.0          0.25          0.15        4 ms
 =========  ===========  ============  ==========  ==========
 
+``ball_height_bias_mm``: how far above the height vision projects the ball's blobs at the truth
+says they sit (:func:`vision.score.ball_height_bias_m`); the default level's value, added to
+``ball.blob_height_above_centre_m`` in configs/vision.yaml, calibrates vision to the renderer.
+
 Baseline: ``cv2.cvtColor`` to YUV, then per colour class one ``cv2.inRange`` and one
 ``cv2.connectedComponentsWithStats`` -- the segmentation alone, with no pattern matching.
 """
@@ -32,7 +36,7 @@ from sim.render import RenderParams
 from sim.script import ScriptedPlay
 from sim.simulator import Simulator
 from vision.pipeline import VisionPipeline
-from vision.score import Score
+from vision.score import Score, ball_height_bias_m
 
 __all__ = ["LEVELS", "opencv_baseline", "run"]
 
@@ -85,7 +89,9 @@ def run(settings: Settings, quick: bool, frames: int | None = None) -> list[Row]
                 if level == "default" and i % max(1, frames // 20) == 0:
                     samples.append((cam, image.copy()))
             sim.advance(script.commands(sim.world.snapshot()))
-        rows.append({"name": f"vision {level}", **score.summary()})
+        bias = ball_height_bias_m(score, {m.id: m.center for m in models},
+                                  settings.vision.ball.blob_height_above_centre_m)  # fmt: skip
+        rows.append({"name": f"vision {level}", **score.summary(), "ball_height_bias_mm": bias * 1e3})
     rows += _timing(settings, {m.id: VisionPipeline(settings.vision, settings.field, m) for m in models}, samples,
                     reps=3 if quick else 10)  # fmt: skip
     return rows

@@ -8,24 +8,37 @@ robot's acceleration toward its last command) enter as control inputs.
 
 Ball model (the simulator's, after the CMDragons thesis): after a kick or a bounce the ball slides
 at ``acc_slide`` until its speed falls to ``slide_to_roll_fraction`` of the speed the slide began
-with, then rolls at ``acc_roll``. Kicks and bounces show as innovations far outside the filter's
-expectation: the velocity covariance is then inflated so the next detections re-acquire it.
+with, then rolls at ``acc_roll``; every touch of a robot starts a new slide. Kicks and bounces show
+as innovations far outside the filter's expectation: the velocity covariance is then inflated so
+the next detections re-acquire it, and the filter as it was is kept until the next detection: if
+that one fits it, the odd detection was not a kick and the motion goes on as before.
 """
 
 from __future__ import annotations
 
+import copy
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import cast
 
 import numpy as np
-from filterpy.kalman import KalmanFilter
+from filterpy.kalman import KalmanFilter, predict_steadystate, update_steadystate
 from numpy.typing import NDArray
+from scipy.linalg import block_diag
 
 from cmdragons.config import Validated, setting
 
-__all__ = ["BallFilter", "BallModelParams", "RobotFilter", "RobotModelParams"]
+__all__ = [
+    "BallFilter",
+    "BallModelParams",
+    "RobotFilter",
+    "RobotModelParams",
+    "SteadyUpdates",
+    "predict_robots",
+    "predicted_states",
+]
 
 Vec = NDArray[np.float64]
 
@@ -44,6 +57,9 @@ class BallModelParams(Validated):
     near_robot_accel_sigma_m_s2: float = setting(8.0, lo=0.0, hi=500.0)
     near_robot_m: float = setting(0.15, lo=0.0, hi=2.0)  # ball centre to robot centre counted as next to it
     switch_band: float = setting(0.12, lo=0.0, hi=1.0)  # +- share of the switch speed where the phase is unsure
+    # after this many regular frames with the same model (time step, process noise) the gain has
+    # settled and the filter runs in filterpy's steady-state mode until a frame differs
+    steady_after_updates: int = setting(30, lo=1, hi=100000)
 
 
 @dataclass(frozen=True)
@@ -111,11 +127,23 @@ class BallFilter:
         self.kf = kf
         self.t = t
         self.cache = _Cache(2, (p.accel_sigma_m_s2, p.accel_sigma_m_s2))
-        self.near_cache = _Cache(2, (p.near_robot_accel_sigma_m_s2, p.near_robot_accel_sigma_m_s2))
+        # process noise by what may move the ball besides the model: nothing, the slide-to-roll
+        # switch (one deceleration for the other), a robot next to it
+        switch_sigma = max(p.accel_sigma_m_s2, abs(p.acc_slide_m_s2 - p.acc_roll_m_s2))
+        self.caches = (self.cache, _Cache(2, (switch_sigma, switch_sigma)),
+                       _Cache(2, (p.near_robot_accel_sigma_m_s2, p.near_robot_accel_sigma_m_s2)))  # fmt: skip
         # a ball first seen may have just been kicked: sliding until its speed is known (as after a kick)
         self.slide_start_speed = math.inf
         self.t_kick = t
         self.kicked = False
+        # after a detection far outside the expectation, the filter as it was before it, kept until
+        # the next detection tells a kick (which it does not fit) from a single bad detection (which
+        # it does: a ball seen at the edge of a camera, a reflection)
+        self.held: BallFilter | None = None
+        self._model: tuple[float, int] = (0.0, 0)  # time step and noise (index in caches) of the last prediction
+        self._regular = 0  # consecutive regular frames with that model
+        self._steady: list[float] | None = None  # settled inverse innovation covariance, row by row
+        self._pending_update = False  # predicted, not yet updated at this time
 
     def _decel(self, v: Vec, dt: float) -> Vec:
         speed = math.hypot(v[0], v[1])
@@ -145,20 +173,51 @@ class BallFilter:
         speed = math.hypot(self.kf.x[2], self.kf.x[3])
         switch = self.p.slide_to_roll_fraction * self.slide_start_speed
         near_switch = math.isfinite(switch) and abs(speed - switch) < self.p.switch_band * switch
-        f, b, q = (self.near_cache if near_robot or near_switch else self.cache).get(dt)
-        self.kf.predict(u=self._decel(self.kf.x[2:], dt), B=b, F=f, Q=q)
+        model = (round(dt, 7), 2 if near_robot else 1 if near_switch else 0)
+        f, b, q = self.caches[model[1]].get(dt)
+        u = self._decel(self.kf.x[2:], dt)
+        if self._steady is not None and model == self._model and not self._pending_update:
+            self.kf.F = f
+            self.kf.predict_steadystate(u=u, B=b)
+        else:
+            self._steady = None
+            self._regular = self._regular if model == self._model and not self._pending_update else 0
+            self.kf.predict(u=u, B=b, F=f, Q=q)
+        self._model = model
+        self._pending_update = True
         self.t = t
+        if near_robot:
+            # every touch of a robot starts a new slide (as a kick does) from the speed it leaves with
+            self.slide_start_speed = math.inf
+            self.t_kick = t
+        if self.held is not None:
+            self.held.predict(t, near_robot)
 
     def nis(self, z: Vec) -> float:
         """Normalised innovation squared of a detection against the current prediction."""
-        y = z - self.kf.x[:2]
-        s = self.kf.P[:2, :2] + self.kf.R
-        return float(y @ np.linalg.solve(s, y))
+        # 2 x 2, in plain floats: numpy's per-call cost would be most of it
+        x0, x1 = cast(list[float], self.kf.x[:2].tolist())
+        y0, y1 = float(z[0]) - x0, float(z[1]) - x1
+        if self._steady is not None and self._pending_update:
+            si = self._steady
+            return y0 * (si[0] * y0 + si[1] * y1) + y1 * (si[2] * y0 + si[3] * y1)
+        (a, b), (c, d) = cast(list[list[float]], (self.kf.P[:2, :2] + self.kf.R).tolist())
+        return (d * y0 * y0 - (b + c) * y0 * y1 + a * y1 * y1) / (a * d - b * c)
 
-    def update(self, z: Vec) -> bool:
-        """Take a detection; returns True when it looked like a kick or bounce."""
-        kicked = self.nis(z) > self.p.kick_gate_chi2
+    def update(self, z: Vec, nis: float | None = None) -> bool:
+        """Take a detection (``nis``: its :meth:`nis`, when already known); returns True when it
+        looked like a kick or bounce."""
+        if self.held is not None:
+            held, self.held = self.held, None
+            if held.nis(z) <= self.p.kick_gate_chi2:
+                # the motion goes on as before the odd detection: that one was not a kick
+                vars(self).update(vars(held))
+                nis = None
+        kicked = (self.nis(z) if nis is None else nis) > self.p.kick_gate_chi2
         if kicked:
+            self.held = copy.deepcopy(self)
+            self._steady = None
+            self._regular = 0
             # the velocity is unknown after a kick: forget it, keep the position's certainty
             self.kf.P[2:, :] = 0.0
             self.kf.P[:, 2:] = 0.0
@@ -166,7 +225,19 @@ class BallFilter:
             self.kf.P[:2, :2] += np.eye(2) * float(np.sum((z - self.kf.x[:2]) ** 2))
             self.slide_start_speed = math.inf  # sliding until the new speed is known
             self.t_kick = self.t
-        self.kf.update(z)
+        if self._steady is not None and self._pending_update:
+            self.kf.update_steadystate(z)
+        else:
+            self._steady = None  # a second view in the same frame: the settled gain does not apply
+            self.kf.update(z)
+            self._regular = self._regular + 1 if self._pending_update else 0
+            if self._regular >= self.p.steady_after_updates:
+                # filterpy's last full update left the settled gain in kf.K; the gate needs the
+                # innovation covariance of the settled prior
+                f, _, q = self.caches[self._model[1]].get(self._model[0])
+                prior = f @ self.kf.P @ f.T + q
+                self._steady = [float(v) for v in np.linalg.inv(prior[:2, :2] + self.kf.R).ravel()]
+        self._pending_update = False
         if self.slide_start_speed == math.inf and self.kf.P[2, 2] < 0.25:
             # the speed is known now, some frames after the kick: the slide began faster than that
             speed = math.hypot(self.kf.x[2], self.kf.x[3])
@@ -206,6 +277,7 @@ class RobotFilter:
         self._steady_list: list[float] = []  # the same, row by row, as floats
         self._gate_floor = np.diag([p.gate_floor_m**2, p.gate_floor_m**2, p.gate_floor_rad**2])
         self._steady_dt = 0.0
+        self._steady_epoch = 0  # tells one settled gain from the next (caches of stacked gains)
         self._dt = 0.0
         self._regular = 0  # consecutive regular frames
         self._pending_update = False  # predicted, not yet updated at this time
@@ -254,6 +326,16 @@ class RobotFilter:
         return [x[0] + x[3] * dt + a[0] * h, x[1] + x[4] * dt + a[1] * h, x[2] + x[5] * dt + a[2] * h,
                 x[3] + a[0] * dt, x[4] + a[1] * dt, x[5] + a[2] * dt]  # fmt: skip
 
+    def steady_step(self, t: float) -> bool:
+        """Whether the step to ``t`` is a regular one in steady-state mode (the settled gain holds)."""
+        return (self._steady is not None and not self._pending_update
+                and abs(t - self.t - self._steady_dt) < 1e-6)  # fmt: skip
+
+    @property
+    def steady_pending(self) -> bool:
+        """Predicted in steady-state mode and waiting for this frame's detection."""
+        return self._steady is not None and self._pending_update
+
     def predict(self, t: float) -> None:
         dt = t - self.t
         if dt <= 0.0:
@@ -276,21 +358,21 @@ class RobotFilter:
         y[2] = _wrap(y[2])
         return y
 
-    def nis(self, z: Vec) -> float:
+    def nis(self, z: Vec | tuple[float, float, float]) -> float:
         if self._steady is not None and self._pending_update:
             # the settled gate: y' S^-1 y in plain floats (called for every detection, every frame)
-            x = self.kf.x
-            y0, y1, y2 = float(z[0] - x[0]), float(z[1] - x[1]), _wrap(float(z[2] - x[2]))
+            x0, x1, x2 = cast(list[float], self.kf.x[:3].tolist())
+            y0, y1, y2 = z[0] - x0, z[1] - x1, _wrap(z[2] - x2)
             si = self._steady_list
             return (y0 * (si[0] * y0 + si[1] * y1 + si[2] * y2) + y1 * (si[3] * y0 + si[4] * y1 + si[5] * y2)
                     + y2 * (si[6] * y0 + si[7] * y1 + si[8] * y2))  # fmt: skip
-        y = self.innovation(z)
+        y = self.innovation(np.asarray(z, dtype=float))
         s = self.kf.P[:3, :3] + self.kf.R + self._gate_floor
         return float(y @ np.linalg.solve(s, y))
 
-    def update(self, z: Vec) -> None:
+    def update(self, z: Vec | tuple[float, float, float]) -> None:
         # the heading measured next to the prediction, so the filter never sees the wrap
-        zz = self.kf.x[:3] + self.innovation(z)
+        zz = self.kf.x[:3] + self.innovation(np.asarray(z, dtype=float))
         if self._steady is not None and self._pending_update:
             self.kf.update_steadystate(zz)
         else:
@@ -315,8 +397,102 @@ class RobotFilter:
         self._steady = np.linalg.inv(prior[:3, :3] + self.kf.R + self._gate_floor)
         self._steady_list = [float(v) for v in self._steady.ravel()]
         self._steady_dt = self._dt
+        self._steady_epoch = next(_EPOCHS)
 
     def _leave_steady(self) -> None:
         if self._steady is not None:
             self._steady = None
             self._regular = 0
+
+
+_EPOCHS = itertools.count(1)
+
+
+def predict_robots(filters: Sequence[RobotFilter], t: float) -> None:
+    """Advance every robot filter to ``t``. Those in steady-state mode on a regular step advance
+    together, their states the columns of one matrix through one filterpy call (per-robot calls
+    cost far more than the algebra); the others one by one."""
+    groups: dict[float, list[RobotFilter]] = {}
+    for f in filters:
+        if f.steady_step(t):
+            groups.setdefault(round(t - f.t, 7), []).append(f)
+        else:
+            f.predict(t)
+    for dt, group in groups.items():
+        fm, bm, _ = group[0].cache.get(dt)
+        x = np.array([f.kf.x for f in group]).T
+        u = np.zeros((3, len(group)))
+        for i, f in enumerate(group):
+            if f.command is not None:  # the accelerations toward our command; none for the opponents
+                u[:, i] = f._accel_tuple(float(x[3, i]), float(x[4, i]), float(x[5, i]), dt, f.command)
+        x = predict_steadystate(x, F=fm, u=u, B=bm)
+        x[2] = (x[2] + math.pi) % (2.0 * math.pi) - math.pi
+        rows = np.ascontiguousarray(x.T)
+        for f, row in zip(group, rows, strict=True):
+            f.kf.x = row
+            f.t = t
+            f._pending_update = True
+
+
+class SteadyUpdates:
+    """One detection each for robots predicted in steady-state mode, gated and taken together: the
+    gates (Mahalanobis distance with each robot's settled innovation covariance) as one array
+    operation, the accepted detections in one filterpy steady-state update, the states stacked into
+    one vector and the settled gains into a block-diagonal gain. The same result as one
+    :meth:`RobotFilter.nis` and :meth:`RobotFilter.update` per robot, for a fraction of the calls."""
+
+    def __init__(self) -> None:
+        self._gate_key: tuple[int, ...] = ()
+        self._s_inv: Vec = np.zeros((0, 3, 3))
+        self._gain_key: tuple[int, ...] = ()
+        self._gain: Vec = np.zeros((0, 0))
+        self._h: Vec = np.zeros((0, 0))
+
+    def take(self, robots: Sequence[RobotFilter], z: Sequence[tuple[float, float, float]],
+             gate_chi2: float) -> NDArray[np.bool_]:  # fmt: skip
+        """Update each of ``robots`` (all :attr:`RobotFilter.steady_pending`) with its detection in
+        ``z`` whose Mahalanobis distance squared is within ``gate_chi2``; returns which were taken."""
+        if not robots:
+            return np.zeros(0, dtype=bool)
+        x = np.array([f.kf.x for f in robots])
+        y = np.array(z) - x[:, :3]
+        y[:, 2] = (y[:, 2] + math.pi) % (2.0 * math.pi) - math.pi  # the heading next to the prediction
+        key = tuple(f._steady_epoch for f in robots)
+        if key != self._gate_key:
+            self._s_inv = np.array([f._steady for f in robots])
+            self._gate_key = key
+        ok: NDArray[np.bool_] = np.einsum("ni,nij,nj->n", y, self._s_inv, y) <= gate_chi2
+        taken = [f for f, good in zip(robots, ok.tolist(), strict=True) if good]
+        if not taken:
+            return ok
+        key = tuple(f._steady_epoch for f in taken)
+        if key != self._gain_key:
+            self._gain = block_diag(*[f.kf.K for f in taken])
+            self._h = block_diag(*[f.kf.H for f in taken])
+            self._gain_key = key
+        xs = update_steadystate(x[ok].ravel(), (x[ok, :3] + y[ok]).ravel(), self._gain, self._h)
+        n = x.shape[1]
+        xs[2::n] = (xs[2::n] + math.pi) % (2.0 * math.pi) - math.pi
+        for i, f in enumerate(taken):
+            f.kf.x = xs[i * n : (i + 1) * n]
+            f._pending_update = False
+        return ok
+
+
+def predicted_states(filters: Sequence[RobotFilter], t: float,
+                     commands: Sequence[Sequence[tuple[float, tuple[float, float, float]]]]) -> Vec:  # fmt: skip
+    """States (one row per filter) at time ``t``, as :meth:`RobotFilter.predicted_state` with each
+    filter's ``commands``. Robots without a command (the opponents) move at constant velocity and
+    are extrapolated together."""
+    out = np.empty((len(filters), 6))
+    free = [i for i, (f, c) in enumerate(zip(filters, commands, strict=True)) if f.command is None and not c]
+    if free:
+        x = np.array([filters[i].kf.x for i in free])
+        dt = np.maximum(t - np.array([filters[i].t for i in free]), 0.0)
+        x[:, :3] += dt[:, None] * x[:, 3:]
+        x[:, 2] = (x[:, 2] + math.pi) % (2.0 * math.pi) - math.pi
+        out[free] = x
+    if len(free) < len(filters):
+        for i in sorted(set(range(len(filters))) - set(free)):
+            out[i] = filters[i].predicted_state(t, commands[i])
+    return out

@@ -25,6 +25,7 @@ import numpy as np
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Team
 from cmdragons.messages import BallState, DetectionFrame, RobotCommand, RobotState, WorldState
+from cmdragons.tracking import filters
 from cmdragons.tracking.filters import BallFilter, BallModelParams, RobotFilter, RobotModelParams
 
 __all__ = ["Tracker", "TrackerParams", "TrackerStats"]
@@ -93,6 +94,8 @@ class Tracker:
         self.stats = TrackerStats()
         self.t = -math.inf  # capture time of the newest frame taken
         self._commands: dict[tuple[Team, int], deque[tuple[float, tuple[float, float, float]]]] = {}
+        self._steady_updates = filters.SteadyUpdates()
+        self._robots_sorted = True  # self.robots in key order
 
     # --- input --------------------------------------------------------------------------------
     def command_sent(self, commands: Iterable[RobotCommand], t_sent: float) -> None:
@@ -115,6 +118,14 @@ class Tracker:
                 break
         return current
 
+    def _apply_commands(self) -> None:
+        """Each robot filter's control input: our command in force at the filter's time (robots we
+        sent nothing, the opponents, keep none)."""
+        for key in self._commands:
+            track = self.robots.get(key)
+            if track is not None:
+                track.filter.command = self._command_at(key, track.filter.t)
+
     def step(self, frames: Sequence[DetectionFrame]) -> WorldState:
         """Take one set of camera frames (any order, any cameras) and return the world state
         predicted to the newest capture time plus ``latency_s``."""
@@ -133,41 +144,64 @@ class Tracker:
     def _take(self, frame: DetectionFrame) -> None:
         t = frame.t_capture
         self.t = t
-        for key, track in self.robots.items():
-            track.filter.command = self._command_at(key, track.filter.t)
-            track.filter.predict(t)
+        self._apply_commands()
+        filters.predict_robots([track.filter for track in self.robots.values()], t)
         near = self.p.ball.near_robot_m
         robots_xy = np.array([r.filter.kf.x[:2] for r in self.robots.values()]).reshape(-1, 2)
         for ball in self.balls:
             d = np.hypot(*(robots_xy - ball.filter.position).T) if len(robots_xy) else np.zeros(0)
             ball.filter.predict(t, near_robot=bool(len(d) and float(d.min()) < near))
+        # a settled robot's first detection of the frame goes with the others into one steady-state
+        # update; the rest (new or unsettled tracks, second views, rejected detections) one by one,
+        # in their order, after it
+        steady: dict[tuple[Team, int], tuple[float, float, float]] = {}
+        one_by_one: list[tuple[tuple[Team, int], tuple[float, float, float]]] = []
         for det in frame.robots:
             self.stats.detections += 1
-            z = np.array([det.x, det.y, det.theta])
-            if not np.all(np.isfinite(z)):
+            if not (math.isfinite(det.x) and math.isfinite(det.y) and math.isfinite(det.theta)):
                 self.stats.non_finite += 1
                 continue
             if det.confidence < self.p.min_confidence:
                 self.stats.low_confidence += 1
                 continue
-            self._take_robot((det.team, det.id), z, t)
+            key, z = (det.team, det.id), (det.x, det.y, det.theta)
+            known = self.robots.get(key)
+            if known is not None and key not in steady and known.filter.steady_pending:
+                steady[key] = z
+            else:
+                one_by_one.append((key, z))
+        if steady:
+            settled = [self.robots[key] for key in steady]
+            taken = self._steady_updates.take([tr.filter for tr in settled], list(steady.values()),
+                                              self.p.robot_gate_chi2)  # fmt: skip
+            rejected = []
+            for (key, z), robot, ok in zip(steady.items(), settled, taken.tolist(), strict=True):
+                if ok:
+                    robot.hits += 1
+                    robot.last_seen = t
+                    robot.rejected.clear()
+                else:
+                    rejected.append((key, z))
+            one_by_one = rejected + one_by_one
+        for key, z in one_by_one:
+            self._take_robot(key, z, t)
         balls = []
         for bd in frame.balls:
             self.stats.detections += 1
-            z = np.array([bd.x, bd.y])
-            if not np.all(np.isfinite(z)):
+            if not (math.isfinite(bd.x) and math.isfinite(bd.y)):
                 self.stats.non_finite += 1
             elif bd.confidence < self.p.min_confidence:
                 self.stats.low_confidence += 1
             else:
-                balls.append(z)
+                balls.append(np.array([bd.x, bd.y]))
         self._take_balls(balls, t)
 
     # --- robots -------------------------------------------------------------------------------
-    def _take_robot(self, key: tuple[Team, int], z: np.ndarray, t: float) -> None:
+    def _take_robot(self, key: tuple[Team, int], z: tuple[float, float, float], t: float) -> None:
         track = self.robots.get(key)
         if track is None:
             self.robots[key] = _RobotTrack(RobotFilter(self.p.robot, z[0], z[1], z[2], t), last_seen=t)
+            self._robots_sorted = False
             return
         if track.filter.nis(z) <= self.p.robot_gate_chi2:
             track.filter.update(z)
@@ -193,20 +227,21 @@ class Tracker:
         pairs = []
         for i, track in enumerate(self.balls):
             reach = self.p.max_ball_speed_m_s * max(t - track.last_seen, 1e-3) + self.p.ball_jump_margin_m
+            px, py = track.filter.position.tolist()
             for j, z in enumerate(detections):
-                d = float(np.linalg.norm(z - track.filter.position))
+                d = math.hypot(z[0] - px, z[1] - py)
                 if d <= reach:
                     pairs.append((track.filter.nis(z), d, i, j))
         pairs.sort()
         used_tracks: set[int] = set()
         used_dets: set[int] = set()
-        for _, _, i, j in pairs:
+        for nis, _, i, j in pairs:
             if i in used_tracks or j in used_dets:
                 continue
             used_tracks.add(i)
             used_dets.add(j)
             track = self.balls[i]
-            if track.filter.update(detections[j]):
+            if track.filter.update(detections[j], nis):
                 self.stats.ball_kicks += 1
             track.hits += 1
             track.last_seen = t
@@ -238,12 +273,14 @@ class Tracker:
         if best is not None:
             x, cov = best.filter.predicted(t)
             ball = BallState(float(x[0]), float(x[1]), float(x[2]), float(x[3]), best.last_seen == self.t, cov)
-        robots = []
-        for (team, rid), track in sorted(self.robots.items()):
-            if track.hits < self.p.robot_confirm_detections:
-                continue
-            track.filter.command = self._command_at((team, rid), track.filter.t)
-            x = track.filter.predicted_state(t, self._commands.get((team, rid), ()))
-            robots.append(RobotState(team, rid, float(x[0]), float(x[1]), float(x[2]), float(x[3]), float(x[4]),
-                                     float(x[5]), track.last_seen == self.t))  # fmt: skip
-        return WorldState(t, ball, tuple(robots))
+        if not self._robots_sorted:  # by team and id; the order only changes when a track is born
+            self.robots = dict(sorted(self.robots.items()))
+            self._robots_sorted = True
+        confirmed = [(key, track) for key, track in self.robots.items()
+                     if track.hits >= self.p.robot_confirm_detections]  # fmt: skip
+        self._apply_commands()
+        states = filters.predicted_states([track.filter for _, track in confirmed], t,
+                                  [self._commands.get(key, ()) for key, _ in confirmed])  # fmt: skip
+        robots = tuple(RobotState(team, rid, x[0], x[1], x[2], x[3], x[4], x[5], track.last_seen == self.t)
+                       for ((team, rid), track), x in zip(confirmed, states.tolist(), strict=True))  # fmt: skip
+        return WorldState(t, ball, robots)

@@ -235,7 +235,7 @@ def test_truth_lists_only_what_is_inside_the_image(clean: CameraRenderer) -> Non
 
 
 def test_same_seed_same_bytes_other_seed_other_noise(small_camera: CameraModel) -> None:
-    params = RenderParams(noise_bank_frames=2)
+    params = RenderParams()
     frames = [snapshot([(0, 5, 0.3, -0.2, 0.4, 1.0, -0.5, 4.0)], np.array([0.5, -0.1, 0.0215, 3.0, 1.0, 0.0]), k)
               for k in range(3)]  # fmt: skip
     a, b = CameraRenderer(small_camera, LEAGUE, params, 11), CameraRenderer(small_camera, LEAGUE, params, 11)
@@ -253,6 +253,26 @@ def test_same_seed_same_bytes_other_seed_other_noise(small_camera: CameraModel) 
     again, _ = a.render(frames[0])
     assert again is not kept and again.tobytes() != kept.tobytes()
     assert kept.tobytes() == copy.tobytes()
+
+
+def test_sensor_noise_is_fresh_every_frame(small_camera: CameraModel) -> None:
+    """A pixel's noise in one frame says nothing of its noise in the next: consecutive and distant
+    frames are uncorrelated, and each frame's noise is N(0, sigma) rounded to grey levels."""
+    sigma = 6.0
+    r = CameraRenderer(small_camera, LEAGUE, RenderParams(noise_sigma_grey=sigma), seed=4)
+    empty = snapshot([])
+    # away from saturation the noise is the image minus the clean background
+    mid = (r.background > 5 * sigma) & (r.background < 255 - 5 * sigma)
+    assert mid.sum() > 30000
+    noise = np.array([(r.render(empty)[0].astype(np.int16) - r.background)[mid] for _ in range(12)], dtype=float)
+    flat = noise.reshape(12, -1)
+    assert abs(flat.mean()) < 0.05
+    assert flat.std() == pytest.approx(np.sqrt(sigma**2 + 1.0 / 12.0), rel=0.02)
+    corr = np.corrcoef(flat)
+    off_diagonal = corr[~np.eye(12, dtype=bool)]
+    assert np.abs(off_diagonal).max() < 0.02, "no frame repeats another's noise"
+    # neighbouring values (channels, pixels) are independent too
+    assert abs(np.corrcoef(flat[0, :-1], flat[0, 1:])[0, 1]) < 0.02
 
 
 def test_params_are_validated() -> None:
@@ -293,7 +313,7 @@ def scene(model: CameraModel, renderer: CameraRenderer) -> tuple[NDArray[np.floa
 
 
 def test_plan_objects_matches_reference(small_camera: CameraModel) -> None:
-    r = CameraRenderer(small_camera, LEAGUE, RenderParams(noise_bank_frames=1, exposure_s=0.004), seed=1)
+    r = CameraRenderer(small_camera, LEAGUE, RenderParams(exposure_s=0.004), seed=1)
     robots, ball = scene(small_camera, r)
     p = r.params
     plan = kern.ObjectPlan(len(robots), p.max_blur_samples)
@@ -332,17 +352,16 @@ def test_segment_distance_is_the_minimum_along_the_segment() -> None:
 
 @pytest.mark.parametrize("noise", [True, False])
 def test_render_frame_matches_reference(small_camera: CameraModel, noise: bool) -> None:
-    r = CameraRenderer(small_camera, LEAGUE, RenderParams(noise_bank_frames=1, noise_sigma_grey=6.0,
-                                                          exposure_s=0.004), seed=2)  # fmt: skip
+    r = CameraRenderer(small_camera, LEAGUE, RenderParams(noise_sigma_grey=6.0, exposure_s=0.004), seed=2)
     robots, ball = scene(small_camera, r)
     p = r.params
     plan = kern.ObjectPlan(len(robots), p.max_blur_samples)
     kern.plan_objects(plan, robots, ball, r.cam, r.shape, r.pink, r.dots, r.palette, p.exposure_s, p.blur_step_px)
-    start: int | None = 1234 if noise else None
+    key: int | None = 2**64 - 1234 if noise else None
     out = np.empty_like(r.background)
-    vis, sil = kern.render_frame(out, r.background, r.bank, start, r.rays, r.foot, r.gain, r.cam, r.shape, r.dots,
+    vis, sil = kern.render_frame(out, r.background, r.noise, key, r.rays, r.foot, r.gain, r.cam, r.shape, r.dots,
                                  r.palette, plan, np.zeros((out.shape[0], 2)), n_chunks=3)  # fmt: skip
-    ref, vis_ref, sil_ref = kern.render_frame_reference(r.background, r.bank, start, r.rays, r.foot, r.gain, r.cam,
+    ref, vis_ref, sil_ref = kern.render_frame_reference(r.background, r.noise, key, r.rays, r.foot, r.gain, r.cam,
                                                         r.shape, r.dots, r.palette, plan)  # fmt: skip
     diff = np.abs(out.astype(np.int16) - ref)
     assert diff.max() <= 1, "float rounding may move a level by one, never more"
@@ -351,9 +370,9 @@ def test_render_frame_matches_reference(small_camera: CameraModel, noise: bool) 
     assert 0.0 < vis < sil, "the ball is partly hidden"
     assert vis == pytest.approx(vis_ref, rel=1e-4)
     assert sil == pytest.approx(sil_ref, rel=1e-4)
-    if start is not None:  # away from the objects' boxes: the background plus saturated noise, exactly
+    if key is not None:  # away from the objects' boxes: the background plus saturated noise, exactly
         free = np.ones(out.shape[:2], dtype=bool)
         for i0, i1, j0, j1 in [*plan.rob_bbox, plan.ball_bbox]:
             free[i0:i1, j0:j1] = False
         assert free.mean() > 0.3
-        np.testing.assert_array_equal(out[free], kern.add_noise_reference(r.background, r.bank, start)[free])
+        np.testing.assert_array_equal(out[free], kern.add_noise_reference(r.background, r.noise, key)[free])

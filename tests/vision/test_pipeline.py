@@ -7,6 +7,7 @@ heading within 1.5 degrees, ball within 3 mm; ids exact; nothing reported that i
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import shutil
 from pathlib import Path
@@ -17,6 +18,7 @@ import pytest
 from cmdragons.camera import CameraModel
 from cmdragons.config import ConfigError
 from cmdragons.geometry import TEAMS
+from cmdragons.messages import BallTruth, GroundTruth
 from cmdragons.runtime.settings import load_settings
 from sim.render import RenderParams
 from vision.pipeline import VisionParams, VisionPipeline
@@ -78,3 +80,32 @@ def test_bad_vision_config_names_the_problem(tmp_path: Path, text: str, fragment
         load_settings(folder)
     assert err.value.file.endswith("vision.yaml")
     assert fragment in str(err.value)
+
+
+def test_calibrated_blob_height_leaves_no_radial_ball_bias(cameras: list[CameraModel]) -> None:
+    """Balls at rest across the whole image of each camera: with the configured blob height the
+    detections lie neither outward nor inward of the truth (within 1 mm of height), while
+    projecting the blob at the ball centre puts them outward (the shaded rim is not orange)."""
+    from vision.score import Score, ball_height_bias_m
+
+    calibrated = VisionParams()
+    at_centre = VisionParams(ball=dataclasses.replace(calibrated.ball, blob_height_above_centre_m=0.0))
+    scores = {"calibrated": Score(), "at_centre": Score()}
+    r = LEAGUE.ball.radius_m
+    for model in cameras:
+        pipes = {"calibrated": VisionPipeline(calibrated, LEAGUE, model),
+                 "at_centre": VisionPipeline(at_centre, LEAGUE, model)}  # fmt: skip
+        for k, (fu, fv) in enumerate([(fu, fv) for fu in (0.1, 0.3, 0.5, 0.7, 0.9) for fv in (0.1, 0.5, 0.9)]):
+            ball = model.unproject(np.array([[model.width * fu, model.height * fv]]), r)[0]
+            snap = snapshot([], ball=(ball[0], ball[1], r), frame=k)
+            image, _ = render(model, snap, seed=k)
+            truth = GroundTruth(k, 0.0, BallTruth(ball[0], ball[1], r, 0.0, 0.0, pixels={model.id: (0.0, 0.0, 1.0)}))
+            for name, pipe in pipes.items():
+                scores[name].add(pipe.process(image, k, 0.0), truth)
+    centres = {m.id: m.center for m in cameras}
+    for score in scores.values():
+        assert len(score.ball_pairs) == 15 * len(cameras)
+    assert abs(ball_height_bias_m(scores["calibrated"], centres, calibrated.ball.blob_height_above_centre_m)) < 1e-3
+    assert ball_height_bias_m(scores["at_centre"], centres, 0.0) > 2e-3
+    calibrated_rms = np.sqrt(np.mean(np.square(scores["calibrated"].ball_err_m)))
+    assert calibrated_rms < np.sqrt(np.mean(np.square(scores["at_centre"].ball_err_m)))

@@ -40,7 +40,7 @@ class BrainParams(Validated):
 
     # planning is bounded by the planner's node budget (configs/planner.yaml), so the same seed gives
     # the same match whatever the machine's load; this deadline is only the safety net
-    plan_deadline_s: float = setting(0.02, lo=0.0001, hi=1.0)
+    plan_deadline_s: float = setting(0.25, lo=0.0001, hi=1.0)
     ball_clearance_m: float = setting(0.05, lo=0.0, hi=1.0)  # kept from the ball when it is an obstacle
     arrive_tolerance_m: float = setting(0.01, lo=0.0, hi=1.0)  # closer than this to the goal: no planning
 

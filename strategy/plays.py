@@ -43,6 +43,7 @@ class StrategyParams(Validated):
     passing: PassParams = PassParams()
     roles: RoleParams = RoleParams()
     defenders: int = setting(2, lo=0, hi=10)
+    defender_spacing_m: float = setting(0.32, lo=0.0, hi=3.0)  # centre to centre: room to be pushed without touching
     shoot_value: float = setting(0.15, lo=0.0, hi=1.0)  # shot evaluation worth shooting at
     pass_value: float = setting(0.05, lo=0.0, hi=1.0)  # pass evaluation worth passing at
     one_touch_value: float = setting(0.1, lo=0.0, hi=1.0)  # shot value at the receiving point for a one-touch
@@ -154,8 +155,8 @@ class Strategy:
             meet = {rid: intercept(r, ball, p.skills, f) for rid, r in own.items()}
             costs = {rid: math.hypot(m.x - own[rid].x, m.y - own[rid].y) for rid, m in meet.items()}
             objectives.append(Objective("attacker", ball.x, ball.y, costs=costs))
-        slots = [0.0] if p.defenders == 1 else list(np.linspace(-0.12 * (p.defenders - 1), 0.12 * (p.defenders - 1),
-                                                                 p.defenders))  # fmt: skip
+        half_span = 0.5 * p.defender_spacing_m * (p.defenders - 1)
+        slots = [0.0] if p.defenders == 1 else list(np.linspace(-half_span, half_span, p.defenders))
         defenders = {}
         for k, slot in enumerate(slots):
             intent = defend(ball, f, own_sign, float(slot), p.skills)
@@ -347,7 +348,13 @@ def keep_away(intents: dict[int, Intent], ball: BallState, pitch: Field, own_sig
         if d < d_min:
             if d < 1e-6:
                 dx, dy, d = own_sign, 0.0, 1.0
-            x, y = ball.x + dx / d * d_min, ball.y + dy / d * d_min
+            # the nearest point of the circle around the ball that lies on the field (where the cameras see us)
+            lim_x, lim_y = pitch.half_length - radius, pitch.half_width - radius
+            base = math.atan2(dy, dx)
+            for turn in (0.0, *(sign * k * math.pi / 12 for k in range(1, 13) for sign in (1.0, -1.0))):
+                x, y = ball.x + d_min * math.cos(base + turn), ball.y + d_min * math.sin(base + turn)
+                if abs(x) <= lim_x and abs(y) <= lim_y:
+                    break
         out[rid] = Intent(x, y, it.theta, dribbler=0.0, avoid_ball=True, allow_own_defense=it.allow_own_defense,
                           max_speed_m_s=p.stop_speed_m_s if slow else it.max_speed_m_s)  # fmt: skip
     return out

@@ -212,7 +212,7 @@ def goalie_block(ball: BallState, field: Field, own_sign: float, p: SkillParams)
 
 def defend(ball: BallState, field: Field, own_sign: float, slot: float, p: SkillParams) -> Intent:
     """Stand on the edge of our defense area (plus a margin) on the line from the goal centre to the
-    ball, shifted sideways by ``slot`` metres (two defenders use -0.12 and +0.12)."""
+    ball, shifted sideways by ``slot`` metres (``StrategyParams.defender_spacing_m`` apart)."""
     gx = own_sign * field.half_length
     depth = field.dims.defense_depth_m + p.defense_margin_m + p.robot_radius_m
     half_w = field.dims.defense_width_m / 2 + p.defense_margin_m + p.robot_radius_m

@@ -316,6 +316,63 @@ def region_rays(grid: np.ndarray, pixels: np.ndarray) -> tuple[np.ndarray, np.nd
 
 
 @numba.njit(cache=True)
+def ball_centre(image: np.ndarray, box: np.ndarray, margin: int) -> tuple[float, float]:
+    """The ball's sub-pixel centre (u, v at pixel centres) in ``image`` (H, W, 3) uint8 around its
+    region's bounding box ``box`` (u0, v0, u1, v1 inclusive): the centroid of each pixel's ball
+    coverage over the box grown by ``margin`` px. An edge pixel's colour is a linear mix
+    ``p * ball + q * background`` (coverage 1 - q; p also carries the shade and light, so the
+    ball's colour is only a direction), unmixed by least squares with the background the median of
+    the one-pixel ring around the window and the ball's colour the mean of the box shrunk by one
+    pixel; coverage is clipped to 0..1. NaN when the two colours cannot be told apart. The
+    reference is :func:`vision.patterns.ball_centre_reference`."""
+    h, w = image.shape[0], image.shape[1]
+    u0, v0, u1, v1 = int(box[0]), int(box[1]), int(box[2]), int(box[3])
+    wu0, wv0, wu1, wv1 = max(u0 - margin, 0), max(v0 - margin, 0), min(u1 + margin, w - 1), min(v1 + margin, h - 1)
+    ru0, rv0, ru1, rv1 = max(wu0 - 1, 0), max(wv0 - 1, 0), min(wu1 + 1, w - 1), min(wv1 + 1, h - 1)
+    ring = np.empty((3, (ru1 - ru0 + 1) * (rv1 - rv0 + 1)))
+    n = 0
+    for i in range(rv0, rv1 + 1):
+        for j in range(ru0, ru1 + 1):
+            if wv0 <= i <= wv1 and wu0 <= j <= wu1:
+                continue
+            for c in range(3):
+                ring[c, n] = image[i, j, c]
+            n += 1
+    if n == 0:
+        return np.nan, np.nan
+    bg = np.empty(3)
+    for c in range(3):
+        bg[c] = np.median(ring[c, :n])
+    iu0, iv0, iu1, iv1 = u0 + 1, v0 + 1, u1 - 1, v1 - 1
+    if iu0 > iu1 or iv0 > iv1:
+        iu0, iv0, iu1, iv1 = u0, v0, u1, v1
+    ball = np.zeros(3)
+    for i in range(iv0, iv1 + 1):
+        for j in range(iu0, iu1 + 1):
+            for c in range(3):
+                ball[c] += image[i, j, c]
+    bb = ball[0] * ball[0] + ball[1] * ball[1] + ball[2] * ball[2]
+    if bb <= 0.0:
+        return np.nan, np.nan
+    k = (bg[0] * ball[0] + bg[1] * ball[1] + bg[2] * ball[2]) / bb
+    g0, g1, g2 = bg[0] - k * ball[0], bg[1] - k * ball[1], bg[2] - k * ball[2]  # background, off the ball's colour
+    den = bg[0] * g0 + bg[1] * g1 + bg[2] * g2
+    if den < 1.0:
+        return np.nan, np.nan
+    sw, su, sv = 0.0, 0.0, 0.0
+    for i in range(wv0, wv1 + 1):
+        for j in range(wu0, wu1 + 1):
+            q = (image[i, j, 0] * g0 + image[i, j, 1] * g1 + image[i, j, 2] * g2) / den
+            a = min(max(1.0 - q, 0.0), 1.0)
+            sw += a
+            su += a * j
+            sv += a * i
+    if sw <= 0.0:
+        return np.nan, np.nan
+    return su / sw + 0.5, sv / sw + 0.5
+
+
+@numba.njit(cache=True)
 def fit_pattern(centre: np.ndarray, w_centre: float, obs: np.ndarray, w_obs: np.ndarray,
                 slots: np.ndarray) -> tuple[float, float, float, float]:  # fmt: skip
     """Weighted least-squares rigid fit (2D Procrustes) of a pattern whose centre dot sits at the

@@ -7,8 +7,11 @@ arrangement is fitted to the template by weighted least squares over position an
 every assignment of dots to template slots (A.2.2-A.2.3). The best fit gives the slots' colours,
 hence the id, the centre and the heading; its residual and the regions' areas give a confidence.
 
-The ball is the orange region of the right size and shape, on the plane of the blob's centroid
-(a calibrated height above the ball centre), that is not inside a detected robot's pattern.
+The ball is the orange region of the right size and shape that is not inside a detected robot's
+pattern; its centre in the image is the centroid of each pixel's ball coverage, read by unmixing
+the pixel's colour into ball and background (:func:`ball_centre_reference`), not of the
+thresholded pixels, so that it follows the ball between pixels and keeps the shaded rim; it is
+projected on the plane of a calibrated height above the ball centre.
 
 Field frame, metres, radians; pixels as in :mod:`vision.cmvision`.
 """
@@ -32,7 +35,15 @@ from vision.cmvision import Regions
 
 F64 = NDArray[np.float64]
 
-__all__ = ["BallParams", "PatternMatcher", "PatternParams", "RegionGeometry", "detect_ball", "fit_reference"]
+__all__ = [
+    "BallParams",
+    "PatternMatcher",
+    "PatternParams",
+    "RegionGeometry",
+    "ball_centre_reference",
+    "detect_ball",
+    "fit_reference",
+]
 
 
 @dataclass(frozen=True)
@@ -59,9 +70,14 @@ class BallParams(Validated):
     min_fill: float = setting(0.4, lo=0.0, hi=1.0)  # area / bounding-box area
     max_balls: int = setting(1, lo=0, hi=16)  # per camera frame, most confident first
     min_confidence: float = setting(0.1, lo=0.0, hi=1.0)
-    # the orange blob's centroid sits this far above the ball's centre, as seen from the camera:
-    # the shaded lower rim falls out of the orange class (vision.score.ball_height_bias_m measures it)
-    blob_height_above_centre_m: float = setting(0.0027, lo=-0.05, hi=0.05)
+    # the ball's centre in the image: "coverage", the centroid of each pixel's unmixed ball coverage
+    # over the region's box grown by centre_margin_px; "centroid", the region's thresholded pixels
+    centre: str = setting("coverage", choices=("coverage", "centroid"))
+    centre_margin_px: int = setting(1, lo=1, hi=4)
+    # the blob's centre sits this far above the ball's centre, as seen from the camera (the coverage
+    # centre: the silhouette's; the thresholded centroid: higher, its shaded lower rim drops out of
+    # the orange class); vision.score.ball_height_bias_m measures what is left
+    blob_height_above_centre_m: float = setting(0.0006, lo=-0.05, hi=0.05)
 
 
 class RegionGeometry:
@@ -72,11 +88,18 @@ class RegionGeometry:
     def __init__(self, regions: Regions, camera: CameraModel, grid: NDArray[np.float32]) -> None:
         self.regions = regions
         self.camera = camera
+        self.grid = grid
         self.rays, self.pixel_area = kern.region_rays(grid, regions.centroid)
 
     def xy(self, idx: NDArray[np.int64], z: float) -> NDArray[np.float64]:
         """Field points (n, 2) of regions ``idx`` on the plane at height ``z`` (m)."""
         out: NDArray[np.float64] = self.camera.center[:2] + (self.camera.center[2] - z) * self.rays[idx]
+        return out
+
+    def pixel_xy(self, pixels: NDArray[np.float64], z: float) -> NDArray[np.float64]:
+        """Field points (n, 2) of image points ``pixels`` (n, 2) (u, v) on the plane at height ``z`` (m)."""
+        rays, _ = kern.region_rays(self.grid, np.ascontiguousarray(pixels, dtype=np.float64))
+        out: NDArray[np.float64] = self.camera.center[:2] + (self.camera.center[2] - z) * rays
         return out
 
     def area_m2(self, idx: NDArray[np.int64], z: float) -> NDArray[np.float64]:
@@ -200,8 +223,38 @@ def merge_duplicates(robots: list[RobotDetection], distance_m: float) -> list[Ro
     return [ranked[k] for k in kept]
 
 
+def ball_centre_reference(image: NDArray[np.uint8], box: NDArray[np.float64], margin: int) -> tuple[float, float]:
+    """The ball's centre (u, v at pixel centres) from the coverage of the pixels around its
+    region's box (u0, v0, u1, v1 inclusive) grown by ``margin``: the plain-numpy reference of
+    :func:`vision._kernels.ball_centre`, which explains the unmixing."""
+    h, w = image.shape[:2]
+    u0, v0, u1, v1 = (int(x) for x in box)
+    wu0, wv0, wu1, wv1 = max(u0 - margin, 0), max(v0 - margin, 0), min(u1 + margin, w - 1), min(v1 + margin, h - 1)
+    ring = np.zeros((h, w), dtype=bool)
+    ring[max(wv0 - 1, 0) : wv1 + 2, max(wu0 - 1, 0) : wu1 + 2] = True
+    ring[wv0 : wv1 + 1, wu0 : wu1 + 1] = False
+    px = image.astype(np.float64)
+    if not ring.any():
+        return math.nan, math.nan
+    bg = np.median(px[ring], axis=0)
+    inner = px[v0 + 1 : v1, u0 + 1 : u1] if u1 - u0 >= 2 and v1 - v0 >= 2 else px[v0 : v1 + 1, u0 : u1 + 1]
+    ball = inner.reshape(-1, 3).sum(axis=0)
+    if ball @ ball <= 0.0:
+        return math.nan, math.nan
+    off = bg - (bg @ ball) / (ball @ ball) * ball
+    den = bg @ off
+    if den < 1.0:
+        return math.nan, math.nan
+    cover = np.clip(1.0 - px[wv0 : wv1 + 1, wu0 : wu1 + 1] @ off / den, 0.0, 1.0)
+    if cover.sum() <= 0.0:
+        return math.nan, math.nan
+    v, u = np.mgrid[wv0 : wv1 + 1, wu0 : wu1 + 1]
+    return float((cover * u).sum() / cover.sum() + 0.5), float((cover * v).sum() / cover.sum() + 0.5)
+
+
 def detect_ball(
     geo: RegionGeometry,
+    image: NDArray[np.uint8],
     orange: int,
     ball_radius_m: float,
     robots: list[RobotDetection],
@@ -210,8 +263,9 @@ def detect_ball(
     params: BallParams,
 ) -> list[BallDetection]:
     """Ball candidates: orange regions of the ball's size and shape, not inside a detected
-    robot's pattern, on the plane of the blob's centroid (the ball centre's height plus
-    ``params.blob_height_above_centre_m``); most confident first."""
+    robot's pattern, centred as ``params.centre`` says in ``image`` (H, W, 3) BGR uint8 and
+    projected on the plane of the ball centre's height plus ``params.blob_height_above_centre_m``;
+    most confident first."""
     regions = geo.regions
     idx = regions.of_class(orange)
     if idx.size == 0 or params.max_balls == 0:
@@ -233,14 +287,20 @@ def detect_ball(
         # a pattern holds no orange: an orange spot inside one is a misread marker
         at_top = geo.xy(idx, robot_height_m[r.team])
         keep &= np.hypot(at_top[:, 0] - r.x, at_top[:, 1] - r.y) >= pattern_radius_m
-    xy = geo.xy(idx, ball_radius_m + params.blob_height_above_centre_m)
+    px = regions.centroid[idx]
+    if params.centre == "coverage":
+        px = px.copy()
+        for j in np.flatnonzero(keep):
+            c = kern.ball_centre(image, regions.bbox[idx[j]], params.centre_margin_px)
+            if math.isfinite(c[0]):  # else (ball and background alike) the region's centroid
+                px[j] = c
+    xy = geo.pixel_xy(px, ball_radius_m + params.blob_height_above_centre_m)
     out = []
     for j in np.flatnonzero(keep):
         size_conf = min(ratio[j], 1.0 / ratio[j])
         shape_conf = min(1.0, 1.5 / elong[j])
         conf = float(np.clip(size_conf * shape_conf / 0.6, 0.0, 1.0))
         if conf >= params.min_confidence:
-            px = regions.centroid[idx[j]]
-            out.append(BallDetection(float(xy[j, 0]), float(xy[j, 1]), conf, (float(px[0]), float(px[1]))))
+            out.append(BallDetection(float(xy[j, 0]), float(xy[j, 1]), conf, (float(px[j, 0]), float(px[j, 1]))))
     out.sort(key=lambda b: -b.confidence)
     return out[: params.max_balls]

@@ -117,7 +117,7 @@ class VisionPipeline:
         geo = RegionGeometry(regions, self.camera, self.grid)
         robots = self.matcher.detect(geo, self.classes, self.heights, lambda px: self._is_pink(image, px))
         # a ball seen beside a robot lies outside its top: only a misread marker is well inside
-        balls = detect_ball(geo, self.classes["ball"], self.league.ball.radius_m, robots, self.heights,
+        balls = detect_ball(geo, image, self.classes["ball"], self.league.ball.radius_m, robots, self.heights,
                             self.pattern_radius_m * 0.8, self.params.ball)  # fmt: skip
         # no wall clock here: the frame is "sent" at its capture time (latency is the runtime's)
         return DetectionFrame(self.camera.id, frame_number, t_capture, t_capture, tuple(balls),

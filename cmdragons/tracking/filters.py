@@ -45,7 +45,7 @@ Vec = NDArray[np.float64]
 
 @dataclass(frozen=True)
 class BallModelParams(Validated):
-    measurement_sigma_m: float = setting(0.0016, lo=1e-5, hi=1.0)  # vision's position noise
+    measurement_sigma_m: float = setting(0.0004, lo=1e-5, hi=1.0)  # vision's position noise, frame to frame
     accel_sigma_m_s2: float = setting(0.5, lo=0.0, hi=100.0)  # white-noise acceleration (model error)
     acc_slide_m_s2: float = setting(3.0, lo=0.0, hi=50.0)
     acc_roll_m_s2: float = setting(0.26, lo=0.0, hi=10.0)
@@ -144,6 +144,8 @@ class BallFilter:
         self._regular = 0  # consecutive regular frames with that model
         self._steady: list[float] | None = None  # settled inverse innovation covariance, row by row
         self._pending_update = False  # predicted, not yet updated at this time
+        self._updated_at = math.nan  # time of the last update
+        self._prior: tuple[float, float, list[float]] = (0.0, 0.0, [0.0] * 4)  # position, S^-1 before it
 
     def _decel(self, v: Vec, dt: float) -> Vec:
         speed = math.hypot(v[0], v[1])
@@ -193,20 +195,36 @@ class BallFilter:
         if self.held is not None:
             self.held.predict(t, near_robot)
 
-    def nis(self, z: Vec) -> float:
-        """Normalised innovation squared of a detection against the current prediction."""
+    def _innovation(self) -> tuple[float, float, list[float]]:
+        """The predicted position and the inverse innovation covariance (row by row)."""
         # 2 x 2, in plain floats: numpy's per-call cost would be most of it
         x0, x1 = cast(list[float], self.kf.x[:2].tolist())
-        y0, y1 = float(z[0]) - x0, float(z[1]) - x1
         if self._steady is not None and self._pending_update:
-            si = self._steady
-            return y0 * (si[0] * y0 + si[1] * y1) + y1 * (si[2] * y0 + si[3] * y1)
+            return x0, x1, self._steady
         (a, b), (c, d) = cast(list[list[float]], (self.kf.P[:2, :2] + self.kf.R).tolist())
-        return (d * y0 * y0 - (b + c) * y0 * y1 + a * y1 * y1) / (a * d - b * c)
+        det = a * d - b * c
+        return x0, x1, [d / det, -b / det, -c / det, a / det]
+
+    @staticmethod
+    def _nis(z: Vec, innovation: tuple[float, float, list[float]]) -> float:
+        x0, x1, si = innovation
+        y0, y1 = float(z[0]) - x0, float(z[1]) - x1
+        return y0 * (si[0] * y0 + si[1] * y1) + y1 * (si[2] * y0 + si[3] * y1)
+
+    def nis(self, z: Vec) -> float:
+        """Normalised innovation squared of a detection against the current prediction."""
+        return self._nis(z, self._innovation())
 
     def update(self, z: Vec, nis: float | None = None) -> bool:
         """Take a detection (``nis``: its :meth:`nis`, when already known); returns True when it
-        looked like a kick or bounce."""
+        looked like a kick or bounce. A second camera's view of an instant whose first view fitted
+        is dropped when it does not fit: a kick cannot show in one camera and not in the other (it
+        is a ball cut by the image's edge or half hidden by a robot)."""
+        if self._updated_at == self.t:
+            if not self.kicked and self._nis(z, self._prior) > self.p.kick_gate_chi2:
+                return False
+        else:
+            self._prior = self._innovation()
         if self.held is not None:
             held, self.held = self.held, None
             if held.nis(z) <= self.p.kick_gate_chi2:
@@ -238,6 +256,7 @@ class BallFilter:
                 prior = f @ self.kf.P @ f.T + q
                 self._steady = [float(v) for v in np.linalg.inv(prior[:2, :2] + self.kf.R).ravel()]
         self._pending_update = False
+        self._updated_at = self.t
         if self.slide_start_speed == math.inf and self.kf.P[2, 2] < 0.25:
             # the speed is known now, some frames after the kick: the slide began faster than that
             speed = math.hypot(self.kf.x[2], self.kf.x[3])

@@ -78,8 +78,8 @@ def test_batched_gate_rejects_as_one_robot_does() -> None:
 
 def test_ball_steady_state_mode_agrees_with_full_updates() -> None:
     # once the gain has settled, filterpy's steady-state mode gives the full filter's estimates
-    settled = BallFilter(BallModelParams(steady_after_updates=30), -2.0, 0.0, t=0.0)
-    full = BallFilter(BallModelParams(steady_after_updates=100000), -2.0, 0.0, t=0.0)
+    settled = BallFilter(BallModelParams(measurement_sigma_m=0.0016, steady_after_updates=30), -2.0, 0.0, t=0.0)
+    full = BallFilter(BallModelParams(measurement_sigma_m=0.0016, steady_after_updates=100000), -2.0, 0.0, t=0.0)
     rng = np.random.default_rng(4)
     entered = False
     for k in range(1, 150):
@@ -94,3 +94,24 @@ def test_ball_steady_state_mode_agrees_with_full_updates() -> None:
         assert np.allclose(settled.position, full.position, rtol=0.0, atol=1e-6)
         assert np.allclose(settled.velocity, full.velocity, rtol=0.0, atol=1e-4)
     assert entered and full._steady is None
+
+
+def test_a_second_view_of_one_instant_that_does_not_fit_is_dropped() -> None:
+    # a ball at rest seen by two cameras: the second camera's view 10 mm off (the ball cut by its
+    # image's edge) cannot be a kick, since the first camera saw the ball where it was
+    ball = BallFilter(BallModelParams(), 1.0, 0.5, t=0.0)
+    rng = np.random.default_rng(2)
+    for k in range(1, 60):
+        ball.predict(k * DT)
+        ball.update(np.array([1.0, 0.5]) + rng.normal(0.0, 0.0004, 2))
+    t = 60 * DT
+    ball.predict(t)
+    assert not ball.update(np.array([1.0, 0.5]))
+    assert not ball.update(np.array([1.01, 0.5]))
+    assert np.allclose(ball.position, [1.0, 0.5], atol=0.001)
+    assert np.linalg.norm(ball.velocity) < 0.05
+    # a kick seen first by one camera and then by the other: both views fit the kick, kept
+    ball.predict(t + DT)
+    assert ball.update(np.array([1.03, 0.5]))
+    assert not ball.update(np.array([1.03, 0.5]))
+    assert np.allclose(ball.position, [1.03, 0.5], atol=0.001)

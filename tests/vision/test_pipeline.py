@@ -84,12 +84,14 @@ def test_bad_vision_config_names_the_problem(tmp_path: Path, text: str, fragment
 
 def test_calibrated_blob_height_leaves_no_radial_ball_bias(cameras: list[CameraModel]) -> None:
     """Balls at rest across the whole image of each camera: with the configured blob height the
-    detections lie neither outward nor inward of the truth (within 1 mm of height), while
-    projecting the blob at the ball centre puts them outward (the shaded rim is not orange)."""
+    detections lie neither outward nor inward of the truth (within 1 mm of height), and the
+    coverage centre needs less than 1 mm of it, while the thresholded pixels' centroid projected at
+    the ball centre lies outward (its shaded rim is not orange)."""
     from vision.score import Score, ball_height_bias_m
 
     calibrated = VisionParams()
-    at_centre = VisionParams(ball=dataclasses.replace(calibrated.ball, blob_height_above_centre_m=0.0))
+    centroid = dataclasses.replace(calibrated.ball, centre="centroid", blob_height_above_centre_m=0.0)
+    at_centre = VisionParams(ball=centroid)
     scores = {"calibrated": Score(), "at_centre": Score()}
     r = LEAGUE.ball.radius_m
     for model in cameras:
@@ -105,7 +107,9 @@ def test_calibrated_blob_height_leaves_no_radial_ball_bias(cameras: list[CameraM
     centres = {m.id: m.center for m in cameras}
     for score in scores.values():
         assert len(score.ball_pairs) == 15 * len(cameras)
-    assert abs(ball_height_bias_m(scores["calibrated"], centres, calibrated.ball.blob_height_above_centre_m)) < 1e-3
+    height = calibrated.ball.blob_height_above_centre_m
+    assert abs(ball_height_bias_m(scores["calibrated"], centres, height)) < 1e-3
+    assert 0.0 <= ball_height_bias_m(scores["calibrated"], centres, height) + height < 1e-3
     assert ball_height_bias_m(scores["at_centre"], centres, 0.0) > 2e-3
     calibrated_rms = np.sqrt(np.mean(np.square(scores["calibrated"].ball_err_m)))
     assert calibrated_rms < np.sqrt(np.mean(np.square(scores["at_centre"].ball_err_m)))

@@ -73,14 +73,12 @@ class _Pass:
 
 @dataclass
 class _Kick:
-    """The attacker's decided kick: what for, where to, how hard, since when."""
+    """The attacker's decided kick: what for, where to, how hard, and for a pass to whom."""
 
     robot: int
     kind: str  # "shot", "pass" or "clear"
     target: tuple[float, float]
     speed: float
-    t: float
-    value: float
     receiver: int | None = None
     shoot_at: tuple[float, float] | None = None
 
@@ -209,7 +207,7 @@ class Strategy:
         """Play the ball where the attacker can meet it: shoot, pass or play it forward."""
         p = self.p
         met = intercept(r, ball, p.skills, self.field)
-        kick = self._decide_kick(t, r, own, opp_xy, met, by_role, attack_sign)
+        kick = self._decide_kick(r, own, opp_xy, met, by_role, attack_sign)
         if kick.kind == "pass" and kick.receiver is not None:
             if self.mem.passing is None or self.mem.passing.receiver != kick.receiver:
                 self.mem.passing = _Pass(r.id, kick.receiver, kick.target, t, shoot_at=kick.shoot_at)
@@ -229,7 +227,7 @@ class Strategy:
             return receive(r, ball, (met.x, met.y), p.skills)
         return kick_to(r, met, kick.target, kick.speed, p.skills)
 
-    def _decide_kick(self, t: float, r: RobotState, own: dict[int, RobotState], opp_xy: np.ndarray,
+    def _decide_kick(self, r: RobotState, own: dict[int, RobotState], opp_xy: np.ndarray,
                      ball: BallState, by_role: dict[str, int], attack_sign: float) -> _Kick:  # fmt: skip
         """Shoot when the open goal angle is good, else pass to the best supporter when its pass is
         good, else play the ball forward through the most open lane."""
@@ -237,7 +235,7 @@ class Strategy:
         ball_xy = np.array([ball.x, ball.y])
         _, aim, shot_value = best_shot(ball_xy, f, attack_sign, opp_xy, self.obstacle_radius, p.passing)
         if shot_value >= p.shoot_value:
-            return _Kick(r.id, "shot", aim, p.skills.max_kick_m_s, t, shot_value)
+            return _Kick(r.id, "shot", aim, p.skills.max_kick_m_s)
         receivers = [(role, rid) for role, rid in by_role.items() if role.startswith("supporter")
                      and (own[rid].x - ball.x) * attack_sign > -p.max_back_pass_m]  # fmt: skip
         if receivers:
@@ -251,7 +249,7 @@ class Strategy:
                 turn = float(one_touch_turn(ball_xy, pts[k : k + 1], np.array([shot_aim]))[0])
                 one_touch = value_there >= p.one_touch_value and turn <= p.passing.max_turn_rad
                 dist = math.hypot(point[0] - ball.x, point[1] - ball.y)
-                return _Kick(r.id, "pass", point, pass_speed(dist, p.skills), t, float(ev.values[k]), rid,
+                return _Kick(r.id, "pass", point, pass_speed(dist, p.skills), rid,
                              shot_aim if one_touch else None)  # fmt: skip
         # nothing good: play the ball forward through the most open lane (around a blocker)
         toward = math.atan2(aim[1] - ball.y, aim[0] - ball.x)
@@ -259,8 +257,8 @@ class Strategy:
         target = (ball.x + 1.5 * math.cos(angle), ball.y + 1.5 * math.sin(angle))
         shooting = (ball.x * attack_sign) > 0 and abs(angle - toward) < 0.2
         if shooting:
-            return _Kick(r.id, "shot", target, p.skills.max_kick_m_s, t, shot_value)
-        return _Kick(r.id, "clear", target, p.clear_speed_m_s, t, 0.0)
+            return _Kick(r.id, "shot", target, p.skills.max_kick_m_s)
+        return _Kick(r.id, "clear", target, p.clear_speed_m_s)
 
     def _update_pass(self, t: float, own: dict[int, RobotState], ball: BallState) -> _Pass | None:
         """Follow a pass: kicked once the ball runs toward the receiver; over when received, lost

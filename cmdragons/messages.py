@@ -125,6 +125,9 @@ class BallDetection:
     y: float
     confidence: float
     pixel: tuple[float, float]
+    # the position's standard deviation per axis (m) as vision judges this view (a ball partly
+    # hidden or cut by the image's edge is less certain); NaN: not known, the tracker's configured one
+    sigma_m: float = math.nan
 
 
 @dataclass(frozen=True)
@@ -138,7 +141,7 @@ class RobotDetection:
     pixel: tuple[float, float]
 
 
-_BALL_DET = np.dtype([("x", "<f8"), ("y", "<f8"), ("confidence", "<f4"), ("u", "<f4"), ("v", "<f4")])
+_BALL_DET = np.dtype([("x", "<f8"), ("y", "<f8"), ("confidence", "<f4"), ("u", "<f4"), ("v", "<f4"), ("sigma", "<f4")])
 _ROBOT_DET = np.dtype(
     [("team", "u1"), ("id", "u1"), ("x", "<f8"), ("y", "<f8"), ("theta", "<f4"),
      ("confidence", "<f4"), ("u", "<f4"), ("v", "<f4")]
@@ -166,6 +169,7 @@ class DetectionFrame:
             "t_sent": self.t_sent,
             "balls": [
                 {"x": b.x, "y": b.y, "confidence": b.confidence, "pixel": [b.pixel[0], b.pixel[1]]}
+                | ({"sigma": b.sigma_m} if math.isfinite(b.sigma_m) else {})
                 for b in self.balls
             ],
             "robots": [
@@ -184,7 +188,8 @@ class DetectionFrame:
                 t_capture=_f(d, "t_capture"),
                 t_sent=_f(d, "t_sent", default=_f(d, "t_capture")),
                 balls=tuple(
-                    BallDetection(_f(b, "x"), _f(b, "y"), _f(b, "confidence", 1.0), _pixel(b.get("pixel")))
+                    BallDetection(_f(b, "x"), _f(b, "y"), _f(b, "confidence", 1.0), _pixel(b.get("pixel")),
+                                  _f(b, "sigma", math.nan))
                     for b in d.get("balls", ())
                 ),
                 robots=tuple(
@@ -197,7 +202,7 @@ class DetectionFrame:
             raise MessageError(f"bad detection frame: {exc!r}") from None
 
     def encode(self) -> bytes:
-        balls = np.array([(b.x, b.y, b.confidence, *b.pixel) for b in self.balls], dtype=_BALL_DET)
+        balls = np.array([(b.x, b.y, b.confidence, *b.pixel, b.sigma_m) for b in self.balls], dtype=_BALL_DET)
         robots = np.array(
             [(_team_code(r.team), r.id, r.x, r.y, r.theta, r.confidence, *r.pixel) for r in self.robots],
             dtype=_ROBOT_DET,
@@ -209,8 +214,8 @@ class DetectionFrame:
         (cam, frame, t_capture, t_sent), (balls, robots) = cls._codec.unpack(data)
         return cls(
             cam, frame, t_capture, t_sent,
-            tuple(BallDetection(float(b["x"]), float(b["y"]), float(b["confidence"]), (float(b["u"]), float(b["v"])))
-                  for b in balls),
+            tuple(BallDetection(float(b["x"]), float(b["y"]), float(b["confidence"]), (float(b["u"]), float(b["v"])),
+                                float(b["sigma"])) for b in balls),
             tuple(RobotDetection(TEAMS[int(r["team"]) & 1], int(r["id"]), float(r["x"]), float(r["y"]),
                                  float(r["theta"]), float(r["confidence"]), (float(r["u"]), float(r["v"])))
                   for r in robots),

@@ -8,6 +8,8 @@ reported at pixel centres (+0.5) by the wrappers, not here.
 
 from __future__ import annotations
 
+import math
+
 import numba
 import numpy as np
 
@@ -316,15 +318,19 @@ def region_rays(grid: np.ndarray, pixels: np.ndarray) -> tuple[np.ndarray, np.nd
 
 
 @numba.njit(cache=True)
-def ball_centre(image: np.ndarray, box: np.ndarray, margin: int) -> tuple[float, float]:
+def ball_centre(image: np.ndarray, box: np.ndarray, margin: int) -> tuple[float, float, float, float]:
     """The ball's sub-pixel centre (u, v at pixel centres) in ``image`` (H, W, 3) uint8 around its
     region's bounding box ``box`` (u0, v0, u1, v1 inclusive): the centroid of each pixel's ball
     coverage over the box grown by ``margin`` px. An edge pixel's colour is a linear mix
     ``p * ball + q * background`` (coverage 1 - q; p also carries the shade and light, so the
     ball's colour is only a direction), unmixed by least squares with the background the median of
     the one-pixel ring around the window and the ball's colour the mean of the box shrunk by one
-    pixel; coverage is clipped to 0..1. NaN when the two colours cannot be told apart. The
-    reference is :func:`vision.patterns.ball_centre_reference`."""
+    pixel; coverage is clipped to 0..1. Also returns the coverage's sum (px: the ball's visible
+    area) and the centre's standard deviation per axis (px) from false coverage: the ring's pixels
+    are background, so their coverage (its positive part, what the clipping keeps) is what each
+    window pixel may carry wrongly, spread over the window as the centroid's lever arms weigh it
+    (sqrt(sum of squared distances to the centre per axis) / coverage sum). NaN when the two
+    colours cannot be told apart. The reference is :func:`vision.patterns.ball_centre_reference`."""
     h, w = image.shape[0], image.shape[1]
     u0, v0, u1, v1 = int(box[0]), int(box[1]), int(box[2]), int(box[3])
     wu0, wv0, wu1, wv1 = max(u0 - margin, 0), max(v0 - margin, 0), min(u1 + margin, w - 1), min(v1 + margin, h - 1)
@@ -339,7 +345,7 @@ def ball_centre(image: np.ndarray, box: np.ndarray, margin: int) -> tuple[float,
                 ring[c, n] = image[i, j, c]
             n += 1
     if n == 0:
-        return np.nan, np.nan
+        return np.nan, np.nan, np.nan, np.nan
     bg = np.empty(3)
     for c in range(3):
         bg[c] = np.median(ring[c, :n])
@@ -353,13 +359,14 @@ def ball_centre(image: np.ndarray, box: np.ndarray, margin: int) -> tuple[float,
                 ball[c] += image[i, j, c]
     bb = ball[0] * ball[0] + ball[1] * ball[1] + ball[2] * ball[2]
     if bb <= 0.0:
-        return np.nan, np.nan
+        return np.nan, np.nan, np.nan, np.nan
     k = (bg[0] * ball[0] + bg[1] * ball[1] + bg[2] * ball[2]) / bb
     g0, g1, g2 = bg[0] - k * ball[0], bg[1] - k * ball[1], bg[2] - k * ball[2]  # background, off the ball's colour
     den = bg[0] * g0 + bg[1] * g1 + bg[2] * g2
     if den < 1.0:
-        return np.nan, np.nan
+        return np.nan, np.nan, np.nan, np.nan
     sw, su, sv = 0.0, 0.0, 0.0
+    nw, pu, pv, puu, pvv = 0.0, 0.0, 0.0, 0.0, 0.0  # the window's pixel positions: count, sums, sums of squares
     for i in range(wv0, wv1 + 1):
         for j in range(wu0, wu1 + 1):
             q = (image[i, j, 0] * g0 + image[i, j, 1] * g1 + image[i, j, 2] * g2) / den
@@ -367,9 +374,20 @@ def ball_centre(image: np.ndarray, box: np.ndarray, margin: int) -> tuple[float,
             sw += a
             su += a * j
             sv += a * i
+            nw += 1.0
+            pu += j
+            pv += i
+            puu += j * j
+            pvv += i * i
     if sw <= 0.0:
-        return np.nan, np.nan
-    return su / sw + 0.5, sv / sw + 0.5
+        return np.nan, np.nan, np.nan, np.nan
+    cu, cv = su / sw, sv / sw
+    false2 = 0.0
+    for m in range(n):
+        a = max(1.0 - (ring[0, m] * g0 + ring[1, m] * g1 + ring[2, m] * g2) / den, 0.0)
+        false2 += a * a
+    lever2 = 0.5 * (puu - 2.0 * cu * pu + nw * cu * cu + pvv - 2.0 * cv * pv + nw * cv * cv)
+    return cu + 0.5, cv + 0.5, sw, math.sqrt(false2 / n * max(lever2, 0.0)) / sw
 
 
 @numba.njit(cache=True)

@@ -74,6 +74,12 @@ class BallParams(Validated):
     # over the region's box grown by centre_margin_px; "centroid", the region's thresholded pixels
     centre: str = setting("coverage", choices=("coverage", "centroid"))
     centre_margin_px: int = setting(1, lo=1, hi=4)
+    # each detection's position standard deviation (coverage centre only): the centre's noise from
+    # false coverage (vision._kernels.ball_centre), a hidden part's pull (the centre of a disc with
+    # a share h cut off by a robot or the image's edge moves about h ball radii: 0.42 for half),
+    # and this floor for what neither covers (the shading, the calibration)
+    sigma_floor_m: float = setting(0.0002, lo=0.0, hi=0.1)
+    hidden_shift_radii: float = setting(1.0, lo=0.0, hi=10.0)  # centre shift per hidden share of the disc, ball radii
     # the blob's centre sits this far above the ball's centre, as seen from the camera (the coverage
     # centre: the silhouette's; the thresholded centroid: higher, its shaded lower rim drops out of
     # the orange class); vision.score.ball_height_bias_m measures what is left
@@ -223,10 +229,13 @@ def merge_duplicates(robots: list[RobotDetection], distance_m: float) -> list[Ro
     return [ranked[k] for k in kept]
 
 
-def ball_centre_reference(image: NDArray[np.uint8], box: NDArray[np.float64], margin: int) -> tuple[float, float]:
+def ball_centre_reference(image: NDArray[np.uint8], box: NDArray[np.float64],
+                          margin: int) -> tuple[float, float, float, float]:  # fmt: skip
     """The ball's centre (u, v at pixel centres) from the coverage of the pixels around its
-    region's box (u0, v0, u1, v1 inclusive) grown by ``margin``: the plain-numpy reference of
-    :func:`vision._kernels.ball_centre`, which explains the unmixing."""
+    region's box (u0, v0, u1, v1 inclusive) grown by ``margin``, the coverage's sum (px) and the
+    centre's standard deviation per axis (px) from false coverage: the plain-numpy reference of
+    :func:`vision._kernels.ball_centre`, which explains the unmixing and the deviation."""
+    nan4 = (math.nan, math.nan, math.nan, math.nan)
     h, w = image.shape[:2]
     u0, v0, u1, v1 = (int(x) for x in box)
     wu0, wv0, wu1, wv1 = max(u0 - margin, 0), max(v0 - margin, 0), min(u1 + margin, w - 1), min(v1 + margin, h - 1)
@@ -235,21 +244,26 @@ def ball_centre_reference(image: NDArray[np.uint8], box: NDArray[np.float64], ma
     ring[wv0 : wv1 + 1, wu0 : wu1 + 1] = False
     px = image.astype(np.float64)
     if not ring.any():
-        return math.nan, math.nan
+        return nan4
     bg = np.median(px[ring], axis=0)
     inner = px[v0 + 1 : v1, u0 + 1 : u1] if u1 - u0 >= 2 and v1 - v0 >= 2 else px[v0 : v1 + 1, u0 : u1 + 1]
     ball = inner.reshape(-1, 3).sum(axis=0)
     if ball @ ball <= 0.0:
-        return math.nan, math.nan
+        return nan4
     off = bg - (bg @ ball) / (ball @ ball) * ball
     den = bg @ off
     if den < 1.0:
-        return math.nan, math.nan
+        return nan4
     cover = np.clip(1.0 - px[wv0 : wv1 + 1, wu0 : wu1 + 1] @ off / den, 0.0, 1.0)
-    if cover.sum() <= 0.0:
-        return math.nan, math.nan
+    total = float(cover.sum())
+    if total <= 0.0:
+        return nan4
     v, u = np.mgrid[wv0 : wv1 + 1, wu0 : wu1 + 1]
-    return float((cover * u).sum() / cover.sum() + 0.5), float((cover * v).sum() / cover.sum() + 0.5)
+    cu, cv = float((cover * u).sum()) / total, float((cover * v).sum()) / total
+    false_cover = np.maximum(1.0 - px[ring] @ off / den, 0.0)  # the ring is background: any coverage there is false
+    lever2 = 0.5 * float(((u - cu) ** 2 + (v - cv) ** 2).sum())
+    sigma = math.sqrt(float(np.mean(false_cover**2)) * lever2) / total
+    return cu + 0.5, cv + 0.5, total, sigma
 
 
 def detect_ball(
@@ -288,19 +302,28 @@ def detect_ball(
         at_top = geo.xy(idx, robot_height_m[r.team])
         keep &= np.hypot(at_top[:, 0] - r.x, at_top[:, 1] - r.y) >= pattern_radius_m
     px = regions.centroid[idx]
+    z = ball_radius_m + params.blob_height_above_centre_m
+    sigma = np.full(idx.size, math.nan)
     if params.centre == "coverage":
         px = px.copy()
+        # metres per pixel on the ball's plane, and the whole ball's area in pixels
+        m_per_px = np.sqrt(geo.pixel_area[idx]) * (geo.camera.center[2] - z)
+        disc_px = math.pi * ball_radius_m**2 / m_per_px**2
         for j in np.flatnonzero(keep):
-            c = kern.ball_centre(image, regions.bbox[idx[j]], params.centre_margin_px)
-            if math.isfinite(c[0]):  # else (ball and background alike) the region's centroid
-                px[j] = c
-    xy = geo.pixel_xy(px, ball_radius_m + params.blob_height_above_centre_m)
+            u, v, covered, noise_px = kern.ball_centre(image, regions.bbox[idx[j]], params.centre_margin_px)
+            if math.isfinite(u):  # else (ball and background alike) the region's centroid
+                px[j] = (u, v)
+                hidden = max(0.0, 1.0 - covered / disc_px[j])  # share of the disc not seen
+                hidden_px = params.hidden_shift_radii * math.sqrt(disc_px[j] / math.pi) * hidden
+                sigma[j] = math.hypot(params.sigma_floor_m, m_per_px[j] * math.hypot(noise_px, hidden_px))
+    xy = geo.pixel_xy(px, z)
     out = []
     for j in np.flatnonzero(keep):
         size_conf = min(ratio[j], 1.0 / ratio[j])
         shape_conf = min(1.0, 1.5 / elong[j])
         conf = float(np.clip(size_conf * shape_conf / 0.6, 0.0, 1.0))
         if conf >= params.min_confidence:
-            out.append(BallDetection(float(xy[j, 0]), float(xy[j, 1]), conf, (float(px[j, 0]), float(px[j, 1]))))
+            out.append(BallDetection(float(xy[j, 0]), float(xy[j, 1]), conf, (float(px[j, 0]), float(px[j, 1])),
+                                     float(sigma[j])))  # fmt: skip
     out.sort(key=lambda b: -b.confidence)
     return out[: params.max_balls]

@@ -45,7 +45,8 @@ Vec = NDArray[np.float64]
 
 @dataclass(frozen=True)
 class BallModelParams(Validated):
-    measurement_sigma_m: float = setting(0.0004, lo=1e-5, hi=1.0)  # vision's position noise, frame to frame
+    # vision's position noise, frame to frame, for detections that carry none of their own
+    measurement_sigma_m: float = setting(0.0004, lo=1e-5, hi=1.0)
     accel_sigma_m_s2: float = setting(0.5, lo=0.0, hi=100.0)  # white-noise acceleration (model error)
     acc_slide_m_s2: float = setting(3.0, lo=0.0, hi=50.0)
     acc_roll_m_s2: float = setting(0.26, lo=0.0, hi=10.0)
@@ -57,9 +58,6 @@ class BallModelParams(Validated):
     near_robot_accel_sigma_m_s2: float = setting(8.0, lo=0.0, hi=500.0)
     near_robot_m: float = setting(0.15, lo=0.0, hi=2.0)  # ball centre to robot centre counted as next to it
     switch_band: float = setting(0.12, lo=0.0, hi=1.0)  # +- share of the switch speed where the phase is unsure
-    # after this many regular frames with the same model (time step, process noise) the gain has
-    # settled and the filter runs in filterpy's steady-state mode until a frame differs
-    steady_after_updates: int = setting(30, lo=1, hi=100000)
 
 
 @dataclass(frozen=True)
@@ -140,12 +138,11 @@ class BallFilter:
         # the next detection tells a kick (which it does not fit) from a single bad detection (which
         # it does: a ball seen at the edge of a camera, a reflection)
         self.held: BallFilter | None = None
-        self._model: tuple[float, int] = (0.0, 0)  # time step and noise (index in caches) of the last prediction
-        self._regular = 0  # consecutive regular frames with that model
-        self._steady: list[float] | None = None  # settled inverse innovation covariance, row by row
-        self._pending_update = False  # predicted, not yet updated at this time
         self._updated_at = math.nan  # time of the last update
-        self._prior: tuple[float, float, list[float]] = (0.0, 0.0, [0.0] * 4)  # position, S^-1 before it
+        # the predicted position and its covariance (x, y, var x, cov xy, var y) before this
+        # instant's first update: a second camera's view of the instant is gated against it
+        self._prior = (0.0, 0.0, 0.0, 0.0, 0.0)
+        self._first_var = 0.0  # the measurement variance of that first update
 
     def _decel(self, v: Vec, dt: float) -> Vec:
         speed = math.hypot(v[0], v[1])
@@ -175,18 +172,8 @@ class BallFilter:
         speed = math.hypot(self.kf.x[2], self.kf.x[3])
         switch = self.p.slide_to_roll_fraction * self.slide_start_speed
         near_switch = math.isfinite(switch) and abs(speed - switch) < self.p.switch_band * switch
-        model = (round(dt, 7), 2 if near_robot else 1 if near_switch else 0)
-        f, b, q = self.caches[model[1]].get(dt)
-        u = self._decel(self.kf.x[2:], dt)
-        if self._steady is not None and model == self._model and not self._pending_update:
-            self.kf.F = f
-            self.kf.predict_steadystate(u=u, B=b)
-        else:
-            self._steady = None
-            self._regular = self._regular if model == self._model and not self._pending_update else 0
-            self.kf.predict(u=u, B=b, F=f, Q=q)
-        self._model = model
-        self._pending_update = True
+        f, b, q = self.caches[2 if near_robot else 1 if near_switch else 0].get(dt)
+        self.kf.predict(u=self._decel(self.kf.x[2:], dt), B=b, F=f, Q=q)
         self.t = t
         if near_robot:
             # every touch of a robot starts a new slide (as a kick does) from the speed it leaves with
@@ -195,47 +182,56 @@ class BallFilter:
         if self.held is not None:
             self.held.predict(t, near_robot)
 
-    def _innovation(self) -> tuple[float, float, list[float]]:
-        """The predicted position and the inverse innovation covariance (row by row)."""
-        # 2 x 2, in plain floats: numpy's per-call cost would be most of it
+    def _position(self) -> tuple[float, float, float, float, float]:
+        """The filter's position and its covariance (x, y, var x, cov xy, var y), plain floats (2 x 2
+        algebra: numpy's per-call cost would be most of it)."""
         x0, x1 = cast(list[float], self.kf.x[:2].tolist())
-        if self._steady is not None and self._pending_update:
-            return x0, x1, self._steady
-        (a, b), (c, d) = cast(list[list[float]], (self.kf.P[:2, :2] + self.kf.R).tolist())
-        det = a * d - b * c
-        return x0, x1, [d / det, -b / det, -c / det, a / det]
+        (a, b), (_, d) = cast(list[list[float]], self.kf.P[:2, :2].tolist())
+        return x0, x1, a, b, d
 
     @staticmethod
-    def _nis(z: Vec, innovation: tuple[float, float, list[float]]) -> float:
-        x0, x1, si = innovation
+    def _nis(z: Vec, position: tuple[float, float, float, float, float], r_var: float) -> float:
+        x0, x1, a, b, d = position
+        a, d = a + r_var, d + r_var
         y0, y1 = float(z[0]) - x0, float(z[1]) - x1
-        return y0 * (si[0] * y0 + si[1] * y1) + y1 * (si[2] * y0 + si[3] * y1)
+        return (d * y0 * y0 - 2.0 * b * y0 * y1 + a * y1 * y1) / (a * d - b * b)
 
-    def nis(self, z: Vec) -> float:
-        """Normalised innovation squared of a detection against the current prediction."""
-        return self._nis(z, self._innovation())
+    def measurement_var(self, sigma_m: float = math.nan) -> float:
+        """The measurement variance (m^2 per axis) of a detection whose own standard deviation is
+        ``sigma_m`` (NaN: not known, the configured one)."""
+        s = sigma_m if math.isfinite(sigma_m) and sigma_m > 0.0 else self.p.measurement_sigma_m
+        return s * s
 
-    def update(self, z: Vec, nis: float | None = None) -> bool:
-        """Take a detection (``nis``: its :meth:`nis`, when already known); returns True when it
-        looked like a kick or bounce. A second camera's view of an instant whose first view fitted
-        is dropped when it does not fit: a kick cannot show in one camera and not in the other (it
-        is a ball cut by the image's edge or half hidden by a robot)."""
+    def nis(self, z: Vec, sigma_m: float = math.nan) -> float:
+        """Normalised innovation squared of a detection (its standard deviation ``sigma_m``, NaN: the
+        configured one) against the current prediction."""
+        return self._nis(z, self._position(), self.measurement_var(sigma_m))
+
+    def update(self, z: Vec, nis: float | None = None, sigma_m: float = math.nan) -> bool:
+        """Take a detection (``nis``: its :meth:`nis`, when already known; ``sigma_m``: its standard
+        deviation per axis, NaN for the configured one, the measurement noise R of this update);
+        returns True when it looked like a kick or bounce. A second camera's view of an instant whose
+        first view fitted is dropped when it does not fit and is no more certain than the first: a
+        kick cannot show in one camera and not in the other (it is a ball cut by the image's edge or
+        half hidden by a robot). A more certain second view is taken as any detection is: the first
+        may have been the partly hidden one."""
+        r_var = self.measurement_var(sigma_m)
         if self._updated_at == self.t:
-            if not self.kicked and self._nis(z, self._prior) > self.p.kick_gate_chi2:
+            if (not self.kicked and r_var >= self._first_var
+                    and self._nis(z, self._prior, r_var) > self.p.kick_gate_chi2):  # fmt: skip
                 return False
         else:
-            self._prior = self._innovation()
+            self._prior = self._position()
+            self._first_var = r_var
         if self.held is not None:
             held, self.held = self.held, None
-            if held.nis(z) <= self.p.kick_gate_chi2:
+            if held.nis(z, sigma_m) <= self.p.kick_gate_chi2:
                 # the motion goes on as before the odd detection: that one was not a kick
                 vars(self).update(vars(held))
                 nis = None
-        kicked = (self.nis(z) if nis is None else nis) > self.p.kick_gate_chi2
+        kicked = (self.nis(z, sigma_m) if nis is None else nis) > self.p.kick_gate_chi2
         if kicked:
             self.held = copy.deepcopy(self)
-            self._steady = None
-            self._regular = 0
             # the velocity is unknown after a kick: forget it, keep the position's certainty
             self.kf.P[2:, :] = 0.0
             self.kf.P[:, 2:] = 0.0
@@ -243,19 +239,8 @@ class BallFilter:
             self.kf.P[:2, :2] += np.eye(2) * float(np.sum((z - self.kf.x[:2]) ** 2))
             self.slide_start_speed = math.inf  # sliding until the new speed is known
             self.t_kick = self.t
-        if self._steady is not None and self._pending_update:
-            self.kf.update_steadystate(z)
-        else:
-            self._steady = None  # a second view in the same frame: the settled gain does not apply
-            self.kf.update(z)
-            self._regular = self._regular + 1 if self._pending_update else 0
-            if self._regular >= self.p.steady_after_updates:
-                # filterpy's last full update left the settled gain in kf.K; the gate needs the
-                # innovation covariance of the settled prior
-                f, _, q = self.caches[self._model[1]].get(self._model[0])
-                prior = f @ self.kf.P @ f.T + q
-                self._steady = [float(v) for v in np.linalg.inv(prior[:2, :2] + self.kf.R).ravel()]
-        self._pending_update = False
+        self.kf.R[0, 0] = self.kf.R[1, 1] = r_var  # in place: a new matrix per update costs more than the update
+        self.kf.update(z)
         self._updated_at = self.t
         if self.slide_start_speed == math.inf and self.kf.P[2, 2] < 0.25:
             # the speed is known now, some frames after the kick: the slide began faster than that

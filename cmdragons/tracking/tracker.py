@@ -193,7 +193,7 @@ class Tracker:
             elif bd.confidence < self.p.min_confidence:
                 self.stats.low_confidence += 1
             else:
-                balls.append(np.array([bd.x, bd.y]))
+                balls.append((np.array([bd.x, bd.y]), bd.sigma_m))
         self._take_balls(balls, t)
 
     # --- robots -------------------------------------------------------------------------------
@@ -221,17 +221,18 @@ class Tracker:
                 self.stats.robot_restarts += 1
 
     # --- ball ---------------------------------------------------------------------------------
-    def _take_balls(self, detections: list[np.ndarray], t: float) -> None:
+    def _take_balls(self, detections: list[tuple[np.ndarray, float]], t: float) -> None:
+        """Ball detections (position, its standard deviation per axis or NaN) to hypotheses."""
         if not detections:
             return
         pairs = []
         for i, track in enumerate(self.balls):
             reach = self.p.max_ball_speed_m_s * max(t - track.last_seen, 1e-3) + self.p.ball_jump_margin_m
             px, py = track.filter.position.tolist()
-            for j, z in enumerate(detections):
+            for j, (z, sigma) in enumerate(detections):
                 d = math.hypot(z[0] - px, z[1] - py)
                 if d <= reach:
-                    pairs.append((track.filter.nis(z), d, i, j))
+                    pairs.append((track.filter.nis(z, sigma), d, i, j))
         pairs.sort()
         used_tracks: set[int] = set()
         used_dets: set[int] = set()
@@ -241,11 +242,12 @@ class Tracker:
             used_tracks.add(i)
             used_dets.add(j)
             track = self.balls[i]
-            if track.filter.update(detections[j], nis):
+            z, sigma = detections[j]
+            if track.filter.update(z, nis, sigma):
                 self.stats.ball_kicks += 1
             track.hits += 1
             track.last_seen = t
-        for j, z in enumerate(detections):
+        for j, (z, _) in enumerate(detections):
             if j not in used_dets:
                 self.balls.append(_BallTrack(BallFilter(self.p.ball, z[0], z[1], t), born=t, last_seen=t))
         if len(self.balls) > self.p.ball_hypotheses:

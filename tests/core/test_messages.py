@@ -25,7 +25,7 @@ from cmdragons.messages import (
 
 DET = DetectionFrame(
     camera_id=1, frame_number=42, t_capture=0.7, t_sent=0.702,
-    balls=(BallDetection(0.5, -0.25, 0.9, (100.5, 200.25)),),
+    balls=(BallDetection(0.5, -0.25, 0.9, (100.5, 200.25)), BallDetection(-1.0, 2.0, 0.4, (5.0, 6.0), 0.004)),
     robots=(RobotDetection("blue", 3, 1.0, 2.0, 0.5, 0.99, (10.0, 20.0)),
             RobotDetection("yellow", 15, -1.0, -2.0, -3.0, 0.5, (30.0, 40.0))),
 )  # fmt: skip
@@ -79,6 +79,7 @@ def test_jsonl_forms_match_the_design() -> None:
     d = DET.to_dict()
     assert set(d) == {"camera_id", "frame_number", "t_capture", "t_sent", "balls", "robots"}
     assert set(d["balls"][0]) == {"x", "y", "confidence", "pixel"}
+    assert set(d["balls"][1]) == {"x", "y", "confidence", "pixel", "sigma"}  # the optional key, when vision knows it
     assert set(d["robots"][0]) == {"team", "id", "x", "y", "theta", "confidence", "pixel"}
     t = TRUTH.to_dict()
     assert {"frame_number", "t", "ball", "robots"} <= set(t)
@@ -87,6 +88,16 @@ def test_jsonl_forms_match_the_design() -> None:
     w = WORLD.to_dict()
     assert set(w["ball"]) == {"x", "y", "vx", "vy", "visible"}
     assert set(w["robots"][0]) == {"team", "id", "x", "y", "theta", "vx", "vy", "omega", "visible"}
+
+
+def test_ball_sigma_is_optional_and_survives_both_encodings() -> None:
+    # a detection without the key (older logs, other vision systems) has no sigma: NaN
+    d = DET.to_dict()
+    del d["balls"][1]["sigma"]
+    assert math.isnan(DetectionFrame.from_dict(d).balls[1].sigma_m)
+    assert DetectionFrame.from_dict(DET.to_dict()).balls[1].sigma_m == 0.004
+    back = DetectionFrame.decode(DET.encode()).balls
+    assert math.isnan(back[0].sigma_m) and back[1].sigma_m == pytest.approx(0.004, rel=1e-6)
 
 
 def test_nan_survives_json_as_null() -> None:

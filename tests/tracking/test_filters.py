@@ -76,24 +76,51 @@ def test_batched_gate_rejects_as_one_robot_does() -> None:
     assert not filters[0].steady_pending and filters[1].steady_pending and filters[2].steady_pending
 
 
-def test_ball_steady_state_mode_agrees_with_full_updates() -> None:
-    # once the gain has settled, filterpy's steady-state mode gives the full filter's estimates
-    settled = BallFilter(BallModelParams(measurement_sigma_m=0.0016, steady_after_updates=30), -2.0, 0.0, t=0.0)
-    full = BallFilter(BallModelParams(measurement_sigma_m=0.0016, steady_after_updates=100000), -2.0, 0.0, t=0.0)
-    rng = np.random.default_rng(4)
-    entered = False
-    for k in range(1, 150):
-        t = k * DT
-        # kicked at 2 m/s at t = 0: the two-phase model, sliding at 3 m/s^2 down to 0.64 x 2 m/s, then rolling
-        x = -2.0 + 2.0 * t - 1.5 * t * t if t < 0.24 else -1.6064 + 1.28 * (t - 0.24) - 0.13 * (t - 0.24) ** 2
-        z = np.array([x, 0.0]) + rng.normal(0.0, 0.0016, 2)
-        for f in (settled, full):
-            f.predict(t, near_robot=20 <= k < 25)  # a robot passes by: a different model for 5 frames
-            f.update(z)
-        entered |= settled._steady is not None
-        assert np.allclose(settled.position, full.position, rtol=0.0, atol=1e-6)
-        assert np.allclose(settled.velocity, full.velocity, rtol=0.0, atol=1e-4)
-    assert entered and full._steady is None
+def _ball_at_rest(sigma_m: float = 0.0003, frames: int = 60) -> BallFilter:
+    """A ball at rest at (1.0, 0.5) tracked for ``frames`` frames of detections with noise ``sigma_m``."""
+    ball = BallFilter(BallModelParams(), 1.0, 0.5, t=0.0)
+    rng = np.random.default_rng(2)
+    for k in range(1, frames):
+        ball.predict(k * DT)
+        ball.update(np.array([1.0, 0.5]) + rng.normal(0.0, sigma_m, 2), sigma_m=sigma_m)
+    return ball
+
+
+def test_a_detections_sigma_is_its_measurement_noise() -> None:
+    # the same 3 mm jump moves the estimate far less when the detection says it is uncertain
+    # (its sigma the update's R); without a sigma the configured one (0.4 mm) applies
+    jumps = {}
+    for sigma in (0.0003, 0.004, math.nan):
+        ball = _ball_at_rest()
+        ball.predict(60 * DT)
+        ball.update(np.array([1.003, 0.5]), sigma_m=sigma)
+        jumps[sigma] = float(ball.position[0]) - 1.0
+    assert jumps[0.004] < 0.2 * jumps[0.0003]
+    assert _ball_at_rest().measurement_var() == BallModelParams().measurement_sigma_m ** 2
+    assert _ball_at_rest().measurement_var(0.004) == 0.004**2
+
+
+def test_an_edge_cut_balls_jump_within_its_sigma_is_no_kick() -> None:
+    # a ball at rest seen by one camera only, cut by its image's edge: 6 mm off, but vision says its
+    # sigma is 5 mm; it is no kick and hardly moves the estimate. The same view without a sigma
+    # (the configured 0.4 mm) is taken for a kick.
+    ball = _ball_at_rest()
+    ball.predict(60 * DT)
+    assert not ball.update(np.array([1.006, 0.5]), sigma_m=0.005)
+    assert abs(float(ball.position[0]) - 1.0) < 0.0005
+    ball = _ball_at_rest()
+    ball.predict(60 * DT)
+    assert ball.update(np.array([1.006, 0.5]))
+
+
+def test_a_more_certain_second_view_can_show_a_kick() -> None:
+    # the first camera sees the ball half behind the kicker, uncertain and barely moved; the second
+    # sees it clearly 15 mm on, kicked: the second view is not dropped, the kick is taken at once
+    ball = _ball_at_rest()
+    ball.predict(60 * DT)
+    assert not ball.update(np.array([1.002, 0.5]), sigma_m=0.004)
+    assert ball.update(np.array([1.015, 0.5]), sigma_m=0.0003)
+    assert abs(float(ball.position[0]) - 1.015) < 0.001
 
 
 def test_a_second_view_of_one_instant_that_does_not_fit_is_dropped() -> None:

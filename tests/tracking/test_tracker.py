@@ -345,3 +345,22 @@ def test_single_odd_ball_detection_is_not_a_kick() -> None:
         if k > 61:
             pos, vel = ball_error(ws, snap)
             assert pos < 0.006 and vel < 0.1
+
+
+def test_tracker_takes_each_ball_detections_sigma() -> None:
+    # a ball at rest seen by two cameras; in one frame the second camera alone sees it, cut by its
+    # image's edge, 8 mm off with the 6 mm sigma vision gives it: no kick, the estimate stays
+    tracker = Tracker(params(sigma=0.0004))
+    rng = np.random.default_rng(5)
+    for k in range(90):
+        t = k * DT
+        frames = []
+        for cam in (0, 1):
+            if k == 60 and cam == 0:
+                continue
+            x, y, s = (0.508, -0.2, 0.006) if k == 60 else (*(np.array([0.5, -0.2]) + rng.normal(0, 0.0003, 2)), 0.0003)
+            frames.append(DetectionFrame(cam, k, t, t, (BallDetection(float(x), float(y), 0.9, (0.0, 0.0), s),)))
+        ws = tracker.step(frames)
+        if k >= 10:
+            assert ws.ball is not None and math.hypot(ws.ball.x - 0.5, ws.ball.y + 0.2) < 0.001
+    assert tracker.stats.ball_kicks == 0

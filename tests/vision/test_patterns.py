@@ -121,5 +121,23 @@ def test_ball_centre_follows_the_disc_between_pixels(centre: tuple[float, float]
     grid = np.arange(24) + 0.5
     v, u = np.nonzero(np.hypot(grid[None, :] - centre[0], grid[:, None] - centre[1]) < 3.3)
     box = np.array([u.min(), v.min(), u.max(), v.max()], dtype=np.float64)
-    got = np.array(kern.ball_centre(image, box, 1))
+    got = np.array(kern.ball_centre(image, box, 1)[:2])
     assert np.hypot(*(got - centre)) < 0.03
+
+
+def test_ball_centre_deviation_grows_with_noise_and_the_visible_area_shrinks_when_cut() -> None:
+    # the same 6.6 px ball: clear at low and at high sensor noise, and cut by the image's left edge
+    # through its middle; the coverage sum is the visible area (pi 3.3^2 = 34 px clear), the
+    # deviation the centre's noise from the background's false coverage
+    rng = np.random.default_rng(3)
+    centre, radius = (11.4, 12.2), 3.3
+    grid = np.arange(24) + 0.5
+    v, u = np.nonzero(np.hypot(grid[None, :] - centre[0], grid[:, None] - centre[1]) < radius)
+    box = np.array([u.min(), v.min(), u.max(), v.max()], dtype=np.float64)
+    clear = kern.ball_centre(_disc_image(centre, radius, rng, 1.0), box, 1)
+    noisy = kern.ball_centre(_disc_image(centre, radius, rng, 6.0), box, 1)
+    cut = kern.ball_centre(_disc_image(centre, radius, rng, 1.0)[:, 11:], box - [11.0, 0.0, 11.0, 0.0], 1)
+    assert abs(clear[2] - math.pi * radius**2) < 0.1 * math.pi * radius**2
+    assert noisy[3] > 2.0 * clear[3] and clear[3] < 0.05
+    assert abs(cut[2] - 0.5 * clear[2]) < 0.15 * clear[2]
+    assert cut[0] - (centre[0] - 11.0) > 0.8  # the missing half pulls the centre away from it (1.4 px)

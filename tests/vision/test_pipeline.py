@@ -113,3 +113,30 @@ def test_calibrated_blob_height_leaves_no_radial_ball_bias(cameras: list[CameraM
     assert ball_height_bias_m(scores["at_centre"], centres, 0.0) > 2e-3
     calibrated_rms = np.sqrt(np.mean(np.square(scores["calibrated"].ball_err_m)))
     assert calibrated_rms < np.sqrt(np.mean(np.square(scores["at_centre"].ball_err_m)))
+
+
+def test_partly_hidden_or_cut_ball_carries_a_larger_sigma(cameras: list[CameraModel]) -> None:
+    """Each ball detection carries its position's standard deviation: about the floor (0.2 mm) in
+    the clear, several times more for a ball half behind a robot's body (seen obliquely, near the
+    image's corner) or cut by the image's edge, whose centres are millimetres off; the error stays
+    within a few of its sigma."""
+    model = cameras[0]
+    r = LEAGUE.ball.radius_m
+    robot = model.unproject(np.array([[model.width * 0.8, model.height * 0.8]]), 0.0)[0]
+    outward = math.atan2(robot[1] - model.center[1], robot[0] - model.center[0])
+    pipe = VisionPipeline(VisionParams(), LEAGUE, model)
+
+    def seen(x: float, y: float, robots: list[list[float]]) -> tuple[float, float]:
+        image, _ = render(model, snapshot(robots, ball=(x, y, r)), seed=1)
+        (ball,) = pipe.process(image, 0, 0.0).balls
+        return math.hypot(ball.x - x, ball.y - y), ball.sigma_m
+
+    robots = [[0, 3, robot[0], robot[1], 0.0]]
+    a = outward + math.radians(45.0)  # beside the robot, on the side it leans over in the image
+    clear_err, clear_sigma = seen(robot[0] + 0.3 * math.cos(a), robot[1] + 0.3 * math.sin(a), robots)
+    hidden_err, hidden_sigma = seen(robot[0] + 0.13 * math.cos(a), robot[1] + 0.13 * math.sin(a), robots)
+    at_edge = model.unproject(np.array([[0.5, model.height * 0.5]]), r)[0]  # centre on the image's first column
+    cut_err, cut_sigma = seen(at_edge[0], at_edge[1], [])
+    assert clear_sigma < 0.5e-3 and clear_err < 3.0 * clear_sigma
+    assert hidden_err > 2e-3 and hidden_sigma > 5.0 * clear_sigma and hidden_err < 3.0 * hidden_sigma
+    assert cut_err > 2e-3 and cut_sigma > 5.0 * clear_sigma and cut_err < 3.0 * cut_sigma

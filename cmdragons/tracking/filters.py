@@ -57,6 +57,9 @@ class BallModelParams(Validated):
     # next to a robot the ball may be pushed, dribbled or kicked at any moment: far less predictable
     near_robot_accel_sigma_m_s2: float = setting(8.0, lo=0.0, hi=500.0)
     near_robot_m: float = setting(0.15, lo=0.0, hi=2.0)  # ball centre to robot centre counted as next to it
+    # ball centre to robot centre counted as touching (robot radius plus ball radius plus the
+    # trackers' noise): every touch starts a new slide from the speed the ball leaves with
+    touch_m: float = setting(0.12, lo=0.0, hi=2.0)
     switch_band: float = setting(0.12, lo=0.0, hi=1.0)  # +- share of the switch speed where the phase is unsure
 
 
@@ -162,11 +165,13 @@ class BallFilter:
         x = f @ self.kf.x + b @ self._decel(self.kf.x[2:], dt)
         return x, f @ self.kf.P @ f.T + q
 
-    def predict(self, t: float, near_robot: bool = False) -> None:
-        """Advance to ``t``; ``near_robot``: a robot is next to the ball and may move it."""
+    def predict(self, t: float, robot_m: float = math.inf) -> None:
+        """Advance to ``t``; ``robot_m``: the distance from the ball to the nearest robot's centre (a
+        robot next to the ball may move it at any moment; one touching it starts a new slide)."""
         dt = t - self.t
         if dt <= 0.0:
             return
+        near_robot = robot_m < self.p.near_robot_m
         # the slide-to-roll switch is only known to within the slide's start speed: around it, the
         # filter follows the detections rather than the model
         speed = math.hypot(self.kf.x[2], self.kf.x[3])
@@ -175,12 +180,12 @@ class BallFilter:
         f, b, q = self.caches[2 if near_robot else 1 if near_switch else 0].get(dt)
         self.kf.predict(u=self._decel(self.kf.x[2:], dt), B=b, F=f, Q=q)
         self.t = t
-        if near_robot:
+        if robot_m < self.p.touch_m:
             # every touch of a robot starts a new slide (as a kick does) from the speed it leaves with
             self.slide_start_speed = math.inf
             self.t_kick = t
         if self.held is not None:
-            self.held.predict(t, near_robot)
+            self.held.predict(t, robot_m)
 
     def _position(self) -> tuple[float, float, float, float, float]:
         """The filter's position and its covariance (x, y, var x, cov xy, var y), plain floats (2 x 2

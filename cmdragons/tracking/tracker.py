@@ -146,11 +146,10 @@ class Tracker:
         self.t = t
         self._apply_commands()
         filters.predict_robots([track.filter for track in self.robots.values()], t)
-        near = self.p.ball.near_robot_m
         robots_xy = np.array([r.filter.kf.x[:2] for r in self.robots.values()]).reshape(-1, 2)
         for ball in self.balls:
             d = np.hypot(*(robots_xy - ball.filter.position).T) if len(robots_xy) else np.zeros(0)
-            ball.filter.predict(t, near_robot=bool(len(d) and float(d.min()) < near))
+            ball.filter.predict(t, float(d.min()) if len(d) else math.inf)
         # a settled robot's first detection of the frame goes with the others into one steady-state
         # update; the rest (new or unsettled tracks, second views, rejected detections) one by one,
         # in their order, after it

@@ -142,3 +142,19 @@ def test_a_second_view_of_one_instant_that_does_not_fit_is_dropped() -> None:
     assert ball.update(np.array([1.03, 0.5]))
     assert not ball.update(np.array([1.03, 0.5]))
     assert np.allclose(ball.position, [1.03, 0.5], atol=0.001)
+
+
+def test_only_a_touching_robot_starts_a_new_slide() -> None:
+    # a rolling ball passing a robot 0.14 m away (next to it: more process noise, no touch) keeps
+    # rolling; one 0.11 m away touches it (0.09 m robot + 0.0215 m ball radius) and starts a slide
+    p = BallModelParams()
+    for robot_m, slides in ((0.14, False), (0.11, True), (math.inf, False)):
+        ball = BallFilter(p, 0.0, 0.0, t=0.0)
+        for k in range(1, 40):
+            t = k * DT
+            ball.predict(t)
+            ball.update(np.array([0.8 * t - 0.13 * t * t, 0.0]), sigma_m=0.0003)
+        rolling_from = ball.slide_start_speed
+        assert math.isfinite(rolling_from)
+        ball.predict(40 * DT, robot_m)
+        assert (ball.slide_start_speed == math.inf) == slides

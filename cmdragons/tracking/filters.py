@@ -54,6 +54,9 @@ class BallModelParams(Validated):
     initial_speed_sigma_m_s: float = setting(3.0, lo=0.01, hi=50.0)  # velocity uncertainty of a new track
     kick_gate_chi2: float = setting(25.0, lo=1.0, hi=1e6)  # innovation (2 dof) beyond this: kick or bounce
     kick_speed_sigma_m_s: float = setting(4.0, lo=0.01, hi=50.0)  # velocity uncertainty after a kick
+    # a kick or bounce changes the ball's velocity by more than this; an innovation beyond the gate
+    # after which the ball is found moving as before was the model's slide that ended earlier
+    kick_min_velocity_change_m_s: float = setting(0.3, lo=0.0, hi=10.0)
     # next to a robot the ball may be pushed, dribbled or kicked at any moment: far less predictable
     near_robot_accel_sigma_m_s2: float = setting(8.0, lo=0.0, hi=500.0)
     near_robot_m: float = setting(0.15, lo=0.0, hi=2.0)  # ball centre to robot centre counted as next to it
@@ -137,6 +140,9 @@ class BallFilter:
         self.slide_start_speed = math.inf
         self.t_kick = t
         self.kicked = False
+        # the velocity before the last detected kick, while the filter had the ball sliding; None
+        # once the velocity after it is known, or when the filter had it rolling
+        self.sliding_before_kick: Vec | None = None
         # after a detection far outside the expectation, the filter as it was before it, kept until
         # the next detection tells a kick (which it does not fit) from a single bad detection (which
         # it does: a ball seen at the edge of a camera, a reflection)
@@ -237,6 +243,9 @@ class BallFilter:
         kicked = (self.nis(z, sigma_m) if nis is None else nis) > self.p.kick_gate_chi2
         if kicked:
             self.held = copy.deepcopy(self)
+            speed = math.hypot(self.kf.x[2], self.kf.x[3])
+            sliding = speed > self.p.slide_to_roll_fraction * self.slide_start_speed
+            self.sliding_before_kick = self.kf.x[2:].copy() if sliding else None
             # the velocity is unknown after a kick: forget it, keep the position's certainty
             self.kf.P[2:, :] = 0.0
             self.kf.P[:, 2:] = 0.0
@@ -251,6 +260,12 @@ class BallFilter:
             # the speed is known now, some frames after the kick: the slide began faster than that
             speed = math.hypot(self.kf.x[2], self.kf.x[3])
             self.slide_start_speed = speed + self.p.acc_slide_m_s2 * max(0.0, self.t - self.t_kick)
+            before = self.sliding_before_kick
+            if before is not None and math.hypot(*(self.kf.x[2:] - before)) < self.p.kick_min_velocity_change_m_s:
+                # no kick: the ball moves on as before, ahead of the slide the filter had it in,
+                # so that slide had ended: it rolls (and a rolling ball only slows down)
+                self.slide_start_speed = speed / max(self.p.slide_to_roll_fraction, 1e-9)
+            self.sliding_before_kick = None
         self.kicked = kicked
         return kicked
 

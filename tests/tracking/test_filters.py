@@ -158,3 +158,21 @@ def test_only_a_touching_robot_starts_a_new_slide() -> None:
         assert math.isfinite(rolling_from)
         ball.predict(40 * DT, robot_m)
         assert (ball.slide_start_speed == math.inf) == slides
+
+
+def test_a_kick_after_which_the_ball_moves_on_as_before_ends_the_slide() -> None:
+    # a ball first seen rolling at 1.8 m/s: the filter has it sliding (a ball first seen may have
+    # just been kicked) and falls behind, takes that for a kick, and then finds the ball moving
+    # as before: the slide had ended, the ball rolls, and no further kicks follow
+    ball = BallFilter(BallModelParams(), -1.0, 0.3, t=0.0)
+    rng = np.random.default_rng(9)
+    kicks = []
+    for k in range(1, 240):
+        t = k * DT
+        ball.predict(t)
+        z = np.array([-1.0 + 1.8 * t - 0.13 * t * t, 0.3]) + rng.normal(0.0, 0.0002, 2)
+        if ball.update(z, sigma_m=0.0002):
+            kicks.append(k)
+    assert len(kicks) <= 1
+    assert ball.slide_start_speed * BallModelParams().slide_to_roll_fraction >= math.hypot(*ball.velocity)
+    assert abs(float(ball.velocity[0]) - (1.8 - 0.26 * 239 * DT)) < 0.02

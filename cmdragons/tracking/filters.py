@@ -221,16 +221,20 @@ class BallFilter:
     def update(self, z: Vec, nis: float | None = None, sigma_m: float = math.nan) -> bool:
         """Take a detection (``nis``: its :meth:`nis`, when already known; ``sigma_m``: its standard
         deviation per axis, NaN for the configured one, the measurement noise R of this update);
-        returns True when it looked like a kick or bounce. A second camera's view of an instant whose
-        first view fitted is dropped when it does not fit and is no more certain than the first: a
-        kick cannot show in one camera and not in the other (it is a ball cut by the image's edge or
-        half hidden by a robot). A more certain second view is taken as any detection is: the first
-        may have been the partly hidden one."""
+        returns True when it looked like a kick or bounce. A second camera's view of one instant is
+        judged against the prediction before that instant, not after the first view: no kick
+        happens between two views of one instant, so one that fits is no kick even where the two
+        cameras disagree by more than their sigmas (their calibrations differ a little). One that
+        does not fit while the first view fitted is dropped, unless it is more certain than the
+        first: a kick cannot show in one camera and not in the other (it is a ball cut by the
+        image's edge or half hidden by a robot), but the first may have been the partly hidden one."""
         r_var = self.measurement_var(sigma_m)
         if self._updated_at == self.t:
-            if (not self.kicked and r_var >= self._first_var
-                    and self._nis(z, self._prior, r_var) > self.p.kick_gate_chi2):  # fmt: skip
+            fits_prior = self._nis(z, self._prior, r_var) <= self.p.kick_gate_chi2
+            if not (fits_prior or self.kicked or r_var < self._first_var):
                 return False
+            if fits_prior:
+                nis = 0.0  # no kick between two views of one instant: cameras that disagree a little
         else:
             self._prior = self._position()
             self._first_var = r_var

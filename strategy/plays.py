@@ -59,6 +59,10 @@ class StrategyParams(Validated):
     meet_speed_m_s: float = setting(0.8, lo=0.0, hi=10.0)  # a ball this fast coming at the attacker is met on its path
     meet_cos: float = setting(0.7, lo=-1.0, hi=1.0)  # ... when its direction is this close to the attacker's
     clear_speed_m_s: float = setting(3.0, lo=0.1, hi=10.0)  # the ball played forward when nothing is good
+    contest_m: float = setting(0.3, lo=0.0, hi=3.0)  # attacker and an opponent this near a slow ball: it is contested
+    contest_ball_speed_m_s: float = setting(0.5, lo=0.0, hi=10.0)  # ... slower than this
+    contest_turn_rad: float = setting(0.6, lo=0.0, hi=3.2)  # a contested ball is kicked at most this far off the approach
+    keep_pass_share: float = setting(0.5, lo=0.0, hi=1.0)  # a decided pass is kept while worth this share of pass_value
 
 
 @dataclass
@@ -146,9 +150,10 @@ class Strategy:
         goal_x = own_sign * f.half_length
         objectives = [Objective("goalie", goal_x, 0.0, fixed_robot=goalie_id)]
         passing = self._update_pass(t, own, ball)
-        if passing is not None and passing.kicked:
+        if passing is not None:
+            # the receiver of a pass, planned or under way, waits at (or meets the ball near) its point
             objectives.append(Objective("receiver", *passing.point, fixed_robot=passing.receiver))
-        else:
+        if passing is None or not passing.kicked:
             # the attacker's cost: the way to where each robot can meet the (moving) ball
             meet = {rid: intercept(r, ball, p.skills, f) for rid, r in own.items()}
             costs = {rid: math.hypot(m.x - own[rid].x, m.y - own[rid].y) for rid, m in meet.items()}
@@ -172,6 +177,9 @@ class Strategy:
                 out[rid] = self._goalie(r, ball, own_sign)
             elif role == "attacker":
                 out[rid] = self._attack(t, r, own, opp_xy, ball, by_role, attack_sign)
+            elif role == "receiver" and passing is not None and not passing.kicked:
+                x, y = passing.point
+                out[rid] = Intent(x, y, math.atan2(ball.y - y, ball.x - x))
             elif role == "receiver":
                 assert passing is not None
                 out[rid] = receive(r, ball, passing.point, p.skills, passing.shoot_at,
@@ -209,7 +217,7 @@ class Strategy:
         met = intercept(r, ball, p.skills, self.field)
         kick = self._decide_kick(r, own, opp_xy, met, by_role, attack_sign)
         if kick.kind == "pass" and kick.receiver is not None:
-            if self.mem.passing is None or self.mem.passing.receiver != kick.receiver:
+            if self.mem.passing is None or (self.mem.passing.receiver, self.mem.passing.passer) != (kick.receiver, r.id):
                 self.mem.passing = _Pass(r.id, kick.receiver, kick.target, t, shoot_at=kick.shoot_at)
         else:
             self.mem.passing = None
@@ -225,7 +233,32 @@ class Strategy:
             if turn <= p.passing.max_turn_rad:
                 return receive(r, ball, (met.x, met.y), p.skills, kick.target, kick.speed)
             return receive(r, ball, (met.x, met.y), p.skills)
+        contest = self._contest_angle(r, met, kick.target, opp_xy)
+        if contest is not None:
+            # an opponent at the ball and ours on the wrong side of it: going around would leave the ball to
+            # the opponent, so the ball is played from the side the attacker is on, as near the aim as it can
+            self.mem.passing = None
+            self.last_action[r.id] = "clear"
+            target = (met.x + 1.5 * math.cos(contest), met.y + 1.5 * math.sin(contest))
+            return kick_to(r, met, target, p.clear_speed_m_s, p.skills)
         return kick_to(r, met, kick.target, kick.speed, p.skills)
+
+    def _contest_angle(self, r: RobotState, ball: BallState, target: tuple[float, float],
+                       opp_xy: np.ndarray) -> float | None:  # fmt: skip
+        """The kick direction nearest the aim that needs at most ``contest_turn_rad`` of way around the
+        ball, when the ball is slow, the attacker at it and an opponent too; None otherwise."""
+        p = self.p
+        if math.hypot(ball.vx, ball.vy) > p.contest_ball_speed_m_s or len(opp_xy) == 0:
+            return None
+        if math.hypot(r.x - ball.x, r.y - ball.y) > p.contest_m:
+            return None
+        if float(np.min(np.hypot(opp_xy[:, 0] - ball.x, opp_xy[:, 1] - ball.y))) > p.contest_m:
+            return None
+        approach = math.atan2(ball.y - r.y, ball.x - r.x)
+        off = math.remainder(math.atan2(target[1] - ball.y, target[0] - ball.x) - approach, 2 * math.pi)
+        if abs(off) <= p.contest_turn_rad:
+            return None
+        return approach + math.copysign(p.contest_turn_rad, off)
 
     def _decide_kick(self, r: RobotState, own: dict[int, RobotState], opp_xy: np.ndarray,
                      ball: BallState, by_role: dict[str, int], attack_sign: float) -> _Kick:  # fmt: skip
@@ -236,6 +269,15 @@ class Strategy:
         _, aim, shot_value = best_shot(ball_xy, f, attack_sign, opp_xy, self.obstacle_radius, p.passing)
         if shot_value >= p.shoot_value:
             return _Kick(r.id, "shot", aim, p.skills.max_kick_m_s)
+        planned = self.mem.passing
+        if planned is not None and not planned.kicked and planned.passer == r.id and planned.receiver in own:
+            # a pass already decided goes to the point its receiver waits at while it stays worth playing
+            pt = np.array([planned.point])
+            ev = pass_values(ball_xy, pt, f, attack_sign, opp_xy, self.obstacle_radius, p.passing)
+            if ev.values[0] >= p.keep_pass_share * p.pass_value:
+                dist = math.hypot(planned.point[0] - ball.x, planned.point[1] - ball.y)
+                return _Kick(r.id, "pass", planned.point, pass_speed(dist, p.skills), planned.receiver,
+                             planned.shoot_at)  # fmt: skip
         receivers = [(role, rid) for role, rid in by_role.items() if role.startswith("supporter")
                      and (own[rid].x - ball.x) * attack_sign > -p.max_back_pass_m]  # fmt: skip
         if receivers:

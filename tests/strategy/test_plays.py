@@ -70,3 +70,50 @@ def test_halt_stops_everyone() -> None:
     world = random_world(np.random.default_rng(1), 6, 0)
     intents = Strategy("blue", FIELD, StrategyParams()).decide(world, GameState(0.0, "halt"))
     assert all(it.max_speed_m_s == 0.0 for it in intents.values())
+
+
+def _robot(team: str, rid: int, x: float, y: float, theta: float = 0.0) -> RobotState:
+    return RobotState(team, rid, x, y, theta)  # type: ignore[arg-type]
+
+
+def test_a_contested_ball_is_played_from_the_attackers_side() -> None:
+    # blue attacks +x; the attacker stands on the goal side of the ball, an opponent right behind it:
+    # swinging round would hand the ball over, so it is kicked from where the attacker stands
+    p = StrategyParams()
+    ball = BallState(2.0, 0.5, 0.0, 0.0)
+    robots = (_robot("blue", 0, -4.3, 0.0), _robot("blue", 1, 2.2, 0.5, math.pi),
+              _robot("yellow", 0, 4.3, 0.0), _robot("yellow", 1, 1.8, 0.5))  # fmt: skip
+    strategy = Strategy("blue", FIELD, p)
+    game = GameState(0.0, "normal", blue_defends_negative_x=True)
+    intent = strategy.decide(WorldState(0.0, ball, robots), game)[1]
+    approach = math.pi  # from the attacker to the ball
+    off = abs(math.remainder(intent.theta - approach, 2 * math.pi))
+    assert off <= p.contest_turn_rad + 1e-6
+    assert strategy.last_action[1] == "clear"
+    # with the opponent gone the same attacker goes round the ball to play it toward their goal
+    alone = Strategy("blue", FIELD, p)
+    intent = alone.decide(WorldState(0.0, ball, robots[:3]), game)[1]
+    assert abs(math.remainder(intent.theta - approach, 2 * math.pi)) > p.contest_turn_rad
+
+
+def test_a_decided_pass_goes_where_its_receiver_waits() -> None:
+    # the receiver is told to wait at the pass point before the kick, and the passer keeps kicking at
+    # that point even when the receiver has drifted from it
+    p = StrategyParams(defenders=0)
+    ball = BallState(-1.0, 0.0, 0.0, 0.0)
+    robots = [_robot("blue", 0, -4.3, 0.0), _robot("blue", 1, -1.3, 0.0), _robot("blue", 2, 1.0, 2.0),
+              _robot("yellow", 0, 4.3, 0.0), _robot("yellow", 1, 0.5, -0.3)]  # fmt: skip
+    strategy = Strategy("blue", FIELD, p)
+    game = GameState(0.0, "normal", blue_defends_negative_x=True)
+    strategy.decide(WorldState(0.0, ball, tuple(robots)), game)
+    planned = strategy.mem.passing
+    assert planned is not None and planned.passer == 1 and not planned.kicked
+    point = planned.point
+    robots[2] = _robot("blue", 2, point[0] + 0.3, point[1] - 0.2)
+    intents = strategy.decide(WorldState(0.05, ball, tuple(robots)), game)
+    assert strategy.roles.roles[planned.receiver] == "receiver"
+    receiver = intents[planned.receiver]
+    assert math.hypot(receiver.x - point[0], receiver.y - point[1]) < 1e-9
+    assert strategy.mem.passing is not None and strategy.mem.passing.point == point
+    kick_dir = intents[1].theta
+    assert abs(math.remainder(kick_dir - math.atan2(point[1] - ball.y, point[0] - ball.x), 2 * math.pi)) < 1e-6

@@ -30,7 +30,7 @@ from strategy.evaluation import (
     pass_values,
 )
 from strategy.roles import Objective, RoleAssigner, RoleParams
-from strategy.skills import Intent, SkillParams, defend, goalie_block, intercept, kick_to, mark, pass_speed, receive
+from strategy.skills import Intent, SkillParams, defend, drive_through, goalie_block, intercept, kick_to, mark, pass_speed, receive
 
 __all__ = ["Strategy", "StrategyParams", "keep_away"]
 
@@ -62,6 +62,8 @@ class StrategyParams(Validated):
     contest_m: float = setting(0.3, lo=0.0, hi=3.0)  # attacker and an opponent this near a slow ball: it is contested
     contest_ball_speed_m_s: float = setting(0.5, lo=0.0, hi=10.0)  # ... slower than this
     contest_turn_rad: float = setting(0.6, lo=0.0, hi=3.2)  # a contested ball is kicked at most this far off the approach
+    stall_s: float = setting(2.0, lo=0.0, hi=60.0)  # a contested ball that lay still this long is driven through
+    stall_moved_m: float = setting(0.05, lo=0.0, hi=1.0)  # ... lying still: within this of where it was
     keep_pass_share: float = setting(0.5, lo=0.0, hi=1.0)  # a decided pass is kept while worth this share of pass_value
 
 
@@ -93,6 +95,8 @@ class _Memory:
     evaluation: PassEvaluation | None = None
     support_points: list[tuple[float, float]] = field(default_factory=list)
     passing: _Pass | None = None
+    ball_still_at: tuple[float, float] = (math.inf, math.inf)  # where the ball lies still ...
+    ball_still_since: float = math.inf  # ... since when
 
 
 class Strategy:
@@ -141,6 +145,9 @@ class Strategy:
         attack_sign = -own_sign
         opp_xy = np.array([[r.x, r.y] for r in opp]) if opp else np.zeros((0, 2))
         ball_xy = np.array([ball.x, ball.y])
+        still = self.mem.ball_still_at
+        if math.hypot(ball.x - still[0], ball.y - still[1]) > p.stall_moved_m:
+            self.mem.ball_still_at, self.mem.ball_still_since = (ball.x, ball.y), t
         if self.mem.evaluation is None or self.mem.frame % p.pass_eval_every_frames == 0:
             self.mem.evaluation = pass_values(ball_xy, self.grid, f, attack_sign, opp_xy, self.obstacle_radius,
                                               p.passing)  # fmt: skip
@@ -239,6 +246,9 @@ class Strategy:
             # the opponent, so the ball is played from the side the attacker is on, as near the aim as it can
             self.mem.passing = None
             self.last_action[r.id] = "clear"
+            if t - self.mem.ball_still_since > p.stall_s:
+                # lining up got nowhere (the point behind the ball is taken): drive through it from here
+                return drive_through(met, contest, p.clear_speed_m_s, p.skills)
             target = (met.x + 1.5 * math.cos(contest), met.y + 1.5 * math.sin(contest))
             return kick_to(r, met, target, p.clear_speed_m_s, p.skills)
         return kick_to(r, met, kick.target, kick.speed, p.skills)

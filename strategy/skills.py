@@ -99,9 +99,7 @@ def kick_to(robot: RobotState, ball: BallState, target: tuple[float, float], spe
                and heading_error < p.lined_up_rad + p.cone_heading_rad_m * gap)  # fmt: skip
     lined_up = along < -contact + 0.02 and in_cone
     if lined_up or (along < 0 and along > -contact - 0.03 and abs(across) < 0.5 * p.lined_up_m):
-        # drive through the ball; the kicker fires when it touches the front
-        return Intent(ball.x + c * 0.05, ball.y + s * 0.05, aim, kick_speed=speed, chip=chip, avoid_ball=False,
-                      max_speed_m_s=p.push_speed_m_s, final_speed_m_s=p.push_speed_m_s, dribbler=0.3)  # fmt: skip
+        return drive_through(ball, aim, speed, p, chip)
     behind = contact + p.approach_distance_m
     px, py = ball.x - c * behind, ball.y - s * behind
     if along > -contact and abs(across) < behind:
@@ -110,6 +108,13 @@ def kick_to(robot: RobotState, ball: BallState, target: tuple[float, float], spe
         px = ball.x - c * 0.5 * behind - s * side * behind * 1.2
         py = ball.y - s * 0.5 * behind + c * side * behind * 1.2
     return Intent(px, py, aim, avoid_ball=True)
+
+
+def drive_through(ball: BallState, aim: float, speed: float, p: SkillParams, chip: bool = False) -> Intent:
+    """Drive through the ball along ``aim`` with the kicker armed: it fires when the ball touches the front."""
+    c, s = math.cos(aim), math.sin(aim)
+    return Intent(ball.x + c * 0.05, ball.y + s * 0.05, aim, kick_speed=speed, chip=chip, avoid_ball=False,
+                  max_speed_m_s=p.push_speed_m_s, final_speed_m_s=p.push_speed_m_s, dribbler=0.3)  # fmt: skip
 
 
 def ball_travel(speed: float, p: SkillParams) -> float:

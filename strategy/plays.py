@@ -26,11 +26,22 @@ from strategy.evaluation import (
     best_shot,
     candidate_grid,
     clearest_direction,
-        one_touch_turn,
+    one_touch_turn,
     pass_values,
 )
 from strategy.roles import Objective, RoleAssigner, RoleParams
-from strategy.skills import Intent, SkillParams, defend, drive_through, goalie_block, intercept, kick_to, mark, pass_speed, receive
+from strategy.skills import (
+    Intent,
+    SkillParams,
+    defend,
+    drive_through,
+    goalie_block,
+    intercept,
+    kick_to,
+    mark,
+    pass_speed,
+    receive,
+)
 
 __all__ = ["Strategy", "StrategyParams", "keep_away"]
 
@@ -61,7 +72,7 @@ class StrategyParams(Validated):
     clear_speed_m_s: float = setting(3.0, lo=0.1, hi=10.0)  # the ball played forward when nothing is good
     contest_m: float = setting(0.3, lo=0.0, hi=3.0)  # attacker and an opponent this near a slow ball: it is contested
     contest_ball_speed_m_s: float = setting(0.5, lo=0.0, hi=10.0)  # ... slower than this
-    contest_turn_rad: float = setting(0.6, lo=0.0, hi=3.2)  # a contested ball is kicked at most this far off the approach
+    contest_turn_rad: float = setting(0.6, lo=0.0, hi=3.2)  # a contested ball is kicked at most this far off
     stall_s: float = setting(2.0, lo=0.0, hi=60.0)  # a contested ball that lay still this long is driven through
     stall_moved_m: float = setting(0.05, lo=0.0, hi=1.0)  # ... lying still: within this of where it was
     keep_pass_share: float = setting(0.5, lo=0.0, hi=1.0)  # a decided pass is kept while worth this share of pass_value
@@ -224,14 +235,15 @@ class Strategy:
         met = intercept(r, ball, p.skills, self.field)
         kick = self._decide_kick(r, own, opp_xy, met, by_role, attack_sign)
         if kick.kind == "pass" and kick.receiver is not None:
-            if self.mem.passing is None or (self.mem.passing.receiver, self.mem.passing.passer) != (kick.receiver, r.id):
+            planned = self.mem.passing
+            if planned is None or (planned.receiver, planned.passer) != (kick.receiver, r.id):
                 self.mem.passing = _Pass(r.id, kick.receiver, kick.target, t, shoot_at=kick.shoot_at)
         else:
             self.mem.passing = None
         self.last_action[r.id] = kick.kind
         speed = math.hypot(ball.vx, ball.vy)
-        toward = ((r.x - ball.x) * ball.vx + (r.y - ball.y) * ball.vy) / max(speed * math.hypot(r.x - ball.x, r.y - ball.y),
-                                                                          1e-9)  # fmt: skip
+        to_robot = math.hypot(r.x - ball.x, r.y - ball.y)
+        toward = ((r.x - ball.x) * ball.vx + (r.y - ball.y) * ball.vy) / max(speed * to_robot, 1e-9)
         if speed > p.meet_speed_m_s and toward > p.meet_cos:
             # the ball comes at the attacker: meet it on its path, redirecting it at the target when the
             # turn allows a one-touch kick, else stopping it with the dribbler

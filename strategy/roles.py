@@ -53,8 +53,9 @@ class RoleAssigner:
                     del free[obj.fixed_robot]
                     continue
             best, best_cost = None, math.inf
+            costs = obj.costs or {}
             for rid, (x, y) in free.items():
-                cost = obj.costs[rid] if obj.costs is not None and rid in obj.costs else math.hypot(x - obj.x, y - obj.y)
+                cost = costs[rid] if rid in costs else math.hypot(x - obj.x, y - obj.y)
                 if previous.get(obj.role) == rid:
                     cost -= self.params.hysteresis_m
                 if cost < best_cost or (cost == best_cost and best is not None and rid < best):

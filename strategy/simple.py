@@ -1,7 +1,8 @@
 """The built-in simple opponent: plays on the true state with plain steering, no planning.
 
-Its lowest id keeps goal (and clears a ball at rest in its area), the robot nearest the ball goes behind it and shoots at the goal's centre,
-the others hold a shape in their half that follows the ball sideways. It keeps the rules' distance
+Its lowest id keeps goal (and clears a ball at rest in its area), the robot nearest the ball goes
+behind it and shoots at the goal's centre, the others hold a shape in their half that follows the
+ball sideways. It keeps the rules' distance
 in a stop and at our restarts. A sparring partner for matches and benchmarks, not a team.
 """
 

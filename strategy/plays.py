@@ -297,9 +297,7 @@ class Strategy:
             pt = np.array([planned.point])
             ev = pass_values(ball_xy, pt, f, attack_sign, opp_xy, self.obstacle_radius, p.passing)
             if ev.values[0] >= p.keep_pass_share * p.pass_value:
-                dist = math.hypot(planned.point[0] - ball.x, planned.point[1] - ball.y)
-                return _Kick(r.id, "pass", planned.point, pass_speed(dist, p.skills), planned.receiver,
-                             planned.shoot_at)  # fmt: skip
+                return self._pass_kick(r.id, ball, planned.point, planned.receiver, planned.shoot_at)
         receivers = [(role, rid) for role, rid in by_role.items() if role.startswith("supporter")
                      and (own[rid].x - ball.x) * attack_sign > -p.max_back_pass_m]  # fmt: skip
         if receivers:
@@ -312,9 +310,7 @@ class Strategy:
                 _, shot_aim, value_there = best_shot(pts[k], f, attack_sign, opp_xy, self.obstacle_radius, p.passing)
                 turn = float(one_touch_turn(ball_xy, pts[k : k + 1], np.array([shot_aim]))[0])
                 one_touch = value_there >= p.one_touch_value and turn <= p.passing.max_turn_rad
-                dist = math.hypot(point[0] - ball.x, point[1] - ball.y)
-                return _Kick(r.id, "pass", point, pass_speed(dist, p.skills), rid,
-                             shot_aim if one_touch else None)  # fmt: skip
+                return self._pass_kick(r.id, ball, point, rid, shot_aim if one_touch else None)
         # nothing good: play the ball forward through the most open lane (around a blocker)
         toward = math.atan2(aim[1] - ball.y, aim[0] - ball.x)
         angle, _ = clearest_direction(ball_xy, toward, opp_xy, self.obstacle_radius)
@@ -323,6 +319,12 @@ class Strategy:
         if shooting:
             return _Kick(r.id, "shot", target, p.skills.max_kick_m_s)
         return _Kick(r.id, "clear", target, p.clear_speed_m_s)
+
+    def _pass_kick(self, passer: int, ball: BallState, point: tuple[float, float], receiver: int,
+                   shoot_at: tuple[float, float] | None) -> _Kick:  # fmt: skip
+        """A pass to ``point``, as fast as it must be kicked to arrive there at the receiving speed."""
+        dist = math.hypot(point[0] - ball.x, point[1] - ball.y)
+        return _Kick(passer, "pass", point, pass_speed(dist, self.p.skills), receiver, shoot_at)
 
     def _update_pass(self, t: float, own: dict[int, RobotState], ball: BallState) -> _Pass | None:
         """Follow a pass: kicked once the ball runs toward the receiver; over when received, lost

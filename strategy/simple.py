@@ -2,8 +2,8 @@
 
 Its lowest id keeps goal (and clears a ball at rest in its area), the robot nearest the ball goes
 behind it and shoots at the goal's centre, the others hold a shape in their half that follows the
-ball sideways. It keeps the rules' distance
-in a stop and at our restarts. A sparring partner for matches and benchmarks, not a team.
+ball sideways. It keeps the rules' distance in a stop and at our restarts. A sparring partner for
+matches and benchmarks, not a team.
 """
 
 from __future__ import annotations

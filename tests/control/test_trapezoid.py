@@ -1,5 +1,8 @@
 """Trapezoidal profiles (Bruce 2006 B.4) against closed forms, a dense search over peak velocities
-and step-by-step integration."""
+and step-by-step integration.
+
+``duration_s`` is the profile's planned travel time (the robot's, in the simulated world), the
+quantity the profile minimises; nothing here measures how long the code takes to run."""
 
 from __future__ import annotations
 

@@ -43,6 +43,9 @@ class BrainParams(Validated):
     plan_deadline_s: float = setting(0.25, lo=0.0001, hi=1.0)
     ball_clearance_m: float = setting(0.05, lo=0.0, hi=1.0)  # kept from the ball when it is an obstacle
     arrive_tolerance_m: float = setting(0.01, lo=0.0, hi=1.0)  # closer than this to the goal: no planning
+    # the motion profile starts from the last command sent while the measured velocity is within this
+    # of it: a robot held back by an opponent keeps pressing on instead of starting from rest every frame
+    command_slip_m_s: float = setting(0.5, lo=0.0, hi=10.0)
 
 
 @dataclass(frozen=True)
@@ -81,6 +84,7 @@ class Brain:
         self.plans: dict[int, RobotPlan] = {}
         self._control_cache: dict[float, ControlParams] = {}
         self._last_seen: dict[int, tuple[float, RobotState]] = {}  # own robots as the world last showed them
+        self._sent: dict[int, tuple[float, float]] = {}  # the last safe velocity command of each robot
 
     def _planner(self, rid: int) -> Planner:
         planner = self.planners.get(rid)
@@ -112,6 +116,7 @@ class Brain:
             safe = self.safety.make_safe(commands + stops, dataclasses.replace(world, robots=world.robots + lost))
         else:
             safe = []
+        self._sent = {c.id: (c.vx, c.vy) for c in safe}
         t3 = time.perf_counter()
         self.times["strategy"].append((t1 - t0) * 1e3)
         self.times["planning_control"].append((t2 - t1) * 1e3)
@@ -176,6 +181,9 @@ class Brain:
                 ux, uy = (goal[0] - start[0]) / d, (goal[1] - start[1]) / d
                 target = MotionTarget(goal[0] + ux * 0.05, goal[1] + uy * 0.05, ux * it.final_speed_m_s,
                                       uy * it.final_speed_m_s, it.theta)  # fmt: skip
+        sent = self._sent.get(robot.id)
+        if sent is not None and math.hypot(sent[0] - robot.vx, sent[1] - robot.vy) <= self.params.command_slip_m_s:
+            robot = dataclasses.replace(robot, vx=sent[0], vy=sent[1])
         move = motion_command(robot, target, control)
         cmd = RobotCommand(self.team, robot.id, move.vx, move.vy, move.omega, it.kick_speed, it.chip, it.dribbler)
         self.plans[robot.id] = RobotPlan(it, path, status, cmd)

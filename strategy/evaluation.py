@@ -9,7 +9,9 @@ ball first). Each input goes through a simple saturating function, and the facto
 weighted product (weights as exponents), so any hopeless factor makes the whole pass hopeless.
 
 Shot evaluation: the widest free part of the goal mouth seen from a point, with the obstacles'
-angular shadows taken out; aim at its centre.
+angular shadows taken out. Between two shadows the shot aims at the gap's centre, so a blocker must
+cover half the gap; a gap that ends at a post is aimed at that end (a post does not move), so the
+blocker must cover all of it: such a gap counts double.
 
 Field frame, metres, radians. "Obstacles" are circles (robots) of one radius; the ball's radius
 should be added to it by the caller when the question is whether the ball passes.
@@ -55,6 +57,7 @@ class PassParams(Validated):
     max_turn_rad: float = setting(1.3, lo=0.1, hi=3.14)
     trap_factor: float = setting(0.5, lo=0.0, hi=1.0)  # value kept when the receiver must trap, not one-touch
     goal_samples: int = setting(24, lo=3, hi=256)  # angular samples across the goal mouth
+    post_margin_m: float = setting(0.1, lo=0.0, hi=1.0)  # shots aim at most this near a post (ball centre)
     weight_length: float = setting(1.0, lo=0.0, hi=10.0)  # exponents of the factors
     weight_lane: float = setting(2.0, lo=0.0, hi=10.0)
     weight_shot_open: float = setting(1.0, lo=0.0, hi=10.0)
@@ -93,12 +96,16 @@ def lane_open_angle(origin: Array, targets: Array, obstacles: Array, radius: flo
 
 
 def open_goal_angle(points: Array, field: Field, goal_sign: float, obstacles: Array, radius: float,
-                    samples: int = 24) -> tuple[Array, Array]:  # fmt: skip
-    """Widest free angle of the goal at x = goal_sign * half_length from each point (N,), and the
-    y on the goal line to aim at (its centre). Obstacles behind the goal line do not block."""
+                    samples: int = 24, post_margin_m: float = 0.1) -> tuple[Array, Array]:  # fmt: skip
+    """Open angle of the goal at x = goal_sign * half_length from each point (N,), and the y on the
+    goal line to aim at. The widest free run of the mouth (aim points up to ``post_margin_m`` from
+    the posts) is aimed at its centre, or at its post end when exactly one of its ends is a post;
+    the open angle is twice the angle from the aim to the nearest shadow (the whole gap when it
+    lies between two shadows or spans the mouth, twice it when it ends at a post). Obstacles
+    behind the goal line do not block."""
     points = np.atleast_2d(points)
     gx = goal_sign * field.half_length
-    gw = field.goal_half_width - radius * 0.5  # aim a little inside the posts
+    gw = max(field.goal_half_width - post_margin_m, 0.0)
     ys = np.linspace(-gw, gw, samples)  # (K,)
     dx = gx - points[:, 0:1]  # (N, 1)
     dy = ys[None, :] - points[:, 1:2]  # (N, K)
@@ -131,13 +138,23 @@ def open_goal_angle(points: Array, field: Field, goal_sign: float, obstacles: Ar
     # a lone free sample is a gap of at most one sample spacing: count it as half a spacing
     spacing = np.abs(np.diff(theta, axis=1)).mean(axis=1) if k > 1 else np.zeros(n)
     width = np.where(best_len == 1, 0.5 * spacing, width)
+    # a gap with one end at a post, aimed at that end: the blocker has all of it to cover
+    lead = np.argmin(np.concatenate([free, np.zeros((n, 1), dtype=bool)], axis=1), axis=1)  # free samples from -gw
+    trail = np.argmin(np.concatenate([free[:, ::-1], np.zeros((n, 1), dtype=bool)], axis=1), axis=1)
+    for run_len, end, post_y in ((lead, 0, ys[0]), (trail, k - 1, ys[-1])):
+        inner = np.clip(end + (run_len - 1) * (1 if end == 0 else -1), 0, k - 1)
+        post_width = np.where(run_len > 1, 2.0 * np.abs(theta[rows, inner] - theta[:, end]), spacing)
+        better = (run_len > 0) & (run_len < k) & (post_width > width)
+        width = np.where(better, post_width, width)
+        aim = np.where(better, post_y, aim)
     return width, aim
 
 
 def best_shot(ball: Array, field: Field, goal_sign: float, obstacles: Array, radius: float,
               params: PassParams) -> tuple[float, tuple[float, float], float]:  # fmt: skip
     """(open angle rad, aim point on the goal line, value 0..1) of a shot from ``ball``."""
-    width, aim = open_goal_angle(ball[None, :], field, goal_sign, obstacles, radius, params.goal_samples)
+    width, aim = open_goal_angle(ball[None, :], field, goal_sign, obstacles, radius, params.goal_samples,
+                                 params.post_margin_m)
     target = (goal_sign * field.half_length, float(aim[0]))
     d = math.hypot(target[0] - ball[0], target[1] - ball[1])
     value = min(1.0, float(width[0]) / params.shot_open_angle_rad) * math.exp(-d / params.shot_distance_scale_m)
@@ -183,7 +200,8 @@ def pass_values(ball: Array, points: Array, field: Field, goal_sign: float, obst
     to_p = points - ball
     len_a = np.hypot(to_p[:, 0], to_p[:, 1])
     open_a = lane_open_angle(ball, points, obstacles, radius, params.lane_open_angle_rad)
-    open_b, aim_y = open_goal_angle(points, field, goal_sign, obstacles, radius, params.goal_samples)
+    open_b, aim_y = open_goal_angle(points, field, goal_sign, obstacles, radius, params.goal_samples,
+                                    params.post_margin_m)
     aims = np.stack([np.full(len(points), goal_sign * field.half_length), aim_y], axis=1)
     to_goal = aims - points
     len_b = np.hypot(to_goal[:, 0], to_goal[:, 1])

@@ -46,8 +46,10 @@ class DSSParams(Validated):
     # of either: a push at walking pace moves a robot several centimetres before it can brake
     pushed_margin_m: float = setting(0.1, lo=0.0, hi=1.0)
     push_range_m: float = setting(0.3, lo=0.0, hi=5.0)  # opponent body to own robot body
-    opponent_margin_m: float = setting(0.05, lo=0.0, hi=1.0)  # kept from an opponent's reachable disc
-    opponent_accel_m_s2: float = setting(3.0, lo=0.0, hi=50.0)  # bound on how opponents may accelerate
+    opponent_margin_m: float = setting(0.0, lo=0.0, hi=1.0)  # kept from an opponent's reachable disc
+    # bound on how opponents may accelerate; 0: they keep their velocity (a disc growing at every
+    # opponent near the ball holds our robot off every contested ball)
+    opponent_accel_m_s2: float = setting(0.0, lo=0.0, hi=50.0)
     static_margin_m: float = setting(0.01, lo=0.0, hi=1.0)  # kept from walls and static obstacles
     static_step_m: float = setting(0.02, lo=0.001, hi=0.5)  # sample spacing of the static check
     random_samples: int = setting(40, lo=0, hi=1000)  # random points of A(v) per searching robot

@@ -19,19 +19,36 @@ NONE = np.zeros((0, 2))
 def test_open_goal_angle_without_obstacles_is_the_goal_mouth() -> None:
     d = 2.0
     width, aim = open_goal_angle(np.array([[FIELD.half_length - d, 0.0]]), FIELD, 1.0, NONE, R, samples=101)
-    gw = FIELD.goal_half_width - R * 0.5
+    gw = FIELD.goal_half_width - P.post_margin_m
     assert width[0] == pytest.approx(2 * math.atan(gw / d), rel=1e-3)
     assert aim[0] == pytest.approx(0.0, abs=1e-9)
 
 
-def test_goalkeeper_shadow_moves_the_aim() -> None:
+def test_goalkeeper_shadow_moves_the_aim_to_the_far_post() -> None:
     keeper = np.array([[FIELD.half_length - 0.1, 0.25]])  # covering the left half of the goal
-    width, aim = open_goal_angle(np.array([[2.5, 0.0]]), FIELD, 1.0, keeper, R, samples=101)
-    free_width, _ = open_goal_angle(np.array([[2.5, 0.0]]), FIELD, 1.0, NONE, R, samples=101)
-    assert 0 < width[0] < free_width[0]
-    assert aim[0] < 0.0  # aim at the open right side
-    _, target, value = best_shot(np.array([2.5, 0.0]), FIELD, 1.0, keeper, R, P)
+    origin = np.array([2.5, 0.0])
+    width, aim = open_goal_angle(origin[None, :], FIELD, 1.0, keeper, R, samples=101)
+    gw = FIELD.goal_half_width - P.post_margin_m
+    assert aim[0] == pytest.approx(-gw)  # the open right side, at its post: the keeper must cover all of the gap
+    rel = keeper[0] - origin
+    shadow_edge = math.atan2(rel[1], rel[0]) - math.asin(R / math.hypot(*rel))
+    gap = shadow_edge - math.atan2(-gw, FIELD.half_length - origin[0])
+    spacing = 2 * math.atan(gw / (FIELD.half_length - origin[0])) / 100
+    assert width[0] == pytest.approx(2 * gap, abs=2 * spacing)  # counted twice: no centre aim halves it
+    _, target, value = best_shot(origin, FIELD, 1.0, keeper, R, P)
     assert target[1] < 0.0 and 0 < value <= 1
+
+
+def test_a_gap_between_two_blockers_is_aimed_at_its_centre() -> None:
+    origin = np.array([2.5, 0.0])
+    blockers = np.array([[FIELD.half_length - 0.3, 0.3], [FIELD.half_length - 0.3, -0.3]])
+    width, aim = open_goal_angle(origin[None, :], FIELD, 1.0, blockers, R, samples=101)
+    assert aim[0] == pytest.approx(0.0, abs=0.02)
+    rel = blockers - origin
+    edges = np.arctan2(rel[:, 1], rel[:, 0]) + np.array([-1, 1]) * np.arcsin(R / np.hypot(rel[:, 0], rel[:, 1]))
+    gw = FIELD.goal_half_width - P.post_margin_m
+    spacing = 2 * math.atan(gw / (FIELD.half_length - origin[0])) / 100
+    assert width[0] == pytest.approx(edges[0] - edges[1], abs=2 * spacing)
 
 
 def test_lane_blocked_by_an_obstacle_on_the_line_but_not_beyond_the_receiver() -> None:

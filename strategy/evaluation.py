@@ -154,7 +154,7 @@ def best_shot(ball: Array, field: Field, goal_sign: float, obstacles: Array, rad
               params: PassParams) -> tuple[float, tuple[float, float], float]:  # fmt: skip
     """(open angle rad, aim point on the goal line, value 0..1) of a shot from ``ball``."""
     width, aim = open_goal_angle(ball[None, :], field, goal_sign, obstacles, radius, params.goal_samples,
-                                 params.post_margin_m)
+                                 params.post_margin_m)  # fmt: skip
     target = (goal_sign * field.half_length, float(aim[0]))
     d = math.hypot(target[0] - ball[0], target[1] - ball[1])
     value = min(1.0, float(width[0]) / params.shot_open_angle_rad) * math.exp(-d / params.shot_distance_scale_m)
@@ -201,7 +201,7 @@ def pass_values(ball: Array, points: Array, field: Field, goal_sign: float, obst
     len_a = np.hypot(to_p[:, 0], to_p[:, 1])
     open_a = lane_open_angle(ball, points, obstacles, radius, params.lane_open_angle_rad)
     open_b, aim_y = open_goal_angle(points, field, goal_sign, obstacles, radius, params.goal_samples,
-                                    params.post_margin_m)
+                                    params.post_margin_m)  # fmt: skip
     aims = np.stack([np.full(len(points), goal_sign * field.half_length), aim_y], axis=1)
     to_goal = aims - points
     len_b = np.hypot(to_goal[:, 0], to_goal[:, 1])

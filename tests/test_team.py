@@ -1,9 +1,12 @@
-"""The brain's safety call: own robots the tracker lost stay in the safety search and are stopped."""
+"""The brain: own robots the tracker lost stay in the safety search and are stopped; a robot held
+back keeps pressing on."""
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from cmdragons.messages import BallState, GameState, RobotCommand, RobotState, WorldState
@@ -47,3 +50,20 @@ def test_team_mates_do_not_drive_into_a_lost_robot() -> None:
     assert blind[0].vx == pytest.approx(2.0)  # without the lost robot nothing is in the way
     seen = safety.make_safe(cmd, world(0.0, robot0, ghost))
     assert seen[0].vx < 2.0
+
+
+def test_a_robot_held_back_keeps_pressing_on() -> None:
+    # a robot that does not move (an opponent holds it) is told, frame after frame, to go on toward
+    # its goal (the goalie's place, far away): its command grows by the acceleration limit each
+    # frame, as if it moved
+    def speed(brain: Brain, frames: int) -> float:
+        held = RobotState("blue", 3, 0.0, 0.0, 0.0)
+        cmds = [brain.step(world(k / 60, held), GameState(0.0))[0] for k in range(frames)]
+        return float(np.hypot(cmds[-1].vx, cmds[-1].vy))
+
+    accel = SETTINGS.control.motion.max_accel_m_s2
+    slip = SETTINGS.team.brain.command_slip_m_s
+    assert speed(Brain("blue", SETTINGS), 10) == pytest.approx(min(10 * accel / 60, slip), rel=0.05)
+    # from the measured velocity alone: one frame of acceleration from rest, each time
+    restarting = Brain("blue", SETTINGS, dataclasses.replace(SETTINGS.team.brain, command_slip_m_s=0.0))
+    assert speed(restarting, 10) == pytest.approx(accel / 60, rel=0.05)

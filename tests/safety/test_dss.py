@@ -124,6 +124,21 @@ def test_walls_and_opponents_are_avoided() -> None:
     assert r.status[0] == KEPT
 
 
+def test_a_robot_at_an_opponent_may_go_round_it() -> None:
+    # at the ball with an opponent 1 cm from its body, a robot moving past the opponent's side may go
+    # on (the opponent keeps its velocity); with the opponent's reach growing as it could accelerate,
+    # nothing but moving away was left, and the attacker stood at every contested ball
+    states = np.array([[0.0, 0.0, 0.0, 0.3]])
+    opponent = np.array([[0.19, 0.0, 0.0, 0.0]])
+    commands = np.array([[0.0, 0.35]])
+    assert make_dss().filter(states, commands, opponent).status[0] == KEPT
+    growing = make_dss(opponent_accel_m_s2=3.0, opponent_margin_m=0.05).filter(states, commands, opponent)
+    assert growing.status[0] != KEPT
+    # driving into it is still refused (at 0.5 m/s it needs 3 cm to brake)
+    toward = np.array([[0.0, 0.0, 0.5, 0.0]])
+    assert make_dss().filter(toward, np.array([[0.5, 0.0]]), opponent).status[0] != KEPT
+
+
 def test_own_robots_keep_farther_apart_where_an_opponent_may_push_one() -> None:
     # a robot creeps at 0.3 m/s toward a team-mate at rest 8 cm away: it may go on, braking short
     # of the 3 cm margin; with an opponent 0.22 m from the team-mate's body it may not

@@ -21,6 +21,7 @@ __all__ = [
     "Intent",
     "SkillParams",
     "defend",
+    "dribble",
     "go_to_pose",
     "goalie_block",
     "intercept",
@@ -56,6 +57,9 @@ class SkillParams(Validated):
     mark_distance_m: float = setting(0.45, lo=0.2, hi=3.0)  # marker between its opponent and our goal
     intercept_speed_m_s: float = setting(1.8, lo=0.1, hi=10.0)  # robot's average speed when meeting a moving ball
     intercept_horizon_s: float = setting(3.0, lo=0.0, hi=20.0)  # the moving ball is predicted this far ahead
+    dribble_speed_m_s: float = setting(1.0, lo=0.05, hi=5.0)  # carrying the ball, and driving onto it to take it
+    dribble_hold_m: float = setting(0.03, lo=0.001, hi=0.5)  # ball centre this near the middle of the face: held
+    dribble_turn_rad: float = setting(0.3, lo=0.01, hi=3.2)  # ... and the robot facing the target within this
 
 
 @dataclass(frozen=True)
@@ -115,6 +119,27 @@ def drive_through(ball: BallState, aim: float, speed: float, p: SkillParams, chi
     c, s = math.cos(aim), math.sin(aim)
     return Intent(ball.x + c * 0.05, ball.y + s * 0.05, aim, kick_speed=speed, chip=chip, avoid_ball=False,
                   max_speed_m_s=p.push_speed_m_s, final_speed_m_s=p.push_speed_m_s, dribbler=0.3)  # fmt: skip
+
+
+def dribble(robot: RobotState, ball: BallState, target: tuple[float, float], p: SkillParams) -> Intent:
+    """Carry the ball to ``target`` on the kicker face, dribbler on: take it from behind on the line
+    to the target (the approach of :func:`kick_to`, driving onto it at ``dribble_speed_m_s`` with no
+    kick), then drive so that the ball arrives at the target, facing the way."""
+    aim = _angle(target[0] - ball.x, target[1] - ball.y)
+    contact = p.front_distance_m + p.ball_radius_m
+    face_x, face_y = robot.x + math.cos(robot.theta) * contact, robot.y + math.sin(robot.theta) * contact
+    on_face = math.hypot(ball.x - face_x, ball.y - face_y) < p.dribble_hold_m
+    arriving = math.hypot(target[0] - ball.x, target[1] - ball.y) < contact  # the aim swings: keep the heading
+    if on_face and (arriving or abs(math.remainder(aim - robot.theta, 2 * math.pi)) < p.dribble_turn_rad):
+        # where the robot stands when the ball lies on the target
+        heading = robot.theta if arriving else aim
+        x, y = target[0] - math.cos(heading) * contact, target[1] - math.sin(heading) * contact
+        return Intent(x, y, heading, dribbler=1.0, avoid_ball=False, max_speed_m_s=p.dribble_speed_m_s)
+    take = kick_to(robot, ball, target, 0.0, p)
+    if take.avoid_ball:
+        return Intent(take.x, take.y, take.theta, dribbler=1.0)  # getting behind the ball
+    return Intent(take.x, take.y, take.theta, dribbler=1.0, avoid_ball=False, max_speed_m_s=p.dribble_speed_m_s,
+                  final_speed_m_s=min(p.push_speed_m_s, p.dribble_speed_m_s))  # fmt: skip
 
 
 def ball_travel(speed: float, p: SkillParams) -> float:

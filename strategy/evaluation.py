@@ -98,11 +98,11 @@ def lane_open_angle(origin: Array, targets: Array, obstacles: Array, radius: flo
 def open_goal_angle(points: Array, field: Field, goal_sign: float, obstacles: Array, radius: float,
                     samples: int = 24, post_margin_m: float = 0.1) -> tuple[Array, Array]:  # fmt: skip
     """Open angle of the goal at x = goal_sign * half_length from each point (N,), and the y on the
-    goal line to aim at. The widest free run of the mouth (aim points up to ``post_margin_m`` from
-    the posts) is aimed at its centre, or at its post end when exactly one of its ends is a post;
-    the open angle is twice the angle from the aim to the nearest shadow (the whole gap when it
-    lies between two shadows or spans the mouth, twice it when it ends at a post). Obstacles
-    behind the goal line do not block."""
+    goal line to aim at (aim points reach up to ``post_margin_m`` from the posts). A free run of the
+    mouth between two shadows (or the whole mouth) is aimed at its centre and counts its width; a
+    run from a post to a shadow is aimed at the post end and counts twice its width (the angle from
+    the aim to the nearest shadow, doubled, in both cases). The best of the widest run and the two
+    post runs is taken. Obstacles behind the goal line do not block."""
     points = np.atleast_2d(points)
     gx = goal_sign * field.half_length
     gw = max(field.goal_half_width - post_margin_m, 0.0)

@@ -146,6 +146,8 @@ def tile_cameras(images: dict[int, NDArray[np.uint8]], models: Sequence[object])
 def _cmd_sim(args: argparse.Namespace) -> int:
     import cv2
 
+    from cmdragons.geometry import TEAMS
+    from cmdragons.messages import GameState, SimEvents, TeamCommands
     from cmdragons.recording import RecordingWriter
     from cmdragons.runtime.log import RunLog, run_folder
     from cmdragons.runtime.settings import load_settings
@@ -173,15 +175,17 @@ def _cmd_sim(args: argparse.Namespace) -> int:
                 frame = sim.capture()
                 if recorder is not None:
                     recorder.write(frame.frame_number, frame.images, frame.truth)
+                g = frame.game if frame.game is not None else GameState(frame.t_capture)
                 log.write("/truth", frame.t_capture, frame.truth.to_dict())
-                log.write("/game", frame.t_capture, frame.game.to_dict())
+                log.write("/referee", frame.t_capture, g.to_dict())
                 commands = script.commands(sim.world.snapshot())
-                for c in commands:
-                    log.write("/commands", frame.t_capture, c.to_dict())
-                for e in sim.advance(commands):
-                    log.write("/events", sim.t, {"type": type(e).__name__.lower(), **_event_dict(e)})
+                for team in TEAMS:
+                    mine = tuple(c for c in commands if c.team == team)
+                    log.write(f"/commands/{team}", frame.t_capture,
+                              TeamCommands(team, frame.frame_number, frame.t_capture, mine).to_dict())  # fmt: skip
+                events = tuple(sim.advance(commands))
+                log.write("/events", sim.t, SimEvents(frame.frame_number, sim.t, sim.ball_xy(), events).to_dict())
                 if i % 15 == 0 or i == n_frames - 1:
-                    g = frame.game
                     progress.update(task, completed=i + 1,
                                     info=f"t={sim.t:6.2f}s  blue {g.score_blue}:{g.score_yellow} yellow")  # fmt: skip
     finally:
@@ -217,55 +221,54 @@ def _cmd_sim(args: argparse.Namespace) -> int:
 def _cmd_play(args: argparse.Namespace) -> int:
     import cv2
 
+    from cmdragons.messages import GameState
     from cmdragons.runtime.log import RunLog, run_folder
     from cmdragons.runtime.match import Match
-    from cmdragons.runtime.overlay import draw_overlays
+    from cmdragons.runtime.overlay import OverlayStage
     from cmdragons.runtime.settings import load_settings
+    from cmdragons.runtime.stages import LoggerStage, Tap
 
     if not (args.seconds > 0 and math.isfinite(args.seconds)):
         print("cmdragons play: --seconds must be a positive number", file=sys.stderr)
         return 2
     overrides = list(args.set) + ([f"field.division={args.division}"] if args.division else [])
     settings = load_settings(args.config, overrides)
-    match = Match(settings, args.opponent, args.perception, seed=args.seed, render=args.video)
     folder = run_folder("play", args.out)
     log = RunLog(folder / "run.mcap")
-    video = None
-    models = match.sim.cameras
-    height = settings.field.robot.height_m
     fps = settings.sim.physics.frame_rate_hz
     n_frames = max(1, round(args.seconds * fps))
+    video: list[cv2.VideoWriter] = []
+    models = settings.camera_models()
+
+    def write_video(drawn: dict[int, NDArray[np.uint8]]) -> None:
+        full = tile_cameras(drawn, models)
+        tiled = cv2.resize(full, (full.shape[1] // 2, full.shape[0] // 2), interpolation=cv2.INTER_AREA)
+        if not video:
+            video.append(cv2.VideoWriter(str(folder / "match.mp4"), cv2.VideoWriter.fourcc(*"mp4v"), fps,
+                                         (tiled.shape[1], tiled.shape[0])))  # fmt: skip
+        video[0].write(tiled)
+
+    game = [GameState(0.0)]
+    extra = [LoggerStage(log), Tap("progress", ("referee",), lambda _topic, g: game.__setitem__(0, g))]
+    if args.video:
+        extra.append(OverlayStage("blue", models, settings.field.robot.height_m, write_video))
     wall0 = time.perf_counter()
     try:
+        match = Match(settings, args.opponent, args.perception, seed=args.seed, render=args.video, extra=extra)
         with _progress(not args.no_progress) as progress:
             task = progress.add_task("play", total=n_frames, info="")
             for i in range(n_frames):
-                frame = match.step()
-                log.write("/truth", frame.t_capture, frame.truth.to_dict())
-                log.write("/game", frame.t_capture, frame.game.to_dict())
-                if match.last_world is not None:
-                    log.write("/world", frame.t_capture, match.last_world.to_dict())
-                for c in match.last_commands:
-                    log.write("/commands", frame.t_capture, c.to_dict())
-                if args.video and frame.images:
-                    drawn = {m.id: draw_overlays(frame.images[m.id], m, match.last_world, match.brain,
-                                                 match.last_commands, height) for m in models}  # fmt: skip
-                    full = tile_cameras(drawn, models)
-                    tiled = cv2.resize(full, (full.shape[1] // 2, full.shape[0] // 2), interpolation=cv2.INTER_AREA)
-                    if video is None:
-                        video = cv2.VideoWriter(str(folder / "match.mp4"), cv2.VideoWriter.fourcc(*"mp4v"), fps,
-                                                (tiled.shape[1], tiled.shape[0]))  # fmt: skip
-                    video.write(tiled)
+                match.step()
                 if i % 15 == 0 or i == n_frames - 1:
-                    g = frame.game
-                    progress.update(task, completed=i + 1, info=f"t={frame.t_capture:6.1f}s  blue {g.score_blue}:"
+                    g = game[0]
+                    progress.update(task, completed=i + 1, info=f"t={g.t:6.1f}s  blue {g.score_blue}:"
                                                                  f"{g.score_yellow} yellow  {g.command}")  # fmt: skip
+        summary = match.summary()
     finally:
         log.close()
-        if video is not None:
-            video.release()
+        if video:
+            video[0].release()
     wall = time.perf_counter() - wall0
-    summary = match.summary()
     summary["wall_seconds"] = round(wall, 3)
     summary["realtime_factor"] = round(summary["seconds"] / wall, 2) if wall > 0 else None
     (folder / "summary.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
@@ -278,12 +281,6 @@ def _cmd_play(args: argparse.Namespace) -> int:
         f"brain {brain:.2f} ms median -> {folder}"
     )
     return 0
-
-
-def _event_dict(e: object) -> dict[str, object]:
-    import dataclasses
-
-    return {k: v for k, v in dataclasses.asdict(e).items()} if dataclasses.is_dataclass(e) else {}  # type: ignore[arg-type]
 
 
 def _cmd_vision(args: argparse.Namespace) -> int:

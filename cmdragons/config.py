@@ -30,6 +30,7 @@ import yaml
 
 __all__ = [
     "ConfigError",
+    "FrozenMap",
     "Validated",
     "apply_override",
     "check_ranges",
@@ -41,6 +42,36 @@ __all__ = [
 ]
 
 T = TypeVar("T")
+K = TypeVar("K")
+V = TypeVar("V")
+
+
+class FrozenMap(Mapping[K, V]):
+    """A read-only mapping for config values: hashable, comparable with dicts, and picklable
+    (``types.MappingProxyType`` is not, and settings cross process boundaries)."""
+
+    __slots__ = ("_data",)
+
+    def __init__(self, data: Mapping[K, V] | None = None) -> None:
+        self._data: dict[K, V] = dict(data or {})
+
+    def __getitem__(self, key: K) -> V:
+        return self._data[key]
+
+    def __iter__(self) -> typing.Iterator[K]:
+        return iter(self._data)
+
+    def __len__(self) -> int:
+        return len(self._data)
+
+    def __hash__(self) -> int:
+        return hash(tuple(self._data.items()))
+
+    def __repr__(self) -> str:
+        return f"FrozenMap({self._data!r})"
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (FrozenMap, (self._data,))
 
 
 class ConfigError(ValueError):
@@ -225,7 +256,7 @@ def _convert(tp: Any, value: Any, file: str, key: str) -> Any:
         out = {}
         for k, v in value.items():
             out[_convert(key_t, k, file, _join(key, str(k)))] = _convert(val_t, v, file, _join(key, str(k)))
-        return types.MappingProxyType(out)
+        return FrozenMap(out)
     if tp is bool:
         if not isinstance(value, bool):
             raise ConfigError(file, key, f"expected true or false, got {value!r}")

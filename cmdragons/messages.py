@@ -7,6 +7,9 @@ bus: a fixed little-endian header followed by packed rows (numpy structured arra
 
 from __future__ import annotations
 
+import base64
+import binascii
+import dataclasses
 import math
 import struct
 from collections.abc import Mapping, Sequence
@@ -20,16 +23,30 @@ from cmdragons.geometry import TEAMS, Team
 
 __all__ = [
     "BallDetection",
+    "BallOut",
     "BallState",
     "BallTruth",
+    "CameraFrame",
+    "Contact",
     "DetectionFrame",
+    "Event",
     "GameState",
+    "Goal",
     "GroundTruth",
+    "Kick",
     "MessageError",
     "RobotCommand",
     "RobotDetection",
+    "RobotReport",
     "RobotState",
     "RobotTruth",
+    "SimEvents",
+    "StageSummary",
+    "TeamCommands",
+    "TeamReport",
+    "Teleport",
+    "Tick",
+    "Timing",
     "WorldState",
 ]
 
@@ -262,8 +279,9 @@ class WorldState:
     t: float
     ball: BallState | None
     robots: tuple[RobotState, ...] = ()
+    frame_number: int = 0  # the camera frame the state was estimated from
 
-    _codec: ClassVar[_Codec] = _Codec("d", _BALL_STATE, _ROBOT_STATE)
+    _codec: ClassVar[_Codec] = _Codec("dq", _BALL_STATE, _ROBOT_STATE)
 
     def robot(self, team: Team, robot_id: int) -> RobotState | None:
         for r in self.robots:
@@ -275,6 +293,7 @@ class WorldState:
         b = self.ball
         return {
             "t": self.t,
+            "frame_number": self.frame_number,
             "ball": None if b is None else {"x": b.x, "y": b.y, "vx": b.vx, "vy": b.vy, "visible": b.visible},
             "robots": [
                 {"team": r.team, "id": r.id, "x": r.x, "y": r.y, "theta": r.theta, "vx": r.vx, "vy": r.vy,
@@ -294,7 +313,7 @@ class WorldState:
                            _f(r, "vx", 0.0), _f(r, "vy", 0.0), _f(r, "omega", 0.0), bool(r.get("visible", True)))
                 for r in d.get("robots", ())
             )  # fmt: skip
-            return cls(_f(d, "t"), ball, robots)
+            return cls(_f(d, "t"), ball, robots, int(d.get("frame_number", 0)))
         except (KeyError, TypeError, AttributeError) as exc:
             raise MessageError(f"bad world state: {exc!r}") from None
 
@@ -305,11 +324,11 @@ class WorldState:
             [(_team_code(r.team), r.id, r.visible, r.x, r.y, r.theta, r.vx, r.vy, r.omega) for r in self.robots],
             dtype=_ROBOT_STATE,
         )
-        return self._codec.pack((self.t,), balls, robots)
+        return self._codec.pack((self.t, self.frame_number), balls, robots)
 
     @classmethod
     def decode(cls, data: bytes | bytearray | memoryview) -> Self:
-        (t,), (balls, robots) = cls._codec.unpack(data)
+        (t, frame), (balls, robots) = cls._codec.unpack(data)
         ball = None
         if len(balls):
             b = balls[0]
@@ -319,6 +338,7 @@ class WorldState:
             tuple(RobotState(TEAMS[int(r["team"]) & 1], int(r["id"]), float(r["x"]), float(r["y"]),
                              float(r["theta"]), float(r["vx"]), float(r["vy"]), float(r["omega"]),
                              bool(r["visible"])) for r in robots),
+            int(frame),
         )  # fmt: skip
 
 
@@ -544,3 +564,301 @@ class GameState:
             raise MessageError(f"unknown game command code {cmd}")
         placement = None if math.isnan(px) else (px, py)
         return cls(t, _COMMANDS[cmd], None if team < 0 else TEAMS[team & 1], sb, sy, bool(blue_neg), placement)
+
+
+# --- simulator events --------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Goal:
+    t: float
+    scoring_team: Team
+    x: float
+    y: float
+
+
+@dataclass(frozen=True)
+class BallOut:
+    t: float
+    x: float  # where the ball crossed the line
+    y: float
+    last_touch: Team | None
+
+
+@dataclass(frozen=True)
+class Kick:
+    t: float
+    team: Team
+    id: int
+    speed_m_s: float
+    chip: bool
+
+
+@dataclass(frozen=True)
+class Contact:
+    """One robot-robot contact, from first touch to separation."""
+
+    t_start: float
+    duration_s: float
+    a: tuple[Team, int]
+    b: tuple[Team, int]
+    max_depth_m: float  # deepest interpenetration seen
+    relative_speed_m_s: float  # closing speed along the contact normal at first touch
+
+
+Event = Goal | BallOut | Kick | Contact
+_EVENT_TYPES: dict[str, type[Any]] = {"goal": Goal, "ballout": BallOut, "kick": Kick, "contact": Contact}
+
+
+def _event_dict(e: Event) -> dict[str, Any]:
+    d: dict[str, Any] = {"type": type(e).__name__.lower()}
+    for f in dataclasses.fields(e):
+        v = getattr(e, f.name)
+        d[f.name] = list(v) if isinstance(v, tuple) else v
+    return d
+
+
+def _event_from_dict(d: Mapping[str, Any]) -> Event:
+    cls = _EVENT_TYPES.get(str(d.get("type")))
+    if cls is None:
+        raise MessageError(f"unknown event type {d.get('type')!r}")
+    kwargs = {}
+    for f in dataclasses.fields(cls):
+        v = d[f.name]
+        kwargs[f.name] = (_team(v[0]), int(v[1])) if f.name in ("a", "b") else v
+    return cls(**kwargs)  # type: ignore[no-any-return]
+
+
+@dataclass(frozen=True)
+class SimEvents:
+    """What happened in one simulated frame (published after the physics stepped it): its events and
+    where the ball lies now, before any restart moves it (what a referee judges)."""
+
+    frame_number: int
+    t: float
+    ball_xy: tuple[float, float]
+    events: tuple[Event, ...] = ()
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"frame_number": self.frame_number, "t": self.t, "ball": list(self.ball_xy),
+                "events": [_event_dict(e) for e in self.events]}  # fmt: skip
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Self:
+        try:
+            bx, by = d["ball"]
+            return cls(int(d["frame_number"]), _f(d, "t"), (float(bx), float(by)),
+                       tuple(_event_from_dict(e) for e in d.get("events", ())))  # fmt: skip
+        except (KeyError, TypeError, ValueError) as exc:
+            raise MessageError(f"bad simulator events: {exc!r}") from None
+
+
+@dataclass(frozen=True)
+class Teleport:
+    """Objects the simulator puts in place at once (a restart's ball, a kickoff formation), in the
+    order given: field frame, metres, radians."""
+
+    t: float
+    robots: tuple[tuple[Team, int, float, float, float], ...] = ()  # (team, id, x, y, theta)
+    ball: tuple[float, float] | None = None  # placed after the robots, at rest
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"t": self.t, "robots": [{"team": t, "id": i, "x": x, "y": y, "theta": th}
+                                        for t, i, x, y, th in self.robots],
+                "ball": None if self.ball is None else list(self.ball)}  # fmt: skip
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Self:
+        try:
+            ball = d.get("ball")
+            return cls(_f(d, "t"), tuple((_team(r["team"]), int(r["id"]), _f(r, "x"), _f(r, "y"), _f(r, "theta"))
+                                         for r in d.get("robots", ())),
+                       None if ball is None else (float(ball[0]), float(ball[1])))  # fmt: skip
+        except (KeyError, TypeError, ValueError, IndexError) as exc:
+            raise MessageError(f"bad teleport: {exc!r}") from None
+
+
+# --- runtime messages --------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, eq=False)
+class CameraFrame:
+    """One camera's image at one instant: BGR, uint8, (height, width, 3)."""
+
+    camera_id: int
+    frame_number: int
+    t_capture: float
+    image: NDArray[np.uint8] = field(repr=False)
+
+    def __eq__(self, other: object) -> bool:
+        return (isinstance(other, CameraFrame) and (self.camera_id, self.frame_number, self.t_capture)
+                == (other.camera_id, other.frame_number, other.t_capture)
+                and np.array_equal(self.image, other.image))  # fmt: skip
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def to_dict(self) -> dict[str, Any]:
+        """The image as raw bytes in base64 (``bgr8``, rows top to bottom)."""
+        h, w = self.image.shape[:2]
+        return {"camera_id": self.camera_id, "frame_number": self.frame_number, "t_capture": self.t_capture,
+                "width": w, "height": h, "encoding": "bgr8",
+                "data": base64.b64encode(np.ascontiguousarray(self.image).tobytes()).decode("ascii")}  # fmt: skip
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Self:
+        try:
+            if d.get("encoding", "bgr8") != "bgr8":
+                raise MessageError(f"camera frame encoding must be bgr8, got {d['encoding']!r}")
+            w, h = int(d["width"]), int(d["height"])
+            raw = np.frombuffer(base64.b64decode(d["data"]), dtype=np.uint8)
+            if raw.size != w * h * 3:
+                raise MessageError(f"camera frame holds {raw.size} bytes, not {w}x{h}x3")
+            return cls(int(d["camera_id"]), int(d["frame_number"]), _f(d, "t_capture"), raw.reshape(h, w, 3).copy())
+        except (KeyError, TypeError, ValueError, binascii.Error) as exc:
+            raise MessageError(f"bad camera frame: {exc!r}") from None
+
+
+@dataclass(frozen=True)
+class Tick:
+    """The clock: capture camera frame ``frame_number`` now (lock-step runs)."""
+
+    frame_number: int
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"frame_number": self.frame_number}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Self:
+        try:
+            return cls(int(d["frame_number"]))
+        except (KeyError, TypeError, ValueError) as exc:
+            raise MessageError(f"bad tick: {exc!r}") from None
+
+
+@dataclass(frozen=True)
+class TeamCommands:
+    """One team's commands for one camera frame: ``frame_number`` is the frame they answer, ``t`` the
+    time of the world state they were decided on."""
+
+    team: Team
+    frame_number: int
+    t: float
+    commands: tuple[RobotCommand, ...] = ()
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"team": self.team, "frame_number": self.frame_number, "t": self.t,
+                "commands": [c.to_dict() for c in self.commands]}  # fmt: skip
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Self:
+        try:
+            return cls(_team(d["team"]), int(d["frame_number"]), _f(d, "t"),
+                       tuple(RobotCommand.from_dict(c) for c in d.get("commands", ())))  # fmt: skip
+        except (KeyError, TypeError, ValueError) as exc:
+            raise MessageError(f"bad team commands: {exc!r}") from None
+
+
+_Points = tuple[tuple[float, float], ...]
+
+
+def _points(value: Any) -> _Points:
+    return tuple((float(x), float(y)) for x, y in value)
+
+
+@dataclass(frozen=True)
+class RobotReport:
+    """What a brain did for one robot in one frame: the strategy's target, the planner's path and
+    status, the command before safety and the braking path the safety search checked."""
+
+    id: int
+    status: str  # the planner's status ("solved", "direct", "halt", ...)
+    target: tuple[float, float, float]  # (x, y, theta) the strategy asked for
+    path: _Points = ()
+    command: RobotCommand | None = None  # before safety
+    braking: _Points = ()
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"id": self.id, "status": self.status, "target": list(self.target),
+                "path": [list(p) for p in self.path], "braking": [list(p) for p in self.braking],
+                "command": None if self.command is None else self.command.to_dict()}  # fmt: skip
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Self:
+        c = d.get("command")
+        x, y, th = d["target"]
+        return cls(int(d["id"]), str(d.get("status", "")), (float(x), float(y), float(th)),
+                   _points(d.get("path", ())), None if c is None else RobotCommand.from_dict(c),
+                   _points(d.get("braking", ())))  # fmt: skip
+
+
+@dataclass(frozen=True)
+class TeamReport:
+    """One team's brain in one frame, for statistics, overlays and logs: per robot what it did, each
+    robot's last action as the strategy decided it ("shot", "pass", ...), the pass evaluation's
+    receiving points and values (wall-clock times go on a topic of their own: :class:`Timing`)."""
+
+    team: Team
+    frame_number: int
+    t: float
+    robots: tuple[RobotReport, ...] = ()
+    actions: Mapping[int, str] = field(default_factory=dict)
+    pass_points: _Points = ()
+    pass_values: tuple[float, ...] = ()
+
+    def robot(self, robot_id: int) -> RobotReport | None:
+        return next((r for r in self.robots if r.id == robot_id), None)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"team": self.team, "frame_number": self.frame_number, "t": self.t,
+                "robots": [r.to_dict() for r in self.robots],
+                "actions": {str(k): v for k, v in self.actions.items()},
+                "pass_points": [list(p) for p in self.pass_points],
+                "pass_values": list(self.pass_values)}  # fmt: skip
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Self:
+        try:
+            return cls(_team(d["team"]), int(d["frame_number"]), _f(d, "t"),
+                       tuple(RobotReport.from_dict(r) for r in d.get("robots", ())),
+                       {int(k): str(v) for k, v in d.get("actions", {}).items()}, _points(d.get("pass_points", ())),
+                       tuple(float(v) for v in d.get("pass_values", ())))  # fmt: skip
+        except (KeyError, TypeError, ValueError) as exc:
+            raise MessageError(f"bad team report: {exc!r}") from None
+
+
+@dataclass(frozen=True)
+class Timing:
+    """Wall-clock milliseconds of a stage's parts in one frame (never the same twice: logs that must
+    be the same for the same seed leave this topic out)."""
+
+    stage: str
+    frame_number: int
+    ms: Mapping[str, float] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"stage": self.stage, "frame_number": self.frame_number, "ms": dict(self.ms)}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Self:
+        try:
+            return cls(str(d["stage"]), int(d["frame_number"]), {str(k): float(v) for k, v in d["ms"].items()})
+        except (KeyError, TypeError, ValueError, AttributeError) as exc:
+            raise MessageError(f"bad timing: {exc!r}") from None
+
+
+@dataclass(frozen=True)
+class StageSummary:
+    """A stage's figures at the end of a run (what summary.json gathers), as plain JSON values."""
+
+    stage: str
+    figures: Mapping[str, Any] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"stage": self.stage, "figures": dict(self.figures)}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Self:
+        try:
+            return cls(str(d["stage"]), dict(d.get("figures", {})))
+        except (KeyError, TypeError, ValueError) as exc:
+            raise MessageError(f"bad stage summary: {exc!r}") from None

@@ -82,6 +82,7 @@ class Brain:
         self.safety: Safety = make_safety(settings.safety, settings.control, self.radius, static, stream=stream)
         self.times: dict[str, list[float]] = defaultdict(list)
         self.plans: dict[int, RobotPlan] = {}
+        self.braking: dict[int, np.ndarray] = {}  # robot id -> the braking path DSS checked, (k, 2)
         self._control_cache: dict[float, ControlParams] = {}
         self._last_seen: dict[int, tuple[float, RobotState]] = {}  # own robots as the world last showed them
         self._sent: dict[int, tuple[float, float]] = {}  # the last safe velocity command of each robot

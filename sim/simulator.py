@@ -15,13 +15,13 @@ from numpy.typing import NDArray
 
 from cmdragons.camera import CameraModel
 from cmdragons.geometry import TEAMS, LeagueParams, Team
-from cmdragons.messages import GameState, GroundTruth, RobotCommand
+from cmdragons.messages import BallOut, Contact, GameState, Goal, GroundTruth, Kick, RobotCommand, Teleport
 from sim.params import SimParams
 from sim.referee import Referee
 from sim.render import CameraRenderer
-from sim.world import BallOut, Contact, Goal, Kick, World
+from sim.world import World
 
-__all__ = ["Frame", "Simulator"]
+__all__ = ["Frame", "Simulator", "referee_summary"]
 
 
 @dataclass(frozen=True)
@@ -32,7 +32,7 @@ class Frame:
     frame_number: int
     images: dict[int, NDArray[np.uint8]]
     truth: GroundTruth
-    game: GameState
+    game: GameState | None  # None when the referee runs as a stage of its own
 
 
 @dataclass
@@ -52,14 +52,20 @@ class Simulator:
         *,
         seed: int | None = None,
         render: bool = True,
+        referee: bool = True,
     ) -> None:
+        """``referee``: judge the game here (``cmdragons sim``); off, the referee is a stage of its own
+        that sends teleports (:meth:`teleport`)."""
         self.league, self.params = league, params
         self.seed = params.seed if seed is None else seed
         counts = {t: params.robots_per_team.get(t, league.dims.robots_per_team) for t in TEAMS}
         self.world = World(league, params.physics, params.robot, params.ball, params.kicker, params.dribbler,
                            robots_per_team=counts)  # fmt: skip
-        self.referee = Referee(self.world, params.referee)
-        self.referee.kickoff_setup("blue")
+        self.world.blue_defends = -1 if params.referee.blue_defends == "negative_x" else 1
+        self.referee: Referee | None = None
+        if referee:
+            self.referee = Referee(self.world.field, self.world.robot_keys(), params.referee)
+            self.world.apply(self.referee.kickoff_setup("blue"))
         self.cameras = list(cameras)
         seeds = np.random.SeedSequence(self.seed).spawn(len(self.cameras) + 1)
         self.rng = np.random.default_rng(seeds[0])  # for scripted play and anything else of the sim
@@ -96,32 +102,54 @@ class Simulator:
         if self.renderers:
             self.times.render_ms.append((time.perf_counter() - t0) * 1e3)
         gt = self.world.ground_truth(snap, ball_px, robot_px)
-        return Frame(snap.t, snap.frame_number, images, gt, self.referee.state())
+        return Frame(snap.t, snap.frame_number, images, gt, None if self.referee is None else self.referee.state())
 
     def advance(self, commands: Iterable[RobotCommand] = ()) -> list[Goal | BallOut | Kick | Contact]:
         """Send ``commands`` now and step one camera frame; returns the frame's events."""
         t0 = time.perf_counter()
         events = self.world.step_frame(commands)
-        self.referee.observe(events)
+        if self.referee is not None:
+            teleport = self.referee.observe(self.world.t, events, self.ball_xy())
+            if teleport is not None:
+                self.world.apply(teleport)
         self.times.physics_ms.append((time.perf_counter() - t0) * 1e3)
         return events
 
+    def ball_xy(self) -> tuple[float, float]:
+        """Where the ball lies now (field frame, m)."""
+        x, y = self.world.ball_body.position
+        return (float(x), float(y))
+
+    def teleport(self, teleport: Teleport) -> None:
+        """Put objects in place at once (a referee's restart)."""
+        self.world.apply(teleport)
+
     def summary(self) -> dict[str, object]:
-        """Facts of the run so far, for summary.json."""
-        contacts = self.referee.contacts + self.world.open_contacts()
-        return {
+        """Facts of the run so far, for summary.json (the referee's too when it judges here)."""
+        out: dict[str, object] = {
             "seconds": round(self.world.t, 6),
             "frames": self.world.frame_number,
             "seed": self.seed,
-            "score": dict(self.referee.score),
-            "kicks": self.referee.kicks,
-            "balls_out": self.referee.balls_out,
-            "keeper_held_ball": self.referee.keeper_held_ball,
-            "robot_contacts": {
-                "count": len(contacts),
-                "max_depth_m": max((c.max_depth_m for c in contacts), default=0.0),
-                "max_relative_speed_m_s": max((c.relative_speed_m_s for c in contacts), default=0.0),
-                "total_duration_s": sum(c.duration_s for c in contacts),
-            },
             "command_faults": self.world.faults.as_dict(),
         }
+        if self.referee is not None:
+            out |= referee_summary(self.referee, self.world.open_contacts())
+        return out
+
+
+def referee_summary(referee: Referee, open_contacts: Sequence[Contact]) -> dict[str, object]:
+    """The referee's figures of a run: score, kicks, balls out, keeper-held balls, robot contacts
+    (those still open at the end included)."""
+    contacts = referee.contacts + list(open_contacts)
+    return {
+        "score": dict(referee.score),
+        "kicks": referee.kicks,
+        "balls_out": referee.balls_out,
+        "keeper_held_ball": referee.keeper_held_ball,
+        "robot_contacts": {
+            "count": len(contacts),
+            "max_depth_m": max((c.max_depth_m for c in contacts), default=0.0),
+            "max_relative_speed_m_s": max((c.relative_speed_m_s for c in contacts), default=0.0),
+            "total_duration_s": sum(c.duration_s for c in contacts),
+        },
+    }

@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import TEAMS, Field, LeagueParams, Team
-from cmdragons.messages import BallTruth, GroundTruth, RobotCommand, RobotTruth
+from cmdragons.messages import BallOut, BallTruth, Contact, Goal, GroundTruth, Kick, RobotCommand, RobotTruth, Teleport
 from sim.snapshot import Snapshot
 
 __all__ = [
@@ -105,46 +105,6 @@ class DribblerParams(Validated):
     grip_force_n: float = setting(1.0, lo=0.0, hi=50.0)  # at full dribbler power
     pull_speed_m_s: float = setting(0.5, lo=0.0, hi=5.0)  # how fast the grip re-centres the ball
     release_distance_m: float = setting(0.03, lo=0.001, hi=0.5)  # ball torn this far away: released
-
-
-# --- events --------------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class Goal:
-    t: float
-    scoring_team: Team
-    x: float
-    y: float
-
-
-@dataclass(frozen=True)
-class BallOut:
-    t: float
-    x: float  # where the ball crossed the line
-    y: float
-    last_touch: Team | None
-
-
-@dataclass(frozen=True)
-class Kick:
-    t: float
-    team: Team
-    id: int
-    speed_m_s: float
-    chip: bool
-
-
-@dataclass(frozen=True)
-class Contact:
-    """One robot-robot contact, from first touch to separation."""
-
-    t_start: float
-    duration_s: float
-    a: tuple[Team, int]
-    b: tuple[Team, int]
-    max_depth_m: float  # deepest interpenetration seen
-    relative_speed_m_s: float  # closing speed along the contact normal at first touch
 
 
 @dataclass
@@ -327,6 +287,13 @@ class World:
         self._ball.z, self._ball.vz = z, 0.0
         self._start_slide(math.hypot(vx, vy))
         self.space.reindex_shapes_for_body(self.ball_body)
+
+    def apply(self, teleport: Teleport) -> None:
+        """Carry out a teleport: its robots in the order given, then its ball, each at rest."""
+        for team, rid, x, y, theta in teleport.robots:
+            self.place_robot(team, rid, x, y, theta)
+        if teleport.ball is not None:
+            self.place_ball(*teleport.ball)
 
     # --- commands -----------------------------------------------------------------------------
     def sanitize(self, cmd: RobotCommand) -> RobotCommand | None:

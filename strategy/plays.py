@@ -16,6 +16,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import NDArray
 
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, Team
@@ -125,6 +126,12 @@ class Strategy:
     def own_sign(self, game: GameState) -> float:
         blue_neg = game.blue_defends_negative_x
         return -1.0 if (self.team == "blue") == blue_neg else 1.0
+
+    @property
+    def pass_heat(self) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
+        """The pass evaluation's last grid: receiving points (n, 2) and their values (n,), or None."""
+        ev = self.mem.evaluation
+        return None if ev is None else (ev.points, ev.values)
 
     def decide(self, world: WorldState, game: GameState) -> dict[int, Intent]:
         """An intent for each of our robots in ``world``."""

@@ -1,4 +1,14 @@
-"""The import rules of DESIGN.md, kept by scanning the source."""
+"""The import rules of docs/architecture.md, kept by scanning the source (relative imports too).
+
+- The floor (config, geometry, messages, camera model) imports nothing else of the project.
+- The simulator never imports vision, strategy or the brain: it must not know how the team sees or
+  thinks.
+- No stage package (vision, sim, strategy and the algorithm packages under cmdragons/) imports the
+  composition: the runtime, the team's brain, the benchmarks or the command line.
+- Heavy I/O libraries stay in the packages that own them: zenoh in the runtime, pymunk in sim/,
+  mcap in the runtime's log, PyAV in the video module, OpenCV's video files in the modules that read
+  or write recordings and videos.
+"""
 
 from __future__ import annotations
 
@@ -8,47 +18,98 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-FLOOR = {"cmdragons.config", "cmdragons.geometry", "cmdragons.messages", "cmdragons.camera", "cmdragons.recording"}
+FLOOR = {"cmdragons.config", "cmdragons.geometry", "cmdragons.messages", "cmdragons.camera"}
 PROJECT = ("cmdragons", "vision", "strategy", "sim")
+COMPOSITION = ("cmdragons.runtime", "cmdragons.team", "cmdragons.bench", "cmdragons.cli", "cmdragons.cli_vision")
+# library -> the module prefixes allowed to import it
+OWNERS: dict[str, tuple[str, ...]] = {
+    "zenoh": ("cmdragons.runtime",),
+    "pymunk": ("sim",),
+    "mcap": ("cmdragons.runtime",),
+    "mcap_protobuf": ("cmdragons.runtime",),
+    "av": ("cmdragons.videoio",),
+    "matplotlib": ("cmdragons.runtime", "cmdragons.bench"),
+}
+CV2_VIDEO = ("VideoWriter", "VideoCapture")
+CV2_VIDEO_OWNERS = ("cmdragons.videoio", "cmdragons.recording", "vision.sources", "cmdragons.cli",
+                    "cmdragons.runtime", "cmdragons.bench")  # fmt: skip
+
+
+def module_name(path: Path) -> str:
+    parts = list(path.relative_to(ROOT).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts.pop()
+    return ".".join(parts)
 
 
 def imports(path: Path) -> set[str]:
-    tree = ast.parse(path.read_text(encoding="utf-8"))
+    """Every module ``path`` imports, relative imports resolved against its package."""
+    return imports_of(path.read_text(encoding="utf-8"), module_name(path), path.name == "__init__.py")
+
+
+def imports_of(source: str, module: str, is_package: bool) -> set[str]:
+    tree = ast.parse(source)
+    package = module.split(".") if is_package else module.split(".")[:-1]
     out: set[str] = set()
     for node in ast.walk(tree):
         if isinstance(node, ast.Import):
             out |= {a.name for a in node.names}
-        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
-            out.add(node.module)
+        elif isinstance(node, ast.ImportFrom):
+            if node.level == 0:
+                base = node.module or ""
+            else:
+                base = ".".join(package[: len(package) - node.level + 1] + ([node.module] if node.module else []))
+            out.add(base)
+            out |= {f"{base}.{a.name}" for a in node.names}  # `from pkg import module`
     return out
 
 
-def sources(package: str) -> list[Path]:
-    return sorted((ROOT / package.replace(".", "/")).rglob("*.py"))
+def sources(*packages: str) -> list[Path]:
+    return sorted(p for pkg in packages for p in (ROOT / pkg.replace(".", "/")).rglob("*.py"))
+
+
+def under(module: str, prefixes: tuple[str, ...]) -> bool:
+    return any(module == p or module.startswith(p + ".") for p in prefixes)
 
 
 def project_imports(path: Path) -> set[str]:
     return {m for m in imports(path) if m.split(".")[0] in PROJECT}
 
 
+ALL = sources(*PROJECT)
+STAGE_PACKAGES = [p for p in ALL if not under(module_name(p), COMPOSITION)]
+
+
+def test_relative_imports_are_resolved() -> None:
+    found = imports_of("from ..runtime import bus\nfrom . import world\n", "cmdragons.planning.errt", False)
+    assert {"cmdragons.runtime", "cmdragons.runtime.bus", "cmdragons.planning.world"} <= found
+    found = imports_of("from .errt import ERRTPlanner\n", "cmdragons.planning", True)
+    assert "cmdragons.planning.errt" in found
+
+
 @pytest.mark.parametrize("module", sorted(FLOOR))
 def test_floor_imports_only_the_floor(module: str) -> None:
     path = ROOT / (module.replace(".", "/") + ".py")
-    assert project_imports(path) <= FLOOR, path
+    assert {m for m in project_imports(path) if not under(m, tuple(FLOOR))} == set(), path
 
 
 @pytest.mark.parametrize("path", sources("sim"), ids=lambda p: p.name)
 def test_sim_never_imports_vision_strategy_or_the_brain(path: Path) -> None:
-    bad = {m for m in project_imports(path) if not (m in FLOOR or m.split(".")[0] == "sim")}
+    bad = {m for m in project_imports(path) if not (under(m, tuple(FLOOR)) or m.split(".")[0] == "sim")}
     assert not bad, f"{path} imports {bad}"
 
 
-@pytest.mark.parametrize(
-    "path",
-    [p for pkg in ("vision", "strategy", "cmdragons") for p in sources(pkg)
-     if "runtime" not in p.parts and "bench" not in p.parts and p.name != "cli.py"],
-    ids=lambda p: str(p.relative_to(ROOT)),
-)  # fmt: skip
-def test_algorithms_import_no_middleware_physics_or_plotting(path: Path) -> None:
-    bad = {m for m in imports(path) if m.split(".")[0] in {"zenoh", "pymunk", "matplotlib"}}
+@pytest.mark.parametrize("path", STAGE_PACKAGES, ids=lambda p: str(p.relative_to(ROOT)))
+def test_stage_packages_do_not_import_the_composition(path: Path) -> None:
+    bad = {m for m in project_imports(path) if under(m, COMPOSITION)}
     assert not bad, f"{path} imports {bad}"
+
+
+@pytest.mark.parametrize("path", ALL, ids=lambda p: str(p.relative_to(ROOT)))
+def test_heavy_io_libraries_stay_with_their_owners(path: Path) -> None:
+    module = module_name(path)
+    bad = {m for m in imports(path) if m.split(".")[0] in OWNERS and not under(module, OWNERS[m.split(".")[0]])}
+    assert not bad, f"{path} imports {bad}"
+    if not under(module, CV2_VIDEO_OWNERS):
+        text = path.read_text(encoding="utf-8")
+        assert not any(f"cv2.{name}" in text for name in CV2_VIDEO), f"{path} opens video files with OpenCV"

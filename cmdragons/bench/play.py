@@ -49,8 +49,8 @@ def _brain_cycle(settings: Settings, division: str, seconds: float) -> dict[str,
     s = dataclasses.replace(settings, field=league)
     m = Match(s, "self", "truth", seed=3)
     m.run(seconds)
-    brain = m.stats.stage_ms["brain"]
-    tracker = m.stats.stage_ms["tracker"]
+    brain = m.stage_ms["brain"]
+    tracker = m.stage_ms["tracker"]
     cycle = np.array(brain) + np.array(tracker)
     return {"name": f"brain_cycle_{league.dims.robots_per_team}_robots", "median_ms": float(np.median(cycle)),
             "p95_ms": float(np.percentile(cycle, 95)), "brain_median_ms": float(np.median(brain)),

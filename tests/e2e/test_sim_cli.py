@@ -41,7 +41,7 @@ def test_sim_record_reads_back(tmp_path: Path, fmt: str) -> None:
     assert snap.stat().st_size > 10_000
     with open(out / "run.mcap", "rb") as f:
         topics = {ch.topic for _, ch, _ in make_reader(f).iter_messages()}
-    assert {"/truth", "/game", "/commands"} <= topics
+    assert {"/truth", "/referee", "/commands/blue", "/commands/yellow", "/events"} <= topics
 
 
 def test_same_seed_same_run(tmp_path: Path) -> None:

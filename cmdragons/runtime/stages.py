@@ -1,0 +1,438 @@
+"""The stages of a match, each a thin adapter between the bus and one algorithm object.
+
+Topics (what each stage reads -> writes):
+
+    clock              Tick                 -> sim
+    camera/<id>/frame  CameraFrame          sim -> vision/<id> (and a video, a logger)
+    truth              GroundTruth          sim -> simple opponent, truth perception, statistics
+    events             SimEvents            sim -> referee, statistics
+    teleport           Teleport             referee -> sim
+    referee            GameState            referee -> brains, opponent, statistics
+    detections/<id>    DetectionFrame       vision/<id> -> trackers
+    perception/<team>  DetectionFrame       truth perception/<team> -> tracker/<team>
+    world/<team>       WorldState           tracker/<team> -> team/<team>
+    commands/<team>    TeamCommands         team/<team> or the opponent -> sim, tracker/<team>
+    report/<team>      TeamReport           team/<team> -> statistics, overlays
+    timing/<team>      Timing               team/<team> -> timings (wall clock: not in same-seed logs)
+    summary/<stage>    StageSummary         every stage, on request -> the match summary
+
+Nothing here reaches into another stage: what a stage needs from another comes on a topic.
+"""
+
+from __future__ import annotations
+
+import math
+from abc import ABC, abstractmethod
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+
+from cmdragons.geometry import TEAMS, Team
+from cmdragons.messages import (
+    BallDetection,
+    BallState,
+    CameraFrame,
+    Contact,
+    DetectionFrame,
+    GameState,
+    GroundTruth,
+    Kick,
+    RobotCommand,
+    RobotDetection,
+    RobotReport,
+    RobotState,
+    SimEvents,
+    StageSummary,
+    TeamCommands,
+    TeamReport,
+    Timing,
+    WorldState,
+)
+from cmdragons.runtime.bus import BaseStage, Publish, topic_matches
+from cmdragons.runtime.log import RunLog
+from cmdragons.team import Brain
+from cmdragons.tracking import Tracker
+from sim.referee import Referee
+from sim.simulator import Simulator
+from strategy.simple import SimpleTeam
+
+__all__ = [
+    "LoggerStage",
+    "RefereeStage",
+    "SimStage",
+    "SimpleOpponentStage",
+    "StatsStage",
+    "SummaryCollector",
+    "Tap",
+    "TeamStage",
+    "TimingStage",
+    "TrackerStage",
+    "TruthPerceptionStage",
+    "VisionStage",
+    "message_time",
+    "truth_world",
+]
+
+
+def truth_world(gt: GroundTruth) -> WorldState:
+    """The simulator's truth as a world state (what the simple opponent plays on)."""
+    b = gt.ball
+    return WorldState(gt.t, BallState(b.x, b.y, b.vx, b.vy), tuple(
+        RobotState(r.team, r.id, r.x, r.y, r.theta, r.vx, r.vy, r.omega) for r in gt.robots),
+        gt.frame_number)  # fmt: skip
+
+
+class SimStage(BaseStage):
+    """The simulator with its cameras. On a tick it captures the frame (truth, then each camera's
+    image); once every playing team's commands for that frame came, it steps the physics and
+    publishes the frame's events; teleports it carries out at once."""
+
+    name = "sim"
+    inputs = ("clock", "commands/*", "teleport")
+
+    def __init__(self, sim: Simulator, teams: Sequence[Team]) -> None:
+        self.sim = sim
+        self.teams = tuple(t for t in TEAMS if t in teams)
+        self.frame_number = -1
+        self._commands: dict[Team, TeamCommands] = {}
+
+    def on_message(self, topic: str, message: Any, publish: Publish) -> None:
+        if topic == "clock":
+            self._capture(publish)
+        elif topic == "teleport":
+            self.sim.teleport(message)
+        elif isinstance(message, TeamCommands) and message.frame_number == self.frame_number:
+            self._commands[message.team] = message
+            if all(t in self._commands for t in self.teams):
+                self._advance(publish)
+
+    def _capture(self, publish: Publish) -> None:
+        frame = self.sim.capture()
+        self.frame_number = frame.frame_number
+        self._commands = {}
+        publish("truth", frame.truth)
+        for cam, image in sorted(frame.images.items()):
+            publish(f"camera/{cam}/frame", CameraFrame(cam, frame.frame_number, frame.t_capture, image))
+        if not self.teams:
+            self._advance(publish)
+
+    def _advance(self, publish: Publish) -> None:
+        commands = [c for t in self.teams for c in self._commands[t].commands]
+        self._commands = {}
+        events = self.sim.advance(commands)
+        publish("events", SimEvents(self.frame_number, self.sim.t, self.sim.ball_xy(), tuple(events)))
+        self.frame_number = -1  # until the next capture, commands are stale
+
+    def summarize(self, publish: Publish) -> None:
+        figures = dict(self.sim.summary())
+        figures["open_contacts"] = [[list(c.a), list(c.b)] for c in self.sim.world.open_contacts()]
+        publish(f"summary/{self.name}", StageSummary(self.name, figures))
+
+
+class VisionStage(BaseStage):
+    """One camera's vision: image -> detections."""
+
+    def __init__(self, camera_id: int, pipeline: Any) -> None:
+        self.name = f"vision/{camera_id}"
+        self.inputs = (f"camera/{camera_id}/frame",)
+        self.camera_id = camera_id
+        self.pipeline = pipeline
+
+    def on_message(self, topic: str, message: Any, publish: Publish) -> None:
+        f: CameraFrame = message
+        publish(f"detections/{self.camera_id}", self.pipeline.process(f.image, f.frame_number, f.t_capture))
+
+
+class TruthPerceptionStage(BaseStage):
+    """Detections made from the simulator's truth plus vision-like noise, for one team (its own
+    draws): for work on strategy, planning and control without vision in the way."""
+
+    def __init__(self, team: Team, sigmas: tuple[float, float, float], seed: int) -> None:
+        self.name = f"perception/{team}"
+        self.inputs = ("truth",)
+        self.topic = f"perception/{team}"
+        self.sigma_ball, self.sigma_xy, self.sigma_theta = sigmas
+        self.rng = np.random.default_rng(seed)
+
+    def on_message(self, topic: str, message: Any, publish: Publish) -> None:
+        gt: GroundTruth = message
+        n, sb, sxy, sth = self.rng.normal, self.sigma_ball, self.sigma_xy, self.sigma_theta
+        ball = (BallDetection(gt.ball.x + n(0, sb), gt.ball.y + n(0, sb), 1.0, (0.0, 0.0)),)
+        robots = tuple(RobotDetection(r.team, r.id, r.x + n(0, sxy), r.y + n(0, sxy), r.theta + n(0, sth), 1.0,
+                                      (0.0, 0.0)) for r in gt.robots)  # fmt: skip
+        publish(self.topic, DetectionFrame(0, gt.frame_number, gt.t, gt.t, ball, robots))
+
+
+class TrackerStage(BaseStage):
+    """One team's tracker: steps once every detection topic it reads has delivered the frame (a
+    newer frame first closes the one in progress with what came), and takes its team's commands as
+    the robots' control input."""
+
+    def __init__(self, team: Team, tracker: Tracker, detection_topics: Sequence[str]) -> None:
+        self.name = f"tracker/{team}"
+        self.team = team
+        self.detection_topics = tuple(detection_topics)
+        self.inputs = (*self.detection_topics, f"commands/{team}")
+        self.tracker = tracker
+        self._frame = -1
+        self._pending: dict[str, DetectionFrame] = {}
+        self._t_capture: dict[int, float] = {}
+
+    def on_message(self, topic: str, message: Any, publish: Publish) -> None:
+        if isinstance(message, TeamCommands):
+            t = self._t_capture.pop(message.frame_number, None)
+            if t is not None:
+                self.tracker.command_sent(message.commands, t)
+            return
+        det: DetectionFrame = message
+        if det.frame_number != self._frame and self._pending:
+            self._step(publish)
+        self._frame = det.frame_number
+        self._pending[topic] = det
+        if len(self._pending) == len(self.detection_topics):
+            self._step(publish)
+
+    def _step(self, publish: Publish) -> None:
+        frames = [self._pending[t] for t in sorted(self._pending, key=self.detection_topics.index)]
+        self._pending = {}
+        world = self.tracker.step(frames)
+        self._t_capture = {self._frame: max(f.t_capture for f in frames)}
+        publish(f"world/{self.team}", WorldState(world.t, world.ball, world.robots, self._frame))
+
+    def summarize(self, publish: Publish) -> None:
+        publish(f"summary/{self.name}", StageSummary(self.name, self.tracker.stats.as_dict()))
+
+
+class _PlayingStage(BaseStage, ABC):
+    """A team that plays: keeps the referee's latest word and answers each of its world inputs
+    with that frame's commands (:meth:`play`)."""
+
+    def __init__(self, name: str, team: Team, world_topic: str) -> None:
+        self.name = name
+        self.inputs = (world_topic, "referee")
+        self.team = team
+        self.game = GameState(0.0)
+
+    def on_message(self, topic: str, message: Any, publish: Publish) -> None:
+        if topic == "referee":
+            self.game = message
+            return
+        world, commands = self.play(message)
+        publish(f"commands/{self.team}", TeamCommands(self.team, world.frame_number, world.t, tuple(commands)))
+        self.after(world, publish)
+
+    @abstractmethod
+    def play(self, message: Any) -> tuple[WorldState, list[RobotCommand]]:
+        """The world state ``message`` gives and this frame's commands on it."""
+
+    def after(self, world: WorldState, publish: Publish) -> None:
+        return None
+
+
+class TeamStage(_PlayingStage):
+    """One team's brain: world state and game state -> that frame's commands, its report and its
+    parts' times."""
+
+    def __init__(self, team: Team, brain: Brain) -> None:
+        super().__init__(f"team/{team}", team, f"world/{team}")
+        self.brain = brain
+
+    def play(self, message: Any) -> tuple[WorldState, list[RobotCommand]]:
+        return message, self.brain.step(message, self.game)
+
+    def after(self, world: WorldState, publish: Publish) -> None:
+        publish(f"report/{self.team}", self._report(world))
+        times = {k: v[-1] for k, v in self.brain.times.items() if v}
+        publish(f"timing/{self.team}", Timing(self.name, world.frame_number, times))
+
+    def _report(self, world: WorldState) -> TeamReport:
+        b = self.brain
+        robots = tuple(
+            RobotReport(rid, p.status, (p.intent.x, p.intent.y, p.intent.theta),
+                        tuple((float(x), float(y)) for x, y in p.path), p.command,
+                        tuple((float(x), float(y)) for x, y in b.braking.get(rid, ())))
+            for rid, p in sorted(b.plans.items())
+        )  # fmt: skip
+        heat = b.strategy.pass_heat
+        points, values = ((), ()) if heat is None else (
+            tuple((float(x), float(y)) for x, y in heat[0]), tuple(float(v) for v in heat[1]))  # fmt: skip
+        return TeamReport(self.team, world.frame_number, world.t, robots, dict(b.strategy.last_action), points,
+                          values)  # fmt: skip
+
+
+class SimpleOpponentStage(_PlayingStage):
+    """The built-in simple team: plays on the true state, plain steering."""
+
+    def __init__(self, team: Team, simple: SimpleTeam) -> None:
+        super().__init__(f"opponent/{team}", team, "truth")
+        self.simple = simple
+
+    def play(self, message: Any) -> tuple[WorldState, list[RobotCommand]]:
+        world = truth_world(message)
+        return world, self.simple.commands(world, self.game)
+
+
+class RefereeStage(BaseStage):
+    """The simulator's referee: the frame's events -> the game state (and a restart's teleport)."""
+
+    name = "referee"
+    inputs = ("events",)
+
+    def __init__(self, referee: Referee) -> None:
+        self.referee = referee
+
+    def start(self, publish: Publish) -> None:
+        publish("teleport", self.referee.kickoff_setup("blue"))
+        publish("referee", self.referee.state())
+
+    def on_message(self, topic: str, message: Any, publish: Publish) -> None:
+        ev: SimEvents = message
+        teleport = self.referee.observe(ev.t, ev.events, ev.ball_xy)
+        if teleport is not None:
+            publish("teleport", teleport)
+        publish("referee", self.referee.state())
+
+    def summarize(self, publish: Publish) -> None:
+        r = self.referee
+        publish(f"summary/{self.name}", StageSummary(self.name, {
+            "score": dict(r.score), "kicks": r.kicks, "balls_out": r.balls_out,
+            "keeper_held_ball": r.keeper_held_ball, "robot_contacts": len(r.contacts)}))  # fmt: skip
+
+
+class StatsStage(BaseStage):
+    """One team's match statistics from the bus: shots and passes (kicks with the action the
+    strategy had decided), passes completed (a team-mate holds the ball next), collisions among
+    own robots and with opponents."""
+
+    def __init__(self, team: Team, pass_timeout_s: float, hold_m: float = 0.15) -> None:
+        self.name = f"stats/{team}"
+        self.inputs = ("truth", "referee", f"report/{team}", "events")
+        self.team = team
+        self.pass_timeout_s = pass_timeout_s
+        self.hold_m = hold_m  # a robot whose centre is this near the ball holds it
+        self.shots = self.passes_tried = self.passes_completed = 0
+        self.own_collisions = self.opponent_collisions = 0
+        self.pending_pass: tuple[float, int] | None = None  # (time kicked, passer id)
+        self._truth: GroundTruth | None = None
+        self._game = GameState(0.0)
+        self._actions: dict[int, str] = {}
+
+    def on_message(self, topic: str, message: Any, publish: Publish) -> None:
+        if topic == "truth":
+            self._truth = message
+        elif topic == "referee":
+            self._game = message
+        elif isinstance(message, TeamReport):
+            self._actions = dict(message.actions)
+        elif isinstance(message, SimEvents):
+            self._count(message)
+
+    def _count(self, ev: SimEvents) -> None:
+        for e in ev.events:
+            if isinstance(e, Kick) and e.team == self.team:
+                action = self._actions.get(e.id)
+                if action == "shot":
+                    self.shots += 1
+                elif action == "pass":
+                    self.passes_tried += 1
+                    self.pending_pass = (e.t, e.id)
+            elif isinstance(e, Contact):
+                teams = {e.a[0], e.b[0]}
+                if teams == {self.team}:
+                    self.own_collisions += 1
+                elif self.team in teams:
+                    self.opponent_collisions += 1
+        if self.pending_pass is not None and self._truth is not None:
+            t_kick, passer = self.pending_pass
+            gt = self._truth
+            holders = [r for r in gt.robots if math.hypot(r.x - gt.ball.x, r.y - gt.ball.y) < self.hold_m]
+            if gt.t - t_kick > self.pass_timeout_s or self._game.command != "normal":
+                self.pending_pass = None
+            elif gt.t - t_kick > 0.2 and holders:
+                if any(r.team == self.team and r.id != passer for r in holders):
+                    self.passes_completed += 1
+                self.pending_pass = None
+
+    def summarize(self, publish: Publish) -> None:
+        publish(f"summary/{self.name}", StageSummary(self.name, {
+            "shots": self.shots, "passes": {"tried": self.passes_tried, "completed": self.passes_completed},
+            "collisions": {"own": self.own_collisions, "opponent": self.opponent_collisions},
+        }))  # fmt: skip
+
+
+class TimingStage(BaseStage):
+    """Median and 95th percentile of every timed part on ``timing/*`` (ms), per stage."""
+
+    name = "timing"
+    inputs = ("timing/*",)
+
+    def __init__(self) -> None:
+        self.ms: dict[str, dict[str, list[float]]] = {}
+
+    def on_message(self, topic: str, message: Any, publish: Publish) -> None:
+        t: Timing = message
+        parts = self.ms.setdefault(t.stage, {})
+        for k, v in t.ms.items():
+            parts.setdefault(k, []).append(v)
+
+    def summarize(self, publish: Publish) -> None:
+        publish(f"summary/{self.name}", StageSummary(self.name, {
+            stage: {k: {"median": float(np.median(v)), "p95": float(np.percentile(v, 95))} for k, v in parts.items()}
+            for stage, parts in self.ms.items()}))  # fmt: skip
+
+
+def message_time(message: Any, default: float) -> float:
+    """A message's own time stamp (capture time, else its time), else ``default`` (s)."""
+    for attr in ("t_capture", "t"):
+        t = getattr(message, attr, None)
+        if isinstance(t, float | int) and math.isfinite(t):
+            return float(t)
+    return default
+
+
+class LoggerStage(BaseStage):
+    """Every topic into an MCAP log, each message at its own time stamp; camera images only when
+    asked (about 2.4 MB a frame and camera). Wall-clock timings are left out by default, so the same
+    seed gives the same log byte for byte."""
+
+    name = "logger"
+    inputs = ("*",)
+
+    def __init__(self, log: RunLog, images: bool = False,
+                 skip: Sequence[str] = ("clock", "timing/*", "summary/timing")) -> None:  # fmt: skip
+        self.log = log
+        self.skip = tuple(skip) + (() if images else ("camera/*",))
+        self._t = 0.0
+
+    def on_message(self, topic: str, message: Any, publish: Publish) -> None:
+        if any(topic_matches(p, topic) for p in self.skip):
+            return
+        self._t = message_time(message, self._t)
+        self.log.write("/" + topic, self._t, message.to_dict())
+
+
+class SummaryCollector(BaseStage):
+    """Keeps the latest summary of every stage (topic ``summary/<stage>``)."""
+
+    name = "summaries"
+    inputs = ("summary/*",)
+
+    def __init__(self) -> None:
+        self.figures: dict[str, dict[str, Any]] = {}
+
+    def on_message(self, topic: str, message: Any, publish: Publish) -> None:
+        s: StageSummary = message
+        self.figures[s.stage] = dict(s.figures)
+
+
+class Tap(BaseStage):
+    """Calls ``fn(topic, message)`` for every message on its topics (progress bars, viewers)."""
+
+    def __init__(self, name: str, inputs: Sequence[str], fn: Callable[[str, Any], None]) -> None:
+        self.name = name
+        self.inputs = tuple(inputs)
+        self.fn = fn
+
+    def on_message(self, topic: str, message: Any, publish: Publish) -> None:
+        self.fn(topic, message)

@@ -35,8 +35,10 @@ __all__ = [
     "apply_override",
     "check_ranges",
     "default_config_dir",
+    "derived",
     "load_yaml",
     "parse",
+    "resolve_derived",
     "setting",
     "to_plain",
 ]
@@ -98,6 +100,33 @@ def setting(
     if default_factory is not dataclasses.MISSING:
         return dataclasses.field(default_factory=default_factory, metadata=meta)
     return dataclasses.field(default=default, metadata=meta)
+
+
+def derived(source: str, default: Any, *, lo: float | None = None, hi: float | None = None) -> Any:
+    """A field whose value is configured once, elsewhere: ``source`` (``concern.key.path``) gives
+    it when the settings are loaded (:func:`resolve_derived`), and a YAML key for it is refused with
+    an error naming the source. Built in code, it holds what is given (default ``default``), checked
+    against ``[lo, hi]`` like any :func:`setting`."""
+    return dataclasses.field(default=default, metadata={"source": source, "lo": lo, "hi": hi, "choices": None})
+
+
+def resolve_derived(obj: T, lookup: typing.Callable[[str], Any]) -> T:
+    """``obj`` with every :func:`derived` field (in nested dataclasses and mappings too) set to
+    ``lookup(source)``."""
+    if isinstance(obj, Mapping):
+        return type(obj)({k: resolve_derived(v, lookup) for k, v in obj.items()})  # type: ignore[call-arg,return-value]
+    if not (dataclasses.is_dataclass(obj) and not isinstance(obj, type)):
+        return obj
+    changes: dict[str, Any] = {}
+    for f in dataclasses.fields(obj):
+        if not f.init:
+            continue
+        value = getattr(obj, f.name)
+        source = f.metadata.get("source")
+        new = lookup(source) if source is not None else resolve_derived(value, lookup)
+        if new is not value:
+            changes[f.name] = new
+    return dataclasses.replace(obj, **changes) if changes else obj  # type: ignore[type-var]
 
 
 def default_config_dir() -> Path:
@@ -287,6 +316,10 @@ def _convert_dataclass(cls: type, value: Any, file: str, key: str) -> Any:
         raise ConfigError(file, key, f"expected a mapping, got {value!r}")
     hints = get_type_hints(cls)
     fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
+    for k in value:
+        source = fields[k].metadata.get("source") if k in fields else None
+        if source is not None:
+            raise ConfigError(file, _join(key, str(k)), f"configured once, as {source}: set that instead")
     unknown = [k for k in value if k not in fields]
     if unknown:
         raise ConfigError(

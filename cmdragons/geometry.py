@@ -74,11 +74,19 @@ class FieldDims(Validated):
 
 @dataclass(frozen=True)
 class RobotShape(Validated):
-    """A robot's body: a cylinder cut flat at the front (the dribbler and kicker side)."""
+    """A robot: its body, a cylinder cut flat at the front (the dribbler and kicker side), and what
+    its motors can do (the one place these facts are configured: the simulator, motion control,
+    the safety search and the tracker all take them from here)."""
 
     radius_m: float = setting(0.09, lo=0.02, hi=0.5)
     height_m: float = setting(0.15, lo=0.02, hi=0.5)
     front_distance_m: float = setting(0.07, lo=0.01, hi=0.5)  # centre to the flat front face
+    max_speed_m_s: float = setting(3.0, lo=0.0, hi=10.0)
+    max_accel_m_s2: float = setting(3.0, lo=0.0, hi=50.0)  # speeding up or turning the velocity
+    max_brake_m_s2: float = setting(6.0, lo=0.0, hi=50.0)  # slowing down
+    max_omega_rad_s: float = setting(20.0, lo=0.0, hi=100.0)
+    max_alpha_rad_s2: float = setting(60.0, lo=0.0, hi=1000.0)  # angular acceleration and braking
+    command_latency_s: float = setting(0.03, lo=0.0, hi=1.0)  # command sent -> wheels act on it
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -99,7 +107,14 @@ class RobotShape(Validated):
 
 @dataclass(frozen=True)
 class BallShape(Validated):
+    """The ball and how it rolls on the carpet: the two-phase model (it slides at ``acc_slide``
+    after a kick or bounce until its speed falls to ``slide_to_roll_fraction`` of the speed the slide
+    began with, then rolls at ``acc_roll``), configured once for the simulator, tracker and strategy."""
+
     radius_m: float = setting(0.0215, lo=0.005, hi=0.2)
+    acc_slide_m_s2: float = setting(3.0, lo=0.0, hi=50.0)  # deceleration while sliding
+    acc_roll_m_s2: float = setting(0.26, lo=0.0, hi=10.0)  # deceleration while rolling
+    slide_to_roll_fraction: float = setting(0.64, lo=0.0, hi=1.0)  # of the speed the slide began with
 
 
 _DEFAULT_DOTS = ((0.035, 0.054772), (0.035, -0.054772), (-0.054772, 0.035), (-0.054772, -0.035))

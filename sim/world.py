@@ -29,7 +29,7 @@ import numpy as np
 import pymunk
 from numpy.typing import NDArray
 
-from cmdragons.config import Validated, setting
+from cmdragons.config import Validated, derived, setting
 from cmdragons.geometry import TEAMS, Field, LeagueParams, Team
 from cmdragons.messages import BallOut, BallTruth, Contact, Goal, GroundTruth, Kick, RobotCommand, RobotTruth, Teleport
 from sim.snapshot import Snapshot
@@ -66,12 +66,13 @@ class PhysicsParams(Validated):
 @dataclass(frozen=True)
 class RobotParams(Validated):
     mass_kg: float = setting(2.5, lo=0.1, hi=50.0)
-    max_speed_m_s: float = setting(3.0, lo=0.0, hi=10.0)
-    max_accel_m_s2: float = setting(3.0, lo=0.0, hi=50.0)  # speeding up or turning the velocity
-    max_brake_m_s2: float = setting(6.0, lo=0.0, hi=50.0)  # slowing down
-    max_omega_rad_s: float = setting(20.0, lo=0.0, hi=100.0)
-    max_alpha_rad_s2: float = setting(60.0, lo=0.0, hi=1000.0)  # angular acceleration
-    command_latency_s: float = setting(0.03, lo=0.0, hi=1.0)  # command sent -> wheels act on it
+    # the robot's limits and latency: configured once, in field.yaml robot
+    max_speed_m_s: float = derived("field.robot.max_speed_m_s", 3.0, lo=0.0, hi=10.0)
+    max_accel_m_s2: float = derived("field.robot.max_accel_m_s2", 3.0, lo=0.0, hi=50.0)
+    max_brake_m_s2: float = derived("field.robot.max_brake_m_s2", 6.0, lo=0.0, hi=50.0)
+    max_omega_rad_s: float = derived("field.robot.max_omega_rad_s", 20.0, lo=0.0, hi=100.0)
+    max_alpha_rad_s2: float = derived("field.robot.max_alpha_rad_s2", 60.0, lo=0.0, hi=1000.0)
+    command_latency_s: float = derived("field.robot.command_latency_s", 0.03, lo=0.0, hi=1.0)
     command_timeout_s: float = setting(0.25, lo=0.0, hi=10.0)  # no new command for this long: brake
     elasticity: float = setting(0.1, lo=0.0, hi=1.0)
     friction: float = setting(0.3, lo=0.0, hi=2.0)  # robot-robot and robot-wall contact friction
@@ -80,9 +81,10 @@ class RobotParams(Validated):
 @dataclass(frozen=True)
 class BallParams(Validated):
     mass_kg: float = setting(0.046, lo=0.001, hi=1.0)
-    acc_slide_m_s2: float = setting(3.0, lo=0.0, hi=50.0)  # deceleration while sliding
-    acc_roll_m_s2: float = setting(0.26, lo=0.0, hi=10.0)  # deceleration while rolling
-    slide_to_roll_fraction: float = setting(0.64, lo=0.0, hi=1.0)  # of the speed the slide began with
+    # the two-phase model: configured once, in field.yaml ball
+    acc_slide_m_s2: float = derived("field.ball.acc_slide_m_s2", 3.0, lo=0.0, hi=50.0)
+    acc_roll_m_s2: float = derived("field.ball.acc_roll_m_s2", 0.26, lo=0.0, hi=10.0)
+    slide_to_roll_fraction: float = derived("field.ball.slide_to_roll_fraction", 0.64, lo=0.0, hi=1.0)
     robot_elasticity: float = setting(0.5, lo=0.0, hi=1.0)  # ball against a robot's body
     wall_elasticity: float = setting(0.6, lo=0.0, hi=1.0)
     chip_restitution: float = setting(0.5, lo=0.0, hi=1.0)  # vertical bounce of a chipped ball

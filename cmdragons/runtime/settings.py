@@ -1,7 +1,9 @@
 """All configuration concerns of a run, loaded together from one config folder.
 
 ``configs/<concern>.yaml`` for each concern below; a file left out takes its defaults, an unknown
-file in the folder is an error (most likely a typo in its name).
+file in the folder is an error (most likely a typo in its name). Each physical fact is configured
+once: a parameter that needs one stated elsewhere (the robot's limits, the ball model, the command
+latency) is a ``derived`` field, filled in from its source when the settings are loaded.
 """
 
 from __future__ import annotations
@@ -12,7 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from cmdragons.camera import CameraModel, CamerasParams, cameras_from_config
-from cmdragons.config import ConfigError, apply_override, default_config_dir, load_yaml, parse
+from cmdragons.config import ConfigError, apply_override, default_config_dir, load_yaml, parse, resolve_derived
 from cmdragons.control.motion import ControlParams
 from cmdragons.geometry import Field, LeagueParams
 from cmdragons.planning.registry import PlannerParams
@@ -85,4 +87,13 @@ def load_settings(config_dir: str | Path | None = None, overrides: Sequence[str]
         if name in touched:
             origin += " (with --set " + ", ".join(touched[name]) + ")"
         parsed[name] = parse(cls, raw[name], file=origin)
-    return Settings(config_dir=folder, **parsed)
+
+    def lookup(source: str) -> Any:
+        concern, *path = source.split(".")
+        value = parsed[concern]
+        for part in path:
+            value = getattr(value, part)
+        return value
+
+    # facts configured once (field.robot limits, the ball model, ...) filled in where they are used
+    return Settings(config_dir=folder, **{name: resolve_derived(obj, lookup) for name, obj in parsed.items()})

@@ -28,7 +28,7 @@ from filterpy.kalman import KalmanFilter, predict_steadystate, update_steadystat
 from numpy.typing import NDArray
 from scipy.linalg import block_diag
 
-from cmdragons.config import Validated, setting
+from cmdragons.config import Validated, derived, setting
 
 __all__ = [
     "BallFilter",
@@ -48,9 +48,10 @@ class BallModelParams(Validated):
     # vision's position noise, frame to frame, for detections that carry none of their own
     measurement_sigma_m: float = setting(0.0004, lo=1e-5, hi=1.0)
     accel_sigma_m_s2: float = setting(0.5, lo=0.0, hi=100.0)  # white-noise acceleration (model error)
-    acc_slide_m_s2: float = setting(3.0, lo=0.0, hi=50.0)
-    acc_roll_m_s2: float = setting(0.26, lo=0.0, hi=10.0)
-    slide_to_roll_fraction: float = setting(0.64, lo=0.0, hi=1.0)
+    # the two-phase model: configured once, in field.yaml ball
+    acc_slide_m_s2: float = derived("field.ball.acc_slide_m_s2", 3.0, lo=0.0, hi=50.0)
+    acc_roll_m_s2: float = derived("field.ball.acc_roll_m_s2", 0.26, lo=0.0, hi=10.0)
+    slide_to_roll_fraction: float = derived("field.ball.slide_to_roll_fraction", 0.64, lo=0.0, hi=1.0)
     initial_speed_sigma_m_s: float = setting(3.0, lo=0.01, hi=50.0)  # velocity uncertainty of a new track
     kick_gate_chi2: float = setting(25.0, lo=1.0, hi=1e6)  # innovation (2 dof) beyond this: kick or bounce
     kick_speed_sigma_m_s: float = setting(4.0, lo=0.01, hi=50.0)  # velocity uncertainty after a kick
@@ -72,8 +73,9 @@ class RobotModelParams(Validated):
     measurement_sigma_rad: float = setting(0.01, lo=1e-5, hi=3.0)
     accel_sigma_m_s2: float = setting(8.0, lo=0.0, hi=100.0)  # model error around the commanded motion
     alpha_sigma_rad_s2: float = setting(20.0, lo=0.0, hi=1000.0)
-    max_accel_m_s2: float = setting(3.0, lo=0.0, hi=50.0)  # what our commands can ask of the motors
-    max_alpha_rad_s2: float = setting(60.0, lo=0.0, hi=1000.0)
+    # what our commands can ask of the motors: configured once, in field.yaml robot
+    max_accel_m_s2: float = derived("field.robot.max_accel_m_s2", 3.0, lo=0.0, hi=50.0)
+    max_alpha_rad_s2: float = derived("field.robot.max_alpha_rad_s2", 60.0, lo=0.0, hi=1000.0)
     initial_speed_sigma_m_s: float = setting(1.0, lo=0.01, hi=20.0)
     # after this many regular frames (one detection each, the same time step) the gain has settled
     # and the filter runs in filterpy's steady-state mode (a third of the cost) until a frame differs

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from cmdragons.config import Validated, setting
+from cmdragons.config import Validated, derived, setting
 from cmdragons.geometry import Team
 from cmdragons.messages import BallState, DetectionFrame, RobotCommand, RobotState, WorldState
 from cmdragons.tracking import filters
@@ -35,7 +35,8 @@ __all__ = ["Tracker", "TrackerParams", "TrackerStats"]
 class TrackerParams(Validated):
     """configs/tracker.yaml."""
 
-    latency_s: float = setting(0.03, lo=0.0, hi=1.0)  # capture -> our next command takes effect
+    # capture -> our next command takes effect: the robots' command latency (field.yaml robot)
+    latency_s: float = derived("field.robot.command_latency_s", 0.03, lo=0.0, hi=1.0)
     min_confidence: float = setting(0.1, lo=0.0, hi=1.0)  # detections below are ignored
     ball: BallModelParams = BallModelParams()
     robot: RobotModelParams = RobotModelParams()

@@ -29,13 +29,30 @@ def test_shipped_configs_equal_the_dataclass_defaults() -> None:
     assert sorted(p.stem for p in REPO_CONFIGS.glob("*.yaml")) == sorted(CONCERNS)
 
 
+def test_each_fact_is_configured_once_and_reaches_every_user() -> None:
+    s = load_settings(REPO_CONFIGS, ["field.robot.max_accel_m_s2=2.5", "field.robot.command_latency_s=0.05",
+                                     "field.ball.acc_roll_m_s2=0.3"])  # fmt: skip
+    assert s.sim.robot.max_accel_m_s2 == s.tracker.robot.max_accel_m_s2 == 2.5
+    assert s.sim.robot.command_latency_s == s.tracker.latency_s == 0.05
+    assert s.sim.ball.acc_roll_m_s2 == s.tracker.ball.acc_roll_m_s2 == 0.3
+
+
+def test_a_derived_value_built_in_code_is_still_range_checked() -> None:
+    from sim.world import RobotParams
+
+    with pytest.raises(ValueError, match="max_accel_m_s2"):
+        RobotParams(max_accel_m_s2=-1.0)
+
+
 @pytest.mark.parametrize(
     ("file", "text", "key", "fragment"),
     [
         ("sim.yaml", "physics:\n  substepz: 4\n", "physics.substepz", "unknown key; allowed keys:"),
         ("sim.yaml", "physics:\n  substeps: fast\n", "physics.substeps", "expected an integer"),
         ("sim.yaml", "physics:\n  substeps: 0\n", "physics.substeps", "out of range; allowed: 1 to 100"),
-        ("sim.yaml", "robot:\n  max_speed_m_s: -1.0\n", "robot.max_speed_m_s", "allowed: 0.0 to 10.0"),
+        ("field.yaml", "robot:\n  max_speed_m_s: -1.0\n", "robot.max_speed_m_s", "allowed: 0.0 to 10.0"),
+        ("sim.yaml", "robot:\n  max_speed_m_s: 2.0\n", "robot.max_speed_m_s", "configured once, as field.robot"),
+        ("tracker.yaml", "ball:\n  acc_roll_m_s2: 0.3\n", "ball.acc_roll_m_s2", "as field.ball.acc_roll_m_s2"),
         ("field.yaml", "division: C\n", "division", "allowed: 'A', 'B'"),
         ("sim.yaml", "physics:\n  wall_elasticity: .nan\n", "physics.wall_elasticity", "finite"),
         ("cameras.yaml", "auto:\n  grid: [2]\n", "auto.grid", "a list of 2 values"),

@@ -114,7 +114,7 @@ def resolve_derived(obj: T, lookup: typing.Callable[[str], Any]) -> T:
     """``obj`` with every :func:`derived` field (in nested dataclasses and mappings too) set to
     ``lookup(source)``."""
     if isinstance(obj, Mapping):
-        return type(obj)({k: resolve_derived(v, lookup) for k, v in obj.items()})  # type: ignore[call-arg,return-value]
+        return type(obj)({k: resolve_derived(v, lookup) for k, v in obj.items()})  # type: ignore[call-arg]
     if not (dataclasses.is_dataclass(obj) and not isinstance(obj, type)):
         return obj
     changes: dict[str, Any] = {}
@@ -126,7 +126,7 @@ def resolve_derived(obj: T, lookup: typing.Callable[[str], Any]) -> T:
         new = lookup(source) if source is not None else resolve_derived(value, lookup)
         if new is not value:
             changes[f.name] = new
-    return dataclasses.replace(obj, **changes) if changes else obj  # type: ignore[type-var]
+    return dataclasses.replace(obj, **changes) if changes else obj
 
 
 def default_config_dir() -> Path:

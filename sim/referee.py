@@ -38,7 +38,6 @@ class RefereeParams(Validated):
     restart_delay_s: float = setting(1.0, lo=0.0, hi=30.0)  # goal or out -> ball placed
     place_robots_on_goal: bool = True  # put both teams in their kickoff formation after a goal
     free_kick_distance_m: float = setting(0.2, lo=0.0, hi=2.0)  # from the lines and defense areas
-    kickoff_clearance_m: float = setting(0.5, lo=0.0, hi=3.0)  # own robots around the ball in a stop
     restart_timeout_s: float = setting(10.0, lo=0.1, hi=600.0)  # a restart not taken by then: play on
     keeper_held_ball_s: float = setting(10.0, lo=0.1, hi=600.0)  # ball this long in a defense area: free kick
     # start poses (x m, y m, theta rad) of the team defending -x, per division; mirrored for the other

@@ -218,14 +218,14 @@ def pass_values(ball: Array, points: Array, field: Field, goal_sign: float, obst
     return PassEvaluation(points, values, aims)
 
 
-def clearest_direction(ball: Array, toward: float, obstacles: Array, radius: float, reach_m: float = 1.5,
-                       spread_rad: float = math.pi / 2, samples: int = 13) -> tuple[float, float]:  # fmt: skip
-    """Among directions within ``spread_rad`` of ``toward``, the one whose lane of length
-    ``reach_m`` from the ball is most open, preferring directions near ``toward`` on ties.
-    Returns (angle, open angle)."""
+def clearest_direction(ball: Array, toward: float, obstacles: Array, radius: float, reach_m: float, spread_rad: float,
+                       samples: int, cap_rad: float, turn_cost: float) -> tuple[float, float]:  # fmt: skip
+    """Among ``samples`` directions within ``spread_rad`` of ``toward``, the one whose lane of length
+    ``reach_m`` from the ball is most open (each side capped at ``cap_rad``), less ``turn_cost``
+    per radian off ``toward``. Returns (angle, open angle)."""
     angles = toward + np.linspace(-spread_rad, spread_rad, samples)
     targets = ball + reach_m * np.stack([np.cos(angles), np.sin(angles)], axis=1)
-    open_ = lane_open_angle(ball, targets, obstacles, radius, 0.6)
-    score = open_ - 0.05 * np.abs(angles - toward)
+    open_ = lane_open_angle(ball, targets, obstacles, radius, cap_rad)
+    score = open_ - turn_cost * np.abs(angles - toward)
     k = int(np.argmax(score))
     return float(angles[k]), float(open_[k])

@@ -16,8 +16,10 @@ import numpy as np
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, Team
 from cmdragons.messages import GameState, RobotCommand, WorldState
+from strategy.defense import ball_to_clear, clear_target
 from strategy.evaluation import clearest_direction
-from strategy.plays import StrategyParams, keep_away
+from strategy.game_states import keep_away
+from strategy.plays import StrategyParams
 from strategy.skills import Intent, goalie_block, kick_to
 
 __all__ = ["SimpleTeam", "SimpleTeamParams", "steer"]
@@ -58,17 +60,19 @@ class SimpleTeam:
         goal = (-own_sign * f.half_length, 0.0)
         goalie = own[0]
         intents: dict[int, Intent] = {goalie.id: goalie_block(ball, f, own_sign, self.sp.skills)}
-        if f.in_defense_area(ball.x, ball.y) == int(own_sign) and math.hypot(ball.vx, ball.vy) < 0.5:
+        if ball_to_clear(ball, f, own_sign, self.sp.defense):
             # the ball at rest in its own area: the goalie clears it up the field, away from the middle
-            clear_to = (-own_sign * f.half_length * 0.5, math.copysign(f.half_width * 0.6, ball.y or 1.0))
+            clear_to = clear_target(ball, f, own_sign, self.sp.defense)
             intents[goalie.id] = kick_to(goalie, ball, clear_to, self.p.shot_speed_m_s, self.sp.skills)
         field_players = own[1:]
         if field_players:
             chaser = min(field_players, key=lambda r: math.hypot(r.x - ball.x, r.y - ball.y))
             others_xy = np.array([[r.x, r.y] for r in world.robots if r.team != self.team]).reshape(-1, 2)
             toward = math.atan2(goal[1] - ball.y, goal[0] - ball.x)
-            radius = self.sp.skills.robot_radius_m + self.sp.skills.ball_radius_m
-            angle, _ = clearest_direction(np.array([ball.x, ball.y]), toward, others_xy, radius)
+            kp = self.sp.kicking
+            angle, _ = clearest_direction(np.array([ball.x, ball.y]), toward, others_xy, self.sp.obstacle_radius_m,
+                                          kp.clear_reach_m, kp.clear_spread_rad, kp.clear_samples,
+                                          kp.clear_lane_cap_rad, kp.clear_turn_cost)  # fmt: skip
             target = (ball.x + 2.0 * math.cos(angle), ball.y + 2.0 * math.sin(angle))
             intents[chaser.id] = kick_to(chaser, ball, target, self.p.shot_speed_m_s, self.sp.skills)
             others = [r for r in field_players if r.id != chaser.id]
@@ -78,5 +82,6 @@ class SimpleTeam:
                 intents[r.id] = Intent(x, y, math.atan2(ball.y - y, ball.x - x))
         ours = game.for_team == self.team
         if game.command == "stop" or (game.command in ("kickoff", "free_kick") and not ours):
-            intents = keep_away(intents, ball, f, own_sign, self.sp, game.command == "kickoff", game.command == "stop")
+            intents = keep_away(intents, ball, f, own_sign, self.sp.game_states, self.sp.robot_radius_m,
+                                game.command == "kickoff", game.command == "stop")  # fmt: skip
         return [steer(self.team, r.id, r.x, r.y, r.theta, intents[r.id], self.p) for r in own]

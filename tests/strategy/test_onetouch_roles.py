@@ -7,7 +7,9 @@ import math
 import pytest
 
 from strategy.onetouch import aim_heading, redirected_velocity
-from strategy.roles import Objective, RoleAssigner, RoleParams
+from strategy.roles import Objective, Role, RoleAssigner, RoleKind, RoleParams
+
+GOALIE, ATTACKER, DEFENDER = Role(RoleKind.GOALIE), Role(RoleKind.ATTACKER), Role(RoleKind.DEFENDER)
 
 
 @pytest.mark.parametrize("v_in", [(0.0, -2.0), (-3.0, 1.0), (1.0, 2.5), (0.0, 0.0)])
@@ -28,22 +30,22 @@ def test_no_retention_means_aim_straight() -> None:
 
 def test_roles_by_priority_with_hysteresis() -> None:
     roles = RoleAssigner(RoleParams(hysteresis_m=0.3))
-    objectives = [Objective("goalie", -4.2, 0.0, fixed_robot=0), Objective("attacker", 0.0, 0.0),
-                  Objective("defender", -3.0, 0.0)]  # fmt: skip
+    objectives = [Objective(GOALIE, -4.2, 0.0, fixed_robot=0), Objective(ATTACKER, 0.0, 0.0),
+                  Objective(DEFENDER, -3.0, 0.0)]  # fmt: skip
     robots = {0: (-4.0, 0.0), 1: (0.7, 0.0), 2: (-0.5, 0.0), 3: (-2.5, 0.0)}
     out = roles.assign(robots, objectives)
-    assert out == {0: "goalie", 2: "attacker", 3: "defender"}
+    assert out == {0: GOALIE, 2: ATTACKER, 3: DEFENDER}
     # robot 1 now slightly nearer: hysteresis keeps robot 2 attacking
     robots[1] = (0.45, 0.0)
     robots[2] = (-0.55, 0.0)
-    assert roles.assign(robots, objectives)[2] == "attacker"
+    assert roles.assign(robots, objectives)[2] == ATTACKER
     # clearly nearer: the role moves
     robots[1] = (0.1, 0.0)
-    assert roles.assign(robots, objectives)[1] == "attacker"
+    assert roles.assign(robots, objectives)[1] == ATTACKER
 
 
 def test_goalie_always_assigned_when_present() -> None:
     roles = RoleAssigner(RoleParams())
-    objectives = [Objective("goalie", -4.2, 0.0, fixed_robot=3), Objective("attacker", 0.0, 0.0)]
+    objectives = [Objective(GOALIE, -4.2, 0.0, fixed_robot=3), Objective(ATTACKER, 0.0, 0.0)]
     out = roles.assign({3: (4.0, 0.0), 1: (-4.0, 0.0)}, objectives)
-    assert out[3] == "goalie"
+    assert out[3] == GOALIE

@@ -14,11 +14,11 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 from cmdragons.config import Validated, setting
-from cmdragons.geometry import Field
+from cmdragons.geometry import Field, Team
 from cmdragons.messages import BallState, GameState, RobotState
 from strategy.skills import Intent
 
-__all__ = ["GameStateParams", "halt", "hold_shape", "keep_away", "our_kickoff", "restart_rules"]
+__all__ = ["GameStateParams", "halt", "hold_shape", "keep_away", "our_kickoff", "own_goal_sign", "restart_rules"]
 
 
 @dataclass(frozen=True)
@@ -32,6 +32,11 @@ class GameStateParams(Validated):
     hold_row_m: float = setting(0.4, lo=0.0, hi=3.0)  # ... its rows this far apart
     hold_rows: int = setting(3, lo=1, hi=11)
     hold_spacing_m: float = setting(0.6, lo=0.0, hi=3.0)  # ... its robots this far apart across the field
+
+
+def own_goal_sign(team: Team, game: GameState) -> float:
+    """-1.0 when ``team`` defends the goal at negative x, else +1.0."""
+    return -1.0 if (team == "blue") == game.blue_defends_negative_x else 1.0
 
 
 def halt(own: Mapping[int, RobotState]) -> dict[int, Intent]:

@@ -23,7 +23,7 @@ from cmdragons.geometry import Field, Team
 from cmdragons.messages import BallState, GameState, RobotState, WorldState
 from strategy.defense import DefenseParams, defender_slots, goalie
 from strategy.evaluation import PassParams
-from strategy.game_states import GameStateParams, halt, hold_shape, keep_away, restart_rules
+from strategy.game_states import GameStateParams, halt, hold_shape, keep_away, own_goal_sign, restart_rules
 from strategy.kicking import Attacker, KickKind, KickParams
 from strategy.passing import PassPlay, PassPlayParams
 from strategy.roles import Objective, Role, RoleAssigner, RoleKind, RoleParams
@@ -89,8 +89,7 @@ class Strategy:
 
     def own_sign(self, game: GameState) -> float:
         """-1 when we defend the goal at negative x, else +1."""
-        blue_neg = game.blue_defends_negative_x
-        return -1.0 if (self.team == "blue") == blue_neg else 1.0
+        return own_goal_sign(self.team, game)
 
     @property
     def pass_heat(self) -> tuple[Array, Array] | None:

@@ -18,7 +18,7 @@ from cmdragons.geometry import Field, Team
 from cmdragons.messages import GameState, RobotCommand, WorldState
 from strategy.defense import ball_to_clear, clear_target
 from strategy.evaluation import clearest_direction
-from strategy.game_states import keep_away
+from strategy.game_states import keep_away, own_goal_sign
 from strategy.plays import StrategyParams
 from strategy.skills import Intent, goalie_block, kick_to
 
@@ -32,6 +32,11 @@ class SimpleTeamParams(Validated):
     heading_gain_1_s: float = setting(5.0, lo=0.0, hi=100.0)
     max_omega_rad_s: float = setting(8.0, lo=0.0, hi=100.0)
     shot_speed_m_s: float = setting(5.0, lo=0.0, hi=10.0)
+    shot_reach_m: float = setting(2.0, lo=0.1, hi=10.0)  # the chaser aims at a point this far along the open lane
+    shape_depth_share: float = setting(0.55, lo=0.0, hi=1.0)  # the others stand this share of their half deep ...
+    shape_step_share: float = setting(0.3, lo=0.0, hi=1.0)  # ... every second one this share further up
+    shape_follow_share: float = setting(0.4, lo=0.0, hi=1.0)  # ... following this share of the ball's y
+    shape_spacing_m: float = setting(1.2, lo=0.0, hi=5.0)  # ... this far apart across the field
 
 
 def steer(team: Team, rid: int, x: float, y: float, theta: float, it: Intent, p: SimpleTeamParams) -> RobotCommand:
@@ -55,7 +60,7 @@ class SimpleTeam:
         ball = world.ball
         if not own or ball is None or game.command == "halt":
             return [RobotCommand(self.team, r.id) for r in own]
-        own_sign = -1.0 if (self.team == "blue") == game.blue_defends_negative_x else 1.0
+        own_sign = own_goal_sign(self.team, game)
         f = self.field
         goal = (-own_sign * f.half_length, 0.0)
         goalie = own[0]
@@ -73,12 +78,12 @@ class SimpleTeam:
             angle, _ = clearest_direction(np.array([ball.x, ball.y]), toward, others_xy, self.sp.obstacle_radius_m,
                                           kp.clear_reach_m, kp.clear_spread_rad, kp.clear_samples,
                                           kp.clear_lane_cap_rad, kp.clear_turn_cost)  # fmt: skip
-            target = (ball.x + 2.0 * math.cos(angle), ball.y + 2.0 * math.sin(angle))
+            target = (ball.x + self.p.shot_reach_m * math.cos(angle), ball.y + self.p.shot_reach_m * math.sin(angle))
             intents[chaser.id] = kick_to(chaser, ball, target, self.p.shot_speed_m_s, self.sp.skills)
             others = [r for r in field_players if r.id != chaser.id]
             for k, r in enumerate(others):
-                x = own_sign * f.half_length * (0.55 - 0.3 * (k % 2))
-                y = ball.y * 0.4 + (k - (len(others) - 1) / 2) * 1.2
+                x = own_sign * f.half_length * (self.p.shape_depth_share - self.p.shape_step_share * (k % 2))
+                y = ball.y * self.p.shape_follow_share + (k - (len(others) - 1) / 2) * self.p.shape_spacing_m
                 intents[r.id] = Intent(x, y, math.atan2(ball.y - y, ball.x - x))
         ours = game.for_team == self.team
         if game.command == "stop" or (game.command in ("kickoff", "free_kick") and not ours):

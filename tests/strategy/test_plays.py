@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from cmdragons.config import ConfigError, parse
 from cmdragons.geometry import Field, LeagueParams
 from cmdragons.messages import BallState, GameState, RobotState, WorldState
 from strategy.defense import DefenseParams
@@ -121,3 +122,33 @@ def test_a_decided_pass_goes_where_its_receiver_waits() -> None:
     assert strategy.passes.current is not None and strategy.passes.current.point == point
     kick_dir = intents[1].theta
     assert abs(math.remainder(kick_dir - math.atan2(point[1] - ball.y, point[0] - ball.x), 2 * math.pi)) < 1e-6
+
+
+def test_the_pass_heat_is_the_last_grid_evaluation_read_only() -> None:
+    strategy = Strategy("blue", FIELD, StrategyParams())
+    assert strategy.pass_heat is None
+    world = random_world(np.random.default_rng(5), 6, 6)
+    strategy.decide(world, GameState(0.0, "normal"))
+    heat = strategy.pass_heat
+    assert heat is not None
+    points, values = heat
+    assert points.shape == (len(strategy.supporters.grid), 2) and values.shape == (len(points),)
+    assert np.all((values >= 0.0) & (values <= 1.0))
+    with pytest.raises(ValueError, match="read-only"):
+        values[0] = 1.0
+    assert strategy.supporters.evaluation is not None and strategy.supporters.evaluation.values.flags.writeable
+
+
+def test_the_radii_are_read_in_one_place() -> None:
+    p = StrategyParams()
+    assert p.robot_radius_m == p.skills.robot_radius_m
+    assert p.obstacle_radius_m == p.skills.robot_radius_m + p.skills.ball_radius_m
+
+
+@pytest.mark.parametrize(("section", "key", "value"), [
+    ("kicking", "meet_cos", 1.5), ("pass_play", "timeout_s", 0.0), ("support", "eval_every_frames", 0),
+    ("game_states", "stop_distance_m", 0.4), ("defense", "defenders", 11)])  # fmt: skip
+def test_out_of_range_settings_are_refused_by_name(section: str, key: str, value: float) -> None:
+    raw = {section: {key: value}}
+    with pytest.raises(ConfigError, match=f"{section}.{key}"):
+        parse(StrategyParams, raw, file="strategy.yaml")

@@ -21,12 +21,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import NDArray
 
 from cmdragons.config import Validated, setting
-from cmdragons.geometry import Field
+from cmdragons.geometry import Field, wrap_angle
 
 __all__ = [
     "PassEvaluation",
@@ -67,8 +68,8 @@ class PassParams(Validated):
 
 
 def _wrap(a: Array) -> Array:
-    out: Array = (a + np.pi) % (2.0 * np.pi) - np.pi
-    return out
+    """:func:`cmdragons.geometry.wrap_angle` elementwise (its arithmetic holds for arrays as it is)."""
+    return cast(Array, wrap_angle(cast(Any, a)))
 
 
 def lane_open_angle(origin: Array, targets: Array, obstacles: Array, radius: float, cap: float) -> Array:

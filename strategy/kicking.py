@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cmdragons.config import Validated, setting
-from cmdragons.geometry import Field
+from cmdragons.geometry import Field, wrap_angle
 from cmdragons.messages import BallState, RobotState
 from strategy.evaluation import PassParams, best_shot, clearest_direction, one_touch_turn, pass_values
 from strategy.passing import PassPlay
@@ -143,7 +143,7 @@ def contest_angle(robot: RobotState, ball: BallState, target: tuple[float, float
     if float(np.min(np.hypot(opponents[:, 0] - ball.x, opponents[:, 1] - ball.y))) > p.contest_m:
         return None
     approach = math.atan2(ball.y - robot.y, ball.x - robot.x)
-    off = math.remainder(math.atan2(target[1] - ball.y, target[0] - ball.x) - approach, 2 * math.pi)
+    off = wrap_angle(math.atan2(target[1] - ball.y, target[0] - ball.x) - approach)
     if abs(off) <= p.contest_turn_rad:
         return None
     return approach + math.copysign(p.contest_turn_rad, off)

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cmdragons.config import Validated, setting
-from cmdragons.geometry import Field
+from cmdragons.geometry import Field, wrap_angle
 from cmdragons.messages import BallState, RobotState
 from strategy.onetouch import aim_heading
 
@@ -118,7 +118,7 @@ def kick_to(robot: RobotState, ball: BallState, target: tuple[float, float], spe
     rx, ry = robot.x - ball.x, robot.y - ball.y
     along, across = rx * c + ry * s, -rx * s + ry * c
     contact = p.contact_m
-    heading_error = abs(math.remainder(aim - robot.theta, 2 * math.pi))
+    heading_error = abs(wrap_angle(aim - robot.theta))
     # behind the ball, inside a cone around the kick line that narrows to lined_up_m at contact: driving
     # straight through the ball closes the lateral error on the way (heading likewise)
     gap = max(0.0, -along - contact)
@@ -156,7 +156,7 @@ def dribble(robot: RobotState, ball: BallState, target: tuple[float, float], p: 
     face_x, face_y = robot.x + math.cos(robot.theta) * contact, robot.y + math.sin(robot.theta) * contact
     on_face = math.hypot(ball.x - face_x, ball.y - face_y) < p.dribble_hold_m
     arriving = math.hypot(target[0] - ball.x, target[1] - ball.y) < contact  # the aim swings: keep the heading
-    if on_face and (arriving or abs(math.remainder(aim - robot.theta, 2 * math.pi)) < p.dribble_turn_rad):
+    if on_face and (arriving or abs(wrap_angle(aim - robot.theta)) < p.dribble_turn_rad):
         # where the robot stands when the ball lies on the target
         heading = robot.theta if arriving else aim
         x, y = target[0] - math.cos(heading) * contact, target[1] - math.sin(heading) * contact

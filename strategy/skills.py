@@ -169,13 +169,6 @@ def dribble(robot: RobotState, ball: BallState, target: tuple[float, float], p: 
                   final_speed_m_s=min(p.push_speed_m_s, p.dribble_speed_m_s))  # fmt: skip
 
 
-def ball_travel(speed: float, p: SkillParams) -> float:
-    """Distance a ball kicked at ``speed`` rolls until it stops (two-phase model)."""
-    v_roll = p.slide_to_roll_fraction * speed
-    slide = (speed**2 - v_roll**2) / (2 * max(p.acc_slide_m_s2, 1e-9))
-    return slide + v_roll**2 / (2 * max(p.acc_roll_m_s2, 1e-9))
-
-
 def speed_after(speed: float, distance: float, p: SkillParams) -> float:
     """Ball speed after rolling ``distance`` from a kick at ``speed`` (0 if it stops before)."""
     v_roll = p.slide_to_roll_fraction * speed

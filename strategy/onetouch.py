@@ -16,6 +16,8 @@ from __future__ import annotations
 
 import math
 
+from cmdragons.geometry import wrap_angle
+
 __all__ = ["aim_heading", "redirected_velocity"]
 
 _BRACKET = math.pi / 2 * 0.999  # the heading is searched within this of the target direction (rad) ...
@@ -32,7 +34,7 @@ def redirected_velocity(heading: float, v_in: tuple[float, float], kick_speed: f
 
 def _error(heading: float, v_in: tuple[float, float], kick_speed: float, retention: float, target: float) -> float:
     vx, vy = redirected_velocity(heading, v_in, kick_speed, retention)
-    return math.remainder(math.atan2(vy, vx) - target, 2.0 * math.pi)
+    return wrap_angle(math.atan2(vy, vx) - target)
 
 
 def aim_heading(target_angle: float, v_in: tuple[float, float], kick_speed: float, retention: float,

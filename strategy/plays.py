@@ -145,7 +145,7 @@ class Strategy:
         attack_sign = -own_sign
         opp_xy = np.array([[r.x, r.y] for r in opp]) if opp else np.zeros((0, 2))
         self.attacker.watch(t, ball)
-        count = max(0, len(own) - 2 - p.defense.defenders)
+        count = max(0, len(own) - 2 - p.defense.defenders)  # supporters: the robots besides goalie, attacker, defenders
         self.supporters.update(self.frame, np.array([ball.x, ball.y]), attack_sign, opp_xy, count)
 
         passing = self.passes.follow(t, own, ball)

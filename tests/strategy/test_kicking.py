@@ -10,7 +10,7 @@ import pytest
 from cmdragons.geometry import Field, LeagueParams
 from cmdragons.messages import BallState, RobotState
 from strategy.evaluation import PassParams
-from strategy.kicking import Kick, KickKind, KickParams, StillBall, contest_angle, decide_kick
+from strategy.kicking import Attacker, Kick, KickKind, KickParams, StillBall, contest_angle, decide_kick
 from strategy.passing import PassPlay, PassPlayParams
 from strategy.plays import StrategyParams
 from strategy.skills import SkillParams, pass_speed
@@ -101,3 +101,35 @@ def test_the_ball_lies_still_since_it_stopped_moving() -> None:
     assert still.since == 0.0
     still.update(2.0, BallState(0.2, 0.0, 0.0, 0.0))
     assert still.since == 2.0 and still.at == (0.2, 0.0)
+
+
+def _attacker() -> Attacker:
+    return Attacker(FIELD, K, PASS, SKILLS, R)
+
+
+def test_a_ball_coming_at_the_attacker_is_met_on_its_path() -> None:
+    attacker, passes = _attacker(), PassPlay(PassPlayParams())
+    robot = _robot(1, 0.0, 0.0)
+    ball = BallState(-2.0, 0.0, 2.5, 0.0)  # straight at the robot
+    attacker.watch(0.0, ball)
+    intent, kind = attacker.play(0.0, robot, {1: robot}, [], NONE, ball, 1.0, passes)
+    assert not intent.avoid_ball  # the ball is met, not avoided
+    assert abs(intent.y) < 1e-9 and -2.0 < intent.x <= 0.0  # on its path, between it and the robot
+    assert kind in (KickKind.SHOT, KickKind.CLEAR)
+
+
+def test_a_contested_ball_lying_still_is_driven_through_after_the_stall_time() -> None:
+    attacker, passes = _attacker(), PassPlay(PassPlayParams())
+    robot = _robot(1, 2.2, 0.5, math.pi)
+    ball = BallState(2.0, 0.5, 0.0, 0.0)
+    opponents = np.array([[1.8, 0.5]])
+    attacker.watch(0.0, ball)
+    before, kind = attacker.play(0.0, robot, {1: robot}, [], opponents, ball, 1.0, passes)
+    assert kind is KickKind.CLEAR and before.avoid_ball  # lining up on its side, at the contest angle
+    assert abs(math.remainder(before.theta - math.pi, 2 * math.pi)) == pytest.approx(K.contest_turn_rad)
+    attacker.watch(K.stall_s + 0.1, ball)
+    after, kind = attacker.play(K.stall_s + 0.1, robot, {1: robot}, [], opponents, ball, 1.0, passes)
+    assert kind is KickKind.CLEAR
+    assert after.kick_speed == K.clear_speed_m_s and not after.avoid_ball  # through the ball from its side
+    assert abs(math.remainder(after.theta - math.pi, 2 * math.pi)) == pytest.approx(K.contest_turn_rad)
+    assert passes.current is None

@@ -21,12 +21,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import NDArray
 
 from cmdragons.config import Validated, setting
-from cmdragons.geometry import Field
+from cmdragons.geometry import Field, wrap_angle
 
 __all__ = [
     "PassEvaluation",
@@ -48,7 +49,8 @@ class PassParams(Validated):
     field_margin_m: float = setting(0.3, lo=0.0, hi=2.0)  # candidates stay this far inside the lines
     defense_margin_m: float = setting(0.2, lo=0.0, hi=2.0)  # ... and this far off the defense areas
     min_pass_m: float = setting(0.6, lo=0.0, hi=10.0)  # shorter passes are not worth the risk
-    max_pass_m: float = setting(6.0, lo=0.1, hi=20.0)  # longer ones are too slow or inaccurate
+    max_pass_m: float = setting(6.0, lo=0.1, hi=20.0)  # longer ones are too slow or inaccurate ...
+    pass_length_fade: float = setting(0.2, lo=0.01, hi=5.0)  # ... their value fades to 0 over this share of max_pass_m
     lane_open_angle_rad: float = setting(0.35, lo=0.01, hi=3.0)  # a pass lane this wide is fully open
     shot_open_angle_rad: float = setting(0.2, lo=0.01, hi=3.0)  # a goal gap this wide is fully open
     shot_distance_scale_m: float = setting(3.0, lo=0.1, hi=20.0)  # shots decay as exp(-distance / scale)
@@ -66,8 +68,8 @@ class PassParams(Validated):
 
 
 def _wrap(a: Array) -> Array:
-    out: Array = (a + np.pi) % (2.0 * np.pi) - np.pi
-    return out
+    """:func:`cmdragons.geometry.wrap_angle` elementwise (its arithmetic holds for arrays as it is)."""
+    return cast(Array, wrap_angle(cast(Any, a)))
 
 
 def lane_open_angle(origin: Array, targets: Array, obstacles: Array, radius: float, cap: float) -> Array:
@@ -95,8 +97,8 @@ def lane_open_angle(origin: Array, targets: Array, obstacles: Array, radius: flo
     return out
 
 
-def open_goal_angle(points: Array, field: Field, goal_sign: float, obstacles: Array, radius: float,
-                    samples: int = 24, post_margin_m: float = 0.1) -> tuple[Array, Array]:  # fmt: skip
+def open_goal_angle(points: Array, field: Field, goal_sign: float, obstacles: Array, radius: float, samples: int,
+                    post_margin_m: float) -> tuple[Array, Array]:  # fmt: skip
     """Open angle of the goal at x = goal_sign * half_length from each point (N,), and the y on the
     goal line to aim at (aim points reach up to ``post_margin_m`` from the posts). A free run of the
     mouth between two shadows (or the whole mouth) is aimed at its centre and counts its width; a
@@ -208,7 +210,8 @@ def pass_values(ball: Array, points: Array, field: Field, goal_sign: float, obst
     turn = one_touch_turn(ball, points, aims)
 
     lo, hi = params.min_pass_m, params.max_pass_m
-    f_len = np.clip(len_a / max(lo, 1e-9), 0.0, 1.0) * np.clip((1.2 * hi - len_a) / (0.2 * hi), 0.0, 1.0)
+    fade = params.pass_length_fade
+    f_len = np.clip(len_a / max(lo, 1e-9), 0.0, 1.0) * np.clip(((1.0 + fade) * hi - len_a) / (fade * hi), 0.0, 1.0)
     f_lane = np.clip(open_a / (2.0 * params.lane_open_angle_rad), 0.0, 1.0)
     f_open = np.clip(open_b / params.shot_open_angle_rad, 0.0, 1.0)
     f_dist = np.exp(-len_b / params.shot_distance_scale_m)
@@ -218,14 +221,14 @@ def pass_values(ball: Array, points: Array, field: Field, goal_sign: float, obst
     return PassEvaluation(points, values, aims)
 
 
-def clearest_direction(ball: Array, toward: float, obstacles: Array, radius: float, reach_m: float = 1.5,
-                       spread_rad: float = math.pi / 2, samples: int = 13) -> tuple[float, float]:  # fmt: skip
-    """Among directions within ``spread_rad`` of ``toward``, the one whose lane of length
-    ``reach_m`` from the ball is most open, preferring directions near ``toward`` on ties.
-    Returns (angle, open angle)."""
+def clearest_direction(ball: Array, toward: float, obstacles: Array, radius: float, reach_m: float, spread_rad: float,
+                       samples: int, cap_rad: float, turn_cost: float) -> tuple[float, float]:  # fmt: skip
+    """Among ``samples`` directions within ``spread_rad`` of ``toward``, the one whose lane of length
+    ``reach_m`` from the ball is most open (each side capped at ``cap_rad``), less ``turn_cost``
+    per radian off ``toward``. Returns (angle, open angle)."""
     angles = toward + np.linspace(-spread_rad, spread_rad, samples)
     targets = ball + reach_m * np.stack([np.cos(angles), np.sin(angles)], axis=1)
-    open_ = lane_open_angle(ball, targets, obstacles, radius, 0.6)
-    score = open_ - 0.05 * np.abs(angles - toward)
+    open_ = lane_open_angle(ball, targets, obstacles, radius, cap_rad)
+    score = open_ - turn_cost * np.abs(angles - toward)
     k = int(np.argmax(score))
     return float(angles[k]), float(open_[k])

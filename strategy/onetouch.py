@@ -16,7 +16,12 @@ from __future__ import annotations
 
 import math
 
+from cmdragons.geometry import wrap_angle
+
 __all__ = ["aim_heading", "redirected_velocity"]
+
+_BRACKET = math.pi / 2 * 0.999  # the heading is searched within this of the target direction (rad) ...
+_BISECTIONS = 60  # ... in at most so many halvings
 
 
 def redirected_velocity(heading: float, v_in: tuple[float, float], kick_speed: float,
@@ -29,7 +34,7 @@ def redirected_velocity(heading: float, v_in: tuple[float, float], kick_speed: f
 
 def _error(heading: float, v_in: tuple[float, float], kick_speed: float, retention: float, target: float) -> float:
     vx, vy = redirected_velocity(heading, v_in, kick_speed, retention)
-    return math.remainder(math.atan2(vy, vx) - target, 2.0 * math.pi)
+    return wrap_angle(math.atan2(vy, vx) - target)
 
 
 def aim_heading(target_angle: float, v_in: tuple[float, float], kick_speed: float, retention: float,
@@ -38,12 +43,12 @@ def aim_heading(target_angle: float, v_in: tuple[float, float], kick_speed: floa
     if kick_speed <= 0.0 or retention == 0.0:
         return target_angle
     # the correction is less than a right angle whenever the kick outruns the retained part
-    lo, hi = target_angle - math.pi / 2 * 0.999, target_angle + math.pi / 2 * 0.999
+    lo, hi = target_angle - _BRACKET, target_angle + _BRACKET
     e_lo = _error(lo, v_in, kick_speed, retention, target_angle)
     e_hi = _error(hi, v_in, kick_speed, retention, target_angle)
     if e_lo * e_hi > 0:  # the retained part dominates: no heading reaches the target, get closest
         return lo if abs(e_lo) < abs(e_hi) else hi
-    for _ in range(60):
+    for _ in range(_BISECTIONS):
         mid = 0.5 * (lo + hi)
         e_mid = _error(mid, v_in, kick_speed, retention, target_angle)
         if abs(e_mid) < tolerance_rad:

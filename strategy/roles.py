@@ -4,17 +4,21 @@ free robot that reaches its objective at the lowest cost, with hysteresis agains
 A role's cost for a robot is the distance from the robot to the role's objective point; the robot
 holding the role since the last frame gets ``hysteresis_m`` off its cost, so two robots at nearly
 the same distance do not swap roles frame after frame.
+
+A role is a value: its kind and, for the kinds a team fills several times (defenders,
+supporters), which one (``Role(RoleKind.DEFENDER, 1)``).
 """
 
 from __future__ import annotations
 
+import enum
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from cmdragons.config import Validated, setting
 
-__all__ = ["Objective", "RoleAssigner", "RoleParams"]
+__all__ = ["Objective", "Role", "RoleAssigner", "RoleKind", "RoleParams"]
 
 
 @dataclass(frozen=True)
@@ -23,9 +27,25 @@ class RoleParams(Validated):
     goalie_id: int = setting(0, lo=-1, hi=15)  # -1: whoever is nearest the goal when play starts
 
 
+class RoleKind(enum.Enum):
+    GOALIE = "goalie"
+    ATTACKER = "attacker"  # plays the ball
+    RECEIVER = "receiver"  # of a pass decided or under way
+    DEFENDER = "defender"  # on the edge of our defense area
+    SUPPORTER = "supporter"  # at a receiving point of the pass evaluation
+
+
+@dataclass(frozen=True)
+class Role:
+    """One role of the team: its kind and, among several of the same kind, its index."""
+
+    kind: RoleKind
+    index: int = 0
+
+
 @dataclass(frozen=True)
 class Objective:
-    role: str
+    role: Role
     x: float
     y: float
     fixed_robot: int | None = None  # a role only this robot may take (the goalie)
@@ -37,13 +57,13 @@ class RoleAssigner:
 
     def __init__(self, params: RoleParams) -> None:
         self.params = params
-        self.roles: dict[int, str] = {}  # robot id -> role
+        self.roles: dict[int, Role] = {}  # robot id -> role
 
-    def assign(self, robots: Mapping[int, tuple[float, float]], objectives: Sequence[Objective]) -> dict[int, str]:
+    def assign(self, robots: Mapping[int, tuple[float, float]], objectives: Sequence[Objective]) -> dict[int, Role]:
         """``objectives`` in priority order; robots left over get no role."""
         free = dict(robots)
         previous = {role: rid for rid, role in self.roles.items()}
-        out: dict[int, str] = {}
+        out: dict[int, Role] = {}
         for obj in objectives:
             if not free:
                 break

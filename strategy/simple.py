@@ -14,10 +14,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from cmdragons.config import Validated, setting
-from cmdragons.geometry import Field, Team
+from cmdragons.geometry import Field, Team, wrap_angle
 from cmdragons.messages import GameState, RobotCommand, WorldState
+from strategy.defense import ball_to_clear, clear_target
 from strategy.evaluation import clearest_direction
-from strategy.plays import StrategyParams, keep_away
+from strategy.game_states import keep_away, own_goal_sign
+from strategy.plays import StrategyParams
 from strategy.skills import Intent, goalie_block, kick_to
 
 __all__ = ["SimpleTeam", "SimpleTeamParams", "steer"]
@@ -30,6 +32,11 @@ class SimpleTeamParams(Validated):
     heading_gain_1_s: float = setting(5.0, lo=0.0, hi=100.0)
     max_omega_rad_s: float = setting(8.0, lo=0.0, hi=100.0)
     shot_speed_m_s: float = setting(5.0, lo=0.0, hi=10.0)
+    shot_reach_m: float = setting(2.0, lo=0.1, hi=10.0)  # the chaser aims at a point this far along the open lane
+    shape_depth_share: float = setting(0.55, lo=0.0, hi=1.0)  # the others stand this share of their half deep ...
+    shape_step_share: float = setting(0.3, lo=0.0, hi=1.0)  # ... every second one this share further up
+    shape_follow_share: float = setting(0.4, lo=0.0, hi=1.0)  # ... following this share of the ball's y
+    shape_spacing_m: float = setting(1.2, lo=0.0, hi=5.0)  # ... this far apart across the field
 
 
 def steer(team: Team, rid: int, x: float, y: float, theta: float, it: Intent, p: SimpleTeamParams) -> RobotCommand:
@@ -39,8 +46,7 @@ def steer(team: Team, rid: int, x: float, y: float, theta: float, it: Intent, p:
     cap = p.max_speed_m_s if it.max_speed_m_s is None else min(p.max_speed_m_s, it.max_speed_m_s)
     v = min(cap, p.position_gain_1_s * d + it.final_speed_m_s)
     vx, vy = (dx / d * v, dy / d * v) if d > 1e-6 else (0.0, 0.0)
-    omega = max(-p.max_omega_rad_s, min(p.max_omega_rad_s, p.heading_gain_1_s * math.remainder(it.theta - theta,
-                                                                                                 2 * math.pi)))
+    omega = max(-p.max_omega_rad_s, min(p.max_omega_rad_s, p.heading_gain_1_s * wrap_angle(it.theta - theta)))
     return RobotCommand(team, rid, vx, vy, omega, it.kick_speed, it.chip, it.dribbler)
 
 
@@ -53,30 +59,33 @@ class SimpleTeam:
         ball = world.ball
         if not own or ball is None or game.command == "halt":
             return [RobotCommand(self.team, r.id) for r in own]
-        own_sign = -1.0 if (self.team == "blue") == game.blue_defends_negative_x else 1.0
+        own_sign = own_goal_sign(self.team, game)
         f = self.field
         goal = (-own_sign * f.half_length, 0.0)
         goalie = own[0]
         intents: dict[int, Intent] = {goalie.id: goalie_block(ball, f, own_sign, self.sp.skills)}
-        if f.in_defense_area(ball.x, ball.y) == int(own_sign) and math.hypot(ball.vx, ball.vy) < 0.5:
+        if ball_to_clear(ball, f, own_sign, self.sp.defense):
             # the ball at rest in its own area: the goalie clears it up the field, away from the middle
-            clear_to = (-own_sign * f.half_length * 0.5, math.copysign(f.half_width * 0.6, ball.y or 1.0))
+            clear_to = clear_target(ball, f, own_sign, self.sp.defense)
             intents[goalie.id] = kick_to(goalie, ball, clear_to, self.p.shot_speed_m_s, self.sp.skills)
         field_players = own[1:]
         if field_players:
             chaser = min(field_players, key=lambda r: math.hypot(r.x - ball.x, r.y - ball.y))
             others_xy = np.array([[r.x, r.y] for r in world.robots if r.team != self.team]).reshape(-1, 2)
             toward = math.atan2(goal[1] - ball.y, goal[0] - ball.x)
-            radius = self.sp.skills.robot_radius_m + self.sp.skills.ball_radius_m
-            angle, _ = clearest_direction(np.array([ball.x, ball.y]), toward, others_xy, radius)
-            target = (ball.x + 2.0 * math.cos(angle), ball.y + 2.0 * math.sin(angle))
+            kp = self.sp.kicking
+            angle, _ = clearest_direction(np.array([ball.x, ball.y]), toward, others_xy, self.sp.obstacle_radius_m,
+                                          kp.clear_reach_m, kp.clear_spread_rad, kp.clear_samples,
+                                          kp.clear_lane_cap_rad, kp.clear_turn_cost)  # fmt: skip
+            target = (ball.x + self.p.shot_reach_m * math.cos(angle), ball.y + self.p.shot_reach_m * math.sin(angle))
             intents[chaser.id] = kick_to(chaser, ball, target, self.p.shot_speed_m_s, self.sp.skills)
             others = [r for r in field_players if r.id != chaser.id]
             for k, r in enumerate(others):
-                x = own_sign * f.half_length * (0.55 - 0.3 * (k % 2))
-                y = ball.y * 0.4 + (k - (len(others) - 1) / 2) * 1.2
+                x = own_sign * f.half_length * (self.p.shape_depth_share - self.p.shape_step_share * (k % 2))
+                y = ball.y * self.p.shape_follow_share + (k - (len(others) - 1) / 2) * self.p.shape_spacing_m
                 intents[r.id] = Intent(x, y, math.atan2(ball.y - y, ball.x - x))
         ours = game.for_team == self.team
         if game.command == "stop" or (game.command in ("kickoff", "free_kick") and not ours):
-            intents = keep_away(intents, ball, f, own_sign, self.sp, game.command == "kickoff", game.command == "stop")
+            intents = keep_away(intents, ball, f, own_sign, self.sp.game_states, self.sp.robot_radius_m,
+                                game.command == "kickoff", game.command == "stop")  # fmt: skip
         return [steer(self.team, r.id, r.x, r.y, r.theta, intents[r.id], self.p) for r in own]

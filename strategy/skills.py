@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cmdragons.config import Validated, setting
-from cmdragons.geometry import Field
+from cmdragons.geometry import Field, wrap_angle
 from cmdragons.messages import BallState, RobotState
 from strategy.onetouch import aim_heading
 
@@ -60,6 +60,27 @@ class SkillParams(Validated):
     dribble_speed_m_s: float = setting(1.0, lo=0.05, hi=5.0)  # carrying the ball, and driving onto it to take it
     dribble_hold_m: float = setting(0.03, lo=0.001, hi=0.5)  # ball centre this near the middle of the face: held
     dribble_turn_rad: float = setting(0.3, lo=0.01, hi=3.2)  # ... and the robot facing the target within this
+    contact_slack_m: float = setting(0.02, lo=0.0, hi=0.2)  # lined up: the face up to this past the ball's back
+    at_ball_m: float = setting(0.03, lo=0.0, hi=0.5)  # the face this near behind the ball ...
+    at_ball_lateral_share: float = setting(0.5, lo=0.0, hi=1.0)  # ... within this share of lined_up_m across: at it
+    swing_back_share: float = setting(0.5, lo=0.0, hi=2.0)  # going round the ball: this share of the waiting distance
+    swing_side_share: float = setting(1.2, lo=0.0, hi=5.0)  # ... behind it and this share to its side
+    through_m: float = setting(0.05, lo=0.0, hi=0.5)  # driving through the ball: the target this far past its centre
+    through_dribbler: float = setting(0.3, lo=0.0, hi=1.0)  # ... with the dribbler at this power
+    hold_dribbler: float = setting(1.0, lo=0.0, hi=1.0)  # the dribbler's power trapping or carrying the ball
+    rest_speed_m_s: float = setting(0.1, lo=0.0, hi=2.0)  # a ball slower than this is met where it lies
+    intercept_step_s: float = setting(0.05, lo=0.001, hi=1.0)  # the moving ball's path is predicted in these steps
+    receive_moving_m_s: float = setting(0.3, lo=0.0, hi=5.0)  # a ball faster than this is met on its path
+    goalie_post_share: float = setting(0.5, lo=0.0, hi=2.0)  # goalie's centre this share of its radius inside a post
+    goalie_shot_speed_m_s: float = setting(0.5, lo=0.0, hi=10.0)  # a ball this fast ...
+    goalie_shot_vx_m_s: float = setting(0.2, lo=0.0, hi=10.0)  # ... coming at our goal line this fast: met on its line
+    goalie_shade: float = setting(0.5, lo=0.0, hi=1.0)  # else the goalie stands at this share of the ball's y
+    mark_max_share: float = setting(0.5, lo=0.0, hi=1.0)  # a marker at most this share of the way to our goal
+
+    @property
+    def contact_m(self) -> float:
+        """Robot centre to ball centre with the ball on the kicker face."""
+        return self.front_distance_m + self.ball_radius_m
 
 
 @dataclass(frozen=True)
@@ -78,6 +99,9 @@ class Intent:
     final_speed_m_s: float = 0.0  # arrive moving (driving through the ball)
 
 
+_BISECTIONS = 40  # halvings of the kick speed range in pass_speed: far below a mm/s
+
+
 def _angle(dx: float, dy: float) -> float:
     return math.atan2(dy, dx)
 
@@ -93,32 +117,34 @@ def kick_to(robot: RobotState, ball: BallState, target: tuple[float, float], spe
     c, s = math.cos(aim), math.sin(aim)
     rx, ry = robot.x - ball.x, robot.y - ball.y
     along, across = rx * c + ry * s, -rx * s + ry * c
-    contact = p.front_distance_m + p.ball_radius_m
-    heading_error = abs(math.remainder(aim - robot.theta, 2 * math.pi))
+    contact = p.contact_m
+    heading_error = abs(wrap_angle(aim - robot.theta))
     # behind the ball, inside a cone around the kick line that narrows to lined_up_m at contact: driving
     # straight through the ball closes the lateral error on the way (heading likewise)
     gap = max(0.0, -along - contact)
     in_cone = (-along < contact + p.approach_distance_m + p.cone_reach_m
                and abs(across) < p.lined_up_m + p.cone_slope * gap
                and heading_error < p.lined_up_rad + p.cone_heading_rad_m * gap)  # fmt: skip
-    lined_up = along < -contact + 0.02 and in_cone
-    if lined_up or (along < 0 and along > -contact - 0.03 and abs(across) < 0.5 * p.lined_up_m):
+    lined_up = along < -contact + p.contact_slack_m and in_cone
+    at_ball = along < 0 and along > -contact - p.at_ball_m and abs(across) < p.at_ball_lateral_share * p.lined_up_m
+    if lined_up or at_ball:
         return drive_through(ball, aim, speed, p, chip)
     behind = contact + p.approach_distance_m
     px, py = ball.x - c * behind, ball.y - s * behind
     if along > -contact and abs(across) < behind:
         # on the wrong side of the ball: swing around it at a safe distance first
         side = 1.0 if across >= 0 else -1.0
-        px = ball.x - c * 0.5 * behind - s * side * behind * 1.2
-        py = ball.y - s * 0.5 * behind + c * side * behind * 1.2
+        px = ball.x - c * p.swing_back_share * behind - s * side * behind * p.swing_side_share
+        py = ball.y - s * p.swing_back_share * behind + c * side * behind * p.swing_side_share
     return Intent(px, py, aim, avoid_ball=True)
 
 
 def drive_through(ball: BallState, aim: float, speed: float, p: SkillParams, chip: bool = False) -> Intent:
     """Drive through the ball along ``aim`` with the kicker armed: it fires when the ball touches the front."""
     c, s = math.cos(aim), math.sin(aim)
-    return Intent(ball.x + c * 0.05, ball.y + s * 0.05, aim, kick_speed=speed, chip=chip, avoid_ball=False,
-                  max_speed_m_s=p.push_speed_m_s, final_speed_m_s=p.push_speed_m_s, dribbler=0.3)  # fmt: skip
+    return Intent(ball.x + c * p.through_m, ball.y + s * p.through_m, aim, kick_speed=speed, chip=chip,
+                  avoid_ball=False, max_speed_m_s=p.push_speed_m_s, final_speed_m_s=p.push_speed_m_s,
+                  dribbler=p.through_dribbler)  # fmt: skip
 
 
 def dribble(robot: RobotState, ball: BallState, target: tuple[float, float], p: SkillParams) -> Intent:
@@ -126,27 +152,21 @@ def dribble(robot: RobotState, ball: BallState, target: tuple[float, float], p: 
     to the target (the approach of :func:`kick_to`, driving onto it at ``dribble_speed_m_s`` with no
     kick), then drive so that the ball arrives at the target, facing the way."""
     aim = _angle(target[0] - ball.x, target[1] - ball.y)
-    contact = p.front_distance_m + p.ball_radius_m
+    contact = p.contact_m
     face_x, face_y = robot.x + math.cos(robot.theta) * contact, robot.y + math.sin(robot.theta) * contact
     on_face = math.hypot(ball.x - face_x, ball.y - face_y) < p.dribble_hold_m
     arriving = math.hypot(target[0] - ball.x, target[1] - ball.y) < contact  # the aim swings: keep the heading
-    if on_face and (arriving or abs(math.remainder(aim - robot.theta, 2 * math.pi)) < p.dribble_turn_rad):
+    if on_face and (arriving or abs(wrap_angle(aim - robot.theta)) < p.dribble_turn_rad):
         # where the robot stands when the ball lies on the target
         heading = robot.theta if arriving else aim
         x, y = target[0] - math.cos(heading) * contact, target[1] - math.sin(heading) * contact
-        return Intent(x, y, heading, dribbler=1.0, avoid_ball=False, max_speed_m_s=p.dribble_speed_m_s)
+        return Intent(x, y, heading, dribbler=p.hold_dribbler, avoid_ball=False, max_speed_m_s=p.dribble_speed_m_s)
     take = kick_to(robot, ball, target, 0.0, p)
     if take.avoid_ball:
-        return Intent(take.x, take.y, take.theta, dribbler=1.0)  # getting behind the ball
-    return Intent(take.x, take.y, take.theta, dribbler=1.0, avoid_ball=False, max_speed_m_s=p.dribble_speed_m_s,
+        return Intent(take.x, take.y, take.theta, dribbler=p.hold_dribbler)  # getting behind the ball
+    return Intent(take.x, take.y, take.theta, dribbler=p.hold_dribbler, avoid_ball=False,
+                  max_speed_m_s=p.dribble_speed_m_s,
                   final_speed_m_s=min(p.push_speed_m_s, p.dribble_speed_m_s))  # fmt: skip
-
-
-def ball_travel(speed: float, p: SkillParams) -> float:
-    """Distance a ball kicked at ``speed`` rolls until it stops (two-phase model)."""
-    v_roll = p.slide_to_roll_fraction * speed
-    slide = (speed**2 - v_roll**2) / (2 * max(p.acc_slide_m_s2, 1e-9))
-    return slide + v_roll**2 / (2 * max(p.acc_roll_m_s2, 1e-9))
 
 
 def speed_after(speed: float, distance: float, p: SkillParams) -> float:
@@ -161,19 +181,18 @@ def speed_after(speed: float, distance: float, p: SkillParams) -> float:
 def pass_speed(distance: float, p: SkillParams) -> float:
     """Kick speed so the ball arrives at ``distance`` with about ``pass_arrival_m_s`` (bisection)."""
     lo, hi = 0.0, p.pass_max_m_s
-    for _ in range(40):
+    for _ in range(_BISECTIONS):
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if speed_after(mid, distance, p) < p.pass_arrival_m_s else (lo, mid)
     return min(max(hi, p.pass_min_m_s), p.pass_max_m_s)
 
 
-def intercept(robot: RobotState, ball: BallState, p: SkillParams, field: Field | None = None,
-              step_s: float = 0.05) -> BallState:  # fmt: skip
+def intercept(robot: RobotState, ball: BallState, p: SkillParams, field: Field | None = None) -> BallState:
     """The moving ball where ``robot`` can meet it: the first point of its predicted path (rolling
     deceleration, stopping at the field's edge) the robot reaches in time at ``intercept_speed_m_s``.
-    A ball at rest is returned as it is."""
+    A ball at rest (slower than ``rest_speed_m_s``) is returned as it is."""
     speed = math.hypot(ball.vx, ball.vy)
-    if speed < 0.1:
+    if speed < p.rest_speed_m_s:
         return ball
     ux, uy = ball.vx / speed, ball.vy / speed
     t_stop = speed / max(p.acc_roll_m_s2, 1e-9)
@@ -190,7 +209,7 @@ def intercept(robot: RobotState, ball: BallState, p: SkillParams, field: Field |
         x, y = nx, ny
         if math.hypot(x - robot.x, y - robot.y) <= p.intercept_speed_m_s * t:
             break
-        t += step_s
+        t += p.intercept_step_s
     v = max(v, 0.0)
     return BallState(x, y, ux * v, uy * v, ball.visible)
 
@@ -201,14 +220,15 @@ def receive(robot: RobotState, ball: BallState, wait_at: tuple[float, float], p:
     aimed with the kick model (B.6), else stop it with the dribbler facing it."""
     speed = math.hypot(ball.vx, ball.vy)
     px, py = wait_at
-    if speed > 0.3:
+    moving = speed > p.receive_moving_m_s
+    if moving:
         # the point of the ball's path nearest the waiting point
         ux, uy = ball.vx / speed, ball.vy / speed
         t = max(0.0, (px - ball.x) * ux + (py - ball.y) * uy)
         px, py = ball.x + ux * t, ball.y + uy * t
     toward_ball = _angle(ball.x - px, ball.y - py)
-    contact = p.front_distance_m + p.ball_radius_m
-    if shoot_at is not None and speed > 0.3:
+    contact = p.contact_m
+    if shoot_at is not None and moving:
         target = _angle(shoot_at[0] - px, shoot_at[1] - py)
         v_in = (ball.vx - robot.vx, ball.vy - robot.vy)
         heading = aim_heading(target, v_in, shot_speed, p.kicker_retention)
@@ -216,17 +236,17 @@ def receive(robot: RobotState, ball: BallState, wait_at: tuple[float, float], p:
         cx, cy = px - math.cos(heading) * contact, py - math.sin(heading) * contact
         return Intent(cx, cy, heading, kick_speed=shot_speed, avoid_ball=False, dribbler=0.0)
     cx, cy = px - math.cos(toward_ball) * contact, py - math.sin(toward_ball) * contact
-    return Intent(cx, cy, toward_ball, dribbler=1.0, avoid_ball=False)
+    return Intent(cx, cy, toward_ball, dribbler=p.hold_dribbler, avoid_ball=False)
 
 
 def goalie_block(ball: BallState, field: Field, own_sign: float, p: SkillParams) -> Intent:
     """Stand between the ball and our goal; meet a ball heading for the goal on its line."""
     gx = own_sign * field.half_length
     x = gx - own_sign * p.goalie_depth_m
-    half = field.goal_half_width - p.robot_radius_m * 0.5
+    half = field.goal_half_width - p.robot_radius_m * p.goalie_post_share
     speed = math.hypot(ball.vx, ball.vy)
-    y = ball.y * 0.5  # default: shade toward the ball
-    if speed > 0.5 and (ball.vx * own_sign) > 0.2:
+    y = ball.y * p.goalie_shade  # default: shade toward the ball
+    if speed > p.goalie_shot_speed_m_s and (ball.vx * own_sign) > p.goalie_shot_vx_m_s:
         t = (x - ball.x) / ball.vx
         if t > 0:
             y = ball.y + ball.vy * t
@@ -265,6 +285,6 @@ def mark(opponent: RobotState, field: Field, own_sign: float, p: SkillParams) ->
     gx = own_sign * field.half_length
     dx, dy = gx - opponent.x, 0.0 - opponent.y
     d = math.hypot(dx, dy)
-    k = min(p.mark_distance_m, d * 0.5) / max(d, 1e-9)
+    k = min(p.mark_distance_m, d * p.mark_max_share) / max(d, 1e-9)
     x, y = opponent.x + dx * k, opponent.y + dy * k
     return Intent(x, y, _angle(opponent.x - x, opponent.y - y))

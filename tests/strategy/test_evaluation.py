@@ -9,16 +9,17 @@ import pytest
 
 from cmdragons.geometry import Field, LeagueParams
 from strategy.evaluation import PassParams, best_shot, candidate_grid, lane_open_angle, open_goal_angle, pass_values
+from strategy.plays import StrategyParams
 
 FIELD = Field(LeagueParams())
-R = 0.09 + 0.0215  # robot radius plus ball radius
+R = StrategyParams().obstacle_radius_m  # robot radius plus ball radius
 P = PassParams()
 NONE = np.zeros((0, 2))
 
 
 def test_open_goal_angle_without_obstacles_is_the_goal_mouth() -> None:
     d = 2.0
-    width, aim = open_goal_angle(np.array([[FIELD.half_length - d, 0.0]]), FIELD, 1.0, NONE, R, samples=101)
+    width, aim = open_goal_angle(np.array([[FIELD.half_length - d, 0.0]]), FIELD, 1.0, NONE, R, 101, P.post_margin_m)
     gw = FIELD.goal_half_width - P.post_margin_m
     assert width[0] == pytest.approx(2 * math.atan(gw / d), rel=1e-3)
     assert aim[0] == pytest.approx(0.0, abs=1e-9)
@@ -27,7 +28,7 @@ def test_open_goal_angle_without_obstacles_is_the_goal_mouth() -> None:
 def test_goalkeeper_shadow_moves_the_aim_to_the_far_post() -> None:
     keeper = np.array([[FIELD.half_length - 0.1, 0.25]])  # covering the left half of the goal
     origin = np.array([2.5, 0.0])
-    width, aim = open_goal_angle(origin[None, :], FIELD, 1.0, keeper, R, samples=101)
+    width, aim = open_goal_angle(origin[None, :], FIELD, 1.0, keeper, R, 101, P.post_margin_m)
     gw = FIELD.goal_half_width - P.post_margin_m
     assert aim[0] == pytest.approx(-gw)  # the open right side, at its post: the keeper must cover all of the gap
     rel = keeper[0] - origin
@@ -42,7 +43,7 @@ def test_goalkeeper_shadow_moves_the_aim_to_the_far_post() -> None:
 def test_a_gap_between_two_blockers_is_aimed_at_its_centre() -> None:
     origin = np.array([2.5, 0.0])
     blockers = np.array([[FIELD.half_length - 0.3, 0.3], [FIELD.half_length - 0.3, -0.3]])
-    width, aim = open_goal_angle(origin[None, :], FIELD, 1.0, blockers, R, samples=101)
+    width, aim = open_goal_angle(origin[None, :], FIELD, 1.0, blockers, R, 101, P.post_margin_m)
     assert aim[0] == pytest.approx(0.0, abs=0.02)
     rel = blockers - origin
     edges = np.arctan2(rel[:, 1], rel[:, 0]) + np.array([-1, 1]) * np.arcsin(R / np.hypot(rel[:, 0], rel[:, 1]))
@@ -81,4 +82,4 @@ def test_grid_best_point_is_open_and_legal() -> None:
     best, value = ev.best()
     assert value > 0
     assert lane_open_angle(ball, best[None, :], opponents, R, 1.0)[0] > 0
-    assert FIELD.in_field(*best, margin=P.field_margin_m - 1e-9)
+    assert FIELD.in_field(float(best[0]), float(best[1]), margin=P.field_margin_m - 1e-9)

@@ -7,9 +7,14 @@ import math
 import numpy as np
 import pytest
 
+from cmdragons.config import ConfigError, parse
 from cmdragons.geometry import Field, LeagueParams
 from cmdragons.messages import BallState, GameState, RobotState, WorldState
+from strategy.defense import DefenseParams
 from strategy.plays import Strategy, StrategyParams
+from strategy.roles import Role, RoleKind
+
+GOALIE = Role(RoleKind.GOALIE)
 
 FIELD = Field(LeagueParams())
 
@@ -33,9 +38,9 @@ def test_goal_never_left_without_a_goalie(seed: int) -> None:
     strategy = Strategy("blue", FIELD, StrategyParams())
     game = GameState(0.0, "normal", blue_defends_negative_x=bool(seed % 2))
     strategy.decide(world, game)
-    assert "goalie" in strategy.roles.roles.values()
+    assert GOALIE in strategy.roles.roles.values()
     own_sign = strategy.own_sign(game)
-    goalie = next(rid for rid, role in strategy.roles.roles.items() if role == "goalie")
+    goalie = next(rid for rid, role in strategy.roles.roles.items() if role == GOALIE)
     intent = strategy.decide(world, game)[goalie]
     assert abs(intent.x - own_sign * FIELD.half_length) < 1.2  # at our goal, whatever else happens
 
@@ -49,7 +54,7 @@ def test_distance_to_the_ball_when_the_rules_ask(seed: int, command: str) -> Non
     p = StrategyParams()
     game = GameState(0.0, command, for_team="yellow" if command == "free_kick" else None)
     for rid, it in Strategy("blue", FIELD, p).decide(world, game).items():
-        assert math.hypot(it.x - world.ball.x, it.y - world.ball.y) >= 0.5 + p.skills.robot_radius_m, rid
+        assert math.hypot(it.x - world.ball.x, it.y - world.ball.y) >= 0.5 + p.robot_radius_m, rid
         if command == "stop":
             assert it.max_speed_m_s is not None and it.max_speed_m_s <= 1.5
         assert it.kick_speed == 0.0
@@ -88,32 +93,62 @@ def test_a_contested_ball_is_played_from_the_attackers_side() -> None:
     intent = strategy.decide(WorldState(0.0, ball, robots), game)[1]
     approach = math.pi  # from the attacker to the ball
     off = abs(math.remainder(intent.theta - approach, 2 * math.pi))
-    assert off <= p.contest_turn_rad + 1e-6
+    assert off <= p.kicking.contest_turn_rad + 1e-6
     assert strategy.last_action[1] == "clear"
     # with the opponent gone the same attacker goes round the ball to play it toward their goal
     alone = Strategy("blue", FIELD, p)
     intent = alone.decide(WorldState(0.0, ball, robots[:3]), game)[1]
-    assert abs(math.remainder(intent.theta - approach, 2 * math.pi)) > p.contest_turn_rad
+    assert abs(math.remainder(intent.theta - approach, 2 * math.pi)) > p.kicking.contest_turn_rad
 
 
 def test_a_decided_pass_goes_where_its_receiver_waits() -> None:
     # the receiver is told to wait at the pass point before the kick, and the passer keeps kicking at
     # that point even when the receiver has drifted from it
-    p = StrategyParams(defenders=0)
+    p = StrategyParams(defense=DefenseParams(defenders=0))
     ball = BallState(-1.0, 0.0, 0.0, 0.0)
     robots = [_robot("blue", 0, -4.3, 0.0), _robot("blue", 1, -1.3, 0.0), _robot("blue", 2, 1.0, 2.0),
               _robot("yellow", 0, 4.3, 0.0), _robot("yellow", 1, 0.5, -0.3)]  # fmt: skip
     strategy = Strategy("blue", FIELD, p)
     game = GameState(0.0, "normal", blue_defends_negative_x=True)
     strategy.decide(WorldState(0.0, ball, tuple(robots)), game)
-    planned = strategy.mem.passing
+    planned = strategy.passes.current
     assert planned is not None and planned.passer == 1 and not planned.kicked
     point = planned.point
     robots[2] = _robot("blue", 2, point[0] + 0.3, point[1] - 0.2)
     intents = strategy.decide(WorldState(0.05, ball, tuple(robots)), game)
-    assert strategy.roles.roles[planned.receiver] == "receiver"
+    assert strategy.roles.roles[planned.receiver] == Role(RoleKind.RECEIVER)
     receiver = intents[planned.receiver]
     assert math.hypot(receiver.x - point[0], receiver.y - point[1]) < 1e-9
-    assert strategy.mem.passing is not None and strategy.mem.passing.point == point
+    assert strategy.passes.current is not None and strategy.passes.current.point == point
     kick_dir = intents[1].theta
     assert abs(math.remainder(kick_dir - math.atan2(point[1] - ball.y, point[0] - ball.x), 2 * math.pi)) < 1e-6
+
+
+def test_the_pass_heat_is_the_last_grid_evaluation_read_only() -> None:
+    strategy = Strategy("blue", FIELD, StrategyParams())
+    assert strategy.pass_heat is None
+    world = random_world(np.random.default_rng(5), 6, 6)
+    strategy.decide(world, GameState(0.0, "normal"))
+    heat = strategy.pass_heat
+    assert heat is not None
+    points, values = heat
+    assert points.shape == (len(strategy.supporters.grid), 2) and values.shape == (len(points),)
+    assert np.all((values >= 0.0) & (values <= 1.0))
+    with pytest.raises(ValueError, match="read-only"):
+        values[0] = 1.0
+    assert strategy.supporters.evaluation is not None and strategy.supporters.evaluation.values.flags.writeable
+
+
+def test_the_radii_are_read_in_one_place() -> None:
+    p = StrategyParams()
+    assert p.robot_radius_m == p.skills.robot_radius_m
+    assert p.obstacle_radius_m == p.skills.robot_radius_m + p.skills.ball_radius_m
+
+
+@pytest.mark.parametrize(("section", "key", "value"), [
+    ("kicking", "meet_cos", 1.5), ("pass_play", "timeout_s", 0.0), ("support", "eval_every_frames", 0),
+    ("game_states", "stop_distance_m", 0.4), ("defense", "defenders", 11)])  # fmt: skip
+def test_out_of_range_settings_are_refused_by_name(section: str, key: str, value: float) -> None:
+    raw = {section: {key: value}}
+    with pytest.raises(ConfigError, match=f"{section}.{key}"):
+        parse(StrategyParams, raw, file="strategy.yaml")

@@ -1,0 +1,87 @@
+"""The pass state machine: a pass from the attacker's decision to its reception.
+
+A pass is planned when the attacker decides it (passer, receiver, the point the receiver waits
+at); it is kicked once the ball runs toward that point; it is over when the receiver has the ball,
+the ball dies, the receiver is gone, or ``timeout_s`` passes (from the decision, and again from
+the kick). Field frame, metres, seconds.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+from cmdragons.config import Validated, setting
+from cmdragons.messages import BallState, RobotState
+
+__all__ = ["Pass", "PassPlay", "PassPlayParams"]
+
+
+@dataclass(frozen=True)
+class PassPlayParams(Validated):
+    timeout_s: float = setting(3.0, lo=0.1, hi=30.0)  # a pass not received by then is over
+    kicked_speed_m_s: float = setting(0.5, lo=0.0, hi=10.0)  # a ball faster than this toward the point: kicked ...
+    kicked_cos: float = setting(0.8, lo=-1.0, hi=1.0)  # ... heading at least this straight at it (cosine)
+    dead_speed_m_s: float = setting(0.2, lo=0.0, hi=10.0)  # a kicked ball slower than this has died: over
+    received_m: float = setting(0.3, lo=0.0, hi=3.0)  # the ball this near the receiver, off its way: received
+
+
+@dataclass(frozen=True)
+class Pass:
+    """A pass decided (``kicked`` False) or under way."""
+
+    passer: int
+    receiver: int
+    point: tuple[float, float]  # where the receiver waits
+    t_start: float  # when it was decided, then when it was kicked
+    kicked: bool = False
+    shoot_at: tuple[float, float] | None = None  # the receiver's one-touch aim; None: trap the ball
+
+
+class PassPlay:
+    """The team's one pass, followed from frame to frame."""
+
+    def __init__(self, params: PassPlayParams) -> None:
+        self.p = params
+        self.current: Pass | None = None
+
+    def plan(self, t: float, passer: int, receiver: int, point: tuple[float, float],
+             shoot_at: tuple[float, float] | None) -> None:  # fmt: skip
+        """The passer decides a pass; the one it decided before to the same receiver is kept as it was."""
+        ps = self.current
+        if ps is None or (ps.receiver, ps.passer) != (receiver, passer):
+            self.current = Pass(passer, receiver, point, t, shoot_at=shoot_at)
+
+    def cancel(self) -> None:
+        self.current = None
+
+    def planned_by(self, passer: int, own: Mapping[int, RobotState]) -> Pass | None:
+        """The pass ``passer`` decided and has not kicked yet, while its receiver is on the field."""
+        ps = self.current
+        if ps is not None and not ps.kicked and ps.passer == passer and ps.receiver in own:
+            return ps
+        return None
+
+    def follow(self, t: float, own: Mapping[int, RobotState], ball: BallState) -> Pass | None:
+        """The pass this frame: kicked once the ball runs toward the point; None once it is over."""
+        ps = self.current
+        if ps is None:
+            return None
+        p = self.p
+        if ps.receiver not in own or t - ps.t_start > p.timeout_s:
+            self.current = None
+            return None
+        speed = math.hypot(ball.vx, ball.vy)
+        to_point = (ps.point[0] - ball.x, ps.point[1] - ball.y)
+        along = ball.vx * to_point[0] + ball.vy * to_point[1]
+        heading_there = speed > p.kicked_speed_m_s and along > p.kicked_cos * speed * math.hypot(*to_point)
+        if not ps.kicked and heading_there:
+            ps = self.current = dataclasses.replace(ps, kicked=True, t_start=t)  # the timeout runs from the kick
+        elif ps.kicked and (speed < p.dead_speed_m_s or not heading_there):
+            receiver = own[ps.receiver]
+            if math.hypot(receiver.x - ball.x, receiver.y - ball.y) < p.received_m or speed < p.dead_speed_m_s:
+                self.current = None  # received (or died): the new attacker takes over
+                return None
+        return ps

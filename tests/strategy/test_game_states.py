@@ -1,0 +1,91 @@
+"""Game states against the rules, one function at a time."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from cmdragons.geometry import Field, LeagueParams
+from cmdragons.messages import BallState, GameState, RobotState
+from strategy.game_states import (
+    GameStateParams,
+    halt,
+    hold_shape,
+    keep_away,
+    our_kickoff,
+    own_goal_sign,
+    restart_rules,
+)
+from strategy.skills import Intent
+
+FIELD = Field(LeagueParams())
+P = GameStateParams()
+RADIUS = 0.09
+CIRCLE = FIELD.dims.center_circle_radius_m
+
+
+def _intents(rng: np.random.Generator, n: int) -> dict[int, Intent]:
+    xy = rng.uniform([-4.4, -2.9], [4.4, 2.9], (n, 2))
+    return {i: Intent(float(x), float(y), 0.3, kick_speed=2.0) for i, (x, y) in enumerate(xy)}
+
+
+@pytest.mark.parametrize(("team", "blue_negative", "sign"), [
+    ("blue", True, -1.0), ("blue", False, 1.0), ("yellow", True, 1.0), ("yellow", False, -1.0)])  # fmt: skip
+def test_own_goal_sign(team: str, blue_negative: bool, sign: float) -> None:
+    game = GameState(0.0, "normal", blue_defends_negative_x=blue_negative)
+    assert own_goal_sign(team, game) == sign  # type: ignore[arg-type]
+
+
+def test_halt_stands_everyone_where_it_is() -> None:
+    own = {3: RobotState("blue", 3, 1.0, -2.0, 0.4)}
+    assert halt(own) == {3: Intent(1.0, -2.0, 0.4, max_speed_m_s=0.0)}
+
+
+@pytest.mark.parametrize("own_sign", [-1.0, 1.0])
+def test_without_a_ball_the_team_holds_a_shape_in_our_half(own_sign: float) -> None:
+    own = {i: RobotState("blue", i, 0.0, 0.0, 0.0) for i in range(6)}
+    out = hold_shape(own, FIELD, own_sign, P)
+    assert all(it.x * own_sign > 0 and abs(it.x) < FIELD.half_length for it in out.values())
+    assert len({(it.x, it.y) for it in out.values()}) == 6
+
+
+@pytest.mark.parametrize("seed", range(10))
+@pytest.mark.parametrize("kickoff", [False, True])
+def test_keep_away_holds_the_distance_on_the_field(seed: int, kickoff: bool) -> None:
+    rng = np.random.default_rng(seed)
+    bx, by = (0.0, 0.0) if kickoff else rng.uniform([-4.4, -2.9], [4.4, 2.9])
+    ball = BallState(float(bx), float(by), 0.0, 0.0)
+    out = keep_away(_intents(rng, 8), ball, FIELD, -1.0, P, RADIUS, kickoff=kickoff, slow=True)
+    for it in out.values():
+        assert math.hypot(it.x - ball.x, it.y - ball.y) >= P.stop_distance_m + RADIUS - 1e-9
+        assert abs(it.x) <= FIELD.half_length - RADIUS + 1e-9 and abs(it.y) <= FIELD.half_width - RADIUS + 1e-9
+        assert it.max_speed_m_s == P.stop_speed_m_s and it.kick_speed == 0.0
+        if kickoff:
+            assert it.x < 0.0 and math.hypot(it.x, it.y) >= CIRCLE + RADIUS
+
+
+def test_at_our_kickoff_all_but_the_kicker_stay_in_our_half_outside_the_circle() -> None:
+    intents = _intents(np.random.default_rng(7), 8)
+    intents[0] = Intent(0.1, 0.05, 0.0, kick_speed=3.0)  # the kicker at the ball
+    out = our_kickoff(intents, FIELD, 1.0, P, RADIUS, kicker=0)
+    assert out[0] == intents[0]
+    for rid, it in out.items():
+        if rid != 0:
+            assert it.x >= RADIUS + P.halfway_margin_m - 1e-12 and math.hypot(it.x, it.y) >= CIRCLE + RADIUS
+
+
+def test_restart_rules_by_command() -> None:
+    intents = _intents(np.random.default_rng(9), 6)
+    ball = BallState(0.5, 0.5, 0.0, 0.0)
+
+    def rules(command: str, ours: bool) -> dict[int, Intent]:
+        return restart_rules(intents, GameState(0.0, command), ours, ball, FIELD, -1.0, P, RADIUS, kicker=None)
+
+    assert rules("normal", False) == intents
+    assert rules("free_kick", True) == intents  # ours: the attacker takes it
+    for command, ours in (("stop", True), ("free_kick", False), ("kickoff", False)):
+        assert rules(command, ours) == keep_away(intents, ball, FIELD, -1.0, P, RADIUS, command == "kickoff",
+                                                 command == "stop")  # fmt: skip
+    assert rules("kickoff", True) == our_kickoff(intents, FIELD, -1.0, P, RADIUS, None)

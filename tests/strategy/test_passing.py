@@ -1,0 +1,78 @@
+"""The pass state machine: planned, kicked, over (received, died, lost receiver, timed out)."""
+
+from __future__ import annotations
+
+import pytest
+
+from cmdragons.messages import BallState, RobotState
+from strategy.passing import PassPlay, PassPlayParams
+
+P = PassPlayParams()
+POINT = (2.0, 0.0)
+
+
+def _own(receiver_at: tuple[float, float] = POINT) -> dict[int, RobotState]:
+    return {1: RobotState("blue", 1, 0.0, 0.0, 0.0), 2: RobotState("blue", 2, *receiver_at, 0.0)}
+
+
+def _planned(t: float = 0.0) -> PassPlay:
+    play = PassPlay(P)
+    play.plan(t, passer=1, receiver=2, point=POINT, shoot_at=None)
+    return play
+
+
+def test_a_pass_stays_planned_while_the_ball_lies() -> None:
+    play = _planned()
+    ps = play.follow(0.5, _own(), BallState(0.1, 0.0, 0.0, 0.0))
+    assert ps is not None and not ps.kicked and ps.t_start == 0.0
+    assert play.planned_by(1, _own()) is ps
+    assert play.planned_by(2, _own()) is None  # only its passer kicks it
+    assert play.planned_by(1, {1: _own()[1]}) is None  # nor once its receiver is gone
+
+
+@pytest.mark.parametrize(("vx", "vy", "kicked"), [
+    (3.0, 0.0, True),  # straight at the point
+    (3.0, 1.0, True),  # cos 0.95 > 0.8
+    (3.0, 3.0, False),  # cos 0.71: not toward the point
+    (0.4, 0.0, False),  # too slow to be a pass
+    (-3.0, 0.0, False),  # away from it
+])  # fmt: skip
+def test_kicked_once_the_ball_runs_toward_the_point(vx: float, vy: float, kicked: bool) -> None:
+    play = _planned()
+    ps = play.follow(1.0, _own(), BallState(0.1, 0.0, vx, vy))
+    assert ps is not None and ps.kicked is kicked
+    assert ps.t_start == (1.0 if kicked else 0.0)  # the timeout runs from the kick
+
+
+def test_over_when_received_or_died() -> None:
+    play = _planned()
+    play.follow(0.1, _own(), BallState(0.1, 0.0, 3.0, 0.0))
+    # the ball goes past the point, off its way, but far from the receiver: still under way
+    ps = play.follow(0.5, _own(receiver_at=(2.0, 1.0)), BallState(2.5, 0.0, 2.0, 0.0))
+    assert ps is not None and ps.kicked
+    # at the receiver, and no longer heading for the point: received
+    assert play.follow(0.6, _own(), BallState(2.1, 0.0, 1.0, 0.0)) is None
+    assert play.current is None
+    died = _planned()
+    died.follow(0.1, _own(), BallState(0.1, 0.0, 3.0, 0.0))
+    assert died.follow(0.9, _own(receiver_at=(3.0, 2.0)), BallState(1.0, 0.0, 0.1, 0.0)) is None
+
+
+def test_over_on_timeout_and_without_its_receiver() -> None:
+    play = _planned()
+    assert play.follow(P.timeout_s - 0.01, _own(), BallState(0.1, 0.0, 0.0, 0.0)) is not None
+    assert play.follow(P.timeout_s + 0.01, _own(), BallState(0.1, 0.0, 0.0, 0.0)) is None
+    lost = _planned()
+    assert lost.follow(0.1, {1: _own()[1]}, BallState(0.1, 0.0, 0.0, 0.0)) is None
+
+
+def test_planning_again_keeps_the_pass_to_the_same_receiver() -> None:
+    play = _planned(t=0.0)
+    first = play.current
+    play.plan(0.5, passer=1, receiver=2, point=(2.5, 0.3), shoot_at=(4.5, 0.0))
+    assert play.current is first  # its receiver already waits at the first point
+    play.plan(0.6, passer=1, receiver=3, point=(1.0, 1.0), shoot_at=None)
+    assert play.current is not None and (play.current.receiver, play.current.point) == (3, (1.0, 1.0))
+    assert play.current.t_start == 0.6
+    play.cancel()
+    assert play.current is None

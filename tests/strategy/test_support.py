@@ -1,0 +1,59 @@
+"""Supporter placement: the best points, spread apart and off the ball; the grid re-evaluated
+every few frames."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+
+from cmdragons.geometry import Field, LeagueParams
+from strategy.evaluation import PassEvaluation, PassParams, candidate_grid
+from strategy.support import Supporters, SupportParams, spread_points
+
+FIELD = Field(LeagueParams())
+P = SupportParams(spacing_m=1.0, min_ball_distance_m=0.5)
+
+
+def _evaluation(points: list[tuple[float, float]], values: list[float]) -> PassEvaluation:
+    pts = np.array(points, dtype=float)
+    return PassEvaluation(pts, np.array(values, dtype=float), np.zeros_like(pts))
+
+
+def test_the_best_points_spread_apart_and_off_the_ball() -> None:
+    ev = _evaluation([(0.2, 0.0), (2.0, 0.0), (2.5, 0.0), (2.0, 1.5), (-2.0, 0.0)],
+                     [0.99, 0.9, 0.8, 0.7, 0.1])  # fmt: skip
+    ball = np.array([0.0, 0.0])
+    # (0.2, 0) is on the ball, (2.5, 0) too near the better (2.0, 0)
+    assert spread_points(ev, ball, 3, P) == [(2.0, 0.0), (2.0, 1.5), (-2.0, 0.0)]
+    assert spread_points(ev, ball, 1, P) == [(2.0, 0.0)]
+    assert spread_points(ev, ball, 0, P) == []
+
+
+def test_spread_points_on_a_random_evaluation_keep_their_promises() -> None:
+    rng = np.random.default_rng(3)
+    pts = rng.uniform([-4.0, -2.5], [4.0, 2.5], (200, 2))
+    ev = _evaluation([tuple(p) for p in pts], list(rng.random(200)))
+    ball = np.array([0.5, -0.3])
+    chosen = spread_points(ev, ball, 4, P)
+    assert len(chosen) == 4
+    for a, b in itertools.combinations(chosen, 2):
+        assert math.dist(a, b) >= P.spacing_m
+    assert all(math.dist(c, ball) >= P.min_ball_distance_m for c in chosen)
+    value = {tuple(p): v for p, v in zip(ev.points, ev.values, strict=True)}
+    assert [value[c] for c in chosen] == sorted((value[c] for c in chosen), reverse=True)  # best first
+
+
+def test_the_grid_is_evaluated_on_the_first_frame_and_every_nth() -> None:
+    supporters = Supporters(FIELD, PassParams(), SupportParams(eval_every_frames=3), obstacle_radius=0.11)
+    assert supporters.evaluation is None
+    ball, opponents = np.array([0.0, 0.0]), np.array([[1.0, 0.5]])
+    supporters.update(1, ball, 1.0, opponents, 2)
+    first = supporters.evaluation
+    assert first is not None and len(first.points) == len(candidate_grid(FIELD, PassParams()))
+    assert len(supporters.points) == 2
+    supporters.update(2, np.array([2.0, 1.0]), 1.0, opponents, 2)
+    assert supporters.evaluation is first  # held between evaluations
+    supporters.update(3, np.array([2.0, 1.0]), 1.0, opponents, 2)
+    assert supporters.evaluation is not first

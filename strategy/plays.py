@@ -102,12 +102,6 @@ class Strategy:
         points.flags.writeable = values.flags.writeable = False
         return points, values
 
-    @property
-    def pass_heat(self) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
-        """The pass evaluation's last grid: receiving points (n, 2) and their values (n,), or None."""
-        ev = self.mem.evaluation
-        return None if ev is None else (ev.points, ev.values)
-
     def decide(self, world: WorldState, game: GameState) -> dict[int, Intent]:
         """An intent for each of our robots in ``world``."""
         self.frame += 1

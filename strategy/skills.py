@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cmdragons.config import Validated, setting
+from cmdragons.config import Validated, derived, setting
 from cmdragons.geometry import Field, wrap_angle
 from cmdragons.messages import BallState, RobotState
 from strategy.onetouch import aim_heading
@@ -34,9 +34,10 @@ __all__ = [
 
 @dataclass(frozen=True)
 class SkillParams(Validated):
-    robot_radius_m: float = setting(0.09, lo=0.02, hi=0.5)
-    ball_radius_m: float = setting(0.0215, lo=0.005, hi=0.2)
-    front_distance_m: float = setting(0.07, lo=0.01, hi=0.5)  # centre to the kicker face
+    # our robots' and the ball's shape: configured once, in field.yaml robot and ball
+    robot_radius_m: float = derived("field.robot.radius_m", 0.09, lo=0.02, hi=0.5)
+    ball_radius_m: float = derived("field.ball.radius_m", 0.0215, lo=0.005, hi=0.2)
+    front_distance_m: float = derived("field.robot.front_distance_m", 0.07, lo=0.01, hi=0.5)  # centre to kicker face
     approach_distance_m: float = setting(0.12, lo=0.0, hi=1.0)  # wait this far behind the ball, lined up
     lined_up_rad: float = setting(0.08, lo=0.001, hi=1.0)  # heading error allowed before driving through
     lined_up_m: float = setting(0.03, lo=0.001, hi=0.5)  # lateral error allowed before driving through
@@ -48,10 +49,12 @@ class SkillParams(Validated):
     pass_arrival_m_s: float = setting(1.5, lo=0.1, hi=6.0)  # the speed a pass should arrive with
     pass_min_m_s: float = setting(1.5, lo=0.1, hi=10.0)
     pass_max_m_s: float = setting(5.0, lo=0.1, hi=10.0)
-    acc_slide_m_s2: float = setting(3.0, lo=0.0, hi=50.0)  # the ball model, for pass speeds and intercepts
-    acc_roll_m_s2: float = setting(0.26, lo=0.0, hi=10.0)
-    slide_to_roll_fraction: float = setting(0.64, lo=0.0, hi=1.0)
-    kicker_retention: float = setting(0.3, lo=0.0, hi=1.0)  # ball velocity across the heading a kick keeps
+    # the ball model, for pass speeds and intercepts: configured once, in field.yaml ball
+    acc_slide_m_s2: float = derived("field.ball.acc_slide_m_s2", 3.0, lo=0.0, hi=50.0)
+    acc_roll_m_s2: float = derived("field.ball.acc_roll_m_s2", 0.26, lo=0.0, hi=10.0)
+    slide_to_roll_fraction: float = derived("field.ball.slide_to_roll_fraction", 0.64, lo=0.0, hi=1.0)
+    # the ball velocity across the heading a kick keeps: the kicker's, configured in sim.yaml kicker
+    kicker_retention: float = derived("sim.kicker.tangential_retention", 0.3, lo=0.0, hi=1.0)
     goalie_depth_m: float = setting(0.15, lo=0.0, hi=2.0)  # goalie stands this far in front of the goal line
     defense_margin_m: float = setting(0.15, lo=0.0, hi=2.0)  # defenders stand this far outside the area
     mark_distance_m: float = setting(0.45, lo=0.2, hi=3.0)  # marker between its opponent and our goal

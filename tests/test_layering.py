@@ -31,7 +31,7 @@ OWNERS: dict[str, tuple[str, ...]] = {
     "matplotlib": ("cmdragons.runtime", "cmdragons.bench"),
 }
 CV2_VIDEO = ("VideoWriter", "VideoCapture")
-CV2_VIDEO_OWNERS = ("cmdragons.videoio", "cmdragons.recording", "vision.sources", "cmdragons.cli",
+CV2_VIDEO_OWNERS = ("cmdragons.videoio", "cmdragons.recording", "vision.sources", "vision.run", "cmdragons.cli",
                     "cmdragons.runtime", "cmdragons.bench")  # fmt: skip
 
 

@@ -97,10 +97,11 @@ def camera_vector(model: CameraModel) -> NDArray[np.float64]:
 @njit(cache=True)
 def _project(cam: NDArray[np.float64], x: float, y: float, z: float) -> tuple[float, float]:
     """Field point (m) -> pixel (u, v), the same model as ``CameraModel.project``; NaN behind."""
-    px, py, pz = x - cam[0], y - cam[1], z - cam[2]
-    xc = px * cam[3] + py * cam[6] + pz * cam[9]
-    yc = px * cam[4] + py * cam[7] + pz * cam[10]
-    zc = px * cam[5] + py * cam[8] + pz * cam[11]
+    c, r = CAM_CENTER, CAM_ROT  # r + 3 * row + column of R_cam_to_field
+    px, py, pz = x - cam[c], y - cam[c + 1], z - cam[c + 2]
+    xc = px * cam[r] + py * cam[r + 3] + pz * cam[r + 6]
+    yc = px * cam[r + 1] + py * cam[r + 4] + pz * cam[r + 7]
+    zc = px * cam[r + 2] + py * cam[r + 5] + pz * cam[r + 8]
     if zc <= 1e-9:
         return math.nan, math.nan
     xn, yn = xc / zc, yc / zc
@@ -167,7 +168,7 @@ def _plan_objects_kernel(
     ball_bbox: NDArray[np.int32], ball_truth: NDArray[np.float64],
 ) -> int:  # fmt: skip
     r, h = shape[SHAPE_ROBOT_RADIUS], shape[SHAPE_ROBOT_HEIGHT]
-    f, cz = cam[CAM_FOCAL], cam[2]
+    f, cz = cam[CAM_FOCAL], cam[CAM_CENTER + 2]
     w_img, h_img = cam[CAM_WIDTH], cam[CAM_HEIGHT]
     n_ids = pink.shape[0]
     for k in range(robots.shape[0]):
@@ -405,7 +406,7 @@ def _ball_sample(cam: NDArray[np.float64], rdx: float, rdy: float, foot: float, 
     """Ray (dx, dy, -1) from the optical centre against the ball sphere at B: (coverage, shade,
     height of the visible surface point). Off the silhouette the nearest point of the ray stands
     in for the hit, so the anti-aliased rim still gets a height and a shade."""
-    wx, wy, wz = bx - cam[0], by - cam[1], bz - cam[2]
+    wx, wy, wz = bx - cam[CAM_CENTER], by - cam[CAM_CENTER + 1], bz - cam[CAM_CENTER + 2]
     dd = rdx * rdx + rdy * rdy + 1.0
     tc = (wx * rdx + wy * rdy - wz) / dd  # ray parameter = descent (m) at the nearest point
     dist2 = max(wx * wx + wy * wy + wz * wz - tc * tc * dd, 0.0)
@@ -423,7 +424,7 @@ def _ball_sample(cam: NDArray[np.float64], rdx: float, rdy: float, foot: float, 
     up = nz / nlen if nlen > 1e-12 else 1.0
     # light from straight above: the rim, facing sideways, darkens to the ambient fraction
     shade = ambient + (1.0 - ambient) * max(up, 0.0)
-    return a, shade, cam[2] - t
+    return a, shade, cam[CAM_CENTER + 2] - t
 
 
 # --- sensor noise: fresh every frame ------------------------------------------------------------
@@ -498,7 +499,7 @@ def _render_frame_kernel(
 ) -> None:  # fmt: skip
     h_img, w3 = out2.shape
     n_rob = rob_k.shape[0]
-    cx, cy, cz = cam[0], cam[1], cam[2]
+    cx, cy, cz = cam[CAM_CENTER], cam[CAM_CENTER + 1], cam[CAM_CENTER + 2]
     h, rb, ambient = shape[SHAPE_ROBOT_HEIGHT], shape[SHAPE_BALL_RADIUS], shape[SHAPE_BALL_AMBIENT]
     side, cover, ball_col = palette[PAL_SIDE], palette[PAL_COVER], palette[PAL_BALL]
     # rows are dealt out round-robin so that both threads share the rows holding objects

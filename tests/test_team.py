@@ -1,15 +1,17 @@
 """The brain: own robots the tracker lost stay in the safety search and are stopped; a robot held
-back keeps pressing on."""
+back keeps pressing on; the planner config is what its planners use."""
 
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from cmdragons.messages import BallState, GameState, RobotCommand, RobotState, WorldState
+from cmdragons.planning import CollisionParams, CollisionWorld, CompiledWorld
 from cmdragons.runtime.settings import load_settings
 from cmdragons.team import Brain
 
@@ -68,3 +70,31 @@ def test_a_robot_held_back_keeps_pressing_on() -> None:
     no_slip = dataclasses.replace(SETTINGS.team.trajectory, command_slip_m_s=0.0)
     restarting = Brain("blue", SETTINGS, dataclasses.replace(SETTINGS.team, trajectory=no_slip))
     assert speed(restarting, 10) == pytest.approx(accel / 60, rel=0.05)
+
+
+@pytest.mark.parametrize(
+    ("override", "expect"),
+    [("planner.collision.broad_phase=aabb_tree", lambda t1, p: p.broad_phase == "aabb_tree"),
+     ("planner.collision.mask_bins=7", lambda t1, p: p.mask_bins == 7),
+     ("planner.horizon_s=0.4", lambda t1, p: t1 == 0.4)],
+)  # fmt: skip
+def test_the_brains_planners_answer_to_the_planner_config(
+    monkeypatch: pytest.MonkeyPatch, override: str, expect: Callable[[float, CollisionParams], bool]
+) -> None:
+    # what `cmdragons play --set ...` loads is what the brain's planners compile their worlds with
+    settings = load_settings(Path(__file__).resolve().parents[1] / "configs", [override])
+    seen: list[tuple[float, CollisionParams]] = []
+    compile_world = CollisionWorld.compile
+
+    def spy(self: CollisionWorld, radius_m: float, t0_s: float = 0.0, t1_s: float = 0.0,
+            params: CollisionParams | None = None) -> CompiledWorld:  # fmt: skip
+        seen.append((t1_s, params or CollisionParams()))
+        return compile_world(self, radius_m, t0_s, t1_s, params)
+
+    brain = Brain("blue", settings)  # (its safety search compiles the static field with its own radius)
+    monkeypatch.setattr(CollisionWorld, "compile", spy)
+    robots = (RobotState("blue", 0, -3.0, 0.0, 0.0), RobotState("blue", 1, 0.0, 1.0, 0.0),
+              RobotState("yellow", 0, -1.0, 0.0, 0.0))  # fmt: skip
+    brain.step(world(0.0, *robots), GameState(0.0))
+    assert seen and all(expect(t1, p) for t1, p in seen)
+    assert not expect(0.0, CollisionParams())  # the override differs from the default

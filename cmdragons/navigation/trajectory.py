@@ -58,11 +58,13 @@ class TrajectoryNavigator:
         self.control = control
         self.path: NDArray[np.float64] = np.zeros((0, 2))
         self.arrival = Arrival()
+        self._next = 1  # the first waypoint of the path not yet passed
         self._sent: tuple[float, float] | None = None
 
     def set_plan(self, path: ArrayLike, arrival: Arrival) -> None:
         self.path = np.asarray(path, dtype=np.float64).reshape(-1, 2)
         self.arrival = arrival
+        self._next = 1
 
     def sent(self, vx: float, vy: float) -> None:
         self._sent = (vx, vy)
@@ -70,13 +72,18 @@ class TrajectoryNavigator:
     def reset(self) -> None:
         self.path = np.zeros((0, 2))
         self.arrival = Arrival()
+        self._next = 1
         self._sent = None
 
     def target(self, robot: RobotState) -> tuple[MotionTarget, ControlParams]:
         """Where the profile leads this frame (field frame) and the limits it runs under."""
         control = capped_control(self.control, self.arrival.max_speed_m_s)
         start = (robot.x, robot.y)
-        target = follow_path(start, self.path, self.arrival.heading_rad, control)
+        # a waypoint once passed stays passed while the plan lasts (the brain plans anew each frame)
+        reached = control.path.waypoint_reached_m
+        while self._next < len(self.path) - 1 and math.dist(start, self.path[self._next]) <= reached:
+            self._next += 1
+        target = follow_path(start, self.path[self._next - 1 :], self.arrival.heading_rad, control)
         through = self.arrival.through_speed_m_s
         if through > 0.0 and len(self.path) and math.dist((target.x, target.y), self.path[-1]) < 1e-9:
             # drive through the goal point (onto the ball) instead of stopping on it

@@ -121,7 +121,8 @@ class Brain:
         self._last_seen: dict[int, tuple[float, RobotState]] = {}  # own robots as the world last showed them
         # which boxes of the frame's world (both defense areas, then the goal walls) each intent keeps:
         # both areas, or only the one at x of the sign given (a goalie may enter its own)
-        every = field_world(self.field).boxes
+        self._field = field_world(self.field)  # the boundary, both defense areas, the goal walls
+        every = self._field.boxes
         self._boxes: dict[str, NDArray[np.bool_]] = {
             key: np.array([any(np.array_equal(row, b) for b in field_world(self.field, defense_areas=side).boxes)
                            for row in every])
@@ -183,8 +184,12 @@ class Brain:
         if world.ball is not None:
             ball = np.array([[world.ball.x, world.ball.y,
                               self.settings.field.ball.radius_m + self.params.brain.ball_clearance_m]])  # fmt: skip
-        cworld = field_world(self.field, xy, vel, self.radius, extra_circles=ball)
-        return Frame(robots, xy, vel, own, cworld, ball is not None)
+        circles = np.column_stack([xy, np.full(len(xy), self.radius)])
+        if ball is not None:
+            circles, vel_all = np.vstack([circles, ball]), np.vstack([vel, np.zeros((1, 2))])
+        else:
+            vel_all = vel
+        return Frame(robots, xy, vel, own, self._field.with_circles(circles, vel_all), ball is not None)
 
     def _robot_world(self, frame: Frame, i: int, it: Intent, game: GameState) -> CollisionWorld:
         """The frame's world as robot ``i`` must avoid it: without itself, without the ball unless its
@@ -194,7 +199,9 @@ class Brain:
         if frame.has_ball and not it.avoid_ball:
             circles[-1] = False
         # the goalie may enter our own area: keep only the opponent's (at x of sign -own_sign)
-        key = ("+x" if self.strategy.own_sign(game) < 0 else "-x") if it.allow_own_defense else "both"
+        key = "both"
+        if it.allow_own_defense:
+            key = "+x" if self.strategy.own_sign(game) < 0 else "-x"
         return frame.world.subset(circles, self._boxes[key])
 
     def _lost_robots(self, world: WorldState) -> tuple[RobotState, ...]:
@@ -232,7 +239,8 @@ class Brain:
         out = []
         for c in commands + stops:
             v = safe_v.get(c.id)
-            out.append(c if v is None else dataclasses.replace(c, vx=float(v[0]), vy=float(v[1])))
+            out.append(c if v is None else RobotCommand(c.team, c.id, float(v[0]), float(v[1]), c.omega, c.kick_speed,
+                                                        c.chip, c.dribbler))  # fmt: skip
         return out
 
     def _navigate(self, frame: Frame, i: int, it: Intent, game: GameState) -> RobotCommand:

@@ -1,5 +1,6 @@
 """The brain: own robots the tracker lost stay in the safety search and are stopped; a robot held
-back keeps pressing on; the planner config is what its planners use."""
+back keeps pressing on; the planner config is what its planners use; every params object of planning,
+control, safety, navigation and the team checks its ranges."""
 
 from __future__ import annotations
 
@@ -10,10 +11,22 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from cmdragons.control import MotionParams, PathParams, TrapezoidParams
 from cmdragons.messages import BallState, GameState, RobotCommand, RobotState, WorldState
-from cmdragons.planning import CollisionParams, CollisionWorld, CompiledWorld
+from cmdragons.navigation import DynamicWindowParams, TrajectoryParams
+from cmdragons.planning import (
+    CollisionParams,
+    CollisionWorld,
+    CompiledWorld,
+    DynamicPRMParams,
+    ERRTParams,
+    PlannerParams,
+    VisGraphParams,
+)
+from cmdragons.planning.errt import SmoothingParams
 from cmdragons.runtime.settings import load_settings
-from cmdragons.team import Brain
+from cmdragons.safety import DSSParams, SafetyParams
+from cmdragons.team import Brain, BrainParams, TeamParams
 
 SETTINGS = load_settings(Path(__file__).resolve().parents[1] / "configs")
 BALL = BallState(2.0, 1.0, 0.0, 0.0)
@@ -98,3 +111,20 @@ def test_the_brains_planners_answer_to_the_planner_config(
     brain.step(world(0.0, *robots), GameState(0.0))
     assert seen and all(expect(t1, p) for t1, p in seen)
     assert not expect(0.0, CollisionParams())  # the override differs from the default
+
+
+@pytest.mark.parametrize(
+    ("cls", "field", "bad"),
+    [(ERRTParams, "step_m", 0.0), (SmoothingParams, "passes", -1), (DynamicPRMParams, "work_budget", 0),
+     (VisGraphParams, "arc_check_step_deg", 0.0), (CollisionParams, "grid_resolution_m", 0.0),
+     (CollisionParams, "broad_phase", "octree"), (PlannerParams, "deadline_ms", 0.0),
+     (PlannerParams, "planner", "astar"), (MotionParams, "max_brake_m_s2", 0.0),
+     (PathParams, "corner_overshoot_m", 0.0), (TrapezoidParams, "split_iterations", 1),
+     (DSSParams, "own_margin_m", -0.1), (SafetyParams, "method", "dynamic_window"),
+     (TrajectoryParams, "command_slip_m_s", -1.0), (DynamicWindowParams, "directions", 2),
+     (BrainParams, "navigate_deadline_ms", 0.0), (TeamParams, "navigator", "magic")],
+)  # fmt: skip
+def test_params_check_their_ranges_however_they_are_built(cls: type, field: str, bad: object) -> None:
+    with pytest.raises(ValueError, match=field):
+        cls(**{field: bad})
+    cls()  # the defaults are in range

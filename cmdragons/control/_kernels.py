@@ -250,12 +250,16 @@ def limit_velocity(
 
 
 @njit(cache=True)
-def motion_commands(states: np.ndarray, targets: np.ndarray, lim: Limits, period: float, iterations: int) -> np.ndarray:
+def motion_commands(
+    states: np.ndarray, targets: np.ndarray, vmax: float, accel: float, brake: float, wmax: float, alpha: float,
+    period: float, iterations: int,
+) -> np.ndarray:  # fmt: skip
     """Commands (n, 3) vx, vy, omega for every robot: the 2D trapezoid toward the target position and
     velocity, the heading's trapezoid toward the target heading, both then held to the limits.
 
-    ``states`` (n, 6): x, y, theta, vx, vy, omega; ``targets`` (n, 5): x, y, vx, vy, theta."""
-    vmax, accel, brake, wmax, alpha = lim.vmax, lim.accel, lim.brake, lim.omega_max, lim.alpha_max
+    ``states`` (n, 6): x, y, theta, vx, vy, omega; ``targets`` (n, 5): x, y, vx, vy, theta; the limits
+    by name as in :class:`Limits` (scalars: the kernel runs once per robot and frame, and numba's
+    dispatch is quickest on them)."""
     out = np.empty((states.shape[0], 3))
     for i in range(states.shape[0]):
         x, y, th, vx, vy, w = states[i, 0], states[i, 1], states[i, 2], states[i, 3], states[i, 4], states[i, 5]

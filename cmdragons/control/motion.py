@@ -97,7 +97,8 @@ def motion_commands(states: ArrayLike, targets: ArrayLike, params: ControlParams
     s = np.ascontiguousarray(states, dtype=np.float64).reshape(-1, 6)
     t = np.ascontiguousarray(targets, dtype=np.float64).reshape(-1, 5)
     m = params.motion
-    return np.asarray(K.motion_commands(s, t, m.limits(), m.period_s, params.trapezoid.split_iterations))
+    return np.asarray(K.motion_commands(s, t, m.max_speed_m_s, m.max_accel_m_s2, m.max_brake_m_s2, m.max_omega_rad_s,
+                                        m.max_alpha_rad_s2, m.period_s, params.trapezoid.split_iterations))  # fmt: skip
 
 
 def motion_command(robot: RobotState, target: MotionTarget, params: ControlParams) -> RobotCommand:

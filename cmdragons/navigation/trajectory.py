@@ -12,7 +12,6 @@ held back by an opponent keeps pressing on instead of starting from rest every f
 from __future__ import annotations
 
 import dataclasses
-import functools
 import math
 from dataclasses import dataclass
 
@@ -39,7 +38,6 @@ class TrajectoryParams(Validated):
     through_beyond_m: float = setting(0.05, lo=0.0, hi=1.0)
 
 
-@functools.lru_cache(maxsize=64)
 def capped_control(control: ControlParams, max_speed_m_s: float | None) -> ControlParams:
     """``control`` with its speed limit lowered to ``max_speed_m_s`` (None or above: unchanged)."""
     if max_speed_m_s is None or max_speed_m_s >= control.motion.max_speed_m_s:
@@ -60,6 +58,7 @@ class TrajectoryNavigator:
         self.arrival = Arrival()
         self._next = 1  # the first waypoint of the path not yet passed
         self._sent: tuple[float, float] | None = None
+        self._capped: dict[float | None, ControlParams] = {}
 
     def set_plan(self, path: ArrayLike, arrival: Arrival) -> None:
         self.path = np.asarray(path, dtype=np.float64).reshape(-1, 2)
@@ -77,7 +76,10 @@ class TrajectoryNavigator:
 
     def target(self, robot: RobotState) -> tuple[MotionTarget, ControlParams]:
         """Where the profile leads this frame (field frame) and the limits it runs under."""
-        control = capped_control(self.control, self.arrival.max_speed_m_s)
+        cap = self.arrival.max_speed_m_s
+        control = self._capped.get(cap)
+        if control is None:
+            control = self._capped[cap] = capped_control(self.control, cap)
         start = (robot.x, robot.y)
         # a waypoint once passed stays passed while the plan lasts (the brain plans anew each frame)
         reached = control.path.waypoint_reached_m
@@ -101,7 +103,8 @@ class TrajectoryNavigator:
         (within ``command_slip_m_s``), else the measured one."""
         sent = self._sent
         if sent is not None and math.hypot(sent[0] - robot.vx, sent[1] - robot.vy) <= self.params.command_slip_m_s:
-            return dataclasses.replace(robot, vx=sent[0], vy=sent[1])
+            return RobotState(robot.team, robot.id, robot.x, robot.y, robot.theta, sent[0], sent[1], robot.omega,
+                              robot.visible)  # fmt: skip
         return robot
 
     def command(self, robot: RobotState, world: CollisionWorld, termination: Termination) -> VelocityCommand:

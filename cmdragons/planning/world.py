@@ -121,12 +121,25 @@ class CollisionWorld:
         """The world keeping only the circles and boxes whose mask entry is True (all when a mask is
         None), in their order: one world per frame, each robot's view leaving itself out. The rows
         are this world's, already checked."""
-        w = object.__new__(CollisionWorld)
         keep_c = self.circles if circles is None else self.circles[circles]
         keep_v = self.velocities if circles is None else self.velocities[circles]
         keep_b = self.boxes if boxes is None else self.boxes[boxes]
-        for name, value in (("bounds", self.bounds), ("circles", keep_c), ("velocities", keep_v), ("boxes", keep_b),
-                            ("_cache", {})):  # fmt: skip
+        return self._checked(keep_c, keep_v, keep_b)
+
+    def with_circles(self, circles: ArrayLike, velocities: ArrayLike) -> CollisionWorld:
+        """This world's bounds and boxes with ``circles`` (n, 3: x, y, radius) moving at ``velocities``
+        (n, 2) in place of its own circles (a frame's robots in the field's static world)."""
+        c = np.asarray(circles, dtype=np.float64).reshape(-1, 3)
+        v = np.asarray(velocities, dtype=np.float64).reshape(-1, 2)
+        if len(v) != len(c) or not (np.isfinite(c).all() and np.isfinite(v).all()) or np.any(c[:, 2] < 0.0):
+            raise ValueError("circles (n, 3) and velocities (n, 2) must be finite, radii >= 0")
+        return self._checked(c, v, self.boxes)
+
+    def _checked(self, circles: FloatArray, velocities: FloatArray, boxes: FloatArray) -> CollisionWorld:
+        # a world of rows already checked (the constructor's checks cost more than a frame can spare)
+        w = object.__new__(CollisionWorld)
+        for name, value in (("bounds", self.bounds), ("circles", circles), ("velocities", velocities),
+                            ("boxes", boxes), ("_cache", {})):  # fmt: skip
             object.__setattr__(w, name, value)
         return w
 

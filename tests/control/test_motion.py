@@ -17,7 +17,7 @@ from cmdragons.control import (
 )
 from cmdragons.control import _kernels as K
 from cmdragons.control import _reference as R
-from cmdragons.geometry import LeagueParams
+from cmdragons.geometry import LeagueParams, wrap_angle
 from cmdragons.messages import RobotCommand, RobotState
 from sim.world import BallParams, DribblerParams, KickerParams, PhysicsParams, RobotParams, World
 
@@ -119,5 +119,5 @@ def test_closed_loop_in_the_simulator_reaches_the_goal_in_the_profile_time(
     # arrives about when the profile says, and stays: within 1 cm and 0.02 rad
     assert arrived is not None and arrived <= ideal + 0.1
     assert math.hypot(row[2] - goal[0], row[3] - goal[1]) < 0.01
-    assert abs((row[4] - goal[2] + math.pi) % (2 * math.pi) - math.pi) < 0.02
+    assert abs(wrap_angle(row[4] - goal[2])) < 0.02
     assert w.faults.clamped == 0

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from cmdragons.control import ControlParams
-from cmdragons.geometry import Field, LeagueParams
+from cmdragons.geometry import Field, LeagueParams, wrap_angle
 from cmdragons.messages import RobotCommand, RobotState
 from cmdragons.navigation import NAVIGATORS, STOP, Arrival, make_navigator
 from cmdragons.planning import budget, deadline, field_world
@@ -64,7 +64,7 @@ def test_every_navigator_reaches_a_free_goal_within_the_limits_and_rests_there(
     for s in states[-60:]:
         assert math.hypot(s[0] - goal[0], s[1] - goal[1]) < 0.01
         assert math.hypot(s[3], s[4]) < 0.01
-    assert abs((states[-1][2] - heading + math.pi) % (2 * math.pi) - math.pi) < 0.02
+    assert abs(wrap_angle(states[-1][2] - heading)) < 0.02
     # the limits: speed, the acceleration set A(v) between two commands, the turn rate
     v = np.array([(c.vx, c.vy) for c in commands])
     assert np.all(np.hypot(v[:, 0], v[:, 1]) <= M.max_speed_m_s + 1e-9)

@@ -2,9 +2,9 @@
 path smoothing, the visibility graph and the roadmap search.
 
 Everything here works in the field frame (metres) on plain numpy arrays. A compiled collision world
-("cw") is one tuple, built by :mod:`cmdragons.planning.world`, for one robot radius and time window:
+("cw") is one named tuple (:class:`CW`), built by :mod:`cmdragons.planning.world`, for one robot radius and time window:
 
-    cw = (obs, aabb, inner, mode, grid, xmask, ymask, tbox, tchild, tleaf)
+    cw = CW(obs, aabb, inner, mode, grid, xmask, ymask, tbox, tchild, tleaf)
 
 * ``obs`` (k, 6): ``kind, p0, p1, p2, p3, R`` per obstacle, already grown by the robot's radius, so
   a robot *centre* is in collision when its distance to the obstacle's core is below ``R``.
@@ -26,12 +26,27 @@ from __future__ import annotations
 
 import heapq
 import math
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numba import njit
 
-CW = tuple[Any, ...]  # a compiled collision world, see the module docstring
+
+class CW(NamedTuple):
+    """A compiled collision world, by name (see the module docstring)."""
+
+    obs: np.ndarray  # (k, 6) kind, p0, p1, p2, p3, R
+    aabb: np.ndarray  # (k, 4) grown bounding boxes
+    inner: np.ndarray  # (4,) the box the robot centre stays in
+    mode: int  # MODE_LINEAR, MODE_MASKS or MODE_AABB_TREE
+    grid: np.ndarray  # (4,) x0, y0, bins per metre in x and y of the extent masks
+    xmask: np.ndarray  # (bins, words) uint64
+    ymask: np.ndarray  # (bins, words) uint64
+    tbox: np.ndarray  # (nodes, 4) AABB tree node boxes
+    tchild: np.ndarray  # (nodes, 2) children, -1 for a leaf
+    tleaf: np.ndarray  # (nodes,) a leaf's obstacle
+
+
 
 EPS_M = 1e-6  # contact tolerance of every collision query, metres
 
@@ -321,8 +336,8 @@ def _range_area(aabb: np.ndarray, order: np.ndarray, lo: int, hi: int) -> float:
 def build_world(
     circles: np.ndarray, vel: np.ndarray, boxes: np.ndarray, bounds: np.ndarray, radius: float,
     t0: float, t1: float, mode: int, n_bins: int,
-) -> tuple[Any, ...]:  # fmt: skip
-    """The compiled world tuple (see the module docstring) for a robot of ``radius`` over the time
+) -> CW:  # fmt: skip
+    """The compiled world (see the module docstring) for a robot of ``radius`` over the time
     window [t0, t1]: circles (x, y, r) moving at ``vel`` become capsules, boxes get the radius as
     clearance, and the chosen broad phase is built."""
     nc, nb = circles.shape[0], boxes.shape[0]
@@ -355,7 +370,7 @@ def build_world(
         tbox, tchild, tleaf = build_aabb_tree(aabb)
     else:
         tbox, tchild, tleaf = np.zeros((1, 4)), -np.ones((1, 2), dtype=np.int32), -np.ones(1, dtype=np.int32)
-    return (obs, aabb, inner, mode, grid, xm, ym, tbox, tchild, tleaf)
+    return CW(obs, aabb, inner, mode, grid, xm, ym, tbox, tchild, tleaf)
 
 
 @njit(cache=True)
@@ -365,7 +380,8 @@ def _box_overlap(b: np.ndarray, i: int, x0: float, y0: float, x1: float, y1: flo
 
 @njit(cache=True)
 def _segment_hits_any(cw: CW, ax: float, ay: float, bx: float, by: float) -> bool:
-    obs, aabb, _inner, mode, grid, xm, ym, tbox, tchild, tleaf = cw
+    obs, aabb, mode, grid, xm, ym = cw.obs, cw.aabb, cw.mode, cw.grid, cw.xmask, cw.ymask
+    tbox, tchild, tleaf = cw.tbox, cw.tchild, cw.tleaf
     x0, x1 = min(ax, bx), max(ax, bx)
     y0, y1 = min(ay, by), max(ay, by)
     k = obs.shape[0]
@@ -419,7 +435,7 @@ def _segment_hits_any(cw: CW, ax: float, ay: float, bx: float, by: float) -> boo
 def segment_free(cw: CW, ax: float, ay: float, bx: float, by: float) -> bool:
     """Swept-circle check: the robot's disc moving from a to b touches no obstacle and stays in the
     field (the inner box is convex, so both endpoints inside is enough)."""
-    inner = cw[2]
+    inner = cw.inner
     if not (_in_inner(inner, ax, ay) and _in_inner(inner, bx, by)):
         return False
     return not _segment_hits_any(cw, ax, ay, bx, by)
@@ -460,7 +476,7 @@ def nearest_free_point(
     Candidates: p pushed straight out of each obstacle it overlaps (to the obstacle's surface plus
     a hair) and clamped into the field, then rings of ``n_angles`` points every ``step_m`` around p
     for the cases where pushing out of one obstacle lands in another. Returns (x, y, found)."""
-    obs, inner = cw[0], cw[2]
+    obs, inner = cw.obs, cw.inner
     margin = 10.0 * EPS_M
     best_d2, bx, by = np.inf, px, py
     cx = min(max(px, inner[0] + margin), inner[2] - margin)
@@ -647,7 +663,7 @@ def errt_grow(
     ``state = (n_nodes, n_bridges, iterations, first_bridge_iteration, waypoint_targets)``, the last
     counting the iterations that aimed at a cached waypoint. Returns a GROW_* code.
     """
-    inner = cw[2]
+    inner = cw.inner
     cap = min(node_limit, nodes.shape[0])
     n_way = waypoints.shape[0]
     for r in range(rand.shape[0]):
@@ -1037,7 +1053,7 @@ def visibility_graph(cw: CW, sx: float, sy: float, gx: float, gy: float, arc_ste
 
     Returns (cost_m, node_xy (n, 2), node_circle (n,), node_angle (n,), route (m,) node indices,
     circles (c, 4), distance from the start (n,)); cost is inf when there is no path."""
-    circles = vis_circles(cw[0])
+    circles = vis_circles(cw.obs)
     pts, circ, e_a, e_b, e_w, counts = vis_start(cw, sx, sy, gx, gy, circles)
     vis_bitangents(cw, circles, pts, circ, e_a, e_b, e_w, counts, 0, circles.shape[0])
     return vis_search(cw, circles, pts, circ, e_a, e_b, e_w, counts, arc_step_rad)

@@ -11,7 +11,7 @@ Queries are about a robot *disc* of a given radius: :meth:`CollisionWorld.compil
 obstacle by that radius (the robot radius as clearance) and sweeps each moving circle over the time
 window ``[t0_s, t1_s]`` into a capsule, so that the rest is about the robot's centre point and its
 straight moves (the swept-circle segment query). The compiled world carries its broad phase
-(extent masks, an AABB tree or a plain scan, §3.2) and hands the numba kernels one tuple.
+(extent masks, an AABB tree or a plain scan, §3.2) and hands the numba kernels one named tuple.
 
 It is the one world query of the team: point and swept-disc checks (planners), the signed
 clearance to the nearest obstacle and its gradient (navigators, DSS's static check, potential
@@ -23,7 +23,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -177,10 +177,10 @@ class CompiledWorld:
         self.params = params
         bounds = np.array(world.bounds)
         mode = BROAD_PHASES[params.broad_phase]
-        self.cw: tuple[Any, ...] = K.build_world(
+        self.cw: K.CW = K.build_world(
             world.circles, world.velocities, world.boxes, bounds, radius_m, t0_s, t1_s, mode, params.mask_bins
         )
-        self.obs, self.aabb, self.inner = self.cw[0], self.cw[1], self.cw[2]
+        self.obs, self.aabb, self.inner = self.cw.obs, self.cw.aabb, self.cw.inner
 
     # --- queries (field frame, metres) ------------------------------------------------------------
     def point_free(self, x: float, y: float) -> bool:

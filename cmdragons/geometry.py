@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from cmdragons.config import Validated, setting
 
@@ -25,6 +25,7 @@ __all__ = [
     "PatternGeometry",
     "RobotShape",
     "Team",
+    "path_length",
     "rotate",
     "wrap_angle",
 ]
@@ -36,6 +37,12 @@ TEAMS: tuple[Team, Team] = ("blue", "yellow")
 def wrap_angle(a: float) -> float:
     """Angle wrapped into [-pi, pi)."""
     return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def path_length(path: ArrayLike) -> float:
+    """Length (m) of a polyline (k, 2)."""
+    pts = np.asarray(path, dtype=np.float64).reshape(-1, 2)
+    return float(np.hypot(*np.diff(pts, axis=0).T).sum())
 
 
 def rotate(v: NDArray[np.float64], theta: float) -> NDArray[np.float64]:

@@ -1,10 +1,15 @@
 """One frame of the team's brain: WorldState -> commands.
 
-Strategy decides an intent per robot (roles, passes, game state); each robot's own planner (ERRT
-with its waypoint cache, Bruce 2006 §4.3) finds a path among the other robots, the ball when it
-must be avoided and the defense areas it may not enter; motion control turns the path into the
-command for the next frame (B.4); the Dynamics Safety Search makes the whole team's commands safe
-together (ch. 5). Each stage's wall-clock time is kept for summaries.
+Strategy decides an intent per robot (roles, passes, game state). Per robot, its global planner
+(``planner.planner`` of configs/planner.yaml: ERRT with its waypoint cache by default, Bruce 2006
+§4.3) finds a path among the other robots, the ball when it must be avoided and the defense areas
+it may not enter; its local navigator (``team.navigator``: trajectory following by default, B.4)
+turns path and world into this frame's command; the Dynamics Safety Search makes the whole team's
+commands safe together (ch. 5). The brain knows neither which planner nor which navigator runs.
+
+Each frame turns the world's robots into arrays once and builds one collision world; each robot's
+queries see it without the robot itself (and without the ball or its own defense area where its
+intent allows). Each stage's wall-clock time is kept for summaries.
 """
 
 from __future__ import annotations
@@ -13,16 +18,28 @@ import dataclasses
 import math
 import time
 from collections import defaultdict
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Literal
 
 import numpy as np
+from numpy.typing import NDArray
 
 from cmdragons.config import Validated, setting
-from cmdragons.control.motion import ControlParams, MotionTarget, follow_path, motion_command
+from cmdragons.control.motion import predict_braking
 from cmdragons.geometry import Team
 from cmdragons.messages import GameState, RobotCommand, RobotState, WorldState
-from cmdragons.planning import Planner, PlanProblem, PlanStatus, deadline_in, field_world, make_planner
+from cmdragons.navigation import NAVIGATORS, Arrival, DynamicWindowParams, Navigator, TrajectoryParams, make_navigator
+from cmdragons.planning import (
+    CollisionWorld,
+    Planner,
+    PlanProblem,
+    PlanStatus,
+    deadline,
+    field_world,
+    make_planner,
+    make_termination,
+)
 from cmdragons.safety import Safety, make_safety
 from strategy.plays import Strategy
 from strategy.simple import SimpleTeamParams
@@ -34,24 +51,28 @@ if TYPE_CHECKING:  # the settings compose this module's params: import them only
 __all__ = ["Brain", "BrainParams", "RobotPlan", "TeamParams"]
 
 
+# which defense areas a robot must keep out of: both, or only the one at x of the sign given
+_DEFENSE_SIDES: tuple[tuple[str, bool | Literal[-1, 1]], ...] = (("both", True), ("+x", 1), ("-x", -1))
+
+
 @dataclass(frozen=True)
 class BrainParams(Validated):
     """configs/team.yaml ``brain``."""
 
-    # planning is bounded by the planner's node budget (configs/planner.yaml), so the same seed gives
-    # the same match whatever the machine's load; this deadline is only the safety net
-    plan_deadline_s: float = setting(0.25, lo=0.0001, hi=1.0)
     ball_clearance_m: float = setting(0.05, lo=0.0, hi=1.0)  # kept from the ball when it is an obstacle
     arrive_tolerance_m: float = setting(0.01, lo=0.0, hi=1.0)  # closer than this to the goal: no planning
-    # the motion profile starts from the last command sent while the measured velocity is within this
-    # of it: a robot held back by an opponent keeps pressing on instead of starting from rest every frame
-    command_slip_m_s: float = setting(0.5, lo=0.0, hi=10.0)
+    # a navigator's deadline per robot and frame: only the safety net of a stalled machine
+    navigate_deadline_ms: float = setting(50.0, lo=0.01, hi=10000.0)
 
 
 @dataclass(frozen=True)
-class TeamParams:
-    """configs/team.yaml: our brain, and the built-in simple opponent."""
+class TeamParams(Validated):
+    """configs/team.yaml: our brain, its navigator (one section per navigator, named like it), and the
+    built-in simple opponent."""
 
+    navigator: str = setting("trajectory", choices=tuple(NAVIGATORS))  # which of NAVIGATORS drives each robot
+    trajectory: TrajectoryParams = TrajectoryParams()
+    dynamic_window: DynamicWindowParams = DynamicWindowParams()
     brain: BrainParams = BrainParams()
     simple_opponent: SimpleTeamParams = SimpleTeamParams()
 
@@ -66,26 +87,47 @@ class RobotPlan:
     command: RobotCommand  # before safety
 
 
+@dataclass(frozen=True, eq=False)
+class Frame:
+    """One frame's robots as arrays (in the world's order) and its collision world: every robot as a
+    circle moving at its velocity, then the ball (when shown), the defense areas and the goal walls."""
+
+    robots: tuple[RobotState, ...]
+    xy: NDArray[np.float64]  # (n, 2) m
+    vel: NDArray[np.float64]  # (n, 2) m/s
+    own: NDArray[np.bool_]  # (n,) our robots
+    world: CollisionWorld
+    has_ball: bool
+
+
 class Brain:
     """The team's brain for one team colour."""
 
-    def __init__(self, team: Team, settings: Settings, params: BrainParams | None = None) -> None:
+    def __init__(self, team: Team, settings: Settings, params: TeamParams | None = None) -> None:
         self.team = team
         self.settings = settings
-        self.params = params or settings.team.brain
+        self.params = params or settings.team
         self.field = settings.field_geometry()
         self.radius = settings.field.robot.radius_m
         self.strategy = Strategy(team, self.field, settings.strategy)
         self.planners: dict[int, Planner] = {}
+        self.navigators: dict[int, Navigator] = {}
         static = field_world(self.field, defense_areas=False)
         stream = 0 if team == "blue" else 1
         self.safety: Safety = make_safety(settings.safety, settings.control, self.radius, static, stream=stream)
         self.times: dict[str, list[float]] = defaultdict(list)
         self.plans: dict[int, RobotPlan] = {}
-        self.braking: dict[int, np.ndarray] = {}  # robot id -> the braking path DSS checked, (k, 2)
-        self._control_cache: dict[float, ControlParams] = {}
+        self.braking: dict[int, np.ndarray] = {}  # robot id -> (k, 2) the braking path DSS checked last frame
         self._last_seen: dict[int, tuple[float, RobotState]] = {}  # own robots as the world last showed them
-        self._sent: dict[int, tuple[float, float]] = {}  # the last safe velocity command of each robot
+        # which boxes of the frame's world (both defense areas, then the goal walls) each intent keeps:
+        # both areas, or only the one at x of the sign given (a goalie may enter its own)
+        self._field = field_world(self.field)  # the boundary, both defense areas, the goal walls
+        every = self._field.boxes
+        self._boxes: dict[str, NDArray[np.bool_]] = {
+            key: np.array([any(np.array_equal(row, b) for b in field_world(self.field, defense_areas=side).boxes)
+                           for row in every])
+            for key, side in _DEFENSE_SIDES
+        }  # fmt: skip
 
     def _planner(self, rid: int) -> Planner:
         planner = self.planners.get(rid)
@@ -93,37 +135,74 @@ class Brain:
             planner = self.planners[rid] = make_planner(self.settings.planner, robot_id=rid)
         return planner
 
-    def _control(self, max_speed: float | None) -> ControlParams:
-        base = self.settings.control
-        if max_speed is None or max_speed >= base.motion.max_speed_m_s:
-            return base
-        c = self._control_cache.get(max_speed)
-        if c is None:
-            motion = dataclasses.replace(base.motion, max_speed_m_s=max(max_speed, 0.01))
-            c = self._control_cache[max_speed] = dataclasses.replace(base, motion=motion)
-        return c
+    def _navigator(self, rid: int) -> Navigator:
+        nav = self.navigators.get(rid)
+        if nav is None:
+            nav = self.navigators[rid] = make_navigator(self.params.navigator, self.params, self.settings.control,
+                                                        self.radius, self.settings.planner.collision)  # fmt: skip
+        return nav
 
     def step(self, world: WorldState, game: GameState) -> list[RobotCommand]:
         """Commands for our robots seen in ``world`` (field frame)."""
         t0 = time.perf_counter()
         intents = self.strategy.decide(world, game)
         t1 = time.perf_counter()
-        own = {r.id: r for r in world.robots if r.team == self.team}
-        commands = [self._navigate(own[rid], intent, world, game) for rid, intent in sorted(intents.items())]
-        t2 = time.perf_counter()
-        if commands:
-            lost = self._lost_robots(world)
-            stops = [RobotCommand(self.team, r.id) for r in lost]
-            safe = self.safety.make_safe(commands + stops, dataclasses.replace(world, robots=world.robots + lost))
-        else:
-            safe = []
-        self._sent = {c.id: (c.vx, c.vy) for c in safe}
-        t3 = time.perf_counter()
         self.times["strategy"].append((t1 - t0) * 1e3)
+        safe = self.drive(world, intents, game)
+        self.times["brain"].append((time.perf_counter() - t0) * 1e3)
+        return safe
+
+    def drive(self, world: WorldState, intents: Mapping[int, Intent], game: GameState) -> list[RobotCommand]:
+        """Everything after strategy: each robot's planner and navigator toward its intent, then team
+        safety (the loop ``cmdragons bench safety`` measures). Robots of ``intents`` must be ours and
+        in ``world``."""
+        t1 = time.perf_counter()
+        frame = self._frame(world)
+        index = {r.id: i for i, r in enumerate(world.robots) if r.team == self.team}
+        commands = [self._navigate(frame, index[rid], intent, game) for rid, intent in sorted(intents.items())]
+        t2 = time.perf_counter()
+        safe = self._make_safe(frame, commands, world) if commands else []
+        sent = {c.id for c in safe}
+        for c in safe:
+            nav = self.navigators.get(c.id)
+            if nav is not None:
+                nav.sent(c.vx, c.vy)
+        for rid, nav in self.navigators.items():
+            if rid not in sent:
+                nav.reset()  # nothing sent this frame: its next profile starts from what it measures
+        t3 = time.perf_counter()
         self.times["planning_control"].append((t2 - t1) * 1e3)
         self.times["safety"].append((t3 - t2) * 1e3)
-        self.times["brain"].append((t3 - t0) * 1e3)
         return safe
+
+    def _frame(self, world: WorldState) -> Frame:
+        robots = world.robots
+        xy = np.array([(r.x, r.y) for r in robots], dtype=np.float64).reshape(-1, 2)
+        vel = np.array([(r.vx, r.vy) for r in robots], dtype=np.float64).reshape(-1, 2)
+        own = np.array([r.team == self.team for r in robots], dtype=np.bool_)
+        ball = None
+        if world.ball is not None:
+            ball = np.array([[world.ball.x, world.ball.y,
+                              self.settings.field.ball.radius_m + self.params.brain.ball_clearance_m]])  # fmt: skip
+        circles = np.column_stack([xy, np.full(len(xy), self.radius)])
+        if ball is not None:
+            circles, vel_all = np.vstack([circles, ball]), np.vstack([vel, np.zeros((1, 2))])
+        else:
+            vel_all = vel
+        return Frame(robots, xy, vel, own, self._field.with_circles(circles, vel_all), ball is not None)
+
+    def _robot_world(self, frame: Frame, i: int, it: Intent, game: GameState) -> CollisionWorld:
+        """The frame's world as robot ``i`` must avoid it: without itself, without the ball unless its
+        intent avoids it, without our own defense area when it may enter it."""
+        circles = np.ones(len(frame.world.circles), dtype=np.bool_)
+        circles[i] = False
+        if frame.has_ball and not it.avoid_ball:
+            circles[-1] = False
+        # the goalie may enter our own area: keep only the opponent's (at x of sign -own_sign)
+        key = "both"
+        if it.allow_own_defense:
+            key = "+x" if self.strategy.own_sign(game) < 0 else "-x"
+        return frame.world.subset(circles, self._boxes[key])
 
     def _lost_robots(self, world: WorldState) -> tuple[RobotState, ...]:
         """Own robots the world no longer shows (the tracker lost them, e.g. off the cameras' view).
@@ -134,58 +213,60 @@ class Brain:
         for r in world.robots:
             if r.team == self.team:
                 self._last_seen[r.id] = (world.t, r)
-        brake = self.settings.control.motion.max_brake_m_s2
+        motion = self.settings.control.motion
         lost = []
         for rid, (t_seen, r) in sorted(self._last_seen.items()):
             if rid in shown:
                 continue
-            speed = math.hypot(r.vx, r.vy)
-            tau = min(max(world.t - t_seen, 0.0), speed / brake)
-            k = (speed - 0.5 * brake * tau) * tau / speed if speed > 0.0 else 0.0  # distance / speed
-            f = (speed - brake * tau) / speed if speed > 0.0 else 0.0
-            lost.append(dataclasses.replace(r, x=r.x + r.vx * k, y=r.y + r.vy * k, vx=r.vx * f, vy=r.vy * f,
-                                            omega=0.0, visible=False))  # fmt: skip
+            x, y, vx, vy = predict_braking(r.x, r.y, r.vx, r.vy, world.t - t_seen, motion)
+            lost.append(dataclasses.replace(r, x=x, y=y, vx=vx, vy=vy, omega=0.0, visible=False))
         return tuple(lost)
 
-    def _navigate(self, robot: RobotState, it: Intent, world: WorldState, game: GameState) -> RobotCommand:
+    def _make_safe(self, frame: Frame, commands: list[RobotCommand], world: WorldState) -> list[RobotCommand]:
+        """The commands made safe together (DSS), with the lost robots stopping among them; the
+        braking paths it checked are kept in :attr:`braking`."""
+        lost = self._lost_robots(world)
+        stops = [RobotCommand(self.team, r.id) for r in lost]
+        ids = [r.id for r in frame.robots if r.team == self.team] + [r.id for r in lost]
+        states = np.vstack([np.hstack([frame.xy[frame.own], frame.vel[frame.own]]),
+                            np.array([(r.x, r.y, r.vx, r.vy) for r in lost]).reshape(-1, 4)])  # fmt: skip
+        opponents = np.hstack([frame.xy[~frame.own], frame.vel[~frame.own]])
+        by_id = {c.id: c for c in commands + stops}
+        asked = np.array([(by_id[i].vx, by_id[i].vy) if i in by_id else (0.0, 0.0) for i in ids]).reshape(-1, 2)
+        result = self.safety.filter(states, asked, opponents)
+        safe_v = {rid: result.velocities[k] for k, rid in enumerate(ids) if rid in by_id}
+        self.braking = {rid: result.braking[k] for k, rid in enumerate(ids)}
+        out = []
+        for c in commands + stops:
+            v = safe_v.get(c.id)
+            out.append(c if v is None else RobotCommand(c.team, c.id, float(v[0]), float(v[1]), c.omega, c.kick_speed,
+                                                        c.chip, c.dribbler))  # fmt: skip
+        return out
+
+    def _navigate(self, frame: Frame, i: int, it: Intent, game: GameState) -> RobotCommand:
+        robot = frame.robots[i]
         if it.max_speed_m_s == 0.0:
             cmd = RobotCommand(self.team, robot.id)
             self.plans[robot.id] = RobotPlan(it, np.array([[robot.x, robot.y]]), "halt", cmd)
+            self._navigator(robot.id)  # it hears what is sent, for when it moves again
             return cmd
         start = (robot.x, robot.y)
         goal = (it.x, it.y)
         path = np.array([start, goal])
         status = "direct"
-        if math.dist(start, goal) > self.params.arrive_tolerance_m:
-            others = [r for r in world.robots if not (r.team == self.team and r.id == robot.id)]
-            xy = np.array([[r.x, r.y] for r in others]).reshape(-1, 2)
-            vel = np.array([[r.vx, r.vy] for r in others]).reshape(-1, 2)
-            ball = None
-            if it.avoid_ball and world.ball is not None:
-                ball = np.array([[world.ball.x, world.ball.y,
-                                  self.settings.field.ball.radius_m + self.params.ball_clearance_m]])  # fmt: skip
-            own_sign = self.strategy.own_sign(game)
-            # the goalie may enter our own area: keep only the opponent's (at x of sign -own_sign)
-            defense: bool | Literal[-1, 1] = (1 if own_sign < 0 else -1) if it.allow_own_defense else True
-            cworld = field_world(self.field, xy, vel, defense_areas=defense, extra_circles=ball)
-            result = self._planner(robot.id).solve(PlanProblem(start, goal, self.radius, cworld),
-                                                   deadline_in(self.params.plan_deadline_s))  # fmt: skip
+        cworld = self._robot_world(frame, i, it, game)
+        if math.dist(start, goal) > self.params.brain.arrive_tolerance_m:
+            p = self.settings.planner
+            problem = PlanProblem(start, goal, self.radius, cworld, p.horizon_s, p.collision)
+            result = self._planner(robot.id).solve(problem, make_termination(p))
             status = result.status.name.lower()
             if result.status in (PlanStatus.SOLVED, PlanStatus.APPROXIMATE) and len(result.path) >= 2:
                 path = np.asarray(result.path)
-        control = self._control(it.max_speed_m_s)
-        target = follow_path(start, path, it.theta, control)
-        if it.final_speed_m_s > 0.0 and math.dist((target.x, target.y), goal) < 1e-9:
-            # drive through the goal point (onto the ball) instead of stopping on it
-            d = math.dist(start, goal)
-            if d > 1e-6:
-                ux, uy = (goal[0] - start[0]) / d, (goal[1] - start[1]) / d
-                target = MotionTarget(goal[0] + ux * 0.05, goal[1] + uy * 0.05, ux * it.final_speed_m_s,
-                                      uy * it.final_speed_m_s, it.theta)  # fmt: skip
-        sent = self._sent.get(robot.id)
-        if sent is not None and math.hypot(sent[0] - robot.vx, sent[1] - robot.vy) <= self.params.command_slip_m_s:
-            robot = dataclasses.replace(robot, vx=sent[0], vy=sent[1])
-        move = motion_command(robot, target, control)
-        cmd = RobotCommand(self.team, robot.id, move.vx, move.vy, move.omega, it.kick_speed, it.chip, it.dribbler)
+        # drive through the goal only where the path ends at it (not at a stand-in for a blocked goal)
+        through = max(it.final_speed_m_s, 0.0) if math.dist(tuple(path[-1]), goal) < 1e-9 else 0.0
+        nav = self._navigator(robot.id)
+        nav.set_plan(path, Arrival(it.theta, through, it.max_speed_m_s))
+        vx, vy, omega = nav.command(robot, cworld, deadline(self.params.brain.navigate_deadline_ms * 1e-3))
+        cmd = RobotCommand(self.team, robot.id, vx, vy, omega, it.kick_speed, it.chip, it.dribbler)
         self.plans[robot.id] = RobotPlan(it, path, status, cmd)
         return cmd

@@ -1,17 +1,32 @@
 """The brain: own robots the tracker lost stay in the safety search and are stopped; a robot held
-back keeps pressing on."""
+back keeps pressing on; the planner config is what its planners use; every params object of planning,
+control, safety, navigation and the team checks its ranges."""
 
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from cmdragons.control import MotionParams, PathParams, TrapezoidParams
 from cmdragons.messages import BallState, GameState, RobotCommand, RobotState, WorldState
+from cmdragons.navigation import DynamicWindowParams, TrajectoryParams
+from cmdragons.planning import (
+    CollisionParams,
+    CollisionWorld,
+    CompiledWorld,
+    DynamicPRMParams,
+    ERRTParams,
+    PlannerParams,
+    VisGraphParams,
+)
+from cmdragons.planning.errt import SmoothingParams
 from cmdragons.runtime.settings import load_settings
-from cmdragons.team import Brain
+from cmdragons.safety import DSSParams, SafetyParams
+from cmdragons.team import Brain, BrainParams, TeamParams
 
 SETTINGS = load_settings(Path(__file__).resolve().parents[1] / "configs")
 BALL = BallState(2.0, 1.0, 0.0, 0.0)
@@ -62,8 +77,54 @@ def test_a_robot_held_back_keeps_pressing_on() -> None:
         return float(np.hypot(cmds[-1].vx, cmds[-1].vy))
 
     accel = SETTINGS.control.motion.max_accel_m_s2
-    slip = SETTINGS.team.brain.command_slip_m_s
+    slip = SETTINGS.team.trajectory.command_slip_m_s
     assert speed(Brain("blue", SETTINGS), 10) == pytest.approx(min(10 * accel / 60, slip), rel=0.05)
     # from the measured velocity alone: one frame of acceleration from rest, each time
-    restarting = Brain("blue", SETTINGS, dataclasses.replace(SETTINGS.team.brain, command_slip_m_s=0.0))
+    no_slip = dataclasses.replace(SETTINGS.team.trajectory, command_slip_m_s=0.0)
+    restarting = Brain("blue", SETTINGS, dataclasses.replace(SETTINGS.team, trajectory=no_slip))
     assert speed(restarting, 10) == pytest.approx(accel / 60, rel=0.05)
+
+
+@pytest.mark.parametrize(
+    ("override", "expect"),
+    [("planner.collision.broad_phase=aabb_tree", lambda t1, p: p.broad_phase == "aabb_tree"),
+     ("planner.collision.mask_bins=7", lambda t1, p: p.mask_bins == 7),
+     ("planner.horizon_s=0.4", lambda t1, p: t1 == 0.4)],
+)  # fmt: skip
+def test_the_brains_planners_answer_to_the_planner_config(
+    monkeypatch: pytest.MonkeyPatch, override: str, expect: Callable[[float, CollisionParams], bool]
+) -> None:
+    # what `cmdragons play --set ...` loads is what the brain's planners compile their worlds with
+    settings = load_settings(Path(__file__).resolve().parents[1] / "configs", [override])
+    seen: list[tuple[float, CollisionParams]] = []
+    compile_world = CollisionWorld.compile
+
+    def spy(self: CollisionWorld, radius_m: float, t0_s: float = 0.0, t1_s: float = 0.0,
+            params: CollisionParams | None = None) -> CompiledWorld:  # fmt: skip
+        seen.append((t1_s, params or CollisionParams()))
+        return compile_world(self, radius_m, t0_s, t1_s, params)
+
+    brain = Brain("blue", settings)  # (its safety search compiles the static field with its own radius)
+    monkeypatch.setattr(CollisionWorld, "compile", spy)
+    robots = (RobotState("blue", 0, -3.0, 0.0, 0.0), RobotState("blue", 1, 0.0, 1.0, 0.0),
+              RobotState("yellow", 0, -1.0, 0.0, 0.0))  # fmt: skip
+    brain.step(world(0.0, *robots), GameState(0.0))
+    assert seen and all(expect(t1, p) for t1, p in seen)
+    assert not expect(0.0, CollisionParams())  # the override differs from the default
+
+
+@pytest.mark.parametrize(
+    ("cls", "field", "bad"),
+    [(ERRTParams, "step_m", 0.0), (SmoothingParams, "passes", -1), (DynamicPRMParams, "work_budget", 0),
+     (VisGraphParams, "arc_check_step_deg", 0.0), (CollisionParams, "grid_resolution_m", 0.0),
+     (CollisionParams, "broad_phase", "octree"), (PlannerParams, "deadline_ms", 0.0),
+     (PlannerParams, "planner", "astar"), (MotionParams, "max_brake_m_s2", 0.0),
+     (PathParams, "corner_overshoot_m", 0.0), (TrapezoidParams, "split_iterations", 1),
+     (DSSParams, "own_margin_m", -0.1), (SafetyParams, "method", "dynamic_window"),
+     (TrajectoryParams, "command_slip_m_s", -1.0), (DynamicWindowParams, "directions", 2),
+     (BrainParams, "navigate_deadline_ms", 0.0), (TeamParams, "navigator", "magic")],
+)  # fmt: skip
+def test_params_check_their_ranges_however_they_are_built(cls: type, field: str, bad: object) -> None:
+    with pytest.raises(ValueError, match=field):
+        cls(**{field: bad})
+    cls()  # the defaults are in range

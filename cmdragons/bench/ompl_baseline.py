@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from cmdragons.planning.problem import PlanProblem, PlanResult, PlanStatus, Stateless, prepare
+from cmdragons.planning.termination import Termination
 from cmdragons.planning.world import CompiledWorld
 
 __all__ = ["OMPLPlanner", "ompl_missing"]
@@ -44,7 +45,7 @@ def _motion_validator(si: Any, cw: CompiledWorld) -> Any:
 
 
 class OMPLPlanner(Stateless):
-    """One OMPL geometric planner (``"RRTConnect"`` or ``"PRM"``) behind ``solve(problem, deadline)``;
+    """One OMPL geometric planner (``"RRTConnect"`` or ``"PRM"``) behind ``solve(problem, termination)`` (its deadline);
     ``simplify`` runs OMPL's path simplifier on the solution (its time counts)."""
 
     def __init__(self, planner: str, simplify: bool) -> None:
@@ -55,7 +56,7 @@ class OMPLPlanner(Stateless):
         self.simplify = simplify
         self.name = f"ompl_{planner.lower()}" + ("_simplified" if simplify else "")
 
-    def solve(self, problem: PlanProblem, deadline: float) -> PlanResult:
+    def solve(self, problem: PlanProblem, termination: Termination) -> PlanResult:
         from ompl import base as ob
         from ompl import geometric as og
 
@@ -84,13 +85,13 @@ class OMPLPlanner(Stateless):
         ss.setOptimizationObjective(objective)
         setup_ms = (time.perf_counter() - t0) * 1e3
         t1 = time.perf_counter()
-        ss.solve(max(1e-4, deadline - t1))
+        ss.solve(max(1e-4, min(termination.deadline_s - t1, 1e6)))
         stats: dict[str, object] = {"setup_ms": setup_ms}
         if not ss.haveExactSolutionPath():
             stats["ms"] = (time.perf_counter() - t1) * 1e3
             return ends.finish(None, PlanStatus.TIMEOUT, stats)
         if self.simplify:
-            ss.simplifySolution(max(1e-4, deadline - time.perf_counter()))
+            ss.simplifySolution(max(1e-4, min(termination.deadline_s - time.perf_counter(), 1e6)))
         p = ss.getSolutionPath()
         path = np.array([[p.getState(i)[0], p.getState(i)[1]] for i in range(p.getStateCount())])
         # the time OMPL takes to plan (and simplify), without building its objects

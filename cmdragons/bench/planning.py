@@ -41,9 +41,10 @@ from numpy.typing import NDArray
 
 from cmdragons.geometry import Field
 from cmdragons.planning import _kernels as K
-from cmdragons.planning.problem import Planner, PlanProblem, PlanResult, PlanStatus, deadline_in
+from cmdragons.planning.problem import Planner, PlanProblem, PlanResult, PlanStatus
 from cmdragons.planning.registry import PlannerParams, make_planner
 from cmdragons.planning.scenes import CrowdScene, MovingScene, random_free_point, random_scene
+from cmdragons.planning.termination import Termination, budget, deadline
 from cmdragons.planning.world import BROAD_PHASES, CollisionParams, CollisionWorld, CompiledWorld, field_world
 from cmdragons.runtime.settings import Settings
 
@@ -180,6 +181,12 @@ def _ompl_planners() -> dict[str, Callable[[], Planner]]:
     }
 
 
+def _termination(planner: Planner, seconds: float) -> Termination:
+    """The bench's deadline and the planner's own configured work budget (none for OMPL's)."""
+    work = getattr(getattr(planner, "params", None), "work_budget", math.inf)
+    return deadline(seconds) | budget(work)
+
+
 def _timed_solve(planner: Planner, prob: PlanProblem) -> tuple[PlanResult, float, float]:
     """Solve with a fresh compiled world (compiling it is part of every frame's cost). Returns the
     result, the wall time of the whole call (ms) and the planning time alone, without compiling
@@ -187,7 +194,7 @@ def _timed_solve(planner: Planner, prob: PlanProblem) -> tuple[PlanResult, float
     ERRT its search (straight line, trees, smoothing, cache), for the others the wall time."""
     prob.world._cache.clear()
     t0 = time.perf_counter()
-    res = planner.solve(prob, deadline_in(BENCH_BUDGET_S))
+    res = planner.solve(prob, _termination(planner, BENCH_BUDGET_S))
     wall_ms = (time.perf_counter() - t0) * 1e3
     if type(planner).__name__ == "OMPLPlanner":
         return res, wall_ms, float(res.stats.get("ms", wall_ms))
@@ -224,7 +231,7 @@ def static_rows(
     problems, best = [], []
     for s in scenes:
         prob = s.problem(field, collision)
-        res = optimum.solve(prob, deadline_in(10.0))
+        res = optimum.solve(prob, deadline(10.0))
         problems.append(prob)
         best.append(res.cost if res.status is PlanStatus.SOLVED else math.inf)
     solvable = [i for i, b in enumerate(best) if np.isfinite(b)]
@@ -409,7 +416,7 @@ def replan_rows(
                                params.collision)  # fmt: skip
             best = math.inf
             if frame % sizes.optimum_every == 0:
-                opt = optimum.solve(prob, deadline_in(10.0))
+                opt = optimum.solve(prob, deadline(10.0))
                 best = opt.cost if opt.status.reached else math.inf
             drive: PlanResult | None = None
             blocked = not prob.compiled().segment_free(prob.start, prob.goal)
@@ -474,7 +481,7 @@ def visgraph_exactness_rows() -> list[Row]:
     for _ in range(50):
         r_obs, r, d = rng.uniform(0.05, 0.5), rng.uniform(0.0, 0.2), rng.uniform(0.8, 3.0)
         world = CollisionWorld((-5.0, -5.0, 5.0, 5.0), np.array([[0.0, 0.0, r_obs]]))
-        res = planner.solve(PlanProblem((-d, 0.0), (d, 0.0), r, world), deadline_in(1.0))
+        res = planner.solve(PlanProblem((-d, 0.0), (d, 0.0), r, world), deadline(10.0))
         big = r_obs + r
         exact = 2 * math.sqrt(d * d - big * big) + big * (math.pi - 2 * math.acos(big / d))
         errors.append(abs(res.cost - exact) / exact)

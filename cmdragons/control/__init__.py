@@ -1,7 +1,6 @@
 """Motion control (Bruce 2006 appendix B.4): time-optimal trapezoidal profiles in 1D and 2D, the
-per-robot velocity command for the next frame period, path following and latency compensation."""
+per-robot velocity command for the next frame period, path following, the braking trajectory."""
 
-from cmdragons.control.latency import LatencyCompensator
 from cmdragons.control.motion import (
     ControlParams,
     MotionParams,
@@ -10,12 +9,12 @@ from cmdragons.control.motion import (
     follow_path,
     motion_command,
     motion_commands,
+    predict_braking,
 )
 from cmdragons.control.trapezoid import Profile1D, Profile2D, TrapezoidParams, trapezoid_1d, trapezoid_2d
 
 __all__ = [
     "ControlParams",
-    "LatencyCompensator",
     "MotionParams",
     "MotionTarget",
     "PathParams",
@@ -25,6 +24,7 @@ __all__ = [
     "follow_path",
     "motion_command",
     "motion_commands",
+    "predict_braking",
     "trapezoid_1d",
     "trapezoid_2d",
 ]

@@ -1,5 +1,6 @@
 """numba kernels of motion control: the time-optimal 1D trapezoidal profile, its 2D split, the robot's
-acceleration model and latency prediction (Bruce 2006 appendix B.4, §5.1).
+acceleration model and the braking trajectory that predicts where a robot will be (Bruce 2006
+appendix B.4, §5.1, §5.3).
 
 Units: metres, seconds, radians. A 1D problem is "move a distance ``d`` starting at velocity ``v0``
 and arrive with velocity ``vt``" under a speed limit ``vmax``, an acceleration ``a`` while the speed
@@ -14,12 +15,28 @@ Plain-numpy references of these kernels live in :mod:`cmdragons.control._referen
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
+from cmdragons.geometry import wrap_angle as _wrap_angle
+
 N_PHASES = 5  # ramp through zero (2) + cruise (1) + ramp through zero (2)
+N_SEG = 4  # segments of a braking trajectory: reaching the command, holding it to the period's end, braking, rest
 _EPS = 1e-12
+
+wrap_angle = njit(cache=True)(_wrap_angle)  # the project's one angle wrap, compiled for the kernels
+
+
+class Limits(NamedTuple):
+    """The robot's limits, by name (configs/control.yaml ``motion``)."""
+
+    vmax: float  # m/s
+    accel: float  # m/s^2 speeding up or turning the velocity
+    brake: float  # m/s^2 slowing down
+    omega_max: float  # rad/s
+    alpha_max: float  # rad/s^2
 
 
 @njit(cache=True)
@@ -234,68 +251,82 @@ def limit_velocity(
 
 @njit(cache=True)
 def motion_commands(
-    states: np.ndarray, targets: np.ndarray, limits: np.ndarray, period: float, iterations: int
-) -> np.ndarray:
+    states: np.ndarray, targets: np.ndarray, vmax: float, accel: float, brake: float, wmax: float, alpha: float,
+    period: float, iterations: int,
+) -> np.ndarray:  # fmt: skip
     """Commands (n, 3) vx, vy, omega for every robot: the 2D trapezoid toward the target position and
     velocity, the heading's trapezoid toward the target heading, both then held to the limits.
 
-    ``states`` (n, 6): x, y, theta, vx, vy, omega; ``targets`` (n, 5): x, y, vx, vy, theta;
-    ``limits``: vmax, accel, brake, omega_max, alpha_max."""
-    vmax, accel, brake, wmax, alpha = limits[0], limits[1], limits[2], limits[3], limits[4]
+    ``states`` (n, 6): x, y, theta, vx, vy, omega; ``targets`` (n, 5): x, y, vx, vy, theta; the limits
+    by name as in :class:`Limits` (scalars: the kernel runs once per robot and frame, and numba's
+    dispatch is quickest on them)."""
     out = np.empty((states.shape[0], 3))
     for i in range(states.shape[0]):
         x, y, th, vx, vy, w = states[i, 0], states[i, 1], states[i, 2], states[i, 3], states[i, 4], states[i, 5]
         cx, cy, _ = command_2d(targets[i, 0] - x, targets[i, 1] - y, vx, vy, targets[i, 2], targets[i, 3],
                                vmax, accel, brake, period, iterations)  # fmt: skip
         out[i, 0], out[i, 1] = limit_velocity(vx, vy, cx, cy, vmax, accel, brake, period)
-        dth = (targets[i, 4] - th + math.pi) % (2.0 * math.pi) - math.pi
+        dth = wrap_angle(targets[i, 4] - th)
         ph, _ = profile_1d(dth, w, 0.0, wmax, alpha, alpha)
         out[i, 2] = phases_state(ph, w, period)[1]
     return out
 
 
-# --- latency: where the robot will be when the next command acts -----------------------------------------
+# --- the robot's braking trajectory (Bruce 2006 §5.1, §5.3): where it will be ---------------------------
 @njit(cache=True)
-def _track(v: float, c: float, rate: float, h: float) -> tuple[float, float]:
-    # a 1D velocity moving toward command c at ``rate`` for h seconds: (displacement, new velocity)
-    t1 = min(abs(c - v) / rate, h) if rate > 0.0 else h
-    acc = rate if c > v else -rate
-    if rate <= 0.0 or c == v:
-        acc = 0.0
-    x = v * t1 + 0.5 * acc * t1 * t1
-    v1 = v + acc * t1
-    if h > t1:
-        x += c * (h - t1)
-        v1 = c
-    return x, v1
+def _put(tr: np.ndarray, k: int, t0: float, t1: float, px: float, py: float, vx: float, vy: float,
+         ax: float, ay: float) -> tuple[float, float, float, float]:  # fmt: skip
+    # write segment k and return the position and velocity at its end
+    tr[k, 0], tr[k, 1], tr[k, 2], tr[k, 3], tr[k, 4], tr[k, 5], tr[k, 6], tr[k, 7] = t0, t1, px, py, vx, vy, ax, ay
+    h = t1 - t0
+    return px + vx * h + 0.5 * ax * h * h, py + vy * h + 0.5 * ay * h * h, vx + ax * h, vy + ay * h
 
 
 @njit(cache=True)
-def predict_motion(
-    states: np.ndarray, commands: np.ndarray, durations: np.ndarray, accel: float, brake: float, alpha: float
+def trajectory(
+    px: float, py: float, vx: float, vy: float, ax: float, ay: float, dt: float, accel: float, brake: float
 ) -> np.ndarray:
-    """Advance each robot (n, 6: x, y, theta, vx, vy, omega) through the commands (n, k, 3: vx, vy,
-    omega) held for ``durations`` (k,) seconds each. The velocity moves straight toward each command
-    at ``brake`` when it slows down against the motion, else at ``accel``; omega moves toward its
-    command at ``alpha`` (the simulator's motor model)."""
-    out = states.copy()
-    for i in range(states.shape[0]):
-        x, y, th, vx, vy, w = states[i, 0], states[i, 1], states[i, 2], states[i, 3], states[i, 4], states[i, 5]
-        for k in range(durations.shape[0]):
-            cx, cy, h = commands[i, k, 0], commands[i, k, 1], durations[k]
-            dvx, dvy = cx - vx, cy - vy
-            dv = math.hypot(dvx, dvy)
-            slowing = dvx * vx + dvy * vy < 0.0 and cx * cx + cy * cy < vx * vx + vy * vy
-            acc = brake if slowing else accel
-            # along the straight line from v to the command the motion is 1D
-            s, u = _track(0.0, dv, acc, h)
-            ux, uy = (dvx / dv, dvy / dv) if dv > 0.0 else (0.0, 0.0)
-            x += vx * h + ux * s
-            y += vy * h + uy * s
-            vx += ux * u
-            vy += uy * u
-            dth, w = _track(w, commands[i, k, 2], alpha, h)
-            th += dth
-        out[i, 0], out[i, 1], out[i, 2] = x, y, (th + math.pi) % (2.0 * math.pi) - math.pi
-        out[i, 3], out[i, 4], out[i, 5] = vx, vy, w
-    return out
+    """Segments (N_SEG, 8) of the command v + a dt held for one period ``dt``, then braking at
+    ``brake`` to rest. The motors reach a commanded velocity as fast as they can (at ``brake`` when
+    it slows the robot against its motion, else at ``accel``) and then hold it, as the simulator's
+    motor model does; the stop command (a = -v / dt) thus brakes at full strength."""
+    tr = np.zeros((N_SEG, 8))
+    cx, cy = vx + ax * dt, vy + ay * dt
+    dvx, dvy = cx - vx, cy - vy
+    dv = math.hypot(dvx, dvy)
+    slowing = dvx * vx + dvy * vy < 0.0 and cx * cx + cy * cy < vx * vx + vy * vy
+    rate = brake if slowing else accel
+    t_reach = min(dv / rate, dt) if rate > 0.0 and dv > 0.0 else 0.0
+    ux, uy = (dvx / dv * rate, dvy / dv * rate) if dv > 0.0 and rate > 0.0 else (0.0, 0.0)
+    qx, qy, wx, wy = _put(tr, 0, 0.0, t_reach, px, py, vx, vy, ux, uy)
+    qx, qy, wx, wy = _put(tr, 1, t_reach, dt, qx, qy, wx, wy, 0.0, 0.0)
+    w = math.hypot(wx, wy)
+    t_brake = w / brake if brake > 0.0 else 0.0
+    bx, by = (-brake * wx / w, -brake * wy / w) if w > 0.0 else (0.0, 0.0)
+    qx, qy, _, _ = _put(tr, 2, dt, dt + t_brake, qx, qy, wx, wy, bx, by)
+    _put(tr, 3, dt + t_brake, math.inf, qx, qy, 0.0, 0.0, 0.0, 0.0)
+    return tr
+
+
+@njit(cache=True)
+def stop_accel(vx: float, vy: float, dt: float) -> tuple[float, float]:
+    """The acceleration that names the stop command (velocity zero): the motors brake at full
+    strength until the robot rests (see :func:`trajectory`)."""
+    return -vx / dt, -vy / dt
+
+
+@njit(cache=True)
+def seg_at(tr: np.ndarray, k: int, t: float) -> tuple[float, float, float, float]:
+    """Position and velocity of segment k of a trajectory at absolute time t (inside the segment)."""
+    h = t - tr[k, 0]
+    return (tr[k, 2] + tr[k, 4] * h + 0.5 * tr[k, 6] * h * h, tr[k, 3] + tr[k, 5] * h + 0.5 * tr[k, 7] * h * h,
+            tr[k, 4] + tr[k, 6] * h, tr[k, 5] + tr[k, 7] * h)  # fmt: skip
+
+
+@njit(cache=True)
+def trajectory_state(tr: np.ndarray, t: float) -> tuple[float, float, float, float]:
+    """Position and velocity (x, y, vx, vy) of a trajectory at time ``t`` >= 0 (at rest after it)."""
+    for k in range(N_SEG - 1):
+        if t <= tr[k, 1]:
+            return seg_at(tr, k, max(t, tr[k, 0]))
+    return tr[N_SEG - 1, 2], tr[N_SEG - 1, 3], 0.0, 0.0

@@ -1,7 +1,7 @@
 """Plain-numpy references of the motion-control kernels, for the tests that check both agree.
 
 They favour the obvious over the fast: the optimal peak velocity by scanning a dense grid of peaks,
-the 2D split by scanning angles, latency prediction by small Euler steps.
+the 2D split by scanning angles.
 """
 
 from __future__ import annotations
@@ -62,28 +62,3 @@ def clip_accel(v: FloatArray, a: FloatArray, accel: float, brake: float) -> Floa
     across = np.linalg.norm(a - along[:, None] * unit, axis=1)
     k = np.where(along >= 0, np.linalg.norm(a, axis=1) / accel, np.hypot(along / brake, across / accel))
     return np.asarray(a / np.maximum(k, 1.0)[:, None], dtype=np.float64)
-
-
-def predict_motion(
-    states: FloatArray, commands: FloatArray, durations: FloatArray, accel: float, brake: float, alpha: float,
-    h: float = 1e-5,
-) -> FloatArray:  # fmt: skip
-    """Euler integration of the motor model of :func:`_kernels.predict_motion`."""
-    out = states.copy()
-    for i in range(len(states)):
-        p, th, v, w = states[i, :2].copy(), float(states[i, 2]), states[i, 3:5].copy(), float(states[i, 5])
-        for c, duration in zip(commands[i], durations, strict=True):
-            cv = c[:2]
-            slowing = (cv - v) @ v < 0 and cv @ cv < v @ v
-            acc = brake if slowing else accel
-            for _ in range(int(round(duration / h))):
-                dv = cv - v
-                n = np.linalg.norm(dv)
-                a = dv / n * min(n, acc * h) / h if n > 0 else np.zeros(2)
-                p += v * h + 0.5 * a * h * h
-                v += a * h
-                dw = float(np.clip(c[2] - w, -alpha * h, alpha * h))
-                th += w * h + 0.5 * dw * h
-                w += dw
-        out[i, :2], out[i, 2], out[i, 3:5], out[i, 5] = p, (th + np.pi) % (2 * np.pi) - np.pi, v, w
-    return out

@@ -22,6 +22,7 @@ from numpy.typing import ArrayLike, NDArray
 from cmdragons.config import Validated, setting
 from cmdragons.control import _kernels as K
 from cmdragons.control.trapezoid import TrapezoidParams
+from cmdragons.geometry import path_length
 from cmdragons.messages import RobotCommand, RobotState
 
 __all__ = [
@@ -32,6 +33,7 @@ __all__ = [
     "follow_path",
     "motion_command",
     "motion_commands",
+    "predict_braking",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -48,17 +50,16 @@ class MotionParams(Validated):
     max_omega_rad_s: float = setting(20.0, lo=0.01, hi=100.0)
     max_alpha_rad_s2: float = setting(60.0, lo=0.01, hi=1000.0)  # angular acceleration and braking
     frame_rate_hz: float = setting(60.0, lo=1.0, hi=1000.0)  # one command per camera frame
-    latency_s: float = setting(0.03, lo=0.0, hi=1.0)  # command sent -> wheels act on it
 
     @property
     def period_s(self) -> float:
         """The control period: one command holds for this long."""
         return 1.0 / self.frame_rate_hz
 
-    def limits(self) -> FloatArray:
-        """(vmax, accel, brake, omega_max, alpha_max) for the kernels."""
-        return np.array([self.max_speed_m_s, self.max_accel_m_s2, self.max_brake_m_s2,
-                         self.max_omega_rad_s, self.max_alpha_rad_s2])  # fmt: skip
+    def limits(self) -> K.Limits:
+        """The limits by name, for the kernels."""
+        return K.Limits(self.max_speed_m_s, self.max_accel_m_s2, self.max_brake_m_s2, self.max_omega_rad_s,
+                        self.max_alpha_rad_s2)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -70,7 +71,7 @@ class PathParams(Validated):
 
 
 @dataclass(frozen=True)
-class ControlParams:
+class ControlParams(Validated):
     """configs/control.yaml: motion control (Bruce 2006 B.4)."""
 
     motion: MotionParams = MotionParams()
@@ -96,7 +97,8 @@ def motion_commands(states: ArrayLike, targets: ArrayLike, params: ControlParams
     s = np.ascontiguousarray(states, dtype=np.float64).reshape(-1, 6)
     t = np.ascontiguousarray(targets, dtype=np.float64).reshape(-1, 5)
     m = params.motion
-    return np.asarray(K.motion_commands(s, t, m.limits(), m.period_s, params.trapezoid.split_iterations))
+    return np.asarray(K.motion_commands(s, t, m.max_speed_m_s, m.max_accel_m_s2, m.max_brake_m_s2, m.max_omega_rad_s,
+                                        m.max_alpha_rad_s2, m.period_s, params.trapezoid.split_iterations))  # fmt: skip
 
 
 def motion_command(robot: RobotState, target: MotionTarget, params: ControlParams) -> RobotCommand:
@@ -128,7 +130,7 @@ def follow_path(position: tuple[float, float], path: ArrayLike, theta: float, pa
     if n_in <= 1e-9 or n_out <= 1e-9:
         return MotionTarget(float(w[0]), float(w[1]), theta=theta)
     m = params.motion
-    rest = n_out + float(np.hypot(*np.diff(pts[k + 1 :], axis=0).T).sum()) if k + 2 < len(pts) else n_out
+    rest = n_out + path_length(pts[k + 1 :]) if k + 2 < len(pts) else n_out
     cos_turn = float(incoming @ outgoing) / (n_in * n_out)
     # the velocity across the next leg (all of it when turning back) is cancelled at max_accel
     across = math.sqrt(max(0.0, 1.0 - cos_turn * cos_turn)) if cos_turn > 0.0 else 1.0
@@ -136,3 +138,15 @@ def follow_path(position: tuple[float, float], path: ArrayLike, theta: float, pa
     speed = min(m.max_speed_m_s, math.sqrt(2.0 * m.max_brake_m_s2 * rest), turn_speed)
     u = incoming / n_in
     return MotionTarget(float(w[0]), float(w[1]), float(u[0] * speed), float(u[1] * speed), theta)
+
+
+def predict_braking(
+    x: float, y: float, vx: float, vy: float, t_s: float, motion: MotionParams
+) -> tuple[float, float, float, float]:
+    """Where a robot at (x, y) moving at (vx, vy), commanded to stop now, is ``t_s`` seconds later and
+    how fast it moves: braking at full strength to rest (the robot model's braking trajectory, the
+    one DSS checks; field frame, m, m/s)."""
+    dt = motion.period_s
+    tr = K.trajectory(x, y, vx, vy, *K.stop_accel(vx, vy, dt), dt, motion.max_accel_m_s2, motion.max_brake_m_s2)
+    px, py, wx, wy = K.trajectory_state(tr, max(float(t_s), 0.0))
+    return float(px), float(py), float(wx), float(wy)

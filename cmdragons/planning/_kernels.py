@@ -2,9 +2,9 @@
 path smoothing, the visibility graph and the roadmap search.
 
 Everything here works in the field frame (metres) on plain numpy arrays. A compiled collision world
-("cw") is one tuple, built by :mod:`cmdragons.planning.world`, for one robot radius and time window:
+("cw") is one named tuple (:class:`CW`), built by :mod:`cmdragons.planning.world`, for one robot radius and time window:
 
-    cw = (obs, aabb, inner, mode, grid, xmask, ymask, tbox, tchild, tleaf)
+    cw = CW(obs, aabb, inner, mode, grid, xmask, ymask, tbox, tchild, tleaf)
 
 * ``obs`` (k, 6): ``kind, p0, p1, p2, p3, R`` per obstacle, already grown by the robot's radius, so
   a robot *centre* is in collision when its distance to the obstacle's core is below ``R``.
@@ -26,12 +26,27 @@ from __future__ import annotations
 
 import heapq
 import math
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numba import njit
 
-CW = tuple[Any, ...]  # a compiled collision world, see the module docstring
+
+class CW(NamedTuple):
+    """A compiled collision world, by name (see the module docstring)."""
+
+    obs: np.ndarray  # (k, 6) kind, p0, p1, p2, p3, R
+    aabb: np.ndarray  # (k, 4) grown bounding boxes
+    inner: np.ndarray  # (4,) the box the robot centre stays in
+    mode: int  # MODE_LINEAR, MODE_MASKS or MODE_AABB_TREE
+    grid: np.ndarray  # (4,) x0, y0, bins per metre in x and y of the extent masks
+    xmask: np.ndarray  # (bins, words) uint64
+    ymask: np.ndarray  # (bins, words) uint64
+    tbox: np.ndarray  # (nodes, 4) AABB tree node boxes
+    tchild: np.ndarray  # (nodes, 2) children, -1 for a leaf
+    tleaf: np.ndarray  # (nodes,) a leaf's obstacle
+
+
 
 EPS_M = 1e-6  # contact tolerance of every collision query, metres
 
@@ -145,10 +160,84 @@ def _hits_segment(obs: np.ndarray, j: int, ax: float, ay: float, bx: float, by: 
 def obstacle_clearance(obs: np.ndarray, j: int, px: float, py: float) -> float:
     """Signed clearance of a robot centre at p from obstacle j, metres (< 0 inside)."""
     if obs[j, 0] == 0.0:
-        d2 = point_segment_dist2(px, py, obs[j, 1], obs[j, 2], obs[j, 3], obs[j, 4])
+        ax, ay, bx, by = obs[j, 1], obs[j, 2], obs[j, 3], obs[j, 4]
+        dx, dy = bx - ax, by - ay
+        den = dx * dx + dy * dy
+        t = 0.0 if den == 0.0 else min(1.0, max(0.0, ((px - ax) * dx + (py - ay) * dy) / den))
+        return float(math.hypot(px - (ax + t * dx), py - (ay + t * dy)) - obs[j, 5])
+    ex = max(obs[j, 1] - px, 0.0, px - obs[j, 3])
+    ey = max(obs[j, 2] - py, 0.0, py - obs[j, 4])
+    return float(math.hypot(ex, ey) - obs[j, 5])
+
+
+@njit(cache=True)
+def clearance(obs: np.ndarray, inner: np.ndarray, px: float, py: float) -> float:
+    """Signed clearance (m) of a robot centre at p from the nearest obstacle (grown by the robot's
+    radius) or wall; < 0 in collision. The one distance query of planners, navigators and safety."""
+    c = min(px - inner[0], inner[2] - px, py - inner[1], inner[3] - py)
+    for j in range(obs.shape[0]):
+        c = min(c, obstacle_clearance(obs, j, px, py))
+    return float(c)
+
+
+@njit(cache=True)
+def _away(obs: np.ndarray, j: int, px: float, py: float) -> tuple[float, float]:
+    # the unit direction in which the clearance from obstacle j grows fastest at p
+    if obs[j, 0] == 0.0:
+        ax, ay, bx, by = obs[j, 1], obs[j, 2], obs[j, 3], obs[j, 4]
+        dx, dy = bx - ax, by - ay
+        den = dx * dx + dy * dy
+        t = 0.0 if den == 0.0 else min(1.0, max(0.0, ((px - ax) * dx + (py - ay) * dy) / den))
+        ux, uy = px - (ax + t * dx), py - (ay + t * dy)
     else:
-        d2 = point_box_dist2(px, py, obs[j, 1], obs[j, 2], obs[j, 3], obs[j, 4])
-    return float(math.sqrt(d2) - obs[j, 5])
+        x0, y0, x1, y1 = obs[j, 1], obs[j, 2], obs[j, 3], obs[j, 4]
+        ux, uy = px - min(max(px, x0), x1), py - min(max(py, y0), y1)
+        if ux == 0.0 and uy == 0.0:  # inside the box's core: out through the nearest face
+            m = min(px - x0, x1 - px, py - y0, y1 - py)
+            if m == px - x0:
+                return -1.0, 0.0
+            if m == x1 - px:
+                return 1.0, 0.0
+            if m == py - y0:
+                return 0.0, -1.0
+            return 0.0, 1.0
+    n = math.hypot(ux, uy)
+    if n == 0.0:
+        return 0.0, 0.0  # on a capsule's core: every direction is as good
+    return ux / n, uy / n
+
+
+@njit(cache=True)
+def clearance_gradient(obs: np.ndarray, inner: np.ndarray, px: float, py: float) -> tuple[float, float, float]:
+    """:func:`clearance` at p and its gradient (the unit direction away from the nearest obstacle or
+    wall; (0, 0) where it is undefined): (c, gx, gy)."""
+    c, gx, gy = px - inner[0], 1.0, 0.0
+    if inner[2] - px < c:
+        c, gx, gy = inner[2] - px, -1.0, 0.0
+    if py - inner[1] < c:
+        c, gx, gy = py - inner[1], 0.0, 1.0
+    if inner[3] - py < c:
+        c, gx, gy = inner[3] - py, 0.0, -1.0
+    for j in range(obs.shape[0]):
+        cj = obstacle_clearance(obs, j, px, py)
+        if cj < c:
+            c = cj
+            gx, gy = _away(obs, j, px, py)
+    return float(c), gx, gy
+
+
+@njit(cache=True)
+def clearance_grid(
+    obs: np.ndarray, inner: np.ndarray, x0: float, y0: float, res: float, nx: int, ny: int
+) -> np.ndarray:
+    """:func:`clearance` at the centres of an (ny, nx) grid of ``res``-metre cells whose lower-left
+    corner is (x0, y0): cell [i, k] is centred at (x0 + (k + 1/2) res, y0 + (i + 1/2) res)."""
+    out = np.empty((ny, nx))
+    for i in range(ny):
+        py = y0 + (i + 0.5) * res
+        for k in range(nx):
+            out[i, k] = clearance(obs, inner, x0 + (k + 0.5) * res, py)
+    return out
 
 
 @njit(cache=True)
@@ -247,8 +336,8 @@ def _range_area(aabb: np.ndarray, order: np.ndarray, lo: int, hi: int) -> float:
 def build_world(
     circles: np.ndarray, vel: np.ndarray, boxes: np.ndarray, bounds: np.ndarray, radius: float,
     t0: float, t1: float, mode: int, n_bins: int,
-) -> tuple[Any, ...]:  # fmt: skip
-    """The compiled world tuple (see the module docstring) for a robot of ``radius`` over the time
+) -> CW:  # fmt: skip
+    """The compiled world (see the module docstring) for a robot of ``radius`` over the time
     window [t0, t1]: circles (x, y, r) moving at ``vel`` become capsules, boxes get the radius as
     clearance, and the chosen broad phase is built."""
     nc, nb = circles.shape[0], boxes.shape[0]
@@ -281,7 +370,7 @@ def build_world(
         tbox, tchild, tleaf = build_aabb_tree(aabb)
     else:
         tbox, tchild, tleaf = np.zeros((1, 4)), -np.ones((1, 2), dtype=np.int32), -np.ones(1, dtype=np.int32)
-    return (obs, aabb, inner, mode, grid, xm, ym, tbox, tchild, tleaf)
+    return CW(obs, aabb, inner, mode, grid, xm, ym, tbox, tchild, tleaf)
 
 
 @njit(cache=True)
@@ -291,7 +380,8 @@ def _box_overlap(b: np.ndarray, i: int, x0: float, y0: float, x1: float, y1: flo
 
 @njit(cache=True)
 def _segment_hits_any(cw: CW, ax: float, ay: float, bx: float, by: float) -> bool:
-    obs, aabb, _inner, mode, grid, xm, ym, tbox, tchild, tleaf = cw
+    obs, aabb, mode, grid, xm, ym = cw.obs, cw.aabb, cw.mode, cw.grid, cw.xmask, cw.ymask
+    tbox, tchild, tleaf = cw.tbox, cw.tchild, cw.tleaf
     x0, x1 = min(ax, bx), max(ax, bx)
     y0, y1 = min(ay, by), max(ay, by)
     k = obs.shape[0]
@@ -345,7 +435,7 @@ def _segment_hits_any(cw: CW, ax: float, ay: float, bx: float, by: float) -> boo
 def segment_free(cw: CW, ax: float, ay: float, bx: float, by: float) -> bool:
     """Swept-circle check: the robot's disc moving from a to b touches no obstacle and stays in the
     field (the inner box is convex, so both endpoints inside is enough)."""
-    inner = cw[2]
+    inner = cw.inner
     if not (_in_inner(inner, ax, ay) and _in_inner(inner, bx, by)):
         return False
     return not _segment_hits_any(cw, ax, ay, bx, by)
@@ -386,7 +476,7 @@ def nearest_free_point(
     Candidates: p pushed straight out of each obstacle it overlaps (to the obstacle's surface plus
     a hair) and clamped into the field, then rings of ``n_angles`` points every ``step_m`` around p
     for the cases where pushing out of one obstacle lands in another. Returns (x, y, found)."""
-    obs, inner = cw[0], cw[2]
+    obs, inner = cw.obs, cw.inner
     margin = 10.0 * EPS_M
     best_d2, bx, by = np.inf, px, py
     cx = min(max(px, inner[0] + margin), inner[2] - margin)
@@ -542,8 +632,16 @@ def errt_grow(
     bridges: np.ndarray,
     rand: np.ndarray,
     waypoints: np.ndarray,
-    fparams: np.ndarray,
-    iparams: np.ndarray,
+    p_goal: float,
+    p_way: float,
+    step: float,
+    connect_r: float,
+    max_ext: int,
+    bidir: bool,
+    max_br: int,
+    extra: int,
+    nn: int,
+    node_limit: int,
 ) -> int:
     """Grow the ERRT trees (Bruce 2006 §4.3, §4.3.4) by one chunk of iterations, one row of ``rand``
     (three uniforms) per iteration.
@@ -557,15 +655,16 @@ def errt_grow(
     stored with its path length; growth stops when ``max_bridges`` are found or ``extra_iterations``
     have passed since the first one (multi-bridge ERRT picks the shortest).
 
-    ``fparams = (p_goal, p_waypoint, step_m, connect_radius_m)``,
-    ``iparams = (max_extensions, bidirectional, max_bridges, extra_iterations, nn_kind)``,
+    ``p_goal``, ``p_way`` (the target probabilities), ``step`` (m), ``connect_r`` (the longest bridge,
+    m), ``max_ext`` (repeated extensions), ``bidir``, ``max_br`` (bridges to collect), ``extra``
+    (iterations after the first bridge) and ``nn`` (NN_BRUTE or NN_KDTREE) are ERRTParams' fields;
+    ``node_limit`` is the work budget: the trees stop growing (GROW_FULL) before they would hold more
+    nodes (at most the arrays' length).
     ``state = (n_nodes, n_bridges, iterations, first_bridge_iteration, waypoint_targets)``, the last
     counting the iterations that aimed at a cached waypoint. Returns a GROW_* code.
     """
-    p_goal, p_way, step, connect_r = fparams[0], fparams[1], fparams[2], fparams[3]
-    max_ext, bidir, max_br, extra, nn = iparams[0], iparams[1], iparams[2], iparams[3], iparams[4]
-    inner = cw[2]
-    cap = nodes.shape[0]
+    inner = cw.inner
+    cap = min(node_limit, nodes.shape[0])
     n_way = waypoints.shape[0]
     for r in range(rand.shape[0]):
         if state[1] >= max_br or (state[1] > 0 and state[2] - state[3] > extra):
@@ -575,7 +674,7 @@ def errt_grow(
             return GROW_FULL
         it = state[2]
         state[2] = it + 1
-        t = 1 if (bidir == 1 and it % 2 == 1) else 0
+        t = 1 if (bidir and it % 2 == 1) else 0
         other = 1 - t
         # target: the other tree's root, a cached waypoint or a uniform point of the field
         u = rand[r, 0]
@@ -629,15 +728,6 @@ def errt_grow(
     if state[1] >= max_br or (state[1] > 0 and state[2] - state[3] > extra):
         return GROW_DONE
     return GROW_RUNNING
-
-
-@njit(cache=True)
-def polyline_length(path: np.ndarray) -> float:
-    """Length of the polyline (n, 2), metres."""
-    total = 0.0
-    for i in range(path.shape[0] - 1):
-        total += math.hypot(path[i + 1, 0] - path[i, 0], path[i + 1, 1] - path[i, 1])
-    return total
 
 
 @njit(cache=True)
@@ -814,19 +904,10 @@ def _arc_free(cw: CW, cx: float, cy: float, r: float, a0: float, a1: float, step
 
 
 @njit(cache=True)
-def visibility_graph(cw: CW, sx: float, sy: float, gx: float, gy: float, arc_step_rad: float) -> tuple[Any, ...]:
-    """Shortest path among the grown obstacles by the reduced visibility graph with exact tangents
-    (Bruce 2006 §4.3.5 uses it as ERRT's optimum reference).
-
-    Nodes: start, goal and the tangent points of every free tangent segment between start, goal and
-    the obstacle circles (point-circle: two, circle-circle: four bitangents). Edges: the free
-    tangent segments and, on every circle, the arcs between angularly consecutive tangent points
-    that no other obstacle covers (checked every ``arc_step_rad``). Dijkstra gives the exact length.
-
-    Returns (cost_m, node_xy (n, 2), node_circle (n,), node_angle (n,), route (m,) node indices,
-    circles (c, 4), distance from the start (n,)); cost is inf when there is no path."""
-    obs = cw[0]
-    circles = vis_circles(obs)
+def vis_start(cw: CW, sx: float, sy: float, gx: float, gy: float, circles: np.ndarray) -> tuple[Any, ...]:
+    """The visibility graph's arrays (see :func:`visibility_graph`) holding start, goal, their straight
+    edge when it is free and their point-circle tangents. Returns (pts, circ, e_a, e_b, e_w, counts)
+    with counts = (nodes, edges, tangent checks)."""
     nc = circles.shape[0]
     cap = 2 + 4 * nc + 4 * nc * (nc - 1)
     pts = np.empty((cap, 2))
@@ -837,10 +918,10 @@ def visibility_graph(cw: CW, sx: float, sy: float, gx: float, gy: float, arc_ste
     n = _add_node(pts, circ, 0, sx, sy, -1)
     n = _add_node(pts, circ, n, gx, gy, -1)
     ne = 0
+    checks = 1
     if segment_free(cw, sx, sy, gx, gy):
         e_a[ne], e_b[ne], e_w[ne] = 0, 1, math.hypot(gx - sx, gy - sy)
         ne += 1
-    # point-circle tangents from start and goal
     for p in range(2):
         px, py = pts[p, 0], pts[p, 1]
         for c in range(nc):
@@ -853,12 +934,26 @@ def visibility_graph(cw: CW, sx: float, sy: float, gx: float, gy: float, arc_ste
             for sgn in (-1.0, 1.0):
                 a = base + sgn * half
                 tx, ty = cx + r * math.cos(a), cy + r * math.sin(a)
+                checks += 1
                 if segment_free(cw, px, py, tx, ty):
                     e_a[ne], e_b[ne], e_w[ne] = p, n, math.hypot(tx - px, ty - py)
                     ne += 1
                     n = _add_node(pts, circ, n, tx, ty, c)
-    # circle-circle bitangents: unit normal nv with nv.(C2 - C1) = r2 - r1, feet C_i - r_i nv
-    for c1 in range(nc):
+    counts = np.array([n, ne, checks], dtype=np.int64)
+    return pts, circ, e_a, e_b, e_w, counts
+
+
+@njit(cache=True)
+def vis_bitangents(
+    cw: CW, circles: np.ndarray, pts: np.ndarray, circ: np.ndarray, e_a: np.ndarray, e_b: np.ndarray,
+    e_w: np.ndarray, counts: np.ndarray, c_lo: int, c_hi: int,
+) -> None:  # fmt: skip
+    """Add the free circle-circle bitangents of the circles c1 in [c_lo, c_hi) with every later
+    circle to the graph's arrays (in place; ``counts`` as :func:`vis_start`)."""
+    nc = circles.shape[0]
+    n, ne, checks = counts[0], counts[1], counts[2]
+    # unit normal nv with nv.(C2 - C1) = r2 - r1, feet C_i - r_i nv
+    for c1 in range(c_lo, min(c_hi, nc)):
         x1, y1, r1 = circles[c1, 0], circles[c1, 1], circles[c1, 2]
         for c2 in range(c1 + 1, nc):
             x2, y2, R2 = circles[c2, 0], circles[c2, 1], circles[c2, 2]
@@ -878,12 +973,23 @@ def visibility_graph(cw: CW, sx: float, sy: float, gx: float, gy: float, arc_ste
                     ny = kk * uy + sg * h * ux
                     ax, ay = x1 - r1 * nx, y1 - r1 * ny
                     bx, by = x2 - r2 * nx, y2 - r2 * ny
+                    checks += 1
                     if segment_free(cw, ax, ay, bx, by):
                         e_a[ne], e_b[ne], e_w[ne] = n, n + 1, math.hypot(bx - ax, by - ay)
                         ne += 1
                         n = _add_node(pts, circ, n, ax, ay, c1)
                         n = _add_node(pts, circ, n, bx, by, c2)
-    # arcs between angularly consecutive tangent points on each circle
+    counts[0], counts[1], counts[2] = n, ne, checks
+
+
+@njit(cache=True)
+def vis_search(
+    cw: CW, circles: np.ndarray, pts: np.ndarray, circ: np.ndarray, e_a: np.ndarray, e_b: np.ndarray,
+    e_w: np.ndarray, counts: np.ndarray, arc_step_rad: float,
+) -> tuple[Any, ...]:  # fmt: skip
+    """The free arcs between angularly consecutive tangent points on each circle, then Dijkstra from
+    the start (node 0) to the goal (node 1). Returns as :func:`visibility_graph`."""
+    n, ne = counts[0], counts[1]
     ang = np.zeros(n)
     for i in range(2, n):
         c = circ[i]
@@ -931,6 +1037,26 @@ def visibility_graph(cw: CW, sx: float, sy: float, gx: float, gy: float, arc_ste
     dist, prev = astar(cw, pts[:n], start, adj, adw, 0, 1, np.ones(2 * total, dtype=np.int8))
     route = route_to(prev, 1) if dist[1] < np.inf else np.empty(0, dtype=np.int64)
     return dist[1], pts[:n].copy(), circ[:n].copy(), ang, route, circles, dist
+
+
+@njit(cache=True)
+def visibility_graph(cw: CW, sx: float, sy: float, gx: float, gy: float, arc_step_rad: float) -> tuple[Any, ...]:
+    """Shortest path among the grown obstacles by the reduced visibility graph with exact tangents
+    (Bruce 2006 §4.3.5 uses it as ERRT's optimum reference), in one call: :func:`vis_start`,
+    :func:`vis_bitangents` over all circles, :func:`vis_search` (the planner runs the middle step in
+    chunks to honour its termination).
+
+    Nodes: start, goal and the tangent points of every free tangent segment between start, goal and
+    the obstacle circles (point-circle: two, circle-circle: four bitangents). Edges: the free
+    tangent segments and, on every circle, the arcs between angularly consecutive tangent points
+    that no other obstacle covers (checked every ``arc_step_rad``). Dijkstra gives the exact length.
+
+    Returns (cost_m, node_xy (n, 2), node_circle (n,), node_angle (n,), route (m,) node indices,
+    circles (c, 4), distance from the start (n,)); cost is inf when there is no path."""
+    circles = vis_circles(cw.obs)
+    pts, circ, e_a, e_b, e_w, counts = vis_start(cw, sx, sy, gx, gy, circles)
+    vis_bitangents(cw, circles, pts, circ, e_a, e_b, e_w, counts, 0, circles.shape[0])
+    return vis_search(cw, circles, pts, circ, e_a, e_b, e_w, counts, arc_step_rad)
 
 
 @njit(cache=True)

@@ -13,8 +13,10 @@ the planner
    trees from both ends joined by several bridges, the shortest of which wins;
 5. smooths the path (shortcuts, then pulls it taut, §4.6.1) and feeds its points to the cache.
 
-The deadline is checked between chunks of iterations; randomness comes from the
-``numpy.random.Generator`` given to the planner.
+The termination condition (:mod:`cmdragons.planning.termination`) is honoured in tree nodes: the
+kernel stops when the work budget of nodes is spent (NO_PATH) and the deadline is checked between
+chunks of iterations (TIMEOUT); randomness comes from the ``numpy.random.Generator`` given to the
+planner.
 """
 
 from __future__ import annotations
@@ -26,18 +28,22 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from cmdragons.config import setting
+from cmdragons.config import Validated, setting
+from cmdragons.geometry import path_length
 from cmdragons.planning import _kernels as K
 from cmdragons.planning.problem import PlanProblem, PlanResult, PlanStatus, RobustEnds, prepare
+from cmdragons.planning.termination import Termination
 from cmdragons.planning.world import CompiledWorld
 
 __all__ = ["ERRTParams", "ERRTPlanner", "SmoothingParams", "smooth"]
 
 FloatArray = NDArray[np.float64]
 
+MAX_NODES = 1_000_000  # the trees never grow beyond this, whatever the termination allows
+
 
 @dataclass(frozen=True)
-class SmoothingParams:
+class SmoothingParams(Validated):
     """Path smoothing (Bruce 2006 §4.6.1): shortcuts, then passes that pull the path taut."""
 
     passes: int = setting(3, lo=0, hi=20)  # taut-pulling passes after the shortcuts
@@ -54,7 +60,7 @@ def smooth(cw: CompiledWorld, path: FloatArray, params: SmoothingParams) -> Floa
 
 
 @dataclass(frozen=True)
-class ERRTParams:
+class ERRTParams(Validated):
     """configs/planner.yaml ``errt`` (Bruce 2006 §4.3, Table 4.5 for the spirit of the values)."""
 
     step_m: float = setting(0.3, lo=0.01, hi=5.0)  # length of one tree extension
@@ -70,13 +76,15 @@ class ERRTParams:
     extra_iterations: int = setting(24, lo=0, hi=100000)  # more iterations after the first bridge
     connect_radius_m: float = setting(20.0, lo=0.0, hi=100.0)  # longest straight bridge tried
     nearest: Literal["brute", "kdtree"] = setting("brute", choices=("brute", "kdtree"))  # measured: brute wins
-    max_nodes: int = setting(2000, lo=16, hi=1000000)  # node budget; spent without a path: NO_PATH
+    # tree nodes per robot and frame (the work budget of its termination): spent without a path, NO_PATH
+    work_budget: int = setting(2000, lo=16, hi=MAX_NODES)
     chunk_iterations: int = setting(256, lo=1, hi=100000)  # iterations between deadline checks (fixed)
     reuse_last_plan: bool = True  # keep the last plan while it stays valid and the goal stays
     goal_tolerance_m: float = setting(0.01, lo=0.0, hi=1.0)  # goal moves less than this: same goal
     smoothing: SmoothingParams = SmoothingParams()
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         if self.p_goal + self.p_waypoint > 1.0:
             raise ValueError("p_goal + p_waypoint must be at most 1")
 
@@ -122,37 +130,44 @@ class ERRTPlanner:
         self.cache = WaypointCache(p.waypoint_cache_size, p.waypoint_replacement, rng)
         self.last_path: FloatArray | None = None
         self.last_goal: tuple[float, float] | None = None
-        cap = p.max_nodes
+        self._allocate(p.work_budget)
+        self._roots = np.array([0, 1], dtype=np.int32)
+        self._state = np.zeros(5, dtype=np.int64)
+        self._bridges = np.zeros((p.max_bridges, 3))
+        self._p_way = p.p_waypoint if p.waypoint_cache else 0.0
+        self._nn = K.NN_KDTREE if p.nearest == "kdtree" else K.NN_BRUTE
+        self._no_waypoints = np.zeros((0, 2))
+        self._rand = np.zeros((0, 3))
+        self._rand_next = 0
+        self._t_search = 0.0
+
+    def _allocate(self, cap: int) -> None:
+        """Room for ``cap`` tree nodes (the arrays the kernel grows the trees in)."""
         self._nodes = np.zeros((cap, 2))
         self._parent = np.full(cap, -1, dtype=np.int32)
         self._tree = np.zeros(cap, dtype=np.int8)
         self._cost = np.zeros(cap)
         self._kdc = np.full((cap, 2), -1, dtype=np.int32)
         self._kdd = np.zeros(cap, dtype=np.int32)
-        self._roots = np.array([0, 1], dtype=np.int32)
         self._stack = np.zeros((cap, 2))
-        self._state = np.zeros(5, dtype=np.int64)
-        self._bridges = np.zeros((p.max_bridges, 3))
-        p_way = p.p_waypoint if p.waypoint_cache else 0.0
-        self._f = np.array([p.p_goal, p_way, p.step_m, p.connect_radius_m])
-        nn = K.NN_KDTREE if p.nearest == "kdtree" else K.NN_BRUTE
-        self._i = np.array(
-            [p.max_extensions, int(p.bidirectional), p.max_bridges, p.extra_iterations, nn], dtype=np.int64
-        )
-        self._no_waypoints = np.zeros((0, 2))
-        self._tree_arrays = (self._nodes, self._parent, self._tree, self._cost, self._kdc, self._kdd, self._roots,
-                             self._stack, self._state, self._bridges)  # fmt: skip
-        self._rand = np.zeros((0, 3))
-        self._rand_next = 0
-        self._t_search = 0.0
+
+    def _grow_room(self) -> None:
+        """Double the room for tree nodes, keeping the trees grown so far."""
+        n = len(self._nodes)
+        old: tuple[NDArray[np.generic], ...] = (self._nodes, self._parent, self._tree, self._cost, self._kdc, self._kdd)
+        self._allocate(min(2 * n, MAX_NODES))
+        grown: tuple[NDArray[np.generic], ...] = (self._nodes, self._parent, self._tree, self._cost, self._kdc,
+                                                  self._kdd)  # fmt: skip
+        for new, a in zip(grown, old, strict=True):
+            new[:n] = a
 
     def reset(self) -> None:
         self.cache.clear()
         self.last_path = None
         self.last_goal = None
 
-    def solve(self, problem: PlanProblem, deadline: float) -> PlanResult:
-        """Plan from ``problem.start`` to ``problem.goal`` by the absolute perf_counter ``deadline``."""
+    def solve(self, problem: PlanProblem, termination: Termination) -> PlanResult:
+        """Plan from ``problem.start`` to ``problem.goal`` until ``termination`` (work: tree nodes)."""
         t0 = time.perf_counter()
         cw, ends = prepare(problem)
         if ends.failure is not None:
@@ -166,7 +181,7 @@ class ERRTPlanner:
             path = np.array([s, g], dtype=np.float64)
             return self._done(ends, path, PlanStatus.SOLVED, {"reused": False, "iterations": 0}, t0)
         waypoints = self.cache.view() if self.params.waypoint_cache else self._no_waypoints
-        code, timed_out = self._grow(cw, s, g, waypoints, deadline)
+        code, timed_out = self._grow(cw, s, g, waypoints, termination)
         n_nodes, n_bridges, iterations = (int(v) for v in self._state[:3])
         stats: dict[str, object] = {"reused": False, "iterations": iterations, "nodes": n_nodes, "bridges": n_bridges,
                                     "waypoint_targets": int(self._state[4]), "cached": len(waypoints)}  # fmt: skip
@@ -180,7 +195,7 @@ class ERRTPlanner:
         b = int(np.argmin(self._bridges[:n_bridges, 2]))
         a0, a1 = int(self._bridges[b, 0]), int(self._bridges[b, 1])
         raw = np.vstack([self._branch(a0)[::-1], self._branch(a1)])
-        stats["raw_length_m"] = float(np.hypot(*np.diff(raw, axis=0).T).sum())
+        stats["raw_length_m"] = path_length(raw)
         path = smooth(cw, raw, self.params.smoothing)
         return self._done(ends, path, PlanStatus.SOLVED, stats, t0, cache_points=raw)
 
@@ -202,9 +217,11 @@ class ERRTPlanner:
         return None
 
     def _grow(
-        self, cw: CompiledWorld, s: tuple[float, float], g: tuple[float, float], waypoints: FloatArray, deadline: float
-    ) -> tuple[int, bool]:
-        """Run the ERRT kernel in chunks until it finishes, runs out of nodes or the deadline passes."""
+        self, cw: CompiledWorld, s: tuple[float, float], g: tuple[float, float], waypoints: FloatArray,
+        termination: Termination,
+    ) -> tuple[int, bool]:  # fmt: skip
+        """Run the ERRT kernel in chunks until it finishes, spends the termination's budget of nodes
+        or its deadline passes."""
         self._nodes[0], self._nodes[1] = s, g
         self._parent[:2] = -1
         self._tree[0], self._tree[1] = 0, 1
@@ -213,14 +230,23 @@ class ERRTPlanner:
         self._kdd[:2] = 0
         self._state[:] = (2, 0, 0, 0, 0)
         chunk = self.params.chunk_iterations
+        limit = termination.work_left(0, MAX_NODES)
         while True:
             rand = self._random_rows(chunk)
             before = int(self._state[2])
-            code = K.errt_grow(cw.cw, *self._tree_arrays, rand, waypoints, self._f, self._i)
+            arrays = (self._nodes, self._parent, self._tree, self._cost, self._kdc, self._kdd, self._roots,
+                      self._stack, self._state, self._bridges)  # fmt: skip
+            p = self.params
+            code = K.errt_grow(cw.cw, *arrays, rand, waypoints, p.p_goal, self._p_way, p.step_m, p.connect_radius_m,
+                               p.max_extensions, p.bidirectional, p.max_bridges, p.extra_iterations, self._nn,
+                               min(limit, len(self._nodes)))  # fmt: skip
             self._rand_next += int(self._state[2]) - before
+            if code == K.GROW_FULL and len(self._nodes) < min(limit, MAX_NODES):
+                self._grow_room()  # the budget allows more nodes than there is room for
+                continue
             if code != K.GROW_RUNNING:
                 return int(code), False
-            if time.perf_counter() >= deadline:
+            if termination.expired():
                 return int(code), True
             # chunks keep a fixed size: the search's result must not depend on the machine's speed
             # (where the chunks end shows in the result), only a deadline that is hit may cut it

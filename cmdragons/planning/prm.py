@@ -6,7 +6,8 @@ field, each linked to the nearest node it sees in every one of ``n_sectors`` dir
 connection technique of §4.4). A query links the start and the goal into it the same way, then runs
 A* that checks nodes and edges against the current robots only when it reaches them (lazy
 validation). When the robots cut every route, it adds random nodes to the roadmap and searches
-again until its node budget or the deadline is spent. The path is smoothed like ERRT's.
+again until the roadmap is full or the termination stops it (work: roadmap nodes added by this
+query, drawn). The path is smoothed like ERRT's.
 """
 
 from __future__ import annotations
@@ -17,10 +18,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from cmdragons.config import setting
+from cmdragons.config import Validated, setting
 from cmdragons.planning import _kernels as K
 from cmdragons.planning.errt import SmoothingParams, smooth
 from cmdragons.planning.problem import PlanProblem, PlanResult, PlanStatus, RobustEnds, prepare
+from cmdragons.planning.termination import Termination
 from cmdragons.planning.world import CompiledWorld
 
 __all__ = ["DynamicPRMParams", "DynamicPRMPlanner"]
@@ -29,7 +31,7 @@ FloatArray = NDArray[np.float64]
 
 
 @dataclass(frozen=True)
-class DynamicPRMParams:
+class DynamicPRMParams(Validated):
     """configs/planner.yaml ``prm``."""
 
     n_nodes: int = setting(300, lo=2, hi=100000)  # roadmap nodes sampled in the static free field
@@ -37,6 +39,8 @@ class DynamicPRMParams:
     connect_radius_m: float = setting(1.5, lo=0.01, hi=100.0)  # longest roadmap edge
     grow_nodes: int = setting(50, lo=1, hi=100000)  # nodes added when the robots cut every route
     max_nodes: int = setting(1000, lo=2, hi=1000000)  # the roadmap's size limit; then NO_PATH
+    # roadmap nodes one query may add (the work budget of its termination); spent: NO_PATH
+    work_budget: int = setting(1000, lo=1, hi=1000000)
     smoothing: SmoothingParams = SmoothingParams()
 
 
@@ -107,7 +111,9 @@ class DynamicPRMPlanner:
             self._key = key
         return self._roadmap
 
-    def solve(self, problem: PlanProblem, deadline: float) -> PlanResult:
+    def solve(self, problem: PlanProblem, termination: Termination) -> PlanResult:
+        """Plan from ``problem.start`` to ``problem.goal`` until ``termination`` (work: roadmap nodes
+        added by this query)."""
         t0 = time.perf_counter()
         cw, ends = prepare(problem)
         if ends.failure is not None:
@@ -117,20 +123,23 @@ class DynamicPRMPlanner:
             return self._finish(ends, np.array([s, g]), PlanStatus.SOLVED, {"searches": 0}, t0)
         rm = self.roadmap(problem)
         searches = 0
+        added = 0
         while True:
             pts, start, adj, w = rm.csr(np.array([s, g]))
             src, dst = len(pts) - 2, len(pts) - 1
             cost, prev = K.astar(cw.cw, pts, start, adj, w, src, dst, np.zeros(len(adj), dtype=np.int8))
             route: NDArray[np.int64] = K.route_to(prev, dst) if np.isfinite(cost[dst]) else np.zeros(0, np.int64)
             searches += 1
-            stats: dict[str, object] = {"searches": searches, "roadmap_nodes": len(rm.pts)}
+            stats: dict[str, object] = {"searches": searches, "roadmap_nodes": len(rm.pts), "added": added}
             if len(route):
                 return self._finish(ends, smooth(cw, pts[route], self.params.smoothing), PlanStatus.SOLVED, stats, t0)
-            if len(rm.pts) >= self.params.max_nodes:
+            room = min(self.params.max_nodes - len(rm.pts), termination.work_left(added, self.params.grow_nodes))
+            if room <= 0:
                 return self._finish(ends, None, PlanStatus.NO_PATH, stats, t0)
-            if time.perf_counter() >= deadline:
+            if termination.expired():
                 return self._finish(ends, None, PlanStatus.TIMEOUT, stats, t0)
-            rm.grow(self.rng, min(self.params.grow_nodes, self.params.max_nodes - len(rm.pts)))
+            rm.grow(self.rng, room)
+            added += room  # nodes drawn, the free ones kept
 
     @staticmethod
     def _finish(

@@ -1,12 +1,13 @@
-"""The planner interface of DESIGN.md: ``solve(problem, deadline) -> PlanResult``.
+"""The planner interface of DESIGN.md: ``solve(problem, termination) -> PlanResult``.
 
 Field frame, metres. A :class:`PlanProblem` holds the start, the goal, the robot's radius and the
 :class:`CollisionWorld`; a planner answers with a :class:`PlanResult` whose ``status`` is a value,
 never an exception.
 
-Deadline: an **absolute** ``time.perf_counter()`` time in seconds, so that all robots of one frame
-can share the frame's deadline; :func:`deadline_in` turns a budget into one. A planner returns by
-the deadline plus the time of one of its work chunks (tens of microseconds).
+Termination (:mod:`cmdragons.planning.termination`): a deadline (an absolute
+``time.perf_counter()`` time, so that all robots of one frame can share the frame's deadline), a
+work budget in the planner's own unit, or both. A planner returns by the deadline plus the time of
+one of its work chunks (tens of microseconds), and as soon as its work budget is spent.
 
 Robust planning (Bruce 2006 §4.6.2) is shared by all planners through :func:`robust_ends`: a start
 inside an obstacle first leaves it by the shortest way (the first segment of the path moves
@@ -24,9 +25,10 @@ from dataclasses import dataclass, field
 from typing import Any, Protocol
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
-from cmdragons.planning import _kernels as K
+from cmdragons.geometry import path_length
+from cmdragons.planning.termination import Termination
 from cmdragons.planning.world import CollisionParams, CollisionWorld, CompiledWorld
 
 __all__ = [
@@ -36,7 +38,6 @@ __all__ = [
     "Planner",
     "RobustEnds",
     "Stateless",
-    "deadline_in",
     "path_length",
     "prepare",
     "robust_ends",
@@ -98,7 +99,7 @@ class Planner(Protocol):
     """A global planner. One object per robot: state that lives across frames (ERRT's waypoint
     cache and last plan, a roadmap) lives in it."""
 
-    def solve(self, problem: PlanProblem, deadline: float) -> PlanResult: ...
+    def solve(self, problem: PlanProblem, termination: Termination) -> PlanResult: ...
 
     def reset(self) -> None:
         """Forget everything learnt from earlier frames."""
@@ -109,16 +110,6 @@ class Stateless:
 
     def reset(self) -> None:
         """Nothing to forget."""
-
-
-def deadline_in(budget_s: float) -> float:
-    """The absolute ``time.perf_counter()`` deadline ``budget_s`` seconds from now."""
-    return time.perf_counter() + budget_s
-
-
-def path_length(path: ArrayLike) -> float:
-    """Length of a polyline (k, 2), metres."""
-    return float(K.polyline_length(np.ascontiguousarray(path, dtype=np.float64).reshape(-1, 2)))
 
 
 @dataclass(frozen=True)

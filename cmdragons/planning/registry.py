@@ -10,14 +10,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cmdragons.config import setting
+from cmdragons.config import Validated, setting
 from cmdragons.planning.errt import ERRTParams, ERRTPlanner
 from cmdragons.planning.prm import DynamicPRMParams, DynamicPRMPlanner
 from cmdragons.planning.problem import Planner
+from cmdragons.planning.termination import Termination, budget, deadline
 from cmdragons.planning.visgraph import VisGraphParams, VisibilityGraphPlanner
 from cmdragons.planning.world import CollisionParams
 
-__all__ = ["PLANNERS", "PlannerParams", "make_planner"]
+__all__ = ["PLANNERS", "PlannerParams", "make_planner", "make_termination"]
 
 
 PLANNERS: dict[str, Callable[[PlannerParams, np.random.Generator], Planner]] = {
@@ -28,12 +29,14 @@ PLANNERS: dict[str, Callable[[PlannerParams, np.random.Generator], Planner]] = {
 
 
 @dataclass(frozen=True)
-class PlannerParams:
+class PlannerParams(Validated):
     """configs/planner.yaml: which global planner drives the robots and how each one is tuned."""
 
     planner: str = setting("errt", choices=tuple(PLANNERS))  # which of PLANNERS drives the robots
     seed: int = setting(1, lo=0, hi=2**63 - 1)  # each robot's planner draws from (seed, robot id)
-    budget_ms: float = setting(1.0, lo=0.01, hi=10000.0)  # planning time per robot and frame
+    # the termination's deadline per robot and frame: only the safety net for a stalled machine, the
+    # planners' work budgets bound planning so that a loaded machine plays the same match
+    deadline_ms: float = setting(250.0, lo=0.01, hi=10000.0)
     horizon_s: float = setting(0.0, lo=0.0, hi=10.0)  # moving robots are avoided over [0, horizon]
     collision: CollisionParams = CollisionParams()
     errt: ERRTParams = ERRTParams()
@@ -48,3 +51,11 @@ def make_planner(params: PlannerParams, robot_id: int = 0, name: str | None = No
     if key not in PLANNERS:
         raise KeyError(f"unknown planner {key!r}; known: {', '.join(sorted(PLANNERS))}")
     return PLANNERS[key](params, np.random.default_rng([params.seed, robot_id]))
+
+
+def make_termination(params: PlannerParams, name: str | None = None) -> Termination:
+    """One robot's planning termination for this frame: ``deadline_ms`` from now or the work budget
+    of planner ``name`` (default ``params.planner``), whichever comes first."""
+    key = name or params.planner
+    work: int = getattr(params, key).work_budget
+    return deadline(params.deadline_ms * 1e-3) | budget(work)

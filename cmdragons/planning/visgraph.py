@@ -7,6 +7,10 @@ tangent segments and arcs of those discs. The kernel :func:`_kernels.visibility_
 free tangent and arc and runs Dijkstra, so ``cost`` is exact up to rounding. The returned polyline
 follows each arc by segments tangent to it (a circumscribed polygon, never cutting into the
 obstacle), so it is a hair longer than ``cost``.
+
+Termination: the work is counted in tangent checks (swept-circle queries of candidate tangents);
+the bitangents are built a few circles at a time, with the termination checked in between
+(TIMEOUT on the deadline, NO_PATH on the spent budget).
 """
 
 from __future__ import annotations
@@ -18,42 +22,57 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from cmdragons.config import setting
+from cmdragons.config import Validated, setting
 from cmdragons.planning import _kernels as K
 from cmdragons.planning.problem import PlanProblem, PlanResult, PlanStatus, Stateless, path_length, prepare
+from cmdragons.planning.termination import Termination
 
 __all__ = ["VisGraphParams", "VisibilityGraphPlanner"]
 
 FloatArray = NDArray[np.float64]
 
 
+CHUNK_CIRCLES = 4  # circles whose bitangents are built between two termination checks
+
+
 @dataclass(frozen=True)
-class VisGraphParams:
+class VisGraphParams(Validated):
     """configs/planner.yaml ``visgraph``."""
 
     arc_check_step_deg: float = setting(2.0, lo=0.01, hi=45.0)  # spacing of the free-arc checks
     arc_polyline_step_deg: float = setting(10.0, lo=0.1, hi=90.0)  # segments of the polyline around an arc
+    # tangent checks per query (the work budget of its termination); spent before the graph is whole: NO_PATH
+    work_budget: int = setting(1_000_000, lo=1, hi=10**9)
 
 
 class VisibilityGraphPlanner(Stateless):
-    """Exact shortest paths among discs and boxes. Stateless; it does not stop at the deadline
-    because one graph is a single kernel call (a few milliseconds with 20 robots)."""
+    """Exact shortest paths among discs and boxes. Stateless."""
 
     name = "visgraph"
 
     def __init__(self, params: VisGraphParams, rng: np.random.Generator | None = None) -> None:
         self.params = params
 
-    def solve(self, problem: PlanProblem, deadline: float) -> PlanResult:
+    def solve(self, problem: PlanProblem, termination: Termination) -> PlanResult:
+        """The shortest path from ``problem.start`` to ``problem.goal``, until ``termination`` (work:
+        tangent checks)."""
         t0 = time.perf_counter()
         cw, ends = prepare(problem)
         if ends.failure is not None:
             return ends.fail(t0)
         (sx, sy), (gx, gy) = ends.start, ends.goal
-        cost, pts, circ, ang, route, circles, dist = K.visibility_graph(
-            cw.cw, sx, sy, gx, gy, math.radians(self.params.arc_check_step_deg)
+        circles = K.vis_circles(cw.obs)
+        pts, circ, e_a, e_b, e_w, counts = K.vis_start(cw.cw, sx, sy, gx, gy, circles)
+        for lo in range(0, len(circles), CHUNK_CIRCLES):
+            if termination.reached(float(counts[2])):
+                stopped = PlanStatus.TIMEOUT if termination.expired() else PlanStatus.NO_PATH
+                cut: dict[str, object] = {"checks": int(counts[2]), "ms": (time.perf_counter() - t0) * 1e3}
+                return ends.finish(None, stopped, cut)
+            K.vis_bitangents(cw.cw, circles, pts, circ, e_a, e_b, e_w, counts, lo, lo + CHUNK_CIRCLES)
+        cost, pts, circ, ang, route, circles, dist = K.vis_search(
+            cw.cw, circles, pts, circ, e_a, e_b, e_w, counts, math.radians(self.params.arc_check_step_deg)
         )
-        stats: dict[str, object] = {"graph_nodes": int(len(pts))}
+        stats: dict[str, object] = {"graph_nodes": int(len(pts)), "checks": int(counts[2])}
         if not np.isfinite(cost):
             stats["ms"] = (time.perf_counter() - t0) * 1e3
             return ends.finish(None, PlanStatus.NO_PATH, stats)

@@ -11,23 +11,28 @@ Queries are about a robot *disc* of a given radius: :meth:`CollisionWorld.compil
 obstacle by that radius (the robot radius as clearance) and sweeps each moving circle over the time
 window ``[t0_s, t1_s]`` into a capsule, so that the rest is about the robot's centre point and its
 straight moves (the swept-circle segment query). The compiled world carries its broad phase
-(extent masks, an AABB tree or a plain scan, §3.2) and hands the numba kernels one tuple.
+(extent masks, an AABB tree or a plain scan, §3.2) and hands the numba kernels one named tuple.
+
+It is the one world query of the team: point and swept-disc checks (planners), the signed
+clearance to the nearest obstacle and its gradient (navigators, DSS's static check, potential
+fields), and the clearance rasterised to a grid (:class:`ClearanceGrid`, where grid planners such
+as NF1 and E* start).
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from cmdragons.config import setting
+from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field
 from cmdragons.planning import _kernels as K
 
-__all__ = ["BROAD_PHASES", "CollisionParams", "CollisionWorld", "CompiledWorld", "field_world"]
+__all__ = ["BROAD_PHASES", "ClearanceGrid", "CollisionParams", "CollisionWorld", "CompiledWorld", "field_world"]
 
 BroadPhase = Literal["linear", "masks", "aabb_tree"]
 BROAD_PHASES: dict[str, int] = {"linear": K.MODE_LINEAR, "masks": K.MODE_MASKS, "aabb_tree": K.MODE_AABB_TREE}
@@ -37,12 +42,31 @@ Point = Sequence[float] | FloatArray  # (x, y), metres
 
 
 @dataclass(frozen=True)
-class CollisionParams:
+class CollisionParams(Validated):
     """configs/planner.yaml ``collision``: how queries are answered (not what collides)."""
 
     # broad phase, Bruce 2006 §3.2: extent masks won the 10-40 obstacle measurement (cmdragons bench planning)
     broad_phase: BroadPhase = setting("masks", choices=("linear", "masks", "aabb_tree"))
     mask_bins: int = setting(32, lo=1, hi=1024)  # extent-mask bins per axis over the field
+    grid_resolution_m: float = setting(0.05, lo=0.001, hi=1.0)  # cell size of the clearance grid
+
+
+@dataclass(frozen=True, eq=False)
+class ClearanceGrid:
+    """The clearance (m, signed, < 0 in collision) of a robot centre at the centres of square cells:
+    ``values[i, k]`` at (x0 + (k + 1/2) resolution_m, y0 + (i + 1/2) resolution_m), field frame."""
+
+    x0: float
+    y0: float
+    resolution_m: float
+    values: FloatArray
+
+    def centres(self) -> tuple[FloatArray, FloatArray]:
+        """The cell centres' x (nx,) and y (ny,) coordinates."""
+        ny, nx = self.values.shape
+        xs = self.x0 + (np.arange(nx, dtype=np.float64) + 0.5) * self.resolution_m
+        ys = self.y0 + (np.arange(ny, dtype=np.float64) + 0.5) * self.resolution_m
+        return np.asarray(xs, dtype=np.float64), np.asarray(ys, dtype=np.float64)
 
 
 def _as_rows(a: ArrayLike | None, width: int, name: str) -> FloatArray:
@@ -67,7 +91,7 @@ class CollisionWorld:
     circles: FloatArray = field(default_factory=lambda: np.zeros((0, 3)))
     velocities: FloatArray = field(default_factory=lambda: np.zeros((0, 2)))
     boxes: FloatArray = field(default_factory=lambda: np.zeros((0, 4)))
-    _cache: dict[tuple[float, float, float, str, int], CompiledWorld] = field(
+    _cache: dict[tuple[float, float, float, CollisionParams], CompiledWorld] = field(
         default_factory=dict, init=False, repr=False
     )
 
@@ -91,6 +115,34 @@ class CollisionWorld:
     def n_obstacles(self) -> int:
         return int(self.circles.shape[0] + self.boxes.shape[0])
 
+    def subset(
+        self, circles: NDArray[np.bool_] | None = None, boxes: NDArray[np.bool_] | None = None
+    ) -> CollisionWorld:
+        """The world keeping only the circles and boxes whose mask entry is True (all when a mask is
+        None), in their order: one world per frame, each robot's view leaving itself out. The rows
+        are this world's, already checked."""
+        keep_c = self.circles if circles is None else self.circles[circles]
+        keep_v = self.velocities if circles is None else self.velocities[circles]
+        keep_b = self.boxes if boxes is None else self.boxes[boxes]
+        return self._checked(keep_c, keep_v, keep_b)
+
+    def with_circles(self, circles: ArrayLike, velocities: ArrayLike) -> CollisionWorld:
+        """This world's bounds and boxes with ``circles`` (n, 3: x, y, radius) moving at ``velocities``
+        (n, 2) in place of its own circles (a frame's robots in the field's static world)."""
+        c = np.asarray(circles, dtype=np.float64).reshape(-1, 3)
+        v = np.asarray(velocities, dtype=np.float64).reshape(-1, 2)
+        if len(v) != len(c) or not (np.isfinite(c).all() and np.isfinite(v).all()) or np.any(c[:, 2] < 0.0):
+            raise ValueError("circles (n, 3) and velocities (n, 2) must be finite, radii >= 0")
+        return self._checked(c, v, self.boxes)
+
+    def _checked(self, circles: FloatArray, velocities: FloatArray, boxes: FloatArray) -> CollisionWorld:
+        # a world of rows already checked (the constructor's checks cost more than a frame can spare)
+        w = object.__new__(CollisionWorld)
+        for name, value in (("bounds", self.bounds), ("circles", circles), ("velocities", velocities),
+                            ("boxes", boxes), ("_cache", {})):  # fmt: skip
+            object.__setattr__(w, name, value)
+        return w
+
     def static_part(self) -> CollisionWorld:
         """The same bounds and boxes without the circles (what a roadmap may precompute against)."""
         return CollisionWorld(self.bounds, boxes=self.boxes)
@@ -100,9 +152,9 @@ class CollisionWorld:
     ) -> CompiledWorld:
         """The world as seen by a robot of ``radius_m`` over the time window [t0_s, t1_s] (seconds
         from now): circles grown by the radius and swept along their velocity over the window.
-        Cached per (radius, window, broad phase): planners of one frame share it."""
+        Cached per (radius, window, params): planners of one frame share it."""
         p = params or CollisionParams()
-        key = (float(radius_m), float(t0_s), float(t1_s), p.broad_phase, p.mask_bins)
+        key = (float(radius_m), float(t0_s), float(t1_s), p)
         hit = self._cache.get(key)
         if hit is None:
             hit = CompiledWorld(self, float(radius_m), float(t0_s), float(t1_s), p)
@@ -125,10 +177,10 @@ class CompiledWorld:
         self.params = params
         bounds = np.array(world.bounds)
         mode = BROAD_PHASES[params.broad_phase]
-        self.cw: tuple[Any, ...] = K.build_world(
+        self.cw: K.CW = K.build_world(
             world.circles, world.velocities, world.boxes, bounds, radius_m, t0_s, t1_s, mode, params.mask_bins
         )
-        self.obs, self.aabb, self.inner = self.cw[0], self.cw[1], self.cw[2]
+        self.obs, self.aabb, self.inner = self.cw.obs, self.cw.aabb, self.cw.inner
 
     # --- queries (field frame, metres) ------------------------------------------------------------
     def point_free(self, x: float, y: float) -> bool:
@@ -150,9 +202,25 @@ class CompiledWorld:
     def clearance(self, x: float, y: float) -> float:
         """Signed distance (m) from the robot's disc at (x, y) to the nearest obstacle or wall; < 0 in
         collision."""
-        walls = min(x - self.inner[0], self.inner[2] - x, y - self.inner[1], self.inner[3] - y)
-        obs = min((K.obstacle_clearance(self.obs, j, float(x), float(y)) for j in range(len(self.obs))), default=np.inf)
-        return float(min(walls, obs))
+        return float(K.clearance(self.obs, self.inner, float(x), float(y)))
+
+    def clearance_gradient(self, x: float, y: float) -> tuple[float, float, float]:
+        """:meth:`clearance` at (x, y) and its gradient: (clearance m, gx, gy), the gradient the unit
+        direction away from the nearest obstacle or wall ((0, 0) on an obstacle's core line)."""
+        c, gx, gy = K.clearance_gradient(self.obs, self.inner, float(x), float(y))
+        return float(c), float(gx), float(gy)
+
+    def clearance_grid(self, resolution_m: float | None = None) -> ClearanceGrid:
+        """The clearance rasterised over the field boundary in square cells of ``resolution_m``
+        (default the params' ``grid_resolution_m``); cells cover the boundary box, the last row and
+        column reaching up to one cell past it."""
+        res = float(resolution_m if resolution_m is not None else self.params.grid_resolution_m)
+        if not res > 0.0:
+            raise ValueError(f"resolution_m must be > 0, not {res}")
+        x0, y0, x1, y1 = self.world.bounds
+        nx, ny = max(1, int(np.ceil((x1 - x0) / res - 1e-9))), max(1, int(np.ceil((y1 - y0) / res - 1e-9)))
+        values = K.clearance_grid(self.obs, self.inner, x0, y0, res, nx, ny)
+        return ClearanceGrid(x0, y0, res, np.asarray(values))
 
     def nearest_free(self, x: float, y: float, step_m: float = 0.02, n_rings: int = 50) -> tuple[float, float] | None:
         """The free robot position nearest to (x, y) (Robust planning, Bruce 2006 §4.6.2), or None

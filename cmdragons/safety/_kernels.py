@@ -1,11 +1,10 @@
-"""numba kernels of Dynamics Safety Search (Bruce 2006 ch. 5) and of the dynamic window (§5.2).
+"""numba kernels of Dynamics Safety Search (Bruce 2006 ch. 5).
 
 Field frame, metres, seconds. A robot's command is modelled as one control period ``dt`` of
 acceleration ``a`` (the velocity command v + a dt, reached as fast as the motors can and then held)
 followed by braking at the maximum deceleration ``brake`` along its velocity until it rests (§5.1,
-§5.3). Such a trajectory is a short list of parabolic segments, stored as rows
-``(t0, t1, px, py, vx, vy, ax, ay)``: position ``p + v (t - t0) + a (t - t0)^2 / 2`` for
-``t0 <= t <= t1``; the last row rests forever (``t1 = inf``).
+§5.3): the robot model's :func:`~cmdragons.control._kernels.trajectory`, a short list of parabolic
+segments ``(t0, t1, px, py, vx, vy, ax, ay)``.
 
 Two trajectories collide when their centres come closer than ``R`` (two radii plus a margin) at
 the same time. On each time interval where both are single parabolas the squared distance minus
@@ -24,70 +23,38 @@ Plain-numpy references of these kernels live in :mod:`cmdragons.safety._referenc
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
-from cmdragons.control._kernels import clip_accel, limit_velocity
+from cmdragons.control._kernels import N_SEG, Limits, clip_accel, limit_velocity, seg_at, stop_accel, trajectory
+from cmdragons.planning._kernels import clearance
 
-N_SEG = 4  # reaching the command, holding it to the period's end, braking, rest
+__all__ = ["N_SEG", "DSSConfig", "stop_accel", "trajectory"]
+
 _BISECT = 40
+
+
+class DSSConfig(NamedTuple):
+    """The search's numbers, by name (metres, seconds): the robot model and the margins of
+    configs/safety.yaml ``dss`` turned into the distances the checks compare with."""
+
+    dt: float  # control period: a command holds for this long
+    own_radius: float  # kept between two own robots' centres (two radii and own_margin_m)
+    pushed_radius: float  # ... instead, while an opponent may push one of them (two radii and pushed_margin_m)
+    push_reach: float  # an opponent centre this close to an own robot's centre may push it
+    own_growth: float  # m/s: the own distance kept grows by this per second of braking (velocity errors)
+    opponent_radius: float  # kept between an own robot's centre and an opponent's (two radii and margin)
+    opponent_accel: float  # m/s^2 an opponent may accelerate in any direction
+    static_margin: float  # kept from walls and static obstacles
+    static_step: float  # sample spacing of the static check
 
 # statuses of a robot after the search
 KEPT = 0  # its own command was safe
 CHANGED = 1  # the safe sample nearest its command
 STOPPED = 2  # nothing else was safe: the stop
 STOP_ASKED = 3  # it asked to stop (always accepted)
-
-
-@njit(cache=True)
-def _put(tr: np.ndarray, k: int, t0: float, t1: float, px: float, py: float, vx: float, vy: float,
-         ax: float, ay: float) -> tuple[float, float, float, float]:  # fmt: skip
-    # write segment k and return the position and velocity at its end
-    tr[k, 0], tr[k, 1], tr[k, 2], tr[k, 3], tr[k, 4], tr[k, 5], tr[k, 6], tr[k, 7] = t0, t1, px, py, vx, vy, ax, ay
-    h = t1 - t0
-    return px + vx * h + 0.5 * ax * h * h, py + vy * h + 0.5 * ay * h * h, vx + ax * h, vy + ay * h
-
-
-@njit(cache=True)
-def trajectory(
-    px: float, py: float, vx: float, vy: float, ax: float, ay: float, dt: float, accel: float, brake: float
-) -> np.ndarray:
-    """Segments (N_SEG, 8) of the command v + a dt held for one period ``dt``, then braking at
-    ``brake`` to rest. The motors reach a commanded velocity as fast as they can (at ``brake`` when
-    it slows the robot against its motion, else at ``accel``) and then hold it, as the simulator's
-    motor model does; the stop command (a = -v / dt) thus brakes at full strength."""
-    tr = np.zeros((N_SEG, 8))
-    cx, cy = vx + ax * dt, vy + ay * dt
-    dvx, dvy = cx - vx, cy - vy
-    dv = math.hypot(dvx, dvy)
-    slowing = dvx * vx + dvy * vy < 0.0 and cx * cx + cy * cy < vx * vx + vy * vy
-    rate = brake if slowing else accel
-    t_reach = min(dv / rate, dt) if rate > 0.0 and dv > 0.0 else 0.0
-    ux, uy = (dvx / dv * rate, dvy / dv * rate) if dv > 0.0 and rate > 0.0 else (0.0, 0.0)
-    qx, qy, wx, wy = _put(tr, 0, 0.0, t_reach, px, py, vx, vy, ux, uy)
-    qx, qy, wx, wy = _put(tr, 1, t_reach, dt, qx, qy, wx, wy, 0.0, 0.0)
-    w = math.hypot(wx, wy)
-    t_brake = w / brake if brake > 0.0 else 0.0
-    bx, by = (-brake * wx / w, -brake * wy / w) if w > 0.0 else (0.0, 0.0)
-    qx, qy, _, _ = _put(tr, 2, dt, dt + t_brake, qx, qy, wx, wy, bx, by)
-    _put(tr, 3, dt + t_brake, math.inf, qx, qy, 0.0, 0.0, 0.0, 0.0)
-    return tr
-
-
-@njit(cache=True)
-def stop_accel(vx: float, vy: float, dt: float) -> tuple[float, float]:
-    """The acceleration that names the stop command (velocity zero): the motors brake at full
-    strength until the robot rests (see :func:`trajectory`)."""
-    return -vx / dt, -vy / dt
-
-
-@njit(cache=True)
-def _seg_at(tr: np.ndarray, k: int, t: float) -> tuple[float, float, float, float]:
-    # position and velocity of segment k at absolute time t (inside the segment)
-    h = t - tr[k, 0]
-    return (tr[k, 2] + tr[k, 4] * h + 0.5 * tr[k, 6] * h * h, tr[k, 3] + tr[k, 5] * h + 0.5 * tr[k, 7] * h * h,
-            tr[k, 4] + tr[k, 6] * h, tr[k, 5] + tr[k, 7] * h)  # fmt: skip
 
 
 @njit(cache=True)
@@ -215,8 +182,8 @@ def pair_hits(ta: np.ndarray, tb: np.ndarray, radius: float, growth: float) -> b
             ka += 1
         while kb < N_SEG - 1 and tb[kb, 1] <= t0 + 1e-12:
             kb += 1
-        ax, ay, avx, avy = _seg_at(ta, ka, t0)
-        bx, by, bvx, bvy = _seg_at(tb, kb, t0)
+        ax, ay, avx, avy = seg_at(ta, ka, t0)
+        bx, by, bvx, bvy = seg_at(tb, kb, t0)
         ex, ey = 0.5 * (ta[ka, 6] - tb[kb, 6]), 0.5 * (ta[ka, 7] - tb[kb, 7])
         if t0 < t_cap - 1e-12:
             r0, r1 = r + growth * t0, growth
@@ -255,27 +222,13 @@ def opponent_hits(tr: np.ndarray, ox: float, oy: float, ovx: float, ovy: float, 
 
 
 @njit(cache=True)
-def static_clearance(px: float, py: float, inner: np.ndarray, boxes: np.ndarray, circles: np.ndarray) -> float:
-    """Clearance (m) of a robot centre from the walls (``inner``: x0, y0, x1, y1 the centre must stay
-    in), the boxes (x0, y0, x1, y1, already grown by the robot radius as a clearance) and circles
-    (x, y, r, grown likewise); < 0 in collision."""
-    c = min(px - inner[0], inner[2] - px, py - inner[1], inner[3] - py)
-    for j in range(boxes.shape[0]):
-        ex = max(boxes[j, 0] - px, 0.0, px - boxes[j, 2])
-        ey = max(boxes[j, 1] - py, 0.0, py - boxes[j, 3])
-        c = min(c, math.hypot(ex, ey) - boxes[j, 4])
-    for j in range(circles.shape[0]):
-        c = min(c, math.hypot(px - circles[j, 0], py - circles[j, 1]) - circles[j, 2])
-    return float(c)
-
-
-@njit(cache=True)
-def static_hits(tr: np.ndarray, inner: np.ndarray, boxes: np.ndarray, circles: np.ndarray, margin: float,
-                step: float) -> bool:  # fmt: skip
-    """Does the trajectory come within ``margin`` of a static obstacle? Sampled so that consecutive
-    samples lie at most ``step`` apart along the path, each held to ``margin + step / 2`` (every
-    point of the path is within step / 2 of a sample). A start already closer only fails deeper."""
-    c0 = static_clearance(tr[0, 2], tr[0, 3], inner, boxes, circles)
+def static_hits(tr: np.ndarray, obs: np.ndarray, inner: np.ndarray, margin: float, step: float) -> bool:
+    """Does the trajectory come within ``margin`` of an obstacle of the compiled collision world
+    (``obs``, ``inner``: see :mod:`cmdragons.planning._kernels`; its clearance query)? Sampled so that
+    consecutive samples lie at most ``step`` apart along the path, each held to ``margin + step / 2``
+    (every point of the path is within step / 2 of a sample). A start already closer only fails
+    deeper."""
+    c0 = clearance(obs, inner, tr[0, 2], tr[0, 3])
     need = min(margin + 0.5 * step, c0 - 1e-9)
     for k in range(N_SEG - 1):
         t0, t1 = tr[k, 0], tr[k, 1]
@@ -285,8 +238,8 @@ def static_hits(tr: np.ndarray, inner: np.ndarray, boxes: np.ndarray, circles: n
                                                               tr[k, 5] + tr[k, 7] * (t1 - t0)))  # fmt: skip
         n = max(1, int(math.ceil(vmax * (t1 - t0) / step)))
         for i in range(1, n + 1):
-            px, py, _, _ = _seg_at(tr, k, t0 + (t1 - t0) * i / n)
-            if static_clearance(px, py, inner, boxes, circles) < need:
+            px, py, _, _ = seg_at(tr, k, t0 + (t1 - t0) * i / n)
+            if clearance(obs, inner, px, py) < need:
                 return True
     return False
 
@@ -306,47 +259,46 @@ def exposed(states: np.ndarray, opp: np.ndarray, reach: float) -> np.ndarray:
 
 @njit(cache=True)
 def _trajectory_hits(
-    i: int, tr: np.ndarray, trs: np.ndarray, pushed: np.ndarray, opp: np.ndarray, inner: np.ndarray,
-    boxes: np.ndarray, circles: np.ndarray, cfg: np.ndarray,
+    i: int, tr: np.ndarray, trs: np.ndarray, pushed: np.ndarray, opp: np.ndarray, obs: np.ndarray,
+    inner: np.ndarray, cfg: DSSConfig,
 ) -> bool:  # fmt: skip
-    # cfg: dt, accel, brake, own radius sum, opponent radius sum, opponent accel, static margin, step,
-    # growth of the own radius sum (m/s), own radius sum where an opponent may push one of the two,
-    # the opponent reach that counts as that
+    # robot i's trajectory tr against the other own robots' trajectories, the opponents and the world
     for j in range(trs.shape[0]):
-        radius = cfg[9] if pushed[i] or pushed[j] else cfg[3]
-        if j != i and pair_hits(tr, trs[j], radius, cfg[8]):
+        radius = cfg.pushed_radius if pushed[i] or pushed[j] else cfg.own_radius
+        if j != i and pair_hits(tr, trs[j], radius, cfg.own_growth):
             return True
     for j in range(opp.shape[0]):
-        if opponent_hits(tr, opp[j, 0], opp[j, 1], opp[j, 2], opp[j, 3], cfg[4], cfg[5]):
+        if opponent_hits(tr, opp[j, 0], opp[j, 1], opp[j, 2], opp[j, 3], cfg.opponent_radius, cfg.opponent_accel):
             return True
-    return static_hits(tr, inner, boxes, circles, cfg[6], cfg[7])
+    return static_hits(tr, obs, inner, cfg.static_margin, cfg.static_step)
 
 
 @njit(cache=True)
-def _feasible(vx: float, vy: float, ax: float, ay: float, lim: np.ndarray, dt: float) -> tuple[float, float]:
-    # the acceleration held to A(v) and the speed limit for one period; lim: vmax, accel, brake
-    cx, cy = limit_velocity(vx, vy, vx + ax * dt, vy + ay * dt, lim[0], lim[1], lim[2], dt)
+def feasible(vx: float, vy: float, ax: float, ay: float, lim: Limits, dt: float) -> tuple[float, float]:
+    """The acceleration (ax, ay) held to A(v) and the speed limit for one period ``dt``."""
+    cx, cy = limit_velocity(vx, vy, vx + ax * dt, vy + ay * dt, lim.vmax, lim.accel, lim.brake, dt)
     return (cx - vx) / dt, (cy - vy) / dt
 
 
 @njit(cache=True)
 def dss(
-    states: np.ndarray, desired: np.ndarray, stop_asked: np.ndarray, opp: np.ndarray, inner: np.ndarray,
-    boxes: np.ndarray, circles: np.ndarray, lim: np.ndarray, cfg: np.ndarray, unit_samples: np.ndarray,
-    heuristics: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    states: np.ndarray, desired: np.ndarray, stop_asked: np.ndarray, opp: np.ndarray, obs: np.ndarray,
+    inner: np.ndarray, lim: Limits, cfg: DSSConfig, unit_samples: np.ndarray, heuristics: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
     """Cooperative Dynamics Safety Search (Bruce 2006 §5.3) over the own robots in turn.
 
     ``states`` (n, 4) x, y, vx, vy; ``desired`` (n, 2) each robot's commanded acceleration;
     ``stop_asked`` (n,) robots that asked to stop; ``opp`` (m, 4) opponents; ``unit_samples``
     (n, k, 2) random points of the unit disc (mapped into each robot's A(v)); ``heuristics`` (h, 3):
     (scale, rotation rad, 1 = from the A(v) boundary) variants of the desired acceleration.
+    ``obs``, ``inner``: the static obstacles as a compiled collision world; ``lim``: the robot's limits.
     Every robot starts on its stop trajectory; in turn, each keeps its command if safe against all
     others' current trajectories, else takes the safe candidate nearest its command, else stops.
-    Returns the accelerations (n, 2) and each robot's status (KEPT, CHANGED, STOPPED, STOP_ASKED)."""
+    Returns the accelerations (n, 2), each robot's status (KEPT, CHANGED, STOPPED, STOP_ASKED) and
+    the braking trajectories checked (n, N_SEG, 8)."""
     n = states.shape[0]
-    dt, accel, brake = cfg[0], cfg[1], cfg[2]
-    pushed = exposed(states, opp, cfg[10])
+    dt, accel, brake = cfg.dt, lim.accel, lim.brake
+    pushed = exposed(states, opp, cfg.push_reach)
     trs = np.empty((n, N_SEG, 8))
     acc = np.empty((n, 2))
     status = np.full(n, STOPPED, dtype=np.int64)
@@ -363,9 +315,9 @@ def dss(
             status[i] = STOP_ASKED
             continue
         px, py, vx, vy = states[i, 0], states[i, 1], states[i, 2], states[i, 3]
-        dx, dy = _feasible(vx, vy, desired[i, 0], desired[i, 1], lim, dt)
+        dx, dy = feasible(vx, vy, desired[i, 0], desired[i, 1], lim, dt)
         tr = trajectory(px, py, vx, vy, dx, dy, dt, accel, brake)
-        if not _trajectory_hits(i, tr, trs, pushed, opp, inner, boxes, circles, cfg):
+        if not _trajectory_hits(i, tr, trs, pushed, opp, obs, inner, cfg):
             trs[i] = tr
             acc[i, 0], acc[i, 1] = dx, dy
             status[i] = KEPT
@@ -377,7 +329,7 @@ def dss(
             c, s = math.cos(heuristics[h, 1]), math.sin(heuristics[h, 1])
             ux, uy = c * dx - s * dy, s * dx + c * dy
             if heuristics[h, 2] > 0.0 and dn > 0.0:
-                bx, by = clip_accel(vx, vy, ux * 1e6 / dn, uy * 1e6 / dn, lim[1], lim[2])
+                bx, by = clip_accel(vx, vy, ux * 1e6 / dn, uy * 1e6 / dn, lim.accel, lim.brake)
                 ux, uy = bx, by
             cand[m, 0], cand[m, 1] = heuristics[h, 0] * ux, heuristics[h, 0] * uy
             m += 1
@@ -387,30 +339,30 @@ def dss(
             ux, uy = unit_samples[i, r, 0], unit_samples[i, r, 1]
             un = math.hypot(ux, uy)
             if un > 0.0:
-                bx, by = clip_accel(vx, vy, ux * 1e6 / un, uy * 1e6 / un, lim[1], lim[2])
+                bx, by = clip_accel(vx, vy, ux * 1e6 / un, uy * 1e6 / un, lim.accel, lim.brake)
                 cand[m, 0], cand[m, 1] = bx * un, by * un
             else:
                 cand[m, 0], cand[m, 1] = 0.0, 0.0
             m += 1
         for r in range(m):
-            fx, fy = _feasible(vx, vy, cand[r, 0], cand[r, 1], lim, dt)
+            fx, fy = feasible(vx, vy, cand[r, 0], cand[r, 1], lim, dt)
             cand[r, 0], cand[r, 1] = fx, fy
             cost[r] = math.hypot(fx - dx, fy - dy)
         order = np.argsort(cost[:m])
         for r in order:
             tr = trajectory(px, py, vx, vy, cand[r, 0], cand[r, 1], dt, accel, brake)
-            if not _trajectory_hits(i, tr, trs, pushed, opp, inner, boxes, circles, cfg):
+            if not _trajectory_hits(i, tr, trs, pushed, opp, obs, inner, cfg):
                 trs[i] = tr
                 acc[i, 0], acc[i, 1] = cand[r, 0], cand[r, 1]
                 status[i] = CHANGED
                 break
-    return acc, status
+    return acc, status, trs
 
 
 @njit(cache=True)
 def trajectories_clear(
-    states: np.ndarray, acc: np.ndarray, opp: np.ndarray, inner: np.ndarray, boxes: np.ndarray,
-    circles: np.ndarray, cfg: np.ndarray,
+    states: np.ndarray, acc: np.ndarray, opp: np.ndarray, obs: np.ndarray, inner: np.ndarray, lim: Limits,
+    cfg: DSSConfig,
 ) -> np.ndarray:  # fmt: skip
     """For each robot: is its trajectory under ``acc`` clear of every other's, the opponents and the
     static obstacles? (The check a finished search must pass.)"""
@@ -418,77 +370,9 @@ def trajectories_clear(
     trs = np.empty((n, N_SEG, 8))
     for i in range(n):
         trs[i] = trajectory(states[i, 0], states[i, 1], states[i, 2], states[i, 3], acc[i, 0], acc[i, 1],
-                            cfg[0], cfg[1], cfg[2])  # fmt: skip
+                            cfg.dt, lim.accel, lim.brake)  # fmt: skip
     out = np.empty(n, dtype=np.bool_)
-    pushed = exposed(states, opp, cfg[10])
+    pushed = exposed(states, opp, cfg.push_reach)
     for i in range(n):
-        out[i] = not _trajectory_hits(i, trs[i], trs, pushed, opp, inner, boxes, circles, cfg)
+        out[i] = not _trajectory_hits(i, trs[i], trs, pushed, opp, obs, inner, cfg)
     return out
-
-
-# --- the dynamic window, Bruce 2006 §5.2 (after Fox, Burgard and Thrun 1997) ---------------------------
-@njit(cache=True)
-def dynamic_window(
-    states: np.ndarray, desired: np.ndarray, others: np.ndarray, inner: np.ndarray, boxes: np.ndarray,
-    circles: np.ndarray, lim: np.ndarray, cfg: np.ndarray, window: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
-    """The dynamic window for each own robot on its own (not cooperative).
-
-    ``states`` (n, 4) own robots x, y, vx, vy; ``desired`` (n, 2) commanded velocities; ``others``
-    (m, 4) every robot it must avoid, own ones included (row i of the own robots is skipped by
-    position); ``window`` (k, 2) points of the unit disc that span the velocities reachable in one
-    period (mapped into A(v)). A velocity is admissible when the robot, moving at it and then braking
-    at full strength, stops short of every obstacle as it stands now (the other robots are taken as
-    standing still, as in the classic method) and of the static obstacles. Among admissible
-    velocities the one maximising -|v - desired| + clearance_weight * min(clearance, cap) is taken;
-    with none admissible, the stop. cfg: dt, accel, brake, radius sum, static margin, static step,
-    clearance weight (1/s), clearance cap (m). Returns velocities (n, 2) and statuses."""
-    n = states.shape[0]
-    dt, accel, brake, radius = cfg[0], cfg[1], cfg[2], cfg[3]
-    out = np.zeros((n, 2))
-    status = np.full(n, STOPPED, dtype=np.int64)
-    rest = np.zeros((N_SEG, 8))
-    for i in range(n):
-        px, py, vx, vy = states[i, 0], states[i, 1], states[i, 2], states[i, 3]
-        dx, dy = desired[i, 0], desired[i, 1]
-        if dx == 0.0 and dy == 0.0:
-            status[i] = STOP_ASKED
-            continue
-        best, best_score = -1, -math.inf
-        bvx, bvy = 0.0, 0.0
-        for r in range(window.shape[0] + 1):
-            if r == window.shape[0]:  # the command itself, held to the limits
-                ax, ay = _feasible(vx, vy, (dx - vx) / dt, (dy - vy) / dt, lim, dt)
-            else:
-                ux, uy = window[r, 0], window[r, 1]
-                un = math.hypot(ux, uy)
-                ax, ay = 0.0, 0.0
-                if un > 0.0:
-                    ex, ey = clip_accel(vx, vy, ux * 1e6 / un, uy * 1e6 / un, lim[1], lim[2])
-                    ax, ay = _feasible(vx, vy, ex * un, ey * un, lim, dt)
-            cx, cy = vx + ax * dt, vy + ay * dt
-            # moving at (cx, cy) from now on, then braking
-            tr = trajectory(px, py, cx, cy, 0.0, 0.0, dt, accel, brake)
-            clear = cfg[7]
-            hit = False
-            for j in range(others.shape[0]):
-                qx, qy = others[j, 0], others[j, 1]
-                if qx == px and qy == py:
-                    continue  # this robot itself
-                rest[N_SEG - 1, 2], rest[N_SEG - 1, 3] = qx, qy
-                for k in range(N_SEG - 1):
-                    rest[k, 0], rest[k, 1], rest[k, 2], rest[k, 3] = tr[k, 0], tr[k, 1], qx, qy
-                rest[N_SEG - 1, 0], rest[N_SEG - 1, 1] = tr[N_SEG - 1, 0], math.inf
-                if pair_hits(tr, rest, radius, 0.0):
-                    hit = True
-                    break
-                clear = min(clear, math.hypot(tr[N_SEG - 1, 2] - qx, tr[N_SEG - 1, 3] - qy) - radius)
-            if hit or static_hits(tr, inner, boxes, circles, cfg[4], cfg[5]):
-                continue
-            score = -math.hypot(cx - dx, cy - dy) + cfg[6] * max(clear, 0.0)
-            if score > best_score:
-                best, best_score, bvx, bvy = r, score, cx, cy
-        if best >= 0:
-            out[i, 0], out[i, 1] = bvx, bvy
-            status[i] = KEPT if best == window.shape[0] else CHANGED
-    return out, status

@@ -1,5 +1,5 @@
 """The safety interface of DESIGN.md, ``make_safe(commands, world) -> commands``, and what every safety
-method shares: the static obstacles as arrays, and the translation between commands and arrays.
+method shares: the translation between commands and arrays.
 
 Field frame, metres, seconds. A safety method sees all own robots at once. It works on arrays:
 own robots' states (x, y, vx, vy) and the velocities their commands ask for, the opponents' states;
@@ -20,46 +20,22 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from cmdragons.messages import RobotCommand, WorldState
-from cmdragons.planning.world import CollisionWorld
 from cmdragons.safety._kernels import CHANGED, KEPT, STOP_ASKED, STOPPED
 
-__all__ = ["CHANGED", "KEPT", "STOPPED", "STOP_ASKED", "ArraySafety", "Safety", "SafetyResult", "StaticObstacles"]
+__all__ = ["CHANGED", "KEPT", "STOPPED", "STOP_ASKED", "ArraySafety", "Safety", "SafetyResult"]
 
 FloatArray = NDArray[np.float64]
-
-
-@dataclass(frozen=True, eq=False)
-class StaticObstacles:
-    """The static part of a :class:`CollisionWorld` for one robot radius, as kernel arrays:
-    ``inner`` (4,) the box the robot centre stays in; ``boxes`` (m, 5) x0, y0, x1, y1 and the robot
-    radius as their clearance; ``circles`` (k, 3) x, y and their radius plus the robot's. Moving
-    circles of the world are left out: moving robots are the safety method's own business."""
-
-    inner: FloatArray
-    boxes: FloatArray
-    circles: FloatArray
-
-    @classmethod
-    def from_world(cls, world: CollisionWorld | None, radius_m: float) -> StaticObstacles:
-        if world is None:
-            big = 1e9
-            return cls(np.array([-big, -big, big, big]), np.zeros((0, 5)), np.zeros((0, 3)))
-        x0, y0, x1, y1 = world.bounds
-        inner = np.array([x0 + radius_m, y0 + radius_m, x1 - radius_m, y1 - radius_m])
-        boxes = np.column_stack([world.boxes, np.full(len(world.boxes), radius_m)]).reshape(-1, 5)
-        still = np.all(world.velocities == 0.0, axis=1)
-        c = world.circles[still]
-        circles = np.column_stack([c[:, :2], c[:, 2] + radius_m]).reshape(-1, 3)
-        return cls(inner, np.ascontiguousarray(boxes), np.ascontiguousarray(circles))
 
 
 @dataclass(frozen=True)
 class SafetyResult:
     """``velocities`` (n, 2) field-frame m/s to send; ``status`` (n,) KEPT, CHANGED, STOPPED or
-    STOP_ASKED per robot."""
+    STOP_ASKED per robot; ``braking`` (n, k, 2) the field points of each robot's braking path that
+    the method checked (k = 0 when it checks none)."""
 
     velocities: FloatArray
     status: NDArray[np.int64]
+    braking: FloatArray
 
 
 class Safety(Protocol):

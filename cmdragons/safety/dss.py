@@ -25,9 +25,9 @@ from numpy.typing import ArrayLike, NDArray
 
 from cmdragons.config import Validated, setting
 from cmdragons.control.motion import MotionParams
-from cmdragons.planning.world import CollisionWorld
+from cmdragons.planning.world import CollisionWorld, CompiledWorld
 from cmdragons.safety import _kernels as K
-from cmdragons.safety.base import ArraySafety, SafetyResult, StaticObstacles
+from cmdragons.safety.base import ArraySafety, SafetyResult
 
 __all__ = ["DSSParams", "DynamicsSafetySearch", "heuristic_table"]
 
@@ -80,15 +80,18 @@ class DynamicsSafetySearch(ArraySafety):
         self.params = params
         self.motion = motion
         self.rng = rng
-        self.static = StaticObstacles.from_world(static, robot_radius_m)
-        self.limits = np.array([motion.max_speed_m_s, motion.max_accel_m_s2, motion.max_brake_m_s2])
-        self.cfg = np.array([
-            motion.period_s, motion.max_accel_m_s2, motion.max_brake_m_s2, 2.0 * robot_radius_m + params.own_margin_m,
-            2.0 * robot_radius_m + params.opponent_margin_m, params.opponent_accel_m_s2,
-            params.static_margin_m, params.static_step_m, 2.0 * params.velocity_error_m_s,
-            2.0 * robot_radius_m + max(params.own_margin_m, params.pushed_margin_m),
-            2.0 * robot_radius_m + params.push_range_m,
-        ])  # fmt: skip
+        # the walls and fixed obstacles as the collision world answers for a robot of this radius
+        unbounded = CollisionWorld((-1e9, -1e9, 1e9, 1e9))
+        self.static: CompiledWorld = (static or unbounded).compile(robot_radius_m)
+        self.limits = motion.limits()
+        d = 2.0 * robot_radius_m
+        self.cfg = K.DSSConfig(
+            dt=motion.period_s, own_radius=d + params.own_margin_m,
+            pushed_radius=d + max(params.own_margin_m, params.pushed_margin_m), push_reach=d + params.push_range_m,
+            own_growth=2.0 * params.velocity_error_m_s, opponent_radius=d + params.opponent_margin_m,
+            opponent_accel=params.opponent_accel_m_s2, static_margin=params.static_margin_m,
+            static_step=params.static_step_m,
+        )  # fmt: skip
         self.heuristics = heuristic_table(params)
 
     def unit_samples(self, n: int) -> FloatArray:
@@ -100,8 +103,9 @@ class DynamicsSafetySearch(ArraySafety):
 
     def search(
         self, states: ArrayLike, velocities: ArrayLike, opponents: ArrayLike
-    ) -> tuple[FloatArray, NDArray[np.int64]]:
-        """The accelerations (n, 2) DSS picks and each robot's status; inputs as :meth:`filter`."""
+    ) -> tuple[FloatArray, NDArray[np.int64], FloatArray]:
+        """The accelerations (n, 2) DSS picks, each robot's status and the braking trajectories it
+        checked (n, N_SEG, 8); inputs as :meth:`filter`."""
         s = np.ascontiguousarray(states, dtype=np.float64).reshape(-1, 4)
         v = np.ascontiguousarray(velocities, dtype=np.float64).reshape(-1, 2)
         opp = np.ascontiguousarray(opponents, dtype=np.float64).reshape(-1, 4)
@@ -109,20 +113,21 @@ class DynamicsSafetySearch(ArraySafety):
         desired = (v - s[:, 2:4]) / dt
         stop_asked = np.all(v == 0.0, axis=1)
         st = self.static
-        acc, status = K.dss(s, desired, stop_asked, opp, st.inner, st.boxes, st.circles, self.limits, self.cfg,
-                            self.unit_samples(len(s)), self.heuristics)  # fmt: skip
-        return np.asarray(acc), np.asarray(status)
+        acc, status, trs = K.dss(s, desired, stop_asked, opp, st.obs, st.inner, self.limits, self.cfg,
+                                 self.unit_samples(len(s)), self.heuristics)  # fmt: skip
+        return np.asarray(acc), np.asarray(status), np.asarray(trs)
 
     def filter(self, states: ArrayLike, velocities: ArrayLike, opponents: ArrayLike) -> SafetyResult:
         """Safe velocities: the command where it is safe, the stop (zero) where nothing else is,
         else the velocity one period of the chosen acceleration reaches."""
         s = np.asarray(states, dtype=np.float64).reshape(-1, 4)
         v = np.asarray(velocities, dtype=np.float64).reshape(-1, 2)
-        acc, status = self.search(s, v, opponents)
+        acc, status, trs = self.search(s, v, opponents)
         out = s[:, 2:4] + acc * self.motion.period_s
         out[status == K.KEPT] = v[status == K.KEPT]
         out[(status == K.STOPPED) | (status == K.STOP_ASKED)] = 0.0
-        return SafetyResult(out, status)
+        # the segments' start points and the rest point: the braking path (straight after the period)
+        return SafetyResult(out, status, trs[:, :, 2:4].copy())
 
     def clear(self, states: ArrayLike, accelerations: ArrayLike, opponents: ArrayLike) -> NDArray[np.bool_]:
         """Per robot: is the trajectory of ``accelerations`` clear of all others, opponents and
@@ -131,4 +136,4 @@ class DynamicsSafetySearch(ArraySafety):
         a = np.ascontiguousarray(accelerations, dtype=np.float64).reshape(-1, 2)
         opp = np.ascontiguousarray(opponents, dtype=np.float64).reshape(-1, 4)
         st = self.static
-        return np.asarray(K.trajectories_clear(s, a, opp, st.inner, st.boxes, st.circles, self.cfg))
+        return np.asarray(K.trajectories_clear(s, a, opp, st.obs, st.inner, self.limits, self.cfg))

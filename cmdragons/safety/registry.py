@@ -11,12 +11,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from cmdragons.config import setting
+from cmdragons.config import Validated, setting
 from cmdragons.control.motion import ControlParams
 from cmdragons.planning.world import CollisionWorld
 from cmdragons.safety.base import KEPT, ArraySafety, Safety, SafetyResult
 from cmdragons.safety.dss import DSSParams, DynamicsSafetySearch
-from cmdragons.safety.dynamic_window import DynamicWindow, DynamicWindowParams
 
 __all__ = ["SAFETY", "NoSafety", "SafetyParams", "make_safety"]
 
@@ -26,7 +25,7 @@ class NoSafety(ArraySafety):
 
     def filter(self, states: ArrayLike, velocities: ArrayLike, opponents: ArrayLike) -> SafetyResult:
         v = np.array(velocities, dtype=np.float64).reshape(-1, 2)
-        return SafetyResult(v, np.full(len(v), KEPT, dtype=np.int64))
+        return SafetyResult(v, np.full(len(v), KEPT, dtype=np.int64), np.zeros((len(v), 0, 2)))
 
 
 Factory = Callable[["SafetyParams", ControlParams, float, CollisionWorld | None, np.random.Generator], Safety]
@@ -34,18 +33,16 @@ Factory = Callable[["SafetyParams", ControlParams, float, CollisionWorld | None,
 SAFETY: dict[str, Factory] = {
     "none": lambda p, c, r, w, rng: NoSafety(),
     "dss": lambda p, c, r, w, rng: DynamicsSafetySearch(p.dss, c.motion, r, w, rng),
-    "dynamic_window": lambda p, c, r, w, rng: DynamicWindow(p.dynamic_window, c, r, w),
 }
 
 
 @dataclass(frozen=True)
-class SafetyParams:
+class SafetyParams(Validated):
     """configs/safety.yaml: which safety stage guards the commands and how each one is tuned."""
 
     method: str = setting("dss", choices=tuple(SAFETY))  # which of SAFETY guards the robots
     seed: int = setting(1, lo=0, hi=2**63 - 1)  # the search's random samples draw from (seed, team)
     dss: DSSParams = DSSParams()
-    dynamic_window: DynamicWindowParams = DynamicWindowParams()
 
 
 def make_safety(

@@ -58,7 +58,7 @@ def test_a_derived_value_built_in_code_is_still_range_checked() -> None:
         ("cameras.yaml", "auto:\n  grid: [2]\n", "auto.grid", "a list of 2 values"),
         ("field.yaml", "robot:\n  front_distance_m: 0.2\n", "robot", "smaller than radius_m"),
         ("planner.yaml", "planner: astar\n", "planner", "allowed: 'errt', 'prm', 'visgraph'"),
-        ("safety.yaml", "method: magic\n", "method", "allowed: 'none', 'dss', 'dynamic_window'"),
+        ("safety.yaml", "method: magic\n", "method", "allowed: 'none', 'dss'"),
         ("safety.yaml", "dss:\n  own_margin_m: -0.1\n", "dss.own_margin_m", "allowed: 0.0 to 1.0"),
         ("planner.yaml", "errt:\n  p_goal: 0.6\n  p_waypoint: 0.6\n", "errt", "p_goal + p_waypoint"),
         ("planner.yaml", "errt:\n  nearest: octree\n", "errt.nearest", "allowed: 'brute', 'kdtree'"),

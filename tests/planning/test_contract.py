@@ -19,7 +19,9 @@ from cmdragons.planning import (
     PlannerParams,
     PlanProblem,
     PlanStatus,
-    deadline_in,
+    Termination,
+    budget,
+    deadline,
     field_world,
     make_planner,
     path_length,
@@ -29,6 +31,11 @@ from tests.planning.conftest import RADIUS_M, problem, ring, wall_with_gap
 
 NAMES = sorted(PLANNERS)
 GENEROUS_S = 5.0  # deadline for scenes that must be solved: far beyond any planner's need
+
+
+def within(name: str) -> Termination:
+    """The generous deadline and the planner's configured work budget."""
+    return deadline(GENEROUS_S) | budget(getattr(PlannerParams(), name).work_budget)
 
 
 def check_path(prob: PlanProblem, path: np.ndarray, from_index: int = 0) -> None:
@@ -52,7 +59,7 @@ def test_solvable_scenes_are_solved_with_valid_paths(name: str, field: Field) ->
     planner = make_planner(PlannerParams(), name=name)
     for prob in solvable_scenes(field):
         planner.reset()
-        result = planner.solve(prob, deadline_in(GENEROUS_S))
+        result = planner.solve(prob, within(name))
         assert result.status is PlanStatus.SOLVED, (name, prob.start, prob.goal, result.stats)
         check_path(prob, result.path)
         assert tuple(result.path[0]) == prob.start and tuple(result.path[-1]) == prob.goal
@@ -62,7 +69,7 @@ def test_solvable_scenes_are_solved_with_valid_paths(name: str, field: Field) ->
 @pytest.mark.parametrize("name", NAMES)
 def test_straight_line_when_free(name: str, field: Field) -> None:
     prob = problem(field_world(field), (-2.0, 1.0), (2.5, -1.0))
-    result = make_planner(PlannerParams(), name=name).solve(prob, deadline_in(GENEROUS_S))
+    result = make_planner(PlannerParams(), name=name).solve(prob, within(name))
     assert result.status is PlanStatus.SOLVED
     np.testing.assert_allclose(result.path, [prob.start, prob.goal])
 
@@ -73,7 +80,7 @@ def test_unreachable_goal_is_a_clean_no_path(name: str, field: Field) -> None:
     world = field_world(field, ring((1.0, 0.5), 0.45, 16))
     prob = problem(world, (-3.0, -1.0), (1.0, 0.5))
     assert prob.compiled().point_free(1.0, 0.5)
-    result = make_planner(PlannerParams(), name=name).solve(prob, deadline_in(GENEROUS_S))
+    result = make_planner(PlannerParams(), name=name).solve(prob, within(name))
     assert result.status is PlanStatus.NO_PATH
     assert result.cost == float("inf")
     assert tuple(result.path[0]) == prob.start
@@ -84,7 +91,7 @@ def test_unreachable_goal_is_a_clean_no_path(name: str, field: Field) -> None:
 def test_start_inside_an_obstacle_leaves_by_the_shortest_way(name: str, field: Field) -> None:
     world = field_world(field, [[0.0, 0.0], [1.0, 0.4], [1.0, -0.4]])
     prob = problem(world, (0.05, 0.0), (3.0, 0.0))  # 5 cm from a robot's centre: deep inside
-    result = make_planner(PlannerParams(), name=name).solve(prob, deadline_in(GENEROUS_S))
+    result = make_planner(PlannerParams(), name=name).solve(prob, within(name))
     assert result.status is PlanStatus.SOLVED and result.stats["escaped_start"]
     assert tuple(result.path[0]) == prob.start
     np.testing.assert_allclose(result.path[1], [0.18, 0.0], atol=1e-4)  # straight out, radially
@@ -95,12 +102,12 @@ def test_start_inside_an_obstacle_leaves_by_the_shortest_way(name: str, field: F
 @pytest.mark.parametrize("name", NAMES)
 def test_goal_inside_an_obstacle_gives_the_nearest_free_goal(name: str, field: Field) -> None:
     prob = problem(field_world(field, [[1.0, 1.0]]), (-2.0, 0.0), (1.0, 1.1))
-    result = make_planner(PlannerParams(), name=name).solve(prob, deadline_in(GENEROUS_S))
+    result = make_planner(PlannerParams(), name=name).solve(prob, within(name))
     assert result.status is PlanStatus.APPROXIMATE and result.stats["goal_moved"]
     np.testing.assert_allclose(result.path[-1], [1.0, 1.18], atol=1e-4)
     check_path(prob, result.path)
     prob = problem(field_world(field), (0.0, 0.0), (4.0, 0.5))  # in the defense area: out of its front
-    result = make_planner(PlannerParams(), name=name).solve(prob, deadline_in(GENEROUS_S))
+    result = make_planner(PlannerParams(), name=name).solve(prob, within(name))
     assert result.status is PlanStatus.APPROXIMATE
     np.testing.assert_allclose(result.path[-1], [3.5 - RADIUS_M, 0.5], atol=1e-4)
 
@@ -108,23 +115,23 @@ def test_goal_inside_an_obstacle_gives_the_nearest_free_goal(name: str, field: F
 @pytest.mark.parametrize("name", NAMES)
 def test_invalid_start_is_a_status(name: str, field: Field) -> None:
     prob = problem(field_world(field), (float("nan"), 0.0), (1.0, 0.0))
-    result = make_planner(PlannerParams(), name=name).solve(prob, deadline_in(GENEROUS_S))
+    result = make_planner(PlannerParams(), name=name).solve(prob, within(name))
     assert result.status is PlanStatus.INVALID_START
 
 
-@pytest.mark.parametrize("name", [n for n in NAMES if n != "visgraph"])  # visgraph: one uninterruptible kernel call
+@pytest.mark.parametrize("name", [n for n in NAMES if n != "visgraph"])  # visgraph: below, its graph is finite
 def test_deadline_is_kept(name: str, field: Field) -> None:
-    # a hard scene (a wall with a narrow gap) and a huge work budget: only the deadline stops it
+    # a hard scene (a ring closed around the goal) and no work budget: only the deadline stops it
     params = PlannerParams()
-    params = type(params)(errt=type(params.errt)(max_nodes=10**6, bidirectional=False),
+    params = type(params)(errt=type(params.errt)(bidirectional=False),
                           prm=type(params.prm)(n_nodes=50, max_nodes=10**6, grow_nodes=5))  # fmt: skip
     world = field_world(field, ring((1.0, 0.5), 0.45, 16))
     prob = problem(world, (-3.0, -1.0), (1.0, 0.5))
     planner = make_planner(params, name=name)
-    planner.solve(prob, deadline_in(0.001))  # compile and build roadmaps outside the timed call
+    planner.solve(prob, deadline(0.001))  # compile and build roadmaps outside the timed call
     for budget_s in (0.002, 0.02):
         t0 = time.perf_counter()
-        result = planner.solve(prob, t0 + budget_s)
+        result = planner.solve(prob, Termination(deadline_s=t0 + budget_s))
         elapsed = time.perf_counter() - t0
         assert result.status is PlanStatus.TIMEOUT
         # the work budget alone would keep it busy for seconds; 0.1 s of slack absorbs a loaded machine
@@ -132,7 +139,29 @@ def test_deadline_is_kept(name: str, field: Field) -> None:
 
 
 @pytest.mark.parametrize("name", NAMES)
+def test_a_spent_work_budget_ends_in_no_path(name: str, field: Field) -> None:
+    # the ring closed around the goal: no path exists, and a small work budget ends the search, on
+    # any machine, with the deadline far away
+    prob = problem(field_world(field, ring((1.0, 0.5), 0.45, 16)), (-3.0, -1.0), (1.0, 0.5))
+    small = make_planner(PlannerParams(), name=name).solve(prob, deadline(GENEROUS_S) | budget(50))
+    assert small.status is PlanStatus.NO_PATH
+    # the same budget twice: the same work, the same answer
+    again = make_planner(PlannerParams(), name=name).solve(prob, deadline(GENEROUS_S) | budget(50))
+    assert again.status is PlanStatus.NO_PATH
+    np.testing.assert_array_equal(again.path, small.path)
+
+
+def test_the_visibility_graph_keeps_its_deadline(field: Field) -> None:
+    # a deadline already passed stops it before the graph is built: TIMEOUT, no path
+    prob = problem(field_world(field, ring((1.0, 0.5), 0.45, 16)), (-3.0, -1.0), (3.0, 0.5))
+    planner = make_planner(PlannerParams(), name="visgraph")
+    assert planner.solve(prob, within("visgraph")).status is PlanStatus.SOLVED
+    late = planner.solve(prob, Termination(deadline_s=time.perf_counter()))
+    assert late.status is PlanStatus.TIMEOUT and not np.isfinite(late.cost)
+
+
+@pytest.mark.parametrize("name", NAMES)
 def test_same_seed_same_path(name: str, field: Field) -> None:
     prob = solvable_scenes(field)[3]
-    paths = [make_planner(PlannerParams(seed=9), name=name).solve(prob, deadline_in(GENEROUS_S)).path for _ in range(2)]
+    paths = [make_planner(PlannerParams(seed=9), name=name).solve(prob, within(name)).path for _ in range(2)]
     np.testing.assert_array_equal(paths[0], paths[1])

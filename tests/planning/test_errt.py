@@ -8,13 +8,27 @@ import numpy as np
 import pytest
 
 from cmdragons.geometry import Field
-from cmdragons.planning import ERRTParams, ERRTPlanner, PlanStatus, deadline_in, field_world, path_length
+from cmdragons.planning import (
+    ERRTParams,
+    ERRTPlanner,
+    PlanStatus,
+    Termination,
+    budget,
+    deadline,
+    field_world,
+    path_length,
+)
 from cmdragons.planning.errt import SmoothingParams, WaypointCache, smooth
 from tests.planning.conftest import problem, ring, wall_with_gap
 
 
 def planner(**kw: object) -> ERRTPlanner:
     return ERRTPlanner(ERRTParams(**kw), np.random.default_rng(5))  # type: ignore[arg-type]
+
+
+def within(seconds: float, nodes: int = ERRTParams().work_budget) -> Termination:
+    """A deadline and ERRT's budget of tree nodes."""
+    return deadline(seconds) | budget(nodes)
 
 
 def test_waypoint_cache_replacement_strategies() -> None:
@@ -34,7 +48,7 @@ def test_a_plan_fills_the_cache_and_is_reused_while_valid(field: Field) -> None:
     world = wall_with_gap(field)
     prob = problem(world, (-3.0, -1.0), (3.0, -1.0))
     errt = planner(waypoint_cache_size=200)
-    first = errt.solve(prob, deadline_in(1.0))
+    first = errt.solve(prob, within(1.0))
     assert first.status is PlanStatus.SOLVED and not first.stats["reused"]
     assert errt.cache.count > 10
     # through the gap at y = 1.5: the cached points lie along that route
@@ -42,13 +56,13 @@ def test_a_plan_fills_the_cache_and_is_reused_while_valid(field: Field) -> None:
     # the robot moved along its path: the remainder is reused, joined from the new start
     here = tuple(first.path[0] + 0.4 * (first.path[1] - first.path[0]))
     moved = problem(world, here, (3.0, -1.0))  # type: ignore[arg-type]
-    again = errt.solve(moved, deadline_in(1.0))
+    again = errt.solve(moved, within(1.0))
     assert again.stats["reused"] and again.status is PlanStatus.SOLVED
     assert moved.compiled().path_free(again.path)
     np.testing.assert_array_equal(again.path[-1], (3.0, -1.0))
     # a robot parks in the gap: the old plan is no longer valid and a new one goes around the wall
     blocked = field_world(field, np.vstack([world.circles[:, :2], [[0.0, 1.5]]]))
-    third = errt.solve(problem(blocked, here, (3.0, -1.0)), deadline_in(1.0))  # type: ignore[arg-type]
+    third = errt.solve(problem(blocked, here, (3.0, -1.0)), within(1.0))  # type: ignore[arg-type]
     assert not third.stats["reused"]
     assert third.status is not PlanStatus.SOLVED or problem(blocked, here, (3.0, -1.0)).compiled().path_free(third.path)  # type: ignore[arg-type]
 
@@ -56,8 +70,8 @@ def test_a_plan_fills_the_cache_and_is_reused_while_valid(field: Field) -> None:
 def test_a_new_goal_is_planned_afresh(field: Field) -> None:
     world = wall_with_gap(field)
     errt = planner()
-    errt.solve(problem(world, (-3.0, -1.0), (3.0, -1.0)), deadline_in(1.0))
-    other = errt.solve(problem(world, (-3.0, -1.0), (3.0, 2.0)), deadline_in(1.0))
+    errt.solve(problem(world, (-3.0, -1.0), (3.0, -1.0)), within(1.0))
+    other = errt.solve(problem(world, (-3.0, -1.0), (3.0, 2.0)), within(1.0))
     assert not other.stats["reused"]
     np.testing.assert_array_equal(other.path[-1], (3.0, 2.0))
 
@@ -76,14 +90,14 @@ def test_a_new_goal_is_planned_afresh(field: Field) -> None:
 )
 def test_variants_find_valid_paths(variant: dict[str, object], field: Field) -> None:
     prob = problem(wall_with_gap(field), (-3.0, -1.0), (3.0, -1.0))
-    result = planner(**variant).solve(prob, deadline_in(2.0))
+    result = planner(**variant).solve(prob, within(2.0))
     assert result.status is PlanStatus.SOLVED
     assert prob.compiled().path_free(result.path)
 
 
 def test_smoothing_keeps_paths_free_and_never_longer(field: Field) -> None:
     prob = problem(wall_with_gap(field), (-3.0, -1.0), (3.0, -1.0))
-    raw = planner(smoothing=SmoothingParams(passes=0)).solve(prob, deadline_in(1.0))
+    raw = planner(smoothing=SmoothingParams(passes=0)).solve(prob, within(1.0))
     cw = prob.compiled()
     for passes in (0, 1, 3, 6):
         out = smooth(cw, raw.path, SmoothingParams(passes=passes))
@@ -106,23 +120,23 @@ def test_cached_waypoints_are_aimed_at_with_the_configured_probability(field: Fi
     # with probability p_waypoint (Bruce 2006 §4.3)
     world = wall_with_gap(field)
     prob = problem(world, (-3.0, -1.0), (3.0, -1.0))
-    errt = planner(p_waypoint=0.4, reuse_last_plan=False, extra_iterations=2000, max_bridges=64, max_nodes=20000)
-    first = errt.solve(prob, deadline_in(1.0))
+    errt = planner(p_waypoint=0.4, reuse_last_plan=False, extra_iterations=2000, max_bridges=64)
+    first = errt.solve(prob, within(1.0, 20000))
     assert first.stats["cached"] == 0 and first.stats["waypoint_targets"] == 0
     cached = errt.cache.view().copy()
     assert len(cached) > 10
-    second = errt.solve(prob, deadline_in(1.0))
+    second = errt.solve(prob, within(1.0, 20000))
     assert second.stats["cached"] == len(cached)
     iterations, hits = 0, 0
     for _ in range(8):
-        res = errt.solve(prob, deadline_in(1.0))
+        res = errt.solve(prob, within(1.0, 20000))
         iterations, hits = iterations + res.stats["iterations"], hits + res.stats["waypoint_targets"]
     assert iterations > 1000
     assert abs(hits / iterations - 0.4) < 4 * np.sqrt(0.4 * 0.6 / iterations)
     # a failed search adds nothing: the cache holds the last successful plans only
     before = errt.cache.view().copy()
     boxed = field_world(field, np.vstack([world.circles[:, :2], ring((3.0, -1.0), 0.5, 12)]))
-    failed = errt.solve(problem(boxed, (-3.0, -1.0), (3.0, -1.0)), deadline_in(1.0))
+    failed = errt.solve(problem(boxed, (-3.0, -1.0), (3.0, -1.0)), within(1.0, 20000))
     # exhausting the nodes gives NO_PATH; on a loaded machine the deadline may come first: a failure too
     assert failed.status in (PlanStatus.NO_PATH, PlanStatus.TIMEOUT)
     np.testing.assert_array_equal(errt.cache.view(), before)

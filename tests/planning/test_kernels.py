@@ -115,10 +115,9 @@ def test_errt_tree_edges_are_collision_free() -> None:
     state = np.array([2, 0, 0, 0, 0], dtype=np.int64)
     bridges = np.zeros((4, 3))
     kd = (np.full((cap, 2), -1, dtype=np.int32), np.zeros(cap, dtype=np.int32), np.array([0, 1], dtype=np.int32))
-    fparams = np.array([0.1, 0.0, 0.3, 20.0])  # p_goal, p_waypoint, step_m, connect_radius_m
-    iparams = np.array([8, 1, 4, 20, K.NN_BRUTE], dtype=np.int64)
     trees = (nodes, parent, tree, np.zeros(cap), *kd, np.zeros((cap, 2)), state, bridges)
-    code = K.errt_grow(cw.cw, *trees, rng.random((300, 3)), np.zeros((0, 2)), fparams, iparams)
+    code = K.errt_grow(cw.cw, *trees, rng.random((300, 3)), np.zeros((0, 2)), p_goal=0.1, p_way=0.0, step=0.3,
+                       connect_r=20.0, max_ext=8, bidir=True, max_br=4, extra=20, nn=K.NN_BRUTE, node_limit=cap)
     assert code in (K.GROW_DONE, K.GROW_FULL, K.GROW_RUNNING)
     n = int(state[0])
     assert n > 2

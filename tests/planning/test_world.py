@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from cmdragons.geometry import Field
-from cmdragons.planning import CollisionWorld, field_world
+from cmdragons.planning import CollisionParams, CollisionWorld, field_world
+from cmdragons.planning import _reference as PR
 
 R = 0.09
 
@@ -99,3 +100,54 @@ def test_bad_worlds_are_refused(kwargs: dict[str, object], fragment: str) -> Non
     args = {"bounds": (-1.0, -1.0, 1.0, 1.0), **kwargs}
     with pytest.raises(ValueError, match=fragment):
         CollisionWorld(**args)  # type: ignore[arg-type]
+
+
+def _moving_world(field: Field) -> CollisionWorld:
+    rng = np.random.default_rng(11)
+    xy = rng.uniform((-4.0, -2.5), (4.0, 2.5), (12, 2))
+    return field_world(field, xy, rng.normal(0.0, 1.0, (12, 2)), extra_circles=[[0.5, 0.5, 0.07]])
+
+
+@pytest.mark.parametrize("window_s", [0.0, 0.3])
+def test_clearance_grid_matches_brute_force_distances(field: Field, window_s: float) -> None:
+    # every cell centre against a plain-numpy distance to every grown obstacle and the walls
+    cw = _moving_world(field).compile(R, 0.0, window_s)
+    grid = cw.clearance_grid(0.1)
+    xs, ys = grid.centres()
+    x0, y0, x1, y1 = field_world(field).bounds
+    assert grid.values.shape == (len(ys), len(xs)) == (int(np.ceil((y1 - y0) / 0.1 - 1e-9)),
+                                                       int(np.ceil((x1 - x0) / 0.1 - 1e-9)))  # fmt: skip
+    assert xs[0] == pytest.approx(x0 + 0.05) and ys[0] == pytest.approx(y0 + 0.05)
+    pts = np.array([(x, y) for y in ys for x in xs])
+    inner = cw.inner
+    walls = np.minimum.reduce([pts[:, 0] - inner[0], inner[2] - pts[:, 0], pts[:, 1] - inner[1], inner[3] - pts[:, 1]])
+    brute = np.minimum(walls, np.min(PR.obstacle_dist(cw.obs, pts) - cw.obs[:, 5:6], axis=0))
+    np.testing.assert_allclose(grid.values.ravel(), brute, atol=1e-12)
+    # the point query is the same function
+    for k in range(0, len(pts), 97):
+        assert cw.clearance(*pts[k]) == pytest.approx(brute[k], abs=1e-12)
+    # the default resolution comes from the params (configs/planner.yaml collision.grid_resolution_m)
+    assert cw.clearance_grid().resolution_m == CollisionParams().grid_resolution_m
+
+
+def test_clearance_gradient_points_away_from_the_nearest_obstacle(field: Field) -> None:
+    cw = _moving_world(field).compile(R, 0.0, 0.2)
+    rng = np.random.default_rng(12)
+    h = 1e-6
+    checked = 0
+    for x, y in rng.uniform((-4.7, -3.2), (4.7, 3.2), (400, 2)):
+        c, gx, gy = cw.clearance_gradient(x, y)
+        assert c == pytest.approx(cw.clearance(x, y), abs=1e-12)
+        fx = (cw.clearance(x + h, y) - cw.clearance(x - h, y)) / (2 * h)
+        fy = (cw.clearance(x, y + h) - cw.clearance(x, y - h)) / (2 * h)
+        if abs(np.hypot(fx, fy) - 1.0) > 1e-4:
+            continue  # a ridge between two nearest obstacles (or inside a box's core): no gradient
+        assert np.hypot(gx, gy) == pytest.approx(1.0)
+        np.testing.assert_allclose((gx, gy), (fx, fy), atol=1e-4)
+        checked += 1
+    assert checked > 350
+    # inside a box's core: out through the nearest face; on a still circle's centre: undefined
+    box = CollisionWorld((-5.0, -5.0, 5.0, 5.0), boxes=np.array([[0.0, 0.0, 1.0, 2.0]])).compile(R)
+    assert box.clearance_gradient(0.2, 1.0)[1:] == (-1.0, 0.0)
+    disc = CollisionWorld((-5.0, -5.0, 5.0, 5.0), np.array([[1.0, 1.0, 0.2]])).compile(R)
+    assert disc.clearance_gradient(1.0, 1.0) == (pytest.approx(-0.29), 0.0, 0.0)

@@ -62,7 +62,7 @@ def test_dss_never_returns_intersecting_braking_trajectories(seed: int, n: int, 
             keep.append(i)
     assume(len(keep) >= 2)
     states, commands = states[keep], commands[keep]
-    acc, status = make_dss(seed).search(states, commands, np.zeros((0, 4)))
+    acc, status, _ = make_dss(seed).search(states, commands, np.zeros((0, 4)))
     trs = trajectories(states, acc)
     for i in range(len(keep)):
         for j in range(i):
@@ -90,8 +90,14 @@ def test_safe_commands_are_kept_unsafe_ones_changed_or_stopped() -> None:
     states = np.array([[-0.7, 0.0, 2.5, 0.0], [0.7, 0.0, -2.5, 0.0]])
     r = make_dss().filter(states, np.array([[2.55, 0.0], [-2.55, 0.0]]), np.zeros((0, 4)))
     assert r.status[0] in (CHANGED, STOPPED)
-    acc, status = make_dss().search(states, np.array([[2.55, 0.0], [-2.55, 0.0]]), np.zeros((0, 4)))
+    acc, status, trs = make_dss().search(states, np.array([[2.55, 0.0], [-2.55, 0.0]]), np.zeros((0, 4)))
     assert make_dss().clear(states, acc, np.zeros((0, 4))).all()
+    # the braking trajectories it returns are those of the accelerations it chose; the filter hands
+    # out their points (from the start to the rest point), what the match video draws
+    for s, a, tr in zip(states, acc, trs, strict=True):
+        np.testing.assert_allclose(tr, K.trajectory(*s, *a, DT, MOTION.max_accel_m_s2, MOTION.max_brake_m_s2))
+    np.testing.assert_allclose(r.braking[:, 0], states[:, :2])
+    assert np.all(np.abs(r.braking[:, -1, 0]) < np.abs(states[:, 0]))  # both rest short of the centre line
 
 
 def test_chosen_commands_keep_the_robot_limits() -> None:
@@ -101,7 +107,7 @@ def test_chosen_commands_keep_the_robot_limits() -> None:
         speed = np.hypot(states[:, 2], states[:, 3])
         states[:, 2:4] *= np.minimum(1.0, MOTION.max_speed_m_s / speed)[:, None]
         commands = rng.normal(0.0, 3.0, (8, 2))
-        acc, status = make_dss(seed).search(states, commands, np.zeros((0, 4)))
+        acc, status, _ = make_dss(seed).search(states, commands, np.zeros((0, 4)))
         # every acceleration lies in A(v) and keeps the speed limit; the stop is velocity zero
         go = status != STOPPED
         np.testing.assert_allclose(CR.clip_accel(states[go, 2:4], acc[go], 3.0, 6.0), acc[go], atol=1e-6)
@@ -195,7 +201,7 @@ def test_closed_loop_with_the_exact_model_never_brings_robots_too_close() -> Non
         states6 = np.column_stack([pos, np.zeros(n), vel, np.zeros(n)])
         targets = np.column_stack([goals, np.zeros((n, 3))])
         cmd = motion_commands(states6, targets, ControlParams())[:, :2]
-        acc, status = dss.search(np.column_stack([pos, vel]), cmd, np.zeros((0, 4)))
+        acc, status, _ = dss.search(np.column_stack([pos, vel]), cmd, np.zeros((0, 4)))
         statuses += status.tolist()
         # the motors' motion over one period (reach the command, hold it)
         trs = trajectories(np.column_stack([pos, vel]), acc)

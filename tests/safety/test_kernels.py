@@ -5,6 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from cmdragons.control import _kernels as CK
+from cmdragons.planning import _kernels as PK
+from cmdragons.planning.world import CollisionWorld
 from cmdragons.safety import _kernels as K
 from cmdragons.safety import _reference as R
 
@@ -76,21 +79,30 @@ def test_opponent_check_agrees_with_dense_sampling() -> None:
 
 
 def test_static_check_is_conservative_by_at_most_one_step() -> None:
+    # the check asks the collision world (boxes and circles grown by the robot radius)
     rng = np.random.default_rng(3)
-    inner = np.array([-1.4, -1.0, 1.4, 1.0])
-    boxes = np.array([[0.2, 0.2, 0.6, 0.5, 0.09], [-0.9, -0.8, -0.5, -0.3, 0.09]])
-    circles = np.array([[0.0, -0.5, 0.2], [-0.4, 0.6, 0.15]])
+    world = CollisionWorld((-1.49, -1.09, 1.49, 1.09), circles=np.array([[0.0, -0.5, 0.11], [-0.4, 0.6, 0.06]]),
+                           boxes=np.array([[0.2, 0.2, 0.6, 0.5], [-0.9, -0.8, -0.5, -0.3]]))  # fmt: skip
+    cw = world.compile(0.09)
     margin, step = 0.01, 0.02
     for _ in range(400):
         tr = random_trajectory(rng)
-        c0 = K.static_clearance(tr[0, 2], tr[0, 3], inner, boxes, circles)
-        low = R.static_min_clearance(tr, inner, boxes, circles)
+        c0 = PK.clearance(cw.obs, cw.inner, tr[0, 2], tr[0, 3])
+        low = R.static_min_clearance(tr, cw.obs, cw.inner)
         need = min(margin, c0)
-        hit = K.static_hits(tr, inner, boxes, circles, margin, step)
+        hit = K.static_hits(tr, cw.obs, cw.inner, margin, step)
         if low < need - 1e-3:
             assert hit  # a real intrusion is always caught
         if low > need + step + 1e-3:
             assert not hit  # and the check is never stricter than one step
-        assert K.static_clearance(tr[0, 2], tr[0, 3], inner, boxes, circles) == pytest.approx(
-            R.static_min_clearance(np.array([[0, np.inf, *tr[0, 2:4], 0, 0, 0, 0]]), inner, boxes, circles, n=1)
-        )
+        assert c0 == pytest.approx(R.static_min_clearance(np.array([[0, np.inf, *tr[0, 2:4], 0, 0, 0, 0]]), cw.obs,
+                                                          cw.inner, n=1))  # fmt: skip
+
+
+def test_trajectory_state_follows_the_segments() -> None:
+    rng = np.random.default_rng(4)
+    for _ in range(100):
+        tr = random_trajectory(rng)
+        t = np.concatenate([rng.uniform(0.0, tr[3, 0] * 1.2, 20), [0.0, tr[3, 0] + 1.0]])
+        got = np.array([CK.trajectory_state(tr, float(ti))[:2] for ti in t])
+        np.testing.assert_allclose(got, R.positions(tr, t), atol=1e-12)

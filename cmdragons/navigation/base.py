@@ -1,0 +1,65 @@
+"""The local navigator interface of DESIGN.md (after Navigation2's controller plugins).
+
+Per robot and frame the brain runs: a global planner (``PLANNERS``) turns the objective into a path;
+a local navigator turns path and world into this frame's velocity command; team safety (DSS) makes
+all own robots' commands safe together. A navigator sees one robot: field frame, metres, seconds,
+radians; it never commands beyond the robot's limits (configs/control.yaml ``motion``).
+
+* :meth:`Navigator.set_plan` hands over the path (k, 2) from the robot to its goal, with how to
+  arrive (:class:`Arrival`: heading, speed through the goal, speed cap);
+* :meth:`Navigator.command` computes ``(vx, vy, omega)`` for the robot's state in the world it must
+  avoid (the frame's :class:`~cmdragons.planning.world.CollisionWorld` without this robot), until
+  the termination condition: a navigator that may not work at all (a spent budget, a passed
+  deadline) commands the stop, which the safety search always accepts;
+* :meth:`Navigator.sent` tells it the command that safety let through to the robot, the start of
+  its next frame's profile;
+* :meth:`Navigator.reset` forgets the plan and the command history.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol
+
+from numpy.typing import ArrayLike
+
+from cmdragons.messages import RobotState
+from cmdragons.planning.termination import Termination
+from cmdragons.planning.world import CollisionWorld
+
+__all__ = ["STOP", "Arrival", "Navigator", "VelocityCommand"]
+
+VelocityCommand = tuple[float, float, float]  # vx, vy (field frame, m/s), omega (rad/s)
+STOP: VelocityCommand = (0.0, 0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class Arrival:
+    """How a robot arrives at the end of its path: facing ``heading_rad``; driving through it at
+    ``through_speed_m_s`` along the line from the robot to it (0: stop on it); never faster than
+    ``max_speed_m_s`` (None: the robot's limit)."""
+
+    heading_rad: float = 0.0
+    through_speed_m_s: float = 0.0
+    max_speed_m_s: float | None = None
+
+    def __post_init__(self) -> None:
+        if not self.through_speed_m_s >= 0.0 or (self.max_speed_m_s is not None and not self.max_speed_m_s >= 0.0):
+            raise ValueError(f"speeds must be >= 0: {self}")
+
+
+class Navigator(Protocol):
+    """A local navigator for one robot; the state it keeps across frames lives in it."""
+
+    def set_plan(self, path: ArrayLike, arrival: Arrival) -> None:
+        """Follow ``path`` (k, 2), field frame, from the robot's position to its goal."""
+
+    def command(self, robot: RobotState, world: CollisionWorld, termination: Termination) -> VelocityCommand:
+        """This frame's command for ``robot`` among ``world``'s obstacles, by ``termination``."""
+        ...
+
+    def sent(self, vx: float, vy: float) -> None:
+        """The velocity (field frame, m/s) that was finally sent to the robot this frame."""
+
+    def reset(self) -> None:
+        """Forget the plan and everything learnt from earlier frames."""

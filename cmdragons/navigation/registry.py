@@ -1,0 +1,39 @@
+"""Navigator registry: ``team.navigator`` in configs/team.yaml picks one of :data:`NAVIGATORS`; each
+navigator has its config section there (``team.trajectory``, ``team.dynamic_window``).
+
+A new navigator is one module, one line here and one config section (a field of
+:class:`cmdragons.team.TeamParams` named like its registry key).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from cmdragons.control.motion import ControlParams
+from cmdragons.navigation.base import Navigator
+from cmdragons.navigation.dynamic_window import DynamicWindowNavigator
+from cmdragons.navigation.trajectory import TrajectoryNavigator
+from cmdragons.planning.world import CollisionParams
+
+__all__ = ["NAVIGATORS", "make_navigator"]
+
+# name -> factory(the config sections by navigator name, the robot model, the robot radius m, the
+# collision queries); a navigator reads its own section and may build on another's
+Factory = Callable[[Any, ControlParams, float, CollisionParams], Navigator]
+
+NAVIGATORS: dict[str, Factory] = {
+    "trajectory": lambda s, control, r, collision: TrajectoryNavigator(s.trajectory, control, r),
+    "dynamic_window": lambda s, control, r, collision: DynamicWindowNavigator(s.dynamic_window, control, r, collision,
+                                                                              s.trajectory),  # fmt: skip
+}
+
+
+def make_navigator(
+    name: str, sections: Any, control: ControlParams, robot_radius_m: float, collision: CollisionParams | None = None
+) -> Navigator:
+    """A fresh navigator ``name`` for one robot; ``sections`` holds each navigator's config section as
+    the attribute of its name (configs/team.yaml: :class:`cmdragons.team.TeamParams`)."""
+    if name not in NAVIGATORS:
+        raise KeyError(f"unknown navigator {name!r}; known: {', '.join(sorted(NAVIGATORS))}")
+    return NAVIGATORS[name](sections, control, robot_radius_m, collision or CollisionParams())

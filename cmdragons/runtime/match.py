@@ -128,6 +128,7 @@ class Match:
         self.last_frame: Frame | None = None
         self.last_world: WorldState | None = None
         self.last_commands: list[RobotCommand] = []
+        self.last_events: list[Any] = []  # the simulator's events of the last step (goals, kicks, ...)
 
     def step(self) -> Frame:
         """One camera frame of the match; returns what the cameras saw."""
@@ -153,6 +154,7 @@ class Match:
                 stats.time(name, self.brain.times[name][-1])
         self._count(frame, events)
         self.last_frame, self.last_world, self.last_commands = frame, world, ours
+        self.last_events = events
         return frame
 
     def _their_commands(self, frame: Frame, detections: list[DetectionFrame]) -> list[RobotCommand]:

@@ -72,7 +72,7 @@ class CompileWatch:
         self._t0 = 0.0
         watch = self
 
-        class _Listener(event.Listener):  # type: ignore[misc]
+        class _Listener(event.Listener):
             def on_start(self, ev: Any) -> None:
                 if watch._depth == 0:
                     watch._t0 = time.perf_counter()
@@ -90,11 +90,11 @@ class CompileWatch:
         self._listener = _Listener()
 
     def start(self) -> None:
-        self._event.register("numba:compile", self._listener)
+        self._event.register("numba:compile", self._listener)  # type: ignore[no-untyped-call]
 
     def stop(self) -> None:
         if self._listener in self._event._registered.get("numba:compile", ()):
-            self._event.unregister("numba:compile", self._listener)
+            self._event.unregister("numba:compile", self._listener)  # type: ignore[no-untyped-call]
 
     def __enter__(self) -> CompileWatch:
         self.start()
@@ -181,7 +181,7 @@ def _warm_vision(config: str | None, overrides: Sequence[str]) -> None:
 
 def _child(spec: dict[str, Any]) -> None:
     """A child of :func:`warm_up`: compile one part, printing each kernel's name as it starts."""
-    from cmdragons.runtime.match import Match
+    from cmdragons.runtime.match import Match, Opponent
     from cmdragons.runtime.settings import load_settings
 
     settings = load_settings(spec["config"], spec["set"])
@@ -196,7 +196,7 @@ def _child(spec: dict[str, Any]) -> None:
             Simulator(settings.field, settings.camera_models(), settings.sim, seed=0).capture()
             return
         # a second of a throwaway match on the true state
-        opponent = "simple" if spec["opponent"] == "self" else spec["opponent"]
+        opponent: Opponent = "none" if spec["opponent"] == "none" else "simple"
         match = Match(settings, opponent, "truth", seed=0, render=False)
         for _ in range(max(1, round(_WARM_SECONDS * settings.sim.physics.frame_rate_hz))):
             match.step()

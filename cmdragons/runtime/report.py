@@ -82,6 +82,7 @@ def load_run(path: str | Path, ours: str = "blue") -> RunData:
                 if not run.score_t or run.score_t[-1][1:] != (s["blue"], s["yellow"]):
                     run.score_t.append((float(d["t"]), s["blue"], s["yellow"]))
             elif topic == "/events":
+                d.setdefault("t", message.log_time / 1e9)
                 if d.get("type") == "kick":
                     if balls:
                         d = {**d, "x": balls[-1][0], "y": balls[-1][1]}

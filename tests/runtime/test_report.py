@@ -1,0 +1,62 @@
+"""The match report and the summary's warnings, from a run's own MCAP log."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import cv2
+import pytest
+
+from cmdragons.runtime.log import RunLog
+from cmdragons.runtime.report import load_run, run_warnings, write_report
+
+
+def write_log(path: Path, frames: int, ball_visible_every: int, robot_1_visible: bool) -> None:
+    with RunLog(path) as log:
+        for i in range(frames):
+            t = i / 60
+            robots = [{"team": "blue", "id": k, "x": -1.0 + k, "y": 0.0, "theta": 0.0} for k in (0, 1)]
+            robots.append({"team": "yellow", "id": 0, "x": 2.0, "y": 0.5, "theta": 0.0})
+            log.write("/truth", t, {"t": t, "ball": {"x": -0.9 + 0.01 * i, "y": 0.0}, "robots": robots})
+            log.write("/game", t, {"t": t, "score": {"blue": int(i > frames // 2), "yellow": 0}})
+            seen = [{"team": "blue", "id": 0, "visible": True}] + ([{"team": "blue", "id": 1, "visible": True}]
+                                                                   if robot_1_visible else [])  # fmt: skip
+            ball = {"x": 0.0, "y": 0.0, "visible": i % ball_visible_every == 0}
+            log.write("/world", t, {"t": t, "ball": ball, "robots": seen})
+        log.write("/events", 0.5, {"type": "kick", "team": "blue", "id": 0, "action": "shot"})
+
+
+def test_ball_seldom_and_a_robot_never_seen_are_warned(tmp_path: Path) -> None:
+    write_log(tmp_path / "run.mcap", 120, ball_visible_every=4, robot_1_visible=False)
+    run = load_run(tmp_path / "run.mcap")
+    assert run.frames == 120
+    assert run.ball_seen == pytest.approx(0.25)
+    assert run.robot_seen == {0: 1.0, 1: 0.0}
+    assert run.possession[0] == "blue" and run.kicks[0]["action"] == "shot"
+    summary = {"perception": "vision", "command_faults": {"clamped": 1}, "realtime_factor": 0.8}
+    warnings = run_warnings(run, summary)
+    assert any("ball seldom (25 % of the frames)" in w for w in warnings)
+    assert any("robot 1 never" in w for w in warnings)
+    assert not any("robot 0" in w for w in warnings)
+    assert any(w.startswith("1 command was clamped") for w in warnings)
+    assert any("slower than real time (0.8x" in w for w in warnings)
+
+
+def test_a_clean_run_has_no_warning(tmp_path: Path) -> None:
+    write_log(tmp_path / "run.mcap", 60, ball_visible_every=1, robot_1_visible=True)
+    run = load_run(tmp_path / "run.mcap")
+    summary = {"perception": "vision", "command_faults": {"clamped": 0}, "realtime_factor": 1.5}
+    assert run_warnings(run, summary) == []
+
+
+def test_report_png_is_one_page(tmp_path: Path) -> None:
+    write_log(tmp_path / "run.mcap", 120, ball_visible_every=1, robot_1_visible=True)
+    summary = json.loads(json.dumps({
+        "score": {"blue": 1, "yellow": 0}, "seconds": 2.0, "opponent": "simple", "perception": "vision", "seed": 1,
+        "passes": {"tried": 1, "completed": 0}, "realtime_factor": 1.2, "compile_seconds": 0.0,
+        "cycle_ms": {"vision": {"median": 1.5, "p95": 2.0}, "brain": {"median": 2.0, "p95": 4.0}},
+    }))  # fmt: skip
+    path = write_report(load_run(tmp_path / "run.mcap"), summary, tmp_path / "report.png")
+    img = cv2.imread(str(path))
+    assert img is not None and img.shape == (1000, 1400, 3)

@@ -6,9 +6,11 @@ import pytest
 
 from cmdragons.bench import TABLE_WIDTH, header, print_table
 
+HEADERS = [("median_ms", "median\nms"), ("max_speed_m_s", "max speed\nm/s"), ("success_rate", "success rate"),
+           ("ns_per_query", "ns per query")]  # fmt: skip
 
-@pytest.mark.parametrize(("metric", "shown"), [("median_ms", "median\nms"), ("max_speed_m_s", "max speed\nm/s"),
-                                               ("success_rate", "success rate"), ("ns_per_query", "ns per query")])  # fmt: skip
+
+@pytest.mark.parametrize(("metric", "shown"), HEADERS)
 def test_header_puts_the_unit_under_the_name(metric: str, shown: str) -> None:
     assert header(metric) == shown
 

@@ -478,7 +478,7 @@ def _cmd_vision(args: argparse.Namespace) -> int:
     except SourceError as exc:
         print(f"cmdragons vision: {exc}", file=sys.stderr)
         return 2
-    folder = run_folder("vision", args.out)
+    folder = run_folder("vision", args.out, overwrite=args.overwrite)
     fps = args.fps or settings.sim.physics.frame_rate_hz
     total = sum(len(s.paths) for s in sources if s.kind == "images") or None
     with _progress(not args.no_progress) as progress:

@@ -43,8 +43,8 @@ TABLE_WIDTH = 100  # columns: a bench table fits a standard terminal
 _NAME_WIDTH = 26  # the row name column; longer names wrap onto a second line (the JSON keeps them whole)
 _CELL_WIDTH = 9  # a number column, borders included
 # metric name endings that are units, shown under the metric's name in the header
-_UNITS = {"_mm_s": "mm·s", "_m_s2": "m/s²", "_m_s": "m/s", "_ms": "ms", "_us": "µs", "_ns": "ns", "_mm": "mm", "_m": "m", "_s": "s",
-          "_rad": "rad", "_deg": "deg", "_px": "px", "_hz": "Hz"}  # fmt: skip
+_UNITS = {"_mm_s": "mm·s", "_m_s2": "m/s²", "_m_s": "m/s", "_ms": "ms", "_us": "µs", "_ns": "ns", "_mm": "mm",
+          "_m": "m", "_s": "s", "_rad": "rad", "_deg": "deg", "_px": "px", "_hz": "Hz"}  # fmt: skip
 
 
 def print_table(suite: str, rows: list[Row], width: int = TABLE_WIDTH) -> None:

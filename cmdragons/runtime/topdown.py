@@ -18,10 +18,12 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
+from cmdragons.control.motion import MotionParams
 from cmdragons.geometry import Field
 from cmdragons.messages import GameState, GroundTruth, RobotCommand, WorldState
+from cmdragons.safety.dss import braking_path
 
-__all__ = ["TopDownView", "ViewFrame", "view_frame"]
+__all__ = ["TopDownView", "ViewFrame", "braking_paths", "view_frame"]
 
 Points = NDArray[np.float64]  # (k, 2) field frame, m
 
@@ -58,14 +60,27 @@ class ViewFrame:
 def view_frame(frame: Any, world: WorldState | None, brain: Any, commands: list[RobotCommand]) -> ViewFrame:
     """A :class:`ViewFrame` from what ``cmdragons play`` has at hand after a match step: the
     simulator's frame (its truth and game state), our tracked world, our brain's plans and pass
-    evaluation, our commands. Braking trajectories are not exposed by the brain yet: empty."""
+    evaluation, our commands, and each own robot's braking trajectory under its command."""
     plans = {rid: np.asarray(p.path, dtype=np.float64).reshape(-1, 2) for rid, p in brain.plans.items()
              if len(p.path) >= 2}  # fmt: skip
     ev = brain.strategy.mem.evaluation
     heat = None
     if ev is not None and len(ev.points):
         heat = (np.asarray(ev.points, dtype=np.float64).reshape(-1, 2), np.asarray(ev.values, dtype=np.float64))
-    return ViewFrame(frame.t_capture, world, frame.truth, frame.game, brain.team, plans, {}, heat, tuple(commands))
+    braking = braking_paths(world, commands, brain.team, brain.settings.control.motion)
+    return ViewFrame(frame.t_capture, world, frame.truth, frame.game, brain.team, plans, braking, heat,
+                     tuple(commands))  # fmt: skip
+
+
+def braking_paths(world: WorldState | None, commands: list[RobotCommand], team: str,
+                  motion: MotionParams) -> dict[int, Points]:  # fmt: skip
+    """Each of ``team``'s robots' braking trajectory under its command, from the tracked state
+    (:func:`cmdragons.safety.dss.braking_path`): own robot id -> points (k, 2), field frame, m."""
+    if world is None:
+        return {}
+    robots = {r.id: r for r in world.robots if r.team == team}
+    return {c.id: braking_path((r.x, r.y), (r.vx, r.vy), (c.vx, c.vy), motion)
+            for c in commands if (r := robots.get(c.id)) is not None}  # fmt: skip
 
 
 class TopDownView:

@@ -29,7 +29,7 @@ from cmdragons.planning.world import CollisionWorld
 from cmdragons.safety import _kernels as K
 from cmdragons.safety.base import ArraySafety, SafetyResult, StaticObstacles
 
-__all__ = ["DSSParams", "DynamicsSafetySearch", "heuristic_table"]
+__all__ = ["DSSParams", "DynamicsSafetySearch", "braking_path", "heuristic_table"]
 
 FloatArray = NDArray[np.float64]
 
@@ -132,3 +132,22 @@ class DynamicsSafetySearch(ArraySafety):
         opp = np.ascontiguousarray(opponents, dtype=np.float64).reshape(-1, 4)
         st = self.static
         return np.asarray(K.trajectories_clear(s, a, opp, st.inner, st.boxes, st.circles, self.cfg))
+
+
+def braking_path(position: ArrayLike, velocity: ArrayLike, command: ArrayLike, motion: MotionParams,
+                 samples_per_phase: int = 6) -> NDArray[np.float64]:  # fmt: skip
+    """The trajectory DSS checks for one robot (§5.1): from ``position`` (m) at ``velocity`` (m/s),
+    the commanded velocity ``command`` (m/s) pursued for one control period, then braking at
+    ``motion.max_brake_m_s2`` to rest; as points (k, 2), field frame, m, from the start."""
+    px, py = (float(v) for v in np.asarray(position, dtype=np.float64).reshape(2))
+    vx, vy = (float(v) for v in np.asarray(velocity, dtype=np.float64).reshape(2))
+    cx, cy = (float(v) for v in np.asarray(command, dtype=np.float64).reshape(2))
+    dt = motion.period_s
+    tr = K.trajectory(px, py, vx, vy, (cx - vx) / dt, (cy - vy) / dt, dt, motion.max_accel_m_s2,
+                      motion.max_brake_m_s2)  # fmt: skip
+    pts = [(px, py)]
+    for t0, t1, x, y, u, w, ax, ay in tr:
+        if math.isfinite(t1) and t1 > t0:
+            for h in np.linspace(0.0, t1 - t0, max(2, samples_per_phase))[1:]:
+                pts.append((x + u * h + 0.5 * ax * h * h, y + w * h + 0.5 * ay * h * h))
+    return np.array(pts)

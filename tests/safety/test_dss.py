@@ -16,7 +16,7 @@ from cmdragons.planning.world import field_world
 from cmdragons.safety import _kernels as K
 from cmdragons.safety import _reference as R
 from cmdragons.safety.base import CHANGED, KEPT, STOP_ASKED, STOPPED
-from cmdragons.safety.dss import DSSParams, DynamicsSafetySearch
+from cmdragons.safety.dss import DSSParams, DynamicsSafetySearch, braking_path
 
 MOTION = MotionParams()
 RADIUS = 0.09
@@ -206,3 +206,17 @@ def test_closed_loop_with_the_exact_model_never_brings_robots_too_close() -> Non
     assert closest >= limit - 1e-6
     assert statuses.count(CHANGED) > 20  # the search did real work
     assert np.linalg.norm(pos - goals, axis=1).max() < 0.05  # and everyone got through
+
+
+def test_braking_path_ends_where_the_robot_stops() -> None:
+    m = MotionParams()
+    dt, a, b = m.period_s, m.max_accel_m_s2, m.max_brake_m_s2
+    # from rest toward +x at 1 m/s: one period at full acceleration, then braking to rest
+    path = braking_path((1.0, 2.0), (0.0, 0.0), (1.0, 0.0), m)
+    v = a * dt
+    assert path[0] == pytest.approx((1.0, 2.0))
+    assert path[-1] == pytest.approx((1.0 + 0.5 * a * dt * dt + v * v / (2 * b), 2.0), abs=1e-9)
+    assert np.all(np.diff(path[:, 0]) >= 0.0) and np.allclose(path[:, 1], 2.0)
+    # moving at 2 m/s along +y and told to stop: braking at once, 2^2 / (2 b) further on
+    path = braking_path((0.0, 0.0), (0.0, 2.0), (0.0, 0.0), m)
+    assert path[-1] == pytest.approx((0.0, 4.0 / (2 * b)), abs=1e-9)

@@ -3,19 +3,21 @@
 numba compiles a kernel on its first call and caches the machine code in the package's
 ``__pycache__`` (``cache=True``); a fresh clone has no cache, and a match would stall on its first
 frames for the better part of a minute without a word. :func:`warm_up` compiles the kernels a
-``play`` calls before the match starts, in three processes at once (the compile is single-threaded):
-the brain's (planning, control, safety) in a child that plays a second of a throwaway match on the
-true state, the renderer's in a child that renders one throwaway frame, and vision's in this
-process on the same frame drawn by the renderer's numpy reference. All write numba's cache, so
+``play`` calls before the match starts, in four processes at once (the compile is single-threaded):
+the planner's in a child that solves a few throwaway queries, motion control's and the safety
+stage's in a child that drives a throwaway crowd of robots, the renderer's in a child that renders
+one throwaway frame, and vision's in this process on the same frame drawn by the renderer's numpy
+reference (what is left, say a kernel only strategy calls, compiles during the match). All write numba's cache, so
 the match then loads every kernel from it. :class:`CompileWatch` counts what compiles in this process (and how
 long it took), so that real-time factors can leave the one-time compile out.
 
-Nothing here changes a match: the throwaway simulator and brain have their own random generators.
+Nothing here changes a match: the throwaway objects have their own random generators.
 """
 
 from __future__ import annotations
 
 import json
+import math
 import os
 import subprocess
 import sys
@@ -35,7 +37,6 @@ _PLAY_KERNELS: dict[str, tuple[str, ...]] = {
     "cmdragons.control._kernels": ("motion_commands",),
     "cmdragons.safety._kernels": ("dss",),
 }
-_WARM_SECONDS = 1.0  # simulated seconds the child plays: the brain's frame kernels are all called by then
 
 
 def cold_kernels(images: bool) -> list[str]:
@@ -124,7 +125,7 @@ def warm_up(config: str | None, overrides: Sequence[str], opponent: str, images:
             on_progress(done[0], name)
 
     children = []
-    for part in ("brain", "render") if images else ("brain",):
+    for part in ("planning", "motion", "render") if images else ("planning", "motion"):
         spec = json.dumps({"part": part, "config": config, "set": list(overrides), "opponent": opponent})
         children.append(subprocess.Popen(
             [sys.executable, "-m", "cmdragons.runtime.warmup", spec], stdout=subprocess.PIPE,
@@ -181,7 +182,6 @@ def _warm_vision(config: str | None, overrides: Sequence[str]) -> None:
 
 def _child(spec: dict[str, Any]) -> None:
     """A child of :func:`warm_up`: compile one part, printing each kernel's name as it starts."""
-    from cmdragons.runtime.match import Match, Opponent
     from cmdragons.runtime.settings import load_settings
 
     settings = load_settings(spec["config"], spec["set"])
@@ -194,18 +194,35 @@ def _child(spec: dict[str, Any]) -> None:
             from sim.simulator import Simulator
 
             Simulator(settings.field, settings.camera_models(), settings.sim, seed=0).capture()
-            return
-        # a second of a throwaway match on the true state
-        opponent: Opponent = "none" if spec["opponent"] == "none" else "simple"
-        match = Match(settings, opponent, "truth", seed=0, render=False)
-        for _ in range(max(1, round(_WARM_SECONDS * settings.sim.physics.frame_rate_hz))):
-            match.step()
-        _warm_planner(settings)
+        elif spec["part"] == "planning":
+            _warm_planner(settings)
+        else:
+            _warm_motion(settings)
+
+
+def _warm_motion(settings: Any) -> None:
+    """Motion control and the safety stage as the brain calls them, on a throwaway crowd of own
+    robots driving into each other and opponents."""
+    from cmdragons.control.motion import follow_path, motion_command
+    from cmdragons.messages import BallState, RobotState, WorldState
+    from cmdragons.planning import field_world
+    from cmdragons.safety import make_safety
+
+    radius = settings.field.robot.radius_m
+    static = field_world(settings.field_geometry(), defense_areas=False)
+    safety = make_safety(settings.safety, settings.control, radius, static)
+    ours = [RobotState("blue", i, -1.0 + 0.25 * i, 0.1 * (i % 2), 0.0, 1.5 - 0.5 * i, 0.0, 0.0) for i in range(6)]
+    theirs = [RobotState("yellow", i, -0.9 + 0.25 * i, 0.3, math.pi, -1.0, 0.0, 0.0) for i in range(3)]
+    world = WorldState(0.0, BallState(0.0, 0.0, 0.0, 0.0), tuple(ours + theirs))
+    path = [(0.0, 0.0), (1.0, 1.0), (2.0, 1.0)]
+    commands = [motion_command(r, follow_path((r.x, r.y), path, r.theta, settings.control), settings.control)
+                for r in ours]  # fmt: skip
+    safety.make_safe(commands, world)
 
 
 def _warm_planner(settings: Any) -> None:
-    """One hard query for the configured planner (what a match meets only now and then): a wall
-    of robots with one gap between start and goal."""
+    """Hard queries for the configured planner (what a match meets only now and then): a wall of
+    robots with one gap between start and goal."""
     import numpy as np
 
     from cmdragons.planning import PlanProblem, deadline_in, field_world, make_planner
@@ -213,7 +230,10 @@ def _warm_planner(settings: Any) -> None:
     ys = [y for y in np.arange(-3.0, 3.01, 0.15) if abs(y - 1.5) > 0.3]
     world = field_world(settings.field_geometry(), np.column_stack([np.zeros(len(ys)), ys]))
     radius = settings.field.robot.radius_m
-    make_planner(settings.planner).solve(PlanProblem((-2.0, -1.0), (2.0, -1.0), radius, world), deadline_in(0.5))
+    planner = make_planner(settings.planner)
+    # the way through the gap; again a step on (the last plan is checked first); from inside a robot
+    for start in ((-2.0, -1.0), (-1.9, -1.0), (0.0, -0.6)):
+        planner.solve(PlanProblem(start, (2.0, -1.0), radius, world), deadline_in(0.5))
 
 
 if __name__ == "__main__":

@@ -262,9 +262,9 @@ def _convert_dataclass(cls: type, value: Any, file: str, key: str) -> Any:
     unknown = [k for k in value if k not in fields]
     if unknown:
         close = difflib.get_close_matches(str(unknown[0]), list(fields), n=1)
-        hint = f"did you mean {close[0]}? " if close else ""
+        hint = f"; did you mean {close[0]}?" if close else ""
         raise ConfigError(
-            file, _join(key, str(unknown[0])), f"unknown key; {hint}allowed keys: {', '.join(sorted(fields))}"
+            file, _join(key, str(unknown[0])), f"unknown key; allowed keys: {', '.join(sorted(fields))}{hint}"
         )
     kwargs = {}
     for name, f in fields.items():

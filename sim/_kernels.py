@@ -501,9 +501,10 @@ def _render_frame_kernel(
     cx, cy, cz = cam[0], cam[1], cam[2]
     h, rb, ambient = shape[SHAPE_ROBOT_HEIGHT], shape[SHAPE_BALL_RADIUS], shape[SHAPE_BALL_AMBIENT]
     side, cover, ball_col = palette[PAL_SIDE], palette[PAL_COVER], palette[PAL_BALL]
-    # rows are dealt out round-robin in chunks. The kernel is serial: numba's parallel compile cost
-    # the first run ~12 s for about 1 ms a frame, and every row is written by one chunk only, so the
-    # image is the same either way.
+    # rows are dealt out round-robin in chunks. The kernel is serial: the parallel version cost the
+    # first run ~12 s of compiling, and with the 2 cores shared it was the slower one (1.8 against
+    # 1.2 ms median a camera frame, 2026-12-01, load 3.4); every row is written by one chunk only,
+    # so the image is the same either way.
     for chunk in range(n_chunks):
         scratch = np.empty(w3, dtype=np.float32)  # the row's clean (noise-free) colours
         nz = np.empty(w3, dtype=np.int8)  # the row's sensor noise

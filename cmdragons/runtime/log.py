@@ -55,6 +55,10 @@ def run_folder(command: str, out: str | Path | None = None, logs: str | Path = "
         while folder.exists():
             n += 1
             folder = Path(logs) / f"{stamp}-{command}-{n}"
+    blocking = _file_in_the_way(folder.parent)
+    if blocking is not None:
+        raise OutputError(f"cannot create the output folder {folder}: {blocking} is a file, not a folder; "
+                          "give another folder with --out DIR")  # fmt: skip
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
@@ -62,6 +66,14 @@ def run_folder(command: str, out: str | Path | None = None, logs: str | Path = "
                           "give a writable one with --out DIR") from None  # fmt: skip
     _check_folder_writable(folder)
     return folder
+
+
+def _file_in_the_way(folder: Path) -> Path | None:
+    """The nearest of ``folder`` and its parents that exists as something other than a folder."""
+    for p in (folder, *folder.parents):
+        if p.exists():
+            return None if p.is_dir() else p
+    return None
 
 
 def _check_folder_writable(folder: Path) -> None:
@@ -76,6 +88,9 @@ def check_writable_file(path: str | Path, option: str) -> Path:
     p = Path(path)
     if p.is_dir():
         raise OutputError(f"{option} {p}: is a folder; give a file name in it, e.g. {p / 'out'}")
+    blocking = _file_in_the_way(p.parent)
+    if blocking is not None:
+        raise OutputError(f"{option} {p}: {blocking} is a file, not a folder; give another path")
     try:
         p.parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:

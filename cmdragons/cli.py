@@ -201,11 +201,11 @@ def _cmd_sim(args: argparse.Namespace, stop: Interrupt) -> int:
     from sim.simulator import Simulator
 
     settings = load_settings(args.config, args.set)
-    folder = run_folder("sim", args.out, overwrite=args.overwrite)
     if args.snapshot:
         if Path(args.snapshot).suffix.lower() not in (".png", ".jpg", ".jpeg"):
             raise OutputError(f"--snapshot {args.snapshot}: not an image file name; give one ending in .png")
         check_writable_file(args.snapshot, "--snapshot")
+    folder = run_folder("sim", args.out, overwrite=args.overwrite)
     models = settings.camera_models()
     sim = Simulator(settings.field, models, settings.sim, seed=args.seed)
     script = ScriptedPlay(settings.field_geometry(), settings.field.robot.radius_m, settings.sim.script, sim.rng)

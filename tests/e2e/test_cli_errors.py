@@ -71,7 +71,7 @@ def test_snapshot_checked_before_the_run(tmp_path: Path, a_file: Path, capsys: p
     code, _, _ = run(["sim", "--seconds", "0.2", "--snapshot", f"{a_file}/x.png", "--out", str(tmp_path / "s"),
                       "--no-progress"], capsys)  # fmt: skip
     assert code == 2
-    assert not (tmp_path / "s" / "run.mcap").exists()
+    assert not (tmp_path / "s").exists()  # nothing made: the run never started
 
 
 def test_out_refuses_another_run_unless_overwrite(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

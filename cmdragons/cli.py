@@ -13,13 +13,42 @@ import sys
 import time
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any, NoReturn
 
 import numpy as np
-from numpy.typing import NDArray
 
 from cmdragons.config import ConfigError
+from cmdragons.runtime.interrupt import Interrupt
+from cmdragons.runtime.log import OutputError
 
 __all__ = ["main"]
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with its errors on one line: the problem, then where the fix is."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"{self.prog}: {message} (see {self.prog} -h)\n")
+
+
+def _seed(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number; give one from 0 to 2**63-1") from None
+    if not 0 <= value < 2**63:
+        raise argparse.ArgumentTypeError(f"{value} is out of range; give a whole number from 0 to 2**63-1")
+    return value
+
+
+def _positive(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number; give a positive number") from None
+    if not (value > 0 and math.isfinite(value)):
+        raise argparse.ArgumentTypeError(f"{text} must be a positive number")
+    return value
 
 
 def _common(parser: argparse.ArgumentParser) -> None:
@@ -31,30 +60,34 @@ def _common(parser: argparse.ArgumentParser) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="cmdragons", description="RoboCup small-size team and simulator")
+    parser = _Parser(prog="cmdragons", description="RoboCup small-size team and simulator")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     p = sub.add_parser("sim", help="run the simulator with scripted motion; record camera frames and truth")
     _common(p)
-    p.add_argument("--seconds", type=float, default=10.0, help="simulated seconds (default 10)")
+    p.add_argument("--seconds", type=_positive, default=10.0, help="simulated seconds (default 10)")
     p.add_argument("--record", action="store_true", help="write camera frames, cameras.yaml and truth.jsonl")
     p.add_argument("--format", choices=("mp4", "png"), default="mp4", help="recorded frames: mp4 video or lossless PNG")
     p.add_argument("--out", metavar="DIR", default=None, help="output folder (default logs/<time>-sim)")
+    p.add_argument("--overwrite", action="store_true", help="let --out replace the run already in that folder")
     p.add_argument("--snapshot", metavar="FILE.png", default=None, help="write the last frame of all cameras, tiled")
-    p.add_argument("--seed", type=int, default=None, help="override sim.seed")
+    p.add_argument("--seed", type=_seed, default=None, help="override sim.seed (0 .. 2**63-1)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
     p = sub.add_parser("play", help="play a match in the simulator; our team sees only the camera images")
     _common(p)
     p.add_argument("--opponent", choices=("simple", "self", "none"), default="simple",
                    help="the built-in simple team (on the true state), a copy of our team, or nobody")
-    p.add_argument("--seconds", type=float, default=30.0, help="match time in simulated seconds (default 30)")
+    p.add_argument("--seconds", type=_positive, default=30.0, help="match time in simulated seconds (default 30)")
     p.add_argument("--division", choices=("A", "B"), default=None, help="field and team size (default: config)")
     p.add_argument("--perception", choices=("vision", "truth"), default="vision",
                    help="vision: our team sees the rendered images (default); truth: noisy true detections")
-    p.add_argument("--video", action="store_true", help="write match.mp4: the cameras with the team's overlays")
+    p.add_argument("--video", action="store_true", help="write match.mp4 (H.264): a top-down view of the match")
+    p.add_argument("--view", choices=("field", "cameras"), default="field",
+                   help="what match.mp4 shows: the top-down field (default) or the camera images with overlays")
     p.add_argument("--out", metavar="DIR", default=None, help="output folder (default logs/<time>-play)")
-    p.add_argument("--seed", type=int, default=None, help="override sim.seed")
+    p.add_argument("--overwrite", action="store_true", help="let --out replace the run already in that folder")
+    p.add_argument("--seed", type=_seed, default=None, help="override sim.seed (0 .. 2**63-1)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
     p = sub.add_parser(
@@ -65,8 +98,9 @@ def build_parser() -> argparse.ArgumentParser:
     _common(p)
     p.add_argument("source", nargs="+", metavar="SOURCE")
     p.add_argument("--out", metavar="DIR", default=None, help="output folder (default logs/<time>-vision)")
+    p.add_argument("--overwrite", action="store_true", help="let --out replace the run already in that folder")
     p.add_argument("--video", action="store_true", help="also write an annotated video per camera")
-    p.add_argument("--fps", type=float, default=None, help="frames per second for t_capture (default: sim's)")
+    p.add_argument("--fps", type=_positive, default=None, help="frames per second for t_capture (default: sim's)")
     p.add_argument("--track", action="store_true", help="also track the detections and write tracks.jsonl")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
@@ -88,80 +122,67 @@ def main(argv: Sequence[str] | None = None) -> int:
         except ConfigError as exc:
             print(f"cmdragons: config error: {exc}", file=sys.stderr)
             return 2
-    args = build_parser().parse_args(argv)
     try:
-        if args.command == "sim":
-            return _cmd_sim(args)
-        if args.command == "bench":
-            return _cmd_bench(args)
-        if args.command == "play":
-            return _cmd_play(args)
-        if args.command == "vision":
-            return _cmd_vision(args)
-    except ConfigError as exc:
-        print(f"cmdragons: config error: {exc}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("cmdragons: interrupted", file=sys.stderr)
-        return 130
+        args = build_parser().parse_args(argv)
+    except SystemExit as exc:  # -h, or a bad argument (already said on one line)
+        return exc.code if isinstance(exc.code, int) else 2
+    with Interrupt() as stop:
+        try:
+            if args.command == "sim":
+                return _cmd_sim(args, stop)
+            if args.command == "bench":
+                return _cmd_bench(args)
+            if args.command == "play":
+                return _cmd_play(args, stop)
+            if args.command == "vision":
+                return _cmd_vision(args)
+        except ConfigError as exc:
+            print(f"cmdragons: config error: {exc}", file=sys.stderr)
+            return 2
+        except OutputError as exc:
+            print(f"cmdragons {args.command}: {exc}", file=sys.stderr)
+            return 2
+        except KeyboardInterrupt:
+            print(f"cmdragons {args.command}: interrupted by {stop.signal or 'SIGINT'} before any result; "
+                  "nothing more was written", file=sys.stderr)  # fmt: skip
+            return stop.exit_code or 130
     return 2
 
 
 def _progress(enabled: bool):  # type: ignore[no-untyped-def]
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
 
     return Progress(
         TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(), TextColumn("{task.fields[info]}"),
-        TimeRemainingColumn(), disable=not enabled, transient=False,
+        TimeElapsedColumn(), TimeRemainingColumn(), disable=not enabled, transient=False,
     )  # fmt: skip
 
 
-def tile_cameras(images: dict[int, NDArray[np.uint8]], models: Sequence[object]) -> NDArray[np.uint8]:
-    """All camera images in one picture, laid out as the cameras hang over the field."""
-    from cmdragons.camera import CameraModel
-
-    cams = [m for m in models if isinstance(m, CameraModel) and m.id in images]
-    if not cams:
-        raise ValueError("no camera images to tile")
-    first = cams[0]
-    # field directions of image 'right' and 'up' in the first camera
-    c = np.array([[first.width / 2, first.height / 2], [first.width / 2 + 50, first.height / 2],
-                  [first.width / 2, first.height / 2 - 50]])  # fmt: skip
-    p = first.unproject(c, 0.0)
-    right, up = p[1] - p[0], p[2] - p[0]
-    right, up = right / np.linalg.norm(right), up / np.linalg.norm(up)
-    pos = {m.id: (float(m.center[:2] @ right), float(m.center[:2] @ up)) for m in cams}
-    cols = sorted({round(v[0], 1) for v in pos.values()})
-    rows = sorted({round(v[1], 1) for v in pos.values()}, reverse=True)
-    h = max(images[m.id].shape[0] for m in cams)
-    w = max(images[m.id].shape[1] for m in cams)
-    out = np.zeros((h * len(rows), w * len(cols), 3), dtype=np.uint8)
-    for m in cams:
-        img = images[m.id]
-        r, k = rows.index(round(pos[m.id][1], 1)), cols.index(round(pos[m.id][0], 1))
-        out[r * h : r * h + img.shape[0], k * w : k * w + img.shape[1]] = img
-    return out
-
-
-def _cmd_sim(args: argparse.Namespace) -> int:
-    import cv2
-
+def _cmd_sim(args: argparse.Namespace, stop: Interrupt) -> int:
     from cmdragons.geometry import TEAMS
     from cmdragons.messages import GameState, SimEvents, TeamCommands
     from cmdragons.recording import RecordingWriter
-    from cmdragons.runtime.log import RunLog, run_folder
+    from cmdragons.runtime.log import RunLog, check_writable_file, run_folder
     from cmdragons.runtime.settings import load_settings
     from sim.script import ScriptedPlay
     from sim.simulator import Simulator
 
-    if not (args.seconds > 0 and math.isfinite(args.seconds)):
-        print("cmdragons sim: --seconds must be a positive number", file=sys.stderr)
-        return 2
     settings = load_settings(args.config, args.set)
+    if args.snapshot:
+        if Path(args.snapshot).suffix.lower() not in (".png", ".jpg", ".jpeg"):
+            raise OutputError(f"--snapshot {args.snapshot}: not an image file name; give one ending in .png")
+        check_writable_file(args.snapshot, "--snapshot")
+    folder = run_folder("sim", args.out, overwrite=args.overwrite)
     models = settings.camera_models()
     sim = Simulator(settings.field, models, settings.sim, seed=args.seed)
     script = ScriptedPlay(settings.field_geometry(), settings.field.robot.radius_m, settings.sim.script, sim.rng)
-    folder = run_folder("sim", args.out)
     fps = settings.sim.physics.frame_rate_hz
     n_frames = max(1, round(args.seconds * fps))
     recorder = RecordingWriter(folder, models, fps, args.format) if args.record else None
@@ -169,9 +190,11 @@ def _cmd_sim(args: argparse.Namespace) -> int:
     wall0 = time.perf_counter()
     frame = None
     try:
-        with _progress(not args.no_progress) as progress:
+        with _progress(not args.no_progress) as progress, stop.soft():
             task = progress.add_task("sim", total=n_frames, info="")
             for i in range(n_frames):
+                if stop.requested:
+                    break
                 frame = sim.capture()
                 if recorder is not None:
                     recorder.write(frame.frame_number, frame.images, frame.truth)
@@ -189,16 +212,22 @@ def _cmd_sim(args: argparse.Namespace) -> int:
                     progress.update(task, completed=i + 1,
                                     info=f"t={sim.t:6.2f}s  blue {g.score_blue}:{g.score_yellow} yellow")  # fmt: skip
     finally:
-        log.close()
-        if recorder is not None:
-            recorder.close()
-    wall = time.perf_counter() - wall0
-    if args.snapshot and frame is not None:
-        Path(args.snapshot).parent.mkdir(parents=True, exist_ok=True)
-        if not cv2.imwrite(args.snapshot, tile_cameras(frame.images, models)):
-            print(f"cmdragons sim: could not write {args.snapshot}", file=sys.stderr)
-            return 1
+        with stop.shield():
+            log.close()
+            if recorder is not None:
+                recorder.close()
+    with stop.shield():
+        return _finish_sim(args, stop, sim, models, folder, frame, time.perf_counter() - wall0, n_frames)
+
+
+def _finish_sim(args: argparse.Namespace, stop: Interrupt, sim: Any, models: Sequence[Any], folder: Path,
+                frame: Any, wall: float, n_frames: int) -> int:  # fmt: skip
+    import cv2
+
+    from cmdragons.runtime.overlay import tile_cameras
+
     summary = sim.summary()
+    summary["interrupted"] = stop.requested
     summary["wall_seconds"] = round(wall, 3)
     summary["realtime_factor"] = round(sim.t / wall, 2) if wall > 0 else None
     summary["cameras"] = [m.id for m in models]
@@ -207,80 +236,161 @@ def _cmd_sim(args: argparse.Namespace) -> int:
         for name, v in (("physics", sim.times.physics_ms), ("render", sim.times.render_ms)) if v
     }  # fmt: skip
     (folder / "summary.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
-    faults = sum(summary["command_faults"].values())  # type: ignore[attr-defined]
+    faults = sum(summary["command_faults"].values())
     score = summary["score"]
     print(
         f"sim: {sim.t:.1f} s simulated in {wall:.1f} s ({summary['realtime_factor']}x real time), "
-        f"{n_frames} frames x {len(models)} cameras, score blue {score['blue']}:{score['yellow']} yellow, "  # type: ignore[index]
-        f"{summary['kicks']} kicks, {summary['balls_out']} balls out, "
-        f"{summary['robot_contacts']['count']} robot contacts, {faults} command faults -> {folder}"  # type: ignore[index]
+        f"{_plural(summary['frames'], 'frame')} x {_plural(len(models), 'camera')}, score blue "
+        f"{score['blue']}:{score['yellow']} yellow, {_plural(summary['kicks'], 'kick')}, "
+        f"{_plural(summary['balls_out'], 'ball')} out, {_plural(summary['robot_contacts']['count'], 'robot contact')}, "
+        f"{_plural(faults, 'command fault')}"
     )
-    return 0
+    code = stop.exit_code
+    if args.snapshot and frame is not None and not cv2.imwrite(args.snapshot, tile_cameras(frame.images, models)):
+        print(f"sim: could not write the snapshot {args.snapshot} (summary.json is written); give a .png path",
+              file=sys.stderr)  # fmt: skip
+        code = code or 1
+    if stop.requested:
+        print(f"sim: interrupted by {stop.signal} after {_plural(summary['frames'], 'frame')} of {n_frames}: "
+              "the output so far is closed and readable, summary.json says \"interrupted\": true")  # fmt: skip
+    print(f"sim: output -> {folder}")
+    return code
 
 
-def _cmd_play(args: argparse.Namespace) -> int:
-    import cv2
-
+def _cmd_play(args: argparse.Namespace, stop: Interrupt) -> int:
     from cmdragons.messages import GameState
+    from cmdragons.runtime.bus import Stage
     from cmdragons.runtime.log import RunLog, run_folder
-    from cmdragons.runtime.match import Match
-    from cmdragons.runtime.overlay import OverlayStage
+    from cmdragons.runtime.match import OURS, Match
+    from cmdragons.runtime.overlay import MatchVideoStage
     from cmdragons.runtime.settings import load_settings
     from cmdragons.runtime.stages import LoggerStage, Tap
+    from cmdragons.runtime.warmup import CompileWatch
 
-    if not (args.seconds > 0 and math.isfinite(args.seconds)):
-        print("cmdragons play: --seconds must be a positive number", file=sys.stderr)
-        return 2
     overrides = list(args.set) + ([f"field.division={args.division}"] if args.division else [])
     settings = load_settings(args.config, overrides)
-    folder = run_folder("play", args.out)
+    folder = run_folder("play", args.out, overwrite=args.overwrite)
+    images = args.perception == "vision" or (args.video and args.view == "cameras")
+    compile_s = _compile_kernels(args, overrides, images)
+    started = time.time()
     log = RunLog(folder / "run.mcap")
     fps = settings.sim.physics.frame_rate_hz
     n_frames = max(1, round(args.seconds * fps))
-    video: list[cv2.VideoWriter] = []
-    models = settings.camera_models()
-
-    def write_video(drawn: dict[int, NDArray[np.uint8]]) -> None:
-        full = tile_cameras(drawn, models)
-        tiled = cv2.resize(full, (full.shape[1] // 2, full.shape[0] // 2), interpolation=cv2.INTER_AREA)
-        if not video:
-            video.append(cv2.VideoWriter(str(folder / "match.mp4"), cv2.VideoWriter.fourcc(*"mp4v"), fps,
-                                         (tiled.shape[1], tiled.shape[0])))  # fmt: skip
-        video[0].write(tiled)
-
-    game = [GameState(0.0)]
-    extra = [LoggerStage(log), Tap("progress", ("referee",), lambda _topic, g: game.__setitem__(0, g))]
+    game = [GameState(0.0)]  # the referee's latest word, for the progress bar
+    extra: list[Stage] = [LoggerStage(log), Tap("progress", ("referee",), lambda _topic, g: game.__setitem__(0, g))]
+    video = None
     if args.video:
-        extra.append(OverlayStage("blue", models, settings.field.robot.height_m, write_video))
-    wall0 = time.perf_counter()
+        video = MatchVideoStage(folder / "match.mp4", args.view, OURS, settings.camera_models(),
+                                settings.field_geometry(), settings.field.robot.radius_m, settings.field.robot.height_m,
+                                fps)  # fmt: skip
+        extra.append(video)
+    watch = CompileWatch()
     try:
-        match = Match(settings, args.opponent, args.perception, seed=args.seed, render=args.video, extra=extra)
-        with _progress(not args.no_progress) as progress:
+        match = Match(settings, args.opponent, args.perception, seed=args.seed, render=images, extra=extra)
+        with _progress(not args.no_progress) as progress, stop.soft():
             task = progress.add_task("play", total=n_frames, info="")
+            watch.on_compile = lambda name: progress.update(task, info=f"compiling {name} (first run only)")
+            wall0 = time.perf_counter()
+            watch.start()
             for i in range(n_frames):
+                if stop.requested:
+                    break
                 match.step()
                 if i % 15 == 0 or i == n_frames - 1:
                     g = game[0]
                     progress.update(task, completed=i + 1, info=f"t={g.t:6.1f}s  blue {g.score_blue}:"
                                                                  f"{g.score_yellow} yellow  {g.command}")  # fmt: skip
-        summary = match.summary()
+        with stop.shield():
+            wall = time.perf_counter() - wall0
+            summary = match.summary()  # the stages' summaries go into the log as well
     finally:
-        log.close()
-        if video:
-            video[0].release()
-    wall = time.perf_counter() - wall0
-    summary["wall_seconds"] = round(wall, 3)
-    summary["realtime_factor"] = round(summary["seconds"] / wall, 2) if wall > 0 else None
+        with stop.shield():
+            watch.stop()
+            log.close()
+            if video is not None:
+                video.close()
+    with stop.shield():
+        summary["interrupted"] = stop.requested
+        summary["started_utc"] = _utc(started)
+        summary["wall_seconds"] = round(wall, 3)
+        summary["compile_seconds"] = round(compile_s + watch.seconds, 3)
+        # the one-time compile is not the team's speed
+        run_wall = wall - watch.seconds
+        summary["realtime_factor"] = round(summary["seconds"] / run_wall, 2) if run_wall > 0 else None
+        geometry = settings.field_geometry()
+        _finish_play(folder, summary, args, stop, (geometry.half_length, geometry.half_width))
+    return stop.exit_code
+
+
+def _utc(t: float) -> str:
+    import datetime as dt
+
+    return dt.datetime.fromtimestamp(t, dt.UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
+
+
+def _plural(n: int, word: str, many: str | None = None) -> str:
+    return f"{n} {word if n == 1 else (many or word + 's')}"
+
+
+def _finish_play(folder: Path, summary: dict[str, Any], args: argparse.Namespace, stop: Interrupt,
+                 half_size_m: tuple[float, float]) -> None:  # fmt: skip
+    """summary.json (with its warnings), the match report and the summary lines; the last line
+    names the output folder."""
+    from cmdragons.runtime.report import load_run, run_warnings, write_report
+
+    run = load_run(folder / "run.mcap")
+    warnings = run_warnings(run, summary)
+    summary["warnings"] = warnings
     (folder / "summary.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
+    report = None
+    if run.frames:
+        report = write_report(run, summary, folder / "report.png", half_size_m)
     score, passes, coll = summary["score"], summary["passes"], summary["collisions"]
     brain = summary["cycle_ms"].get("brain", {}).get("median", float("nan"))
+    rtf = summary["realtime_factor"]
+    compile_note = f", not counting {summary['compile_seconds']:.0f} s of first-run compile" \
+        if summary["compile_seconds"] >= 1 else ""  # fmt: skip
+    played = f"{summary['seconds']:.1f} s of {args.seconds:g} s" if stop.requested else f"{summary['seconds']:.0f} s"
     print(
-        f"play: {summary['seconds']:.0f} s against {args.opponent} ({args.perception}) in {wall:.1f} s: "
-        f"blue {score['blue']}:{score['yellow']} yellow, {summary['shots']} shots, "
-        f"passes {passes['completed']}/{passes['tried']}, own collisions {coll['own']}, "
-        f"brain {brain:.2f} ms median -> {folder}"
+        f"play: {played} against {args.opponent} ({args.perception}) in {summary['wall_seconds']:.1f} s "
+        f"({rtf}x real time{compile_note}): blue (us) {score['blue']}:{score['yellow']} yellow (them); ours: "
+        f"{_plural(summary['shots'], 'shot')}, passes {passes['completed']}/{passes['tried']} completed, "
+        f"{_plural(coll['own'], 'own collision')}; brain {brain:.2f} ms median"
     )
-    return 0
+    for w in warnings:
+        print(f"play: warning: {w}")
+    if stop.requested:
+        print(f"play: interrupted by {stop.signal}: the output so far is closed and readable, "
+              "summary.json says \"interrupted\": true")  # fmt: skip
+    files = ["run.mcap", "summary.json"] + (["match.mp4"] if args.video and (folder / "match.mp4").exists() else [])
+    files += [report.name] if report is not None else []
+    print(f"play: {', '.join(files)} -> {folder}")
+
+
+def _compile_kernels(args: argparse.Namespace, overrides: Sequence[str], images: bool) -> float:
+    """Compile the play's numba kernels before the match when they have no cache yet, with a
+    progress line; returns the wall seconds it took (0 when every kernel was cached)."""
+    from cmdragons.runtime.warmup import cold_kernels, warm_up
+
+    if not cold_kernels(images):
+        return 0.0
+    title = "compiling kernels (first run only)"
+    if args.no_progress:
+        print(f"{args.command}: {title} ...", file=sys.stderr, flush=True)
+    with _progress(not args.no_progress) as progress:
+        task = progress.add_task(title, total=None, info="")
+        counted = [0]
+
+        def show(n: int, name: str) -> None:
+            counted[0] = n
+            progress.update(task, info=f"{n} kernels, now {name}")
+
+        seconds = warm_up(args.config, overrides, args.opponent, images, show)
+        progress.update(task, total=1, completed=1, info=f"{counted[0]} kernels in {seconds:.0f} s, cached")
+    if args.no_progress:
+        print(f"{args.command}: compiled {counted[0]} kernels in {seconds:.0f} s (cached for next time)",
+              file=sys.stderr, flush=True)  # fmt: skip
+    return seconds
 
 
 def _cmd_vision(args: argparse.Namespace) -> int:
@@ -295,7 +405,7 @@ def _cmd_vision(args: argparse.Namespace) -> int:
     except SourceError as exc:
         print(f"cmdragons vision: {exc}", file=sys.stderr)
         return 2
-    folder = run_folder("vision", args.out)
+    folder = run_folder("vision", args.out, overwrite=args.overwrite)
     fps = args.fps or settings.sim.physics.frame_rate_hz
     total = sum(len(s.paths) for s in sources if s.kind == "images") or None
     with _progress(not args.no_progress) as progress:
@@ -325,12 +435,15 @@ def _cmd_vision(args: argparse.Namespace) -> int:
 
 def _cmd_bench(args: argparse.Namespace) -> int:
     from cmdragons.bench import SUITES, print_table, write_json
+    from cmdragons.runtime.log import check_writable_file
     from cmdragons.runtime.settings import load_settings
 
     if args.suite not in SUITES:
         print(f"cmdragons bench: unknown suite {args.suite!r}; suites: {', '.join(sorted(SUITES))}", file=sys.stderr)
         return 2
     settings = load_settings(args.config, args.set)
+    if args.json:
+        check_writable_file(args.json, "--json")  # before the bench: its rows are not lost at the end
     rows = SUITES[args.suite](settings, args.quick)
     print_table(args.suite, rows)
     if args.json:

@@ -19,6 +19,7 @@ Ranges and choices are declared on the dataclass fields with :func:`setting`::
 from __future__ import annotations
 
 import dataclasses
+import difflib
 import math
 import types
 import typing
@@ -177,7 +178,9 @@ def apply_override(raw: dict[str, dict[str, Any]], assignment: str) -> None:
     try:
         value = yaml.safe_load(text)
     except yaml.YAMLError as exc:
-        raise ConfigError(origin, path, f"value is not valid YAML: {exc}") from None
+        problem = getattr(exc, "problem", None) or type(exc).__name__
+        raise ConfigError(origin, path, f"value {text!r} is not valid YAML ({problem}); write a number, true/false, "
+                                        "a word, or a list such as [1, 2]") from None  # fmt: skip
     node: Any = raw[concern]
     for i, key in enumerate(parts[1:-1], start=1):
         if isinstance(node, list):
@@ -322,8 +325,10 @@ def _convert_dataclass(cls: type, value: Any, file: str, key: str) -> Any:
             raise ConfigError(file, _join(key, str(k)), f"configured once, as {source}: set that instead")
     unknown = [k for k in value if k not in fields]
     if unknown:
+        close = difflib.get_close_matches(str(unknown[0]), list(fields), n=1)
+        hint = f"; did you mean {close[0]}?" if close else ""
         raise ConfigError(
-            file, _join(key, str(unknown[0])), f"unknown key; allowed keys: {', '.join(sorted(fields))}"
+            file, _join(key, str(unknown[0])), f"unknown key; allowed keys: {', '.join(sorted(fields))}{hint}"
         )
     kwargs = {}
     for name, f in fields.items():

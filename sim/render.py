@@ -8,7 +8,7 @@ occlusions of a real overhead camera (SSL-Vision's setting, Bruce's thesis §2).
 
 Cost model: the static scene (carpet, lines, goals in 3D, lighting) is drawn once per camera;
 a frame is a noisy copy of it plus the dynamic objects inside their projected bounding boxes,
-all in one parallel numba pass (:mod:`sim._kernels`).
+all in one numba pass (:mod:`sim._kernels`).
 """
 
 from __future__ import annotations

@@ -14,7 +14,7 @@ from typing import Any
 
 from cmdragons.runtime.settings import Settings
 
-__all__ = ["SUITES", "print_table", "write_json"]
+__all__ = ["SUITES", "TABLE_WIDTH", "header", "print_table", "write_json"]
 
 Row = dict[str, Any]
 
@@ -39,8 +39,18 @@ SUITES: dict[str, Callable[[Settings, bool], list[Row]]] = {
 }
 
 
-def print_table(suite: str, rows: list[Row]) -> None:
-    """One table per run of consecutive rows that share their metrics."""
+TABLE_WIDTH = 100  # columns: a bench table fits a standard terminal
+_NAME_WIDTH = 26  # the row name column; longer names wrap onto a second line (the JSON keeps them whole)
+_CELL_WIDTH = 9  # a number column, borders included
+# metric name endings that are units, shown under the metric's name in the header
+_UNITS = {"_mm_s": "mm·s", "_m_s2": "m/s²", "_m_s": "m/s", "_ms": "ms", "_us": "µs", "_ns": "ns", "_mm": "mm",
+          "_m": "m", "_s": "s", "_rad": "rad", "_deg": "deg", "_px": "px", "_hz": "Hz"}  # fmt: skip
+
+
+def print_table(suite: str, rows: list[Row], width: int = TABLE_WIDTH) -> None:
+    """One table per run of consecutive rows that share their metrics, each at most ``width``
+    columns wide: metric columns beyond that go to a further table with the same row names; text
+    fields (notes) are printed under the table, one line per row."""
     groups: list[list[Row]] = []
     for row in rows:
         if groups and set(groups[-1][0]) == set(row):
@@ -48,23 +58,44 @@ def print_table(suite: str, rows: list[Row]) -> None:
         else:
             groups.append([row])
     for group in groups:
-        _print_group(suite, group)
+        _print_group(suite, group, width)
 
 
-def _print_group(suite: str, rows: list[Row]) -> None:
+def header(metric: str) -> str:
+    """A metric's column header: its words, the unit on a line of its own (``median_ms`` ->
+    "median\\nms", ``max_speed_m_s`` -> "max speed\\nm/s"); other names as words."""
+    for unit, shown in _UNITS.items():
+        if metric.endswith(unit) and len(metric) > len(unit):
+            return f"{metric[: -len(unit)].replace('_', ' ')}\n{shown}"
+    return metric.replace("_", " ")
+
+
+def _print_group(suite: str, rows: list[Row], width: int) -> None:
     from rich.console import Console
     from rich.table import Table
+    from rich.text import Text
 
     metrics: list[str] = []
     for row in rows:
         metrics += [k for k in row if k != "name" and k not in metrics]
-    table = Table(title=f"cmdragons bench {suite}")
-    table.add_column("name")
-    for m in metrics:
-        table.add_column(m, justify="right")
+    texts = [m for m in metrics if any(isinstance(r.get(m), str) for r in rows)]
+    numbers = [m for m in metrics if m not in texts]
+    per_table = max(1, (width - _NAME_WIDTH - 4) // _CELL_WIDTH)
+    console = Console(width=width, highlight=False)
+    chunks = [numbers[i : i + per_table] for i in range(0, len(numbers), per_table)]
+    for k, chunk in enumerate(chunks):
+        part = f" ({k + 1}/{len(chunks)})" if len(chunks) > 1 else ""
+        table = Table(title=Text(f"cmdragons bench {suite}{part}"), title_justify="left")
+        table.add_column("name", max_width=_NAME_WIDTH, overflow="fold")
+        for m in chunk:
+            table.add_column(Text(header(m)), justify="right", overflow="fold")
+        for row in rows:
+            table.add_row(Text(row["name"].replace("_", " ")), *(Text(_fmt(row.get(m))) for m in chunk))
+        console.print(table)
     for row in rows:
-        table.add_row(row["name"], *(_fmt(row.get(m)) for m in metrics))
-    Console(width=160).print(table)
+        for m in texts:
+            if row.get(m):
+                console.print(Text(f"{row['name']}: {m}: {row[m]}"), soft_wrap=False)
 
 
 def _fmt(v: Any) -> str:

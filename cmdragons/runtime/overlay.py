@@ -1,4 +1,5 @@
-"""Overlays on the camera images for match videos: what the team believed and intended.
+"""Match videos from the bus: the top-down view or the camera images with overlays of what the
+team believed and intended.
 
 Drawn per camera through its own model, so they sit on the objects they describe: tracked robots
 (circle, id, heading) and ball, planned paths, each robot's command before (thin) and after (thick)
@@ -7,7 +8,8 @@ the safety search, and the pass evaluation as a heat map of receiving points.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
+from pathlib import Path
 from typing import Any
 
 import cv2
@@ -15,11 +17,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cmdragons.camera import CameraModel
-from cmdragons.geometry import Team
-from cmdragons.messages import CameraFrame, RobotCommand, TeamCommands, TeamReport, WorldState
+from cmdragons.geometry import Field, Team
+from cmdragons.messages import CameraFrame, GameState, GroundTruth, RobotCommand, TeamCommands, TeamReport, WorldState
 from cmdragons.runtime.bus import BaseStage, Publish
 
-__all__ = ["OverlayStage", "draw_overlays"]
+__all__ = ["MatchVideoStage", "draw_overlays", "tile_cameras"]
 
 _OURS = (255, 255, 255)
 _THEIRS = (0, 215, 255)
@@ -78,29 +80,90 @@ def draw_overlays(image: NDArray[np.uint8], model: CameraModel, world: WorldStat
     return out
 
 
-class OverlayStage(BaseStage):
-    """Draws one team's overlays on every camera's image of a frame once the frame's world, report
-    and commands came, and hands the drawn images (camera id -> BGR) to ``sink``."""
+def tile_cameras(images: dict[int, NDArray[np.uint8]], models: Sequence[CameraModel]) -> NDArray[np.uint8]:
+    """All camera images in one picture, laid out as the cameras hang over the field."""
+    cams = [m for m in models if m.id in images]
+    if not cams:
+        raise ValueError("no camera images to tile")
+    first = cams[0]
+    # field directions of image 'right' and 'up' in the first camera
+    c = np.array([[first.width / 2, first.height / 2], [first.width / 2 + 50, first.height / 2],
+                  [first.width / 2, first.height / 2 - 50]])  # fmt: skip
+    p = first.unproject(c, 0.0)
+    right, up = p[1] - p[0], p[2] - p[0]
+    right, up = right / np.linalg.norm(right), up / np.linalg.norm(up)
+    pos = {m.id: (float(m.center[:2] @ right), float(m.center[:2] @ up)) for m in cams}
+    cols = sorted({round(v[0], 1) for v in pos.values()})
+    rows = sorted({round(v[1], 1) for v in pos.values()}, reverse=True)
+    h = max(images[m.id].shape[0] for m in cams)
+    w = max(images[m.id].shape[1] for m in cams)
+    out = np.zeros((h * len(rows), w * len(cols), 3), dtype=np.uint8)
+    for m in cams:
+        img = images[m.id]
+        r, k = rows.index(round(pos[m.id][1], 1)), cols.index(round(pos[m.id][0], 1))
+        out[r * h : r * h + img.shape[0], k * w : k * w + img.shape[1]] = img
+    return out
 
-    def __init__(self, team: Team, models: Sequence[CameraModel], robot_height: float,
-                 sink: Callable[[dict[int, NDArray[np.uint8]]], None]) -> None:  # fmt: skip
-        self.name = f"overlay/{team}"
-        self.inputs = ("camera/*", f"world/{team}", f"report/{team}", f"commands/{team}")
-        self.models = {m.id: m for m in models}
-        self.robot_height = robot_height
-        self.sink = sink
+
+class MatchVideoStage(BaseStage):
+    """``match.mp4`` from the bus: once a frame's commands of ``team`` came, the frame drawn as the
+    top-down field (``view`` "field", :mod:`cmdragons.runtime.topdown`) or as the camera images with
+    the team's overlays, tiled as the cameras hang ("cameras"); H.264 through PyAV."""
+
+    name = "video"
+
+    def __init__(self, path: Path, view: str, team: Team, models: Sequence[CameraModel], geometry: Field,
+                 robot_radius_m: float, robot_height_m: float, fps: float) -> None:  # fmt: skip
+        from cmdragons.runtime.topdown import TopDownView
+
+        self.inputs = ("camera/*", "truth", "referee", f"world/{team}", f"report/{team}", f"commands/{team}")
+        self.path, self.view, self.team, self.fps = path, view, team, fps
+        self.models = list(models)
+        self.robot_height_m = robot_height_m
+        self.topdown = TopDownView(geometry, robot_radius_m)
+        self.writer: Any = None
         self._images: dict[int, CameraFrame] = {}
+        self._truth: GroundTruth | None = None
+        self._game = GameState(0.0)
         self._world: WorldState | None = None
         self._report: TeamReport | None = None
 
     def on_message(self, topic: str, message: Any, publish: Publish) -> None:
         if isinstance(message, CameraFrame):
             self._images[message.camera_id] = message
+        elif isinstance(message, GroundTruth):
+            self._truth = message
+        elif isinstance(message, GameState):
+            self._game = message
         elif isinstance(message, WorldState):
             self._world = message
         elif isinstance(message, TeamReport):
             self._report = message
-        elif isinstance(message, TeamCommands) and self._report is not None and self._images:
-            frames = {cam: f for cam, f in self._images.items() if f.frame_number == message.frame_number}
-            self.sink({cam: draw_overlays(f.image, self.models[cam], self._world, self._report, message.commands,
-                                          self.robot_height) for cam, f in sorted(frames.items())})  # fmt: skip
+        elif isinstance(message, TeamCommands) and self._report is not None:
+            image = self._draw(message)
+            if image is not None:
+                self._write(image)
+
+    def _draw(self, commands: TeamCommands) -> NDArray[np.uint8] | None:
+        from cmdragons.runtime.topdown import view_frame
+
+        assert self._report is not None
+        if self.view == "field":
+            return self.topdown.draw(view_frame(self._truth, self._game, self._world, self._report, commands.commands))
+        frames = {cam: f for cam, f in self._images.items() if f.frame_number == commands.frame_number}
+        if not frames:
+            return None
+        drawn = {cam: draw_overlays(f.image, next(m for m in self.models if m.id == cam), self._world, self._report,
+                                    commands.commands, self.robot_height_m) for cam, f in frames.items()}  # fmt: skip
+        return tile_cameras(drawn, self.models)
+
+    def _write(self, image: NDArray[np.uint8]) -> None:
+        from cmdragons.videoio import VideoWriter
+
+        if self.writer is None:
+            self.writer = VideoWriter(self.path, image.shape[1], image.shape[0], self.fps)
+        self.writer.write(image)
+
+    def close(self) -> None:
+        if self.writer is not None:
+            self.writer.close()

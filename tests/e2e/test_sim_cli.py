@@ -62,6 +62,6 @@ def test_same_seed_same_run(tmp_path: Path) -> None:
 
 def test_bad_arguments(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["sim", "--seconds", "-1", "--no-progress"]) == 2
-    assert "--seconds must be a positive number" in capsys.readouterr().err
+    assert "--seconds: -1 must be a positive number" in capsys.readouterr().err
     assert main(["bench", "nosuch"]) == 2
     assert "unknown suite" in capsys.readouterr().err

@@ -19,8 +19,8 @@ from cmdragons.navigation import _reference as R
 from cmdragons.navigation.dynamic_window import window_points
 from cmdragons.planning import deadline, field_world
 from cmdragons.runtime.match import Match
-from cmdragons.runtime.stages import TeamStage
 from cmdragons.runtime.settings import load_settings
+from cmdragons.runtime.stages import TeamStage
 from cmdragons.safety import _reference as SR
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"

@@ -1,0 +1,238 @@
+"""What a play run's own output says: read back from its MCAP log, checked, and drawn on one page.
+
+:func:`load_run` reads ``run.mcap`` (topics /truth, /world/<ours>, /referee, /events and
+/report/<ours>: the bus's own messages) into arrays, so that nothing here depends on the match
+loop. :func:`run_warnings` says what looks wrong (a ball or an
+own robot vision never or seldom saw, commands the simulator clamped, a match slower than real
+time). :func:`write_report` draws the match report PNG with matplotlib: the shot map, possession
+and passes over time, the robots' traces, and the stage timings of summary.json.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["RunData", "load_run", "run_warnings", "write_report"]
+
+SELDOM = 0.5  # an object tracked as visible in fewer than this fraction of the frames is "seldom seen"
+_POSSESSION_M = 0.15  # a robot within this of the ball (centre to centre) has it
+
+
+@dataclass
+class RunData:
+    """A play run read back from its MCAP log. Times in s, positions field frame in m."""
+
+    ours: str = "blue"
+    t: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))  # /truth times
+    ball: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 2)))  # true ball per frame
+    traces: dict[tuple[str, int], NDArray[np.float64]] = field(default_factory=dict)  # true (n, 3): t, x, y
+    possession: list[str | None] = field(default_factory=list)  # per /truth frame: "blue", "yellow" or None
+    ball_seen: float = 0.0  # fraction of /world frames with the ball tracked as visible
+    robot_seen: dict[int, float] = field(default_factory=dict)  # own robot id -> fraction of /world frames
+    kicks: list[dict[str, Any]] = field(default_factory=list)  # /events of type kick, with x, y of the ball
+    goals: list[dict[str, Any]] = field(default_factory=list)
+    score_t: list[tuple[float, int, int]] = field(default_factory=list)  # (t, blue, yellow) at each change
+
+    @property
+    def frames(self) -> int:
+        return len(self.t)
+
+
+def load_run(path: str | Path, ours: str = "blue") -> RunData:
+    """Read ``run.mcap`` (see the module docstring)."""
+    from mcap.reader import make_reader
+
+    run = RunData(ours=ours)
+    times: list[float] = []
+    balls: list[tuple[float, float]] = []
+    traces: dict[tuple[str, int], list[tuple[float, float, float]]] = {}
+    world_frames, ball_visible = 0, 0
+    robot_visible: dict[int, int] = {}
+    actions: dict[int, str] = {}  # our robots' actions as the latest report had them
+    with open(path, "rb") as f:
+        for _, channel, message in make_reader(f).iter_messages():
+            d = json.loads(message.data)
+            topic = channel.topic
+            if topic == "/truth":
+                t = float(d["t"])
+                times.append(t)
+                b = d["ball"]
+                balls.append((b["x"], b["y"]))
+                near, holder = _POSSESSION_M, None
+                for r in d["robots"]:
+                    traces.setdefault((r["team"], r["id"]), []).append((t, r["x"], r["y"]))
+                    dist = math.hypot(r["x"] - b["x"], r["y"] - b["y"])
+                    if dist < near:
+                        near, holder = dist, r["team"]
+                run.possession.append(holder)
+            elif topic == f"/world/{ours}":
+                world_frames += 1
+                if d.get("ball") is not None and d["ball"].get("visible", True):
+                    ball_visible += 1
+                for r in d["robots"]:
+                    if r["team"] == ours and r.get("visible", True):
+                        robot_visible[r["id"]] = robot_visible.get(r["id"], 0) + 1
+            elif topic == f"/report/{ours}":
+                actions = {int(k): str(v) for k, v in d.get("actions", {}).items()}
+            elif topic == "/referee":
+                s = d["score"]
+                if not run.score_t or run.score_t[-1][1:] != (s["blue"], s["yellow"]):
+                    run.score_t.append((float(d["t"]), s["blue"], s["yellow"]))
+            elif topic == "/events":
+                for e in d.get("events", ()):
+                    if e.get("type") == "kick":
+                        if e.get("team") == ours:
+                            e = {**e, "action": actions.get(int(e["id"]))}  # what the strategy meant it for
+                        if balls:
+                            e = {**e, "x": balls[-1][0], "y": balls[-1][1]}
+                        run.kicks.append(e)
+                    elif e.get("type") == "goal":
+                        run.goals.append(e)
+    run.t = np.array(times)
+    run.ball = np.array(balls).reshape(-1, 2)
+    run.traces = {k: np.array(v) for k, v in traces.items()}
+    run.ball_seen = ball_visible / world_frames if world_frames else 0.0
+    for team, rid in run.traces:
+        if team == ours:
+            run.robot_seen[rid] = robot_visible.get(rid, 0) / world_frames if world_frames else 0.0
+    return run
+
+
+def _seen(fraction: float) -> str | None:
+    if fraction <= 0.0:
+        return "never"
+    if fraction < SELDOM:
+        return f"seldom ({100 * fraction:.0f} % of the frames)"
+    return None
+
+
+def run_warnings(run: RunData, summary: dict[str, Any]) -> list[str]:
+    """What looks wrong in a run, one sentence each (empty when nothing does)."""
+    out = []
+    if summary.get("perception") != "truth" and run.frames:
+        how = _seen(run.ball_seen)
+        if how:
+            out.append(f"our tracker saw the ball {how}: the team could hardly play "
+                       "(check the vision colours: cmdragons vision tune)")  # fmt: skip
+        for rid, fraction in sorted(run.robot_seen.items()):
+            how = _seen(fraction)
+            if how:
+                out.append(f"our tracker saw our robot {rid} {how} (check its pattern and the vision colours)")
+    clamped = summary.get("command_faults", {}).get("clamped", 0)
+    if clamped:
+        out.append(f"{clamped} command{'s were' if clamped != 1 else ' was'} clamped by the simulator to the "
+                   "robots' limits (the team asked for more than the robots can do)")  # fmt: skip
+    for name in ("non_finite", "timed_out", "unknown_robot"):
+        n = summary.get("command_faults", {}).get(name, 0)
+        if n:
+            out.append(f"{n} command fault{'s' if n != 1 else ''} of kind {name} (see summary.json command_faults)")
+    rtf = summary.get("realtime_factor")
+    if rtf is not None and rtf < 1.0:
+        out.append(f"the match ran slower than real time ({rtf}x, not counting the first-run compile): "
+                   "the team would fall behind a real game")  # fmt: skip
+    return out
+
+
+def write_report(run: RunData, summary: dict[str, Any], path: str | Path,
+                 half_size_m: tuple[float, float] = (4.5, 3.0)) -> Path:  # fmt: skip
+    """The one-page match report PNG (see the module docstring) of a field of ``half_size_m``
+    (half length, half width; m); returns its path."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Rectangle
+
+    path = Path(path)
+    fig = plt.figure(figsize=(14, 10), dpi=100)
+    grid = fig.add_gridspec(3, 2, height_ratios=[1.25, 0.6, 1.0])
+    score = summary.get("score", {})
+    fig.suptitle(f"Match report: blue (us) {score.get('blue', 0)} : {score.get('yellow', 0)} yellow (them), "
+                 f"{summary.get('seconds', 0):.0f} s against {summary.get('opponent')} "
+                 f"({summary.get('perception')}), seed {summary.get('seed')}"
+                 + ("  [interrupted]" if summary.get("interrupted") else ""), fontsize=13)  # fmt: skip
+    fl, fw = half_size_m
+    hl = max([fl] + [float(abs(tr[:, 1]).max()) for tr in run.traces.values() if len(tr)])
+    hw = max([fw] + [float(abs(tr[:, 2]).max()) for tr in run.traces.values() if len(tr)])
+
+    def field_axes(ax: Any, title: str) -> None:
+        ax.add_patch(Rectangle((-fl, -fw), 2 * fl, 2 * fw, fill=False, lw=1, color="0.5"))
+        ax.axvline(0.0, color="0.7", lw=0.8)
+        ax.set_xlim(-hl - 0.3, hl + 0.3)
+        ax.set_ylim(-hw - 0.3, hw + 0.3)
+        ax.set_aspect("equal")
+        ax.set_title(title, fontsize=11)
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel("y (m)")
+
+    # shot map: where each of our kicks started, by what it was for
+    ax = fig.add_subplot(grid[0, 0])
+    field_axes(ax, "Our kicks (where the ball was): shots, passes, clears; goals ringed")
+    marks = {"shot": ("o", "tab:red"), "pass": ("^", "tab:purple"), "clear": ("s", "tab:gray")}
+    for kind, (m, c) in marks.items():
+        k = [e for e in run.kicks if e.get("team") == run.ours and e.get("action") == kind]
+        ax.scatter([e["x"] for e in k], [e["y"] for e in k], marker=m, color=c, s=50,
+                   label=f"{kind} ({len(k)})")  # fmt: skip
+    goals = [g for g in run.goals if g.get("scoring_team") == run.ours]
+    if goals:
+        ax.scatter([g["x"] for g in goals], [g["y"] for g in goals], s=200, facecolors="none", edgecolors="gold",
+                   linewidths=2, label=f"our goals ({len(goals)})")  # fmt: skip
+    ax.legend(loc="upper left", fontsize=8)
+
+    # robot traces
+    ax = fig.add_subplot(grid[0, 1])
+    field_axes(ax, "Robot traces (truth): blue us, yellow them; ball black")
+    for (team, _rid), tr in sorted(run.traces.items()):
+        ax.plot(tr[:, 1], tr[:, 2], lw=0.8, color="tab:blue" if team == run.ours else "goldenrod",
+                alpha=0.9 if team == run.ours else 0.5)  # fmt: skip
+    if len(run.ball):
+        ax.plot(run.ball[:, 0], run.ball[:, 1], lw=0.6, color="black", alpha=0.6)
+
+    # possession and passes over time
+    ax = fig.add_subplot(grid[1, :])
+    ax.set_title("Possession over time (robot within 0.15 m of the ball) and our kicks", fontsize=11)
+    if run.frames:
+        code = np.array([1.0 if p == run.ours else (-1.0 if p is not None else 0.0) for p in run.possession])
+        ax.fill_between(run.t, 0, code, where=code > 0, step="mid", color="tab:blue", label="blue (us)")
+        ax.fill_between(run.t, 0, code, where=code < 0, step="mid", color="goldenrod", label="yellow")
+        ours_share = float(np.mean(code > 0))
+        theirs_share = float(np.mean(code < 0))
+        ax.text(0.01, 0.92, f"us {100 * ours_share:.0f} %, them {100 * theirs_share:.0f} %, "
+                f"loose {100 * (1 - ours_share - theirs_share):.0f} %", transform=ax.transAxes, fontsize=9)  # fmt: skip
+        for kind, (_m, c) in marks.items():
+            ts = [e["t"] for e in run.kicks if e.get("team") == run.ours and e.get("action") == kind]
+            if ts:
+                ax.vlines(ts, -1.0, 1.0, colors=c, lw=1.2, label=kind)
+        ax.set_xlim(0, max(float(run.t[-1]), 1e-3))
+    passes = summary.get("passes", {})
+    ax.set_xlabel(f"time (s); passes {passes.get('completed', 0)}/{passes.get('tried', 0)} completed")
+    ax.set_yticks([-1, 0, 1], ["them", "loose", "us"])
+    ax.legend(loc="upper right", fontsize=8, ncol=5)
+
+    # timings
+    ax = fig.add_subplot(grid[2, :])
+    cycle = summary.get("cycle_ms", {})
+    names = [n for n in ("render", "vision", "tracker", "brain", "strategy", "planning_control", "safety",
+                         "physics_and_opponent", "frame") if n in cycle]  # fmt: skip
+    y = np.arange(len(names))
+    ax.barh(y - 0.2, [cycle[n]["median"] for n in names], height=0.4, color="tab:green", label="median")
+    ax.barh(y + 0.2, [cycle[n]["p95"] for n in names], height=0.4, color="tab:olive", label="95th percentile")
+    ax.set_yticks(y, names)
+    ax.invert_yaxis()
+    ax.set_xlabel("ms per frame")
+    rtf = summary.get("realtime_factor")
+    compile_s = summary.get("compile_seconds", 0)
+    ax.set_title(f"Stage timings per camera frame (brain and vision are ours); {rtf}x real time, "
+                 f"not counting {compile_s:.0f} s of first-run compile", fontsize=11)  # fmt: skip
+    ax.legend(loc="lower right", fontsize=8)
+    fig.tight_layout(rect=(0, 0, 1, 0.96))
+    fig.savefig(path)
+    plt.close(fig)
+    return path

@@ -1,0 +1,235 @@
+"""The first run's kernel compile, made visible and split over two processes.
+
+numba compiles a kernel on its first call and caches the machine code in the package's
+``__pycache__`` (``cache=True``); a fresh clone has no cache, and a match would stall on its first
+frames for the better part of a minute without a word. :func:`warm_up` compiles the kernels a
+``play`` calls before the match starts, in four processes at once (the compile is single-threaded):
+the planner's in a child that solves a few throwaway queries, motion control's and the safety
+stage's in a child that drives a throwaway crowd of robots, the renderer's in a child that renders
+one throwaway frame, and vision's in this process on the same frame drawn by the renderer's numpy
+reference (what is left, say a kernel only strategy calls, compiles during the match). All write numba's cache, so
+the match then loads every kernel from it. :class:`CompileWatch` counts what compiles in this process (and how
+long it took), so that real-time factors can leave the one-time compile out.
+
+Nothing here changes a match: the throwaway objects have their own random generators.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Callable, Sequence
+from types import TracebackType
+from typing import Any
+
+__all__ = ["CompileWatch", "cold_kernels", "warm_up"]
+
+# the top-level kernels of a play, by module: if any has no cache index, the run compiles
+_PLAY_KERNELS: dict[str, tuple[str, ...]] = {
+    "sim._kernels": ("_render_frame_kernel", "_plan_objects_kernel"),
+    "vision._kernels": ("classify", "match_patterns", "ball_centre"),
+    "cmdragons.planning._kernels": ("build_world", "errt_grow", "point_free"),
+    "cmdragons.control._kernels": ("motion_commands",),
+    "cmdragons.safety._kernels": ("dss",),
+}
+
+
+def cold_kernels(images: bool) -> list[str]:
+    """Names of the play's kernels with no numba cache yet (``images``: the run renders and sees
+    camera images, so the renderer's and vision's kernels count too)."""
+    import importlib
+
+    cold = []
+    for module, names in _PLAY_KERNELS.items():
+        if not images and module in ("sim._kernels", "vision._kernels"):
+            continue
+        mod = importlib.import_module(module)
+        for name in names:
+            cache = getattr(mod, name)._cache
+            if not os.path.exists(cache._cache_file._index_path):
+                cold.append(f"{module}.{name}")
+    return cold
+
+
+class CompileWatch:
+    """Counts the numba compiles of this process while active: ``count``, ``seconds`` (wall time
+    spent compiling, outermost compiles only) and the name of the last kernel; ``on_compile(name)``
+    is called as each one starts."""
+
+    def __init__(self, on_compile: Callable[[str], None] | None = None) -> None:
+        from numba.core import event
+
+        self._event = event
+        self.on_compile = on_compile
+        self.count = 0
+        self.seconds = 0.0
+        self.last = ""
+        self._depth = 0
+        self._t0 = 0.0
+        watch = self
+
+        class _Listener(event.Listener):
+            def on_start(self, ev: Any) -> None:
+                if watch._depth == 0:
+                    watch._t0 = time.perf_counter()
+                    watch.last = _kernel_name(ev)
+                    if watch.on_compile is not None:
+                        watch.on_compile(watch.last)
+                watch._depth += 1
+
+            def on_end(self, ev: Any) -> None:
+                watch._depth -= 1
+                if watch._depth == 0:
+                    watch.count += 1
+                    watch.seconds += time.perf_counter() - watch._t0
+
+        self._listener = _Listener()
+
+    def start(self) -> None:
+        self._event.register("numba:compile", self._listener)  # type: ignore[no-untyped-call]
+
+    def stop(self) -> None:
+        if self._listener in self._event._registered.get("numba:compile", ()):
+            self._event.unregister("numba:compile", self._listener)  # type: ignore[no-untyped-call]
+
+    def __enter__(self) -> CompileWatch:
+        self.start()
+        return self
+
+    def __exit__(self, kind: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None) -> None:
+        self.stop()
+
+
+def _kernel_name(ev: Any) -> str:
+    fn = ev.data["dispatcher"].py_func
+    return f"{fn.__module__.rsplit('.', 2)[-2]}.{fn.__name__}"
+
+
+def warm_up(config: str | None, overrides: Sequence[str], opponent: str, images: bool,
+            on_progress: Callable[[int, str], None]) -> float:  # fmt: skip
+    """Compile the play's kernels now (see the module docstring); returns the wall seconds it took.
+    ``on_progress(kernels compiled so far, last kernel's name)`` is called from this thread and a
+    reader thread. A child that fails only leaves its kernels to compile during the match."""
+    t0 = time.perf_counter()
+    done = [0]
+    lock = threading.Lock()
+
+    def tick(name: str) -> None:
+        with lock:
+            done[0] += 1
+            on_progress(done[0], name)
+
+    children = []
+    for part in ("planning", "motion", "render") if images else ("planning", "motion"):
+        spec = json.dumps({"part": part, "config": config, "set": list(overrides), "opponent": opponent})
+        children.append(subprocess.Popen(
+            [sys.executable, "-m", "cmdragons.runtime.warmup", spec], stdout=subprocess.PIPE,
+            stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL, text=True,
+        ))  # fmt: skip
+
+    def read(child: subprocess.Popen[str]) -> None:
+        assert child.stdout is not None
+        for line in child.stdout:
+            tick(line.strip())
+
+    readers = [threading.Thread(target=read, args=(c,), daemon=True) for c in children]
+    for r in readers:
+        r.start()
+    try:
+        if images:
+            with CompileWatch(tick):
+                _warm_vision(config, overrides)
+        for c in children:
+            c.wait()
+        for r in readers:
+            r.join()
+    finally:
+        for c in children:
+            if c.poll() is None:
+                c.terminate()
+                c.wait()
+    return time.perf_counter() - t0
+
+
+def _warm_vision(config: str | None, overrides: Sequence[str]) -> None:
+    """Vision on one throwaway frame of every camera, drawn by the renderer's numpy reference
+    (the compiled renderer is the other child's)."""
+    import numpy as np
+
+    from cmdragons.runtime.settings import load_settings
+    from sim import _kernels as kern
+    from sim.simulator import Simulator
+    from vision.pipeline import VisionPipeline
+
+    settings = load_settings(config, overrides)
+    sim = Simulator(settings.field, settings.camera_models(), settings.sim, seed=0)
+    snap = sim.world.snapshot()
+    robots = np.ascontiguousarray(snap.robots, dtype=np.float64).reshape(-1, 8)
+    ball = np.ascontiguousarray(snap.ball, dtype=np.float64)
+    for r in sim.renderers:
+        p = r.params
+        plan = kern.plan_objects_reference(r.model, robots, ball, r.shape, r.pink, r.palette, p.exposure_s,
+                                           p.max_blur_samples, p.blur_step_px)  # fmt: skip
+        image = kern.render_frame_reference(r.background, r.noise, None, r.rays, r.foot, r.gain, r.cam, r.shape,
+                                            r.dots, r.palette, plan)[0]  # fmt: skip
+        VisionPipeline(settings.vision, settings.field, r.model).process(image, 0, 0.0)
+
+
+def _child(spec: dict[str, Any]) -> None:
+    """A child of :func:`warm_up`: compile one part, printing each kernel's name as it starts."""
+    from cmdragons.runtime.settings import load_settings
+
+    settings = load_settings(spec["config"], spec["set"])
+
+    def say(name: str) -> None:
+        print(name, flush=True)
+
+    with CompileWatch(say):
+        if spec["part"] == "render":
+            from sim.simulator import Simulator
+
+            Simulator(settings.field, settings.camera_models(), settings.sim, seed=0).capture()
+        elif spec["part"] == "planning":
+            _warm_planner(settings)
+        else:
+            _warm_motion(settings)
+
+
+def _warm_motion(settings: Any) -> None:
+    """The brain's navigators and safety stage as a match calls them: a few frames of the brain on
+    a throwaway crowd of own robots driving into each other and opponents."""
+    from cmdragons.messages import BallState, GameState, RobotState, WorldState
+    from cmdragons.team import Brain
+
+    brain = Brain("blue", settings)
+    n = settings.field.dims.robots_per_team
+    for k in range(3):
+        ours = [RobotState("blue", i, -1.0 + 0.25 * i, 0.1 * (i % 2), 0.0, 1.5 - 0.5 * i, 0.0, 0.0) for i in range(n)]
+        theirs = [RobotState("yellow", i, -0.9 + 0.25 * i, 0.3, math.pi, -1.0, 0.0, 0.0) for i in range(3)]
+        world = WorldState(k / 60.0, BallState(0.3, 0.0, 0.0, 0.0), tuple(ours + theirs), k)
+        brain.step(world, GameState(k / 60.0))
+
+
+def _warm_planner(settings: Any) -> None:
+    """Hard queries for the configured planner (what a match meets only now and then): a wall of
+    robots with one gap between start and goal."""
+    import numpy as np
+
+    from cmdragons.planning import PlanProblem, deadline, field_world, make_planner
+
+    ys = [y for y in np.arange(-3.0, 3.01, 0.15) if abs(y - 1.5) > 0.3]
+    world = field_world(settings.field_geometry(), np.column_stack([np.zeros(len(ys)), ys]))
+    radius = settings.field.robot.radius_m
+    planner = make_planner(settings.planner)
+    # the way through the gap; again a step on (the last plan is checked first); from inside a robot
+    for start in ((-2.0, -1.0), (-1.9, -1.0), (0.0, -0.6)):
+        planner.solve(PlanProblem(start, (2.0, -1.0), radius, world), deadline(0.5))
+
+
+if __name__ == "__main__":
+    _child(json.loads(sys.argv[1]))

@@ -1,0 +1,93 @@
+"""Every bad input a user may give: one line on stderr naming the problem and the fix, exit code 2,
+no traceback, and nothing already done lost (checks that can fail late run before the work)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from cmdragons.cli import main
+
+
+def run(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
+    code = main(argv)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def one_line(err: str) -> str:
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert "Traceback" not in err
+    return lines[0]
+
+
+@pytest.fixture
+def a_file(tmp_path: Path) -> Path:
+    p = tmp_path / "a_file"
+    p.write_text("not a folder\n")
+    return p
+
+
+# (argv, words the one line must hold); {file} is a regular file, {tmp} the test's folder
+CASES = [
+    (["play", "--seed", "-1"], ["--seed", "-1", "0 to 2**63-1"]),
+    (["sim", "--seed", "one"], ["--seed", "'one' is not a whole number"]),
+    (["play", "--seconds", "0"], ["--seconds", "positive number"]),
+    (["sim", "--seconds", "nan"], ["--seconds", "positive number"]),
+    (["vision", "x", "--fps", "-5"], ["--fps", "positive number"]),
+    (["play", "--bogus"], ["unrecognized arguments: --bogus", "-h"]),
+    (["play", "--out", "{file}"], ["--out", "is a file", "new folder"]),
+    (["play", "--out", "{file}/sub"], ["cannot create the output folder", "a_file is a file", "--out DIR"]),
+    (["sim", "--out", "{file}/sub/deeper"], ["cannot create the output folder", "a_file is a file", "--out DIR"]),
+    (["play", "--out", "/proc/no_such_folder"], ["cannot create the output folder", "--out DIR"]),
+    (["bench", "sim", "--quick", "--json", "{file}/rows.json"], ["--json", "a_file is a file"]),
+    (["bench", "sim", "--quick", "--json", "{tmp}"], ["--json", "is a folder", "file name"]),
+    (["sim", "--snapshot", "{file}/last.png", "--out", "{tmp}/s"], ["--snapshot", "a_file is a file"]),
+    (["sim", "--snapshot", "{tmp}/last.txt", "--out", "{tmp}/s"], ["--snapshot", "ending in .png"]),
+    (["play", "--set", "sim.physics.substeps=[1"], ["sim.physics.substeps", "not valid YAML", "[1, 2]"]),
+    (["play", "--set", "sim.render.noise_sigma=0"], ["render.noise_sigma", "did you mean noise_sigma_grey?"]),
+    (["play", "--set", "nosuch.key=1"], ["unknown concern"]),
+    (["play", "--config", "{tmp}/no_configs"], ["config folder not found"]),
+    (["bench", "nosuch"], ["unknown suite", "planning"]),
+]
+
+
+@pytest.mark.parametrize(("argv", "words"), CASES, ids=[" ".join(c[0]) for c in CASES])
+def test_bad_input_one_line_exit_2(argv: list[str], words: list[str], tmp_path: Path, a_file: Path,
+                                   capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
+    argv = [a.format(file=a_file, tmp=tmp_path) for a in argv]
+    code, out, err = run([*argv, "--no-progress"] if argv[0] in ("play", "sim") else argv, capsys)
+    assert code == 2
+    line = one_line(err)
+    for w in words:
+        assert w in line, line
+    assert "cmdragons bench" not in out  # no table: the bench never ran
+
+
+def test_snapshot_checked_before_the_run(tmp_path: Path, a_file: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code, _, _ = run(["sim", "--seconds", "0.2", "--snapshot", f"{a_file}/x.png", "--out", str(tmp_path / "s"),
+                      "--no-progress"], capsys)  # fmt: skip
+    assert code == 2
+    assert not (tmp_path / "s").exists()  # nothing made: the run never started
+
+
+def test_out_refuses_another_run_unless_overwrite(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "run"
+    argv = ["play", "--seconds", "0.2", "--perception", "truth", "--opponent", "none", "--no-progress", "--out",
+            str(out)]  # fmt: skip
+    assert run(argv, capsys)[0] == 0
+    (out / "notes.txt").write_text("mine\n")
+    first = json.loads((out / "summary.json").read_text())
+    code, _, err = run(argv, capsys)
+    assert code == 2
+    line = one_line(err)
+    assert "holds another run" in line and "--overwrite" in line
+    assert json.loads((out / "summary.json").read_text()) == first  # the first run is untouched
+    code, stdout, _ = run([*argv, "--overwrite", "--seed", "3"], capsys)
+    assert code == 0
+    assert json.loads((out / "summary.json").read_text())["seed"] == 3
+    assert (out / "notes.txt").read_text() == "mine\n"  # a file the runs did not write stays
+    assert stdout.strip().splitlines()[-1].endswith(str(out))

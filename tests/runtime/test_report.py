@@ -1,0 +1,78 @@
+"""The match report and the summary's warnings, from a run's own MCAP log."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import cv2
+import pytest
+
+from cmdragons.messages import (
+    BallState,
+    BallTruth,
+    GameState,
+    GroundTruth,
+    Kick,
+    RobotState,
+    RobotTruth,
+    SimEvents,
+    TeamReport,
+    WorldState,
+)
+from cmdragons.runtime.log import RunLog
+from cmdragons.runtime.report import load_run, run_warnings, write_report
+
+
+def write_log(path: Path, frames: int, ball_visible_every: int, robot_1_visible: bool) -> None:
+    """A play log as the match's bus writes it (the messages' own dict forms)."""
+    with RunLog(path) as log:
+        for i in range(frames):
+            t = i / 60
+            robots = tuple(RobotTruth("blue", k, -1.0 + k, 0.0, 0.0, 0.0, 0.0, 0.0) for k in (0, 1)) + (
+                RobotTruth("yellow", 0, 2.0, 0.5, 0.0, 0.0, 0.0, 0.0),)  # fmt: skip
+            ball_truth = BallTruth(-0.9 + 0.01 * i, 0.0, 0.0215, 0.0, 0.0)
+            log.write("/truth", t, GroundTruth(i, t, ball_truth, robots).to_dict())
+            log.write("/referee", t, GameState(t, score_blue=int(i > frames // 2)).to_dict())
+            seen = (RobotState("blue", 0, -1.0, 0.0, 0.0),) + ((RobotState("blue", 1, 0.0, 0.0, 0.0),)
+                                                               if robot_1_visible else ())  # fmt: skip
+            ball = BallState(0.0, 0.0, 0.0, 0.0, visible=i % ball_visible_every == 0)
+            log.write("/world/blue", t, WorldState(t, ball, seen, i).to_dict())
+            log.write("/report/blue", t, TeamReport("blue", i, t, actions={0: "shot"}).to_dict())
+            kicks = (Kick(t, "blue", 0, 3.0, False),) if i == 30 else ()
+            log.write("/events", t, SimEvents(i, t, (0.0, 0.0), kicks).to_dict())
+
+
+def test_ball_seldom_and_a_robot_never_seen_are_warned(tmp_path: Path) -> None:
+    write_log(tmp_path / "run.mcap", 120, ball_visible_every=4, robot_1_visible=False)
+    run = load_run(tmp_path / "run.mcap")
+    assert run.frames == 120
+    assert run.ball_seen == pytest.approx(0.25)
+    assert run.robot_seen == {0: 1.0, 1: 0.0}
+    assert run.possession[0] == "blue" and run.kicks[0]["action"] == "shot"
+    summary = {"perception": "vision", "command_faults": {"clamped": 1}, "realtime_factor": 0.8}
+    warnings = run_warnings(run, summary)
+    assert any("ball seldom (25 % of the frames)" in w for w in warnings)
+    assert any("robot 1 never" in w for w in warnings)
+    assert not any("robot 0" in w for w in warnings)
+    assert any(w.startswith("1 command was clamped") for w in warnings)
+    assert any("slower than real time (0.8x" in w for w in warnings)
+
+
+def test_a_clean_run_has_no_warning(tmp_path: Path) -> None:
+    write_log(tmp_path / "run.mcap", 60, ball_visible_every=1, robot_1_visible=True)
+    run = load_run(tmp_path / "run.mcap")
+    summary = {"perception": "vision", "command_faults": {"clamped": 0}, "realtime_factor": 1.5}
+    assert run_warnings(run, summary) == []
+
+
+def test_report_png_is_one_page(tmp_path: Path) -> None:
+    write_log(tmp_path / "run.mcap", 120, ball_visible_every=1, robot_1_visible=True)
+    summary = json.loads(json.dumps({
+        "score": {"blue": 1, "yellow": 0}, "seconds": 2.0, "opponent": "simple", "perception": "vision", "seed": 1,
+        "passes": {"tried": 1, "completed": 0}, "realtime_factor": 1.2, "compile_seconds": 0.0,
+        "cycle_ms": {"vision": {"median": 1.5, "p95": 2.0}, "brain": {"median": 2.0, "p95": 4.0}},
+    }))  # fmt: skip
+    path = write_report(load_run(tmp_path / "run.mcap"), summary, tmp_path / "report.png")
+    img = cv2.imread(str(path))
+    assert img is not None and img.shape == (1000, 1400, 3)

@@ -38,7 +38,10 @@ def build_parser() -> argparse.ArgumentParser:
     _common(p)
     p.add_argument("--seconds", type=float, default=10.0, help="simulated seconds (default 10)")
     p.add_argument("--record", action="store_true", help="write camera frames, cameras.yaml and truth.jsonl")
-    p.add_argument("--format", choices=("mp4", "png"), default="mp4", help="recorded frames: mp4 video or lossless PNG")
+    p.add_argument("--format", choices=("h264", "ffv1", "png"), default=None,
+                   help="recorded frames: H.264 .mp4, lossless FFV1 .mkv or lossless PNG (default: cameras.yaml recording)")
+    p.add_argument("--crf", type=int, choices=range(52), default=None, metavar="0-51",
+                   help="H.264 quality on x264's scale, 0 best (default: cameras.yaml recording.crf)")
     p.add_argument("--out", metavar="DIR", default=None, help="output folder (default logs/<time>-sim)")
     p.add_argument("--snapshot", metavar="FILE.png", default=None, help="write the last frame of all cameras, tiled")
     p.add_argument("--seed", type=int, default=None, help="override sim.seed")
@@ -144,6 +147,8 @@ def tile_cameras(images: dict[int, NDArray[np.uint8]], models: Sequence[object])
 
 
 def _cmd_sim(args: argparse.Namespace) -> int:
+    import dataclasses
+
     import cv2
 
     from cmdragons.recording import RecordingWriter
@@ -162,7 +167,9 @@ def _cmd_sim(args: argparse.Namespace) -> int:
     folder = run_folder("sim", args.out)
     fps = settings.sim.physics.frame_rate_hz
     n_frames = max(1, round(args.seconds * fps))
-    recorder = RecordingWriter(folder, models, fps, args.format) if args.record else None
+    rec = settings.cameras.recording
+    rec = dataclasses.replace(rec, codec=args.format or rec.codec, crf=rec.crf if args.crf is None else args.crf)
+    recorder = RecordingWriter(folder, models, fps, rec) if args.record else None
     log = RunLog(folder / "run.mcap")
     wall0 = time.perf_counter()
     frame = None
@@ -315,6 +322,8 @@ def _cmd_vision(args: argparse.Namespace) -> int:
         if frames:
             print(f"vision: {len(frames)} {name.replace('_', ' ')} frame(s): {', '.join(frames[:20])}"
                   + (" ..." if len(frames) > 20 else ""))  # fmt: skip
+    for message in summary.broken_off:
+        print(f"cmdragons vision: {message}; the frames before it were processed", file=sys.stderr)
     if summary.score:
         print("vision: against truth: " + ", ".join(f"{k} {v:.4g}" for k, v in summary.score.items()))
     if args.track:

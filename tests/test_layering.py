@@ -8,7 +8,8 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-FLOOR = {"cmdragons.config", "cmdragons.geometry", "cmdragons.messages", "cmdragons.camera", "cmdragons.recording"}
+FLOOR = {"cmdragons.config", "cmdragons.geometry", "cmdragons.messages", "cmdragons.camera", "cmdragons.recording",
+         "cmdragons.videoio"}
 PROJECT = ("cmdragons", "vision", "strategy", "sim")
 
 
@@ -52,3 +53,11 @@ def test_sim_never_imports_vision_strategy_or_the_brain(path: Path) -> None:
 def test_algorithms_import_no_middleware_physics_or_plotting(path: Path) -> None:
     bad = {m for m in imports(path) if m.split(".")[0] in {"zenoh", "pymunk", "matplotlib"}}
     assert not bad, f"{path} imports {bad}"
+
+
+@pytest.mark.parametrize(
+    "path", [p for pkg in PROJECT for p in sources(pkg) if p != ROOT / "cmdragons" / "videoio.py"],
+    ids=lambda p: str(p.relative_to(ROOT)),
+)  # fmt: skip
+def test_only_videoio_imports_pyav(path: Path) -> None:
+    assert "av" not in {m.split(".")[0] for m in imports(path)}, f"{path} imports PyAV: go through cmdragons.videoio"

@@ -76,6 +76,27 @@ def test_vision_on_a_glob_and_a_video(recording: Path, tmp_path: Path, capsys: p
     assert main(["vision", str(tmp_path / "nothing*.png"), "--config", str(CONFIGS), "--out", str(out)]) == 2
 
 
+def test_vision_on_a_cut_off_video_processes_every_frame_before_the_break(tmp_path: Path, capsys: Capture) -> None:
+    rec = tmp_path / "rec"
+    assert main(["sim", "--config", str(CONFIGS), "--seconds", "0.5", "--record", "--out", str(rec),
+                 "--no-progress"]) == 0  # fmt: skip
+    meta = yaml.safe_load((rec / "cameras.yaml").read_text())
+    assert meta["recording"] == {"codec": "h264", "crf": 18}  # the recording says what it holds
+    video = rec / "camera_0.mp4"
+    data = video.read_bytes()
+    video.write_bytes(data[: len(data) // 2])
+    capsys.readouterr()
+    out = tmp_path / "vision"
+    assert main(["vision", str(rec), "--config", str(CONFIGS), "--out", str(out), "--no-progress"]) == 0
+    err = capsys.readouterr().err
+    lines = [json.loads(line) for line in (out / "detections.jsonl").read_text().splitlines()]
+    cam0 = [d["frame_number"] for d in lines if d["camera_id"] == 0]
+    assert [d["frame_number"] for d in lines if d["camera_id"] == 1] == list(range(30))
+    assert 5 <= len(cam0) < 30 and cam0 == list(range(len(cam0)))
+    assert f"camera_0.mp4: frame {len(cam0)} " in err and "the frames before it were processed" in err
+    assert json.loads((out / "summary.json").read_text())["broken_off"][0].startswith(str(video))
+
+
 def test_tune_from_truth_and_from_labels(recording: Path, tmp_path: Path) -> None:
     config = tmp_path / "configs"
     shutil.copytree(CONFIGS, config)

@@ -71,6 +71,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--video", action="store_true", help="also write an annotated video per camera")
     p.add_argument("--fps", type=float, default=None, help="frames per second for t_capture (default: sim's)")
     p.add_argument("--track", action="store_true", help="also track the detections and write tracks.jsonl")
+    p.add_argument("--track-ahead", action="store_true",
+                   help="tracks predicted tracker.latency_s past each frame, as the live loop hands them to the team "
+                   "(default: the estimate at each frame's capture time)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
     p = sub.add_parser("bench", help="run a benchmark suite and print its table")
@@ -329,8 +332,10 @@ def _cmd_vision(args: argparse.Namespace) -> int:
     if args.track:
         from cmdragons.runtime.tracks import track_detections
 
-        counts = track_detections(folder / "detections.jsonl", folder / "tracks.jsonl", settings.tracker)
-        print(f"vision: tracked {counts['frames']} frames -> {folder / 'tracks.jsonl'}"
+        ahead = settings.tracker.latency_s if args.track_ahead else 0.0
+        counts = track_detections(folder / "detections.jsonl", folder / "tracks.jsonl", settings.tracker, ahead)
+        print(f"vision: tracked {counts['frames']} frames -> {folder / 'tracks.jsonl'} "
+              + (f"(predicted {ahead * 1e3:.0f} ms ahead, as the live loop)" if ahead else "(at capture time)")
               + (f" ({counts['bad_lines']} unreadable detection lines skipped)" if counts["bad_lines"] else ""))
     return 0 if len(bad) < summary.frames else 1
 

@@ -1,5 +1,9 @@
 """``cmdragons vision calibrate`` and ``cmdragons vision tune``: argument handling and config writing
-around :mod:`vision.calibrate` and :mod:`vision.tune`."""
+around :mod:`vision.calibrate` and :mod:`vision.tune`.
+
+Both rewrite a file the user edits, so both go through ruamel.yaml's round trip: every comment,
+key order and flow style of the file stays; only the values the command derives change.
+"""
 
 from __future__ import annotations
 
@@ -9,9 +13,13 @@ import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
+from typing import Any
+
 import cv2
 import numpy as np
 import yaml
+from ruamel.yaml import YAML
+from ruamel.yaml.comments import CommentedMap, CommentedSeq
 
 from cmdragons.camera import CameraParams, CamerasParams
 from cmdragons.config import ConfigError, to_plain
@@ -102,14 +110,70 @@ def _tune(args: argparse.Namespace, settings: object) -> int:
             images.append(np.asarray(img, dtype=np.uint8))
         samples = samples_from_labels(images, read_labels(args.labels), vis.colour_space)
     boxes = boxes_from_samples(samples, margin=args.margin)
-    colours = dict(vis.colours)
-    colours.update(boxes)
-    tuned = dataclasses.replace(vis, colours=colours)
-    out = Path(args.out) if args.out else settings.config_dir / "vision.yaml"  # type: ignore[attr-defined]
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(yaml.safe_dump(to_plain(tuned), sort_keys=False, default_flow_style=None), encoding="utf-8")
+    source = settings.config_dir / "vision.yaml"  # type: ignore[attr-defined]
+    out = Path(args.out) if args.out else source
+    doc = _load_round_trip(out if out.exists() else source)
+    colours = doc.setdefault("colours", CommentedMap())
     for name, box in boxes.items():
         n = sum(len(p) for p in samples[name])
-        print(f"tune: {name:8s} lo {list(box.lo)} hi {list(box.hi)} from {n} pixels")
-    print(f"tune: -> {out}")
+        entry = colours.get(name)
+        was = f"lo {list(entry['lo'])} hi {list(entry['hi'])}" if entry and "lo" in entry and "hi" in entry else "(new)"
+        print(f"tune: {name:8s} {n:7d} labelled pixels: {was} -> lo {list(box.lo)} hi {list(box.hi)}")
+        if entry is None:
+            entry = colours[name] = _flow(CommentedMap(min_area_px=box.min_area_px))
+        for key, value in (("lo", box.lo), ("hi", box.hi)):
+            if isinstance(entry.get(key), CommentedSeq):
+                entry[key][:] = list(value)  # in place: keeps the list's flow style and comments
+            else:
+                entry[key] = _flow(CommentedSeq(list(value)))
+    _write_round_trip(doc, out, _check_vision)
+    print(f"tune: only the colour boxes changed -> {out}")
     return 0
+
+
+def _yaml() -> YAML:
+    rt = YAML(typ="rt")
+    rt.preserve_quotes = True
+    rt.width = 4096  # never fold a long comment line
+    return rt
+
+
+def _load_round_trip(path: Path) -> Any:
+    """A YAML file as ruamel's round-trip document (a mapping that keeps comments and order)."""
+    try:
+        doc = _yaml().load(path.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise ValueError(f"{path}: cannot be read ({exc})") from None
+    except Exception as exc:  # ruamel's parser and scanner errors share no base class but Exception
+        raise ConfigError(path, "", f"not valid YAML: {exc}") from None
+    if doc is None:
+        doc = CommentedMap()
+    if not isinstance(doc, CommentedMap):
+        raise ConfigError(path, "", "expected a mapping at the top level")
+    return doc
+
+
+def _flow(node: Any) -> Any:
+    node.fa.set_flow_style()
+    return node
+
+
+def _check_vision(data: dict[str, Any], path: Path) -> None:
+    """An edited vision.yaml parses (raises ConfigError otherwise)."""
+    from cmdragons.config import parse
+    from vision.pipeline import VisionParams
+
+    parse(VisionParams, data, file=path)
+
+
+def _write_round_trip(doc: Any, path: Path, check: Callable[[dict[str, Any], Path], None]) -> None:
+    """Write ``doc`` to ``path`` after ``check`` accepted it as plain data (a bad result never
+    replaces a good file)."""
+    import io
+
+    buf = io.StringIO()
+    _yaml().dump(doc, buf)
+    text = buf.getvalue()
+    check(yaml.safe_load(text) or {}, path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text, encoding="utf-8")

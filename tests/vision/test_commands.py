@@ -97,10 +97,25 @@ def test_vision_on_a_cut_off_video_processes_every_frame_before_the_break(tmp_pa
     assert json.loads((out / "summary.json").read_text())["broken_off"][0].startswith(str(video))
 
 
-def test_tune_from_truth_and_from_labels(recording: Path, tmp_path: Path) -> None:
+def test_tune_from_truth_and_from_labels(recording: Path, tmp_path: Path, capsys: Capture) -> None:
     config = tmp_path / "configs"
     shutil.copytree(CONFIGS, config)
+    before = (config / "vision.yaml").read_text()
+    capsys.readouterr()
     assert main(["vision", "tune", str(recording), "--config", str(config)]) == 0
+    # every line but the colour boxes' stays as it was, comments and all
+    after = (config / "vision.yaml").read_text()
+    box_lines = [k for k, line in enumerate(before.splitlines()) if line.lstrip().startswith(
+        ("orange:", "blue:", "yellow:", "pink:", "green:")) and "lo:" in line]  # fmt: skip
+    assert len(box_lines) == 5 and len(after.splitlines()) == len(before.splitlines())
+    for k, (a, b) in enumerate(zip(before.splitlines(), after.splitlines(), strict=True)):
+        if k in box_lines:
+            assert a.split("{")[0] == b.split("{")[0] and "min_area_px: 6}" in b  # the key and min area stay
+        else:
+            assert a == b, (k, a, b)
+    assert after != before
+    printed = capsys.readouterr().out
+    assert "tune: blue" in printed and "labelled pixels: lo [67, 168, 46]" in printed and " -> lo [" in printed
     tuned = load_settings(config).vision
     assert set(tuned.colours) == {"orange", "blue", "yellow", "pink", "green"}
     # the tuned boxes hold the shipped colours' centres: blue's U is high, yellow's Y is high

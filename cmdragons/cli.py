@@ -39,7 +39,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seconds", type=float, default=10.0, help="simulated seconds (default 10)")
     p.add_argument("--record", action="store_true", help="write camera frames, cameras.yaml and truth.jsonl")
     p.add_argument("--format", choices=("h264", "ffv1", "png"), default=None,
-                   help="recorded frames: H.264 .mp4, lossless FFV1 .mkv or lossless PNG (default: cameras.yaml recording)")
+                   help="recorded frames: H.264 .mp4, lossless FFV1 .mkv or lossless PNG "
+                   "(default: cameras.yaml recording)")
     p.add_argument("--crf", type=int, choices=range(52), default=None, metavar="0-51",
                    help="H.264 quality on x264's scale, 0 best (default: cameras.yaml recording.crf)")
     p.add_argument("--out", metavar="DIR", default=None, help="output folder (default logs/<time>-sim)")

@@ -50,9 +50,10 @@ class RecordingWriter:
     """Writes frames of every camera and their truth into ``folder``, encoded as ``params`` says."""
 
     def __init__(self, folder: str | Path, cameras: Sequence[CameraModel], fps: float,
-                 params: RecordingParams = RecordingParams()) -> None:  # fmt: skip
+                 params: RecordingParams | None = None) -> None:  # fmt: skip
         self.folder = Path(folder)
         self.folder.mkdir(parents=True, exist_ok=True)
+        params = params or RecordingParams()
         self.params, self.fps = params, fps
         self.cameras = {c.id: c for c in cameras}
         meta = CamerasParams(layout="list", cameras=tuple(c.params for c in cameras), recording=params)

@@ -22,11 +22,23 @@ from types import TracebackType
 from typing import Any, Literal
 
 import av
-import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["CODECS", "Codec", "VideoError", "VideoWriter", "read_video", "video_info"]
+from cmdragons import _kernels as kern
+
+__all__ = [
+    "CODECS",
+    "Codec",
+    "VideoError",
+    "VideoWriter",
+    "bgr_to_i420",
+    "bgr_to_i420_reference",
+    "i420_to_bgr",
+    "i420_to_bgr_reference",
+    "read_video",
+    "video_info",
+]
 
 Codec = Literal["h264", "ffv1"]
 CODECS: tuple[Codec, ...] = ("h264", "ffv1")
@@ -76,6 +88,9 @@ class VideoWriter:
         except (av.FFmpegError, OSError) as exc:
             raise VideoError(f"{self.path}: cannot be opened for writing ({exc})") from None
         self._stream.width, self._stream.height, self._stream.pix_fmt = width, height, pix_fmt
+        if codec == "h264":  # say what the samples are: BT.601 (SMPTE 170M) in the limited range
+            ctx = self._stream.codec_context
+            ctx.colorspace, ctx.color_primaries, ctx.color_trc, ctx.color_range = 6, 6, 6, 1
         self._closed = False
 
     def write(self, image: NDArray[np.uint8]) -> None:
@@ -86,8 +101,7 @@ class VideoWriter:
             raise VideoError(f"{self.path}: frame {self.frames} is {image.dtype} {image.shape}, "
                              f"expected uint8 ({self.height}, {self.width}, 3)")  # fmt: skip
         if self.codec == "h264":
-            # OpenCV's BT.601 conversion: FFmpeg's default scaler darkens a round trip by ~2 grey levels
-            frame = av.VideoFrame.from_ndarray(cv2.cvtColor(image, cv2.COLOR_BGR2YUV_I420), format="yuv420p")
+            frame = av.VideoFrame.from_ndarray(bgr_to_i420(image), format="yuv420p")
         else:
             frame = av.VideoFrame.from_ndarray(np.ascontiguousarray(image), format="bgr24")
         frame.pts = self.frames
@@ -132,11 +146,75 @@ def video_info(path: str | Path) -> dict[str, Any]:
         raise VideoError(f"{path}: cannot be opened as a video ({exc})") from None
 
 
+# BT.601 in the limited range (Y 16..235, Cb and Cr 16..240), rows Y, Cb, Cr over (B, G, R, 1)
+_TO_YUV = np.array([[24.966, 128.553, 65.481, 16.0 * 255.0], [112.0, -74.203, -37.797, 128.0 * 255.0],
+                    [-18.214, -93.786, 112.0, 128.0 * 255.0]], dtype=np.float64) / 255.0  # fmt: skip
+# and back: rows B, G, R over (Y, Cb, Cr, 1)
+_TO_BGR = np.linalg.inv(np.vstack([_TO_YUV, [0.0, 0.0, 0.0, 1.0]]))[:3]
+
+
+def bgr_to_i420(image: NDArray[np.uint8]) -> NDArray[np.uint8]:
+    """BGR (H, W, 3) uint8, H and W even -> planar 4:2:0 (H * 3 / 2, W) uint8 as H.264 stores it:
+    BT.601 in the limited range, each chroma sample where the standard puts it (MPEG-2 siting: on
+    the even luma columns, between each pair of luma rows), low-passed to that grid ([1, 2, 1] / 4
+    along rows, the mean of the two rows). Point samples or 2 x 2 means at another place shift a
+    colour by half a pixel against its brightness (OpenCV's own I420 conversion does, by +0.5 px
+    in u and v), which moves every colour blob's centre."""
+    h, w = image.shape[:2]
+    out = np.empty(h * w * 3 // 2, np.uint8)
+    kern.bgr_to_i420(np.ascontiguousarray(image), _TO_YUV, out)
+    return out.reshape(h * 3 // 2, w)
+
+
+def i420_to_bgr(planes: NDArray[np.uint8], h: int, w: int) -> NDArray[np.uint8]:
+    """Planar 4:2:0 (H * W * 3 / 2 bytes, any shape) uint8 (BT.601, limited range, MPEG-2 chroma
+    siting) -> BGR (H, W, 3) uint8, the chroma interpolated linearly at every pixel's true
+    position: the inverse of :func:`bgr_to_i420` up to the chroma resolution lost."""
+    out = np.empty((h, w, 3), np.uint8)
+    kern.i420_to_bgr(np.ascontiguousarray(planes).reshape(-1), _TO_BGR, out)
+    return out
+
+
+def _u8(x: NDArray[np.float64]) -> NDArray[np.uint8]:
+    return np.clip(np.floor(x + 0.5), 0, 255).astype(np.uint8)
+
+
+def bgr_to_i420_reference(image: NDArray[np.uint8]) -> NDArray[np.uint8]:
+    """Plain numpy of :func:`bgr_to_i420` (the kernel's arithmetic, in float64)."""
+    h, w = image.shape[:2]
+    px = np.concatenate([image.astype(np.float64), np.ones((h, w, 1))], axis=-1)
+    y = _u8(px @ _TO_YUV[0])
+    pair = 0.5 * (px[0::2] + px[1::2])  # between the rows
+    left = np.concatenate([pair[:, :1], pair[:, 1:-1:2]], axis=1)  # column 2j - 1, 0 at the edge
+    site = 0.25 * left + 0.5 * pair[:, 0::2] + 0.25 * pair[:, 1::2]
+    return np.concatenate([y.ravel(), _u8(site @ _TO_YUV[1]).ravel(), _u8(site @ _TO_YUV[2]).ravel()]).reshape(
+        h * 3 // 2, w)  # fmt: skip
+
+
+def i420_to_bgr_reference(planes: NDArray[np.uint8], h: int, w: int) -> NDArray[np.uint8]:
+    """Plain numpy of :func:`i420_to_bgr`."""
+    flat = planes.reshape(-1).astype(np.float64)
+    hc, wc = h // 2, w // 2
+    y = flat[: h * w].reshape(h, w)
+    c = np.stack([flat[h * w : h * w + hc * wc].reshape(hc, wc), flat[h * w + hc * wc :].reshape(hc, wc)], axis=-1)
+    up = np.concatenate([c[:1], c[:-1]], axis=0)  # rows sit 1/4 of a chroma row off their sample
+    down = np.concatenate([c[1:], c[-1:]], axis=0)
+    rows = np.empty((h, wc, 2))
+    rows[0::2] = 0.75 * c + 0.25 * up
+    rows[1::2] = 0.75 * c + 0.25 * down
+    full = np.empty((h, w, 2))
+    full[:, 0::2] = rows  # even columns on the sample, odd ones halfway to the next
+    full[:, 1::2] = 0.5 * (rows + np.concatenate([rows[:, 1:], rows[:, -1:]], axis=1))
+    yuv1 = np.concatenate([y[..., None], full, np.ones((h, w, 1))], axis=-1)
+    return _u8(yuv1 @ _TO_BGR.T)
+
+
 def _bgr(frame: Any) -> NDArray[np.uint8]:
-    """A decoded frame as BGR uint8: 4:2:0 video by OpenCV's BT.601 conversion (the inverse of
-    the writer's), any other pixel format by FFmpeg's scaler."""
+    """A decoded frame as BGR uint8: 4:2:0 video by :func:`i420_to_bgr` (the inverse of the
+    writer's conversion; FFmpeg's default scaler darkens by ~2 grey levels and replicates the
+    chroma), any other pixel format by FFmpeg's scaler."""
     if frame.format.name == "yuv420p" and frame.width % 2 == 0 and frame.height % 2 == 0:
-        return np.asarray(cv2.cvtColor(frame.to_ndarray(), cv2.COLOR_YUV2BGR_I420), dtype=np.uint8)
+        return i420_to_bgr(frame.to_ndarray(), frame.height, frame.width)
     return np.ascontiguousarray(frame.to_ndarray(format="bgr24"), dtype=np.uint8)
 
 

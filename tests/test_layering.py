@@ -9,7 +9,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 FLOOR = {"cmdragons.config", "cmdragons.geometry", "cmdragons.messages", "cmdragons.camera", "cmdragons.recording",
-         "cmdragons.videoio"}
+         "cmdragons.videoio", "cmdragons._kernels"}
 PROJECT = ("cmdragons", "vision", "strategy", "sim")
 
 

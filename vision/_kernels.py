@@ -41,16 +41,17 @@ def _channel_value(src: np.ndarray, j: int, a: np.ndarray) -> int:
 
 
 @numba.njit(cache=True, inline="always")
-def _screen_row(c1: np.ndarray, screen: np.ndarray, hit: np.ndarray) -> bool:
-    """``hit[j] = 1`` where channel-1 value ``c1[j]`` lies in one of the intervals
-    ``[lo, lo + width]`` (rows of ``screen``): one vectorised pass per interval, the range test
-    done as one unsigned compare. Returns whether the row has any hit."""
+def _screen_row(c0: np.ndarray, c1: np.ndarray, screen: np.ndarray, hit: np.ndarray) -> bool:
+    """``hit[j] = 1`` where channels 0 and 1 of pixel ``j`` (``c0[j]``, ``c1[j]``) both lie in the
+    ranges of one class: rows of ``screen`` are ``(lo0, width0, lo1, width1)`` per class, a range
+    ``[lo, lo + width]``. One vectorised pass per class, each range test one unsigned compare.
+    Returns whether the row has any hit."""
     w = c1.shape[0]
     hit[:w] = 0
     for k in range(screen.shape[0]):
-        lo, width = screen[k, 0], screen[k, 1]
+        lo0, w0, lo1, w1 = screen[k, 0], screen[k, 1], screen[k, 2], screen[k, 3]
         for j in range(w):
-            hit[j] |= np.uint8(np.uint8(c1[j] - lo) <= width)
+            hit[j] |= np.uint8(np.uint8(c0[j] - lo0) <= w0) & np.uint8(np.uint8(c1[j] - lo1) <= w1)
     words = hit.view(np.uint64)
     acc = np.uint64(0)
     for q in range(words.shape[0]):
@@ -79,15 +80,15 @@ def _put_run(runs: np.ndarray, n: int, start: int, end: int, cls: int) -> int:
 
 
 @numba.njit(cache=True, inline="always")
-def _classify_row(src: np.ndarray, conv: np.ndarray, lut: np.ndarray, c1: np.ndarray, hit: np.ndarray,
-                  out: np.ndarray, runs: np.ndarray) -> int:  # fmt: skip
+def _classify_row(src: np.ndarray, conv: np.ndarray, lut: np.ndarray, c0: np.ndarray, c1: np.ndarray,
+                  hit: np.ndarray, out: np.ndarray, runs: np.ndarray) -> int:  # fmt: skip
     """Finish one screened row: at each hit, the full class bit set (all three tables); writes it
     to ``out`` (non-zero entries only) and runs of one class to ``runs``, a pixel taking its lowest
     class (config order is priority). Blocks of 8 pixels without a hit are skipped whole, so the
     encoding touches only screened pixels and the ends of runs. Returns the number of runs."""
     w = c1.shape[0]
     words = hit.view(np.uint64)
-    a0, a2 = conv[0], conv[2]
+    a2 = conv[2]
     n = 0
     cur = -1
     start = 0
@@ -101,7 +102,7 @@ def _classify_row(src: np.ndarray, conv: np.ndarray, lut: np.ndarray, c1: np.nda
             continue
         m = np.uint32(0)
         if hit[j]:
-            m = lut[1, c1[j]] & lut[0, _channel_value(src, j, a0)] & lut[2, _channel_value(src, j, a2)]
+            m = lut[0, c0[j]] & lut[1, c1[j]] & lut[2, _channel_value(src, j, a2)]
             out[j] = m
         cls = -1 if m == 0 else _lowest_bit(m)
         if cls != cur:
@@ -121,11 +122,14 @@ def classify(image: np.ndarray, conv: np.ndarray, lut: np.ndarray, screen: np.nd
     """Classification (thesis A.1.3) and run-length encoding in one pass over the image.
 
     A pixel's bit set is ``lut[0, c0] & lut[1, c1] & lut[2, c2]``: the classes whose threshold box
-    holds it. Channel 1 (U in YUV) is computed first, alone, for every pixel, and screened against
-    ``screen`` (k, 2) uint8: the intervals ``[lo, lo + width]`` of channel-1 values whose table
-    entry is non-zero, exactly those (``vision.cmvision._screen_intervals``). The carpet, the field
-    lines and the robots' black covers fail on U alone, so channels 0 and 2 are computed only at
-    the few pixels that pass, and a row without one is done after the screen.
+    holds it. Channels 0 and 1 (Y and U in YUV) are computed first for every pixel and screened
+    against ``screen`` (k, 4) uint8: per class its ranges on those two channels
+    (``vision.cmvision._screen_boxes``), so a pixel passes when one class holds both its values.
+    The carpet, the field lines and the robots' black covers fail there (the carpet's U lies
+    inside the green id dots' range, its Y inside the blue centre dots': one channel alone no
+    longer screens it out once the boxes reach toward grey for compressed video), so channel 2
+    (and the run-length encoding) is computed only at the few pixels that pass, and a row without
+    one is done after the screen.
 
     The bit sets are written to ``bits`` (H, W) when it has H rows (else ``bits`` is unused). When
     ``runs`` has H rows, ``runs[row, k] = (u_start, u_end inclusive, class)`` and ``counts[row]``
@@ -134,11 +138,12 @@ def classify(image: np.ndarray, conv: np.ndarray, lut: np.ndarray, screen: np.nd
 
     Serial: with this little work per pixel, a 2-core machine shared with other jobs ran it faster
     on one thread than in parallel over blocks of rows (0.49 against 0.55 ms median per 1024x768
-    frame).
+    frame, with one screened channel).
     """
     h, w = image.shape[0], image.shape[1]
     flat = image.reshape(h, w * 3)
     keep_bits, encode = bits.shape[0] == h, runs.shape[0] == h
+    c0 = np.empty(w, np.uint8)
     c1 = np.empty(w, np.uint8)
     hit = np.zeros((w + 7) // 8 * 8, np.uint8)  # whole 8-pixel words; the tail stays 0
     row = np.empty(w, np.uint32)
@@ -147,10 +152,11 @@ def classify(image: np.ndarray, conv: np.ndarray, lut: np.ndarray, screen: np.nd
         out = bits[i] if keep_bits else row
         if keep_bits:
             out[:] = 0
+        _channel_row(flat[i], conv[0], c0)
         _channel_row(flat[i], conv[1], c1)
         n = 0
-        if _screen_row(c1, screen, hit):
-            n = _classify_row(flat[i], conv, lut, c1, hit, out, runs[i] if encode else no_runs)
+        if _screen_row(c0, c1, screen, hit):
+            n = _classify_row(flat[i], conv, lut, c0, c1, hit, out, runs[i] if encode else no_runs)
         if encode:
             counts[i] = n
 

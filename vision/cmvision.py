@@ -5,8 +5,8 @@ An image (H, W, 3) BGR uint8 becomes colour regions in four steps:
 1. Thresholding (A.1.3): each colour class is a box ``lo <= c <= hi`` in a colour space (YUV by
    default, A.1.2). The boxes are compiled into three tables of 256 bit masks, one per channel,
    so one pass classifies every pixel into up to 32 classes with three look-ups and two ANDs.
-   U is computed first, alone, and screened against the U table: most of a field (carpet, lines,
-   the robots' black covers) fails on U, so Y and V are computed only where it passes.
+   Y and U are computed first and screened against each class's Y and U ranges: most of a field
+   (carpet, lines, the robots' black covers) fails there, so V is computed only where it passes.
 2. Run-length encoding: runs of one class along each row.
 3. Connected regions (A.1.4): runs that touch across rows are joined by union-find.
 4. Region statistics (A.1.5): area, centroid, bounding box, second moments; density-based merging
@@ -41,6 +41,7 @@ __all__ = [
     "merge_reference",
     "regions_reference",
     "runs_reference",
+    "screen_reference",
 ]
 
 MAX_CLASSES = 32
@@ -102,14 +103,20 @@ def build_lut(classes: Sequence[ColourClass]) -> NDArray[np.uint32]:
     return lut
 
 
-def _screen_intervals(table: NDArray[np.uint32]) -> NDArray[np.uint8]:
-    """The values whose entry in one channel's table is non-zero, as intervals: rows
-    ``(lo, width)`` uint8 for ``[lo, lo + width]``, in increasing order. The kernel screens pixels
-    on channel 1 with these (a vectorised compare per interval instead of a table look-up)."""
-    inside = np.concatenate([[False], table != 0, [False]])
-    edges = np.flatnonzero(np.diff(inside.astype(np.int8)))
-    starts, ends = edges[0::2], edges[1::2] - 1
-    return np.stack([starts, ends - starts], axis=1).astype(np.uint8).reshape(-1, 2)
+def _screen_boxes(classes: Sequence[ColourClass]) -> NDArray[np.uint8]:
+    """Per class, its ranges on channels 0 and 1 as rows ``(lo0, width0, lo1, width1)`` uint8 for
+    ``[lo, lo + width]``: the kernel lets a pixel through to the full classification when one
+    class holds both its channel-0 and channel-1 values (a superset of the pixels of any class)."""
+    return np.array([[c.lo[0], c.hi[0] - c.lo[0], c.lo[1], c.hi[1] - c.lo[1]] for c in classes],
+                    dtype=np.uint8).reshape(-1, 4)  # fmt: skip
+
+
+def screen_reference(c0: NDArray[np.int64], c1: NDArray[np.int64], classes: Sequence[ColourClass]) -> NDArray[np.bool_]:
+    """Which (channel 0, channel 1) values pass the kernel's screen: the plain-numpy reference."""
+    out = np.zeros(np.broadcast(c0, c1).shape, dtype=bool)
+    for c in classes:
+        out |= (c0 >= c.lo[0]) & (c0 <= c.hi[0]) & (c1 >= c.lo[1]) & (c1 <= c.hi[1])
+    return out
 
 
 def classify_reference(
@@ -176,7 +183,7 @@ class Segmenter:
         self.space = space
         self.params = params
         self.lut = build_lut(self.classes)
-        self._screen = _screen_intervals(self.lut[1])
+        self._screen = _screen_boxes(self.classes)
         self.conv = _CONVERSIONS[space]
         self.min_area = np.array([c.min_area_px for c in self.classes], dtype=np.float64)
         self._runs: NDArray[np.int32] = np.zeros((0, 0, 3), dtype=np.int32)

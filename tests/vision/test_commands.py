@@ -84,7 +84,7 @@ def test_vision_on_a_cut_off_video_processes_every_frame_before_the_break(tmp_pa
     assert meta["recording"] == {"codec": "h264", "crf": 18}  # the recording says what it holds
     video = rec / "camera_0.mp4"
     data = video.read_bytes()
-    video.write_bytes(data[: len(data) // 2])
+    video.write_bytes(data[: len(data) * 3 // 4])
     capsys.readouterr()
     out = tmp_path / "vision"
     assert main(["vision", str(rec), "--config", str(CONFIGS), "--out", str(out), "--no-progress"]) == 0
@@ -115,7 +115,7 @@ def test_tune_from_truth_and_from_labels(recording: Path, tmp_path: Path, capsys
             assert a == b, (k, a, b)
     assert after != before
     printed = capsys.readouterr().out
-    assert "tune: blue" in printed and "labelled pixels: lo [67, 168, 46]" in printed and " -> lo [" in printed
+    assert "tune: blue" in printed and "labelled pixels: lo [62, 154, 45]" in printed and " -> lo [" in printed
     tuned = load_settings(config).vision
     assert set(tuned.colours) == {"orange", "blue", "yellow", "pink", "green"}
     # the tuned boxes hold the shipped colours' centres: blue's U is high, yellow's Y is high

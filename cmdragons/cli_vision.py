@@ -88,9 +88,10 @@ def _calibrate(args: argparse.Namespace, settings: object) -> int:
         raise ValueError("give either POINTS.yaml or --lines IMAGE")
     image = None
     if args.lines is not None:
-        image = cv2.imread(args.lines, cv2.IMREAD_COLOR)
-        if image is None:
+        read = cv2.imread(args.lines, cv2.IMREAD_COLOR)
+        if read is None:
             raise ValueError(f"{args.lines}: cannot be read as an image")
+        image = np.asarray(read, dtype=np.uint8)
         if args.resolution is None:
             args.resolution = (image.shape[1], image.shape[0])
     if args.resolution:
@@ -108,7 +109,7 @@ def _calibrate(args: argparse.Namespace, settings: object) -> int:
         if not 0.3 < height < 50.0:
             raise ValueError(f"--height must be 0.3 to 50 m, got {height}")
         sees = tuple(args.sees) if args.sees else _footprint(guess)
-        start = rough_start(guess, height, sees)  # type: ignore[arg-type]
+        start = rough_start(guess, height, sees)
         if args.focal:
             start = dataclasses.replace(start, focal_px=args.focal)
         fit = calibrate_from_lines(image, settings.field, start, args.reach)  # type: ignore[attr-defined]

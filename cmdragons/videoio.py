@@ -25,7 +25,7 @@ import av
 import numpy as np
 from numpy.typing import NDArray
 
-from cmdragons import _kernels as kern
+import cmdragons._kernels as kern
 
 __all__ = [
     "CODECS",
@@ -82,15 +82,15 @@ class VideoWriter:
             # written still opens and reads up to its last whole fragment
             fmt_options = {"movflags": "frag_keyframe+empty_moov+default_base_moof"} if self.path.suffix.lower() in (
                 ".mp4", ".mov") else {}
-            self._container: Any = av.open(str(self.path), mode="w", options=fmt_options)
-            self._stream: Any = self._container.add_stream(encoder, rate=Fraction(fps).limit_denominator(1001),
-                                                           options=options)  # fmt: skip
+            container: Any = av.open(str(self.path), mode="w", options=fmt_options)
+            stream: Any = container.add_stream(encoder, rate=Fraction(fps).limit_denominator(1001), options=options)
         except (av.FFmpegError, OSError) as exc:
             raise VideoError(f"{self.path}: cannot be opened for writing ({exc})") from None
-        self._stream.width, self._stream.height, self._stream.pix_fmt = width, height, pix_fmt
+        stream.width, stream.height, stream.pix_fmt = width, height, pix_fmt
         if codec == "h264":  # say what the samples are: BT.601 (SMPTE 170M) in the limited range
-            ctx = self._stream.codec_context
+            ctx = stream.codec_context
             ctx.colorspace, ctx.color_primaries, ctx.color_trc, ctx.color_range = 6, 6, 6, 1
+        self._container, self._stream = container, stream
         self._closed = False
 
     def write(self, image: NDArray[np.uint8]) -> None:

@@ -5,8 +5,9 @@ An image (H, W, 3) BGR uint8 becomes colour regions in four steps:
 1. Thresholding (A.1.3): each colour class is a box ``lo <= c <= hi`` in a colour space (YUV by
    default, A.1.2). The boxes are compiled into three tables of 256 bit masks, one per channel,
    so one pass classifies every pixel into up to 32 classes with three look-ups and two ANDs.
-   Y and U are computed first and screened against each class's Y and U ranges: most of a field
-   (carpet, lines, the robots' black covers) fails there, so V is computed only where it passes.
+   All three channels are computed in vectorised rows and screened against every class's box
+   first: most of a field (carpet, lines, the robots' black covers) fails there, so the look-ups
+   and the run-length encoding touch only the few pixels of some class.
 2. Run-length encoding: runs of one class along each row.
 3. Connected regions (A.1.4): runs that touch across rows are joined by union-find.
 4. Region statistics (A.1.5): area, centroid, bounding box, second moments; density-based merging
@@ -41,7 +42,6 @@ __all__ = [
     "merge_reference",
     "regions_reference",
     "runs_reference",
-    "screen_reference",
 ]
 
 MAX_CLASSES = 32
@@ -104,19 +104,11 @@ def build_lut(classes: Sequence[ColourClass]) -> NDArray[np.uint32]:
 
 
 def _screen_boxes(classes: Sequence[ColourClass]) -> NDArray[np.uint8]:
-    """Per class, its ranges on channels 0 and 1 as rows ``(lo0, width0, lo1, width1)`` uint8 for
-    ``[lo, lo + width]``: the kernel lets a pixel through to the full classification when one
-    class holds both its channel-0 and channel-1 values (a superset of the pixels of any class)."""
-    return np.array([[c.lo[0], c.hi[0] - c.lo[0], c.lo[1], c.hi[1] - c.lo[1]] for c in classes],
-                    dtype=np.uint8).reshape(-1, 4)  # fmt: skip
-
-
-def screen_reference(c0: NDArray[np.int64], c1: NDArray[np.int64], classes: Sequence[ColourClass]) -> NDArray[np.bool_]:
-    """Which (channel 0, channel 1) values pass the kernel's screen: the plain-numpy reference."""
-    out = np.zeros(np.broadcast(c0, c1).shape, dtype=bool)
-    for c in classes:
-        out |= (c0 >= c.lo[0]) & (c0 <= c.hi[0]) & (c1 >= c.lo[1]) & (c1 <= c.hi[1])
-    return out
+    """Per class, its box as a row ``(lo0, width0, lo1, width1, lo2, width2)`` uint8, each range
+    ``[lo, lo + width]``: the kernel's vectorised screen, which lets a pixel through to the table
+    look-ups and the run-length encoding when one class holds it."""
+    return np.array([[v for ch in range(3) for v in (c.lo[ch], c.hi[ch] - c.lo[ch])] for c in classes],
+                    dtype=np.uint8).reshape(-1, 6)  # fmt: skip
 
 
 def classify_reference(

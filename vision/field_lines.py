@@ -134,9 +134,9 @@ def _sample(img: NDArray[np.float32], px: F64) -> F64:
     """Bilinear samples of ``img`` at pixel positions (n, 2) (u, v from the top-left corner)."""
     n = len(px)
     cols = 1024  # OpenCV's maps stay below 32767 rows and columns
-    maps = np.zeros((-(-n // cols) * cols, 2), np.float32)
-    maps[:n] = px - 0.5  # OpenCV measures from the top-left pixel's centre
-    maps = maps.reshape(-1, cols, 2)
+    flat = np.zeros((-(-n // cols) * cols, 2), np.float32)
+    flat[:n] = px - 0.5  # OpenCV measures from the top-left pixel's centre
+    maps = flat.reshape(-1, cols, 2)
     out = cv2.remap(img, maps[..., 0], maps[..., 1], cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
     return np.asarray(out, dtype=np.float64).ravel()[:n]
 
@@ -245,7 +245,8 @@ def _fine(start: CameraParams, pts: F64, tan: F64, strength: NDArray[np.float32]
         def resid(x: F64, sub: F64 = sub, centres: F64 = centres, nrm: F64 = nrm, n_fit: int = n_fit,
                   base: CameraParams = p) -> F64:  # fmt: skip
             proj = CameraModel(_params(x, base, n_fit)).project(sub)
-            return np.nan_to_num(np.sum((proj - centres) * nrm, axis=1), nan=50.0)
+            out: F64 = np.nan_to_num(np.sum((proj - centres) * nrm, axis=1), nan=50.0)
+            return out
 
         lo, hi = _bounds(p, n_fit, 0.1)
         sol = least_squares(resid, np.clip(_vector(p)[:n_fit], lo, hi), bounds=(lo, hi), loss="soft_l1", f_scale=1.0,

@@ -34,16 +34,17 @@ __all__ = ["ColourRoles", "VisionParams", "VisionPipeline", "default_colours"]
 
 def default_colours() -> dict[str, ColourClass]:
     """Boxes (YUV) for the simulator's default colours, derived by ``cmdragons vision tune`` (margin
-    16) from 2 s recordings with truth (seed 11, not the bench's) at the bench's low, default and
-    high noise levels, each recorded lossless (PNG) and as H.264 in 4:2:0 at crf 18 and 23: one set
-    of boxes for lossless and compressed frames alike (4:2:0 pulls a small dot's chroma toward
+    16) from recordings with truth (seed 11, not the bench's): 2 s at the bench's low, default and
+    high noise levels and 6 s at the default level (a kick: a moving, blurred ball), each recorded
+    lossless (PNG) and as H.264 in 4:2:0 at crf 18 and 23; one set of boxes for lossless and
+    compressed frames alike (4:2:0 pulls a small dot's chroma toward
     grey, so the boxes reach further toward it than lossless frames alone would ask)."""
     return {
-        "orange": ColourClass(lo=(80, 40, 156), hi=(165, 100, 220), min_area_px=6),
-        "blue": ColourClass(lo=(62, 154, 45), hi=(131, 223, 109), min_area_px=6),
-        "yellow": ColourClass(lo=(157, 0, 123), hi=(238, 73, 181), min_area_px=6),
-        "pink": ColourClass(lo=(98, 118, 151), hi=(181, 184, 227), min_area_px=6),
-        "green": ColourClass(lo=(111, 46, 30), hi=(200, 119, 108), min_area_px=6),
+        "orange": ColourClass(lo=(80, 40, 147), hi=(165, 112, 221), min_area_px=6),
+        "blue": ColourClass(lo=(63, 155, 45), hi=(131, 223, 108), min_area_px=6),
+        "yellow": ColourClass(lo=(157, 0, 122), hi=(238, 74, 181), min_area_px=6),
+        "pink": ColourClass(lo=(99, 118, 151), hi=(181, 183, 226), min_area_px=6),
+        "green": ColourClass(lo=(112, 46, 30), hi=(200, 119, 108), min_area_px=6),
     }
 
 

@@ -42,6 +42,6 @@ def track_detections(detections: Path, out: Path, params: TrackerParams, ahead_s
     with open(out, "w", encoding="utf-8") as f:
         for n in sorted(frames):
             world = tracker.step(frames[n], ahead_s)
-            line = {**world.to_dict(), "t_capture": tracker.t, "ahead_s": ahead_s}
-            f.write(json.dumps(line, separators=(",", ":"), allow_nan=False) + "\n")
+            row = {**world.to_dict(), "t_capture": tracker.t, "ahead_s": ahead_s}
+            f.write(json.dumps(row, separators=(",", ":"), allow_nan=False) + "\n")
     return {"frames": len(frames), "bad_lines": bad, **tracker.stats.as_dict()}

@@ -74,8 +74,7 @@ def every_colour(step: int = 3) -> NDArray[np.uint8]:
 def test_screened_classification_equals_direct_thresholds_over_colour_space(
     space: str, classes: dict[str, ColourClass]
 ) -> None:
-    # the default boxes screen most colours out on channels 0 and 1; the wide ones let every pixel
-    # through the screen
+    # the default boxes screen most colours out; the wide ones let many pixels through the screen
     image = every_colour()
     seg = Segmenter(classes, space, RegionParams())  # type: ignore[arg-type]
     bits = classify_reference(image, list(classes.values()), space)  # type: ignore[arg-type]
@@ -86,21 +85,15 @@ def test_screened_classification_equals_direct_thresholds_over_colour_space(
 
 
 @pytest.mark.parametrize("classes", [CLASSES, wide_classes(), {}], ids=["default", "wide", "none"])
-def test_screen_passes_exactly_the_channel_0_1_values_of_some_class(classes: dict[str, ColourClass]) -> None:
-    from vision.cmvision import screen_reference
-
+def test_screen_rows_are_the_class_boxes_in_unsigned_compare_form(classes: dict[str, ColourClass]) -> None:
     boxes = _screen_boxes(list(classes.values()))
-    assert boxes.dtype == np.uint8 and boxes.shape == (len(classes), 4)
-    c0, c1 = np.meshgrid(np.arange(256), np.arange(256), indexing="ij")
-    held = np.zeros((256, 256), bool)
-    for c in classes.values():
-        held[c.lo[0] : c.hi[0] + 1, c.lo[1] : c.hi[1] + 1] = True
-    np.testing.assert_array_equal(screen_reference(c0, c1, list(classes.values())), held)
-    # the kernel's unsigned-compare form of the same test
-    got = np.zeros((256, 256), bool)
-    for lo0, w0, lo1, w1 in boxes.astype(np.int64):
-        got |= ((c0 - lo0) % 256 <= w0) & ((c1 - lo1) % 256 <= w1)
-    np.testing.assert_array_equal(got, held)
+    assert boxes.dtype == np.uint8 and boxes.shape == (len(classes), 6)
+    v = np.arange(256)
+    for row, c in zip(boxes.astype(np.int64), classes.values(), strict=True):
+        for ch in range(3):
+            lo, width = row[2 * ch], row[2 * ch + 1]
+            # the kernel's test: uint8(value - lo) <= width, exactly lo <= value <= hi
+            np.testing.assert_array_equal((v - lo) % 256 <= width, (v >= c.lo[ch]) & (v <= c.hi[ch]))
 
 
 def test_yuv_matches_opencv_within_one_level() -> None:

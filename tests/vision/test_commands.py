@@ -115,7 +115,7 @@ def test_tune_from_truth_and_from_labels(recording: Path, tmp_path: Path, capsys
             assert a == b, (k, a, b)
     assert after != before
     printed = capsys.readouterr().out
-    assert "tune: blue" in printed and "labelled pixels: lo [62, 154, 45]" in printed and " -> lo [" in printed
+    assert "tune: blue" in printed and "labelled pixels: lo [63, 155, 45]" in printed and " -> lo [" in printed
     tuned = load_settings(config).vision
     assert set(tuned.colours) == {"orange", "blue", "yellow", "pink", "green"}
     # the tuned boxes hold the shipped colours' centres: blue's U is high, yellow's Y is high

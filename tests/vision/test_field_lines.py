@@ -15,8 +15,8 @@ import yaml
 
 from cmdragons.camera import CameraModel, CameraParams, CamerasParams, cameras_from_config
 from cmdragons.cli import main
-from cmdragons.geometry import FieldDims, LeagueParams
-from sim.render import RenderParams
+from cmdragons.geometry import FieldDims
+from sim.render import CameraRenderer, RenderParams
 from vision.field_lines import calibrate_from_lines, rough_start
 
 from .conftest import LEAGUE, render, snapshot
@@ -62,7 +62,8 @@ def test_lines_on_a_frame_of_other_colours_tilt_and_distortion(cameras: list[Cam
     look = RenderParams(carpet_bgr=(60, 95, 20), line_bgr=(200, 225, 230), noise_sigma_grey=4.0,
                         vignetting_fraction=0.2, gradient_fraction=0.15)  # fmt: skip
     image, _ = render(CameraModel(true), snapshot(ROBOTS, ball=(-2.5, 0.3, 0.0215)), look, seed=5)
-    start = dataclasses.replace(off_start(base, -0.2, 0.2), position_m=(*off_start(base, -0.2, 0.2).position_m[:2], 3.7))
+    rough = off_start(base, -0.2, 0.2)
+    start = dataclasses.replace(rough, position_m=(*rough.position_m[:2], 3.7))  # the height measured
     fit = calibrate_from_lines(image, LEAGUE, start)
     dist, angle = pose_errors(fit.params, true)
     assert fit.rms_px <= 1.5  # the target for a frame the pipeline never produced
@@ -77,10 +78,7 @@ def test_lines_on_a_small_custom_field() -> None:
     league = dataclasses.replace(LEAGUE, divisions={"B": small, "A": LEAGUE.divisions["A"]})
     models = cameras_from_config(CamerasParams(), league)
     true = models[-1].params
-    renderer_league = league
-    from sim.render import CameraRenderer
-
-    image, _ = CameraRenderer(models[-1], renderer_league, RenderParams(), seed=2).render(
+    image, _ = CameraRenderer(models[-1], league, RenderParams(), seed=2).render(
         snapshot(ROBOTS[:2], ball=(1.0, 0.3, 0.0215)))  # fmt: skip
     fit = calibrate_from_lines(image.copy(), league, off_start(true, 0.2, 0.2))
     dist, angle = pose_errors(fit.params, true)

@@ -30,6 +30,13 @@ def _common(parser: argparse.ArgumentParser) -> None:
     )  # fmt: skip
 
 
+def _crf(text: str) -> int:
+    """x264's constant rate factor, 0 to 51."""
+    if not (text.isdigit() and 0 <= int(text) <= 51):
+        raise argparse.ArgumentTypeError(f"must be a whole number 0 to 51, got {text!r}")
+    return int(text)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="cmdragons", description="RoboCup small-size team and simulator")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
@@ -41,7 +48,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--format", choices=("h264", "ffv1", "png"), default=None,
                    help="recorded frames: H.264 .mp4, lossless FFV1 .mkv or lossless PNG "
                    "(default: cameras.yaml recording)")
-    p.add_argument("--crf", type=int, choices=range(52), default=None, metavar="0-51",
+    p.add_argument("--crf", type=_crf, default=None, metavar="0-51",
                    help="H.264 quality on x264's scale, 0 best (default: cameras.yaml recording.crf)")
     p.add_argument("--out", metavar="DIR", default=None, help="output folder (default logs/<time>-sim)")
     p.add_argument("--snapshot", metavar="FILE.png", default=None, help="write the last frame of all cameras, tiled")

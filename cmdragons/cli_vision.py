@@ -109,6 +109,10 @@ def _calibrate(args: argparse.Namespace, settings: object) -> int:
         if not 0.3 < height < 50.0:
             raise ValueError(f"--height must be 0.3 to 50 m, got {height}")
         sees = tuple(args.sees) if args.sees else _footprint(guess)
+        if not (abs(sees[2] - sees[0]) >= 0.2 and abs(sees[3] - sees[1]) >= 0.2):
+            raise ValueError(f"--sees must be a field rectangle X0 Y0 X1 Y1 at least 0.2 m each way, got {list(sees)}")
+        if not 0.0 <= args.reach <= 3.0:
+            raise ValueError(f"--reach must be 0 to 3 m, got {args.reach}")
         start = rough_start(guess, height, sees)
         if args.focal:
             start = dataclasses.replace(start, focal_px=args.focal)

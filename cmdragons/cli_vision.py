@@ -103,7 +103,7 @@ def _calibrate(args: argparse.Namespace, settings: object) -> int:
     if args.focal:
         guess = dataclasses.replace(guess, focal_px=args.focal)
     if image is not None:
-        from vision.field_lines import calibrate_from_lines, draw_field, rough_start
+        from vision.field_lines import LineFitParams, calibrate_from_lines, draw_field, rough_start
 
         height = args.height if args.height is not None else guess.position_m[2]
         if not 0.3 < height < 50.0:
@@ -111,12 +111,14 @@ def _calibrate(args: argparse.Namespace, settings: object) -> int:
         sees = tuple(args.sees) if args.sees else _footprint(guess)
         if not (abs(sees[2] - sees[0]) >= 0.2 and abs(sees[3] - sees[1]) >= 0.2):
             raise ValueError(f"--sees must be a field rectangle X0 Y0 X1 Y1 at least 0.2 m each way, got {list(sees)}")
-        if not 0.0 <= args.reach <= 3.0:
-            raise ValueError(f"--reach must be 0 to 3 m, got {args.reach}")
         start = rough_start(guess, height, sees)
         if args.focal:
             start = dataclasses.replace(start, focal_px=args.focal)
-        fit = calibrate_from_lines(image, settings.field, start, args.reach)  # type: ignore[attr-defined]
+        try:
+            fit_params = LineFitParams(reach_m=args.reach)
+        except ValueError as exc:
+            raise ValueError(f"--reach: {exc}") from None
+        fit = calibrate_from_lines(image, settings.field, start, fit_params)  # type: ignore[attr-defined]
         params, rms, worst, what = fit.params, fit.rms_px, fit.max_px, f"{fit.points} line points"
         overlay = Path(args.overlay) if args.overlay else Path(args.lines).with_name(
             Path(args.lines).stem + "_calibration.png")  # fmt: skip

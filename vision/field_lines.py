@@ -37,11 +37,34 @@ from scipy.optimize import least_squares
 from scipy.spatial import cKDTree
 
 from cmdragons.camera import CameraModel, CameraParams
+from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, LeagueParams
 
-__all__ = ["LineCalibration", "calibrate_from_lines", "draw_field", "field_samples", "line_strength", "rough_start"]
+__all__ = [
+    "LineCalibration",
+    "LineFitParams",
+    "calibrate_from_lines",
+    "draw_field",
+    "field_samples",
+    "line_strength",
+    "rough_start",
+]
 
 F64 = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class LineFitParams(Validated):
+    """How far the rough start may be off, and what counts as a painted line."""
+
+    reach_m: float = setting(0.4, lo=0.0, hi=3.0)  # the search over position: +- this along x and y
+    grid_steps: int = setting(9, lo=1, hi=41)  # positions per axis in that search
+    focal_range: float = setting(0.15, lo=0.0, hi=0.5)  # the search over focal length: +- this share
+    white_chroma: float = setting(60.0, lo=1.0, hi=255.0)  # grey levels from grey where a pixel stops being white
+    min_strength_grey: float = setting(8.0, lo=0.0, hi=255.0)  # a line pixel's top-hat, at least (noise's reach)
+    coarse_cap_px: float = setting(20.0, lo=2.0, hi=200.0)  # chamfer distances truncated here in the search
+    refine_cap_px: float = setting(6.0, lo=1.0, hi=50.0)  # ... and here in its refinement
+    search_px: float = setting(5.0, lo=1.0, hi=50.0)  # line centres looked for this far across a projected line
 
 
 @dataclass(frozen=True)
@@ -74,23 +97,23 @@ def field_samples(league: LeagueParams, step_m: float) -> tuple[F64, F64]:
     return np.concatenate([xy, np.zeros((len(xy), 1))], axis=1), np.concatenate(tan)
 
 
-def line_strength(image: NDArray[np.uint8], line_width_px: float) -> NDArray[np.float32]:
+def line_strength(image: NDArray[np.uint8], line_width_px: float, white_chroma: float = 60.0) -> NDArray[np.float32]:
     """How much each pixel looks like a painted line: the white top-hat of the brightness over a
     window of a few line widths, times the pixel's lack of colour (1 for grey, 0 from a chroma
-    distance of 60 grey levels up); float32 grey levels, 0 where nothing is."""
+    distance of ``white_chroma`` grey levels up); float32 grey levels, 0 where nothing is."""
     ycc = cv2.cvtColor(image, cv2.COLOR_BGR2YCrCb).astype(np.float32)
     k = 2 * max(2, int(math.ceil(2.0 * line_width_px))) + 1
     tophat = cv2.morphologyEx(ycc[..., 0], cv2.MORPH_TOPHAT, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
     chroma = np.hypot(ycc[..., 1] - 128.0, ycc[..., 2] - 128.0)
-    out: NDArray[np.float32] = tophat * np.clip(1.0 - chroma / 60.0, 0.0, 1.0)
+    out: NDArray[np.float32] = tophat * np.clip(1.0 - chroma / white_chroma, 0.0, 1.0)
     return out
 
 
-def _line_mask(strength: NDArray[np.float32]) -> NDArray[np.uint8]:
+def _line_mask(strength: NDArray[np.float32], floor: float) -> NDArray[np.uint8]:
     """Line pixels: strength above a third of the strong lines' (the 99.5th percentile of the
-    non-zero strengths) and above 8 grey levels, noise's reach."""
+    non-zero strengths) and above ``floor`` grey levels."""
     nz = strength[strength > 1.0]
-    level = max(8.0, float(np.percentile(nz, 99.5)) / 3.0) if nz.size else 8.0
+    level = max(floor, float(np.percentile(nz, 99.5)) / 3.0) if nz.size else floor
     return (strength > level).astype(np.uint8)
 
 
@@ -165,30 +188,32 @@ def _bounds(p: CameraParams, n: int, reach_m: float) -> tuple[F64, F64]:
     return (v - half)[:n], (v + half)[:n]
 
 
-def _coarse(start: CameraParams, pts: F64, dist: NDArray[np.float32], line_px: F64, reach_m: float) -> CameraParams:
+def _coarse(start: CameraParams, pts: F64, dist: NDArray[np.float32], line_px: F64,
+            fit: LineFitParams) -> CameraParams:  # fmt: skip
     """The best candidate camera around ``start`` by the truncated chamfer distance: a grid over
-    position (+- ``reach_m``), the half turn and the focal length (+- 15 %), then a least-squares
-    refinement (yaw, tilts, position, focal length) of the best few."""
+    position (+- ``reach_m``), the half turn and the focal length (+- ``focal_range``, five
+    steps), then a least-squares refinement (yaw, tilts, position, focal length) of the best few."""
     cands = []
     x0, y0 = start.position_m[:2]
-    steps = np.linspace(-reach_m, reach_m, 9)
+    steps = np.linspace(-fit.reach_m, fit.reach_m, fit.grid_steps)
+    cap0, cap1 = fit.coarse_cap_px, fit.refine_cap_px
     for turn in (0.0, math.pi):
-        for fs in (0.85, 0.925, 1.0, 1.075, 1.15):
+        for fs in 1.0 + np.linspace(-fit.focal_range, fit.focal_range, 5):
             for dx in steps:
                 for dy in steps:
                     p = dataclasses.replace(start, yaw_rad=start.yaw_rad + turn, focal_px=start.focal_px * fs,
                                             position_m=(x0 + dx, y0 + dy, start.position_m[2]))  # fmt: skip
-                    cands.append((float(np.mean(_chamfer(p, pts, dist, line_px, 20.0))), p))
+                    cands.append((float(np.mean(_chamfer(p, pts, dist, line_px, cap0))), p))
     cands.sort(key=lambda c: c[0])
     best, best_cost = start, math.inf
     for _, p in cands[:4]:
         lo, hi = _bounds(p, 6, 0.15)
-        for cap in (20.0, 6.0):
+        for cap in (cap0, cap1):
             sol = least_squares(lambda x, p=p, cap=cap: _chamfer(_params(x, p, 6), pts, dist, line_px, cap),
                                 np.clip(_vector(p)[:6], lo, hi), bounds=(lo, hi), diff_step=1e-3, max_nfev=100,
                                 x_scale=np.array([0.01, 0.01, 0.01, 0.02, 0.02, 5.0]))  # fmt: skip
             p = _params(sol.x, p, 6)
-        cost = float(np.mean(_chamfer(p, pts, dist, line_px, 6.0)))
+        cost = float(np.mean(_chamfer(p, pts, dist, line_px, cap1)))
         if cost < best_cost:
             best, best_cost = p, cost
     return best
@@ -231,12 +256,14 @@ def _centres(model: CameraModel, pts: F64, tan: F64, strength: NDArray[np.float3
     return idx, px[idx] + t[:, None] * nrm[idx], nrm[idx]
 
 
-def _fine(start: CameraParams, pts: F64, tan: F64, strength: NDArray[np.float32],
-          level: float) -> tuple[CameraParams, F64]:  # fmt: skip
-    """Point-to-line least squares on measured line centres, measured again after each fit."""
+def _fine(start: CameraParams, pts: F64, tan: F64, strength: NDArray[np.float32], level: float,
+          search_px: float) -> tuple[CameraParams, F64]:  # fmt: skip
+    """Point-to-line least squares on measured line centres, measured again after each fit: the
+    first time ``search_px`` across each line and without distortion, then ever closer with it."""
     p = start
     res = np.zeros(0)
-    for reach, n_fit in ((5.0, 6), (3.0, 8), (2.0, 8), (2.0, 8), (2.0, 8)):
+    near = min(search_px, 2.0)
+    for reach, n_fit in ((search_px, 6), (min(search_px, 3.0), 8), (near, 8), (near, 8), (near, 8)):
         idx, centres, nrm = _centres(CameraModel(p), pts, tan, strength, level, reach)
         if len(idx) < 20:
             raise ValueError(f"only {len(idx)} line points found near the model: the rough start is too far off")
@@ -257,16 +284,18 @@ def _fine(start: CameraParams, pts: F64, tan: F64, strength: NDArray[np.float32]
 
 
 def calibrate_from_lines(image: NDArray[np.uint8], league: LeagueParams, start: CameraParams,
-                         reach_m: float = 0.4) -> LineCalibration:  # fmt: skip
+                         fit: LineFitParams | None = None) -> LineCalibration:  # fmt: skip
     """Fit one camera to the field lines in ``image`` (H, W, 3) BGR uint8, from ``start`` (its
-    height is kept; its position may be off by up to about ``reach_m``, its focal length by 15 %,
-    its yaw by a few degrees or a half turn). Raises ValueError when the lines cannot be found."""
+    height is kept; its position may be off by up to about ``fit.reach_m``, its focal length by
+    ``fit.focal_range``, its yaw by a few degrees or a half turn). Raises ValueError when the
+    lines cannot be found."""
+    fit = fit or LineFitParams()
     if image.shape[:2] != (start.resolution_px[1], start.resolution_px[0]):
         w, h = start.resolution_px
         raise ValueError(f"the image is {image.shape[1]}x{image.shape[0]} px, the camera {w}x{h}: give its resolution")
     scale = start.focal_px / start.position_m[2]  # px per metre on the carpet, roughly
-    strength = line_strength(image, league.dims.line_width_m * scale)
-    mask = _line_mask(strength)
+    strength = line_strength(image, league.dims.line_width_m * scale, fit.white_chroma)
+    mask = _line_mask(strength, fit.min_strength_grey)
     if int(mask.sum()) < 200:
         raise ValueError(f"only {int(mask.sum())} line pixels found: is the field in view and lit?")
     dist = cv2.distanceTransform((1 - mask).astype(np.uint8), cv2.DIST_L2, 5).astype(np.float32)
@@ -274,11 +303,11 @@ def calibrate_from_lines(image: NDArray[np.uint8], league: LeagueParams, start: 
     v, u = np.nonzero(mask)
     pick = np.random.default_rng(0).permutation(len(u))[:1500]  # a fixed sample: the same fit every run
     line_px = np.stack([u[pick] + 0.5, v[pick] + 0.5], axis=1).astype(np.float64)
-    p = _coarse(start, coarse_pts, dist, line_px, reach_m)
+    p = _coarse(start, coarse_pts, dist, line_px, fit)
     pts, tan = field_samples(league, max(0.005, 3.0 / scale))
     nz = strength[mask > 0]
     level = 0.5 * float(np.median(nz))
-    p, res = _fine(p, pts, tan, strength, level)
+    p, res = _fine(p, pts, tan, strength, level, fit.search_px)
     err = np.abs(res)
     return LineCalibration(p, float(np.sqrt(np.mean(err**2))), float(err.max()), len(res), int(mask.sum()))
 

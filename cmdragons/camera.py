@@ -30,6 +30,7 @@ __all__ = [
     "CameraModel",
     "CameraParams",
     "CamerasParams",
+    "RecordingParams",
     "cameras_from_config",
     "opencv_extrinsics",
     "params_from_opencv",
@@ -87,12 +88,23 @@ class AutoLayout(Validated):
 
 
 @dataclass(frozen=True)
+class RecordingParams(Validated):
+    """How ``cmdragons sim --record`` stores the cameras' frames (a recording's own cameras.yaml
+    says what it holds): H.264 video in 4:2:0 at x264 quality ``crf`` (0 best .. 51; 18 visually
+    lossless, 23 x264's default), lossless FFV1 video in .mkv, or lossless PNG frames."""
+
+    codec: Literal["h264", "ffv1", "png"] = "h264"
+    crf: int = setting(18, lo=0, hi=51)  # h264 only
+
+
+@dataclass(frozen=True)
 class CamerasParams(Validated):
     """configs/cameras.yaml."""
 
     layout: Literal["auto", "list"] = "auto"
     auto: AutoLayout = AutoLayout()
     cameras: tuple[CameraParams, ...] = ()
+    recording: RecordingParams = RecordingParams()
 
     def __post_init__(self) -> None:
         super().__post_init__()

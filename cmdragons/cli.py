@@ -31,6 +31,13 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: {message} (see {self.prog} -h)\n")
 
 
+def _crf(text: str) -> int:
+    """x264's constant rate factor, 0 to 51."""
+    if not (text.isdigit() and 0 <= int(text) <= 51):
+        raise argparse.ArgumentTypeError(f"must be a whole number 0 to 51, got {text!r}")
+    return int(text)
+
+
 def _seed(text: str) -> int:
     try:
         value = int(text)
@@ -67,7 +74,11 @@ def build_parser() -> argparse.ArgumentParser:
     _common(p)
     p.add_argument("--seconds", type=_positive, default=10.0, help="simulated seconds (default 10)")
     p.add_argument("--record", action="store_true", help="write camera frames, cameras.yaml and truth.jsonl")
-    p.add_argument("--format", choices=("mp4", "png"), default="mp4", help="recorded frames: mp4 video or lossless PNG")
+    p.add_argument("--format", choices=("h264", "ffv1", "png"), default=None,
+                   help="recorded frames: H.264 .mp4, lossless FFV1 .mkv or lossless PNG "
+                   "(default: cameras.yaml recording)")
+    p.add_argument("--crf", type=_crf, default=None, metavar="0-51",
+                   help="H.264 quality on x264's scale, 0 best (default: cameras.yaml recording.crf)")
     p.add_argument("--out", metavar="DIR", default=None, help="output folder (default logs/<time>-sim)")
     p.add_argument("--overwrite", action="store_true", help="let --out replace the run already in that folder")
     p.add_argument("--snapshot", metavar="FILE.png", default=None, help="write the last frame of all cameras, tiled")
@@ -102,6 +113,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--video", action="store_true", help="also write an annotated video per camera")
     p.add_argument("--fps", type=_positive, default=None, help="frames per second for t_capture (default: sim's)")
     p.add_argument("--track", action="store_true", help="also track the detections and write tracks.jsonl")
+    p.add_argument("--track-ahead", action="store_true",
+                   help="tracks predicted tracker.latency_s past each frame, as the live loop hands them to the team "
+                   "(default: the estimate at each frame's capture time)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
     p = sub.add_parser("bench", help="run a benchmark suite and print its table")
@@ -166,6 +180,8 @@ def _progress(enabled: bool):  # type: ignore[no-untyped-def]
 
 
 def _cmd_sim(args: argparse.Namespace, stop: Interrupt) -> int:
+    import dataclasses
+
     from cmdragons.geometry import TEAMS
     from cmdragons.messages import GameState, SimEvents, TeamCommands
     from cmdragons.recording import RecordingWriter
@@ -185,7 +201,9 @@ def _cmd_sim(args: argparse.Namespace, stop: Interrupt) -> int:
     script = ScriptedPlay(settings.field_geometry(), settings.field.robot.radius_m, settings.sim.script, sim.rng)
     fps = settings.sim.physics.frame_rate_hz
     n_frames = max(1, round(args.seconds * fps))
-    recorder = RecordingWriter(folder, models, fps, args.format) if args.record else None
+    rec = settings.cameras.recording
+    rec = dataclasses.replace(rec, codec=args.format or rec.codec, crf=rec.crf if args.crf is None else args.crf)
+    recorder = RecordingWriter(folder, models, fps, rec) if args.record else None
     log = RunLog(folder / "run.mcap")
     wall0 = time.perf_counter()
     frame = None
@@ -422,13 +440,17 @@ def _cmd_vision(args: argparse.Namespace) -> int:
         if frames:
             print(f"vision: {len(frames)} {name.replace('_', ' ')} frame(s): {', '.join(frames[:20])}"
                   + (" ..." if len(frames) > 20 else ""))  # fmt: skip
+    for message in summary.broken_off:
+        print(f"cmdragons vision: {message}; the frames before it were processed", file=sys.stderr)
     if summary.score:
         print("vision: against truth: " + ", ".join(f"{k} {v:.4g}" for k, v in summary.score.items()))
     if args.track:
         from cmdragons.runtime.tracks import track_detections
 
-        counts = track_detections(folder / "detections.jsonl", folder / "tracks.jsonl", settings.tracker)
-        print(f"vision: tracked {counts['frames']} frames -> {folder / 'tracks.jsonl'}"
+        ahead = settings.tracker.latency_s if args.track_ahead else 0.0
+        counts = track_detections(folder / "detections.jsonl", folder / "tracks.jsonl", settings.tracker, ahead)
+        print(f"vision: tracked {counts['frames']} frames -> {folder / 'tracks.jsonl'} "
+              + (f"(predicted {ahead * 1e3:.0f} ms ahead, as the live loop)" if ahead else "(at capture time)")
               + (f" ({counts['bad_lines']} unreadable detection lines skipped)" if counts["bad_lines"] else ""))
     return 0 if len(bad) < summary.frames else 1
 

@@ -1,8 +1,10 @@
 """Recordings on disk: what ``cmdragons sim --record`` writes and ``cmdragons vision`` reads.
 
-A recording is a folder with, per camera, ``camera_<id>.mp4`` (or ``camera_<id>/<frame>.png``,
-lossless), ``cameras.yaml`` (the camera models used, loadable as configs/cameras.yaml with
-``layout: list``) and ``truth.jsonl`` (one :class:`GroundTruth` a line) where the truth is known.
+A recording is a folder with, per camera, ``camera_<id>.mp4`` (H.264), ``camera_<id>.mkv``
+(FFV1, lossless) or ``camera_<id>/<frame>.png`` (lossless), ``cameras.yaml`` (the camera models
+used, loadable as configs/cameras.yaml with ``layout: list``, and under ``recording`` the codec and
+quality the frames were written with) and ``truth.jsonl`` (one :class:`GroundTruth` a line) where
+the truth is known.
 """
 
 from __future__ import annotations
@@ -10,45 +12,63 @@ from __future__ import annotations
 import json
 from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import IO, Literal
+from typing import IO
 
 import cv2
 import numpy as np
 import yaml
 from numpy.typing import NDArray
 
-from cmdragons.camera import CameraModel, CameraParams, CamerasParams
+from cmdragons.camera import CameraModel, CameraParams, CamerasParams, RecordingParams
 from cmdragons.config import ConfigError, load_yaml, parse, to_plain
 from cmdragons.messages import GroundTruth
+from cmdragons.videoio import VideoError, VideoWriter, read_video
 
-__all__ = ["RecordingError", "RecordingReader", "RecordingWriter"]
+__all__ = ["RecordingError", "RecordingReader", "RecordingWriter", "camera_files"]
 
-VideoFormat = Literal["mp4", "png"]
+SUFFIX = {"h264": ".mp4", "ffv1": ".mkv"}
 
 
 class RecordingError(RuntimeError):
     """A recording folder that cannot be written or read."""
 
 
+def camera_files(folder: Path, cam: int) -> tuple[str, list[Path]]:
+    """Where a recording keeps camera ``cam``'s frames: ``("video", [file])`` or
+    ``("images", [png, ...])`` in frame order; RecordingError when it has none."""
+    for suffix in (".mp4", ".mkv"):
+        video = folder / f"camera_{cam}{suffix}"
+        if video.exists():
+            return "video", [video]
+    images = folder / f"camera_{cam}"
+    if images.is_dir():
+        return "images", sorted(images.glob("*.png"))
+    raise RecordingError(f"{folder}: no frames for camera {cam}")
+
+
 class RecordingWriter:
-    """Writes frames of every camera and their truth into ``folder``."""
+    """Writes frames of every camera and their truth into ``folder``, encoded as ``params`` says."""
 
     def __init__(self, folder: str | Path, cameras: Sequence[CameraModel], fps: float,
-                 fmt: VideoFormat = "mp4") -> None:  # fmt: skip
+                 params: RecordingParams | None = None) -> None:  # fmt: skip
         self.folder = Path(folder)
         self.folder.mkdir(parents=True, exist_ok=True)
-        self.fmt, self.fps = fmt, fps
+        params = params or RecordingParams()
+        self.params, self.fps = params, fps
         self.cameras = {c.id: c for c in cameras}
-        params = CamerasParams(layout="list", cameras=tuple(c.params for c in cameras))
+        meta = CamerasParams(layout="list", cameras=tuple(c.params for c in cameras), recording=params)
         with open(self.folder / "cameras.yaml", "w", encoding="utf-8") as f:
-            yaml.safe_dump(to_plain(params), f, sort_keys=False)
-        self._videos: dict[int, cv2.VideoWriter] = {}
+            f.write(f"# written by cmdragons sim --record: the camera models and how the frames are stored "
+                    f"({params.codec}{f', crf {params.crf}' if params.codec == 'h264' else ''})\n")
+            yaml.safe_dump(to_plain(meta), f, sort_keys=False)
+        self._videos: dict[int, VideoWriter] = {}
         self._truth: IO[str] = open(self.folder / "truth.jsonl", "w", encoding="utf-8")  # noqa: SIM115
         self.frames = 0
 
     def write(self, frame_number: int, images: dict[int, NDArray[np.uint8]], truth: GroundTruth | None) -> None:
+        codec = self.params.codec
         for cam, image in images.items():
-            if self.fmt == "png":
+            if codec == "png":
                 d = self.folder / f"camera_{cam}"
                 d.mkdir(exist_ok=True)
                 if not cv2.imwrite(str(d / f"{frame_number:06d}.png"), image):
@@ -57,10 +77,11 @@ class RecordingWriter:
             video = self._videos.get(cam)
             if video is None:
                 h, w = image.shape[:2]
-                path = str(self.folder / f"camera_{cam}.mp4")
-                video = cv2.VideoWriter(path, cv2.VideoWriter.fourcc(*"mp4v"), self.fps, (w, h))
-                if not video.isOpened():
-                    raise RecordingError(f"could not open {path} for writing (codec mp4v)")
+                try:
+                    video = VideoWriter(self.folder / f"camera_{cam}{SUFFIX[codec]}", w, h, self.fps, codec,
+                                        self.params.crf if codec == "h264" else None)  # fmt: skip
+                except VideoError as exc:
+                    raise RecordingError(str(exc)) from None
                 self._videos[cam] = video
             video.write(image)
         if truth is not None:
@@ -69,7 +90,7 @@ class RecordingWriter:
 
     def close(self) -> None:
         for video in self._videos.values():
-            video.release()
+            video.close()
         self._videos.clear()
         self._truth.close()
 
@@ -93,29 +114,20 @@ class RecordingReader:
             raise RecordingError(str(exc)) from None
         self.camera_params: dict[int, CameraParams] = {c.id: c for c in params.cameras}
         self.camera_ids = sorted(self.camera_params)
+        self.recording = params.recording
 
     def camera_model(self, cam: int) -> CameraModel:
         return CameraModel(self.camera_params[cam])
 
     def frames(self, cam: int) -> Iterator[NDArray[np.uint8]]:
-        """The camera's frames in order (BGR uint8)."""
-        video = self.folder / f"camera_{cam}.mp4"
-        if video.exists():
-            cap = cv2.VideoCapture(str(video))
-            if not cap.isOpened():
-                raise RecordingError(f"{video}: cannot be opened as a video")
-            try:
-                while True:
-                    ok, image = cap.read()
-                    if not ok:
-                        return
-                    yield np.asarray(image, dtype=np.uint8)
-            finally:
-                cap.release()
-        folder = self.folder / f"camera_{cam}"
-        if not folder.is_dir():
-            raise RecordingError(f"{self.folder}: no frames for camera {cam}")
-        for path in sorted(folder.glob("*.png")):
+        """The camera's frames in order (BGR uint8); a video that breaks off raises
+        :class:`VideoError` after its last good frame."""
+        kind, paths = camera_files(self.folder, cam)
+        if kind == "video":
+            for _, image in read_video(paths[0]):
+                yield image
+            return
+        for path in paths:
             read = cv2.imread(str(path), cv2.IMREAD_COLOR)
             if read is None:
                 raise RecordingError(f"{path}: cannot be read as an image")

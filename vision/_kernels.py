@@ -19,38 +19,39 @@ R_COLS = 11
 
 
 @numba.njit(cache=True, inline="always")
-def _channel_row(src: np.ndarray, a: np.ndarray, out: np.ndarray) -> None:
-    """One channel of one row of interleaved (b, g, r) bytes: the fixed-point (x 256) linear map
-    ``a[:3]`` plus the offset ``a[3]``, clamped to 0..255. Every step is cast back to int32 so that
-    LLVM keeps 32-bit lanes (numba widens integer arithmetic to int64, which halves the lanes); the
-    values fit: |a| <= 256 per coefficient, so a sum is at most 3 * 256 * 255 in magnitude."""
-    a0, a1, a2, a3 = np.int32(a[0]), np.int32(a[1]), np.int32(a[2]), np.int32(a[3])
-    for j in range(out.shape[0]):
-        x = np.int32(
-            np.int32(a0 * np.int32(src[3 * j])) + np.int32(a1 * np.int32(src[3 * j + 1]))
-            + np.int32(a2 * np.int32(src[3 * j + 2])) + np.int32(128)
-        )  # fmt: skip
-        out[j] = np.uint8(min(max(np.int32(np.int32(x >> np.int32(8)) + a3), np.int32(0)), np.int32(255)))
+def _channels_row(src: np.ndarray, conv: np.ndarray, c0: np.ndarray, c1: np.ndarray, c2: np.ndarray) -> None:
+    """The three channels of one row of interleaved (b, g, r) bytes, in one pass over the row: each
+    the fixed-point (x 256) linear map ``conv[k, :3]`` plus the offset ``conv[k, 3]``, clamped to
+    0..255. Every step is cast back to int32 so that LLVM keeps 32-bit lanes (numba widens integer
+    arithmetic to int64, which halves the lanes); the values fit: |a| <= 256 per coefficient, so a
+    sum is at most 3 * 256 * 255 in magnitude."""
+    a00, a01, a02, a03 = np.int32(conv[0, 0]), np.int32(conv[0, 1]), np.int32(conv[0, 2]), np.int32(conv[0, 3])
+    a10, a11, a12, a13 = np.int32(conv[1, 0]), np.int32(conv[1, 1]), np.int32(conv[1, 2]), np.int32(conv[1, 3])
+    a20, a21, a22, a23 = np.int32(conv[2, 0]), np.int32(conv[2, 1]), np.int32(conv[2, 2]), np.int32(conv[2, 3])
+    r128, lo, hi = np.int32(128), np.int32(0), np.int32(255)
+    for j in range(c0.shape[0]):
+        b, g, r = np.int32(src[3 * j]), np.int32(src[3 * j + 1]), np.int32(src[3 * j + 2])
+        x0 = np.int32(np.int32(np.int32(a00 * b) + np.int32(a01 * g) + np.int32(a02 * r) + r128) >> np.int32(8))
+        x1 = np.int32(np.int32(np.int32(a10 * b) + np.int32(a11 * g) + np.int32(a12 * r) + r128) >> np.int32(8))
+        x2 = np.int32(np.int32(np.int32(a20 * b) + np.int32(a21 * g) + np.int32(a22 * r) + r128) >> np.int32(8))
+        c0[j] = np.uint8(min(max(np.int32(x0 + a03), lo), hi))
+        c1[j] = np.uint8(min(max(np.int32(x1 + a13), lo), hi))
+        c2[j] = np.uint8(min(max(np.int32(x2 + a23), lo), hi))
 
 
 @numba.njit(cache=True, inline="always")
-def _channel_value(src: np.ndarray, j: int, a: np.ndarray) -> int:
-    """Pixel ``j`` of ``src`` in one channel: the same arithmetic as :func:`_channel_row`."""
-    b, g, r = np.int32(src[3 * j]), np.int32(src[3 * j + 1]), np.int32(src[3 * j + 2])
-    return int(min(max(((a[0] * b + a[1] * g + a[2] * r + 128) >> 8) + a[3], 0), 255))
-
-
-@numba.njit(cache=True, inline="always")
-def _screen_row(c1: np.ndarray, screen: np.ndarray, hit: np.ndarray) -> bool:
-    """``hit[j] = 1`` where channel-1 value ``c1[j]`` lies in one of the intervals
-    ``[lo, lo + width]`` (rows of ``screen``): one vectorised pass per interval, the range test
-    done as one unsigned compare. Returns whether the row has any hit."""
+def _screen_row(c0: np.ndarray, c1: np.ndarray, c2: np.ndarray, screen: np.ndarray, hit: np.ndarray) -> bool:
+    """``hit[j] = 1`` where the three channels of pixel ``j`` lie in the box of one class: rows of
+    ``screen`` are ``(lo0, width0, lo1, width1, lo2, width2)`` per class, a range
+    ``[lo, lo + width]``. One vectorised pass per class, each range test one unsigned compare.
+    Returns whether the row has any hit."""
     w = c1.shape[0]
     hit[:w] = 0
     for k in range(screen.shape[0]):
-        lo, width = screen[k, 0], screen[k, 1]
+        lo0, w0, lo1, w1, lo2, w2 = screen[k, 0], screen[k, 1], screen[k, 2], screen[k, 3], screen[k, 4], screen[k, 5]
         for j in range(w):
-            hit[j] |= np.uint8(np.uint8(c1[j] - lo) <= width)
+            hit[j] |= (np.uint8(np.uint8(c0[j] - lo0) <= w0) & np.uint8(np.uint8(c1[j] - lo1) <= w1)
+                       & np.uint8(np.uint8(c2[j] - lo2) <= w2))  # fmt: skip
     words = hit.view(np.uint64)
     acc = np.uint64(0)
     for q in range(words.shape[0]):
@@ -79,7 +80,7 @@ def _put_run(runs: np.ndarray, n: int, start: int, end: int, cls: int) -> int:
 
 
 @numba.njit(cache=True, inline="always")
-def _classify_row(src: np.ndarray, conv: np.ndarray, lut: np.ndarray, c1: np.ndarray, hit: np.ndarray,
+def _classify_row(lut: np.ndarray, c0: np.ndarray, c1: np.ndarray, c2: np.ndarray, hit: np.ndarray,
                   out: np.ndarray, runs: np.ndarray) -> int:  # fmt: skip
     """Finish one screened row: at each hit, the full class bit set (all three tables); writes it
     to ``out`` (non-zero entries only) and runs of one class to ``runs``, a pixel taking its lowest
@@ -87,7 +88,6 @@ def _classify_row(src: np.ndarray, conv: np.ndarray, lut: np.ndarray, c1: np.nda
     encoding touches only screened pixels and the ends of runs. Returns the number of runs."""
     w = c1.shape[0]
     words = hit.view(np.uint64)
-    a0, a2 = conv[0], conv[2]
     n = 0
     cur = -1
     start = 0
@@ -101,7 +101,7 @@ def _classify_row(src: np.ndarray, conv: np.ndarray, lut: np.ndarray, c1: np.nda
             continue
         m = np.uint32(0)
         if hit[j]:
-            m = lut[1, c1[j]] & lut[0, _channel_value(src, j, a0)] & lut[2, _channel_value(src, j, a2)]
+            m = lut[0, c0[j]] & lut[1, c1[j]] & lut[2, c2[j]]
             out[j] = m
         cls = -1 if m == 0 else _lowest_bit(m)
         if cls != cur:
@@ -121,11 +121,13 @@ def classify(image: np.ndarray, conv: np.ndarray, lut: np.ndarray, screen: np.nd
     """Classification (thesis A.1.3) and run-length encoding in one pass over the image.
 
     A pixel's bit set is ``lut[0, c0] & lut[1, c1] & lut[2, c2]``: the classes whose threshold box
-    holds it. Channel 1 (U in YUV) is computed first, alone, for every pixel, and screened against
-    ``screen`` (k, 2) uint8: the intervals ``[lo, lo + width]`` of channel-1 values whose table
-    entry is non-zero, exactly those (``vision.cmvision._screen_intervals``). The carpet, the field
-    lines and the robots' black covers fail on U alone, so channels 0 and 2 are computed only at
-    the few pixels that pass, and a row without one is done after the screen.
+    holds it. All three channels are computed for every pixel (vectorised rows) and screened
+    against ``screen`` (k, 6) uint8, each class's box (``vision.cmvision._screen_boxes``): a pixel
+    passes when one class holds it, so the screen is exact and the table look-ups and the
+    run-length encoding touch only the few pixels of some class; a row without one is done after
+    the screen. (One or two channels screened the carpet out while the boxes were tuned on
+    lossless frames; boxes that reach toward grey for compressed video hold the carpet's U in the
+    green id dots' range, its Y and U in the ball's, its Y and V in the blue centre dots'.)
 
     The bit sets are written to ``bits`` (H, W) when it has H rows (else ``bits`` is unused). When
     ``runs`` has H rows, ``runs[row, k] = (u_start, u_end inclusive, class)`` and ``counts[row]``
@@ -134,12 +136,14 @@ def classify(image: np.ndarray, conv: np.ndarray, lut: np.ndarray, screen: np.nd
 
     Serial: with this little work per pixel, a 2-core machine shared with other jobs ran it faster
     on one thread than in parallel over blocks of rows (0.49 against 0.55 ms median per 1024x768
-    frame).
+    frame, with one screened channel).
     """
     h, w = image.shape[0], image.shape[1]
     flat = image.reshape(h, w * 3)
     keep_bits, encode = bits.shape[0] == h, runs.shape[0] == h
+    c0 = np.empty(w, np.uint8)
     c1 = np.empty(w, np.uint8)
+    c2 = np.empty(w, np.uint8)
     hit = np.zeros((w + 7) // 8 * 8, np.uint8)  # whole 8-pixel words; the tail stays 0
     row = np.empty(w, np.uint32)
     no_runs = np.empty((0, 3), np.int32)
@@ -147,10 +151,10 @@ def classify(image: np.ndarray, conv: np.ndarray, lut: np.ndarray, screen: np.nd
         out = bits[i] if keep_bits else row
         if keep_bits:
             out[:] = 0
-        _channel_row(flat[i], conv[1], c1)
+        _channels_row(flat[i], conv, c0, c1, c2)
         n = 0
-        if _screen_row(c1, screen, hit):
-            n = _classify_row(flat[i], conv, lut, c1, hit, out, runs[i] if encode else no_runs)
+        if _screen_row(c0, c1, c2, screen, hit):
+            n = _classify_row(lut, c0, c1, c2, hit, out, runs[i] if encode else no_runs)
         if encode:
             counts[i] = n
 

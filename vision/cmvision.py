@@ -5,8 +5,9 @@ An image (H, W, 3) BGR uint8 becomes colour regions in four steps:
 1. Thresholding (A.1.3): each colour class is a box ``lo <= c <= hi`` in a colour space (YUV by
    default, A.1.2). The boxes are compiled into three tables of 256 bit masks, one per channel,
    so one pass classifies every pixel into up to 32 classes with three look-ups and two ANDs.
-   U is computed first, alone, and screened against the U table: most of a field (carpet, lines,
-   the robots' black covers) fails on U, so Y and V are computed only where it passes.
+   All three channels are computed in vectorised rows and screened against every class's box
+   first: most of a field (carpet, lines, the robots' black covers) fails there, so the look-ups
+   and the run-length encoding touch only the few pixels of some class.
 2. Run-length encoding: runs of one class along each row.
 3. Connected regions (A.1.4): runs that touch across rows are joined by union-find.
 4. Region statistics (A.1.5): area, centroid, bounding box, second moments; density-based merging
@@ -102,14 +103,12 @@ def build_lut(classes: Sequence[ColourClass]) -> NDArray[np.uint32]:
     return lut
 
 
-def _screen_intervals(table: NDArray[np.uint32]) -> NDArray[np.uint8]:
-    """The values whose entry in one channel's table is non-zero, as intervals: rows
-    ``(lo, width)`` uint8 for ``[lo, lo + width]``, in increasing order. The kernel screens pixels
-    on channel 1 with these (a vectorised compare per interval instead of a table look-up)."""
-    inside = np.concatenate([[False], table != 0, [False]])
-    edges = np.flatnonzero(np.diff(inside.astype(np.int8)))
-    starts, ends = edges[0::2], edges[1::2] - 1
-    return np.stack([starts, ends - starts], axis=1).astype(np.uint8).reshape(-1, 2)
+def _screen_boxes(classes: Sequence[ColourClass]) -> NDArray[np.uint8]:
+    """Per class, its box as a row ``(lo0, width0, lo1, width1, lo2, width2)`` uint8, each range
+    ``[lo, lo + width]``: the kernel's vectorised screen, which lets a pixel through to the table
+    look-ups and the run-length encoding when one class holds it."""
+    return np.array([[v for ch in range(3) for v in (c.lo[ch], c.hi[ch] - c.lo[ch])] for c in classes],
+                    dtype=np.uint8).reshape(-1, 6)  # fmt: skip
 
 
 def classify_reference(
@@ -176,7 +175,7 @@ class Segmenter:
         self.space = space
         self.params = params
         self.lut = build_lut(self.classes)
-        self._screen = _screen_intervals(self.lut[1])
+        self._screen = _screen_boxes(self.classes)
         self.conv = _CONVERSIONS[space]
         self.min_area = np.array([c.min_area_px for c in self.classes], dtype=np.float64)
         self._runs: NDArray[np.int32] = np.zeros((0, 0, 3), dtype=np.int32)

@@ -2,7 +2,8 @@
 detections.jsonl (DESIGN.md), an optional annotated video per camera, and a summary.
 
 A frame that cannot be read, is empty or has the wrong size is counted and reported by number; it
-never stops the run.
+never stops the run. A video that breaks off (truncated, corrupt) is processed up to its last good
+frame and the break is reported by file and frame.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from cmdragons.camera import CameraModel
 from cmdragons.geometry import LeagueParams
 from cmdragons.messages import DetectionFrame, GroundTruth
 from cmdragons.recording import RecordingReader
+from cmdragons.videoio import VideoError, VideoWriter
 from vision.pipeline import VisionParams, VisionPipeline
 from vision.score import Score
 from vision.sources import FrameSource
@@ -35,6 +37,7 @@ class RunSummary:
     unreadable: list[str] = field(default_factory=list)  # "<source>#<frame>"
     empty: list[str] = field(default_factory=list)
     wrong_size: list[str] = field(default_factory=list)
+    broken_off: list[str] = field(default_factory=list)  # a video's message: file, first frame not read
     robots: int = 0
     balls: int = 0
     ms: list[float] = field(default_factory=list)
@@ -45,6 +48,7 @@ class RunSummary:
         return {
             "frames": self.frames,
             "bad_frames": {"unreadable": self.unreadable, "empty": self.empty, "wrong_size": self.wrong_size},
+            "broken_off": self.broken_off,
             "robots_per_frame": self.robots / n,
             "balls_per_frame": self.balls / n,
             "ms_per_frame": {
@@ -101,8 +105,16 @@ def run_vision(sources: Sequence[FrameSource], cameras: dict[int, CameraModel], 
             if model is None:
                 raise ValueError(f"{src.name}: no camera model for camera id {src.camera_id} (see --config cameras)")
             pipe = VisionPipeline(params, league, model)
-            writer: cv2.VideoWriter | None = None
-            for k, image in src.frames():
+            writer: VideoWriter | None = None
+            frames = src.frames()
+            while True:
+                try:
+                    k, image = next(frames)
+                except StopIteration:
+                    break
+                except VideoError as exc:
+                    summary.broken_off.append(str(exc))
+                    break
                 where = f"{src.name}#{k}"
                 summary.frames += 1
                 if progress is not None:
@@ -126,13 +138,13 @@ def run_vision(sources: Sequence[FrameSource], cameras: dict[int, CameraModel], 
                 if score is not None and k in truth:
                     score.add(det, truth[k])
                 if video:
+                    # H.264 in 4:2:0 takes even sizes: an odd last column or row is left out
+                    w2, h2 = model.width // 2 * 2, model.height // 2 * 2
                     if writer is None:
-                        path = out / f"annotated_camera_{src.camera_id}.mp4"
-                        writer = cv2.VideoWriter(str(path), cv2.VideoWriter.fourcc(*"mp4v"), fps,
-                                                 (model.width, model.height))  # fmt: skip
-                    writer.write(annotate(image, pipe, det))
+                        writer = VideoWriter(out / f"annotated_camera_{src.camera_id}.mp4", w2, h2, fps, "h264", 23)
+                    writer.write(np.ascontiguousarray(annotate(image, pipe, det)[:h2, :w2]))
             if writer is not None:
-                writer.release()
+                writer.close()
     if score is not None:
         summary.score = score.summary()
     (out / "summary.json").write_text(json.dumps(summary.as_dict(), indent=2) + "\n", encoding="utf-8")

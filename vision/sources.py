@@ -1,7 +1,9 @@
 """Where camera frames come from: a recording folder, a video file, an image folder or a glob.
 
 A source yields ``(frame_number, image or None)``; None marks a frame that exists but cannot be
-read (a corrupt or empty file), so that the caller can count it and go on.
+read (a corrupt or empty file), so that the caller can count it and go on. A video that breaks
+off (truncated, corrupt) yields its frames up to the last good one and then raises
+:class:`cmdragons.videoio.VideoError` naming the file and frame.
 """
 
 from __future__ import annotations
@@ -16,12 +18,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cmdragons.camera import CameraModel
-from cmdragons.recording import RecordingReader
+from cmdragons.recording import RecordingError, RecordingReader, camera_files
+from cmdragons.videoio import read_video
 
 __all__ = ["FrameSource", "SourceError", "open_sources"]
 
 IMAGE_SUFFIXES = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff"}
-VIDEO_SUFFIXES = {".mp4", ".avi", ".mkv", ".mov"}
+VIDEO_SUFFIXES = {".mp4", ".avi", ".mkv", ".mov", ".webm", ".m4v", ".ts"}
 Frame = tuple[int, NDArray[np.uint8] | None]
 
 
@@ -41,7 +44,7 @@ class FrameSource:
 
     def frames(self) -> Iterator[Frame]:
         if self.kind == "video":
-            yield from _video(self.paths[0])
+            yield from read_video(self.paths[0])
         else:
             for k, path in enumerate(self.paths):
                 # recordings name frames by number; other folders count in sorted order
@@ -58,22 +61,6 @@ def _image(path: Path) -> NDArray[np.uint8] | None:
     return None if img is None else np.asarray(img, dtype=np.uint8)
 
 
-def _video(path: Path) -> Iterator[Frame]:
-    cap = cv2.VideoCapture(str(path))
-    if not cap.isOpened():
-        raise SourceError(f"{path}: cannot be opened as a video")
-    try:
-        k = 0
-        while True:
-            ok, image = cap.read()
-            if not ok:
-                return
-            yield k, np.asarray(image, dtype=np.uint8)
-            k += 1
-    finally:
-        cap.release()
-
-
 def _images(paths: list[Path]) -> list[Path]:
     return sorted(p for p in paths if p.suffix.lower() in IMAGE_SUFFIXES)
 
@@ -87,16 +74,14 @@ def open_sources(specs: list[str]) -> tuple[list[FrameSource], Path | None]:
     for pos, spec in enumerate(specs):
         path = Path(spec)
         if path.is_dir() and (path / "cameras.yaml").exists():
-            reader = RecordingReader(path)
-            recording = path
-            for cam in reader.camera_ids:
-                video = path / f"camera_{cam}.mp4"
-                if video.exists():
-                    src = FrameSource(f"{path.name}/camera_{cam}", cam, reader.camera_model(cam), "video", [video])
-                else:
-                    pngs = _images(list((path / f"camera_{cam}").glob("*")))
-                    src = FrameSource(f"{path.name}/camera_{cam}", cam, reader.camera_model(cam), "images", pngs)
-                out.append(src)
+            try:
+                reader = RecordingReader(path)
+                recording = path
+                for cam in reader.camera_ids:
+                    kind, files = camera_files(path, cam)
+                    out.append(FrameSource(f"{path.name}/camera_{cam}", cam, reader.camera_model(cam), kind, files))
+            except RecordingError as exc:
+                raise SourceError(str(exc)) from None
         elif path.is_dir():
             files = _images(list(path.iterdir()))
             if not files:

@@ -1,8 +1,13 @@
 """``cmdragons bench vision``: detection quality against the simulator's truth at three noise and
-lighting levels, and the time per camera frame next to an OpenCV baseline on the same frames.
+lighting levels, on compressed video and at 1920x1200, and the time per camera frame next to an
+OpenCV baseline on the same frames.
 
-Frames are rendered in-process (lossless; a video codec would smear the colours) from a scripted
-Division B game, both default cameras. Levels (RenderParams):
+Frames are rendered in-process (lossless) from a scripted Division B game, both default cameras.
+The default level's frames are also encoded as H.264 in 4:2:0 (what ``cmdragons sim --record``
+writes by default, at configs/cameras.yaml ``recording.crf``, and at crf 23, x264's default and
+what most camera software writes) through :mod:`cmdragons.videoio`, decoded and scored on the
+same truth, with the same configs. The 1920x1200 row renders the automatic camera layout at that
+resolution (one camera over the whole field). Levels (RenderParams):
 
 =========  ===========  ============  ==========  ==========
 level      noise grey   vignetting    gradient    exposure
@@ -23,22 +28,28 @@ Baseline: ``cv2.cvtColor`` to YUV, then per colour class one ``cv2.inRange`` and
 from __future__ import annotations
 
 import dataclasses
+import tempfile
 import time
+from collections.abc import Iterator
+from pathlib import Path
 from typing import Any
 
 import cv2
 import numpy as np
 from numpy.typing import NDArray
 
+from cmdragons.camera import CameraModel, cameras_from_config
 from cmdragons.geometry import Field
+from cmdragons.messages import GroundTruth
 from cmdragons.runtime.settings import Settings
+from cmdragons.videoio import VideoWriter, read_video
 from sim.render import RenderParams
 from sim.script import ScriptedPlay
 from sim.simulator import Simulator
 from vision.pipeline import VisionPipeline
 from vision.score import Score, ball_height_bias_m
 
-__all__ = ["LEVELS", "opencv_baseline", "run"]
+__all__ = ["BIG_RESOLUTION", "LEVELS", "opencv_baseline", "run"]
 
 Row = dict[str, Any]
 
@@ -56,6 +67,7 @@ def _levels(default: RenderParams) -> dict[str, RenderParams]:
 
 
 LEVELS = ("low", "default", "high")
+BIG_RESOLUTION = (1920, 1200)  # px, what the league's cameras deliver today
 
 
 def opencv_baseline(image: NDArray[np.uint8], boxes: list[tuple[NDArray[np.uint8], NDArray[np.uint8]]]) -> int:
@@ -70,31 +82,93 @@ def opencv_baseline(image: NDArray[np.uint8], boxes: list[tuple[NDArray[np.uint8
     return n
 
 
+def _render(settings: Settings, models: list[CameraModel], render: RenderParams,
+            frames: int) -> Iterator[tuple[int, dict[int, NDArray[np.uint8]], GroundTruth]]:  # fmt: skip
+    """The scripted game's first ``frames`` frames through ``models``: (index, images, truth)."""
+    sim_params = dataclasses.replace(settings.sim, render=render)
+    sim = Simulator(settings.field, models, sim_params, seed=settings.sim.seed)
+    script = ScriptedPlay(Field(settings.field), settings.field.robot.radius_m, sim_params.script, sim.rng)
+    for i in range(frames):
+        frame = sim.capture()
+        yield i, frame.images, frame.truth
+        sim.advance(script.commands(sim.world.snapshot()))
+
+
+def _quality(name: str, settings: Settings, models: list[CameraModel], score: Score) -> Row:
+    """The score's row; the ball height bias only with two cameras or more (one camera straight
+    over the field's centre sees most balls near its nadir, where the fit has no lever)."""
+    row: Row = {"name": name, **score.summary()}
+    if len(models) > 1:
+        bias = ball_height_bias_m(score, {m.id: m.center for m in models},
+                                  settings.vision.ball.blob_height_above_centre_m)  # fmt: skip
+        row["ball_height_bias_mm"] = bias * 1e3
+    return row
+
+
 def run(settings: Settings, quick: bool, frames: int | None = None) -> list[Row]:
-    """Quality rows per level, then timing rows; ``frames`` per level (default 40 quick, 300 full)."""
+    """Quality rows per level, per compressed input and at 1920x1200, then timing rows; ``frames``
+    per input (default 40 quick, 300 full; 1920x1200: a quarter of that)."""
     frames = frames or (40 if quick else 300)
     models = settings.camera_models()
     rows: list[Row] = []
     samples: list[tuple[int, NDArray[np.uint8]]] = []
-    for level in LEVELS:
-        sim_params = dataclasses.replace(settings.sim, render=_levels(settings.sim.render)[level])
-        sim = Simulator(settings.field, models, sim_params, seed=settings.sim.seed)
-        script = ScriptedPlay(Field(settings.field), settings.field.robot.radius_m, sim_params.script, sim.rng)
-        pipes = {m.id: VisionPipeline(settings.vision, settings.field, m) for m in models}
-        score = Score()
-        for i in range(frames):
-            frame = sim.capture()
-            for cam, image in frame.images.items():
-                score.add(pipes[cam].process(image, frame.frame_number, frame.t_capture), frame.truth)
-                if level == "default" and i % max(1, frames // 20) == 0:
-                    samples.append((cam, image.copy()))
-            sim.advance(script.commands(sim.world.snapshot()))
-        bias = ball_height_bias_m(score, {m.id: m.center for m in models},
-                                  settings.vision.ball.blob_height_above_centre_m)  # fmt: skip
-        rows.append({"name": f"vision {level}", **score.summary(), "ball_height_bias_mm": bias * 1e3})
+    crf = settings.cameras.recording.crf
+    compressed = {f"h264 crf {crf} (sim --record default)": crf, "h264 crf 23 (4:2:0, x264 default)": 23}
+    with tempfile.TemporaryDirectory(prefix="bench-vision-") as tmp:
+        truths: list[GroundTruth] = []
+        writers: dict[tuple[int, int], VideoWriter] = {}
+        for level in LEVELS:
+            pipes = {m.id: VisionPipeline(settings.vision, settings.field, m) for m in models}
+            score = Score()
+            for i, images, truth in _render(settings, models, _levels(settings.sim.render)[level], frames):
+                for cam, image in images.items():
+                    score.add(pipes[cam].process(image, i, 0.0), truth)
+                    if level != "default":
+                        continue
+                    if i % max(1, frames // 20) == 0:
+                        samples.append((cam, image.copy()))
+                    for q in compressed.values():
+                        if (q, cam) not in writers:
+                            h, w = image.shape[:2]
+                            writers[q, cam] = VideoWriter(Path(tmp) / f"{q}_{cam}.mp4", w, h, 60.0, "h264", q)
+                        writers[q, cam].write(image)
+                if level == "default":
+                    truths.append(truth)
+            rows.append(_quality(f"vision {level}", settings, models, score))
+        for writer in writers.values():
+            writer.close()
+        for name, q in compressed.items():
+            pipes = {m.id: VisionPipeline(settings.vision, settings.field, m) for m in models}
+            score = Score()
+            for m in models:
+                for i, image in read_video(Path(tmp) / f"{q}_{m.id}.mp4"):
+                    score.add(pipes[m.id].process(image, i, 0.0), truths[i])
+            rows.append(_quality(f"vision default, {name}", settings, models, score))
+    big_models = _big_cameras(settings)
+    big_pipes = {m.id: VisionPipeline(settings.vision, settings.field, m) for m in big_models}
+    big_samples: list[tuple[int, NDArray[np.uint8]]] = []
+    big_score = Score()
+    big_frames = max(2, frames // 4)
+    for i, images, truth in _render(settings, big_models, settings.sim.render, big_frames):
+        for cam, image in images.items():
+            big_score.add(big_pipes[cam].process(image, i, 0.0), truth)
+            if i % max(1, big_frames // 10) == 0:
+                big_samples.append((cam, image.copy()))
+    w, h = big_models[0].width, big_models[0].height
+    rows.append(_quality(f"vision default, {w}x{h} ({len(big_models)} camera{'s' * (len(big_models) > 1)})",
+                         settings, big_models, big_score))  # fmt: skip
+    reps = 3 if quick else 10
     rows += _timing(settings, {m.id: VisionPipeline(settings.vision, settings.field, m) for m in models}, samples,
-                    reps=3 if quick else 10)  # fmt: skip
+                    reps)  # fmt: skip
+    rows += _timing(settings, big_pipes, big_samples, reps)
     return rows
+
+
+def _big_cameras(settings: Settings) -> list[CameraModel]:
+    """The automatic layout with today's league resolution, 1920x1200 (over a Division B field: one
+    camera at the configured height sees it all, the ball still 6 px across)."""
+    auto = dataclasses.replace(settings.cameras.auto, resolution_px=BIG_RESOLUTION)
+    return cameras_from_config(dataclasses.replace(settings.cameras, layout="auto", auto=auto), settings.field)
 
 
 def _timing(settings: Settings, pipes: dict[int, VisionPipeline], samples: list[tuple[int, NDArray[np.uint8]]],

@@ -10,7 +10,8 @@ is plausible, and reports the most credible. Tracks are confirmed after a few de
 through occlusion with growing covariance and ``visible = False``, and dropped after a timeout.
 
 The world state handed to the team is predicted ahead to the moment its next command takes effect
-(``latency_s``), as the CMDragons tracker did (Bruce 2006, ch. 2).
+(``latency_s``), as the CMDragons tracker did (Bruce 2006, ch. 2); offline tracking asks for the
+estimate at the capture time instead (``step(frames, ahead_s=0.0)``).
 """
 
 from __future__ import annotations
@@ -127,9 +128,11 @@ class Tracker:
             if track is not None:
                 track.filter.command = self._command_at(key, track.filter.t)
 
-    def step(self, frames: Sequence[DetectionFrame]) -> WorldState:
+    def step(self, frames: Sequence[DetectionFrame], ahead_s: float | None = None) -> WorldState:
         """Take one set of camera frames (any order, any cameras) and return the world state
-        predicted to the newest capture time plus ``latency_s``."""
+        predicted to the newest capture time plus ``ahead_s``: by default ``latency_s``, what the
+        live loop hands the team; 0 gives the filtered estimate at the capture time (offline
+        tracks, scoring against truth)."""
         for frame in sorted(frames, key=lambda f: f.t_capture):
             if frame.t_capture < self.t - 1e-9 or not math.isfinite(frame.t_capture):
                 self.stats.stale_frames += 1
@@ -140,7 +143,7 @@ class Tracker:
             if track.last_seen != self.t:
                 track.filter.miss()
         self._drop_stale()
-        return self.world_state(self.t + self.p.latency_s)
+        return self.world_state(self.t + (self.p.latency_s if ahead_s is None else ahead_s))
 
     def _take(self, frame: DetectionFrame) -> None:
         t = frame.t_capture

@@ -13,7 +13,7 @@ from cmdragons.cli import main
 from cmdragons.recording import RecordingReader
 
 
-@pytest.mark.parametrize("fmt", ["mp4", "png"])
+@pytest.mark.parametrize("fmt", ["h264", "ffv1", "png"])
 def test_sim_record_reads_back(tmp_path: Path, fmt: str) -> None:
     out = tmp_path / "run"
     snap = tmp_path / "snap.png"

@@ -44,14 +44,17 @@ def test_tiny_vision_bench_meets_the_quality_targets() -> None:
 
     assert "vision" in SUITES
     rows = {r["name"]: r for r in run(load_settings(CONFIGS), True, frames=3)}
-    for level in ("low", "default", "high"):
-        row = rows[f"vision {level}"]
-        assert row["camera_frames"] == 6
+    quality = ["vision low", "vision default", "vision high", "vision default, h264 crf 18 (sim --record default)",
+               "vision default, h264 crf 23 (4:2:0, x264 default)", "vision default, 1920x1200 (1 camera)"]  # fmt: skip
+    for name in quality:
+        row = rows[name]
+        assert row["camera_frames"] == (2 if "1920" in name else 6)
         assert row["robot_rms_mm"] <= 5.0 and row["heading_rms_deg"] <= 2.0
         assert row["id_accuracy"] == 1.0 and row["robot_detection_rate"] == 1.0
         assert row["false_per_frame"] == 0.0
     timing = [r for r in rows.values() if "median_ms" in r]
-    assert len(timing) == 3 and all(r["median_ms"] > 0 for r in timing)
+    assert len(timing) == 6 and all(r["median_ms"] > 0 for r in timing)
+    assert {r["name"].split("(")[1] for r in timing} == {"1024x768)", "1920x1200)"}
 
 
 def test_ball_height_bias_recovers_a_known_blob_height() -> None:

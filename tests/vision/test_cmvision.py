@@ -15,7 +15,7 @@ from vision.cmvision import (
     ColourClass,
     RegionParams,
     Segmenter,
-    _screen_intervals,
+    _screen_boxes,
     build_lut,
     classify_reference,
     merge_reference,
@@ -74,8 +74,7 @@ def every_colour(step: int = 3) -> NDArray[np.uint8]:
 def test_screened_classification_equals_direct_thresholds_over_colour_space(
     space: str, classes: dict[str, ColourClass]
 ) -> None:
-    # the default boxes screen most colours out on channel 1; the wide ones (channel 1 all of
-    # 0..255) let every pixel through the screen
+    # the default boxes screen most colours out; the wide ones let many pixels through the screen
     image = every_colour()
     seg = Segmenter(classes, space, RegionParams())  # type: ignore[arg-type]
     bits = classify_reference(image, list(classes.values()), space)  # type: ignore[arg-type]
@@ -85,21 +84,16 @@ def test_screened_classification_equals_direct_thresholds_over_colour_space(
     assert got == runs_reference(bits)
 
 
-@pytest.mark.parametrize(
-    "ranges", [[], [(0, 255)], [(0, 0)], [(255, 255)], [(0, 100), (131, 222)], [(5, 9), (10, 20), (40, 40)]]
-)
-def test_screen_intervals_cover_exactly_the_nonzero_entries(ranges: list[tuple[int, int]]) -> None:
-    table = np.zeros(256, np.uint32)
-    for k, (lo, hi) in enumerate(ranges):
-        table[lo : hi + 1] |= np.uint32(1 << k)
-    got = _screen_intervals(table)
-    assert got.dtype == np.uint8 and got.shape[1] == 2
-    covered = np.zeros(256, bool)
-    for lo, width in got.astype(int):
-        covered[lo : lo + width + 1] = True
-    np.testing.assert_array_equal(covered, table != 0)
-    ends = got[:, 0].astype(int) + got[:, 1]
-    assert np.all(got[1:, 0] > ends[:-1] + 1), "sorted, apart, adjacent ranges joined"
+@pytest.mark.parametrize("classes", [CLASSES, wide_classes(), {}], ids=["default", "wide", "none"])
+def test_screen_rows_are_the_class_boxes_in_unsigned_compare_form(classes: dict[str, ColourClass]) -> None:
+    boxes = _screen_boxes(list(classes.values()))
+    assert boxes.dtype == np.uint8 and boxes.shape == (len(classes), 6)
+    v = np.arange(256)
+    for row, c in zip(boxes.astype(np.int64), classes.values(), strict=True):
+        for ch in range(3):
+            lo, width = row[2 * ch], row[2 * ch + 1]
+            # the kernel's test: uint8(value - lo) <= width, exactly lo <= value <= hi
+            np.testing.assert_array_equal((v - lo) % 256 <= width, (v >= c.lo[ch]) & (v <= c.hi[ch]))
 
 
 def test_yuv_matches_opencv_within_one_level() -> None:

@@ -76,10 +76,46 @@ def test_vision_on_a_glob_and_a_video(recording: Path, tmp_path: Path, capsys: p
     assert main(["vision", str(tmp_path / "nothing*.png"), "--config", str(CONFIGS), "--out", str(out)]) == 2
 
 
-def test_tune_from_truth_and_from_labels(recording: Path, tmp_path: Path) -> None:
+def test_vision_on_a_cut_off_video_processes_every_frame_before_the_break(tmp_path: Path, capsys: Capture) -> None:
+    rec = tmp_path / "rec"
+    assert main(["sim", "--config", str(CONFIGS), "--seconds", "0.5", "--record", "--out", str(rec),
+                 "--no-progress"]) == 0  # fmt: skip
+    meta = yaml.safe_load((rec / "cameras.yaml").read_text())
+    assert meta["recording"] == {"codec": "h264", "crf": 18}  # the recording says what it holds
+    video = rec / "camera_0.mp4"
+    data = video.read_bytes()
+    video.write_bytes(data[: len(data) * 3 // 4])
+    capsys.readouterr()
+    out = tmp_path / "vision"
+    assert main(["vision", str(rec), "--config", str(CONFIGS), "--out", str(out), "--no-progress"]) == 0
+    err = capsys.readouterr().err
+    lines = [json.loads(line) for line in (out / "detections.jsonl").read_text().splitlines()]
+    cam0 = [d["frame_number"] for d in lines if d["camera_id"] == 0]
+    assert [d["frame_number"] for d in lines if d["camera_id"] == 1] == list(range(30))
+    assert 5 <= len(cam0) < 30 and cam0 == list(range(len(cam0)))
+    assert f"camera_0.mp4: frame {len(cam0)} " in err and "the frames before it were processed" in err
+    assert json.loads((out / "summary.json").read_text())["broken_off"][0].startswith(str(video))
+
+
+def test_tune_from_truth_and_from_labels(recording: Path, tmp_path: Path, capsys: Capture) -> None:
     config = tmp_path / "configs"
     shutil.copytree(CONFIGS, config)
+    before = (config / "vision.yaml").read_text()
+    capsys.readouterr()
     assert main(["vision", "tune", str(recording), "--config", str(config)]) == 0
+    # every line but the colour boxes' stays as it was, comments and all
+    after = (config / "vision.yaml").read_text()
+    box_lines = [k for k, line in enumerate(before.splitlines()) if line.lstrip().startswith(
+        ("orange:", "blue:", "yellow:", "pink:", "green:")) and "lo:" in line]  # fmt: skip
+    assert len(box_lines) == 5 and len(after.splitlines()) == len(before.splitlines())
+    for k, (a, b) in enumerate(zip(before.splitlines(), after.splitlines(), strict=True)):
+        if k in box_lines:
+            assert a.split("{")[0] == b.split("{")[0] and "min_area_px: 6}" in b  # the key and min area stay
+        else:
+            assert a == b, (k, a, b)
+    assert after != before
+    printed = capsys.readouterr().out
+    assert "tune: blue" in printed and "labelled pixels: lo [63, 155, 45]" in printed and " -> lo [" in printed
     tuned = load_settings(config).vision
     assert set(tuned.colours) == {"orange", "blue", "yellow", "pink", "green"}
     # the tuned boxes hold the shipped colours' centres: blue's U is high, yellow's Y is high

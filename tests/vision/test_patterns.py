@@ -76,6 +76,13 @@ def test_a_missed_dot_is_read_from_the_image_with_three_dots(cameras: list[Camer
     five = next(r for r in loose.robots if r.id == 5)
     assert math.hypot(five.x - x, five.y - y) < 0.005 and five.team == TEAMS[1]
     assert five.confidence <= 0.5
+    # through 4:2:0 (H.264's chroma), the missed dot's colour is still read right from its mean
+    from cmdragons.videoio import bgr_to_i420, i420_to_bgr
+
+    h, w = image.shape[:2]
+    got = VisionPipeline(params, LEAGUE, model).process(i420_to_bgr(bgr_to_i420(image), h, w), 0, 0.0)
+    assert next(r for r in got.robots if r.id == 5).confidence <= 0.5  # found with three dots
+    assert sorted(r.id for r in got.robots) == list(range(16))
 
 
 def _disc_image(centre: tuple[float, float], radius_px: float, rng: np.random.Generator,

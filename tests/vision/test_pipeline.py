@@ -110,7 +110,7 @@ def test_calibrated_blob_height_leaves_no_radial_ball_bias(cameras: list[CameraM
     height = calibrated.ball.blob_height_above_centre_m
     assert abs(ball_height_bias_m(scores["calibrated"], centres, height)) < 1e-3
     assert 0.0 <= ball_height_bias_m(scores["calibrated"], centres, height) + height < 1e-3
-    assert ball_height_bias_m(scores["at_centre"], centres, 0.0) > 2e-3
+    assert ball_height_bias_m(scores["at_centre"], centres, 0.0) > 1.5e-3
     calibrated_rms = np.sqrt(np.mean(np.square(scores["calibrated"].ball_err_m)))
     assert calibrated_rms < np.sqrt(np.mean(np.square(scores["at_centre"].ball_err_m)))
 

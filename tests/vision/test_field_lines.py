@@ -1,0 +1,120 @@
+"""Calibration from the field lines (vision.field_lines, `vision calibrate --lines`): a known
+camera recovered from rendered frames, on any field size, and the command's output."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import shutil
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+import yaml
+
+from cmdragons.camera import CameraModel, CameraParams, CamerasParams, cameras_from_config
+from cmdragons.cli import main
+from cmdragons.geometry import FieldDims
+from sim.render import CameraRenderer, RenderParams
+from vision.field_lines import calibrate_from_lines, rough_start
+
+from .conftest import LEAGUE, render, snapshot
+
+CONFIGS = Path(__file__).resolve().parents[2] / "configs"
+ROBOTS = [[0, 1, -2.0, 0.5, 0.3], [1, 4, -3.0, -1.0, 2.0], [0, 7, -1.0, -1.5, 1.0], [1, 9, 2.0, 0.2, 0.0],
+          [0, 3, 3.1, -1.2, 1.0], [1, 2, 0.2, 1.1, 2.5]]  # fmt: skip
+
+
+def pose_errors(got: CameraParams, true: CameraParams) -> tuple[float, float]:
+    """Position error (m) and the angle (degrees) of the rotation between the two orientations."""
+    r = CameraModel(got).R_cam_to_field.T @ CameraModel(true).R_cam_to_field
+    angle = math.degrees(math.acos(min(1.0, (float(np.trace(r)) - 1.0) / 2.0)))
+    return float(np.linalg.norm(np.subtract(got.position_m, true.position_m))), angle
+
+
+def off_start(true: CameraParams, dx: float, dy: float) -> CameraParams:
+    """The rough start a user gives: the true height, the field rectangle the camera sees moved by
+    (dx, dy) m and cut to whole decimetres."""
+    m = CameraModel(true)
+    c = m.unproject(np.array([[0.0, 0.0], [m.width, m.height]]), 0.0)
+    sees = (round(c[:, 0].min() + dx, 1), round(c[:, 1].min() + dy, 1), round(c[:, 0].max() + dx, 1),
+            round(c[:, 1].max() + dy, 1))  # fmt: skip
+    return rough_start(true, true.position_m[2], sees)
+
+
+@pytest.mark.parametrize("cam", [0, 1])
+def test_lines_recover_the_simulators_cameras(cameras: list[CameraModel], cam: int) -> None:
+    true = cameras[cam].params
+    image, _ = render(cameras[cam], snapshot(ROBOTS, ball=(-2.5, 0.3, 0.0215)), seed=cam)
+    fit = calibrate_from_lines(image, LEAGUE, off_start(true, 0.3, -0.25))
+    dist, angle = pose_errors(fit.params, true)
+    assert dist < 0.01 and angle < 0.5  # the issue's targets (seen: 0.2 mm, 0.002 degrees)
+    assert fit.rms_px <= 0.5 and fit.points > 1000
+    assert fit.params.focal_px == pytest.approx(true.focal_px, rel=1e-3)
+    assert fit.params.k1 == pytest.approx(true.k1, abs=2e-3)
+
+
+def test_lines_on_a_frame_of_other_colours_tilt_and_distortion(cameras: list[CameraModel]) -> None:
+    base = cameras[0].params
+    true = dataclasses.replace(base, k1=-0.07, k2=0.01, tilt_x_rad=0.03, tilt_y_rad=-0.02, yaw_rad=base.yaw_rad + 0.02,
+                               position_m=(base.position_m[0] + 0.1, base.position_m[1] - 0.15, 3.7))  # fmt: skip
+    look = RenderParams(carpet_bgr=(60, 95, 20), line_bgr=(200, 225, 230), noise_sigma_grey=4.0,
+                        vignetting_fraction=0.2, gradient_fraction=0.15)  # fmt: skip
+    image, _ = render(CameraModel(true), snapshot(ROBOTS, ball=(-2.5, 0.3, 0.0215)), look, seed=5)
+    rough = off_start(base, -0.2, 0.2)
+    start = dataclasses.replace(rough, position_m=(*rough.position_m[:2], 3.7))  # the height measured
+    fit = calibrate_from_lines(image, LEAGUE, start)
+    dist, angle = pose_errors(fit.params, true)
+    assert fit.rms_px <= 1.5  # the issue's target for a frame the pipeline never produced
+    assert dist < 0.01 and angle < 0.5
+    assert (fit.params.k1, fit.params.k2) == pytest.approx((-0.07, 0.01), abs=5e-3)
+
+
+def test_lines_on_a_small_custom_field() -> None:
+    """A 6.05 x 4.05 m field (an older size, as a custom division in field.yaml)."""
+    small = FieldDims(length_m=6.05, width_m=4.05, goal_width_m=0.7, defense_width_m=1.4, defense_depth_m=0.8,
+                      center_circle_radius_m=0.5)  # fmt: skip
+    league = dataclasses.replace(LEAGUE, divisions={"B": small, "A": LEAGUE.divisions["A"]})
+    models = cameras_from_config(CamerasParams(), league)
+    true = models[-1].params
+    image, _ = CameraRenderer(models[-1], league, RenderParams(), seed=2).render(
+        snapshot(ROBOTS[:2], ball=(1.0, 0.3, 0.0215)))  # fmt: skip
+    fit = calibrate_from_lines(image.copy(), league, off_start(true, 0.2, 0.2))
+    dist, angle = pose_errors(fit.params, true)
+    assert dist < 0.01 and angle < 0.5 and fit.rms_px <= 0.5
+
+
+def test_calibrate_lines_command_keeps_comments_and_draws_the_overlay(cameras: list[CameraModel],
+                                                                      tmp_path: Path) -> None:  # fmt: skip
+    config = tmp_path / "configs"
+    shutil.copytree(CONFIGS, config)
+    before = (config / "cameras.yaml").read_text()
+    true = cameras[1].params
+    image, _ = render(cameras[1], snapshot(ROBOTS), seed=4)
+    frame = tmp_path / "cam1.png"
+    cv2.imwrite(str(frame), image)
+    m = CameraModel(true)
+    c = m.unproject(np.array([[0.0, 0.0], [m.width, m.height]]), 0.0)
+    sees = [str(round(v, 1)) for v in (c[:, 0].min() - 0.2, c[:, 1].min(), c[:, 0].max() - 0.2, c[:, 1].max())]
+    argv = ["vision", "calibrate", "--lines", str(frame), "--camera", "1", "--height", "4.0", "--sees", *sees,
+            "--config", str(config)]  # fmt: skip
+    assert main(argv) == 0
+    after = (config / "cameras.yaml").read_text()
+    comments = [line for line in before.splitlines() if line.lstrip().startswith("#")]
+    assert comments and all(line in after.splitlines() for line in comments)  # every comment line stays
+    data = yaml.safe_load(after)
+    assert data["layout"] == "list" and [c["id"] for c in data["cameras"]] == [0, 1]
+    got = CameraParams(**{k: tuple(v) if isinstance(v, list) else v for k, v in data["cameras"][1].items()})
+    dist, angle = pose_errors(got, true)
+    assert dist < 0.01 and angle < 0.5
+    assert data["cameras"][0]["position_m"] == pytest.approx(list(cameras[0].params.position_m))  # kept
+    overlay = cv2.imread(str(tmp_path / "cam1_calibration.png"))
+    assert overlay.shape == image.shape and np.count_nonzero(np.any(overlay != image, axis=-1)) > 2000
+    # a second run updates the entry in place: still two cameras, still every comment
+    assert main(argv) == 0
+    again = yaml.safe_load((config / "cameras.yaml").read_text())
+    assert [c["id"] for c in again["cameras"]] == [0, 1]
+    # bad input: one line on stderr, exit code 2
+    assert main(["vision", "calibrate", "--lines", str(tmp_path / "none.png"), "--config", str(config)]) == 2
+    assert main(["vision", "calibrate", "--config", str(config)]) == 2

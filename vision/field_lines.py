@@ -1,0 +1,338 @@
+"""Camera calibration from the field's painted lines: no hand-picked points.
+
+From a rough start (the camera's height, measured, and the part of the field it sees) the camera
+model of :mod:`cmdragons.camera` (pose, focal length, radial distortion k1, k2) is fitted to the
+white-line pixels of one image, in three steps:
+
+1. **Line pixels** (:func:`line_strength`): a white top-hat of the image's brightness (what is
+   brighter than its surroundings over a few line widths), kept where the pixel is not coloured
+   (the robots' dots, the ball and the team colours are brighter than the carpet too).
+2. **Coarse search**: the field model (every straight line and the centre circle of
+   configs/field.yaml, sampled along their centre lines) projected through candidate cameras
+   around the rough start (position, the half turn the field's symmetry leaves open, the focal
+   length), scored by the chamfer distance to the line pixels (truncated, so that a
+   line hidden by a robot costs no more than a fixed amount); the best few are refined by least
+   squares on the same distance.
+3. **Fine fit**: for every model point, the line's centre is measured across the projected line
+   (the strength profile along its normal, the peak's weighted centroid: sub-pixel), and all
+   parameters are fitted by least squares to the normal distances (point to line, robust loss),
+   the correspondences measured again from each new fit until it settles.
+
+A camera looking at one plane sees the same from height h with focal length f (and k1, k2) as
+from k h with k f (k^2 k1, k^4 k2): the height is kept from the rough start, as in
+:func:`vision.calibrate.calibrate`. The reprojection error is the RMS of the measured line
+centres' distances to the fitted model's lines (px).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import least_squares
+from scipy.spatial import cKDTree
+
+from cmdragons.camera import CameraModel, CameraParams
+from cmdragons.config import Validated, setting
+from cmdragons.geometry import Field, LeagueParams
+
+__all__ = [
+    "LineCalibration",
+    "LineFitParams",
+    "calibrate_from_lines",
+    "draw_field",
+    "field_samples",
+    "line_strength",
+    "rough_start",
+]
+
+F64 = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class LineFitParams(Validated):
+    """How far the rough start may be off, and what counts as a painted line."""
+
+    reach_m: float = setting(0.4, lo=0.0, hi=3.0)  # the search over position: +- this along x and y
+    grid_steps: int = setting(9, lo=1, hi=41)  # positions per axis in that search
+    focal_range: float = setting(0.15, lo=0.0, hi=0.5)  # the search over focal length: +- this share
+    white_chroma: float = setting(60.0, lo=1.0, hi=255.0)  # grey levels from grey where a pixel stops being white
+    min_strength_grey: float = setting(8.0, lo=0.0, hi=255.0)  # a line pixel's top-hat, at least (noise's reach)
+    coarse_cap_px: float = setting(20.0, lo=2.0, hi=200.0)  # chamfer distances truncated here in the search
+    refine_cap_px: float = setting(6.0, lo=1.0, hi=50.0)  # ... and here in its refinement
+    search_px: float = setting(5.0, lo=1.0, hi=50.0)  # line centres looked for this far across a projected line
+
+
+@dataclass(frozen=True)
+class LineCalibration:
+    params: CameraParams
+    rms_px: float  # measured line centres to the fitted lines
+    max_px: float
+    points: int  # line centres measured in the last fit
+    line_pixels: int  # pixels the line detector found
+
+
+def field_samples(league: LeagueParams, step_m: float) -> tuple[F64, F64]:
+    """Points along the centre lines of every field marking (n, 3) at z = 0 and each point's unit
+    tangent (n, 2) in the field frame, about ``step_m`` apart."""
+    f = Field(league)
+    pts, tan = [], []
+    for seg in f.line_segments():
+        a, b = np.array(seg.a), np.array(seg.b)
+        length = float(np.hypot(*(b - a)))
+        n = max(2, int(math.ceil(length / step_m)) + 1)
+        t = np.linspace(0.0, 1.0, n)[:, None]
+        pts.append(a + t * (b - a))
+        tan.append(np.repeat(((b - a) / length)[None], n, axis=0))
+    r = f.dims.center_circle_radius_m
+    n = max(8, int(math.ceil(2 * math.pi * r / step_m)))
+    phi = np.arange(n) * 2 * math.pi / n
+    pts.append(np.stack([r * np.cos(phi), r * np.sin(phi)], axis=1))
+    tan.append(np.stack([-np.sin(phi), np.cos(phi)], axis=1))
+    xy = np.concatenate(pts)
+    return np.concatenate([xy, np.zeros((len(xy), 1))], axis=1), np.concatenate(tan)
+
+
+def line_strength(image: NDArray[np.uint8], line_width_px: float, white_chroma: float = 60.0) -> NDArray[np.float32]:
+    """How much each pixel looks like a painted line: the white top-hat of the brightness over a
+    window of a few line widths, times the pixel's lack of colour (1 for grey, 0 from a chroma
+    distance of ``white_chroma`` grey levels up); float32 grey levels, 0 where nothing is."""
+    ycc = cv2.cvtColor(image, cv2.COLOR_BGR2YCrCb).astype(np.float32)
+    k = 2 * max(2, int(math.ceil(2.0 * line_width_px))) + 1
+    tophat = cv2.morphologyEx(ycc[..., 0], cv2.MORPH_TOPHAT, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
+    chroma = np.hypot(ycc[..., 1] - 128.0, ycc[..., 2] - 128.0)
+    out: NDArray[np.float32] = tophat * np.clip(1.0 - chroma / white_chroma, 0.0, 1.0)
+    return out
+
+
+def _line_mask(strength: NDArray[np.float32], floor: float) -> NDArray[np.uint8]:
+    """Line pixels: strength above a third of the strong lines' (the 99.5th percentile of the
+    non-zero strengths) and above ``floor`` grey levels."""
+    nz = strength[strength > 1.0]
+    level = max(floor, float(np.percentile(nz, 99.5)) / 3.0) if nz.size else floor
+    return (strength > level).astype(np.uint8)
+
+
+def rough_start(base: CameraParams, height_m: float, sees: tuple[float, float, float, float]) -> CameraParams:
+    """A downward camera at ``height_m`` over the centre of the field rectangle ``sees``
+    (x0, y0, x1, y1, m), the image's width along the rectangle's longer side, the focal length that
+    fits the rectangle into the image; resolution and principal point from ``base``."""
+    x0, y0, x1, y1 = sees
+    w, h = base.resolution_px
+    along_x = abs(x1 - x0) >= abs(y1 - y0)
+    half_u = (abs(x1 - x0) if along_x else abs(y1 - y0)) / 2.0
+    half_v = (abs(y1 - y0) if along_x else abs(x1 - x0)) / 2.0
+    focal = min(w / 2.0 / (half_u / height_m), h / 2.0 / (half_v / height_m))
+    return dataclasses.replace(
+        base, position_m=((x0 + x1) / 2.0, (y0 + y1) / 2.0, height_m), yaw_rad=0.0 if along_x else -math.pi / 2.0,
+        tilt_x_rad=0.0, tilt_y_rad=0.0, focal_px=focal, k1=0.0, k2=0.0,
+    )  # fmt: skip
+
+
+_POSE = ("yaw_rad", "tilt_x_rad", "tilt_y_rad", "x", "y", "focal_px", "k1", "k2")
+
+
+def _params(x: F64, base: CameraParams, n: int) -> CameraParams:
+    """``base`` with the first ``n`` of (yaw, tilt x, tilt y, x, y, focal, k1, k2) from ``x``."""
+    full = [base.yaw_rad, base.tilt_x_rad, base.tilt_y_rad, base.position_m[0], base.position_m[1], base.focal_px,
+            base.k1, base.k2]  # fmt: skip
+    full[:n] = [float(v) for v in x[:n]]
+    yaw, tx, ty, px, py, f, k1, k2 = full
+    return dataclasses.replace(
+        base, yaw_rad=math.remainder(yaw, 2 * math.pi), tilt_x_rad=float(np.clip(tx, -0.49, 0.49)),
+        tilt_y_rad=float(np.clip(ty, -0.49, 0.49)), position_m=(px, py, base.position_m[2]),
+        focal_px=max(f, 10.0), k1=float(np.clip(k1, -0.99, 0.99)), k2=float(np.clip(k2, -0.99, 0.99)),
+    )  # fmt: skip
+
+
+def _vector(p: CameraParams) -> F64:
+    return np.array([p.yaw_rad, p.tilt_x_rad, p.tilt_y_rad, p.position_m[0], p.position_m[1], p.focal_px, p.k1, p.k2])
+
+
+def _sample(img: NDArray[np.float32], px: F64) -> F64:
+    """Bilinear samples of ``img`` at pixel positions (n, 2) (u, v from the top-left corner)."""
+    n = len(px)
+    cols = 1024  # OpenCV's maps stay below 32767 rows and columns
+    flat = np.zeros((-(-n // cols) * cols, 2), np.float32)
+    flat[:n] = px - 0.5  # OpenCV measures from the top-left pixel's centre
+    maps = flat.reshape(-1, cols, 2)
+    out = cv2.remap(img, maps[..., 0], maps[..., 1], cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+    return np.asarray(out, dtype=np.float64).ravel()[:n]
+
+
+def _chamfer(params: CameraParams, pts: F64, dist: NDArray[np.float32], line_px: F64, cap_px: float) -> F64:
+    """Both ways of the truncated chamfer distance (px): from each model point's projection to
+    the nearest line pixel (a point outside the image costs the cap: pushing lines out of view
+    gains nothing), and from each of the sampled line pixels ``line_px`` (n, 2) to the nearest
+    projected model point (so that a model shrunk onto a few lines gains nothing either)."""
+    model = CameraModel(params)
+    px = model.project(pts)
+    inside = np.isfinite(px).all(axis=1) & model.in_image(np.nan_to_num(px, nan=-1.0), margin=1.0)
+    out = np.full(len(pts) + len(line_px), cap_px)
+    if inside.any():
+        out[: len(pts)][inside] = np.minimum(_sample(dist, px[inside]), cap_px)
+        d, _ = cKDTree(px[inside]).query(line_px, distance_upper_bound=cap_px)
+        out[len(pts) :] = np.minimum(d, cap_px)
+    return out
+
+
+def _bounds(p: CameraParams, n: int, reach_m: float) -> tuple[F64, F64]:
+    """Least-squares bounds around ``p`` for its first ``n`` parameters: what a rough start can
+    be off by (tilts 0.2 rad, position ``reach_m``, focal length 25 %, k1 and k2 0.3)."""
+    v = _vector(p)
+    half = np.array([0.35, 0.2, 0.2, reach_m, reach_m, 0.25 * p.focal_px, 0.3, 0.3])
+    return (v - half)[:n], (v + half)[:n]
+
+
+def _coarse(start: CameraParams, pts: F64, dist: NDArray[np.float32], line_px: F64,
+            fit: LineFitParams) -> CameraParams:  # fmt: skip
+    """The best candidate camera around ``start`` by the truncated chamfer distance: a grid over
+    position (+- ``reach_m``), the half turn and the focal length (+- ``focal_range``, five
+    steps), then a least-squares refinement (yaw, tilts, position, focal length) of the best few."""
+    cands = []
+    x0, y0 = start.position_m[:2]
+    steps = np.linspace(-fit.reach_m, fit.reach_m, fit.grid_steps)
+    cap0, cap1 = fit.coarse_cap_px, fit.refine_cap_px
+    for turn in (0.0, math.pi):
+        for fs in 1.0 + np.linspace(-fit.focal_range, fit.focal_range, 5):
+            for dx in steps:
+                for dy in steps:
+                    p = dataclasses.replace(start, yaw_rad=start.yaw_rad + turn, focal_px=start.focal_px * fs,
+                                            position_m=(x0 + dx, y0 + dy, start.position_m[2]))  # fmt: skip
+                    cands.append((float(np.mean(_chamfer(p, pts, dist, line_px, cap0))), p))
+    cands.sort(key=lambda c: c[0])
+    best, best_cost = start, math.inf
+    for _, p in cands[:4]:
+        lo, hi = _bounds(p, 6, 0.15)
+        for cap in (cap0, cap1):
+            sol = least_squares(lambda x, p=p, cap=cap: _chamfer(_params(x, p, 6), pts, dist, line_px, cap),
+                                np.clip(_vector(p)[:6], lo, hi), bounds=(lo, hi), diff_step=1e-3, max_nfev=100,
+                                x_scale=np.array([0.01, 0.01, 0.01, 0.02, 0.02, 5.0]))  # fmt: skip
+            p = _params(sol.x, p, 6)
+        cost = float(np.mean(_chamfer(p, pts, dist, line_px, cap1)))
+        if cost < best_cost:
+            best, best_cost = p, cost
+    return best
+
+
+def _normals(model: CameraModel, pts: F64, tan: F64) -> tuple[F64, F64]:
+    """Projected points (n, 2) and the unit normals (n, 2) of their lines in the image."""
+    px = model.project(pts)
+    ahead = model.project(pts + np.concatenate([tan * 0.01, np.zeros((len(tan), 1))], axis=1))
+    d = ahead - px
+    d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-12)
+    return px, np.stack([-d[:, 1], d[:, 0]], axis=1)
+
+
+def _centres(model: CameraModel, pts: F64, tan: F64, strength: NDArray[np.float32], level: float,
+             reach_px: float) -> tuple[NDArray[np.int64], F64, F64]:  # fmt: skip
+    """Where the line of each model point really is: along the projected normal within
+    ``reach_px``, the strength profile's peak and the weighted centroid of the profile around it
+    (+- 1.5 px). Returns the model points kept, the measured centres (n, 2) and the normals."""
+    px, nrm = _normals(model, pts, tan)
+    ok = np.isfinite(px).all(axis=1) & np.isfinite(nrm).all(axis=1)
+    ok &= model.in_image(np.nan_to_num(px, nan=-1.0), margin=reach_px + 2.0)
+    idx = np.flatnonzero(ok)
+    if idx.size == 0:
+        return idx, np.zeros((0, 2)), np.zeros((0, 2))
+    offs = np.arange(-reach_px, reach_px + 1e-9, 0.25)
+    grid = px[idx, None, :] + offs[None, :, None] * nrm[idx, None, :]
+    prof = _sample(strength, grid.reshape(-1, 2)).reshape(len(idx), len(offs))
+    peak = np.argmax(prof, axis=1)
+    top = prof[np.arange(len(idx)), peak]
+    near = np.abs(offs[None, :] - offs[peak][:, None]) <= 1.5
+    wts = np.where(near, np.maximum(prof - 0.3 * top[:, None], 0.0), 0.0)
+    t = (wts * offs[None, :]).sum(axis=1) / np.maximum(wts.sum(axis=1), 1e-12)
+    # a peak at the window's edge is another line or none; one below the line level is no line
+    keep = (top > level) & (np.abs(offs[peak]) < reach_px - 0.5)
+    # a second strong peak in the window (a parallel line, a goal wall's edge): ambiguous
+    other = np.where(~(np.abs(offs[None, :] - offs[peak][:, None]) <= 3.0), prof, 0.0).max(axis=1)
+    keep &= other < 0.6 * top
+    idx, t = idx[keep], t[keep]
+    return idx, px[idx] + t[:, None] * nrm[idx], nrm[idx]
+
+
+def _fine(start: CameraParams, pts: F64, tan: F64, strength: NDArray[np.float32], level: float,
+          search_px: float) -> tuple[CameraParams, F64]:  # fmt: skip
+    """Point-to-line least squares on measured line centres, measured again after each fit: the
+    first time ``search_px`` across each line and without distortion, then ever closer with it."""
+    p = start
+    res = np.zeros(0)
+    near = min(search_px, 2.0)
+    for reach, n_fit in ((search_px, 6), (min(search_px, 3.0), 8), (near, 8), (near, 8), (near, 8)):
+        idx, centres, nrm = _centres(CameraModel(p), pts, tan, strength, level, reach)
+        if len(idx) < 20:
+            raise ValueError(f"only {len(idx)} line points found near the model: the rough start is too far off")
+        sub = pts[idx]
+
+        def resid(x: F64, sub: F64 = sub, centres: F64 = centres, nrm: F64 = nrm, n_fit: int = n_fit,
+                  base: CameraParams = p) -> F64:  # fmt: skip
+            proj = CameraModel(_params(x, base, n_fit)).project(sub)
+            out: F64 = np.nan_to_num(np.sum((proj - centres) * nrm, axis=1), nan=50.0)
+            return out
+
+        lo, hi = _bounds(p, n_fit, 0.1)
+        sol = least_squares(resid, np.clip(_vector(p)[:n_fit], lo, hi), bounds=(lo, hi), loss="soft_l1", f_scale=1.0,
+                            x_scale=np.array([1e-3, 1e-3, 1e-3, 2e-3, 2e-3, 1.0, 1e-3, 1e-3])[:n_fit])  # fmt: skip
+        p = _params(sol.x, p, n_fit)
+        res = resid(sol.x)
+    return p, res
+
+
+def calibrate_from_lines(image: NDArray[np.uint8], league: LeagueParams, start: CameraParams,
+                         fit: LineFitParams | None = None) -> LineCalibration:  # fmt: skip
+    """Fit one camera to the field lines in ``image`` (H, W, 3) BGR uint8, from ``start`` (its
+    height is kept; its position may be off by up to about ``fit.reach_m``, its focal length by
+    ``fit.focal_range``, its yaw by a few degrees or a half turn). Raises ValueError when the
+    lines cannot be found."""
+    fit = fit or LineFitParams()
+    if image.shape[:2] != (start.resolution_px[1], start.resolution_px[0]):
+        w, h = start.resolution_px
+        raise ValueError(f"the image is {image.shape[1]}x{image.shape[0]} px, the camera {w}x{h}: give its resolution")
+    scale = start.focal_px / start.position_m[2]  # px per metre on the carpet, roughly
+    strength = line_strength(image, league.dims.line_width_m * scale, fit.white_chroma)
+    mask = _line_mask(strength, fit.min_strength_grey)
+    if int(mask.sum()) < 200:
+        raise ValueError(f"only {int(mask.sum())} line pixels found: is the field in view and lit?")
+    dist = cv2.distanceTransform((1 - mask).astype(np.uint8), cv2.DIST_L2, 5).astype(np.float32)
+    coarse_pts, _ = field_samples(league, max(0.02, 8.0 / scale))
+    v, u = np.nonzero(mask)
+    pick = np.random.default_rng(0).permutation(len(u))[:1500]  # a fixed sample: the same fit every run
+    line_px = np.stack([u[pick] + 0.5, v[pick] + 0.5], axis=1).astype(np.float64)
+    p = _coarse(start, coarse_pts, dist, line_px, fit)
+    pts, tan = field_samples(league, max(0.005, 3.0 / scale))
+    nz = strength[mask > 0]
+    level = 0.5 * float(np.median(nz))
+    p, res = _fine(p, pts, tan, strength, level, fit.search_px)
+    err = np.abs(res)
+    return LineCalibration(p, float(np.sqrt(np.mean(err**2))), float(err.max()), len(res), int(mask.sum()))
+
+
+def draw_field(image: NDArray[np.uint8], params: CameraParams, league: LeagueParams) -> NDArray[np.uint8]:
+    """A copy of ``image`` with the field model drawn through the camera (magenta, 1 px)."""
+    out = image.copy()
+    model = CameraModel(params)
+    pts, _ = field_samples(league, 0.01)
+    px = model.project(pts)
+    f = Field(league)
+    start = 0
+    lengths = []
+    for seg in f.line_segments():
+        length = float(np.hypot(seg.b[0] - seg.a[0], seg.b[1] - seg.a[1]))
+        lengths.append(max(2, int(math.ceil(length / 0.01)) + 1))
+    r = f.dims.center_circle_radius_m
+    lengths.append(max(8, int(math.ceil(2 * math.pi * r / 0.01))))
+    for k, n in enumerate(lengths):
+        piece = px[start : start + n]
+        if k == len(lengths) - 1:
+            piece = np.concatenate([piece, piece[:1]])
+        start += n
+        good = np.isfinite(piece).all(axis=1)
+        if good.sum() >= 2:
+            poly = np.round((piece[good] - 0.5) * 16).astype(np.int32)  # OpenCV's pixel centres, 4 fractional bits
+            cv2.polylines(out, [poly.reshape(-1, 1, 2)], False, (255, 0, 255), 1, cv2.LINE_AA, shift=4)
+    return out

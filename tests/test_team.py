@@ -128,3 +128,18 @@ def test_params_check_their_ranges_however_they_are_built(cls: type, field: str,
     with pytest.raises(ValueError, match=field):
         cls(**{field: bad})
     cls()  # the defaults are in range
+
+
+def test_the_braking_paths_dss_checked_are_kept_for_the_video() -> None:
+    brain = Brain("blue", SETTINGS)
+    robots = (RobotState("blue", 0, -1.0, 0.0, 0.0, 1.5, 0.0), RobotState("blue", 2, 1.0, 1.0, 0.0, 0.0, -1.0),
+              RobotState("yellow", 0, 0.0, -2.0, 0.0))  # fmt: skip
+    brain.step(world(0.0, *robots), GameState(0.0))
+    assert sorted(brain.braking) == [0, 2]  # our robots only
+    for r in robots[:2]:
+        path = brain.braking[r.id]
+        assert path.ndim == 2 and path.shape[1] == 2
+        np.testing.assert_allclose(path[0], (r.x, r.y))  # from where the robot is ...
+        # ... along its velocity to where it rests: moving at most the command's period plus braking
+        reach = np.hypot(r.vx, r.vy) + 0.1
+        assert np.hypot(*(path[-1] - (r.x, r.y))) <= reach**2 / (2 * SETTINGS.control.motion.max_brake_m_s2) + 0.1

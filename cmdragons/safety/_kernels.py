@@ -31,7 +31,8 @@ from numba import njit
 from cmdragons.control._kernels import N_SEG, Limits, clip_accel, limit_velocity, seg_at, stop_accel, trajectory
 from cmdragons.planning._kernels import clearance
 
-__all__ = ["N_SEG", "DSSConfig", "stop_accel", "trajectory"]
+# the robot model's braking trajectory (N_SEG, trajectory, stop_accel) is used here as defined in
+# cmdragons.control._kernels, and is reachable from this module for the safety tests
 
 _BISECT = 40
 

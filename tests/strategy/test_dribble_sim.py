@@ -44,7 +44,7 @@ def test_dribble_carries_the_ball_to_the_target(start: tuple[float, float, float
         if math.hypot(b.x - target[0], b.y - target[1]) < 0.05 and math.hypot(b.vx, b.vy) < 0.05:
             break
         intent = dribble(robot, ball, target, skills)
-        cmd = brain._navigate(robot, intent, WorldState(truth.t, ball, (robot,)), game)  # noqa: SLF001
+        (cmd,) = brain.drive(WorldState(truth.t, ball, (robot,)), {0: intent}, game)
         world.step_frame([cmd])
         held_frames += world.holding("blue", 0)
     b = world.ground_truth().ball

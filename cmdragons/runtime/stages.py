@@ -249,16 +249,19 @@ class TeamStage(_PlayingStage):
     def _report(self, world: WorldState) -> TeamReport:
         b = self.brain
         robots = tuple(
-            RobotReport(rid, p.status, (p.intent.x, p.intent.y, p.intent.theta),
-                        tuple((float(x), float(y)) for x, y in p.path), p.command,
-                        tuple((float(x), float(y)) for x, y in b.braking.get(rid, ())))
+            RobotReport(rid, p.status, (p.intent.x, p.intent.y, p.intent.theta), _points(p.path), p.command,
+                        _points(b.braking.get(rid, ())))
             for rid, p in sorted(b.plans.items())
         )  # fmt: skip
         heat = b.strategy.pass_heat
-        points, values = ((), ()) if heat is None else (
-            tuple((float(x), float(y)) for x, y in heat[0]), tuple(float(v) for v in heat[1]))  # fmt: skip
+        points, values = ((), ()) if heat is None else (_points(heat[0]), tuple(np.asarray(heat[1]).tolist()))
         return TeamReport(self.team, world.frame_number, world.t, robots, dict(b.strategy.last_action), points,
                           values)  # fmt: skip
+
+
+def _points(a: Any) -> tuple[tuple[float, float], ...]:
+    """(k, 2) points as a tuple of (x, y) (through numpy's tolist, not per element in Python)."""
+    return tuple((x, y) for x, y in np.asarray(a, dtype=np.float64).reshape(-1, 2).tolist())
 
 
 class SimpleOpponentStage(_PlayingStage):

@@ -28,6 +28,7 @@ from numpy.typing import NDArray
 
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, wrap_angle
+from strategy._kernels import goal_samples_free
 
 __all__ = [
     "PassEvaluation",
@@ -97,6 +98,21 @@ def lane_open_angle(origin: Array, targets: Array, obstacles: Array, radius: flo
     return out
 
 
+def goal_samples_free_reference(points: Array, ys: Array, gx: float, obstacles: Array, radius: float) -> NDArray[np.bool_]:
+    """The plain-numpy reference of :func:`strategy._kernels.goal_samples_free`."""
+    dx = gx - points[:, 0:1]
+    dy = ys[None, :] - points[:, 1:2]
+    theta, dist = np.arctan2(dy, dx), np.hypot(dx, dy)
+    rel = obstacles[None, :, :] - points[:, None, :]  # (N, M, 2)
+    d = np.hypot(rel[..., 0], rel[..., 1])  # (N, M)
+    phi = np.arctan2(rel[..., 1], rel[..., 0])
+    alpha = np.arcsin(np.clip(radius / np.maximum(d, 1e-9), 0.0, 1.0))
+    # an obstacle shadows a goal sample when it is nearer than the sample and within its angle
+    near = (d[:, None, :] < dist[:, :, None]) & (d[:, None, :] > radius)
+    hit = np.abs(_wrap(theta[:, :, None] - phi[:, None, :])) <= alpha[:, None, :]
+    return np.asarray(~(near & hit).any(axis=2))
+
+
 def open_goal_angle(points: Array, field: Field, goal_sign: float, obstacles: Array, radius: float, samples: int,
                     post_margin_m: float) -> tuple[Array, Array]:  # fmt: skip
     """Open angle of the goal at x = goal_sign * half_length from each point (N,), and the y on the
@@ -112,17 +128,10 @@ def open_goal_angle(points: Array, field: Field, goal_sign: float, obstacles: Ar
     dx = gx - points[:, 0:1]  # (N, 1)
     dy = ys[None, :] - points[:, 1:2]  # (N, K)
     theta = np.arctan2(dy, dx)  # (N, K)
-    dist = np.hypot(dx, dy)
     free: NDArray[np.bool_] = np.ones(theta.shape, dtype=bool)
     if len(obstacles):
-        rel = obstacles[None, :, :] - points[:, None, :]  # (N, M, 2)
-        d = np.hypot(rel[..., 0], rel[..., 1])  # (N, M)
-        phi = np.arctan2(rel[..., 1], rel[..., 0])
-        alpha = np.arcsin(np.clip(radius / np.maximum(d, 1e-9), 0.0, 1.0))
-        # an obstacle shadows a goal sample when it is nearer than the sample and within its angle
-        near = (d[:, None, :] < dist[:, :, None]) & (d[:, None, :] > radius)
-        hit = np.abs(_wrap(theta[:, :, None] - phi[:, None, :])) <= alpha[:, None, :]
-        free = np.asarray(~(near & hit).any(axis=2))
+        free = goal_samples_free(np.ascontiguousarray(points, dtype=np.float64), ys, float(gx),
+                                 np.ascontiguousarray(obstacles, dtype=np.float64), float(radius))  # fmt: skip
     # the longest run of free samples, per point
     n, k = free.shape
     best_len = np.zeros(n, dtype=np.int64)

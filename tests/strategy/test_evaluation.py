@@ -83,3 +83,17 @@ def test_grid_best_point_is_open_and_legal() -> None:
     assert value > 0
     assert lane_open_angle(ball, best[None, :], opponents, R, 1.0)[0] > 0
     assert FIELD.in_field(float(best[0]), float(best[1]), margin=P.field_margin_m - 1e-9)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_the_goal_shadow_kernel_agrees_with_its_numpy_reference(seed: int) -> None:
+    from strategy._kernels import goal_samples_free
+    from strategy.evaluation import goal_samples_free_reference
+
+    rng = np.random.default_rng(seed)
+    points = rng.uniform([-4.5, -3.0], [4.5, 3.0], size=(200, 2))
+    obstacles = rng.uniform([-4.5, -3.0], [4.5, 3.0], size=(int(rng.integers(1, 22)), 2))
+    ys = np.linspace(-0.4, 0.4, 24)
+    expected = goal_samples_free_reference(points, ys, 4.5, obstacles, 0.1115)
+    assert np.array_equal(goal_samples_free(points, ys, 4.5, obstacles, 0.1115), expected)
+    assert 0 < expected.sum() < expected.size  # some samples shadowed, some free

@@ -758,28 +758,31 @@ class TeamCommands:
             raise MessageError(f"bad team commands: {exc!r}") from None
 
 
-_Points = tuple[tuple[float, float], ...]
+def _points(value: Any) -> NDArray[np.float64]:
+    """Points (k, 2), field frame, m, as a float array (read from a list of [x, y])."""
+    return np.asarray(value, dtype=np.float64).reshape(-1, 2)
 
 
-def _points(value: Any) -> _Points:
-    return tuple((float(x), float(y)) for x, y in value)
+def _no_points() -> NDArray[np.float64]:
+    return np.zeros((0, 2))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class RobotReport:
     """What a brain did for one robot in one frame: the strategy's target, the planner's path and
-    status, the command before safety and the braking path the safety search checked."""
+    status, the command before safety and the braking path the safety search checked (points (k, 2),
+    field frame, m)."""
 
     id: int
     status: str  # the planner's status ("solved", "direct", "halt", ...)
     target: tuple[float, float, float]  # (x, y, theta) the strategy asked for
-    path: _Points = ()
+    path: NDArray[np.float64] = field(default_factory=_no_points)
     command: RobotCommand | None = None  # before safety
-    braking: _Points = ()
+    braking: NDArray[np.float64] = field(default_factory=_no_points)
 
     def to_dict(self) -> dict[str, Any]:
         return {"id": self.id, "status": self.status, "target": list(self.target),
-                "path": [list(p) for p in self.path], "braking": [list(p) for p in self.braking],
+                "path": np.asarray(self.path).tolist(), "braking": np.asarray(self.braking).tolist(),
                 "command": None if self.command is None else self.command.to_dict()}  # fmt: skip
 
     @classmethod
@@ -791,19 +794,20 @@ class RobotReport:
                    _points(d.get("braking", ())))  # fmt: skip
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class TeamReport:
     """One team's brain in one frame, for statistics, overlays and logs: per robot what it did, each
-    robot's last action as the strategy decided it ("shot", "pass", ...), the pass evaluation's
-    receiving points and values (wall-clock times go on a topic of their own: :class:`Timing`)."""
+    robot's last action as the strategy decided it ("shot", "pass", ...), and the pass evaluation's
+    receiving points (n, 2) and values (n,) when it was redone this frame (empty in the frames
+    between: the last one holds). Wall-clock times go on a topic of their own (:class:`Timing`)."""
 
     team: Team
     frame_number: int
     t: float
     robots: tuple[RobotReport, ...] = ()
     actions: Mapping[int, str] = field(default_factory=dict)
-    pass_points: _Points = ()
-    pass_values: tuple[float, ...] = ()
+    pass_points: NDArray[np.float64] = field(default_factory=_no_points)
+    pass_values: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
 
     def robot(self, robot_id: int) -> RobotReport | None:
         return next((r for r in self.robots if r.id == robot_id), None)
@@ -812,8 +816,8 @@ class TeamReport:
         return {"team": self.team, "frame_number": self.frame_number, "t": self.t,
                 "robots": [r.to_dict() for r in self.robots],
                 "actions": {str(k): v for k, v in self.actions.items()},
-                "pass_points": [list(p) for p in self.pass_points],
-                "pass_values": list(self.pass_values)}  # fmt: skip
+                "pass_points": np.asarray(self.pass_points).tolist(),
+                "pass_values": np.asarray(self.pass_values).tolist()}  # fmt: skip
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> Self:
@@ -821,7 +825,7 @@ class TeamReport:
             return cls(_team(d["team"]), int(d["frame_number"]), _f(d, "t"),
                        tuple(RobotReport.from_dict(r) for r in d.get("robots", ())),
                        {int(k): str(v) for k, v in d.get("actions", {}).items()}, _points(d.get("pass_points", ())),
-                       tuple(float(v) for v in d.get("pass_values", ())))  # fmt: skip
+                       np.asarray(d.get("pass_values", ()), dtype=np.float64))  # fmt: skip
         except (KeyError, TypeError, ValueError) as exc:
             raise MessageError(f"bad team report: {exc!r}") from None
 

@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, wrap_angle
-from strategy._kernels import goal_samples_free
+from strategy._kernels import free_runs, goal_samples_free
 
 __all__ = [
     "PassEvaluation",
@@ -98,7 +98,8 @@ def lane_open_angle(origin: Array, targets: Array, obstacles: Array, radius: flo
     return out
 
 
-def goal_samples_free_reference(points: Array, ys: Array, gx: float, obstacles: Array, radius: float) -> NDArray[np.bool_]:
+def goal_samples_free_reference(points: Array, ys: Array, gx: float, obstacles: Array,
+                                radius: float) -> NDArray[np.bool_]:  # fmt: skip
     """The plain-numpy reference of :func:`strategy._kernels.goal_samples_free`."""
     dx = gx - points[:, 0:1]
     dy = ys[None, :] - points[:, 1:2]
@@ -132,16 +133,9 @@ def open_goal_angle(points: Array, field: Field, goal_sign: float, obstacles: Ar
     if len(obstacles):
         free = goal_samples_free(np.ascontiguousarray(points, dtype=np.float64), ys, float(gx),
                                  np.ascontiguousarray(obstacles, dtype=np.float64), float(radius))  # fmt: skip
-    # the longest run of free samples, per point
+    # the longest run of free samples per point, and the free runs from each post
     n, k = free.shape
-    best_len = np.zeros(n, dtype=np.int64)
-    best_end = np.zeros(n, dtype=np.int64)
-    run = np.zeros(n, dtype=np.int64)
-    for j in range(k):
-        run = np.where(free[:, j], run + 1, 0)
-        better = run > best_len
-        best_len = np.where(better, run, best_len)
-        best_end = np.where(better, j, best_end)
+    best_len, best_end, lead, trail = free_runs(free)
     start = best_end - best_len + 1
     rows = np.arange(n)
     width = np.where(best_len > 1, np.abs(theta[rows, best_end] - theta[rows, np.maximum(start, 0)]), 0.0)
@@ -150,8 +144,6 @@ def open_goal_angle(points: Array, field: Field, goal_sign: float, obstacles: Ar
     spacing = np.abs(np.diff(theta, axis=1)).mean(axis=1) if k > 1 else np.zeros(n)
     width = np.where(best_len == 1, 0.5 * spacing, width)
     # a gap with one end at a post, aimed at that end: the blocker has all of it to cover
-    lead = np.argmin(np.concatenate([free, np.zeros((n, 1), dtype=bool)], axis=1), axis=1)  # free samples from -gw
-    trail = np.argmin(np.concatenate([free[:, ::-1], np.zeros((n, 1), dtype=bool)], axis=1), axis=1)
     for run_len, end, post_y in ((lead, 0, ys[0]), (trail, k - 1, ys[-1])):
         inner = np.clip(end + (run_len - 1) * (1 if end == 0 else -1), 0, k - 1)
         post_width = np.where(run_len > 1, 2.0 * np.abs(theta[rows, inner] - theta[:, end]), spacing)

@@ -62,7 +62,8 @@ def runnable(line: str, rec: dict[str, Path], tmp: Path) -> list[str]:
     line = line.replace("--lines frame.png", f"--lines {frame}")
     argv = shlex.split(line)[1:]
     if argv[:2] in (["vision", "calibrate"], ["vision", "tune"]):  # they write a config: into the test's folder
-        return argv + ["--out", str(tmp / "out.yaml")] + (["--overlay", str(tmp / "o.png")] if "--lines" in argv else [])
+        overlay = ["--overlay", str(tmp / "o.png")] if "--lines" in argv else []
+        return argv + ["--out", str(tmp / "out.yaml")] + overlay
     for i, a in enumerate(argv[:-1]):  # outputs go to the test's folder
         if a in ("--out", "--snapshot", "--json") and not Path(argv[i + 1]).is_absolute():
             argv[i + 1] = str(tmp / argv[i + 1])

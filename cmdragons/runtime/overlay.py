@@ -23,6 +23,8 @@ from cmdragons.runtime.bus import BaseStage, Publish
 
 __all__ = ["MatchVideoStage", "draw_overlays", "tile_cameras"]
 
+Heat = tuple[NDArray[np.float64], NDArray[np.float64]]  # the pass evaluation: points (n, 2), values (n,)
+
 _OURS = (255, 255, 255)
 _THEIRS = (0, 215, 255)
 _PATH = (255, 200, 0)
@@ -36,12 +38,13 @@ def _px(model: CameraModel, xy: NDArray[np.float64], z: float) -> NDArray[np.int
 
 
 def draw_overlays(image: NDArray[np.uint8], model: CameraModel, world: WorldState | None, report: TeamReport,
-                  commands: Sequence[RobotCommand], robot_height: float) -> NDArray[np.uint8]:  # fmt: skip
+                  commands: Sequence[RobotCommand], robot_height: float,
+                  heat: Heat | None = None) -> NDArray[np.uint8]:  # fmt: skip
     """A copy of ``image`` with the overlays drawn (BGR): ``world`` and ``commands`` (after safety)
-    of ``report``'s team in the same frame."""
+    of ``report``'s team in the same frame, and the latest pass evaluation ``heat`` (points, values)."""
     out = image.copy()
-    if report.pass_points:
-        points, values = np.array(report.pass_points), np.array(report.pass_values)
+    if heat is not None and len(heat[0]):
+        points, values = heat
         vmax = max(float(values.max()), 1e-9)
         for (x, y), v in zip(_px(model, points, 0.0), values, strict=True):
             if v > 0.02 * vmax:
@@ -127,6 +130,7 @@ class MatchVideoStage(BaseStage):
         self._game = GameState(0.0)
         self._world: WorldState | None = None
         self._report: TeamReport | None = None
+        self._heat: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None  # the latest pass evaluation
 
     def on_message(self, topic: str, message: Any, publish: Publish) -> None:
         if isinstance(message, CameraFrame):
@@ -139,6 +143,8 @@ class MatchVideoStage(BaseStage):
             self._world = message
         elif isinstance(message, TeamReport):
             self._report = message
+            if len(message.pass_points):
+                self._heat = (message.pass_points, message.pass_values)
         elif isinstance(message, TeamCommands) and self._report is not None:
             image = self._draw(message)
             if image is not None:
@@ -149,12 +155,14 @@ class MatchVideoStage(BaseStage):
 
         assert self._report is not None
         if self.view == "field":
-            return self.topdown.draw(view_frame(self._truth, self._game, self._world, self._report, commands.commands))
+            return self.topdown.draw(view_frame(self._truth, self._game, self._world, self._report, commands.commands,
+                                                self._heat))  # fmt: skip
         frames = {cam: f for cam, f in self._images.items() if f.frame_number == commands.frame_number}
         if not frames:
             return None
         drawn = {cam: draw_overlays(f.image, next(m for m in self.models if m.id == cam), self._world, self._report,
-                                    commands.commands, self.robot_height_m) for cam, f in frames.items()}  # fmt: skip
+                                    commands.commands, self.robot_height_m, self._heat)
+                 for cam, f in frames.items()}  # fmt: skip
         return tile_cameras(drawn, self.models)
 
     def _write(self, image: NDArray[np.uint8]) -> None:

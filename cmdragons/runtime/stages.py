@@ -27,6 +27,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from cmdragons.geometry import TEAMS, Team
 from cmdragons.messages import (
@@ -237,6 +238,7 @@ class TeamStage(_PlayingStage):
     def __init__(self, team: Team, brain: Brain) -> None:
         super().__init__(f"team/{team}", team, f"world/{team}")
         self.brain = brain
+        self._heat: tuple[Any, Any] | None = None  # the pass evaluation last sent
 
     def play(self, message: Any) -> tuple[WorldState, list[RobotCommand]]:
         return message, self.brain.step(message, self.game)
@@ -254,14 +256,23 @@ class TeamStage(_PlayingStage):
             for rid, p in sorted(b.plans.items())
         )  # fmt: skip
         heat = b.strategy.pass_heat
-        points, values = ((), ()) if heat is None else (_points(heat[0]), tuple(np.asarray(heat[1]).tolist()))
+        points, values = _points(()), np.zeros(0)
+        if heat is not None and not (self._heat is not None and _same(self._heat[0], heat[0])
+                                     and _same(self._heat[1], heat[1])):  # fmt: skip
+            points, values = heat  # the grid is evaluated every few frames only: sent when it was
+            self._heat = heat
         return TeamReport(self.team, world.frame_number, world.t, robots, dict(b.strategy.last_action), points,
                           values)  # fmt: skip
 
 
-def _points(a: Any) -> tuple[tuple[float, float], ...]:
-    """(k, 2) points as a tuple of (x, y) (through numpy's tolist, not per element in Python)."""
-    return tuple((x, y) for x, y in np.asarray(a, dtype=np.float64).reshape(-1, 2).tolist())
+def _same(a: Any, b: Any) -> bool:
+    """Whether two arrays are (views of) the same memory: an evaluation not redone."""
+    return bool((a.base if a.base is not None else a) is (b.base if b.base is not None else b))
+
+
+def _points(a: Any) -> NDArray[np.float64]:
+    """(k, 2) points, field frame, m."""
+    return np.asarray(a, dtype=np.float64).reshape(-1, 2)
 
 
 class SimpleOpponentStage(_PlayingStage):

@@ -56,15 +56,16 @@ class ViewFrame:
 
 
 def view_frame(truth: GroundTruth | None, game: GameState, world: WorldState | None, report: TeamReport,
-               commands: Sequence[RobotCommand]) -> ViewFrame:  # fmt: skip
+               commands: Sequence[RobotCommand],
+               heat: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None) -> ViewFrame:  # fmt: skip
     """A :class:`ViewFrame` from one frame's messages on the bus: the simulator's truth, the
     referee's game state, our tracked world, our team's report (plans, the braking paths the safety
-    search checked, the pass evaluation) and our commands after safety."""
+    search checked), our commands after safety, and the latest pass evaluation (points, values:
+    reports carry it only in the frames it was redone)."""
     plans = {r.id: np.asarray(r.path, dtype=np.float64).reshape(-1, 2) for r in report.robots if len(r.path) >= 2}
     braking = {r.id: np.asarray(r.braking, dtype=np.float64).reshape(-1, 2) for r in report.robots if len(r.braking)}
-    heat = None
-    if report.pass_points:
-        heat = (np.asarray(report.pass_points, dtype=np.float64), np.asarray(report.pass_values, dtype=np.float64))
+    if len(report.pass_points):
+        heat = (report.pass_points, report.pass_values)
     t = truth.t if truth is not None else report.t
     return ViewFrame(t, world, truth, game, report.team, plans, braking, heat, tuple(commands))
 

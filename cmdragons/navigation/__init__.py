@@ -1,0 +1,1 @@
+"""Local navigators and grid navigation functions (the seeds' navigation catalogue)."""

@@ -123,6 +123,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("suite", help="suite name (see `cmdragons bench --help`: sim, planning, safety, ...)")
     p.add_argument("--quick", action="store_true", help="a reduced suite, well under a minute")
     p.add_argument("--json", metavar="PATH", default=None, help="also write the rows as JSON")
+    p.add_argument("--maps", metavar="DIR", default=None,
+                   help="grid: a folder of Moving AI .map files with their .map.scen "
+                   "(default ../shared/benchdata/moving_ai)")
     return parser
 
 
@@ -456,7 +459,7 @@ def _cmd_vision(args: argparse.Namespace) -> int:
 
 
 def _cmd_bench(args: argparse.Namespace) -> int:
-    from cmdragons.bench import SUITES, print_table, write_json
+    from cmdragons.bench import OPTIONS, SUITES, print_table, write_json
     from cmdragons.runtime.log import check_writable_file
     from cmdragons.runtime.settings import load_settings
 
@@ -466,7 +469,16 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     settings = load_settings(args.config, args.set)
     if args.json:
         check_writable_file(args.json, "--json")  # before the bench: its rows are not lost at the end
-    rows = SUITES[args.suite](settings, args.quick)
+    options = {k: getattr(args, k) for k in OPTIONS.get(args.suite, ()) if getattr(args, k) is not None}
+    for k in ("maps",):
+        if getattr(args, k) is not None and k not in OPTIONS.get(args.suite, ()):
+            print(f"cmdragons bench: --{k} is for the grid suite, not {args.suite}", file=sys.stderr)
+            return 2
+    try:
+        rows = SUITES[args.suite](settings, args.quick, **options)
+    except FileNotFoundError as exc:  # a suite's input data (the grid suite's maps) is not there
+        print(f"cmdragons bench: {exc}; give a folder with --maps DIR", file=sys.stderr)
+        return 2
     print_table(args.suite, rows)
     if args.json:
         write_json(args.json, args.suite, rows)

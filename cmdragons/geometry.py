@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Literal, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -34,8 +34,11 @@ Team = Literal["blue", "yellow"]
 TEAMS: tuple[Team, Team] = ("blue", "yellow")
 
 
-def wrap_angle(a: float) -> float:
-    """Angle wrapped into [-pi, pi)."""
+AngleT = TypeVar("AngleT", float, NDArray[np.float64])
+
+
+def wrap_angle(a: AngleT) -> AngleT:
+    """Angle(s) wrapped into [-pi, pi): a float, or element-wise an array (radians)."""
     return (a + math.pi) % (2.0 * math.pi) - math.pi
 
 

@@ -19,24 +19,29 @@ __all__ = ["SUITES", "TABLE_WIDTH", "header", "print_table", "write_json"]
 Row = dict[str, Any]
 
 
-def _lazy(module: str) -> Callable[[Settings, bool], list[Row]]:
+Suite = Callable[..., list[Row]]  # run(settings, quick, **options): options a suite takes by name (maps=...)
+
+
+def _lazy(module: str) -> Suite:
     """A suite's ``run`` imported on first use (a suite may pull in heavy or optional packages)."""
 
-    def run(settings: Settings, quick: bool) -> list[Row]:
-        rows: list[Row] = importlib.import_module(module).run(settings, quick)
+    def run(settings: Settings, quick: bool, **options: Any) -> list[Row]:
+        rows: list[Row] = importlib.import_module(module).run(settings, quick, **options)
         return rows
 
     return run
 
 
-SUITES: dict[str, Callable[[Settings, bool], list[Row]]] = {
+SUITES: dict[str, Suite] = {
     "sim": _lazy("cmdragons.bench.sim"),
     "planning": _lazy("cmdragons.bench.planning"),
     "safety": _lazy("cmdragons.bench.safety"),
     "tracking": _lazy("cmdragons.bench.tracking"),
     "play": _lazy("cmdragons.bench.play"),
     "vision": _lazy("cmdragons.bench.vision"),
+    "grid": _lazy("cmdragons.bench.grid"),
 }
+OPTIONS: dict[str, tuple[str, ...]] = {"grid": ("maps",)}  # the options each suite takes
 
 
 TABLE_WIDTH = 100  # columns: a bench table fits a standard terminal

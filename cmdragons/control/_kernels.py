@@ -266,7 +266,7 @@ def motion_commands(
         cx, cy, _ = command_2d(targets[i, 0] - x, targets[i, 1] - y, vx, vy, targets[i, 2], targets[i, 3],
                                vmax, accel, brake, period, iterations)  # fmt: skip
         out[i, 0], out[i, 1] = limit_velocity(vx, vy, cx, cy, vmax, accel, brake, period)
-        dth = wrap_angle(targets[i, 4] - th)
+        dth: float = wrap_angle(targets[i, 4] - th)
         ph, _ = profile_1d(dth, w, 0.0, wmax, alpha, alpha)
         out[i, 2] = phases_state(ph, w, period)[1]
     return out

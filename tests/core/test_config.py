@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import dataclasses
 import shutil
+from collections.abc import Mapping
 from pathlib import Path
 
 import pytest
 
-from cmdragons.config import ConfigError
+from cmdragons.config import ConfigError, Validated
 from cmdragons.runtime.settings import CONCERNS, load_settings
 from sim.params import SimParams
 
@@ -132,3 +134,21 @@ def test_cli_reports_config_errors(configs: Path, capsys: pytest.CaptureFixture[
     assert main(["sim", "--config", str(configs), "--seconds", "0.1", "--no-progress"]) == 2
     err = capsys.readouterr().err
     assert "sim.yaml: physics.substeps: 0 is out of range; allowed: 1 to 100" in err
+
+
+def _param_types(obj: object, path: str = "") -> list[tuple[str, type]]:
+    """Every params dataclass reachable from ``obj`` with where it sits."""
+    if isinstance(obj, Mapping):
+        return [t for k, v in obj.items() for t in _param_types(v, f"{path}.{k}")]
+    if not (dataclasses.is_dataclass(obj) and not isinstance(obj, type)):
+        return []
+    out = [(path, type(obj))]
+    for f in dataclasses.fields(obj):
+        out += _param_types(getattr(obj, f.name), f"{path}.{f.name}".strip("."))
+    return out
+
+
+def test_every_params_object_validates_its_ranges_however_it_is_built() -> None:
+    s = load_settings(REPO_CONFIGS)
+    types = {t: path for path, t in _param_types(s) if t is not type(s)}
+    assert [path for t, path in types.items() if not issubclass(t, Validated)] == []

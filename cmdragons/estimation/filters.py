@@ -1,0 +1,300 @@
+"""The estimation examples' filters (Newman's lecture notes, ch. 4-7): the linear Kalman filter of
+the Mars lander, EKF localisation against known landmarks, EKF-SLAM, and a particle filter.
+
+filterpy carries the Kalman algebra (``KalmanFilter``, ``ExtendedKalmanFilter``); the models, their
+Jacobians and the particle filter are ours (:mod:`cmdragons.estimation.models`). Every filter also
+reports its consistency: the NEES (normalised estimation error squared) of its estimate against a
+truth, which for a consistent filter follows a chi-square distribution with the state's degrees of
+freedom.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from filterpy.kalman import ExtendedKalmanFilter, KalmanFilter
+from numpy.typing import ArrayLike, NDArray
+
+from cmdragons.estimation.models import (
+    compose,
+    compose_jacobians,
+    observation_to_landmark,
+    observation_to_landmark_jacobians,
+    observe,
+    observe_jacobians,
+)
+from cmdragons.estimation.simulate import Sighting
+from cmdragons.geometry import wrap_angle
+
+__all__ = ["EKFLocalisation", "EKFSlam", "Lander", "ParticleLocalisation", "lander_filter", "nees", "simulate_lander"]
+
+FloatArray = NDArray[np.float64]
+
+
+def nees(error: ArrayLike, cov: ArrayLike) -> float:
+    """e^T P^-1 e of an estimation error ``e`` with covariance ``P``."""
+    e = np.asarray(error, dtype=np.float64)
+    return float(e @ np.linalg.solve(np.asarray(cov, dtype=np.float64), e))
+
+
+def _pose_error(estimate: ArrayLike, truth: ArrayLike) -> FloatArray:
+    e = np.asarray(estimate, dtype=np.float64) - np.asarray(truth, dtype=np.float64)
+    e[2] = wrap_angle(float(e[2]))
+    return e
+
+
+def _residual(a: FloatArray, b: FloatArray) -> FloatArray:
+    """Residual of two range-bearing column vectors (2, 1), the bearing wrapped."""
+    d = np.asarray(a, dtype=np.float64) - np.asarray(b, dtype=np.float64)
+    d[1, 0] = wrap_angle(float(d[1, 0]))
+    return d
+
+
+# --- the Mars lander: a linear Kalman filter ----------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Lander:
+    """A lander falling under gravity with its engine's thrust, its altitude measured by radar.
+    State (altitude m, vertical speed m/s); the control is the engine's acceleration (m/s^2)."""
+
+    dt_s: float = 0.1
+    gravity_m_s2: float = 3.71  # Mars
+    accel_sigma_m_s2: float = 0.05  # unmodelled accelerations (wind, thrust noise)
+    radar_sigma_m: float = 5.0
+
+
+def lander_filter(lander: Lander, altitude_m: float, speed_m_s: float) -> KalmanFilter:
+    """The linear Kalman filter for ``lander``: x' = F x + B (thrust - g), z = H x."""
+    dt = lander.dt_s
+    kf = KalmanFilter(dim_x=2, dim_z=1, dim_u=1)
+    kf.F = np.array([[1.0, dt], [0.0, 1.0]])
+    kf.B = np.array([[0.5 * dt * dt], [dt]])
+    kf.H = np.array([[1.0, 0.0]])
+    g = np.array([[0.5 * dt * dt], [dt]])
+    kf.Q = g @ g.T * lander.accel_sigma_m_s2**2
+    kf.R = np.array([[lander.radar_sigma_m**2]])
+    kf.x = np.array([[altitude_m], [speed_m_s]])
+    kf.P = np.diag([100.0**2, 10.0**2])
+    return kf
+
+
+def simulate_lander(lander: Lander, seed: int = 0, altitude_m: float = 10000.0, speed_m_s: float = -300.0,
+                    steps: int = 5000) -> dict[str, FloatArray]:  # fmt: skip
+    """A descent (the engine braking to hold a speed schedule from the filter's estimate) with its
+    truth, the radar's readings and the filter's estimates and variances, per step."""
+    rng = np.random.default_rng(seed)
+    kf = lander_filter(lander, altitude_m + rng.normal(0, 100.0), speed_m_s + rng.normal(0, 10.0))
+    x = np.array([altitude_m, speed_m_s])
+    dt = lander.dt_s
+    out: dict[str, list[float]] = {k: [] for k in ("t", "altitude", "speed", "radar", "est_altitude", "est_speed",
+                                                   "var_altitude", "var_speed")}  # fmt: skip
+    for k in range(steps):
+        est_h, est_v = float(kf.x[0, 0]), float(kf.x[1, 0])
+        target_v = -max(2.0, 0.02 * max(est_h, 0.0))  # slow down near the ground
+        thrust = float(np.clip(lander.gravity_m_s2 + (target_v - est_v) / (5 * dt), 0.0, 3 * lander.gravity_m_s2))
+        a = thrust - lander.gravity_m_s2 + rng.normal(0.0, lander.accel_sigma_m_s2)
+        x = np.array([x[0] + x[1] * dt + 0.5 * a * dt * dt, x[1] + a * dt])
+        z = x[0] + rng.normal(0.0, lander.radar_sigma_m)
+        kf.predict(u=np.array([[thrust - lander.gravity_m_s2]]))
+        kf.update(np.array([[z]]))
+        for key, value in (("t", (k + 1) * dt), ("altitude", x[0]), ("speed", x[1]), ("radar", z),
+                           ("est_altitude", kf.x[0, 0]), ("est_speed", kf.x[1, 0]), ("var_altitude", kf.P[0, 0]),
+                           ("var_speed", kf.P[1, 1])):  # fmt: skip
+            out[key].append(float(value))
+        if x[0] <= 0.0:
+            break
+    return {k: np.array(v) for k, v in out.items()}
+
+
+# --- EKF localisation against known landmarks ---------------------------------------------------
+
+
+class _OdometryEKF(ExtendedKalmanFilter):  # type: ignore[misc]
+    """filterpy's EKF with the odometry motion model: x' = x (+) u, F = J1, Q = J2 U J2^T."""
+
+    def predict_odometry(self, u: FloatArray, u_cov: FloatArray, pose_slice: slice = slice(0, 3)) -> None:
+        pose = self.x[pose_slice, 0]
+        j1, j2 = compose_jacobians(pose, u)
+        n = self.x.shape[0]
+        f = np.eye(n)
+        f[pose_slice, pose_slice] = j1
+        q = np.zeros((n, n))
+        q[pose_slice, pose_slice] = j2 @ u_cov @ j2.T
+        self.x[pose_slice, 0] = compose(pose, u)
+        self.F, self.Q = f, q
+        self.P = f @ self.P @ f.T + q  # type: ignore[has-type]
+        self.x_prior, self.P_prior = self.x.copy(), self.P.copy()
+
+
+class EKFLocalisation:
+    """The vehicle's pose from odometry and range-bearing sightings of landmarks at known places."""
+
+    def __init__(self, landmarks: ArrayLike, start: ArrayLike, start_cov: ArrayLike, sensor_cov: ArrayLike) -> None:
+        self.landmarks = np.asarray(landmarks, dtype=np.float64)
+        self.ekf = _OdometryEKF(dim_x=3, dim_z=2)
+        self.ekf.x = np.asarray(start, dtype=np.float64).reshape(3, 1).copy()
+        self.ekf.P = np.asarray(start_cov, dtype=np.float64).copy()
+        self.R = np.asarray(sensor_cov, dtype=np.float64)
+
+    @property
+    def pose(self) -> FloatArray:
+        return np.array(self.ekf.x[:, 0], dtype=np.float64)
+
+    @property
+    def cov(self) -> FloatArray:
+        return np.asarray(self.ekf.P, dtype=np.float64).copy()
+
+    def predict(self, odometry: ArrayLike, odometry_cov: ArrayLike) -> None:
+        self.ekf.predict_odometry(np.asarray(odometry, dtype=np.float64), np.asarray(odometry_cov, dtype=np.float64))
+
+    def update(self, sightings: list[Sighting]) -> None:
+        for s in sightings:
+            lm = self.landmarks[s.landmark]
+            self.ekf.update(s.z.reshape(2, 1), lambda x, lm=lm: observe_jacobians(x[:, 0], lm)[0],
+                            lambda x, lm=lm: observe(x[:, 0], lm).reshape(2, 1), R=self.R,
+                            residual=_residual)  # fmt: skip
+            self.ekf.x[2, 0] = wrap_angle(float(self.ekf.x[2, 0]))
+
+    def nees(self, truth: ArrayLike) -> float:
+        return nees(_pose_error(self.pose, truth), self.cov)
+
+
+# --- EKF-SLAM -----------------------------------------------------------------------------------
+
+
+class EKFSlam:
+    """Pose and landmark map together: state (x, y, theta, l1x, l1y, ...); a landmark joins the
+    state the first time it is seen (its mean by the inverse sensor model, its covariance and its
+    correlation with the pose through the model's Jacobians, lecture notes §7.6)."""
+
+    def __init__(self, n_landmarks: int, start: ArrayLike, start_cov: ArrayLike, sensor_cov: ArrayLike) -> None:
+        n = 3 + 2 * n_landmarks
+        self.ekf = _OdometryEKF(dim_x=n, dim_z=2)
+        self.ekf.x = np.zeros((n, 1))
+        self.ekf.x[:3, 0] = np.asarray(start, dtype=np.float64)
+        self.ekf.P = np.zeros((n, n))
+        self.ekf.P[:3, :3] = np.asarray(start_cov, dtype=np.float64)
+        self.known = np.zeros(n_landmarks, dtype=bool)
+        self.R = np.asarray(sensor_cov, dtype=np.float64)
+
+    @property
+    def pose(self) -> FloatArray:
+        return np.array(self.ekf.x[:3, 0], dtype=np.float64)
+
+    @property
+    def pose_cov(self) -> FloatArray:
+        return np.asarray(self.ekf.P[:3, :3], dtype=np.float64).copy()
+
+    def landmark(self, i: int) -> FloatArray:
+        return np.array(self.ekf.x[3 + 2 * i : 5 + 2 * i, 0], dtype=np.float64)
+
+    def landmark_cov(self, i: int) -> FloatArray:
+        s = slice(3 + 2 * i, 5 + 2 * i)
+        return np.asarray(self.ekf.P[s, s], dtype=np.float64).copy()
+
+    def predict(self, odometry: ArrayLike, odometry_cov: ArrayLike) -> None:
+        self.ekf.predict_odometry(np.asarray(odometry, dtype=np.float64), np.asarray(odometry_cov, dtype=np.float64))
+
+    def _add(self, i: int, z: FloatArray) -> None:
+        pose = self.ekf.x[:3, 0]
+        s = slice(3 + 2 * i, 5 + 2 * i)
+        self.ekf.x[s, 0] = observation_to_landmark(pose, z)
+        gx, gz = observation_to_landmark_jacobians(pose, z)
+        p = self.ekf.P
+        cross = gx @ p[:3, :]  # the new landmark's correlation with every state, through the pose
+        p[s, :] = cross
+        p[:, s] = cross.T
+        p[s, s] = gx @ p[:3, :3] @ gx.T + gz @ self.R @ gz.T
+        self.known[i] = True
+
+    def update(self, sightings: list[Sighting]) -> None:
+        n = self.ekf.x.shape[0]
+        for sgt in sightings:
+            i = sgt.landmark
+            if not self.known[i]:
+                self._add(i, sgt.z)
+                continue
+            s = slice(3 + 2 * i, 5 + 2 * i)
+
+            def jac(x: FloatArray, s: slice = s) -> FloatArray:
+                jx, jl = observe_jacobians(x[:3, 0], x[s, 0])
+                h = np.zeros((2, n))
+                h[:, :3], h[:, s] = jx, jl
+                return h
+
+            self.ekf.update(sgt.z.reshape(2, 1), jac, lambda x, s=s: observe(x[:3, 0], x[s, 0]).reshape(2, 1),
+                            R=self.R, residual=_residual)  # fmt: skip
+            self.ekf.x[2, 0] = wrap_angle(float(self.ekf.x[2, 0]))
+
+    def nees(self, truth: ArrayLike) -> float:
+        """The pose's NEES."""
+        return nees(_pose_error(self.pose, truth), self.pose_cov)
+
+
+# --- particle filter localisation ---------------------------------------------------------------
+
+
+class ParticleLocalisation:
+    """Monte Carlo localisation: particles moved by sampled odometry, weighted by the sightings'
+    likelihood, resampled systematically when the effective sample size drops below half."""
+
+    def __init__(self, landmarks: ArrayLike, start: ArrayLike, start_cov: ArrayLike, sensor_cov: ArrayLike,
+                 n: int = 500, seed: int = 0) -> None:  # fmt: skip
+        self.rng = np.random.default_rng(seed)
+        self.landmarks = np.asarray(landmarks, dtype=np.float64)
+        self.particles = self.rng.multivariate_normal(np.asarray(start, dtype=np.float64),
+                                                      np.asarray(start_cov, dtype=np.float64), size=n)  # fmt: skip
+        self.weights = np.full(n, 1.0 / n)
+        self.R_inv = np.linalg.inv(np.asarray(sensor_cov, dtype=np.float64))
+
+    def predict(self, odometry: ArrayLike, odometry_cov: ArrayLike) -> None:
+        u = np.asarray(odometry, dtype=np.float64)
+        noisy = self.rng.multivariate_normal(u, np.asarray(odometry_cov, dtype=np.float64), size=len(self.particles))
+        p = self.particles
+        c, s = np.cos(p[:, 2]), np.sin(p[:, 2])
+        p[:, 0] += c * noisy[:, 0] - s * noisy[:, 1]
+        p[:, 1] += s * noisy[:, 0] + c * noisy[:, 1]
+        p[:, 2] = wrap_angle(p[:, 2] + noisy[:, 2])
+
+    def update(self, sightings: list[Sighting]) -> None:
+        if not sightings:
+            return
+        p = self.particles
+        log_w = np.log(np.maximum(self.weights, 1e-300))
+        for sgt in sightings:
+            lx, ly = self.landmarks[sgt.landmark]
+            dx, dy = lx - p[:, 0], ly - p[:, 1]
+            r = np.hypot(dx, dy)
+            b = np.arctan2(dy, dx) - p[:, 2]
+            e = np.stack([sgt.z[0] - r, wrap_angle(sgt.z[1] - b)], axis=1)
+            log_w -= 0.5 * np.einsum("ni,ij,nj->n", e, self.R_inv, e)
+        log_w -= log_w.max()
+        w = np.exp(log_w)
+        self.weights = w / w.sum()
+        if 1.0 / np.sum(self.weights**2) < 0.5 * len(p):
+            self._resample()
+
+    def _resample(self) -> None:
+        n = len(self.particles)
+        positions = (self.rng.random() + np.arange(n)) / n
+        idx = np.searchsorted(np.cumsum(self.weights), positions)
+        self.particles = self.particles[np.minimum(idx, n - 1)]
+        self.weights = np.full(n, 1.0 / n)
+
+    @property
+    def pose(self) -> FloatArray:
+        w, p = self.weights, self.particles
+        theta = math.atan2(float(np.sum(w * np.sin(p[:, 2]))), float(np.sum(w * np.cos(p[:, 2]))))
+        return np.array([float(np.sum(w * p[:, 0])), float(np.sum(w * p[:, 1])), theta])
+
+    @property
+    def cov(self) -> FloatArray:
+        e = self.particles - self.pose
+        e[:, 2] = wrap_angle(e[:, 2])
+        return np.asarray((self.weights[:, None] * e).T @ e, dtype=np.float64)
+
+    def nees(self, truth: ArrayLike) -> float:
+        return nees(_pose_error(self.pose, truth), self.cov)

@@ -1,0 +1,132 @@
+"""The estimation examples against the truth of their simulated runs: errors, and consistency (the
+NEES of a consistent filter follows a chi-square distribution with the state's dimension)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.stats import chi2
+
+from cmdragons.estimation.filters import EKFLocalisation, EKFSlam, Lander, ParticleLocalisation, simulate_lander
+from cmdragons.estimation.models import (
+    compose,
+    compose_jacobians,
+    invert,
+    observation_to_landmark,
+    observation_to_landmark_jacobians,
+    observe,
+    observe_jacobians,
+)
+from cmdragons.estimation.simulate import simulate_run
+
+
+def numeric_jacobian(f, x: np.ndarray, eps: float = 1e-6) -> np.ndarray:  # type: ignore[no-untyped-def]
+    x = np.asarray(x, dtype=np.float64)
+    cols = []
+    for k in range(len(x)):
+        d = np.zeros_like(x)
+        d[k] = eps
+        cols.append((f(x + d) - f(x - d)) / (2 * eps))
+    return np.stack(cols, axis=1)
+
+
+def test_model_jacobians_match_finite_differences() -> None:
+    a, b = np.array([1.0, -2.0, 0.7]), np.array([0.3, 0.2, -0.4])
+    j1, j2 = compose_jacobians(a, b)
+    assert np.allclose(j1, numeric_jacobian(lambda x: compose(x, b), a), atol=1e-6)
+    assert np.allclose(j2, numeric_jacobian(lambda x: compose(a, x), b), atol=1e-6)
+    assert np.allclose(compose(a, invert(a)), 0.0, atol=1e-12)
+    lm = np.array([4.0, 1.0])
+    jx, jl = observe_jacobians(a, lm)
+    assert np.allclose(jx, numeric_jacobian(lambda x: observe(x, lm), a), atol=1e-6)
+    assert np.allclose(jl, numeric_jacobian(lambda x: observe(a, x), lm), atol=1e-6)
+    z = observe(a, lm)
+    assert np.allclose(observation_to_landmark(a, z), lm)
+    gx, gz = observation_to_landmark_jacobians(a, z)
+    assert np.allclose(gx, numeric_jacobian(lambda x: observation_to_landmark(x, z), a), atol=1e-6)
+    assert np.allclose(gz, numeric_jacobian(lambda x: observation_to_landmark(a, x), z), atol=1e-6)
+
+
+def test_the_lander_filter_beats_its_radar_and_is_consistent() -> None:
+    lander = Lander()
+    run = simulate_lander(lander, seed=1)
+    late = slice(len(run["t"]) // 4, None)  # after the start's uncertainty settled
+    radar_rms = float(np.sqrt(np.mean((run["radar"][late] - run["altitude"][late]) ** 2)))
+    est_err = run["est_altitude"][late] - run["altitude"][late]
+    assert float(np.sqrt(np.mean(est_err**2))) < 0.5 * radar_rms
+    # altitude errors normalised by the filter's own sigma: about unit variance
+    z = est_err / np.sqrt(run["var_altitude"][late])
+    assert 0.5 < float(np.mean(z**2)) < 2.0
+    assert run["altitude"][-1] <= 0.5 and abs(run["speed"][-1]) < 5.0  # it landed, slowly
+
+
+def _start(run, seed: int = 0):  # type: ignore[no-untyped-def]
+    """A start estimate drawn from its own covariance around the true start (a filter told it is
+    unsure by P0 must be wrong by about that much, or its NEES says it is too careful)."""
+    p0 = np.diag([0.01, 0.01, 0.001])
+    return run.truth[0] + np.random.default_rng(100 + seed).multivariate_normal(np.zeros(3), p0), p0
+
+
+def test_ekf_localisation_nees_lies_within_its_chi_square_bounds() -> None:
+    # the NEES averaged over N independent runs: within the two-sided 95% bounds of chi2(3N)/N
+    n_runs, steps = 20, 300
+    totals = np.zeros(steps)
+    errors = []
+    for seed in range(n_runs):
+        run = simulate_run(seed=seed, steps=steps)
+        x0, p0 = _start(run, seed)
+        ekf = EKFLocalisation(run.landmarks, x0, p0, run.sensor_cov)
+        for k in range(steps):
+            ekf.predict(run.odometry[k], run.odometry_cov)
+            ekf.update(run.sightings[k])
+            totals[k] += ekf.nees(run.truth[k + 1])
+            errors.append(math.hypot(*(ekf.pose[:2] - run.truth[k + 1][:2])))
+    mean_nees = totals / n_runs
+    lo, hi = chi2.ppf([0.025, 0.975], 3 * n_runs) / n_runs
+    inside = np.mean((mean_nees >= lo) & (mean_nees <= hi))
+    assert inside >= 0.9, (inside, lo, hi, float(np.mean(mean_nees)))
+    assert float(np.median(errors)) < 0.1
+
+
+def test_ekf_slam_maps_the_landmarks_and_keeps_the_pose_consistent() -> None:
+    run = simulate_run(seed=3, steps=600)
+    x0, p0 = _start(run)
+    slam = EKFSlam(len(run.landmarks), x0, p0, run.sensor_cov)
+    nees_values = []
+    for k in range(600):
+        slam.predict(run.odometry[k], run.odometry_cov)
+        slam.update(run.sightings[k])
+        nees_values.append(slam.nees(run.truth[k + 1]))
+    seen = np.flatnonzero(slam.known)
+    assert len(seen) >= 10
+    # the map's shape: distances between landmarks (the absolute frame carries the start's error)
+    pairs = [(i, j) for i in seen for j in seen if i < j]
+    shape = [abs(math.dist(slam.landmark(i), slam.landmark(j)) - math.dist(run.landmarks[i], run.landmarks[j]))
+             for i, j in pairs]  # fmt: skip
+    assert float(np.median(shape)) < 0.1
+    assert math.dist(slam.pose[:2], run.truth[-1][:2]) < 0.5
+    # one run: the pose's NEES averaged over time near its dimension, 3
+    assert 1.0 < float(np.mean(nees_values)) < 6.0
+    # the landmarks' own covariances say how far off they are (2 dof, averaged over the map)
+    lm_nees = [float(e @ np.linalg.solve(slam.landmark_cov(i), e))
+               for i, e in ((i, slam.landmark(i) - run.landmarks[i]) for i in seen)]  # fmt: skip
+    assert 0.5 < float(np.mean(lm_nees)) < 5.0
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_particle_localisation_follows_the_vehicle(seed: int) -> None:
+    run = simulate_run(seed=seed, steps=300)
+    x0, p0 = _start(run)
+    pf = ParticleLocalisation(run.landmarks, x0, p0, run.sensor_cov, n=500, seed=seed)
+    ekf = EKFLocalisation(run.landmarks, x0, p0, run.sensor_cov)
+    pf_err, ekf_err = [], []
+    for k in range(300):
+        for f in (pf, ekf):
+            f.predict(run.odometry[k], run.odometry_cov)
+            f.update(run.sightings[k])
+        pf_err.append(math.dist(pf.pose[:2], run.truth[k + 1][:2]))
+        ekf_err.append(math.dist(ekf.pose[:2], run.truth[k + 1][:2]))
+    assert float(np.median(pf_err)) < 0.15
+    assert float(np.median(pf_err)) < 2.0 * float(np.median(ekf_err)) + 0.02

@@ -415,6 +415,7 @@ def _compile_kernels(args: argparse.Namespace, overrides: Sequence[str], images:
 
 
 def _cmd_vision(args: argparse.Namespace) -> int:
+    from cmdragons.recording import RecordingError
     from cmdragons.runtime.log import run_folder
     from cmdragons.runtime.settings import load_settings
     from vision.run import run_vision
@@ -431,8 +432,12 @@ def _cmd_vision(args: argparse.Namespace) -> int:
     total = sum(len(s.paths) for s in sources if s.kind == "images") or None
     with _progress(not args.no_progress) as progress:
         task = progress.add_task("vision", total=total, info="")
-        summary = run_vision(sources, {m.id: m for m in settings.camera_models()}, settings.vision, settings.field,
-                             folder, args.video, fps, recording, lambda n: progress.advance(task, n))  # fmt: skip
+        try:
+            summary = run_vision(sources, {m.id: m for m in settings.camera_models()}, settings.vision, settings.field,
+                                 folder, args.video, fps, recording, lambda n: progress.advance(task, n))  # fmt: skip
+        except (SourceError, RecordingError) as exc:
+            print(f"cmdragons vision: {exc}", file=sys.stderr)
+            return 2
     d = summary.as_dict()
     bad = summary.unreadable + summary.empty + summary.wrong_size
     ms = d["ms_per_frame"]["median"]
@@ -444,7 +449,7 @@ def _cmd_vision(args: argparse.Namespace) -> int:
             print(f"vision: {len(frames)} {name.replace('_', ' ')} frame(s): {', '.join(frames[:20])}"
                   + (" ..." if len(frames) > 20 else ""))  # fmt: skip
     for message in summary.broken_off:
-        print(f"cmdragons vision: {message}; the frames before it were processed", file=sys.stderr)
+        print(f"cmdragons vision: {message}", file=sys.stderr)
     if summary.score:
         print("vision: against truth: " + ", ".join(f"{k} {v:.4g}" for k, v in summary.score.items()))
     if args.track:

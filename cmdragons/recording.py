@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 
 from cmdragons.camera import CameraModel, CameraParams, CamerasParams, RecordingParams
 from cmdragons.config import ConfigError, load_yaml, parse, to_plain
-from cmdragons.messages import GroundTruth
+from cmdragons.messages import GroundTruth, MessageError
 from cmdragons.videoio import VideoError, VideoWriter, read_video
 
 __all__ = ["RecordingError", "RecordingReader", "RecordingWriter", "camera_files"]
@@ -115,6 +115,7 @@ class RecordingReader:
         self.camera_params: dict[int, CameraParams] = {c.id: c for c in params.cameras}
         self.camera_ids = sorted(self.camera_params)
         self.recording = params.recording
+        self.truth_broken: str | None = None  # where truth.jsonl broke off, once read
 
     def camera_model(self, cam: int) -> CameraModel:
         return CameraModel(self.camera_params[cam])
@@ -134,10 +135,22 @@ class RecordingReader:
             yield np.asarray(read, dtype=np.uint8)
 
     def truth(self) -> Iterator[GroundTruth]:
+        """The recording's truth, a frame a line. A last line cut off (a recording that was
+        stopped) ends it, with :attr:`truth_broken` saying where; a bad line before the last is a
+        :class:`RecordingError` naming the file and line."""
         path = self.folder / "truth.jsonl"
         if not path.exists():
             return
         with open(path, encoding="utf-8") as f:
-            for line in f:
-                if line.strip():
-                    yield GroundTruth.from_dict(json.loads(line))
+            lines = f.readlines()
+        for k, line in enumerate(lines, start=1):
+            if not line.strip():
+                continue
+            try:
+                yield GroundTruth.from_dict(json.loads(line))
+            except (json.JSONDecodeError, MessageError) as exc:
+                if k == len(lines):
+                    self.truth_broken = f"{path}: line {k} is cut off; the truth of the frames before it is used"
+                    return
+                raise RecordingError(f"{path}: line {k} is not a frame's truth ({exc}); mend or remove that line"
+                                     ) from None

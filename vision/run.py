@@ -26,7 +26,7 @@ from cmdragons.recording import RecordingReader
 from cmdragons.videoio import VideoError, VideoWriter
 from vision.pipeline import VisionParams, VisionPipeline
 from vision.score import Score
-from vision.sources import FrameSource
+from vision.sources import FrameSource, SourceError
 
 __all__ = ["RunSummary", "annotate", "run_vision"]
 
@@ -95,15 +95,21 @@ def run_vision(sources: Sequence[FrameSource], cameras: dict[int, CameraModel], 
     ``out/annotated_camera_<id>.mp4``. With a recording's truth, the detections are scored."""
     out.mkdir(parents=True, exist_ok=True)
     summary = RunSummary()
+    missing = [s for s in sources if s.camera is None and s.camera_id not in cameras]
+    if missing:  # before any frame is processed
+        raise SourceError(f"{len(sources)} sources but only {len(cameras)} camera model(s) in the config: "
+                          f"{missing[0].name} would be camera {missing[0].camera_id}; give one source per camera "
+                          "(or a config whose cameras.yaml lists more)")  # fmt: skip
     truth: dict[int, GroundTruth] = {}
     if recording is not None:
-        truth = {t.frame_number: t for t in RecordingReader(recording).truth()}
+        reader = RecordingReader(recording)
+        truth = {t.frame_number: t for t in reader.truth()}
+        if reader.truth_broken:
+            summary.broken_off.append(reader.truth_broken)
     score = Score() if truth else None
     with open(out / "detections.jsonl", "w", encoding="utf-8") as jsonl:
         for src in sources:
-            model = src.camera or cameras.get(src.camera_id)
-            if model is None:
-                raise ValueError(f"{src.name}: no camera model for camera id {src.camera_id} (see --config cameras)")
+            model = src.camera or cameras[src.camera_id]
             pipe = VisionPipeline(params, league, model)
             writer: VideoWriter | None = None
             frames = src.frames()
@@ -113,7 +119,7 @@ def run_vision(sources: Sequence[FrameSource], cameras: dict[int, CameraModel], 
                 except StopIteration:
                     break
                 except VideoError as exc:
-                    summary.broken_off.append(str(exc))
+                    summary.broken_off.append(f"{exc}; the frames before it were processed")
                     break
                 where = f"{src.name}#{k}"
                 summary.frames += 1

@@ -91,3 +91,38 @@ def test_out_refuses_another_run_unless_overwrite(tmp_path: Path, capsys: pytest
     assert json.loads((out / "summary.json").read_text())["seed"] == 3
     assert (out / "notes.txt").read_text() == "mine\n"  # a file the runs did not write stays
     assert stdout.strip().splitlines()[-1].endswith(str(out))
+
+
+def _recording(tmp_path: Path) -> Path:
+    rec = tmp_path / "rec"
+    assert main(["sim", "--seconds", "0.2", "--record", "--format", "png", "--out", str(rec), "--no-progress"]) == 0
+    return rec
+
+
+def test_a_truth_file_cut_mid_line_keeps_the_frames_before(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    rec = _recording(tmp_path)
+    truth = rec / "truth.jsonl"
+    text = truth.read_text()
+    truth.write_text(text[: len(text) - 40])  # the last line cut off
+    capsys.readouterr()
+    assert main(["vision", str(rec), "--out", str(tmp_path / "v"), "--no-progress"]) == 0
+    err = capsys.readouterr().err
+    assert "truth.jsonl: line 12 is cut off; the truth of the frames before it is used" in err
+    assert "Traceback" not in err
+    # a bad line in the middle: one line naming file and line, exit 2
+    lines = text.splitlines()
+    truth.write_text("\n".join(lines[:3] + ["{not json"] + lines[4:]) + "\n")
+    assert main(["vision", str(rec), "--out", str(tmp_path / "w"), "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "truth.jsonl: line 4 is not a frame's truth" in err[0]
+
+
+def test_more_sources_than_cameras_is_one_line_before_any_work(tmp_path: Path,
+                                                               capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
+    rec = _recording(tmp_path)
+    frames = [str(rec / "camera_0"), str(rec / "camera_1"), str(rec / "camera_0")]
+    capsys.readouterr()
+    assert main(["vision", *frames, "--out", str(tmp_path / "v"), "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "3 sources but only 2 camera model(s)" in err[0], err
+    assert not (tmp_path / "v" / "detections.jsonl").exists() or not (tmp_path / "v" / "detections.jsonl").read_text()

@@ -201,18 +201,32 @@ def _child(spec: dict[str, Any]) -> None:
 
 
 def _warm_motion(settings: Any) -> None:
-    """The brain's navigators and safety stage as a match calls them: a few frames of the brain on
-    a throwaway crowd of own robots driving into each other and opponents."""
-    from cmdragons.messages import BallState, GameState, RobotState, WorldState
-    from cmdragons.team import Brain
+    """The navigator and the safety stage as the brain calls them (not through the brain: its
+    planners are the planning part's), on a throwaway crowd of own robots driving into each other
+    and opponents."""
+    import numpy as np
 
-    brain = Brain("blue", settings)
+    from cmdragons.messages import BallState, RobotCommand, RobotState, WorldState
+    from cmdragons.navigation import Arrival, make_navigator
+    from cmdragons.planning import deadline, field_world
+    from cmdragons.safety import make_safety
+
+    radius = settings.field.robot.radius_m
+    geometry = settings.field_geometry()
+    static = field_world(geometry, defense_areas=False)
+    safety = make_safety(settings.safety, settings.control, radius, static)
     n = settings.field.dims.robots_per_team
-    for k in range(3):
-        ours = [RobotState("blue", i, -1.0 + 0.25 * i, 0.1 * (i % 2), 0.0, 1.5 - 0.5 * i, 0.0, 0.0) for i in range(n)]
-        theirs = [RobotState("yellow", i, -0.9 + 0.25 * i, 0.3, math.pi, -1.0, 0.0, 0.0) for i in range(3)]
-        world = WorldState(k / 60.0, BallState(0.3, 0.0, 0.0, 0.0), tuple(ours + theirs), k)
-        brain.step(world, GameState(k / 60.0))
+    ours = [RobotState("blue", i, -1.0 + 0.25 * i, 0.1 * (i % 2), 0.0, 1.5 - 0.5 * i, 0.0, 0.0) for i in range(n)]
+    theirs = [RobotState("yellow", i, -0.9 + 0.25 * i, 0.3, math.pi, -1.0, 0.0, 0.0) for i in range(3)]
+    world = WorldState(0.0, BallState(0.0, 0.0, 0.0, 0.0), tuple(ours + theirs))
+    others = field_world(geometry, np.array([[r.x, r.y] for r in theirs]), np.array([[r.vx, r.vy] for r in theirs]))
+    nav = make_navigator(settings.team.navigator, settings.team, settings.control, radius, settings.planner.collision)
+    commands = []
+    for r in ours:
+        nav.set_plan(np.array([(r.x, r.y), (1.0, 1.0), (2.0, 1.0)]), Arrival(0.0))
+        vx, vy, omega = nav.command(r, others, deadline(0.5))
+        commands.append(RobotCommand("blue", r.id, vx, vy, omega))
+    safety.make_safe(commands, world)
 
 
 def _warm_planner(settings: Any) -> None:
@@ -220,8 +234,15 @@ def _warm_planner(settings: Any) -> None:
     robots with one gap between start and goal."""
     import numpy as np
 
+    from cmdragons.messages import BallState, GameState, RobotState, WorldState
     from cmdragons.planning import PlanProblem, deadline, field_world, make_planner
+    from strategy.plays import Strategy
 
+    # strategy's kernels (the shot and pass evaluation) on a few robots round the ball
+    strategy = Strategy("blue", settings.field_geometry(), settings.strategy)
+    robots = tuple(RobotState(t, i, (-1.0 if t == "blue" else 1.0) * (0.5 + i), 0.3 * i, 0.0)
+                   for t in ("blue", "yellow") for i in range(3))  # fmt: skip
+    strategy.decide(WorldState(0.0, BallState(0.2, 0.1, 0.0, 0.0), robots), GameState(0.0))
     ys = [y for y in np.arange(-3.0, 3.01, 0.15) if abs(y - 1.5) > 0.3]
     world = field_world(settings.field_geometry(), np.column_stack([np.zeros(len(ys)), ys]))
     radius = settings.field.robot.radius_m

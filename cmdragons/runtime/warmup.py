@@ -153,6 +153,8 @@ def warm_up(config: str | None, overrides: Sequence[str], opponent: str, images:
             if c.poll() is None:
                 c.terminate()
                 c.wait()
+            if c.stdout is not None:
+                c.stdout.close()
     return time.perf_counter() - t0
 
 

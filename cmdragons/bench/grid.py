@@ -191,17 +191,11 @@ def _speed_rows(name: str, free: NDArray[np.bool_], quick: bool) -> list[dict[st
     nf1(free, (gr, gc))
     nf1_ms = _median_ms(lambda: nf1(free, (gr, gc)), repeats)
     row = {"name": f"nf1/{name}", "median_ms": nf1_ms}
-    try:
-        from roboticstoolbox import DistanceTransformPlanner
-
-        occ = (~free).astype(int)
-        dt = DistanceTransformPlanner(occ, metric="manhattan")
-        t0 = time.perf_counter()
-        dt.plan(goal=(gc, gr))
-        rtb_ms = (time.perf_counter() - t0) * 1e3
-        row |= {"rtb_distance_transform_ms": rtb_ms, "speedup_vs_rtb": rtb_ms / nf1_ms}
-    except ImportError:
+    rtb_ms = _toolbox_plan_ms("DistanceTransformPlanner", free, (gc, gr), metric="manhattan")
+    if rtb_ms is None:
         row["rtb"] = "not installed (pip install -e '.[bench]')"
+    else:
+        row |= {"rtb_distance_transform_ms": rtb_ms, "speedup_vs_rtb": rtb_ms / nf1_ms}
     rows.append(row)
     rows.append(_dstar_row(free, quick))
     return rows
@@ -226,18 +220,25 @@ def _dstar_row(free: NDArray[np.bool_], quick: bool) -> dict[str, Any]:
     e.compute()
     replan_ms = (time.perf_counter() - t0) * 1e3
     row: dict[str, Any] = {"name": f"estar_vs_dstar/{n}x{n}", "plan_ms": plan_ms, "replan_ms": replan_ms}
-    try:
-        from roboticstoolbox import DstarPlanner
-
-        occ = (~crop).astype(int)
-        ds = DstarPlanner(occ)
-        t0 = time.perf_counter()
-        ds.plan(goal=(gc, gr))
-        rtb_plan = (time.perf_counter() - t0) * 1e3
-        row |= {"rtb_dstar_plan_ms": rtb_plan, "speedup_plan": rtb_plan / plan_ms}
-    except ImportError:
+    rtb_plan = _toolbox_plan_ms("DstarPlanner", crop, (gc, gr))
+    if rtb_plan is None:
         row["rtb"] = "not installed (pip install -e '.[bench]')"
+    else:
+        row |= {"rtb_dstar_plan_ms": rtb_plan, "speedup_plan": rtb_plan / plan_ms}
     return row
+
+
+def _toolbox_plan_ms(planner: str, free: NDArray[np.bool_], goal_xy: tuple[int, int], **kwargs: Any) -> float | None:
+    """Milliseconds the Robotics Toolbox's ``planner`` takes to plan toward ``goal_xy`` on the grid
+    (None when the toolbox is not installed)."""
+    try:
+        import roboticstoolbox
+    except ImportError:
+        return None
+    p = getattr(roboticstoolbox, planner)((~free).astype(int), **kwargs)
+    t0 = time.perf_counter()
+    p.plan(goal=goal_xy)
+    return (time.perf_counter() - t0) * 1e3
 
 
 def run(settings: Settings, quick: bool, maps: Path | None = None) -> list[dict[str, Any]]:

@@ -1,4 +1,5 @@
-"""numba kernels of the floor: the colour conversion between BGR and H.264's planar 4:2:0.
+"""numba kernels of the floor: the colour conversion between BGR and H.264's planar 4:2:0, and the
+sorts of the few values a kernel orders.
 
 BT.601 in the limited range, chroma at the MPEG-2 sites (on the even luma columns, between each
 pair of luma rows). The planar frame is flat: H * W luma bytes, then the (H / 2) x (W / 2) Cb
@@ -69,3 +70,32 @@ def i420_to_bgr(planes: np.ndarray, to_bgr: np.ndarray, out: np.ndarray) -> None
             y = float(planes[i * w + j])
             for ch in range(3):
                 out[i, j, ch] = _u8(to_bgr[ch, 0] * y + to_bgr[ch, 1] * cb + to_bgr[ch, 2] * cr + to_bgr[ch, 3])
+
+
+# numba's np.sort and np.argsort compile its generic quicksort into every kernel that calls them,
+# seconds of a fresh clone's first run each; the kernels that order a handful of values use these.
+@njit(cache=True)
+def sort_small(a: np.ndarray, n: int) -> None:
+    """Sort ``a[:n]`` ascending in place (insertion sort: for tens of values, no NaN)."""
+    for i in range(1, n):
+        v = a[i]
+        j = i - 1
+        while j >= 0 and a[j] > v:
+            a[j + 1] = a[j]
+            j -= 1
+        a[j + 1] = v
+
+
+@njit(cache=True)
+def argsort_small(keys: np.ndarray, n: int) -> np.ndarray:
+    """The indices that order ``keys[:n]`` ascending, equal keys in index order (a stable insertion
+    sort: for tens of values, no NaN)."""
+    order = np.empty(n, dtype=np.int64)
+    for i in range(n):
+        v = keys[i]
+        j = i - 1
+        while j >= 0 and keys[order[j]] > v:
+            order[j + 1] = order[j]
+            j -= 1
+        order[j + 1] = i
+    return order

@@ -518,7 +518,8 @@ def _render_frame_kernel(
                 for q in range(w3):
                     o[q] = min(max(np.int32(b[q]) + np.int32(nz[q]), 0), 255)
             else:
-                o[:] = b
+                for q in range(w3):  # not o[:] = b: numba's slice assignment compiles for seconds
+                    o[q] = b[q]
             row_ball[i, 0] = row_ball[i, 1] = 0.0
             n_act = 0
             for k in range(n_rob):

@@ -20,6 +20,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from cmdragons._kernels import sort_small
 from cmdragons.geometry import wrap_angle as _wrap_angle
 
 N_PHASES = 5  # ramp through zero (2) + cruise (1) + ramp through zero (2)
@@ -88,7 +89,7 @@ def best_peak(d: float, v0: float, vt: float, vmax: float, a: float, b: float) -
     pts[0], pts[1], pts[2] = -vmax, 0.0, vmax
     pts[3] = min(max(v0, -vmax), vmax)
     pts[4] = vt
-    pts.sort()
+    sort_small(pts, 5)
     best_v, best_t = 0.0, math.inf
     for i in range(5):
         t = _peak_time(d, v0, vt, pts[i], a, b)

@@ -339,7 +339,8 @@ def build_world(
 ) -> CW:  # fmt: skip
     """The compiled world (see the module docstring) for a robot of ``radius`` over the time
     window [t0, t1]: circles (x, y, r) moving at ``vel`` become capsules, boxes get the radius as
-    clearance, and the chosen broad phase is built."""
+    clearance, and the extent masks are built when ``mode`` asks for them (the AABB tree is the
+    caller's: :class:`cmdragons.planning.world.CompiledWorld`)."""
     nc, nb = circles.shape[0], boxes.shape[0]
     k = nc + nb
     obs = np.empty((k, 6))
@@ -366,10 +367,9 @@ def build_world(
     else:
         xm = np.zeros((1, 1), dtype=np.uint64)
         ym = np.zeros((1, 1), dtype=np.uint64)
-    if mode == MODE_AABB_TREE:
-        tbox, tchild, tleaf = build_aabb_tree(aabb)
-    else:
-        tbox, tchild, tleaf = np.zeros((1, 4)), -np.ones((1, 2), dtype=np.int32), -np.ones(1, dtype=np.int32)
+    # the AABB tree is built by the caller (:func:`build_aabb_tree`) when the mode asks for it, so
+    # that a run on another broad phase never compiles it
+    tbox, tchild, tleaf = np.zeros((1, 4)), -np.ones((1, 2), dtype=np.int32), -np.ones(1, dtype=np.int32)
     return CW(obs, aabb, inner, mode, grid, xm, ym, tbox, tchild, tleaf)
 
 

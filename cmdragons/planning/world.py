@@ -180,6 +180,9 @@ class CompiledWorld:
         self.cw: K.CW = K.build_world(
             world.circles, world.velocities, world.boxes, bounds, radius_m, t0_s, t1_s, mode, params.mask_bins
         )
+        if mode == K.MODE_AABB_TREE:
+            tbox, tchild, tleaf = K.build_aabb_tree(self.cw.aabb)
+            self.cw = self.cw._replace(tbox=tbox, tchild=tchild, tleaf=tleaf)
         self.obs, self.aabb, self.inner = self.cw.obs, self.cw.aabb, self.cw.inner
 
     # --- queries (field frame, metres) ------------------------------------------------------------

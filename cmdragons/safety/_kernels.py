@@ -28,6 +28,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from cmdragons._kernels import argsort_small, sort_small
 from cmdragons.control._kernels import N_SEG, Limits, clip_accel, limit_velocity, seg_at, stop_accel, trajectory
 from cmdragons.planning._kernels import clearance
 
@@ -172,7 +173,7 @@ def pair_hits(ta: np.ndarray, tb: np.ndarray, radius: float, growth: float) -> b
         n += 2
     times[n] = t_end
     times[n + 1] = min(t_cap, t_end)
-    times = np.sort(times[: n + 2])
+    sort_small(times, n + 2)
     n += 1
     ka, kb = 0, 0
     for i in range(n):
@@ -282,6 +283,15 @@ def feasible(vx: float, vy: float, ax: float, ay: float, lim: Limits, dt: float)
 
 
 @njit(cache=True)
+def _store(trs: np.ndarray, i: int, tr: np.ndarray) -> None:
+    """``trs[i] = tr``, element by element: numba's array slice assignment brings a shape-mismatch
+    message formatter that costs seconds of the first run's compile."""
+    for s in range(tr.shape[0]):
+        for c in range(tr.shape[1]):
+            trs[i, s, c] = tr[s, c]
+
+
+@njit(cache=True)
 def dss(
     states: np.ndarray, desired: np.ndarray, stop_asked: np.ndarray, opp: np.ndarray, obs: np.ndarray,
     inner: np.ndarray, lim: Limits, cfg: DSSConfig, unit_samples: np.ndarray, heuristics: np.ndarray,
@@ -306,7 +316,7 @@ def dss(
     for i in range(n):
         sx, sy = stop_accel(states[i, 2], states[i, 3], dt)
         acc[i, 0], acc[i, 1] = sx, sy
-        trs[i] = trajectory(states[i, 0], states[i, 1], states[i, 2], states[i, 3], sx, sy, dt, accel, brake)
+        _store(trs, i, trajectory(states[i, 0], states[i, 1], states[i, 2], states[i, 3], sx, sy, dt, accel, brake))
     k_rand = unit_samples.shape[1]
     n_h = heuristics.shape[0]
     cand = np.empty((1 + n_h + k_rand + 1, 2))
@@ -319,7 +329,7 @@ def dss(
         dx, dy = feasible(vx, vy, desired[i, 0], desired[i, 1], lim, dt)
         tr = trajectory(px, py, vx, vy, dx, dy, dt, accel, brake)
         if not _trajectory_hits(i, tr, trs, pushed, opp, obs, inner, cfg):
-            trs[i] = tr
+            _store(trs, i, tr)
             acc[i, 0], acc[i, 1] = dx, dy
             status[i] = KEPT
             continue
@@ -349,11 +359,11 @@ def dss(
             fx, fy = feasible(vx, vy, cand[r, 0], cand[r, 1], lim, dt)
             cand[r, 0], cand[r, 1] = fx, fy
             cost[r] = math.hypot(fx - dx, fy - dy)
-        order = np.argsort(cost[:m])
+        order = argsort_small(cost, m)
         for r in order:
             tr = trajectory(px, py, vx, vy, cand[r, 0], cand[r, 1], dt, accel, brake)
             if not _trajectory_hits(i, tr, trs, pushed, opp, obs, inner, cfg):
-                trs[i] = tr
+                _store(trs, i, tr)
                 acc[i, 0], acc[i, 1] = cand[r, 0], cand[r, 1]
                 status[i] = CHANGED
                 break
@@ -370,8 +380,8 @@ def trajectories_clear(
     n = states.shape[0]
     trs = np.empty((n, N_SEG, 8))
     for i in range(n):
-        trs[i] = trajectory(states[i, 0], states[i, 1], states[i, 2], states[i, 3], acc[i, 0], acc[i, 1],
-                            cfg.dt, lim.accel, lim.brake)  # fmt: skip
+        _store(trs, i, trajectory(states[i, 0], states[i, 1], states[i, 2], states[i, 3], acc[i, 0], acc[i, 1],
+                                  cfg.dt, lim.accel, lim.brake))  # fmt: skip
     out = np.empty(n, dtype=np.bool_)
     pushed = exposed(states, opp, cfg.push_reach)
     for i in range(n):

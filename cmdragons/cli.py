@@ -11,7 +11,7 @@ import json
 import math
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, NoReturn
 
@@ -292,8 +292,6 @@ def _cmd_play(args: argparse.Namespace, stop: Interrupt) -> int:
     settings = load_settings(args.config, overrides)
     folder = run_folder("play", args.out, overwrite=args.overwrite)
     images = args.perception == "vision" or (args.video and args.view == "cameras")
-    compile_s = _compile_kernels(args, overrides, images)
-    started = time.time()
     log = RunLog(folder / "run.mcap")
     fps = settings.sim.physics.frame_rate_hz
     n_frames = max(1, round(args.seconds * fps))
@@ -306,8 +304,14 @@ def _cmd_play(args: argparse.Namespace, stop: Interrupt) -> int:
                                 fps)  # fmt: skip
         extra.append(video)
     watch = CompileWatch()
+    built: list[Match] = []
     try:
-        match = Match(settings, args.opponent, args.perception, seed=args.seed, render=images, extra=extra)
+        # a first run builds the match while its kernels compile in other processes
+        compile_s = _compile_kernels(args, overrides, images, lambda: built.append(
+            Match(settings, args.opponent, args.perception, seed=args.seed, render=images, extra=extra)))
+        match = built[0] if built else Match(settings, args.opponent, args.perception, seed=args.seed,
+                                             render=images, extra=extra)  # fmt: skip
+        started = time.time()
         with _progress(not args.no_progress) as progress, stop.soft():
             task = progress.add_task("play", total=n_frames, info="")
             watch.on_compile = lambda name: progress.update(task, info=f"compiling {name} (first run only)")
@@ -388,9 +392,11 @@ def _finish_play(folder: Path, summary: dict[str, Any], args: argparse.Namespace
     print(f"play: {', '.join(files)} -> {folder}")
 
 
-def _compile_kernels(args: argparse.Namespace, overrides: Sequence[str], images: bool) -> float:
+def _compile_kernels(args: argparse.Namespace, overrides: Sequence[str], images: bool,
+                     meanwhile: Callable[[], None]) -> float:  # fmt: skip
     """Compile the play's numba kernels before the match when they have no cache yet, with a
-    progress line; returns the wall seconds it took (0 when every kernel was cached)."""
+    progress line, running ``meanwhile`` as it goes; returns the wall seconds it took (0 when every
+    kernel was cached, and then ``meanwhile`` is not run)."""
     from cmdragons.runtime.warmup import cold_kernels, warm_up
 
     if not cold_kernels(images):
@@ -406,7 +412,7 @@ def _compile_kernels(args: argparse.Namespace, overrides: Sequence[str], images:
             counted[0] = n
             progress.update(task, info=f"{n} kernels, now {name}")
 
-        seconds = warm_up(args.config, overrides, args.opponent, images, show)
+        seconds = warm_up(args.config, overrides, args.opponent, images, show, meanwhile)
         progress.update(task, total=1, completed=1, info=f"{counted[0]} kernels in {seconds:.0f} s, cached")
     if args.no_progress:
         print(f"{args.command}: compiled {counted[0]} kernels in {seconds:.0f} s (cached for next time)",

@@ -111,10 +111,12 @@ def _kernel_name(ev: Any) -> str:
 
 
 def warm_up(config: str | None, overrides: Sequence[str], opponent: str, images: bool,
-            on_progress: Callable[[int, str], None]) -> float:  # fmt: skip
+            on_progress: Callable[[int, str], None], meanwhile: Callable[[], None] | None = None) -> float:  # fmt: skip
     """Compile the play's kernels now (see the module docstring); returns the wall seconds it took.
     ``on_progress(kernels compiled so far, last kernel's name)`` is called from this thread and a
-    reader thread. A child that fails only leaves its kernels to compile during the match."""
+    reader thread. ``meanwhile`` runs in this thread while the children compile (the caller builds
+    its match there, so that the two cores stay busy to the end). A child that fails only leaves its
+    kernels to compile during the match."""
     t0 = time.perf_counter()
     done = [0]
     lock = threading.Lock()
@@ -141,8 +143,10 @@ def warm_up(config: str | None, overrides: Sequence[str], opponent: str, images:
     for r in readers:
         r.start()
     try:
-        if images:
-            with CompileWatch(tick):
+        with CompileWatch(tick):
+            if meanwhile is not None:
+                meanwhile()
+            if images:
                 _warm_vision(config, overrides)
         for c in children:
             c.wait()

@@ -258,39 +258,162 @@ def region_stats(flat: np.ndarray, label: np.ndarray, n_regions: int) -> np.ndar
 
 
 @numba.njit(cache=True)
+def argsort_stable(keys: np.ndarray) -> np.ndarray:
+    """Indices that sort ``keys`` (1-d, no NaN) ascending; equal keys keep their index order (what
+    ``np.argsort(keys, kind="stable")`` returns). Bottom-up merge sort, written out because numba's
+    generic ``argsort`` costs seconds of first-run compile per call site."""
+    n = keys.shape[0]
+    idx = np.empty(n, np.int64)
+    for k in range(n):
+        idx[k] = k
+    tmp = np.empty(n, np.int64)
+    width = 1
+    while width < n:
+        lo = 0
+        while lo < n:
+            mid, hi = min(lo + width, n), min(lo + 2 * width, n)
+            a, b, k = lo, mid, lo
+            while a < mid and b < hi:
+                if keys[idx[b]] < keys[idx[a]]:  # the right one only when strictly smaller: stable
+                    tmp[k] = idx[b]
+                    b += 1
+                else:
+                    tmp[k] = idx[a]
+                    a += 1
+                k += 1
+            while a < mid:
+                tmp[k] = idx[a]
+                a += 1
+                k += 1
+            while b < hi:
+                tmp[k] = idx[b]
+                b += 1
+                k += 1
+            lo = hi
+        idx, tmp = tmp, idx
+        width *= 2
+    return idx
+
+
+@numba.njit(cache=True)
+def median(values: np.ndarray) -> float:
+    """The median of ``values`` (1-d, no NaN), as ``np.median``: the middle value, or the mean of
+    the two middle values for an even count; NaN for none."""
+    n = values.shape[0]
+    if n == 0:
+        return np.nan
+    order = argsort_stable(values)
+    half = n >> 1
+    if n & 1:
+        return float(values[order[half]])
+    return float((values[order[half - 1]] + values[order[half]]) / 2)
+
+
+# side of the grid cells (px) that `merge_regions` files the regions' bounding boxes in
+MERGE_CELL_PX = 16
+
+
+@numba.njit(cache=True)
+def _box_cells(lo: float, hi: float, n_cells: int) -> tuple[int, int]:
+    """The range of grid cells (inclusive, clipped to the grid) that ``[lo, hi]`` (px) overlaps."""
+    c0 = int(math.floor(lo / MERGE_CELL_PX)) if lo > 0.0 else 0
+    c1 = int(math.floor(hi / MERGE_CELL_PX)) if hi > 0.0 else 0
+    return min(c0, n_cells - 1), min(c1, n_cells - 1)
+
+
+@numba.njit(cache=True)
+def _file_boxes(stats: np.ndarray, nu: int, nv: int, slots: np.ndarray, items: np.ndarray) -> None:
+    """Each region's index into every grid cell its bounding box overlaps (cells row by row, ``nu``
+    per row): with no ``items``, count them per cell into ``slots``; else write them to
+    ``items[slots[cell]]``, advancing ``slots`` (each cell's first position)."""
+    for k in range(stats.shape[0]):
+        cu0, cu1 = _box_cells(stats[k, R_U0], stats[k, R_U1], nu)
+        cv0, cv1 = _box_cells(stats[k, R_V0], stats[k, R_V1], nv)
+        for cv in range(cv0, cv1 + 1):
+            for cu in range(cu0, cu1 + 1):
+                c = cv * nu + cu
+                if items.shape[0] > 0:
+                    items[slots[c]] = k
+                slots[c] += 1
+
+
+@numba.njit(cache=True)
+def _next_merge_candidate(stats: np.ndarray, i: int, after: int, rank: np.ndarray, alive: np.ndarray,
+                          cell_start: np.ndarray, cell_items: np.ndarray, nu: int, nv: int,
+                          max_gap_px: float) -> int:  # fmt: skip
+    """The smallest rank above ``after`` of a live region of region ``i``'s class whose bounding box
+    is at most ``max_gap_px`` from ``i``'s (per axis), or -1: looked up in the grid cells that the
+    box of ``i`` grown by the gap overlaps (a region within the gap overlaps that grown box)."""
+    reach = max_gap_px + 1.0
+    cu0, cu1 = _box_cells(stats[i, R_U0] - reach, stats[i, R_U1] + reach, nu)
+    cv0, cv1 = _box_cells(stats[i, R_V0] - reach, stats[i, R_V1] + reach, nv)
+    best = -1
+    for cv in range(cv0, cv1 + 1):
+        for cu in range(cu0, cu1 + 1):
+            c = cv * nu + cu
+            for q in range(cell_start[c], cell_start[c + 1]):
+                j = cell_items[q]
+                r = rank[j]
+                if r <= after or (best >= 0 and r >= best) or not alive[j] or stats[j, R_CLASS] != stats[i, R_CLASS]:
+                    continue
+                gap_u = max(stats[j, R_U0] - stats[i, R_U1], stats[i, R_U0] - stats[j, R_U1]) - 1.0
+                gap_v = max(stats[j, R_V0] - stats[i, R_V1], stats[i, R_V0] - stats[j, R_V1]) - 1.0
+                if gap_u <= max_gap_px and gap_v <= max_gap_px:
+                    best = r
+    return best
+
+
+@numba.njit(cache=True)
 def merge_regions(stats: np.ndarray, max_gap_px: float, min_density: float) -> np.ndarray:
     """Density-based merging (thesis A.1.6): two regions of one class whose bounding boxes are at
     most ``max_gap_px`` apart are joined when the joined region still fills at least
-    ``min_density`` of its bounding box. Larger regions absorb smaller ones, in one greedy pass.
+    ``min_density`` of its bounding box. Larger regions absorb smaller ones, in one greedy pass:
+    in order of decreasing area (equal areas in table order), each live region tries every later
+    live region in that order, its box growing with each one it absorbs.
+
+    The regions' boxes are filed in a grid of ``MERGE_CELL_PX`` cells, so that each region looks
+    only at the few regions near its box instead of all later ones (a frame's hundreds of
+    one-pixel regions along line edges made that pass quadratic); the result is the same pass.
 
     Merges ``stats`` in place and returns a mask of the regions that survive.
     """
     n = stats.shape[0]
     alive = np.ones(n, dtype=np.bool_)
-    order = np.argsort(-stats[:, R_AREA], kind="mergesort")
+    if n < 2:
+        return alive
+    order = argsort_stable(-stats[:, R_AREA])
+    rank = np.empty(n, np.int64)
+    for a in range(n):
+        rank[order[a]] = a
+    u_max, v_max = 0.0, 0.0
+    for k in range(n):
+        u_max, v_max = max(u_max, stats[k, R_U1]), max(v_max, stats[k, R_V1])
+    nu, nv = int(u_max) // MERGE_CELL_PX + 1, int(v_max) // MERGE_CELL_PX + 1
+    counts = np.zeros(nu * nv, np.int64)
+    _file_boxes(stats, nu, nv, counts, np.empty(0, np.int64))
+    cell_start = np.zeros(nu * nv + 1, np.int64)
+    for c in range(nu * nv):
+        cell_start[c + 1] = cell_start[c] + counts[c]
+    cell_items = np.empty(cell_start[nu * nv], np.int64)
+    _file_boxes(stats, nu, nv, cell_start[:-1].copy(), cell_items)
     for a in range(n):
         i = order[a]
         if not alive[i]:
             continue
-        for b in range(a + 1, n):
+        b = _next_merge_candidate(stats, i, a, rank, alive, cell_start, cell_items, nu, nv, max_gap_px)
+        while b >= 0:
             j = order[b]
-            if not alive[j] or stats[j, R_CLASS] != stats[i, R_CLASS]:
-                continue
-            gap_u = max(stats[j, R_U0] - stats[i, R_U1], stats[i, R_U0] - stats[j, R_U1]) - 1.0
-            gap_v = max(stats[j, R_V0] - stats[i, R_V1], stats[i, R_V0] - stats[j, R_V1]) - 1.0
-            if gap_u > max_gap_px or gap_v > max_gap_px:
-                continue
             u0 = min(stats[i, R_U0], stats[j, R_U0])
             u1 = max(stats[i, R_U1], stats[j, R_U1])
             v0 = min(stats[i, R_V0], stats[j, R_V0])
             v1 = max(stats[i, R_V1], stats[j, R_V1])
             box = (u1 - u0 + 1.0) * (v1 - v0 + 1.0)
-            if (stats[i, R_AREA] + stats[j, R_AREA]) < min_density * box:
-                continue
-            for c in range(R_AREA, R_SUM_UV + 1):
-                stats[i, c] += stats[j, c]
-            stats[i, R_U0], stats[i, R_U1], stats[i, R_V0], stats[i, R_V1] = u0, u1, v0, v1
-            alive[j] = False
+            if (stats[i, R_AREA] + stats[j, R_AREA]) >= min_density * box:
+                for c in range(R_AREA, R_SUM_UV + 1):
+                    stats[i, c] += stats[j, c]
+                stats[i, R_U0], stats[i, R_U1], stats[i, R_V0], stats[i, R_V1] = u0, u1, v0, v1
+                alive[j] = False
+            b = _next_merge_candidate(stats, i, b, rank, alive, cell_start, cell_items, nu, nv, max_gap_px)
     return alive
 
 
@@ -352,7 +475,7 @@ def ball_centre(image: np.ndarray, box: np.ndarray, margin: int) -> tuple[float,
         return np.nan, np.nan, np.nan, np.nan
     bg = np.empty(3)
     for c in range(3):
-        bg[c] = np.median(ring[c, :n])
+        bg[c] = median(ring[c, :n])
     iu0, iv0, iu1, iv1 = u0 + 1, v0 + 1, u1 - 1, v1 - 1
     if iu0 > iu1 or iv0 > iv1:
         iu0, iv0, iu1, iv1 = u0, v0, u1, v1
@@ -467,8 +590,9 @@ def match_patterns(cxy: np.ndarray, cw: np.ndarray, dxy: np.ndarray, dw: np.ndar
                 m += 1
         if m < min_dots:
             continue
-        order = np.argsort(off[:m])[:k_max]
-        k = order.shape[0]
+        # nearest the ring first; ties keep index order, as numba's argsort does for up to 15 values
+        order = argsort_stable(off[:m])
+        k = min(m, k_max)
         min_w = cw[c]
         for i in range(k):
             obs[i, 0] = dxy[near[order[i]], 0]

@@ -19,24 +19,48 @@ R_COLS = 11
 
 
 @numba.njit(cache=True, inline="always")
-def _channels_row(src: np.ndarray, conv: np.ndarray, c0: np.ndarray, c1: np.ndarray, c2: np.ndarray) -> None:
-    """The three channels of one row of interleaved (b, g, r) bytes, in one pass over the row: each
-    the fixed-point (x 256) linear map ``conv[k, :3]`` plus the offset ``conv[k, 3]``, clamped to
-    0..255. Every step is cast back to int32 so that LLVM keeps 32-bit lanes (numba widens integer
-    arithmetic to int64, which halves the lanes); the values fit: |a| <= 256 per coefficient, so a
-    sum is at most 3 * 256 * 255 in magnitude."""
-    a00, a01, a02, a03 = np.int32(conv[0, 0]), np.int32(conv[0, 1]), np.int32(conv[0, 2]), np.int32(conv[0, 3])
-    a10, a11, a12, a13 = np.int32(conv[1, 0]), np.int32(conv[1, 1]), np.int32(conv[1, 2]), np.int32(conv[1, 3])
-    a20, a21, a22, a23 = np.int32(conv[2, 0]), np.int32(conv[2, 1]), np.int32(conv[2, 2]), np.int32(conv[2, 3])
-    r128, lo, hi = np.int32(128), np.int32(0), np.int32(255)
+def _yuv_row(src: np.ndarray, c0: np.ndarray, c1: np.ndarray, c2: np.ndarray) -> None:
+    """Y, U, V of one row of interleaved (b, g, r) bytes: the fixed-point (x 256) full-range YCbCr of
+    ``vision.cmvision._CONVERSIONS["yuv"]``, its coefficients written in as constants (LLVM turns the
+    x 128 into shifts and needs no table of coefficients: a third less time than the same map read
+    from an array). Every step is cast back to int32 so that LLVM keeps 32-bit lanes (numba widens
+    integer arithmetic to int64, which halves the lanes). No clamp below: Y lies in 0..255 (the
+    coefficients are positive and sum to 256), U and V in 1..256 (one positive coefficient of 128),
+    so only U and V are clamped at 255."""
+    r128, hi, eight = np.int32(128), np.int32(255), np.int32(8)
     for j in range(c0.shape[0]):
         b, g, r = np.int32(src[3 * j]), np.int32(src[3 * j + 1]), np.int32(src[3 * j + 2])
-        x0 = np.int32(np.int32(np.int32(a00 * b) + np.int32(a01 * g) + np.int32(a02 * r) + r128) >> np.int32(8))
-        x1 = np.int32(np.int32(np.int32(a10 * b) + np.int32(a11 * g) + np.int32(a12 * r) + r128) >> np.int32(8))
-        x2 = np.int32(np.int32(np.int32(a20 * b) + np.int32(a21 * g) + np.int32(a22 * r) + r128) >> np.int32(8))
-        c0[j] = np.uint8(min(max(np.int32(x0 + a03), lo), hi))
-        c1[j] = np.uint8(min(max(np.int32(x1 + a13), lo), hi))
-        c2[j] = np.uint8(min(max(np.int32(x2 + a23), lo), hi))
+        y = np.int32(np.int32(29) * b) + np.int32(np.int32(150) * g) + np.int32(np.int32(77) * r)
+        u = np.int32(b << np.int32(7)) - np.int32(np.int32(85) * g) - np.int32(np.int32(43) * r)
+        v = np.int32(r << np.int32(7)) - np.int32(np.int32(107) * g) - np.int32(np.int32(21) * b)
+        c0[j] = np.uint8(np.int32(np.int32(y + r128) >> eight))
+        c1[j] = np.uint8(min(np.int32(np.int32(np.int32(u + r128) >> eight) + r128), hi))
+        c2[j] = np.uint8(min(np.int32(np.int32(np.int32(v + r128) >> eight) + r128), hi))
+
+
+@numba.njit(cache=True, inline="always")
+def _bgr_row(src: np.ndarray, c0: np.ndarray, c1: np.ndarray, c2: np.ndarray) -> None:
+    """The channels of one row of interleaved (b, g, r) bytes, unchanged (the "bgr" space)."""
+    for j in range(c0.shape[0]):
+        c0[j], c1[j], c2[j] = src[3 * j], src[3 * j + 1], src[3 * j + 2]
+
+
+@numba.njit(cache=True)
+def channels(image: np.ndarray, yuv: bool) -> np.ndarray:
+    """The image (H, W, 3) BGR uint8 in YUV (``yuv``) or BGR, as ``classify`` computes it: the
+    kernel side of :func:`vision.cmvision.convert_colour` (for the tests)."""
+    h, w = image.shape[0], image.shape[1]
+    flat = image.reshape(h, w * 3)
+    out = np.empty((h, w, 3), np.uint8)
+    c0, c1, c2 = np.empty(w, np.uint8), np.empty(w, np.uint8), np.empty(w, np.uint8)
+    for i in range(h):
+        if yuv:
+            _yuv_row(flat[i], c0, c1, c2)
+        else:
+            _bgr_row(flat[i], c0, c1, c2)
+        for j in range(w):
+            out[i, j, 0], out[i, j, 1], out[i, j, 2] = c0[j], c1[j], c2[j]
+    return out
 
 
 @numba.njit(cache=True, inline="always")
@@ -116,13 +140,13 @@ def _classify_row(lut: np.ndarray, c0: np.ndarray, c1: np.ndarray, c2: np.ndarra
 
 
 @numba.njit(cache=True)
-def classify(image: np.ndarray, conv: np.ndarray, lut: np.ndarray, screen: np.ndarray, bits: np.ndarray,
+def classify(image: np.ndarray, yuv: bool, lut: np.ndarray, screen: np.ndarray, bits: np.ndarray,
              runs: np.ndarray, counts: np.ndarray) -> None:  # fmt: skip
     """Classification (thesis A.1.3) and run-length encoding in one pass over the image.
 
     A pixel's bit set is ``lut[0, c0] & lut[1, c1] & lut[2, c2]``: the classes whose threshold box
-    holds it. All three channels are computed for every pixel (vectorised rows) and screened
-    against ``screen`` (k, 6) uint8, each class's box (``vision.cmvision._screen_boxes``): a pixel
+    holds it, in YUV (``yuv``) or BGR. All three channels are computed for every pixel (vectorised
+    rows) and screened against ``screen`` (k, 6) uint8, each class's box (``vision.cmvision._screen_boxes``): a pixel
     passes when one class holds it, so the screen is exact and the table look-ups and the
     run-length encoding touch only the few pixels of some class; a row without one is done after
     the screen. (One or two channels screened the carpet out while the boxes were tuned on
@@ -134,9 +158,10 @@ def classify(image: np.ndarray, conv: np.ndarray, lut: np.ndarray, screen: np.nd
     runs: pixels of no class make no runs; a row with more runs than ``runs.shape[1]`` keeps the
     first.
 
-    Serial: with this little work per pixel, a 2-core machine shared with other jobs ran it faster
-    on one thread than in parallel over blocks of rows (0.49 against 0.55 ms median per 1024x768
-    frame, with one screened channel).
+    Serial: with this little work per pixel, a 2-core machine shared with other jobs ran it about as
+    fast on one thread as in parallel over blocks of rows, and the parallel kernel costs seconds
+    more to compile (1920x1200, load average 2 to 3 on 2 cores: 2.2 ms median either way, the
+    parallel one 1.1 ms at best against 1.65; 1024x768: 0.73 ms median either way).
     """
     h, w = image.shape[0], image.shape[1]
     flat = image.reshape(h, w * 3)
@@ -151,7 +176,10 @@ def classify(image: np.ndarray, conv: np.ndarray, lut: np.ndarray, screen: np.nd
         out = bits[i] if keep_bits else row
         if keep_bits:
             out[:] = 0
-        _channels_row(flat[i], conv, c0, c1, c2)
+        if yuv:
+            _yuv_row(flat[i], c0, c1, c2)
+        else:
+            _bgr_row(flat[i], c0, c1, c2)
         n = 0
         if _screen_row(c0, c1, c2, screen, hit):
             n = _classify_row(lut, c0, c1, c2, hit, out, runs[i] if encode else no_runs)

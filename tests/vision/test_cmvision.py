@@ -199,6 +199,18 @@ def test_density_merge_joins_fragments_and_min_area_drops_specks() -> None:
     assert sorted(unmerged.area.tolist()) == [40.0, 50.0]
 
 
+@pytest.mark.parametrize("space", ["yuv", "bgr"])
+def test_kernel_colour_conversion_equals_reference_for_every_colour(space: str) -> None:
+    from vision.cmvision import convert_colour
+
+    g, r = np.meshgrid(np.arange(256), np.arange(256), indexing="ij")
+    for b in range(0, 256, 32):  # all 2^24 colours, 32 blue levels at a time
+        image = np.stack([np.broadcast_to(np.arange(b, b + 32)[:, None, None], (32, 256, 256)),
+                          np.broadcast_to(g, (32, 256, 256)), np.broadcast_to(r, (32, 256, 256))],
+                         axis=-1).astype(np.uint8).reshape(32 * 256, 256, 3)  # fmt: skip
+        np.testing.assert_array_equal(kern.channels(image, space == "yuv"), convert_colour(image, space))  # type: ignore[arg-type]
+
+
 def speckled_stats(seed: int) -> NDArray[np.float64]:
     """Region statistics of a field of one-pixel and few-pixel specks and some larger blobs, two
     classes: many fragments within the merge gap of each other, as along a field line's edges."""

@@ -4,6 +4,11 @@ connect runs into regions, region statistics and density-based merging.
 Every kernel has a plain-numpy reference in :mod:`vision.cmvision` and a test that both agree.
 Pixel coordinates are (u, v) = (column, row) of the pixel's top-left corner; centroids are
 reported at pixel centres (+0.5) by the wrappers, not here.
+
+First-run compile: arrays are made by ``np.empty`` and filled in loops, and sorting and the median
+are written out here (:func:`argsort_stable`, :func:`median`), because numba compiles each use of
+``np.zeros``, ``np.ones``, ``np.full``, ``np.arange``, ``np.argsort`` and ``np.median`` (per
+signature) anew, a tenth of a second to seconds each, for no run-time gain.
 """
 
 from __future__ import annotations
@@ -169,7 +174,9 @@ def classify(image: np.ndarray, yuv: bool, lut: np.ndarray, screen: np.ndarray, 
     c0 = np.empty(w, np.uint8)
     c1 = np.empty(w, np.uint8)
     c2 = np.empty(w, np.uint8)
-    hit = np.zeros((w + 7) // 8 * 8, np.uint8)  # whole 8-pixel words; the tail stays 0
+    hit = np.empty((w + 7) // 8 * 8, np.uint8)  # whole 8-pixel words; the tail stays 0
+    for j in range(hit.shape[0]):
+        hit[j] = 0
     row = np.empty(w, np.uint32)
     no_runs = np.empty((0, 3), np.int32)
     for i in range(h):
@@ -208,7 +215,8 @@ def connect_runs(runs: np.ndarray, counts: np.ndarray, eight: bool) -> tuple[np.
     regions numbered in order of their first run (raster order); ``n_regions`` as a 1-array.
     """
     h = counts.shape[0]
-    offsets = np.zeros(h + 1, dtype=np.int64)
+    offsets = np.empty(h + 1, np.int64)
+    offsets[0] = 0
     for i in range(h):
         offsets[i + 1] = offsets[i] + counts[i]
     n = offsets[h]
@@ -220,7 +228,9 @@ def connect_runs(runs: np.ndarray, counts: np.ndarray, eight: bool) -> tuple[np.
             flat[idx, 1] = runs[i, k, 0]
             flat[idx, 2] = runs[i, k, 1]
             flat[idx, 3] = runs[i, k, 2]
-    parent = np.arange(np.int64(n))
+    parent = np.empty(n, np.int64)
+    for p in range(n):
+        parent[p] = p
     slack = 1 if eight else 0
     for i in range(1, h):
         q = offsets[i - 1]
@@ -240,8 +250,10 @@ def connect_runs(runs: np.ndarray, counts: np.ndarray, eight: bool) -> tuple[np.
                         else:
                             parent[ra] = rb
                 qq += 1
-    label = np.empty(n, dtype=np.int64)
-    region_of_root = np.full(n, -1, dtype=np.int64)
+    label = np.empty(n, np.int64)
+    region_of_root = np.empty(n, np.int64)
+    for p in range(n):
+        region_of_root[p] = -1
     count = 0
     for p in range(n):
         root = _find(parent, p)
@@ -249,7 +261,8 @@ def connect_runs(runs: np.ndarray, counts: np.ndarray, eight: bool) -> tuple[np.
             region_of_root[root] = count
             count += 1
         label[p] = region_of_root[root]
-    n_regions = np.array([count], dtype=np.int64)
+    n_regions = np.empty(1, np.int64)
+    n_regions[0] = count
     return flat, label, n_regions
 
 
@@ -257,8 +270,10 @@ def connect_runs(runs: np.ndarray, counts: np.ndarray, eight: bool) -> tuple[np.
 def region_stats(flat: np.ndarray, label: np.ndarray, n_regions: int) -> np.ndarray:
     """Per region: class, area, sums of u, v, u^2, v^2, uv and the bounding box (thesis A.1.5),
     from the runs in closed form (sums of integer ranges), u and v at pixel corners."""
-    out = np.zeros((n_regions, R_COLS), dtype=np.float64)
+    out = np.empty((n_regions, R_COLS), np.float64)
     for k in range(n_regions):
+        for c in range(R_COLS):
+            out[k, c] = 0.0
         out[k, R_U0] = 1e18
         out[k, R_V0] = 1e18
         out[k, R_U1] = -1.0
@@ -406,7 +421,9 @@ def merge_regions(stats: np.ndarray, max_gap_px: float, min_density: float) -> n
     Merges ``stats`` in place and returns a mask of the regions that survive.
     """
     n = stats.shape[0]
-    alive = np.ones(n, dtype=np.bool_)
+    alive = np.empty(n, np.bool_)
+    for k in range(n):
+        alive[k] = True
     if n < 2:
         return alive
     order = argsort_stable(-stats[:, R_AREA])
@@ -417,9 +434,12 @@ def merge_regions(stats: np.ndarray, max_gap_px: float, min_density: float) -> n
     for k in range(n):
         u_max, v_max = max(u_max, stats[k, R_U1]), max(v_max, stats[k, R_V1])
     nu, nv = int(u_max) // MERGE_CELL_PX + 1, int(v_max) // MERGE_CELL_PX + 1
-    counts = np.zeros(nu * nv, np.int64)
+    counts = np.empty(nu * nv, np.int64)
+    for c in range(nu * nv):
+        counts[c] = 0
     _file_boxes(stats, nu, nv, counts, np.empty(0, np.int64))
-    cell_start = np.zeros(nu * nv + 1, np.int64)
+    cell_start = np.empty(nu * nv + 1, np.int64)
+    cell_start[0] = 0
     for c in range(nu * nv):
         cell_start[c + 1] = cell_start[c] + counts[c]
     cell_items = np.empty(cell_start[nu * nv], np.int64)
@@ -507,7 +527,9 @@ def ball_centre(image: np.ndarray, box: np.ndarray, margin: int) -> tuple[float,
     iu0, iv0, iu1, iv1 = u0 + 1, v0 + 1, u1 - 1, v1 - 1
     if iu0 > iu1 or iv0 > iv1:
         iu0, iv0, iu1, iv1 = u0, v0, u1, v1
-    ball = np.zeros(3)
+    ball = np.empty(3)
+    for c in range(3):
+        ball[c] = 0.0
     for i in range(iv0, iv1 + 1):
         for j in range(iu0, iu1 + 1):
             for c in range(3):
@@ -599,7 +621,10 @@ def match_patterns(cxy: np.ndarray, cw: np.ndarray, dxy: np.ndarray, dw: np.ndar
     dots used, the smallest area weight among the dots (1 = as expected).
     """
     n_c, k_max = cxy.shape[0], slots.shape[0]
-    out = np.zeros((n_c, M_COLS))
+    out = np.empty((n_c, M_COLS))
+    for c in range(n_c):
+        for col in range(M_COLS):
+            out[c, col] = 0.0
     ring = 0.0
     for s in range(k_max):
         ring += np.sqrt(slots[s, 0] ** 2 + slots[s, 1] ** 2) / k_max

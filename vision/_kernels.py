@@ -166,7 +166,8 @@ def classify(image: np.ndarray, yuv: bool, lut: np.ndarray, screen: np.ndarray, 
     Serial: with this little work per pixel, a 2-core machine shared with other jobs ran it about as
     fast on one thread as in parallel over blocks of rows, and the parallel kernel costs seconds
     more to compile (1920x1200, load average 2 to 3 on 2 cores: 2.2 ms median either way, the
-    parallel one 1.1 ms at best against 1.65; 1024x768: 0.73 ms median either way).
+    parallel one 1.1 ms at best against 1.65; 1024x768: 0.73 ms median either way; measured before
+    the conversion took its coefficients as constants).
     """
     h, w = image.shape[0], image.shape[1]
     flat = image.reshape(h, w * 3)

@@ -4,6 +4,11 @@ connect runs into regions, region statistics and density-based merging.
 Every kernel has a plain-numpy reference in :mod:`vision.cmvision` and a test that both agree.
 Pixel coordinates are (u, v) = (column, row) of the pixel's top-left corner; centroids are
 reported at pixel centres (+0.5) by the wrappers, not here.
+
+First-run compile: arrays are made by ``np.empty`` and filled in loops, and sorting and the median
+are written out here (:func:`argsort_stable`, :func:`median`), because numba compiles each use of
+``np.zeros``, ``np.ones``, ``np.full``, ``np.arange``, ``np.argsort`` and ``np.median`` (per
+signature) anew, a tenth of a second to seconds each, for no run-time gain.
 """
 
 from __future__ import annotations
@@ -19,24 +24,48 @@ R_COLS = 11
 
 
 @numba.njit(cache=True, inline="always")
-def _channels_row(src: np.ndarray, conv: np.ndarray, c0: np.ndarray, c1: np.ndarray, c2: np.ndarray) -> None:
-    """The three channels of one row of interleaved (b, g, r) bytes, in one pass over the row: each
-    the fixed-point (x 256) linear map ``conv[k, :3]`` plus the offset ``conv[k, 3]``, clamped to
-    0..255. Every step is cast back to int32 so that LLVM keeps 32-bit lanes (numba widens integer
-    arithmetic to int64, which halves the lanes); the values fit: |a| <= 256 per coefficient, so a
-    sum is at most 3 * 256 * 255 in magnitude."""
-    a00, a01, a02, a03 = np.int32(conv[0, 0]), np.int32(conv[0, 1]), np.int32(conv[0, 2]), np.int32(conv[0, 3])
-    a10, a11, a12, a13 = np.int32(conv[1, 0]), np.int32(conv[1, 1]), np.int32(conv[1, 2]), np.int32(conv[1, 3])
-    a20, a21, a22, a23 = np.int32(conv[2, 0]), np.int32(conv[2, 1]), np.int32(conv[2, 2]), np.int32(conv[2, 3])
-    r128, lo, hi = np.int32(128), np.int32(0), np.int32(255)
+def _yuv_row(src: np.ndarray, c0: np.ndarray, c1: np.ndarray, c2: np.ndarray) -> None:
+    """Y, U, V of one row of interleaved (b, g, r) bytes: the fixed-point (x 256) full-range YCbCr of
+    ``vision.cmvision._CONVERSIONS["yuv"]``, its coefficients written in as constants (LLVM turns the
+    x 128 into shifts and needs no table of coefficients: a third less time than the same map read
+    from an array). Every step is cast back to int32 so that LLVM keeps 32-bit lanes (numba widens
+    integer arithmetic to int64, which halves the lanes). No clamp below: Y lies in 0..255 (the
+    coefficients are positive and sum to 256), U and V in 1..256 (one positive coefficient of 128),
+    so only U and V are clamped at 255."""
+    r128, hi, eight = np.int32(128), np.int32(255), np.int32(8)
     for j in range(c0.shape[0]):
         b, g, r = np.int32(src[3 * j]), np.int32(src[3 * j + 1]), np.int32(src[3 * j + 2])
-        x0 = np.int32(np.int32(np.int32(a00 * b) + np.int32(a01 * g) + np.int32(a02 * r) + r128) >> np.int32(8))
-        x1 = np.int32(np.int32(np.int32(a10 * b) + np.int32(a11 * g) + np.int32(a12 * r) + r128) >> np.int32(8))
-        x2 = np.int32(np.int32(np.int32(a20 * b) + np.int32(a21 * g) + np.int32(a22 * r) + r128) >> np.int32(8))
-        c0[j] = np.uint8(min(max(np.int32(x0 + a03), lo), hi))
-        c1[j] = np.uint8(min(max(np.int32(x1 + a13), lo), hi))
-        c2[j] = np.uint8(min(max(np.int32(x2 + a23), lo), hi))
+        y = np.int32(np.int32(29) * b) + np.int32(np.int32(150) * g) + np.int32(np.int32(77) * r)
+        u = np.int32(b << np.int32(7)) - np.int32(np.int32(85) * g) - np.int32(np.int32(43) * r)
+        v = np.int32(r << np.int32(7)) - np.int32(np.int32(107) * g) - np.int32(np.int32(21) * b)
+        c0[j] = np.uint8(np.int32(np.int32(y + r128) >> eight))
+        c1[j] = np.uint8(min(np.int32(np.int32(np.int32(u + r128) >> eight) + r128), hi))
+        c2[j] = np.uint8(min(np.int32(np.int32(np.int32(v + r128) >> eight) + r128), hi))
+
+
+@numba.njit(cache=True, inline="always")
+def _bgr_row(src: np.ndarray, c0: np.ndarray, c1: np.ndarray, c2: np.ndarray) -> None:
+    """The channels of one row of interleaved (b, g, r) bytes, unchanged (the "bgr" space)."""
+    for j in range(c0.shape[0]):
+        c0[j], c1[j], c2[j] = src[3 * j], src[3 * j + 1], src[3 * j + 2]
+
+
+@numba.njit(cache=True)
+def channels(image: np.ndarray, yuv: bool) -> np.ndarray:
+    """The image (H, W, 3) BGR uint8 in YUV (``yuv``) or BGR, as ``classify`` computes it: the
+    kernel side of :func:`vision.cmvision.convert_colour` (for the tests)."""
+    h, w = image.shape[0], image.shape[1]
+    flat = image.reshape(h, w * 3)
+    out = np.empty((h, w, 3), np.uint8)
+    c0, c1, c2 = np.empty(w, np.uint8), np.empty(w, np.uint8), np.empty(w, np.uint8)
+    for i in range(h):
+        if yuv:
+            _yuv_row(flat[i], c0, c1, c2)
+        else:
+            _bgr_row(flat[i], c0, c1, c2)
+        for j in range(w):
+            out[i, j, 0], out[i, j, 1], out[i, j, 2] = c0[j], c1[j], c2[j]
+    return out
 
 
 @numba.njit(cache=True, inline="always")
@@ -116,13 +145,13 @@ def _classify_row(lut: np.ndarray, c0: np.ndarray, c1: np.ndarray, c2: np.ndarra
 
 
 @numba.njit(cache=True)
-def classify(image: np.ndarray, conv: np.ndarray, lut: np.ndarray, screen: np.ndarray, bits: np.ndarray,
+def classify(image: np.ndarray, yuv: bool, lut: np.ndarray, screen: np.ndarray, bits: np.ndarray,
              runs: np.ndarray, counts: np.ndarray) -> None:  # fmt: skip
     """Classification (thesis A.1.3) and run-length encoding in one pass over the image.
 
     A pixel's bit set is ``lut[0, c0] & lut[1, c1] & lut[2, c2]``: the classes whose threshold box
-    holds it. All three channels are computed for every pixel (vectorised rows) and screened
-    against ``screen`` (k, 6) uint8, each class's box (``vision.cmvision._screen_boxes``): a pixel
+    holds it, in YUV (``yuv``) or BGR. All three channels are computed for every pixel (vectorised
+    rows) and screened against ``screen`` (k, 6) uint8, each class's box (``vision.cmvision._screen_boxes``): a pixel
     passes when one class holds it, so the screen is exact and the table look-ups and the
     run-length encoding touch only the few pixels of some class; a row without one is done after
     the screen. (One or two channels screened the carpet out while the boxes were tuned on
@@ -134,9 +163,11 @@ def classify(image: np.ndarray, conv: np.ndarray, lut: np.ndarray, screen: np.nd
     runs: pixels of no class make no runs; a row with more runs than ``runs.shape[1]`` keeps the
     first.
 
-    Serial: with this little work per pixel, a 2-core machine shared with other jobs ran it faster
-    on one thread than in parallel over blocks of rows (0.49 against 0.55 ms median per 1024x768
-    frame, with one screened channel).
+    Serial: with this little work per pixel, a 2-core machine shared with other jobs ran it about as
+    fast on one thread as in parallel over blocks of rows, and the parallel kernel costs seconds
+    more to compile (1920x1200, load average 2 to 3 on 2 cores: 2.2 ms median either way, the
+    parallel one 1.1 ms at best against 1.65; 1024x768: 0.73 ms median either way; measured before
+    the conversion took its coefficients as constants).
     """
     h, w = image.shape[0], image.shape[1]
     flat = image.reshape(h, w * 3)
@@ -144,14 +175,19 @@ def classify(image: np.ndarray, conv: np.ndarray, lut: np.ndarray, screen: np.nd
     c0 = np.empty(w, np.uint8)
     c1 = np.empty(w, np.uint8)
     c2 = np.empty(w, np.uint8)
-    hit = np.zeros((w + 7) // 8 * 8, np.uint8)  # whole 8-pixel words; the tail stays 0
+    hit = np.empty((w + 7) // 8 * 8, np.uint8)  # whole 8-pixel words; the tail stays 0
+    for j in range(hit.shape[0]):
+        hit[j] = 0
     row = np.empty(w, np.uint32)
     no_runs = np.empty((0, 3), np.int32)
     for i in range(h):
         out = bits[i] if keep_bits else row
         if keep_bits:
             out[:] = 0
-        _channels_row(flat[i], conv, c0, c1, c2)
+        if yuv:
+            _yuv_row(flat[i], c0, c1, c2)
+        else:
+            _bgr_row(flat[i], c0, c1, c2)
         n = 0
         if _screen_row(c0, c1, c2, screen, hit):
             n = _classify_row(lut, c0, c1, c2, hit, out, runs[i] if encode else no_runs)
@@ -180,7 +216,8 @@ def connect_runs(runs: np.ndarray, counts: np.ndarray, eight: bool) -> tuple[np.
     regions numbered in order of their first run (raster order); ``n_regions`` as a 1-array.
     """
     h = counts.shape[0]
-    offsets = np.zeros(h + 1, dtype=np.int64)
+    offsets = np.empty(h + 1, np.int64)
+    offsets[0] = 0
     for i in range(h):
         offsets[i + 1] = offsets[i] + counts[i]
     n = offsets[h]
@@ -192,7 +229,9 @@ def connect_runs(runs: np.ndarray, counts: np.ndarray, eight: bool) -> tuple[np.
             flat[idx, 1] = runs[i, k, 0]
             flat[idx, 2] = runs[i, k, 1]
             flat[idx, 3] = runs[i, k, 2]
-    parent = np.arange(np.int64(n))
+    parent = np.empty(n, np.int64)
+    for p in range(n):
+        parent[p] = p
     slack = 1 if eight else 0
     for i in range(1, h):
         q = offsets[i - 1]
@@ -212,8 +251,10 @@ def connect_runs(runs: np.ndarray, counts: np.ndarray, eight: bool) -> tuple[np.
                         else:
                             parent[ra] = rb
                 qq += 1
-    label = np.empty(n, dtype=np.int64)
-    region_of_root = np.full(n, -1, dtype=np.int64)
+    label = np.empty(n, np.int64)
+    region_of_root = np.empty(n, np.int64)
+    for p in range(n):
+        region_of_root[p] = -1
     count = 0
     for p in range(n):
         root = _find(parent, p)
@@ -221,7 +262,8 @@ def connect_runs(runs: np.ndarray, counts: np.ndarray, eight: bool) -> tuple[np.
             region_of_root[root] = count
             count += 1
         label[p] = region_of_root[root]
-    n_regions = np.array([count], dtype=np.int64)
+    n_regions = np.empty(1, np.int64)
+    n_regions[0] = count
     return flat, label, n_regions
 
 
@@ -229,8 +271,10 @@ def connect_runs(runs: np.ndarray, counts: np.ndarray, eight: bool) -> tuple[np.
 def region_stats(flat: np.ndarray, label: np.ndarray, n_regions: int) -> np.ndarray:
     """Per region: class, area, sums of u, v, u^2, v^2, uv and the bounding box (thesis A.1.5),
     from the runs in closed form (sums of integer ranges), u and v at pixel corners."""
-    out = np.zeros((n_regions, R_COLS), dtype=np.float64)
+    out = np.empty((n_regions, R_COLS), np.float64)
     for k in range(n_regions):
+        for c in range(R_COLS):
+            out[k, c] = 0.0
         out[k, R_U0] = 1e18
         out[k, R_V0] = 1e18
         out[k, R_U1] = -1.0
@@ -258,39 +302,167 @@ def region_stats(flat: np.ndarray, label: np.ndarray, n_regions: int) -> np.ndar
 
 
 @numba.njit(cache=True)
+def argsort_stable(keys: np.ndarray) -> np.ndarray:
+    """Indices that sort ``keys`` (1-d, no NaN) ascending; equal keys keep their index order (what
+    ``np.argsort(keys, kind="stable")`` returns). Bottom-up merge sort, written out because numba's
+    generic ``argsort`` costs seconds of first-run compile per call site."""
+    n = keys.shape[0]
+    idx = np.empty(n, np.int64)
+    for k in range(n):
+        idx[k] = k
+    tmp = np.empty(n, np.int64)
+    width = 1
+    while width < n:
+        lo = 0
+        while lo < n:
+            mid, hi = min(lo + width, n), min(lo + 2 * width, n)
+            a, b, k = lo, mid, lo
+            while a < mid and b < hi:
+                if keys[idx[b]] < keys[idx[a]]:  # the right one only when strictly smaller: stable
+                    tmp[k] = idx[b]
+                    b += 1
+                else:
+                    tmp[k] = idx[a]
+                    a += 1
+                k += 1
+            while a < mid:
+                tmp[k] = idx[a]
+                a += 1
+                k += 1
+            while b < hi:
+                tmp[k] = idx[b]
+                b += 1
+                k += 1
+            lo = hi
+        idx, tmp = tmp, idx
+        width *= 2
+    return idx
+
+
+@numba.njit(cache=True)
+def median(values: np.ndarray) -> float:
+    """The median of ``values`` (1-d, no NaN), as ``np.median``: the middle value, or the mean of
+    the two middle values for an even count; NaN for none."""
+    n = values.shape[0]
+    if n == 0:
+        return np.nan
+    order = argsort_stable(values)
+    half = n >> 1
+    if n & 1:
+        return float(values[order[half]])
+    return float((values[order[half - 1]] + values[order[half]]) / 2)
+
+
+# side of the grid cells (px) that `merge_regions` files the regions' bounding boxes in
+MERGE_CELL_PX = 16
+
+
+@numba.njit(cache=True)
+def _box_cells(lo: float, hi: float, n_cells: int) -> tuple[int, int]:
+    """The range of grid cells (inclusive, clipped to the grid) that ``[lo, hi]`` (px) overlaps."""
+    c0 = int(math.floor(lo / MERGE_CELL_PX)) if lo > 0.0 else 0
+    c1 = int(math.floor(hi / MERGE_CELL_PX)) if hi > 0.0 else 0
+    return min(c0, n_cells - 1), min(c1, n_cells - 1)
+
+
+@numba.njit(cache=True)
+def _file_boxes(stats: np.ndarray, nu: int, nv: int, slots: np.ndarray, items: np.ndarray) -> None:
+    """Each region's index into every grid cell its bounding box overlaps (cells row by row, ``nu``
+    per row): with no ``items``, count them per cell into ``slots``; else write them to
+    ``items[slots[cell]]``, advancing ``slots`` (each cell's first position)."""
+    for k in range(stats.shape[0]):
+        cu0, cu1 = _box_cells(stats[k, R_U0], stats[k, R_U1], nu)
+        cv0, cv1 = _box_cells(stats[k, R_V0], stats[k, R_V1], nv)
+        for cv in range(cv0, cv1 + 1):
+            for cu in range(cu0, cu1 + 1):
+                c = cv * nu + cu
+                if items.shape[0] > 0:
+                    items[slots[c]] = k
+                slots[c] += 1
+
+
+@numba.njit(cache=True)
+def _next_merge_candidate(stats: np.ndarray, i: int, after: int, rank: np.ndarray, alive: np.ndarray,
+                          cell_start: np.ndarray, cell_items: np.ndarray, nu: int, nv: int,
+                          max_gap_px: float) -> int:  # fmt: skip
+    """The smallest rank above ``after`` of a live region of region ``i``'s class whose bounding box
+    is at most ``max_gap_px`` from ``i``'s (per axis), or -1: looked up in the grid cells that the
+    box of ``i`` grown by the gap overlaps (a region within the gap overlaps that grown box)."""
+    reach = max_gap_px + 1.0
+    cu0, cu1 = _box_cells(stats[i, R_U0] - reach, stats[i, R_U1] + reach, nu)
+    cv0, cv1 = _box_cells(stats[i, R_V0] - reach, stats[i, R_V1] + reach, nv)
+    best = -1
+    for cv in range(cv0, cv1 + 1):
+        for cu in range(cu0, cu1 + 1):
+            c = cv * nu + cu
+            for q in range(cell_start[c], cell_start[c + 1]):
+                j = cell_items[q]
+                r = rank[j]
+                if r <= after or (best >= 0 and r >= best) or not alive[j] or stats[j, R_CLASS] != stats[i, R_CLASS]:
+                    continue
+                gap_u = max(stats[j, R_U0] - stats[i, R_U1], stats[i, R_U0] - stats[j, R_U1]) - 1.0
+                gap_v = max(stats[j, R_V0] - stats[i, R_V1], stats[i, R_V0] - stats[j, R_V1]) - 1.0
+                if gap_u <= max_gap_px and gap_v <= max_gap_px:
+                    best = r
+    return best
+
+
+@numba.njit(cache=True)
 def merge_regions(stats: np.ndarray, max_gap_px: float, min_density: float) -> np.ndarray:
     """Density-based merging (thesis A.1.6): two regions of one class whose bounding boxes are at
     most ``max_gap_px`` apart are joined when the joined region still fills at least
-    ``min_density`` of its bounding box. Larger regions absorb smaller ones, in one greedy pass.
+    ``min_density`` of its bounding box. Larger regions absorb smaller ones, in one greedy pass:
+    in order of decreasing area (equal areas in table order), each live region tries every later
+    live region in that order, its box growing with each one it absorbs.
+
+    The regions' boxes are filed in a grid of ``MERGE_CELL_PX`` cells, so that each region looks
+    only at the few regions near its box instead of all later ones (a frame's hundreds of
+    one-pixel regions along line edges made that pass quadratic); the result is the same pass.
 
     Merges ``stats`` in place and returns a mask of the regions that survive.
     """
     n = stats.shape[0]
-    alive = np.ones(n, dtype=np.bool_)
-    order = np.argsort(-stats[:, R_AREA], kind="mergesort")
+    alive = np.empty(n, np.bool_)
+    for k in range(n):
+        alive[k] = True
+    if n < 2:
+        return alive
+    order = argsort_stable(-stats[:, R_AREA])
+    rank = np.empty(n, np.int64)
+    for a in range(n):
+        rank[order[a]] = a
+    u_max, v_max = 0.0, 0.0
+    for k in range(n):
+        u_max, v_max = max(u_max, stats[k, R_U1]), max(v_max, stats[k, R_V1])
+    nu, nv = int(u_max) // MERGE_CELL_PX + 1, int(v_max) // MERGE_CELL_PX + 1
+    counts = np.empty(nu * nv, np.int64)
+    for c in range(nu * nv):
+        counts[c] = 0
+    _file_boxes(stats, nu, nv, counts, np.empty(0, np.int64))
+    cell_start = np.empty(nu * nv + 1, np.int64)
+    cell_start[0] = 0
+    for c in range(nu * nv):
+        cell_start[c + 1] = cell_start[c] + counts[c]
+    cell_items = np.empty(cell_start[nu * nv], np.int64)
+    _file_boxes(stats, nu, nv, cell_start[:-1].copy(), cell_items)
     for a in range(n):
         i = order[a]
         if not alive[i]:
             continue
-        for b in range(a + 1, n):
+        b = _next_merge_candidate(stats, i, a, rank, alive, cell_start, cell_items, nu, nv, max_gap_px)
+        while b >= 0:
             j = order[b]
-            if not alive[j] or stats[j, R_CLASS] != stats[i, R_CLASS]:
-                continue
-            gap_u = max(stats[j, R_U0] - stats[i, R_U1], stats[i, R_U0] - stats[j, R_U1]) - 1.0
-            gap_v = max(stats[j, R_V0] - stats[i, R_V1], stats[i, R_V0] - stats[j, R_V1]) - 1.0
-            if gap_u > max_gap_px or gap_v > max_gap_px:
-                continue
             u0 = min(stats[i, R_U0], stats[j, R_U0])
             u1 = max(stats[i, R_U1], stats[j, R_U1])
             v0 = min(stats[i, R_V0], stats[j, R_V0])
             v1 = max(stats[i, R_V1], stats[j, R_V1])
             box = (u1 - u0 + 1.0) * (v1 - v0 + 1.0)
-            if (stats[i, R_AREA] + stats[j, R_AREA]) < min_density * box:
-                continue
-            for c in range(R_AREA, R_SUM_UV + 1):
-                stats[i, c] += stats[j, c]
-            stats[i, R_U0], stats[i, R_U1], stats[i, R_V0], stats[i, R_V1] = u0, u1, v0, v1
-            alive[j] = False
+            if (stats[i, R_AREA] + stats[j, R_AREA]) >= min_density * box:
+                for c in range(R_AREA, R_SUM_UV + 1):
+                    stats[i, c] += stats[j, c]
+                stats[i, R_U0], stats[i, R_U1], stats[i, R_V0], stats[i, R_V1] = u0, u1, v0, v1
+                alive[j] = False
+            b = _next_merge_candidate(stats, i, b, rank, alive, cell_start, cell_items, nu, nv, max_gap_px)
     return alive
 
 
@@ -352,11 +524,13 @@ def ball_centre(image: np.ndarray, box: np.ndarray, margin: int) -> tuple[float,
         return np.nan, np.nan, np.nan, np.nan
     bg = np.empty(3)
     for c in range(3):
-        bg[c] = np.median(ring[c, :n])
+        bg[c] = median(ring[c, :n])
     iu0, iv0, iu1, iv1 = u0 + 1, v0 + 1, u1 - 1, v1 - 1
     if iu0 > iu1 or iv0 > iv1:
         iu0, iv0, iu1, iv1 = u0, v0, u1, v1
-    ball = np.zeros(3)
+    ball = np.empty(3)
+    for c in range(3):
+        ball[c] = 0.0
     for i in range(iv0, iv1 + 1):
         for j in range(iu0, iu1 + 1):
             for c in range(3):
@@ -448,7 +622,10 @@ def match_patterns(cxy: np.ndarray, cw: np.ndarray, dxy: np.ndarray, dw: np.ndar
     dots used, the smallest area weight among the dots (1 = as expected).
     """
     n_c, k_max = cxy.shape[0], slots.shape[0]
-    out = np.zeros((n_c, M_COLS))
+    out = np.empty((n_c, M_COLS))
+    for c in range(n_c):
+        for col in range(M_COLS):
+            out[c, col] = 0.0
     ring = 0.0
     for s in range(k_max):
         ring += np.sqrt(slots[s, 0] ** 2 + slots[s, 1] ** 2) / k_max
@@ -467,8 +644,9 @@ def match_patterns(cxy: np.ndarray, cw: np.ndarray, dxy: np.ndarray, dw: np.ndar
                 m += 1
         if m < min_dots:
             continue
-        order = np.argsort(off[:m])[:k_max]
-        k = order.shape[0]
+        # nearest the ring first; ties keep index order, as numba's argsort does for up to 15 values
+        order = argsort_stable(off[:m])
+        k = min(m, k_max)
         min_w = cw[c]
         for i in range(k):
             obs[i, 0] = dxy[near[order[i]], 0]

@@ -176,7 +176,6 @@ class Segmenter:
         self.params = params
         self.lut = build_lut(self.classes)
         self._screen = _screen_boxes(self.classes)
-        self.conv = _CONVERSIONS[space]
         self.min_area = np.array([c.min_area_px for c in self.classes], dtype=np.float64)
         self._runs: NDArray[np.int32] = np.zeros((0, 0, 3), dtype=np.int32)
         self._counts: NDArray[np.int64] = np.zeros(0, dtype=np.int64)
@@ -189,7 +188,8 @@ class Segmenter:
     def classify(self, image: NDArray[np.uint8]) -> NDArray[np.uint32]:
         """Per pixel, the bit set of classes (bit k: class k) whose box holds it."""
         out = np.empty(image.shape[:2], dtype=np.uint32)
-        kern.classify(np.ascontiguousarray(image), self.conv, self.lut, self._screen, out, self._no_runs, self._counts)
+        kern.classify(np.ascontiguousarray(image), self.space == "yuv", self.lut, self._screen, out, self._no_runs,
+                      self._counts)  # fmt: skip
         return out
 
     def runs(self, image: NDArray[np.uint8]) -> tuple[NDArray[np.int32], NDArray[np.int64]]:
@@ -200,7 +200,7 @@ class Segmenter:
             self._runs = np.zeros((h, self.params.max_runs_per_row, 3), dtype=np.int32)
             self._counts = np.zeros(h, dtype=np.int64)
         image = np.ascontiguousarray(image)
-        kern.classify(image, self.conv, self.lut, self._screen, self._no_bits, self._runs, self._counts)
+        kern.classify(image, self.space == "yuv", self.lut, self._screen, self._no_bits, self._runs, self._counts)
         return self._runs, self._counts
 
     def regions(self, image: NDArray[np.uint8], merge: bool = True) -> Regions:

@@ -217,12 +217,12 @@ def merge_duplicates(robots: list[RobotDetection], distance_m: float) -> list[Ro
     ``distance_m`` to a reported robot, is the same robot seen twice and is dropped."""
     ranked = sorted(robots, key=lambda r: -r.confidence)
     xy = np.array([[r.x, r.y] for r in ranked]).reshape(-1, 2)
+    # all pairwise distances at once, then plain Python: a dozen robots make numpy calls per robot cost more
+    apart = (np.hypot(xy[:, None, 0] - xy[None, :, 0], xy[:, None, 1] - xy[None, :, 1]) >= distance_m).tolist()
     kept: list[int] = []
     seen: set[tuple[str, int]] = set()
     for k, r in enumerate(ranked):
-        if (r.team, r.id) in seen:
-            continue
-        if kept and float(np.min(np.hypot(*(xy[kept] - xy[k]).T))) < distance_m:
+        if (r.team, r.id) in seen or not all(apart[j][k] for j in kept):
             continue
         kept.append(k)
         seen.add((r.team, r.id))
@@ -297,10 +297,12 @@ def detect_ball(
         & (elong <= params.max_elongation)
         & (fill >= params.min_fill)
     )
-    for r in robots:
-        # a pattern holds no orange: an orange spot inside one is a misread marker
-        at_top = geo.xy(idx, robot_height_m[r.team])
-        keep &= np.hypot(at_top[:, 0] - r.x, at_top[:, 1] - r.y) >= pattern_radius_m
+    # a pattern holds no orange: an orange spot inside one is a misread marker
+    for team in {r.team for r in robots}:
+        at_top = geo.xy(idx, robot_height_m[team])
+        rxy = np.array([(r.x, r.y) for r in robots if r.team == team])
+        off = np.hypot(at_top[:, None, 0] - rxy[None, :, 0], at_top[:, None, 1] - rxy[None, :, 1])
+        keep &= np.all(off >= pattern_radius_m, axis=1)
     px = regions.centroid[idx]
     z = ball_radius_m + params.blob_height_above_centre_m
     sigma = np.full(idx.size, math.nan)

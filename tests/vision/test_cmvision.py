@@ -197,3 +197,45 @@ def test_density_merge_joins_fragments_and_min_area_drops_specks() -> None:
     np.testing.assert_allclose(merged.centroid[0], [15.0, 15.0 + 0.5 / 9.0 * 1.0], atol=0.06)
     unmerged = seg.regions(image, merge=False)
     assert sorted(unmerged.area.tolist()) == [40.0, 50.0]
+
+
+@pytest.mark.parametrize("space", ["yuv", "bgr"])
+def test_kernel_colour_conversion_equals_reference_for_every_colour(space: str) -> None:
+    from vision.cmvision import convert_colour
+
+    g, r = np.meshgrid(np.arange(256), np.arange(256), indexing="ij")
+    for b in range(0, 256, 32):  # all 2^24 colours, 32 blue levels at a time
+        image = np.stack([np.broadcast_to(np.arange(b, b + 32)[:, None, None], (32, 256, 256)),
+                          np.broadcast_to(g, (32, 256, 256)), np.broadcast_to(r, (32, 256, 256))],
+                         axis=-1).astype(np.uint8).reshape(32 * 256, 256, 3)  # fmt: skip
+        np.testing.assert_array_equal(kern.channels(image, space == "yuv"), convert_colour(image, space))  # type: ignore[arg-type]
+
+
+def speckled_stats(seed: int) -> NDArray[np.float64]:
+    """Region statistics of a field of one-pixel and few-pixel specks and some larger blobs, two
+    classes: many fragments within the merge gap of each other, as along a field line's edges."""
+    rng = np.random.default_rng(seed)
+    image = np.zeros((90, 140, 3), np.uint8)
+    for _ in range(12):
+        v, u, h, w = rng.integers(0, 80), rng.integers(0, 130), rng.integers(2, 9), rng.integers(2, 9)
+        image[v : v + h, u : u + w] = (255, 255, 255) if rng.random() < 0.5 else (0, 0, 255)
+    specks = rng.random(image.shape[:2]) < 0.08
+    image[specks] = np.where(rng.random((int(specks.sum()), 1)) < 0.5, [255, 255, 255], [0, 0, 255])
+    classes = {"white": ColourClass(lo=(200, 0, 0), hi=(255, 255, 255)),
+               "red": ColourClass(lo=(50, 0, 200), hi=(120, 120, 255))}  # fmt: skip
+    seg = Segmenter(classes, "yuv", RegionParams())
+    runs, counts = seg.runs(image)
+    flat, label, n = kern.connect_runs(runs, counts, True)
+    return kern.region_stats(flat, label, int(n[0]))
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+@pytest.mark.parametrize(("gap", "density"), [(1.0, 0.6), (0.0, 0.3), (2.5, 0.4), (40.0, 0.05)])
+def test_merge_kernel_equals_reference_among_many_specks(seed: int, gap: float, density: float) -> None:
+    stats = speckled_stats(seed)
+    assert len(stats) > 300 and set(stats[:, kern.R_CLASS]) == {0.0, 1.0}
+    ref = merge_reference(stats, gap, density)
+    got = stats.copy()
+    alive = kern.merge_regions(got, gap, density)
+    assert len(ref) < len(stats), "the case merges"
+    np.testing.assert_array_equal(got[alive], ref)  # the same merges in the same order: the same sums

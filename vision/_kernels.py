@@ -6,7 +6,8 @@ Pixel coordinates are (u, v) = (column, row) of the pixel's top-left corner; cen
 reported at pixel centres (+0.5) by the wrappers, not here.
 
 First-run compile: arrays are made by ``np.empty`` and filled in loops, and sorting and the median
-are written out here (:func:`argsort_stable`, :func:`median`), because numba compiles each use of
+are the floor's (:func:`cmdragons._kernels.argsort_stable`, :func:`cmdragons._kernels.median`),
+because numba compiles each use of
 ``np.zeros``, ``np.ones``, ``np.full``, ``np.arange``, ``np.argsort`` and ``np.median`` (per
 signature) anew, a tenth of a second to seconds each, for no run-time gain.
 """
@@ -17,6 +18,8 @@ import math
 
 import numba
 import numpy as np
+
+from cmdragons._kernels import argsort_stable, median
 
 # region table columns (float64), filled by `region_stats` and `merge_regions`
 R_CLASS, R_AREA, R_SUM_U, R_SUM_V, R_SUM_UU, R_SUM_VV, R_SUM_UV, R_U0, R_V0, R_U1, R_V1 = range(11)
@@ -299,58 +302,6 @@ def region_stats(flat: np.ndarray, label: np.ndarray, n_regions: int) -> np.ndar
         out[k, R_V0] = min(out[k, R_V0], v)
         out[k, R_V1] = max(out[k, R_V1], v)
     return out
-
-
-@numba.njit(cache=True)
-def argsort_stable(keys: np.ndarray) -> np.ndarray:
-    """Indices that sort ``keys`` (1-d, no NaN) ascending; equal keys keep their index order (what
-    ``np.argsort(keys, kind="stable")`` returns). Bottom-up merge sort, written out because numba's
-    generic ``argsort`` costs seconds of first-run compile per call site."""
-    n = keys.shape[0]
-    idx = np.empty(n, np.int64)
-    for k in range(n):
-        idx[k] = k
-    tmp = np.empty(n, np.int64)
-    width = 1
-    while width < n:
-        lo = 0
-        while lo < n:
-            mid, hi = min(lo + width, n), min(lo + 2 * width, n)
-            a, b, k = lo, mid, lo
-            while a < mid and b < hi:
-                if keys[idx[b]] < keys[idx[a]]:  # the right one only when strictly smaller: stable
-                    tmp[k] = idx[b]
-                    b += 1
-                else:
-                    tmp[k] = idx[a]
-                    a += 1
-                k += 1
-            while a < mid:
-                tmp[k] = idx[a]
-                a += 1
-                k += 1
-            while b < hi:
-                tmp[k] = idx[b]
-                b += 1
-                k += 1
-            lo = hi
-        idx, tmp = tmp, idx
-        width *= 2
-    return idx
-
-
-@numba.njit(cache=True)
-def median(values: np.ndarray) -> float:
-    """The median of ``values`` (1-d, no NaN), as ``np.median``: the middle value, or the mean of
-    the two middle values for an even count; NaN for none."""
-    n = values.shape[0]
-    if n == 0:
-        return np.nan
-    order = argsort_stable(values)
-    half = n >> 1
-    if n & 1:
-        return float(values[order[half]])
-    return float((values[order[half - 1]] + values[order[half]]) / 2)
 
 
 # side of the grid cells (px) that `merge_regions` files the regions' bounding boxes in

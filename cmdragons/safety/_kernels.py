@@ -28,7 +28,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from cmdragons._kernels import argsort_small, sort_small
+from cmdragons._kernels import argsort_stable, sort_small
 from cmdragons.control._kernels import N_SEG, Limits, clip_accel, limit_velocity, seg_at, stop_accel, trajectory
 from cmdragons.planning._kernels import clearance
 
@@ -359,7 +359,7 @@ def dss(
             fx, fy = feasible(vx, vy, cand[r, 0], cand[r, 1], lim, dt)
             cand[r, 0], cand[r, 1] = fx, fy
             cost[r] = math.hypot(fx - dx, fy - dy)
-        order = argsort_small(cost, m)
+        order = argsort_stable(cost[:m])
         for r in order:
             tr = trajectory(px, py, vx, vy, cand[r, 0], cand[r, 1], dt, accel, brake)
             if not _trajectory_hits(i, tr, trs, pushed, opp, obs, inner, cfg):

@@ -1,11 +1,12 @@
-"""The vision kernels' hand-written helpers against numpy: exact agreement, ties included."""
+"""The floor's sorts and median (cmdragons._kernels), which the other kernels use instead of numba's,
+against numpy: exact agreement, ties included."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from vision import _kernels as kern
+from cmdragons import _kernels as kern
 
 
 def values_with_ties(rng: np.random.Generator, n: int, levels: int) -> np.ndarray:
@@ -42,3 +43,13 @@ def test_median_of_a_strided_view_and_of_nothing() -> None:
     ring = np.arange(30, dtype=np.float64).reshape(3, 10)[:, ::-1]
     assert kern.median(ring[1, :7]) == np.median(ring[1, :7])
     assert np.isnan(kern.median(np.empty(0)))
+
+
+@pytest.mark.parametrize("n", [0, 1, 2, 5, 17, 60])
+def test_sort_small_equals_numpy_sort(n: int) -> None:
+    rng = np.random.default_rng(n)
+    for _ in range(20):
+        a = values_with_ties(rng, n + 4, 7)
+        want = np.concatenate([np.sort(a[:n]), a[n:]])  # the tail past n stays untouched
+        kern.sort_small(a, n)
+        np.testing.assert_array_equal(a, want)

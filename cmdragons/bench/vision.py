@@ -30,7 +30,7 @@ from __future__ import annotations
 import dataclasses
 import tempfile
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -173,29 +173,31 @@ def _big_cameras(settings: Settings) -> list[CameraModel]:
 
 def _timing(settings: Settings, pipes: dict[int, VisionPipeline], samples: list[tuple[int, NDArray[np.uint8]]],
             reps: int) -> list[Row]:  # fmt: skip
-    """Median and 95th percentile of the time per camera frame, all methods on the same frames,
-    interleaved so that a busy machine slows them alike."""
+    """Median and 95th percentile of the time per camera frame, all methods on the same frames: each
+    method over all the frames in turn, round after round, so that a busy machine slows them alike
+    and no method starts a frame in caches another method has just filled with its own temporaries
+    (each frame still comes cold: the frames together are larger than the caches, as a camera's
+    fresh frame is)."""
     vis = settings.vision
     if vis.colour_space != "yuv":
         raise ValueError("the OpenCV baseline uses YUV boxes: run the bench with colour_space yuv")
     # OpenCV's YCrCb holds V before U
     boxes = [(np.array([c.lo[0], c.lo[2], c.lo[1]], np.uint8), np.array([c.hi[0], c.hi[2], c.hi[1]], np.uint8))
              for c in vis.colours.values()]  # fmt: skip
-    times: dict[str, list[float]] = {"cmvision + patterns": [], "cmvision regions": [], "opencv baseline": []}
+    methods: dict[str, Callable[[int, NDArray[np.uint8]], object]] = {
+        "cmvision + patterns": lambda cam, image: pipes[cam].process(image, 0, 0.0),
+        "cmvision regions": lambda cam, image: pipes[cam].segmenter.regions(image),
+        "opencv baseline": lambda _cam, image: opencv_baseline(image, boxes),
+    }
+    times: dict[str, list[float]] = {name: [] for name in methods}
     for cam, image in samples:  # warm-up: numba compilation or cache load
         pipes[cam].process(image, 0, 0.0)
     for _ in range(reps):
-        for cam, image in samples:
-            t0 = time.perf_counter()
-            pipes[cam].process(image, 0, 0.0)
-            t1 = time.perf_counter()
-            pipes[cam].segmenter.regions(image)
-            t2 = time.perf_counter()
-            opencv_baseline(image, boxes)
-            t3 = time.perf_counter()
-            times["cmvision + patterns"].append((t1 - t0) * 1e3)
-            times["cmvision regions"].append((t2 - t1) * 1e3)
-            times["opencv baseline"].append((t3 - t2) * 1e3)
+        for name, method in methods.items():
+            for cam, image in samples:
+                t0 = time.perf_counter()
+                method(cam, image)
+                times[name].append((time.perf_counter() - t0) * 1e3)
     base = float(np.median(times["opencv baseline"]))
     h, w = samples[0][1].shape[:2]
     return [

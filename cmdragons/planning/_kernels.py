@@ -227,6 +227,17 @@ def clearance_gradient(obs: np.ndarray, inner: np.ndarray, px: float, py: float)
 
 
 @njit(cache=True)
+def clearance_gradients(obs: np.ndarray, inner: np.ndarray, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`clearance_gradient` at each point of ``pts`` (n, 2): clearances (n,) and gradients (n, 2)."""
+    n = pts.shape[0]
+    c = np.empty(n)
+    g = np.empty((n, 2))
+    for i in range(n):
+        c[i], g[i, 0], g[i, 1] = clearance_gradient(obs, inner, pts[i, 0], pts[i, 1])
+    return c, g
+
+
+@njit(cache=True)
 def clearance_grid(
     obs: np.ndarray, inner: np.ndarray, x0: float, y0: float, res: float, nx: int, ny: int
 ) -> np.ndarray:

@@ -211,6 +211,13 @@ class CompiledWorld:
         c, gx, gy = K.clearance_gradient(self.obs, self.inner, float(x), float(y))
         return float(c), float(gx), float(gy)
 
+    def clearance_gradients(self, points: ArrayLike) -> tuple[FloatArray, FloatArray]:
+        """:meth:`clearance_gradient` at each row of ``points`` (n, 2): clearances (n,) and gradients
+        (n, 2), in one kernel call (the elastic band's query)."""
+        pts = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2)
+        c, g = K.clearance_gradients(self.obs, self.inner, pts)
+        return np.asarray(c), np.asarray(g)
+
     def clearance_grid(self, resolution_m: float | None = None, walls: bool = True,
                        cap_m: float = math.inf) -> ClearanceGrid:  # fmt: skip
         """The clearance rasterised over the field boundary in square cells of ``resolution_m``

@@ -5,6 +5,7 @@ it, and the band gives way to a robot that moves into it."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 
@@ -14,9 +15,15 @@ from cmdragons.messages import RobotCommand, RobotState
 from cmdragons.navigation import Arrival, RoboxNavigator, make_navigator
 from cmdragons.navigation.robox import along
 from cmdragons.planning import deadline, field_world
+from cmdragons.planning.errt import ERRTPlanner
+from cmdragons.planning.gridplan import EStarPlanner
+from cmdragons.runtime.match import Match
+from cmdragons.runtime.settings import load_settings, load_team_settings
+from cmdragons.runtime.stages import TeamStage
 from cmdragons.team import TeamParams
 from sim.world import BallParams, DribblerParams, KickerParams, PhysicsParams, RobotParams, World
 
+CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 CONTROL = ControlParams()
 FIELD = Field(LeagueParams())
 RADIUS = 0.09
@@ -73,3 +80,18 @@ def test_along_a_polyline() -> None:
     np.testing.assert_allclose(along(path, 0.5), (0.5, 0.0))
     np.testing.assert_allclose(along(path, 1.5), (1.0, 0.5))
     np.testing.assert_allclose(along(path, 9.0), (1.0, 2.0))
+
+
+def test_a_match_of_the_errt_team_against_the_robox_stack() -> None:
+    # what `cmdragons play --opponent self --opponent-set team.navigator=robox --opponent-set
+    # planner.planner=estar` runs (on truth, for speed): each team plans and navigates with its own
+    theirs = load_team_settings(CONFIGS, [], ["team.navigator=robox", "planner.planner=estar"])
+    match = Match(load_settings(CONFIGS), "self", "truth", seed=2, opponent_settings=theirs)
+    summary = match.run(10.0)
+    brains = {s.team: s.brain for s in match.bus.stages if isinstance(s, TeamStage)}
+    assert all(isinstance(p, ERRTPlanner) for p in brains["blue"].planners.values())
+    assert all(isinstance(p, EStarPlanner) for p in brains["yellow"].planners.values())
+    assert all(isinstance(n, RoboxNavigator) for n in brains["yellow"].navigators.values())
+    assert {p.status for p in brains["yellow"].plans.values()} <= {"solved", "approximate", "direct", "halt"}
+    assert summary["collisions"]["own"] == 0 and summary["opponent_team"]["collisions"]["own"] == 0
+    assert summary["cycle_ms"]["opponent_brain"]["median"] > 0.0

@@ -110,8 +110,8 @@ def _timing_rows(settings: Settings, steps: int) -> list[dict[str, Any]]:
         rows.append({"name": label, "median_ms": float(np.median(ms)), "p95_ms": float(np.percentile(ms, 95)),
                      "ratio_to_pythonrobotics_dwa": float(np.median(ms)) / PYTHONROBOTICS_DWA_MS,
                      "note": what})  # fmt: skip
-    rows[-1]["note"] = f"{parts[-1][2]}; reference: PythonRobotics DWA {PYTHONROBOTICS_DWA_MS:g} ms a step (issue #17, " \
-        "not run here)"
+    reference = f"PythonRobotics DWA {PYTHONROBOTICS_DWA_MS:g} ms a step (issue #17, not run here)"
+    rows[-1]["note"] = f"{parts[-1][2]}; reference: {reference}"
     return rows
 
 

@@ -27,6 +27,7 @@ propagated (E*), cells of the wavefront (NF1).
 
 from __future__ import annotations
 
+import abc
 import math
 import time
 from dataclasses import dataclass
@@ -131,7 +132,7 @@ def _links(cw: CompiledWorld, grid: CostGrid, point: tuple[float, float],
     return np.column_stack([rr[free], cc[free]]).astype(np.int64), d[free]
 
 
-class _GridPlanner:
+class _GridPlanner(abc.ABC):
     """What E* and NF1 share: the robust ends, the direct path, the cost grid, the links of start
     and goal to it, the smoothing and the final check."""
 
@@ -178,12 +179,12 @@ class _GridPlanner:
             return ends.finish(None, PlanStatus.NO_PATH, stats)
         return ends.finish(smoothed, PlanStatus.SOLVED, stats)
 
+    @abc.abstractmethod
     def _descend(self, grid: CostGrid, goal_cells: NDArray[np.int64], goal_d: FloatArray,
                  start_cells: NDArray[np.int64], start_d: FloatArray, ends: RobustEnds, termination: Termination,
                  stats: dict[str, Any]) -> tuple[PlanStatus, FloatArray]:  # fmt: skip
         """The status and the descent's points in cell units (x along columns, y along rows) from a
-        start link to a goal link."""
-        raise NotImplementedError
+        start link (rows of ``start_cells``, ``start_d`` cells from the start) to a goal link."""
 
 
 class EStarPlanner(_GridPlanner):

@@ -89,6 +89,10 @@ def build_parser() -> argparse.ArgumentParser:
     _common(p)
     p.add_argument("--opponent", choices=("simple", "self", "none"), default="simple",
                    help="the built-in simple team (on the true state), a copy of our team, or nobody")
+    p.add_argument("--opponent-set", metavar="KEY=VALUE", action="append", default=[],
+                   help="with --opponent self: override one value of the copy's own config, on top of --config "
+                   "and --set (its brain and tracker: planner, control, safety, tracker, strategy, team), "
+                   "e.g. --opponent-set team.navigator=robox --opponent-set planner.planner=estar (repeatable)")
     p.add_argument("--seconds", type=_positive, default=30.0, help="match time in simulated seconds (default 30)")
     p.add_argument("--division", choices=("A", "B"), default=None, help="field and team size (default: config)")
     p.add_argument("--perception", choices=("vision", "truth"), default="vision",
@@ -284,12 +288,17 @@ def _cmd_play(args: argparse.Namespace, stop: Interrupt) -> int:
     from cmdragons.runtime.log import RunLog, run_folder
     from cmdragons.runtime.match import OURS, Match
     from cmdragons.runtime.overlay import MatchVideoStage
-    from cmdragons.runtime.settings import load_settings
+    from cmdragons.runtime.settings import load_settings, load_team_settings
     from cmdragons.runtime.stages import LoggerStage, Tap
     from cmdragons.runtime.warmup import CompileWatch
 
     overrides = list(args.set) + ([f"field.division={args.division}"] if args.division else [])
+    if args.opponent_set and args.opponent != "self":
+        print(f"cmdragons play: --opponent-set configures a copy of our team: it needs --opponent self, "
+              f"not {args.opponent}", file=sys.stderr)  # fmt: skip
+        return 2
     settings = load_settings(args.config, overrides)
+    theirs = load_team_settings(args.config, overrides, args.opponent_set) if args.opponent_set else None
     folder = run_folder("play", args.out, overwrite=args.overwrite)
     images = args.perception == "vision" or (args.video and args.view == "cameras")
     log = RunLog(folder / "run.mcap")
@@ -306,11 +315,13 @@ def _cmd_play(args: argparse.Namespace, stop: Interrupt) -> int:
     watch = CompileWatch()
     built: list[Match] = []
     try:
+        def build() -> Match:
+            return Match(settings, args.opponent, args.perception, seed=args.seed, render=images, extra=extra,
+                         opponent_settings=theirs)  # fmt: skip
+
         # a first run builds the match while its kernels compile in other processes
-        compile_s = _compile_kernels(args, overrides, images, lambda: built.append(
-            Match(settings, args.opponent, args.perception, seed=args.seed, render=images, extra=extra)))
-        match = built[0] if built else Match(settings, args.opponent, args.perception, seed=args.seed,
-                                             render=images, extra=extra)  # fmt: skip
+        compile_s = _compile_kernels(args, overrides, images, lambda: built.append(build()))
+        match = built[0] if built else build()
         started = time.time()
         with _progress(not args.no_progress) as progress, stop.soft():
             task = progress.add_task("play", total=n_frames, info="")
@@ -381,6 +392,7 @@ def _finish_play(folder: Path, summary: dict[str, Any], args: argparse.Namespace
         f"({rtf}x real time{compile_note}): blue (us) {score['blue']}:{score['yellow']} yellow (them); ours: "
         f"{_plural(summary['shots'], 'shot')}, passes {passes['completed']}/{passes['tried']} completed, "
         f"{_plural(coll['own'], 'own collision')}; brain {brain:.2f} ms median"
+        + _their_line(summary)
     )
     for w in warnings:
         print(f"play: warning: {w}")
@@ -390,6 +402,16 @@ def _finish_play(folder: Path, summary: dict[str, Any], args: argparse.Namespace
     files = ["run.mcap", "summary.json"] + (["match.mp4"] if args.video and (folder / "match.mp4").exists() else [])
     files += [report.name] if report is not None else []
     print(f"play: {', '.join(files)} -> {folder}")
+
+
+def _their_line(summary: dict[str, Any]) -> str:
+    """The copy of our team's figures for the summary line (a self match only)."""
+    them = summary.get("opponent_team")
+    if them is None:
+        return ""
+    brain = summary["cycle_ms"].get("opponent_brain", {}).get("median", float("nan"))
+    return (f"; theirs: {_plural(them['shots'], 'shot')}, {_plural(them['collisions']['own'], 'own collision')}, "
+            f"brain {brain:.2f} ms median")  # fmt: skip
 
 
 def _compile_kernels(args: argparse.Namespace, overrides: Sequence[str], images: bool,

@@ -29,7 +29,16 @@ from cmdragons.config import Validated, setting
 from cmdragons.control.motion import predict_braking
 from cmdragons.geometry import Team
 from cmdragons.messages import GameState, RobotCommand, RobotState, WorldState
-from cmdragons.navigation import NAVIGATORS, Arrival, DynamicWindowParams, Navigator, TrajectoryParams, make_navigator
+from cmdragons.navigation import (
+    NAVIGATORS,
+    Arrival,
+    BandParams,
+    DynamicWindowParams,
+    Navigator,
+    RoboxParams,
+    TrajectoryParams,
+    make_navigator,
+)
 from cmdragons.planning import (
     CollisionWorld,
     Planner,
@@ -73,6 +82,8 @@ class TeamParams(Validated):
     navigator: str = setting("trajectory", choices=tuple(NAVIGATORS))  # which of NAVIGATORS drives each robot
     trajectory: TrajectoryParams = TrajectoryParams()
     dynamic_window: DynamicWindowParams = DynamicWindowParams()
+    elastic_band: BandParams = BandParams()  # the Robox stack's band
+    robox: RoboxParams = RoboxParams()
     brain: BrainParams = BrainParams()
     simple_opponent: SimpleTeamParams = SimpleTeamParams()
 

@@ -40,6 +40,7 @@ SUITES: dict[str, Suite] = {
     "play": _lazy("cmdragons.bench.play"),
     "vision": _lazy("cmdragons.bench.vision"),
     "grid": _lazy("cmdragons.bench.grid"),
+    "robox": _lazy("cmdragons.bench.robox"),
 }
 OPTIONS: dict[str, tuple[str, ...]] = {"grid": ("maps",)}  # the options each suite takes
 

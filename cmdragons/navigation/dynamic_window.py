@@ -87,6 +87,19 @@ class DynamicWindowNavigator:
         if termination.reached(0):
             return STOP
         vx_want, vy_want, omega = self.follow.command(robot, world, termination)
+        return self._choose(robot, world, termination, vx_want, vy_want, omega)
+
+    def command_toward(self, robot: RobotState, world: CollisionWorld, termination: Termination,
+                       want: tuple[float, float]) -> VelocityCommand:  # fmt: skip
+        """The admissible velocity of the window closest to ``want`` (m/s, field frame: a velocity the
+        caller chose, such as the Robox stack's heading along its band), the path's omega."""
+        if termination.reached(0):
+            return STOP
+        _, _, omega = self.follow.command(robot, world, termination)
+        return self._choose(robot, world, termination, want[0], want[1], omega)
+
+    def _choose(self, robot: RobotState, world: CollisionWorld, termination: Termination, vx_want: float,
+                vy_want: float, omega: float) -> VelocityCommand:  # fmt: skip
         start = self.follow.start_state(robot)
         cw = world.compile(self.radius, 0.0, 0.0, self.collision)
         limits = self.follow.target(robot)[1].motion.limits()

@@ -106,6 +106,17 @@ class ElasticBand:
         d, _ = clearance(pts)
         return np.minimum(np.asarray(d, dtype=np.float64), self.p.max_bubble_m)
 
+    def advance(self, start: ArrayLike) -> None:
+        """Move the band's start to ``start`` (the robot) and drop the bubbles it has passed: a
+        bubble goes while the robot is nearer to the bubble after it than that bubble is."""
+        p0 = np.asarray(start, dtype=np.float64).reshape(2)
+        pts, radii = self.points, self.radii
+        k = 1
+        while k < len(pts) - 1 and math.dist(p0, pts[k + 1]) <= math.dist(pts[k], pts[k + 1]):
+            k += 1
+        self.points = np.vstack([p0, pts[k:]])
+        self.radii = np.r_[radii[0], radii[k:]]
+
     def update(self, clearance: Clearance, start: ArrayLike | None = None, goal: ArrayLike | None = None) -> bool:
         """Move the band's ends to ``start`` / ``goal`` (if given) and deform it ``iterations`` times
         in the world ``clearance`` describes; returns whether the band is clear."""

@@ -1,5 +1,6 @@
 """Navigator registry: ``team.navigator`` in configs/team.yaml picks one of :data:`NAVIGATORS`; each
-navigator has its config section there (``team.trajectory``, ``team.dynamic_window``).
+navigator has its config section there (``team.trajectory``, ``team.dynamic_window``, ``team.robox`` with
+``team.elastic_band``).
 
 A new navigator is one module, one line here and one config section (a field of
 :class:`cmdragons.team.TeamParams` named like its registry key).
@@ -13,6 +14,7 @@ from typing import Any
 from cmdragons.control.motion import ControlParams
 from cmdragons.navigation.base import Navigator
 from cmdragons.navigation.dynamic_window import DynamicWindowNavigator
+from cmdragons.navigation.robox import RoboxNavigator
 from cmdragons.navigation.trajectory import TrajectoryNavigator
 from cmdragons.planning.world import CollisionParams
 
@@ -26,6 +28,8 @@ NAVIGATORS: dict[str, Factory] = {
     "trajectory": lambda s, control, r, collision: TrajectoryNavigator(s.trajectory, control, r),
     "dynamic_window": lambda s, control, r, collision: DynamicWindowNavigator(s.dynamic_window, control, r, collision,
                                                                               s.trajectory),  # fmt: skip
+    "robox": lambda s, control, r, collision: RoboxNavigator(s.robox, s.elastic_band, s.dynamic_window, control, r,
+                                                             collision, s.trajectory),  # fmt: skip
 }
 
 

@@ -227,6 +227,17 @@ def clearance_gradient(obs: np.ndarray, inner: np.ndarray, px: float, py: float)
 
 
 @njit(cache=True)
+def clearance_gradients(obs: np.ndarray, inner: np.ndarray, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`clearance_gradient` at each point of ``pts`` (n, 2): clearances (n,) and gradients (n, 2)."""
+    n = pts.shape[0]
+    c = np.empty(n)
+    g = np.empty((n, 2))
+    for i in range(n):
+        c[i], g[i, 0], g[i, 1] = clearance_gradient(obs, inner, pts[i, 0], pts[i, 1])
+    return c, g
+
+
+@njit(cache=True)
 def clearance_grid(
     obs: np.ndarray, inner: np.ndarray, x0: float, y0: float, res: float, nx: int, ny: int
 ) -> np.ndarray:
@@ -237,6 +248,34 @@ def clearance_grid(
         py = y0 + (i + 0.5) * res
         for k in range(nx):
             out[i, k] = clearance(obs, inner, x0 + (k + 0.5) * res, py)
+    return out
+
+
+@njit(cache=True)
+def clearance_grid_capped(
+    obs: np.ndarray, aabb: np.ndarray, inner: np.ndarray, x0: float, y0: float, res: float, nx: int, ny: int,
+    cap: float,
+) -> np.ndarray:  # fmt: skip
+    """``min(clearance, cap)`` at the cell centres of :func:`clearance_grid`: each obstacle visits
+    only the cells within ``cap`` of its bounding box (what a cost grid needs: its soft costs end at a
+    clearance, so the cells farther from every obstacle all take ``cap``)."""
+    out = np.empty((ny, nx))
+    for i in range(ny):
+        py = y0 + (i + 0.5) * res
+        for k in range(nx):
+            px = x0 + (k + 0.5) * res
+            out[i, k] = min(px - inner[0], inner[2] - px, py - inner[1], inner[3] - py, cap)
+    for j in range(obs.shape[0]):
+        k0 = max(0, int(math.floor((aabb[j, 0] - cap - x0) / res - 0.5)))
+        k1 = min(nx - 1, int(math.ceil((aabb[j, 2] + cap - x0) / res - 0.5)))
+        i0 = max(0, int(math.floor((aabb[j, 1] - cap - y0) / res - 0.5)))
+        i1 = min(ny - 1, int(math.ceil((aabb[j, 3] + cap - y0) / res - 0.5)))
+        for i in range(i0, i1 + 1):
+            py = y0 + (i + 0.5) * res
+            for k in range(k0, k1 + 1):
+                c = obstacle_clearance(obs, j, x0 + (k + 0.5) * res, py)
+                if c < out[i, k]:
+                    out[i, k] = c
     return out
 
 

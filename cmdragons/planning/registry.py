@@ -12,6 +12,7 @@ import numpy as np
 
 from cmdragons.config import Validated, setting
 from cmdragons.planning.errt import ERRTParams, ERRTPlanner
+from cmdragons.planning.gridplan import EStarParams, EStarPlanner, GridParams, NF1Params, NF1Planner
 from cmdragons.planning.prm import DynamicPRMParams, DynamicPRMPlanner
 from cmdragons.planning.problem import Planner
 from cmdragons.planning.termination import Termination, budget, deadline
@@ -25,6 +26,8 @@ PLANNERS: dict[str, Callable[[PlannerParams, np.random.Generator], Planner]] = {
     "errt": lambda p, rng: ERRTPlanner(p.errt, rng),
     "prm": lambda p, rng: DynamicPRMPlanner(p.prm, rng),
     "visgraph": lambda p, rng: VisibilityGraphPlanner(p.visgraph, rng),
+    "estar": lambda p, rng: EStarPlanner(p.estar, p.grid, rng),
+    "nf1": lambda p, rng: NF1Planner(p.nf1, p.grid, rng),
 }
 
 
@@ -42,6 +45,9 @@ class PlannerParams(Validated):
     errt: ERRTParams = ERRTParams()
     prm: DynamicPRMParams = DynamicPRMParams()
     visgraph: VisGraphParams = VisGraphParams()
+    grid: GridParams = GridParams()  # the cost grid of estar and nf1
+    estar: EStarParams = EStarParams()
+    nf1: NF1Params = NF1Params()
 
 
 def make_planner(params: PlannerParams, robot_id: int = 0, name: str | None = None) -> Planner:

@@ -21,6 +21,7 @@ as NF1 and E* start).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Literal
@@ -213,16 +214,30 @@ class CompiledWorld:
         c, gx, gy = K.clearance_gradient(self.obs, self.inner, float(x), float(y))
         return float(c), float(gx), float(gy)
 
-    def clearance_grid(self, resolution_m: float | None = None) -> ClearanceGrid:
+    def clearance_gradients(self, points: ArrayLike) -> tuple[FloatArray, FloatArray]:
+        """:meth:`clearance_gradient` at each row of ``points`` (n, 2): clearances (n,) and gradients
+        (n, 2), in one kernel call (the elastic band's query)."""
+        pts = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2)
+        c, g = K.clearance_gradients(self.obs, self.inner, pts)
+        return np.asarray(c), np.asarray(g)
+
+    def clearance_grid(self, resolution_m: float | None = None, walls: bool = True,
+                       cap_m: float = math.inf) -> ClearanceGrid:  # fmt: skip
         """The clearance rasterised over the field boundary in square cells of ``resolution_m``
         (default the params' ``grid_resolution_m``); cells cover the boundary box, the last row and
-        column reaching up to one cell past it."""
+        column reaching up to one cell past it. ``walls=False``: the clearance from the obstacles
+        alone, the boundary left out (a weighted region's own grid); ``cap_m``: the clearance capped
+        there, each obstacle touching only the cells within that of it (much faster)."""
         res = float(resolution_m if resolution_m is not None else self.params.grid_resolution_m)
         if not res > 0.0:
             raise ValueError(f"resolution_m must be > 0, not {res}")
         x0, y0, x1, y1 = self.world.bounds
         nx, ny = max(1, int(np.ceil((x1 - x0) / res - 1e-9))), max(1, int(np.ceil((y1 - y0) / res - 1e-9)))
-        values = K.clearance_grid(self.obs, self.inner, x0, y0, res, nx, ny)
+        inner = self.inner if walls else np.array([-np.inf, -np.inf, np.inf, np.inf])
+        if math.isfinite(cap_m):
+            values = K.clearance_grid_capped(self.obs, self.aabb, inner, x0, y0, res, nx, ny, float(cap_m))
+        else:
+            values = K.clearance_grid(self.obs, inner, x0, y0, res, nx, ny)
         return ClearanceGrid(x0, y0, res, np.asarray(values))
 
     def nearest_free(self, x: float, y: float, step_m: float = 0.02, n_rings: int = 50) -> tuple[float, float] | None:

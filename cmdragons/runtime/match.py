@@ -56,8 +56,10 @@ THEIRS: Team = "yellow"
 
 
 def wiring(settings: Settings, sim: Simulator, opponent: Opponent, perception: Perception,
-           seed: int) -> list[Stage]:  # fmt: skip
-    """The stages of a match, in the order they subscribe (which fixes the order of delivery)."""
+           seed: int, opponent_settings: Settings | None = None) -> list[Stage]:  # fmt: skip
+    """The stages of a match, in the order they subscribe (which fixes the order of delivery).
+    ``opponent_settings``: the brain and tracker settings of the copy of our team (``self``; default
+    ours)."""
     playing: list[Team] = [OURS] if opponent == "none" else [OURS, THEIRS]
     stages: list[Stage] = [
         SimStage(sim, playing),
@@ -75,11 +77,14 @@ def wiring(settings: Settings, sim: Simulator, opponent: Opponent, perception: P
         stages += [TruthPerceptionStage(team, sigmas, seed + k) for k, team in enumerate(brains)]
         topics = {team: [f"perception/{team}"] for team in brains}
     for team in brains:
-        stages += [TrackerStage(team, Tracker(settings.tracker), topics[team]), TeamStage(team, Brain(team, settings))]
+        own = opponent_settings if team == THEIRS and opponent_settings is not None else settings
+        stages += [TrackerStage(team, Tracker(own.tracker), topics[team]), TeamStage(team, Brain(team, own))]
     if opponent == "simple":
         simple = SimpleTeam(THEIRS, settings.field_geometry(), settings.team.simple_opponent, settings.strategy)
         stages.append(SimpleOpponentStage(THEIRS, simple))
     stages += [StatsStage(OURS, settings.strategy.pass_timeout_s), TimingStage()]
+    if opponent == "self":  # the copy of our team: its own figures too
+        stages.append(StatsStage(THEIRS, (opponent_settings or settings).strategy.pass_timeout_s))
     return stages
 
 
@@ -108,11 +113,15 @@ class Match:
     """Runs one match frame by frame; ``summary()`` gives the figures of summary.json.
 
     ``render``: draw the camera images even when the team plays on truth (for videos).
-    ``extra``: more stages on the same bus (a logger, a video, a progress bar)."""
+    ``extra``: more stages on the same bus (a logger, a video, a progress bar).
+    ``opponent_settings``: with ``opponent="self"``, the copy's own brain and tracker settings
+    (:func:`~cmdragons.runtime.settings.load_team_settings`; default ours)."""
 
     def __init__(self, settings: Settings, opponent: Opponent = "simple", perception: Perception = "vision",
                  seed: int | None = None, render: bool = False, extra: Sequence[Stage] = (),
-                 transport: Transport | None = None) -> None:  # fmt: skip
+                 transport: Transport | None = None, opponent_settings: Settings | None = None) -> None:  # fmt: skip
+        if opponent_settings is not None and opponent != "self":
+            raise ValueError("opponent_settings are for a copy of our team (opponent 'self')")
         params = settings.sim
         if opponent == "none":
             params = dataclasses.replace(params, robots_per_team={**params.robots_per_team, THEIRS: 0})
@@ -125,7 +134,8 @@ class Match:
         self.cameras = list(self.sim.cameras)
         self.bus = Bus(transport)
         self._summaries = SummaryCollector()
-        stages: list[Stage] = [*wiring(settings, self.sim, opponent, perception, self.seed), *extra, self._summaries]
+        stages: list[Stage] = [*wiring(settings, self.sim, opponent, perception, self.seed, opponent_settings), *extra,
+                               self._summaries]  # fmt: skip
         for stage in stages:
             self.bus.add(stage)
         self.frames = 0
@@ -143,6 +153,8 @@ class Match:
         for name, keys in _TIMINGS.items():
             self.stage_ms.setdefault(name, []).append(_sum_times(times, keys))
         self.stage_ms.setdefault("frame", []).append(frame_ms)
+        if self.opponent == "self":  # the copy's brain apart (it is also in physics_and_opponent)
+            self.stage_ms.setdefault("opponent_brain", []).append(times.get(f"team/{THEIRS}", 0.0))
 
     def run(self, seconds: float, on_frame: Callable[[int], None] | None = None) -> dict[str, Any]:
         n = max(1, round(seconds * self.settings.sim.physics.frame_rate_hz))
@@ -176,4 +188,11 @@ class Match:
             "balls_out": referee["balls_out"],
             "command_faults": sim["command_faults"],
             "tracker": f[f"tracker/{OURS}"],
+            **({"opponent_team": self._their_figures(f, open_pairs)} if self.opponent == "self" else {}),
         }  # fmt: skip
+
+    def _their_figures(self, f: dict[str, Any], open_pairs: list[set[str]]) -> dict[str, Any]:
+        """The copy of our team's own figures: shots, passes, collisions among its robots."""
+        stats = f[f"stats/{THEIRS}"]
+        return {"shots": stats["shots"], "passes": stats["passes"],
+                "collisions": {"own": stats["collisions"]["own"] + sum(p == {THEIRS} for p in open_pairs)}}  # fmt: skip

@@ -25,7 +25,7 @@ from sim.params import SimParams
 from strategy.plays import StrategyParams
 from vision.pipeline import VisionParams
 
-__all__ = ["CONCERNS", "Settings", "load_settings"]
+__all__ = ["CONCERNS", "TEAM_CONCERNS", "Settings", "load_settings", "load_team_settings"]
 
 CONCERNS: dict[str, type] = {
     "field": LeagueParams,
@@ -39,6 +39,10 @@ CONCERNS: dict[str, type] = {
     "team": TeamParams,
     "vision": VisionParams,
 }
+
+# the concerns a team may have its own of in a match (its brain and its tracker); the field, the
+# simulator, the cameras and vision are the match's
+TEAM_CONCERNS: tuple[str, ...] = ("planner", "control", "safety", "tracker", "strategy", "team")
 
 
 @dataclass(frozen=True)
@@ -97,3 +101,17 @@ def load_settings(config_dir: str | Path | None = None, overrides: Sequence[str]
 
     # facts configured once (field.robot limits, the ball model, ...) filled in where they are used
     return Settings(config_dir=folder, **{name: resolve_derived(obj, lookup) for name, obj in parsed.items()})
+
+
+def load_team_settings(config_dir: str | Path | None, overrides: Sequence[str], team_overrides: Sequence[str],
+                       flag: str = "--opponent-set") -> Settings:  # fmt: skip
+    """The settings of one team of a match: the match's (``config_dir`` with ``overrides``) with
+    ``team_overrides`` on top, each of which must set a concern of :data:`TEAM_CONCERNS` (a team has
+    its own brain and tracker, not its own field or simulator). Raises :class:`ConfigError` naming
+    ``flag`` and the key."""
+    for assignment in team_overrides:
+        key = assignment.partition("=")[0]
+        if key.partition(".")[0] not in TEAM_CONCERNS:
+            raise ConfigError(flag, key, "a team's own config covers its brain and tracker only; allowed concerns: "
+                              + ", ".join(TEAM_CONCERNS) + " (the match's field, sim, cameras and vision: --set)")
+    return load_settings(config_dir, [*overrides, *team_overrides])

@@ -52,6 +52,11 @@ CASES = [
     (["play", "--set", "nosuch.key=1"], ["unknown concern"]),
     (["play", "--config", "{tmp}/no_configs"], ["config folder not found"]),
     (["bench", "nosuch"], ["unknown suite", "planning"]),
+    (["play", "--opponent-set", "team.navigator=robox"], ["--opponent-set", "needs --opponent self", "simple"]),
+    (["play", "--opponent", "self", "--opponent-set", "field.division=A"],
+     ["--opponent-set", "field.division", "brain and tracker", "planner", "--set"]),
+    (["play", "--opponent", "self", "--opponent-set", "team.navigator=magic"], ["team.navigator", "'robox'"]),
+    (["play", "--opponent", "self", "--opponent-set", "planner.estar.neighbours=6"], ["estar.neighbours", "4, 8"]),
 ]
 
 

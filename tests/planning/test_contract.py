@@ -30,6 +30,7 @@ from cmdragons.planning.scenes import random_scene
 from tests.planning.conftest import RADIUS_M, problem, ring, wall_with_gap
 
 NAMES = sorted(PLANNERS)
+FINITE = ("visgraph", "estar", "nf1")  # their work is finite: a hard scene ends before any deadline
 GENEROUS_S = 5.0  # deadline for scenes that must be solved: far beyond any planner's need
 
 
@@ -119,7 +120,7 @@ def test_invalid_start_is_a_status(name: str, field: Field) -> None:
     assert result.status is PlanStatus.INVALID_START
 
 
-@pytest.mark.parametrize("name", [n for n in NAMES if n != "visgraph"])  # visgraph: below, its graph is finite
+@pytest.mark.parametrize("name", [n for n in NAMES if n not in FINITE])  # the finite ones: below
 def test_deadline_is_kept(name: str, field: Field) -> None:
     # a hard scene (a ring closed around the goal) and no work budget: only the deadline stops it
     params = PlannerParams()
@@ -149,11 +150,13 @@ def test_a_spent_work_budget_ends_in_no_path(name: str, field: Field) -> None:
     np.testing.assert_array_equal(again.path, small.path)
 
 
-def test_the_visibility_graph_keeps_its_deadline(field: Field) -> None:
-    # a deadline already passed stops it before the graph is built: TIMEOUT, no path
+@pytest.mark.parametrize("name", FINITE)
+def test_a_planner_with_finite_work_keeps_its_deadline(name: str, field: Field) -> None:
+    # a deadline already passed stops it before its graph or grid is built: TIMEOUT, no path (also
+    # for a grid planner that keeps its field from the frame before)
     prob = problem(field_world(field, ring((1.0, 0.5), 0.45, 16)), (-3.0, -1.0), (3.0, 0.5))
-    planner = make_planner(PlannerParams(), name="visgraph")
-    assert planner.solve(prob, within("visgraph")).status is PlanStatus.SOLVED
+    planner = make_planner(PlannerParams(), name=name)
+    assert planner.solve(prob, within(name)).status is PlanStatus.SOLVED
     late = planner.solve(prob, Termination(deadline_s=time.perf_counter()))
     assert late.status is PlanStatus.TIMEOUT and not np.isfinite(late.cost)
 

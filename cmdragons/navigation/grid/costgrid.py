@@ -32,10 +32,14 @@ FloatArray = NDArray[np.float64]
 class Clearances(Protocol):
     """What a clearance grid offers (cmdragons.planning.world.ClearanceGrid)."""
 
-    x0: float
-    y0: float
-    resolution_m: float
-    values: FloatArray
+    @property
+    def x0(self) -> float: ...
+    @property
+    def y0(self) -> float: ...
+    @property
+    def resolution_m(self) -> float: ...
+    @property
+    def values(self) -> FloatArray: ...
 
 
 @dataclass(frozen=True)

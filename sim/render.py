@@ -47,9 +47,6 @@ class RenderParams(Validated):
     blur_step_px: float = setting(0.5, lo=0.05, hi=10.0)  # samples at most this far apart (px)
     static_supersampling: int = setting(4, lo=1, hi=8)  # per axis, for the goals' edges (once)
     ball_ambient_fraction: float = setting(0.6, lo=0.0, hi=1.0)  # ball rim brightness vs its top
-    # cameras rendered at once, each in its own thread (the kernel runs without the GIL); the
-    # images are the same either way
-    camera_threads: int = setting(2, lo=1, hi=16)
 
     carpet_bgr: BGR = setting((40, 110, 40), lo=0, hi=255)
     line_bgr: BGR = setting((235, 235, 235), lo=0, hi=255)

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import time
 from collections.abc import Iterable, Sequence
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -76,7 +75,6 @@ class Simulator:
             if render else []
         )  # fmt: skip
         self.times = StageTimes()
-        self._pool: ThreadPoolExecutor | None = None  # the cameras' render threads, made on first use
 
     @property
     def t(self) -> float:
@@ -93,15 +91,9 @@ class Simulator:
         ball_px: dict[int, tuple[float, float, float]] = {}
         robot_px: dict[tuple[Team, int], dict[int, tuple[float, float]]] = {}
         t0 = time.perf_counter()
-        threads = min(self.params.render.camera_threads, len(self.renderers))
-        if threads > 1:
-            if self._pool is None:
-                self._pool = ThreadPoolExecutor(threads, thread_name_prefix="render")
-            rendered = list(self._pool.map(lambda r: r.render(snap), self.renderers))
-        else:
-            rendered = [r.render(snap) for r in self.renderers]
-        for renderer, (image, truth) in zip(self.renderers, rendered, strict=True):
+        for renderer in self.renderers:
             cam = renderer.model.id
+            image, truth = renderer.render(snap)
             images[cam] = image
             if truth.ball is not None:
                 ball_px[cam] = truth.ball

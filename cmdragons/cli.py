@@ -7,6 +7,7 @@ Every command takes ``--config DIR`` (default ``./configs``) and repeatable
 from __future__ import annotations
 
 import argparse
+import importlib
 import json
 import math
 import sys
@@ -288,6 +289,7 @@ def _cmd_play(args: argparse.Namespace, stop: Interrupt) -> int:
     from cmdragons.runtime.log import RunLog, run_folder
     from cmdragons.runtime.match import OURS, Match
     from cmdragons.runtime.overlay import MatchVideoStage
+    from cmdragons.runtime.report import pyplot
     from cmdragons.runtime.settings import load_settings, load_team_settings
     from cmdragons.runtime.stages import LoggerStage, Tap
     from cmdragons.runtime.warmup import CompileWatch
@@ -319,8 +321,14 @@ def _cmd_play(args: argparse.Namespace, stop: Interrupt) -> int:
             return Match(settings, args.opponent, args.perception, seed=args.seed, render=images, extra=extra,
                          opponent_settings=theirs)  # fmt: skip
 
-        # a first run builds the match while its kernels compile in other processes
-        compile_s = _compile_kernels(args, overrides, images, lambda: built.append(build()))
+        def prepare() -> None:
+            """A first run builds the match while its kernels compile in other processes, and loads
+            what the match and its report import later (filterpy brings scipy.stats: a second)."""
+            built.append(build())
+            importlib.import_module("filterpy.kalman")
+            pyplot()
+
+        compile_s = _compile_kernels(args, overrides, images, prepare)
         match = built[0] if built else build()
         started = time.time()
         with _progress(not args.no_progress) as progress, stop.soft():

@@ -140,15 +140,23 @@ def run_warnings(run: RunData, summary: dict[str, Any]) -> list[str]:
     return out
 
 
-def write_report(run: RunData, summary: dict[str, Any], path: str | Path,
-                 half_size_m: tuple[float, float] = (4.5, 3.0)) -> Path:  # fmt: skip
-    """The one-page match report PNG (see the module docstring) of a field of ``half_size_m``
-    (half length, half width; m); returns its path."""
+def pyplot() -> Any:
+    """matplotlib's pyplot on the Agg backend (files only, no screen), imported on first use."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
+    return plt
+
+
+def write_report(run: RunData, summary: dict[str, Any], path: str | Path,
+                 half_size_m: tuple[float, float] = (4.5, 3.0)) -> Path:  # fmt: skip
+    """The one-page match report PNG (see the module docstring) of a field of ``half_size_m``
+    (half length, half width; m); returns its path."""
     from matplotlib.patches import Rectangle
+
+    plt = pyplot()
 
     path = Path(path)
     fig = plt.figure(figsize=(14, 10), dpi=100)

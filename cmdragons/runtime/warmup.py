@@ -1,15 +1,17 @@
-"""The first run's kernel compile, made visible and split over two processes.
+"""The first run's kernel compile, made visible and split over four processes.
 
 numba compiles a kernel on its first call and caches the machine code in the package's
 ``__pycache__`` (``cache=True``); a fresh clone has no cache, and a match would stall on its first
 frames for the better part of a minute without a word. :func:`warm_up` compiles the kernels a
 ``play`` calls before the match starts, in four processes at once (the compile is single-threaded):
-the planner's in a child that solves a few throwaway queries, motion control's and the safety
-stage's in a child that drives a throwaway crowd of robots, the renderer's in a child that renders
-one throwaway frame, and vision's in this process on the same frame drawn by the renderer's numpy
-reference (what is left, say a kernel only strategy calls, compiles during the match). All write numba's cache, so
-the match then loads every kernel from it. :class:`CompileWatch` counts what compiles in this process (and how
-long it took), so that real-time factors can leave the one-time compile out.
+the planner's and the collision world's in a child that solves a few throwaway queries; motion
+control's, the safety stage's and strategy's in a child that drives a throwaway crowd of robots;
+the renderer's in a child that renders one throwaway frame; and vision's in this process on the
+same frame drawn by the renderer's numpy reference, after which this process builds the match
+(what is left compiles during the match). No kernel compiles twice: the parts that need the
+collision world load it from the cache the planning child writes first. :class:`CompileWatch`
+counts what compiles in this process (and how long it took), so that real-time factors can leave
+the one-time compile out.
 
 Nothing here changes a match: the throwaway objects have their own random generators.
 """
@@ -144,10 +146,10 @@ def warm_up(config: str | None, overrides: Sequence[str], opponent: str, images:
         r.start()
     try:
         with CompileWatch(tick):
-            if meanwhile is not None:
-                meanwhile()
             if images:
                 _warm_vision(config, overrides)
+            if meanwhile is not None:  # after vision: the children have cached the world's kernels by now
+                meanwhile()
         for c in children:
             c.wait()
         for r in readers:
@@ -209,14 +211,19 @@ def _child(spec: dict[str, Any]) -> None:
 def _warm_motion(settings: Any) -> None:
     """The navigator and the safety stage as the brain calls them (not through the brain: its
     planners are the planning part's), on a throwaway crowd of own robots driving into each other
-    and opponents."""
+    and opponents, then strategy's kernels (the shot and pass evaluation; here, to even out the
+    parts). Motion control first: the planning part compiles the collision world meanwhile, and this
+    part then loads it from the cache."""
     import numpy as np
 
-    from cmdragons.messages import BallState, RobotCommand, RobotState, WorldState
+    from cmdragons.control.motion import motion_commands
+    from cmdragons.messages import BallState, GameState, RobotCommand, RobotState, WorldState
     from cmdragons.navigation import Arrival, make_navigator
     from cmdragons.planning import deadline, field_world
     from cmdragons.safety import make_safety
+    from strategy.plays import Strategy
 
+    motion_commands(np.zeros((1, 6)), np.ones((1, 5)), settings.control)
     radius = settings.field.robot.radius_m
     geometry = settings.field_geometry()
     static = field_world(geometry, defense_areas=False)
@@ -233,6 +240,11 @@ def _warm_motion(settings: Any) -> None:
         vx, vy, omega = nav.command(r, others, deadline(0.5))
         commands.append(RobotCommand("blue", r.id, vx, vy, omega))
     safety.make_safe(commands, world)
+    # strategy's kernels (the shot and pass evaluation) on a few robots round the ball
+    strategy = Strategy("blue", settings.field_geometry(), settings.strategy)
+    robots = tuple(RobotState(t, i, (-1.0 if t == "blue" else 1.0) * (0.5 + i), 0.3 * i, 0.0)
+                   for t in ("blue", "yellow") for i in range(3))  # fmt: skip
+    strategy.decide(WorldState(0.0, BallState(0.2, 0.1, 0.0, 0.0), robots), GameState(0.0))
 
 
 def _warm_planner(settings: Any) -> None:
@@ -240,15 +252,8 @@ def _warm_planner(settings: Any) -> None:
     robots with one gap between start and goal."""
     import numpy as np
 
-    from cmdragons.messages import BallState, GameState, RobotState, WorldState
     from cmdragons.planning import PlanProblem, deadline, field_world, make_planner
-    from strategy.plays import Strategy
 
-    # strategy's kernels (the shot and pass evaluation) on a few robots round the ball
-    strategy = Strategy("blue", settings.field_geometry(), settings.strategy)
-    robots = tuple(RobotState(t, i, (-1.0 if t == "blue" else 1.0) * (0.5 + i), 0.3 * i, 0.0)
-                   for t in ("blue", "yellow") for i in range(3))  # fmt: skip
-    strategy.decide(WorldState(0.0, BallState(0.2, 0.1, 0.0, 0.0), robots), GameState(0.0))
     ys = [y for y in np.arange(-3.0, 3.01, 0.15) if abs(y - 1.5) > 0.3]
     world = field_world(settings.field_geometry(), np.column_stack([np.zeros(len(ys)), ys]))
     radius = settings.field.robot.radius_m

@@ -165,8 +165,9 @@ def warm_up(config: str | None, overrides: Sequence[str], opponent: str, images:
 
 
 def _warm_vision(config: str | None, overrides: Sequence[str]) -> None:
-    """Vision on one throwaway frame of every camera, drawn by the renderer's numpy reference
-    (the compiled renderer is the other child's)."""
+    """Vision on one throwaway frame of the first camera (the ball at the centre spot and robots in
+    view: every kernel of the pipeline runs), drawn by the renderer's numpy reference (the compiled
+    renderer is the other child's)."""
     import numpy as np
 
     from cmdragons.runtime.settings import load_settings
@@ -175,7 +176,7 @@ def _warm_vision(config: str | None, overrides: Sequence[str]) -> None:
     from vision.pipeline import VisionPipeline
 
     settings = load_settings(config, overrides)
-    sim = Simulator(settings.field, settings.camera_models(), settings.sim, seed=0)
+    sim = Simulator(settings.field, settings.camera_models()[:1], settings.sim, seed=0)
     snap = sim.world.snapshot()
     robots = np.ascontiguousarray(snap.robots, dtype=np.float64).reshape(-1, 8)
     ball = np.ascontiguousarray(snap.ball, dtype=np.float64)

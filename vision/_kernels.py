@@ -147,10 +147,11 @@ def _classify_row(lut: np.ndarray, c0: np.ndarray, c1: np.ndarray, c2: np.ndarra
     return n
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def classify(image: np.ndarray, yuv: bool, lut: np.ndarray, screen: np.ndarray, bits: np.ndarray,
-             runs: np.ndarray, counts: np.ndarray) -> None:  # fmt: skip
-    """Classification (thesis A.1.3) and run-length encoding in one pass over the image.
+             runs: np.ndarray, counts: np.ndarray, row0: int, row1: int) -> None:  # fmt: skip
+    """Classification (thesis A.1.3) and run-length encoding in one pass over rows [row0, row1) of
+    the image.
 
     A pixel's bit set is ``lut[0, c0] & lut[1, c1] & lut[2, c2]``: the classes whose threshold box
     holds it, in YUV (``yuv``) or BGR. All three channels are computed for every pixel (vectorised
@@ -166,11 +167,10 @@ def classify(image: np.ndarray, yuv: bool, lut: np.ndarray, screen: np.ndarray, 
     runs: pixels of no class make no runs; a row with more runs than ``runs.shape[1]`` keeps the
     first.
 
-    Serial: with this little work per pixel, a 2-core machine shared with other jobs ran it about as
-    fast on one thread as in parallel over blocks of rows, and the parallel kernel costs seconds
-    more to compile (1920x1200, load average 2 to 3 on 2 cores: 2.2 ms median either way, the
-    parallel one 1.1 ms at best against 1.65; 1024x768: 0.73 ms median either way; measured before
-    the conversion took its coefficients as constants).
+    Serial, without the GIL: the caller may run bands of rows on threads at once (rows are
+    independent; :class:`vision.cmvision.Segmenter` does for large images). numba's own parallel
+    loop costs seconds more to compile and, on a 2-core machine shared with other jobs, ran no
+    faster (1920x1200, load average 2 to 3: 2.2 ms median either way).
     """
     h, w = image.shape[0], image.shape[1]
     flat = image.reshape(h, w * 3)
@@ -183,7 +183,7 @@ def classify(image: np.ndarray, yuv: bool, lut: np.ndarray, screen: np.ndarray, 
         hit[j] = 0
     row = np.empty(w, np.uint32)
     no_runs = np.empty((0, 3), np.int32)
-    for i in range(h):
+    for i in range(row0, row1):
         out = bits[i] if keep_bits else row
         if keep_bits:
             out[:] = 0

@@ -20,6 +20,7 @@ centre of pixel (i, j) is (j + 0.5, i + 0.5), as in :mod:`cmdragons.camera`.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Literal
 
@@ -77,6 +78,10 @@ class RegionParams(Validated):
     merge_gap_px: float = setting(1.0, lo=0.0, hi=50.0)  # bounding boxes at most this far apart may merge
     merge_min_density: float = setting(0.6, lo=0.0, hi=1.0)  # merged area / merged bounding-box area, at least
     max_runs_per_row: int = setting(256, lo=8, hi=8192)  # more runs in a row are dropped (pure noise)
+    # images of at least this many pixels are classified in bands of rows on this many threads at
+    # once (the same runs either way); smaller ones on one
+    threads: int = setting(2, lo=1, hi=64)
+    threads_min_pixels: int = setting(1_500_000, lo=0, hi=10**9)
 
 
 def convert_colour(image: NDArray[np.uint8], space: ColourSpace) -> NDArray[np.int32]:
@@ -181,6 +186,7 @@ class Segmenter:
         self._counts: NDArray[np.int64] = np.zeros(0, dtype=np.int64)
         self._no_runs = np.zeros((0, 1, 3), dtype=np.int32)  # "keep no runs" for the kernel
         self._no_bits = np.zeros((0, 1), dtype=np.uint32)
+        self._pool: ThreadPoolExecutor | None = None  # the bands' threads for large images, made on first use
 
     def index(self, name: str) -> int:
         return self.names.index(name)
@@ -189,7 +195,7 @@ class Segmenter:
         """Per pixel, the bit set of classes (bit k: class k) whose box holds it."""
         out = np.empty(image.shape[:2], dtype=np.uint32)
         kern.classify(np.ascontiguousarray(image), self.space == "yuv", self.lut, self._screen, out, self._no_runs,
-                      self._counts)  # fmt: skip
+                      self._counts, 0, image.shape[0])  # fmt: skip
         return out
 
     def runs(self, image: NDArray[np.uint8]) -> tuple[NDArray[np.int32], NDArray[np.int64]]:
@@ -200,7 +206,19 @@ class Segmenter:
             self._runs = np.zeros((h, self.params.max_runs_per_row, 3), dtype=np.int32)
             self._counts = np.zeros(h, dtype=np.int64)
         image = np.ascontiguousarray(image)
-        kern.classify(image, self.space == "yuv", self.lut, self._screen, self._no_bits, self._runs, self._counts)
+        yuv, threads = self.space == "yuv", self.params.threads
+        if threads > 1 and h * image.shape[1] >= self.params.threads_min_pixels:
+            if self._pool is None:
+                self._pool = ThreadPoolExecutor(threads - 1, thread_name_prefix="cmvision")
+            bands = np.linspace(0, h, threads + 1).astype(int).tolist()
+            args = (image, yuv, self.lut, self._screen, self._no_bits, self._runs, self._counts)
+            done = [self._pool.submit(kern.classify, *args, a, b) for a, b in zip(bands[1:-1], bands[2:], strict=True)]
+            # the first band in this thread
+            kern.classify(*args, 0, bands[1])
+            for job in done:
+                job.result()
+        else:
+            kern.classify(image, yuv, self.lut, self._screen, self._no_bits, self._runs, self._counts, 0, h)
         return self._runs, self._counts
 
     def regions(self, image: NDArray[np.uint8], merge: bool = True) -> Regions:

@@ -126,6 +126,17 @@ def test_fused_runs_equal_reference(seed: int) -> None:
     assert got == ref
 
 
+@pytest.mark.parametrize("threads", [2, 3, 7])
+def test_runs_in_bands_on_threads_equal_reference(threads: int) -> None:
+    # every image counts as large: the rows are split into ``threads`` bands classified at once
+    image = random_image(threads, (61, 90))
+    seg = Segmenter(wide_classes(), "yuv", RegionParams(threads=threads, threads_min_pixels=0))
+    runs, counts = seg.runs(image)
+    ref = runs_reference(classify_reference(image, list(wide_classes().values()), "yuv"))
+    got = [[tuple(int(x) for x in runs[i, k]) for k in range(counts[i])] for i in range(image.shape[0])]
+    assert got == ref
+
+
 def test_runs_beyond_capacity_are_dropped() -> None:
     image = np.zeros((4, 64, 3), np.uint8)
     image[:, ::2] = 255  # 32 one-pixel runs per row

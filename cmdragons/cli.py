@@ -7,7 +7,6 @@ Every command takes ``--config DIR`` (default ``./configs``) and repeatable
 from __future__ import annotations
 
 import argparse
-import importlib
 import json
 import math
 import sys
@@ -293,6 +292,7 @@ def _cmd_play(args: argparse.Namespace, stop: Interrupt) -> int:
     from cmdragons.runtime.settings import load_settings, load_team_settings
     from cmdragons.runtime.stages import LoggerStage, Tap
     from cmdragons.runtime.warmup import CompileWatch
+    from cmdragons.tracking.filters import kalman
 
     overrides = list(args.set) + ([f"field.division={args.division}"] if args.division else [])
     if args.opponent_set and args.opponent != "self":
@@ -325,7 +325,7 @@ def _cmd_play(args: argparse.Namespace, stop: Interrupt) -> int:
             """A first run builds the match while its kernels compile in other processes, and loads
             what the match and its report import later (filterpy brings scipy.stats: a second)."""
             built.append(build())
-            importlib.import_module("filterpy.kalman")
+            kalman()
             pyplot()
 
         compile_s = _compile_kernels(args, overrides, images, prepare)

@@ -8,8 +8,9 @@ the planner's and the collision world's in a child that solves a few throwaway q
 control's, the safety stage's and strategy's in a child that drives a throwaway crowd of robots;
 the renderer's in a child that renders one throwaway frame; and vision's in this process on the
 same frame drawn by the renderer's numpy reference, after which this process builds the match
-(what is left compiles during the match). No kernel compiles twice: the parts that need the
-collision world load it from the cache the planning child writes first. :class:`CompileWatch`
+(what is left compiles during the match). The parts are ordered so that the collision world, which
+all of them need, compiles once: the planning child starts with it, the others reach it seconds
+later and load it from the cache. :class:`CompileWatch`
 counts what compiles in this process (and how long it took), so that real-time factors can leave
 the one-time compile out.
 

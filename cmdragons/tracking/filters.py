@@ -42,7 +42,7 @@ __all__ = [
 Vec = NDArray[np.float64]
 
 
-def _kalman() -> Any:
+def kalman() -> Any:
     """filterpy's Kalman module, imported on first use: importing filterpy brings scipy.stats with it
     (a second or more), which a process that never tracks (the first run's compile children, the
     planning and simulator benches) should not pay."""
@@ -133,7 +133,7 @@ class BallFilter:
 
     def __init__(self, p: BallModelParams, x: float, y: float, t: float) -> None:
         self.p = p
-        kf = _kalman().KalmanFilter(dim_x=4, dim_z=2)
+        kf = kalman().KalmanFilter(dim_x=4, dim_z=2)
         kf.x = np.array([x, y, 0.0, 0.0])
         kf.P = np.diag([p.measurement_sigma_m**2] * 2 + [p.initial_speed_sigma_m_s**2] * 2)
         kf.H = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0]])
@@ -301,7 +301,7 @@ class RobotFilter:
 
     def __init__(self, p: RobotModelParams, x: float, y: float, theta: float, t: float) -> None:
         self.p = p
-        kf = _kalman().KalmanFilter(dim_x=6, dim_z=3)
+        kf = kalman().KalmanFilter(dim_x=6, dim_z=3)
         kf.x = np.array([x, y, theta, 0.0, 0.0, 0.0])
         kf.P = np.diag([p.measurement_sigma_m**2] * 2 + [p.measurement_sigma_rad**2]
                        + [p.initial_speed_sigma_m_s**2] * 2 + [(4 * p.initial_speed_sigma_m_s) ** 2])  # fmt: skip
@@ -463,7 +463,7 @@ def predict_robots(filters: Sequence[RobotFilter], t: float) -> None:
         for i, f in enumerate(group):
             if f.command is not None:  # the accelerations toward our command; none for the opponents
                 u[:, i] = f._accel_tuple(float(x[3, i]), float(x[4, i]), float(x[5, i]), dt, f.command)
-        x = _kalman().predict_steadystate(x, F=fm, u=u, B=bm)
+        x = kalman().predict_steadystate(x, F=fm, u=u, B=bm)
         x[2] = (x[2] + math.pi) % (2.0 * math.pi) - math.pi
         rows = np.ascontiguousarray(x.T)
         for f, row in zip(group, rows, strict=True):
@@ -508,7 +508,7 @@ class SteadyUpdates:
             self._gain = block_diag(*[f.kf.K for f in taken])
             self._h = block_diag(*[f.kf.H for f in taken])
             self._gain_key = key
-        xs = _kalman().update_steadystate(x[ok].ravel(), (x[ok, :3] + y[ok]).ravel(), self._gain, self._h)
+        xs = kalman().update_steadystate(x[ok].ravel(), (x[ok, :3] + y[ok]).ravel(), self._gain, self._h)
         n = x.shape[1]
         xs[2::n] = (xs[2::n] + math.pi) % (2.0 * math.pi) - math.pi
         for i, f in enumerate(taken):

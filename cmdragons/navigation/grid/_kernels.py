@@ -222,6 +222,27 @@ def _upwind(a: float, b: float, c: float) -> float:
 
 
 @njit(cache=True, inline="always")
+def _corners(cost: np.ndarray, w: int, i: int) -> int:
+    """The diagonals cell ``i`` may take as bits (north-east, south-west, north-west, south-east):
+    a corner whose two cells beside it are free."""
+    fn, fs, fw, fe = cost[i - w] < INF, cost[i + w] < INF, cost[i - 1] < INF, cost[i + 1] < INF
+    return int((fn and fe) | ((fs and fw) << 1) | ((fn and fw) << 2) | ((fs and fe) << 3))
+
+
+@njit(cache=True, inline="always")
+def _diagonal(v: np.ndarray, ci: float, w: int, i: int, corners: int) -> float:
+    """The upwind update along the diagonals (spacing sqrt 2) over the open ``corners``
+    (:func:`_corners`)."""
+    a = v[i - w + 1] if corners & 1 else INF
+    if corners & 2 and v[i + w - 1] < a:
+        a = v[i + w - 1]
+    b = v[i - w - 1] if corners & 4 else INF
+    if corners & 8 and v[i + w + 1] < b:
+        b = v[i + w + 1]
+    return _upwind(a, b, SQRT2 * ci)
+
+
+@njit(cache=True, inline="always")
 def estar_kernel(v: np.ndarray, cost: np.ndarray, w: int, i: int, eight: bool) -> float:
     """The value of inner cell ``i`` from its neighbours: the upwind update on the 4-neighbourhood,
     and with ``eight`` the smaller of it and the same update on the diagonal neighbours (spacing
@@ -233,14 +254,7 @@ def estar_kernel(v: np.ndarray, cost: np.ndarray, w: int, i: int, eight: bool) -
     x = _upwind(min(v[i - 1], v[i + 1]), min(v[i - w], v[i + w]), ci)
     if not eight:
         return x
-    fn, fs, fw, fe = cost[i - w] < INF, cost[i + w] < INF, cost[i - 1] < INF, cost[i + 1] < INF
-    a = v[i - w + 1] if fn and fe else INF  # north-east
-    if fs and fw and v[i + w - 1] < a:  # south-west
-        a = v[i + w - 1]
-    b = v[i - w - 1] if fn and fw else INF  # north-west
-    if fs and fe and v[i + w + 1] < b:  # south-east
-        b = v[i + w + 1]
-    return min(x, _upwind(a, b, SQRT2 * ci))
+    return min(x, _diagonal(v, ci, w, i, _corners(cost, w, i)))
 
 
 @njit(cache=True, inline="always")
@@ -339,68 +353,82 @@ def estar_full(v: np.ndarray, rhs: np.ndarray, cost: np.ndarray, w: int, goal: n
     consistent (``rhs == v``), so repairs start from here. Returns the cells finalised."""
     n = len(v)
     offsets = _offsets(w, eight)
-    cap = len(offsets) * n + len(seeds) + 1
-    hk = np.empty(cap, np.float64)
-    hi = np.empty(cap, np.int64)
+    # closed: final, an obstacle or a goal cell (its value is given), never updated again; corners:
+    # the diagonals each free cell may take (the kernel's corner rule, read once per cell here)
+    closed = np.empty(n, np.bool_)
+    corners = np.zeros(n, np.uint8)
+    for i in range(n):
+        closed[i] = cost[i] == INF or goal[i] or v[i] < INF
+    if eight:
+        for i in range(w, n - w):
+            if cost[i] < INF:
+                corners[i] = _corners(cost, w, i)
+    heap = np.empty((len(offsets) * n + len(seeds) + 1, 2), np.float64)
     m = 0
     for s in range(len(seeds)):
         rhs[seeds[s]] = seed_values[s]
-        m = _lazy_push(hk, hi, m, seed_values[s], seeds[s])
+        m = _lazy_push(heap, m, seed_values[s], seeds[s])
     done = 0
     while m > 0:
-        key, i = hk[0], hi[0]
-        m = _lazy_pop(hk, hi, m)
+        key, i = heap[0, 0], int(heap[0, 1])
+        m = _lazy_pop(heap, m)
         if v[i] < INF or key != rhs[i]:
             continue  # final already, or a stale entry
         v[i] = key
+        closed[i] = True
         done += 1
         for o in offsets:
             j = i + o
-            if v[j] < INF or cost[j] == INF or goal[j]:
-                continue  # final, an obstacle, or a goal cell (its value is given)
-            x = estar_kernel(v, cost, w, j, eight)
+            if closed[j]:
+                continue
+            x = _upwind(min(v[j - 1], v[j + 1]), min(v[j - w], v[j + w]), cost[j])
+            if eight:
+                x = min(x, _diagonal(v, cost[j], w, j, corners[j]))
             if x < rhs[j]:
                 rhs[j] = x
-                m = _lazy_push(hk, hi, m, x, j)
+                m = _lazy_push(heap, m, x, j)
     return done
 
 
+# a 4-ary min-heap of (key, item) rows, item stored as a float (exact below 2**53): key and item
+# in one cache line, fewer levels than a binary heap; ties in any order (equal keys are equal values)
+
+
 @njit(cache=True, inline="always")
-def _lazy_push(hk: np.ndarray, hi: np.ndarray, m: int, key: float, item: int) -> int:
-    """Push onto a 4-ary min-heap of (key, item), ties by item (fewer levels than a binary heap)."""
+def _lazy_push(heap: np.ndarray, m: int, key: float, item: int) -> int:
+    """Push onto the heap of size ``m``; returns the new size."""
     k = m
     while k > 0:
         p = (k - 1) >> 2
-        if key < hk[p] or (key == hk[p] and item < hi[p]):
-            hk[k], hi[k] = hk[p], hi[p]
+        if key < heap[p, 0]:
+            heap[k, 0], heap[k, 1] = heap[p, 0], heap[p, 1]
             k = p
         else:
             break
-    hk[k], hi[k] = key, item
+    heap[k, 0], heap[k, 1] = key, item
     return m + 1
 
 
 @njit(cache=True, inline="always")
-def _lazy_pop(hk: np.ndarray, hi: np.ndarray, m: int) -> int:
-    """Drop the top of the 4-ary heap (read it first); returns the new size."""
+def _lazy_pop(heap: np.ndarray, m: int) -> int:
+    """Drop the top of the heap of size ``m`` (read it first); returns the new size."""
     m -= 1
-    key, item = hk[m], hi[m]
+    key, item = heap[m, 0], heap[m, 1]
     k = 0
     while True:
         first = 4 * k + 1
         if first >= m:
             break
-        b = first
-        last = min(first + 4, m)
-        for c in range(first + 1, last):
-            if hk[c] < hk[b] or (hk[c] == hk[b] and hi[c] < hi[b]):
-                b = c
-        if hk[b] < key or (hk[b] == key and hi[b] < item):
-            hk[k], hi[k] = hk[b], hi[b]
+        b, bk = first, heap[first, 0]
+        for c in range(first + 1, min(first + 4, m)):
+            if heap[c, 0] < bk:
+                b, bk = c, heap[c, 0]
+        if bk < key:
+            heap[k, 0], heap[k, 1] = bk, heap[b, 1]
             k = b
         else:
             break
-    hk[k], hi[k] = key, item
+    heap[k, 0], heap[k, 1] = key, item
     return m
 
 

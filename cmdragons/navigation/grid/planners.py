@@ -30,6 +30,8 @@ __all__ = ["EStar", "GridPath", "descend_nf1", "nf1", "octile_path"]
 
 Cell = tuple[int, int]
 FloatArray = NDArray[np.float64]
+# the kernels' indexed heap: keys, items, positions, size
+Heap = tuple[NDArray[np.float64], NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]
 
 
 @dataclass(frozen=True)
@@ -119,23 +121,24 @@ class EStar:
     The repaired field equals a recomputation from scratch cell for cell."""
 
     def __init__(self, cost: FloatArray, goals: Sequence[Cell], neighbours: int = 8,
-                 goal_values: Sequence[float] | None = None) -> None:  # fmt: skip
+                 goal_values: Sequence[float] | None = None, *, padded: FloatArray | None = None) -> None:  # fmt: skip
         """``neighbours``: the interpolation on the 4-neighbourhood (first-order fast marching) or
         on the 8-neighbourhood (also along the diagonals: about 1% of Euclidean distance instead of
         up to 7%); ``goal_values``: each goal cell's own starting value (default 0), e.g. exact
-        distances on a disc around a goal point."""
+        distances on a disc around a goal point; ``padded``: ``cost`` already with its border
+        (:func:`_padded`), taken as the field's own."""
         if neighbours not in (4, 8):
             raise ValueError("neighbours must be 4 or 8")
         self.eight = neighbours == 8
         self.h, self.w = _check(cost)
         # inside, the grid carries a border of obstacle cells: every cell has all its neighbours
         self.W = self.w + 2
-        self.cost = _padded(cost)
+        self.cost = _padded(cost) if padded is None else padded
         n = len(self.cost)
         self.v = np.full(n, np.inf)
-        self.rhs = np.full(n, np.inf)
+        self.rhs = self.v.copy()
         self.goal = np.zeros(n, np.bool_)
-        self.keys, self.items, self.pos, self.size = k.new_heap(n)
+        self._heap: Heap | None = None
         self.pops = 0  # cells processed by the last compute()
         values = [0.0] * len(goals) if goal_values is None else list(goal_values)
         seeds = []
@@ -173,7 +176,7 @@ class EStar:
                 if (d <= exact_radius or (r, c) == (r0, c0)) and k.sight(padded, w + 2, gx + 1, gy + 1, c + 1, r + 1):
                     cells.append((r, c))
                     values.append(d * cost[r, c])
-        e = cls(cost, cells, neighbours, values)
+        e = cls(cost, cells, neighbours, values, padded=padded)
         e.goal_point = (float(gx), float(gy))
         return e
 
@@ -182,13 +185,21 @@ class EStar:
             raise ValueError(f"cell {(r, c)} is outside the {self.h} x {self.w} grid")
         return (r + 1) * self.W + c + 1
 
+    @property
+    def heap(self) -> Heap:
+        """The repair queue (keys, items, positions, size), made when a repair first needs it: a
+        field computed once in one pass never does."""
+        if self._heap is None:
+            self._heap = k.new_heap(len(self.cost))
+        return self._heap
+
     def _queue_seeds(self) -> None:
         """The goal cells onto the repair queue (before the first compute, when the one-pass kernel
         is not used)."""
         if self._fresh:
             self._fresh = False
             for i, value in zip(*self._seeds, strict=True):
-                k.heap_set(self.keys, self.items, self.pos, self.size, int(i), float(value))
+                k.heap_set(*self.heap, int(i), float(value))
 
     @property
     def value(self) -> FloatArray:
@@ -199,7 +210,7 @@ class EStar:
     @property
     def pending(self) -> int:
         """Cells queued for (re)computation."""
-        return int(self.size[0]) + (len(self._seeds[0]) if self._fresh else 0)
+        return (0 if self._heap is None else int(self._heap[3][0])) + (len(self._seeds[0]) if self._fresh else 0)
 
     def compute(self, until: Cell | None = None, max_cells: int = -1) -> bool:
         """Propagate queued changes: everywhere, or (``until``) only until that cell's value is final;
@@ -210,8 +221,8 @@ class EStar:
             return True
         self._queue_seeds()
         stop = -1 if until is None else self._index(*until)
-        self.pops, done = k.estar_propagate(self.v, self.rhs, self.cost, self.W, self.goal, self.keys, self.items,
-                                            self.pos, self.size, stop, max_cells, self.eight)  # fmt: skip
+        self.pops, done = k.estar_propagate(self.v, self.rhs, self.cost, self.W, self.goal, *self.heap, stop,
+                                            max_cells, self.eight)  # fmt: skip
         return bool(done)
 
     def set_costs(self, cells: NDArray[np.int64], costs: FloatArray | float) -> int:
@@ -224,8 +235,8 @@ class EStar:
         values = np.broadcast_to(np.asarray(costs, dtype=np.float64), flat.shape).copy()
         if np.any(self.goal[flat] & ~np.isfinite(values)):
             raise ValueError("a goal cell cannot become an obstacle")
-        return int(k.estar_set_costs(self.v, self.rhs, self.cost, self.W, self.goal, self.keys, self.items,
-                                     self.pos, self.size, flat, values, self.eight))  # fmt: skip
+        return int(k.estar_set_costs(self.v, self.rhs, self.cost, self.W, self.goal, *self.heap, flat, values,
+                                     self.eight))  # fmt: skip
 
     def path(self, start_xy: tuple[float, float], step: float = 0.5, max_steps: int | None = None,
              taut: bool = True) -> GridPath:  # fmt: skip

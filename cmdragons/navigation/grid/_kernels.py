@@ -377,13 +377,16 @@ def estar_full(v: np.ndarray, rhs: np.ndarray, cost: np.ndarray, w: int, goal: n
         v[i] = key
         closed[i] = True
         done += 1
-        for o in offsets:
-            j = i + o
+        # a neighbour's look-ahead is the smaller of its axis and its diagonal update, and only the
+        # one with cell i among its inputs has changed: rhs already holds the other
+        for q in range(len(offsets)):
+            j = i + offsets[q]
             if closed[j]:
                 continue
-            x = _upwind(min(v[j - 1], v[j + 1]), min(v[j - w], v[j + w]), cost[j])
-            if eight:
-                x = min(x, _diagonal(v, cost[j], w, j, corners[j]))
+            if q < 4:
+                x = _upwind(min(v[j - 1], v[j + 1]), min(v[j - w], v[j + w]), cost[j])
+            else:
+                x = _diagonal(v, cost[j], w, j, corners[j])
             if x < rhs[j]:
                 rhs[j] = x
                 m = _lazy_push(heap, m, x, j)

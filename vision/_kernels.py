@@ -555,6 +555,34 @@ def fit_pattern(centre: np.ndarray, w_centre: float, obs: np.ndarray, w_obs: np.
     return theta, px, py, np.sqrt(err / wsum)
 
 
+@numba.njit(cache=True)
+def fit_score(centre: np.ndarray, w_centre: float, obs: np.ndarray, w_obs: np.ndarray, slots: np.ndarray) -> float:
+    """What ranks the assignments of :func:`fit_pattern`, without its trigonometry: the weighted
+    squared residual of the best rotation less the observations' own spread (the same for every
+    assignment of the same dots), ``sum w |t - mt|^2 - 2 |(dot, cross)|`` (2D Procrustes)."""
+    k = obs.shape[0]
+    wsum = w_centre
+    mox, moy = w_centre * centre[0], w_centre * centre[1]
+    mtx, mty = 0.0, 0.0
+    for i in range(k):
+        wsum += w_obs[i]
+        mox += w_obs[i] * obs[i, 0]
+        moy += w_obs[i] * obs[i, 1]
+        mtx += w_obs[i] * slots[i, 0]
+        mty += w_obs[i] * slots[i, 1]
+    mox, moy, mtx, mty = mox / wsum, moy / wsum, mtx / wsum, mty / wsum
+    cross = w_centre * ((-mtx) * (centre[1] - moy) - (-mty) * (centre[0] - mox))
+    dot = w_centre * ((-mtx) * (centre[0] - mox) + (-mty) * (centre[1] - moy))
+    spread = w_centre * (mtx * mtx + mty * mty)
+    for i in range(k):
+        tx, ty = slots[i, 0] - mtx, slots[i, 1] - mty
+        ox, oy = obs[i, 0] - mox, obs[i, 1] - moy
+        cross += w_obs[i] * (tx * oy - ty * ox)
+        dot += w_obs[i] * (tx * ox + ty * oy)
+        spread += w_obs[i] * (tx * tx + ty * ty)
+    return spread - 2.0 * math.sqrt(cross * cross + dot * dot)
+
+
 # pattern match table columns, filled by `match_patterns`
 M_OK, M_X, M_Y, M_THETA, M_RES, M_PINK, M_MISSING, M_DOTS, M_AREA = range(9)
 M_COLS = 9
@@ -604,16 +632,19 @@ def match_patterns(cxy: np.ndarray, cw: np.ndarray, dxy: np.ndarray, dw: np.ndar
             obs[i, 1] = dxy[near[order[i]], 1]
             w_obs[i] = dw[near[order[i]]]
             min_w = min(min_w, w_obs[i])
-        best_res, best = np.inf, -1
-        bt, bx, by = 0.0, 0.0, 0.0
+        best_score, best = np.inf, -1
         for a in range(assign.shape[0]):
             # an assignment of k dots: its first k slots distinct (rows repeat for k < k_max)
             for i in range(k):
                 t[i, 0] = slots[assign[a, i], 0]
                 t[i, 1] = slots[assign[a, i], 1]
-            theta, x, y, res = fit_pattern(cxy[c], cw[c], obs[:k], w_obs[:k], t[:k])
-            if res < best_res:
-                best_res, best, bt, bx, by = res, a, theta, x, y
+            score = fit_score(cxy[c], cw[c], obs[:k], w_obs[:k], t[:k])
+            if score < best_score:
+                best_score, best = score, a
+        for i in range(k):
+            t[i, 0] = slots[assign[best, i], 0]
+            t[i, 1] = slots[assign[best, i], 1]
+        bt, bx, by, best_res = fit_pattern(cxy[c], cw[c], obs[:k], w_obs[:k], t[:k])
         pink = 0
         used = 0
         for i in range(k):
@@ -628,3 +659,99 @@ def match_patterns(cxy: np.ndarray, cw: np.ndarray, dxy: np.ndarray, dw: np.ndar
         out[c, M_X], out[c, M_Y], out[c, M_THETA], out[c, M_RES] = bx, by, bt, best_res
         out[c, M_PINK], out[c, M_MISSING], out[c, M_DOTS], out[c, M_AREA] = pink, missing, k, min_w
     return out
+
+
+# robot verdicts, filled by `robot_verdicts`: rejected, a robot, a robot if the missing dot's colour
+# (read from the image by the caller) completes a known id
+V_REJECT, V_ROBOT, V_READ_MISSING = 0, 1, 2
+
+
+@numba.njit(cache=True)
+def robot_verdicts(table: np.ndarray, id_of_code: np.ndarray, max_res: float, res_scale: float,
+                   min_conf: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    """Per row of a :func:`match_patterns` table: the verdict (``V_*``), the robot id (``id_of_code``
+    at the pink bits; -1 unknown) and the confidence: the fit residual against the pattern noise
+    (``exp(-(res / res_scale)^2 / 2)``) times how far the smallest dot falls short of its expected
+    area (half the area or less: no trust), halved where a dot is missing. A fit above
+    ``max_res``, an unknown code or a confidence below ``min_conf`` is rejected."""
+    n = table.shape[0]
+    verdict = np.empty(n, np.int64)
+    rid = np.empty(n, np.int64)
+    conf = np.empty(n)
+    for r in range(n):
+        verdict[r], rid[r], conf[r] = V_REJECT, -1, 0.0
+        if table[r, M_OK] == 0.0 or table[r, M_RES] > max_res:
+            continue
+        area_conf = min(1.0, max(0.0, (table[r, M_AREA] - 0.5) / 0.4))
+        q = table[r, M_RES] / res_scale
+        c = math.exp(-0.5 * (q * q)) * area_conf
+        if table[r, M_MISSING] >= 0:
+            c *= 0.5
+        if c < min_conf:
+            continue
+        conf[r] = c
+        if table[r, M_MISSING] >= 0:
+            verdict[r] = V_READ_MISSING
+            continue
+        rid[r] = id_of_code[int(table[r, M_PINK])]
+        if rid[r] >= 0:
+            verdict[r] = V_ROBOT
+    return verdict, rid, conf
+
+
+@numba.njit(cache=True)
+def distinct_robots(xy: np.ndarray, conf: np.ndarray, key: np.ndarray, distance: float) -> np.ndarray:
+    """Indices of the detections kept, most confident first (ties in index order): one of a key
+    (team and id) already kept, or closer than ``distance`` to a kept one, is the same robot seen
+    twice and is dropped."""
+    n = conf.shape[0]
+    neg = np.empty(n)
+    for k in range(n):
+        neg[k] = -conf[k]
+    order = argsort_stable(neg)
+    kept = np.empty(n, np.int64)
+    m = 0
+    for a in range(n):
+        k = order[a]
+        same = False
+        for b in range(m):
+            j = kept[b]
+            if key[j] == key[k] or np.hypot(xy[j, 0] - xy[k, 0], xy[j, 1] - xy[k, 1]) < distance:
+                same = True
+                break
+        if not same:
+            kept[m] = k
+            m += 1
+    return kept[:m]
+
+
+@numba.njit(cache=True)
+def ball_candidates(area: np.ndarray, moments: np.ndarray, bbox: np.ndarray, rays: np.ndarray,
+                    pixel_area: np.ndarray, cam: np.ndarray, ball_radius: float, robot_xy: np.ndarray,
+                    robot_z: np.ndarray, pattern_radius: float, min_area: float, max_area: float,
+                    max_elongation: float, min_fill: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    """Which orange regions (their areas, central moments, boxes, rays and pixel areas) are ball
+    candidates: an area on the ball's plane within ``min_area``..``max_area`` of the ball's, the
+    moments' axes no longer than ``max_elongation`` to one, at least ``min_fill`` of the box, and
+    none inside a robot's pattern (seen on the plane of that robot's top, ``robot_xy``/``robot_z``,
+    within ``pattern_radius``). Returns keep, the area ratio and the elongation."""
+    n = area.shape[0]
+    keep = np.empty(n, np.bool_)
+    ratio = np.empty(n)
+    elong = np.empty(n)
+    depth = cam[2] - ball_radius
+    ball_area = math.pi * ball_radius**2
+    for k in range(n):
+        ratio[k] = area[k] * pixel_area[k] * (depth * depth) / ball_area
+        tr, det = moments[k, 0] + moments[k, 1], moments[k, 0] * moments[k, 1] - moments[k, 2] ** 2
+        disc = math.sqrt(max(tr * tr / 4.0 - det, 0.0))
+        elong[k] = math.sqrt((tr / 2.0 + disc) / max(tr / 2.0 - disc, 1e-6))
+        fill = area[k] / ((bbox[k, 2] - bbox[k, 0] + 1.0) * (bbox[k, 3] - bbox[k, 1] + 1.0))
+        keep[k] = min_area <= ratio[k] <= max_area and elong[k] <= max_elongation and fill >= min_fill
+        for r in range(robot_xy.shape[0]):
+            if not keep[k]:
+                break
+            down = cam[2] - robot_z[r]
+            x, y = cam[0] + down * rays[k, 0], cam[1] + down * rays[k, 1]
+            keep[k] = np.hypot(x - robot_xy[r, 0], y - robot_xy[r, 1]) >= pattern_radius
+    return keep, ratio, elong

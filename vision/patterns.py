@@ -147,9 +147,10 @@ class PatternMatcher:
         self.pattern, self.params = pattern, params
         self.slots = np.array(pattern.dot_positions_m, dtype=np.float64)
         self.assign = np.array(list(itertools.permutations(range(len(self.slots)))), dtype=np.int64)
-        self.code_to_id = {
-            sum(1 << s for s, ch in enumerate(code) if ch == "P"): i for i, code in enumerate(pattern.ids)
-        }
+        # the id of each code (pink slots as bits), -1 for a code no robot has
+        self.id_of_code = np.full(1 << len(self.slots), -1, dtype=np.int64)
+        for i, code in enumerate(pattern.ids):
+            self.id_of_code[sum(1 << s for s, ch in enumerate(code) if ch == "P")] = i
         self.centre_area = math.pi * (pattern.center_dot_diameter_m / 2.0) ** 2
         self.dot_area = math.pi * (pattern.id_dot_diameter_m / 2.0) ** 2
 
@@ -175,58 +176,43 @@ class PatternMatcher:
             dw = geo.area_m2(dot_idx, z) / self.dot_area
             table = kern.match_patterns(geo.xy(c_idx, z), cw, geo.xy(dot_idx, z), dw, dpink, (dw >= lo) & (dw <= hi),
                                         self.slots, self.assign, params.search_radius_m, params.min_dots)  # fmt: skip
-            for row, k in zip(table, c_idx, strict=True):
-                det = self._robot(team, row, regions.centroid[k], z, geo.camera, is_pink)
-                if det is not None:
-                    found.append(det)
+            verdict, rid, conf = kern.robot_verdicts(table, self.id_of_code, params.max_residual_m,
+                                                     params.residual_scale_m, params.min_confidence)  # fmt: skip
+            for r in np.flatnonzero(verdict != kern.V_REJECT):
+                row, robot_id = table[r], int(rid[r])
+                if verdict[r] == kern.V_READ_MISSING:
+                    robot_id = self._complete(row, z, geo.camera, is_pink)
+                    if robot_id < 0:
+                        continue
+                pixel = regions.centroid[c_idx[r]]
+                found.append(RobotDetection(team, robot_id, float(row[kern.M_X]), float(row[kern.M_Y]),
+                                            math.remainder(float(row[kern.M_THETA]), 2.0 * math.pi), float(conf[r]),
+                                            (float(pixel[0]), float(pixel[1]))))  # fmt: skip
         return merge_duplicates(found, params.duplicate_distance_m)
 
-    def _robot(self, team: Team, row: NDArray[np.float64], pixel: NDArray[np.float64], z: float, camera: CameraModel,
-               is_pink: Callable[[NDArray[np.float64]], bool | None]) -> RobotDetection | None:  # fmt: skip
-        if row[kern.M_OK] == 0.0 or row[kern.M_RES] > self.params.max_residual_m:
-            return None
-        pink = int(row[kern.M_PINK])
+    def _complete(self, row: NDArray[np.float64], z: float, camera: CameraModel,
+                  is_pink: Callable[[NDArray[np.float64]], bool | None]) -> int:  # fmt: skip
+        """The id of a fit with a dot the regions missed (glare, a dark corner), its colour read
+        where the fit puts it; -1 where neither colour is there or the code is no robot's."""
         missing = int(row[kern.M_MISSING])
-        if missing >= 0:
-            # a dot the regions missed (glare, a dark corner): read its colour where the fit puts it
-            c, s = math.cos(row[kern.M_THETA]), math.sin(row[kern.M_THETA])
-            sx, sy = self.slots[missing]
-            at = camera.project_xy(np.array([row[kern.M_X] + c * sx - s * sy, row[kern.M_Y] + s * sx + c * sy]), z)
-            colour = is_pink(at)
-            if colour is None:
-                return None
-            pink |= int(colour) << missing
-        rid = self.code_to_id.get(pink)
-        if rid is None:
-            return None
-        # confidence: the fit residual against the pattern noise, and how far the smallest dot
-        # falls short of its expected area (half the area or less: no trust)
-        area_conf = min(1.0, max(0.0, (row[kern.M_AREA] - 0.5) / 0.4))
-        conf = math.exp(-0.5 * (row[kern.M_RES] / self.params.residual_scale_m) ** 2) * area_conf
-        if missing >= 0:
-            conf *= 0.5
-        if conf < self.params.min_confidence:
-            return None
-        return RobotDetection(team, rid, float(row[kern.M_X]), float(row[kern.M_Y]),
-                              math.remainder(float(row[kern.M_THETA]), 2.0 * math.pi), conf,
-                              (float(pixel[0]), float(pixel[1])))  # fmt: skip
+        c, s = math.cos(row[kern.M_THETA]), math.sin(row[kern.M_THETA])
+        sx, sy = self.slots[missing]
+        at = camera.project_xy(np.array([row[kern.M_X] + c * sx - s * sy, row[kern.M_Y] + s * sx + c * sy]), z)
+        colour = is_pink(at)
+        if colour is None:
+            return -1
+        return int(self.id_of_code[int(row[kern.M_PINK]) | int(colour) << missing])
 
 
 def merge_duplicates(robots: list[RobotDetection], distance_m: float) -> list[RobotDetection]:
     """Most confident first; a detection of a (team, id) already reported, or closer than
     ``distance_m`` to a reported robot, is the same robot seen twice and is dropped."""
-    ranked = sorted(robots, key=lambda r: -r.confidence)
-    xy = np.array([[r.x, r.y] for r in ranked]).reshape(-1, 2)
-    # all pairwise distances at once, then plain Python: a dozen robots make numpy calls per robot cost more
-    apart = (np.hypot(xy[:, None, 0] - xy[None, :, 0], xy[:, None, 1] - xy[None, :, 1]) >= distance_m).tolist()
-    kept: list[int] = []
-    seen: set[tuple[str, int]] = set()
-    for k, r in enumerate(ranked):
-        if (r.team, r.id) in seen or not all(apart[j][k] for j in kept):
-            continue
-        kept.append(k)
-        seen.add((r.team, r.id))
-    return [ranked[k] for k in kept]
+    if not robots:
+        return []
+    xy = np.array([(r.x, r.y) for r in robots])
+    conf = np.array([r.confidence for r in robots])
+    key = np.array([r.id * len(TEAMS) + TEAMS.index(r.team) for r in robots], dtype=np.int64)
+    return [robots[k] for k in kern.distinct_robots(xy, conf, key, distance_m)]
 
 
 def ball_centre_reference(image: NDArray[np.uint8], box: NDArray[np.float64],
@@ -284,25 +270,12 @@ def detect_ball(
     idx = regions.of_class(orange)
     if idx.size == 0 or params.max_balls == 0:
         return []
-    ratio = geo.area_m2(idx, ball_radius_m) / (math.pi * ball_radius_m**2)
-    mom = regions.moments[idx]
-    tr, det = mom[:, 0] + mom[:, 1], mom[:, 0] * mom[:, 1] - mom[:, 2] ** 2
-    disc = np.sqrt(np.maximum(tr * tr / 4.0 - det, 0.0))
-    elong = np.sqrt((tr / 2.0 + disc) / np.maximum(tr / 2.0 - disc, 1e-6))
-    box = regions.bbox[idx]
-    fill = regions.area[idx] / ((box[:, 2] - box[:, 0] + 1.0) * (box[:, 3] - box[:, 1] + 1.0))
-    keep = (
-        (ratio >= params.min_area_fraction)
-        & (ratio <= params.max_area_fraction)
-        & (elong <= params.max_elongation)
-        & (fill >= params.min_fill)
-    )
-    # a pattern holds no orange: an orange spot inside one is a misread marker
-    for team in {r.team for r in robots}:
-        at_top = geo.xy(idx, robot_height_m[team])
-        rxy = np.array([(r.x, r.y) for r in robots if r.team == team])
-        off = np.hypot(at_top[:, None, 0] - rxy[None, :, 0], at_top[:, None, 1] - rxy[None, :, 1])
-        keep &= np.all(off >= pattern_radius_m, axis=1)
+    heights = [robot_height_m[r.team] for r in robots]
+    keep, ratio, elong = kern.ball_candidates(
+        regions.area[idx], regions.moments[idx], regions.bbox[idx], geo.rays[idx], geo.pixel_area[idx],
+        geo.camera.center, ball_radius_m, np.array([(r.x, r.y) for r in robots]).reshape(-1, 2),
+        np.array(heights, dtype=np.float64), pattern_radius_m, params.min_area_fraction, params.max_area_fraction,
+        params.max_elongation, params.min_fill)  # fmt: skip
     px = regions.centroid[idx]
     z = ball_radius_m + params.blob_height_above_centre_m
     sigma = np.full(idx.size, math.nan)

@@ -48,6 +48,12 @@ def test_fit_kernel_equals_numpy_reference(seed: int) -> None:
     for a in range(len(perms)):
         got = kern.fit_pattern(centre, 1.2, obs, w, slots[perms[a]])
         np.testing.assert_allclose(got, (t_ref[a], p_ref[a, 0], p_ref[a, 1], r_ref[a]), atol=1e-12)
+        # the trigonometry-free score that ranks assignments: the squared residual sum less the
+        # observations' spread about their weighted mean (the same for every assignment)
+        w_all, o = np.concatenate([[1.2], w]), np.vstack([centre, obs])
+        spread = float(w_all @ ((o - w_all @ o / w_all.sum()) ** 2).sum(axis=1))
+        score = kern.fit_score(centre, 1.2, obs, w, slots[perms[a]])
+        assert score + spread == pytest.approx(r_ref[a] ** 2 * w_all.sum(), abs=1e-12)
     best = int(np.argmin(r_ref))
     assert best == 0  # the identity assignment fits
     assert abs(math.remainder(t_ref[best] - theta, 2 * math.pi)) < 0.1

@@ -519,12 +519,14 @@ def ball_centre(image: np.ndarray, box: np.ndarray, margin: int) -> tuple[float,
     return cu + 0.5, cv + 0.5, sw, math.sqrt(false2 / n * max(lever2, 0.0)) / sw
 
 
-@numba.njit(cache=True)
-def fit_pattern(centre: np.ndarray, w_centre: float, obs: np.ndarray, w_obs: np.ndarray,
-                slots: np.ndarray) -> tuple[float, float, float, float]:  # fmt: skip
-    """Weighted least-squares rigid fit (2D Procrustes) of a pattern whose centre dot sits at the
-    template origin and whose k id dots sit at ``slots`` (k, 2), to the observed centre and dots
-    ``obs`` (k, 2). Returns heading, x, y and the weighted RMS residual (m)."""
+@numba.njit(cache=True, inline="always")
+def _procrustes_sums(centre: np.ndarray, w_centre: float, obs: np.ndarray, w_obs: np.ndarray,
+                     slots: np.ndarray) -> tuple[float, float, float, float, float, float, float, float]:  # fmt: skip
+    """The weighted 2D Procrustes sums of a pattern whose centre dot sits at the template origin
+    and whose k id dots sit at ``slots`` (k, 2), against the observed centre and dots ``obs``
+    (k, 2): total weight, the observations' and the template's weighted means, the cross and dot
+    sums of the centred pairs (the best rotation is their angle) and the template's weighted
+    spread about its mean."""
     k = obs.shape[0]
     wsum = w_centre
     mox, moy = w_centre * centre[0], w_centre * centre[1]
@@ -539,16 +541,28 @@ def fit_pattern(centre: np.ndarray, w_centre: float, obs: np.ndarray, w_obs: np.
     # the centre dot: template (0, 0) against the observed centre
     cross = w_centre * ((-mtx) * (centre[1] - moy) - (-mty) * (centre[0] - mox))
     dot = w_centre * ((-mtx) * (centre[0] - mox) + (-mty) * (centre[1] - moy))
+    spread = w_centre * (mtx * mtx + mty * mty)
     for i in range(k):
         tx, ty = slots[i, 0] - mtx, slots[i, 1] - mty
         ox, oy = obs[i, 0] - mox, obs[i, 1] - moy
         cross += w_obs[i] * (tx * oy - ty * ox)
         dot += w_obs[i] * (tx * ox + ty * oy)
+        spread += w_obs[i] * (tx * tx + ty * ty)
+    return wsum, mox, moy, mtx, mty, cross, dot, spread
+
+
+@numba.njit(cache=True)
+def fit_pattern(centre: np.ndarray, w_centre: float, obs: np.ndarray, w_obs: np.ndarray,
+                slots: np.ndarray) -> tuple[float, float, float, float]:  # fmt: skip
+    """Weighted least-squares rigid fit (2D Procrustes) of a pattern whose centre dot sits at the
+    template origin and whose k id dots sit at ``slots`` (k, 2), to the observed centre and dots
+    ``obs`` (k, 2). Returns heading, x, y and the weighted RMS residual (m)."""
+    wsum, mox, moy, mtx, mty, cross, dot, _ = _procrustes_sums(centre, w_centre, obs, w_obs, slots)
     theta = np.arctan2(cross, dot)
     c, s = np.cos(theta), np.sin(theta)
     px, py = mox - (c * mtx - s * mty), moy - (s * mtx + c * mty)
     err = w_centre * ((px - centre[0]) ** 2 + (py - centre[1]) ** 2)
-    for i in range(k):
+    for i in range(obs.shape[0]):
         ex = c * slots[i, 0] - s * slots[i, 1] + px - obs[i, 0]
         ey = s * slots[i, 0] + c * slots[i, 1] + py - obs[i, 1]
         err += w_obs[i] * (ex * ex + ey * ey)
@@ -559,27 +573,8 @@ def fit_pattern(centre: np.ndarray, w_centre: float, obs: np.ndarray, w_obs: np.
 def fit_score(centre: np.ndarray, w_centre: float, obs: np.ndarray, w_obs: np.ndarray, slots: np.ndarray) -> float:
     """What ranks the assignments of :func:`fit_pattern`, without its trigonometry: the weighted
     squared residual of the best rotation less the observations' own spread (the same for every
-    assignment of the same dots), ``sum w |t - mt|^2 - 2 |(dot, cross)|`` (2D Procrustes)."""
-    k = obs.shape[0]
-    wsum = w_centre
-    mox, moy = w_centre * centre[0], w_centre * centre[1]
-    mtx, mty = 0.0, 0.0
-    for i in range(k):
-        wsum += w_obs[i]
-        mox += w_obs[i] * obs[i, 0]
-        moy += w_obs[i] * obs[i, 1]
-        mtx += w_obs[i] * slots[i, 0]
-        mty += w_obs[i] * slots[i, 1]
-    mox, moy, mtx, mty = mox / wsum, moy / wsum, mtx / wsum, mty / wsum
-    cross = w_centre * ((-mtx) * (centre[1] - moy) - (-mty) * (centre[0] - mox))
-    dot = w_centre * ((-mtx) * (centre[0] - mox) + (-mty) * (centre[1] - moy))
-    spread = w_centre * (mtx * mtx + mty * mty)
-    for i in range(k):
-        tx, ty = slots[i, 0] - mtx, slots[i, 1] - mty
-        ox, oy = obs[i, 0] - mox, obs[i, 1] - moy
-        cross += w_obs[i] * (tx * oy - ty * ox)
-        dot += w_obs[i] * (tx * ox + ty * oy)
-        spread += w_obs[i] * (tx * tx + ty * ty)
+    assignment of the same dots), ``sum w |t - mt|^2 - 2 |(dot, cross)|``."""
+    _, _, _, _, _, cross, dot, spread = _procrustes_sums(centre, w_centre, obs, w_obs, slots)
     return spread - 2.0 * math.sqrt(cross * cross + dot * dot)
 
 

@@ -579,21 +579,52 @@ def fit_score(centre: np.ndarray, w_centre: float, obs: np.ndarray, w_obs: np.nd
 
 
 # pattern match table columns, filled by `match_patterns`
-M_OK, M_X, M_Y, M_THETA, M_RES, M_PINK, M_MISSING, M_DOTS, M_AREA = range(9)
-M_COLS = 9
+M_OK, M_X, M_Y, M_THETA, M_RES, M_PINK, M_MISSING, M_DOTS, M_AREA, M_VERDICT, M_ID, M_CONF = range(12)
+M_COLS = 12
+# verdicts: rejected, a robot, a robot if the missing dot's colour (read from the image by the
+# caller) completes a known id
+V_REJECT, V_ROBOT, V_READ_MISSING = 0, 1, 2
+
+
+@numba.njit(cache=True, inline="always")
+def _verdict(row: np.ndarray, id_of_code: np.ndarray, max_res: float, res_scale: float, min_conf: float) -> None:
+    """A fitted row's verdict, robot id (``id_of_code`` at the pink bits; -1 unknown) and
+    confidence: the fit residual against the pattern noise (``exp(-(res / res_scale)^2 / 2)``)
+    times how far the smallest dot falls short of its expected area (half the area or less: no
+    trust), halved where a dot is missing. A fit above ``max_res``, an unknown code or a
+    confidence below ``min_conf`` is rejected."""
+    row[M_VERDICT], row[M_ID], row[M_CONF] = V_REJECT, -1.0, 0.0
+    if row[M_RES] > max_res:
+        return
+    area_conf = min(1.0, max(0.0, (row[M_AREA] - 0.5) / 0.4))
+    q = row[M_RES] / res_scale
+    c = math.exp(-0.5 * (q * q)) * area_conf
+    if row[M_MISSING] >= 0:
+        c *= 0.5
+    if c < min_conf:
+        return
+    row[M_CONF] = c
+    if row[M_MISSING] >= 0:
+        row[M_VERDICT] = V_READ_MISSING
+        return
+    row[M_ID] = id_of_code[int(row[M_PINK])]
+    if row[M_ID] >= 0:
+        row[M_VERDICT] = V_ROBOT
 
 
 @numba.njit(cache=True)
 def match_patterns(cxy: np.ndarray, cw: np.ndarray, dxy: np.ndarray, dw: np.ndarray, dpink: np.ndarray,
-                   dgood: np.ndarray, slots: np.ndarray, assign: np.ndarray, search_r: float,
-                   min_dots: int) -> np.ndarray:  # fmt: skip
+                   dgood: np.ndarray, slots: np.ndarray, assign: np.ndarray, search_r: float, min_dots: int,
+                   id_of_code: np.ndarray, max_res: float, res_scale: float,
+                   min_conf: float) -> np.ndarray:  # fmt: skip
     """For each centre dot (field xy (n, 2), area weight (n,)), the id dots within ``search_r``
     (at most as many as the pattern has slots, those nearest the pattern's ring), fitted to the
     template under every assignment of dots to slots (``assign`` (m, k_max): slot per observed
     dot; rows for fewer dots use the leading columns). Thesis A.2.2-A.2.3.
 
     Row per centre: ok, x, y, theta, residual, pink slots as bits, the slot left empty (or -1),
-    dots used, the smallest area weight among the dots (1 = as expected).
+    dots used, the smallest area weight among the dots (1 = as expected), and the verdict, id and
+    confidence of :func:`_verdict` (a centre without its dots: rejected).
     """
     n_c, k_max = cxy.shape[0], slots.shape[0]
     out = np.empty((n_c, M_COLS))
@@ -653,65 +684,31 @@ def match_patterns(cxy: np.ndarray, cw: np.ndarray, dxy: np.ndarray, dw: np.ndar
         out[c, M_OK] = 1.0
         out[c, M_X], out[c, M_Y], out[c, M_THETA], out[c, M_RES] = bx, by, bt, best_res
         out[c, M_PINK], out[c, M_MISSING], out[c, M_DOTS], out[c, M_AREA] = pink, missing, k, min_w
+        _verdict(out[c], id_of_code, max_res, res_scale, min_conf)
     return out
-
-
-# robot verdicts, filled by `robot_verdicts`: rejected, a robot, a robot if the missing dot's colour
-# (read from the image by the caller) completes a known id
-V_REJECT, V_ROBOT, V_READ_MISSING = 0, 1, 2
-
-
-@numba.njit(cache=True)
-def robot_verdicts(table: np.ndarray, id_of_code: np.ndarray, max_res: float, res_scale: float,
-                   min_conf: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
-    """Per row of a :func:`match_patterns` table: the verdict (``V_*``), the robot id (``id_of_code``
-    at the pink bits; -1 unknown) and the confidence: the fit residual against the pattern noise
-    (``exp(-(res / res_scale)^2 / 2)``) times how far the smallest dot falls short of its expected
-    area (half the area or less: no trust), halved where a dot is missing. A fit above
-    ``max_res``, an unknown code or a confidence below ``min_conf`` is rejected."""
-    n = table.shape[0]
-    verdict = np.empty(n, np.int64)
-    rid = np.empty(n, np.int64)
-    conf = np.empty(n)
-    for r in range(n):
-        verdict[r], rid[r], conf[r] = V_REJECT, -1, 0.0
-        if table[r, M_OK] == 0.0 or table[r, M_RES] > max_res:
-            continue
-        area_conf = min(1.0, max(0.0, (table[r, M_AREA] - 0.5) / 0.4))
-        q = table[r, M_RES] / res_scale
-        c = math.exp(-0.5 * (q * q)) * area_conf
-        if table[r, M_MISSING] >= 0:
-            c *= 0.5
-        if c < min_conf:
-            continue
-        conf[r] = c
-        if table[r, M_MISSING] >= 0:
-            verdict[r] = V_READ_MISSING
-            continue
-        rid[r] = id_of_code[int(table[r, M_PINK])]
-        if rid[r] >= 0:
-            verdict[r] = V_ROBOT
-    return verdict, rid, conf
 
 
 @numba.njit(cache=True)
 def distinct_robots(xy: np.ndarray, conf: np.ndarray, key: np.ndarray, distance: float) -> np.ndarray:
     """Indices of the detections kept, most confident first (ties in index order): one of a key
     (team and id) already kept, or closer than ``distance`` to a kept one, is the same robot seen
-    twice and is dropped."""
+    twice and is dropped. (A dozen detections: picked by selection, most confident left first.)"""
     n = conf.shape[0]
-    neg = np.empty(n)
+    taken = np.empty(n, np.bool_)
     for k in range(n):
-        neg[k] = -conf[k]
-    order = argsort_stable(neg)
+        taken[k] = False
     kept = np.empty(n, np.int64)
     m = 0
-    for a in range(n):
-        k = order[a]
+    for _ in range(n):
+        k = -1
+        for j in range(n):
+            if not taken[j] and (k < 0 or conf[j] > conf[k]):
+                k = j
+        taken[k] = True
         same = False
         for b in range(m):
             j = kept[b]
-            if key[j] == key[k] or np.hypot(xy[j, 0] - xy[k, 0], xy[j, 1] - xy[k, 1]) < distance:
+            if key[j] == key[k] or math.hypot(xy[j, 0] - xy[k, 0], xy[j, 1] - xy[k, 1]) < distance:
                 same = True
                 break
         if not same:
@@ -748,5 +745,5 @@ def ball_candidates(area: np.ndarray, moments: np.ndarray, bbox: np.ndarray, ray
                 break
             down = cam[2] - robot_z[r]
             x, y = cam[0] + down * rays[k, 0], cam[1] + down * rays[k, 1]
-            keep[k] = np.hypot(x - robot_xy[r, 0], y - robot_xy[r, 1]) >= pattern_radius
+            keep[k] = math.hypot(x - robot_xy[r, 0], y - robot_xy[r, 1]) >= pattern_radius
     return keep, ratio, elong

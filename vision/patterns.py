@@ -175,19 +175,19 @@ class PatternMatcher:
             c_idx, cw = c_idx[ok], cw[ok]
             dw = geo.area_m2(dot_idx, z) / self.dot_area
             table = kern.match_patterns(geo.xy(c_idx, z), cw, geo.xy(dot_idx, z), dw, dpink, (dw >= lo) & (dw <= hi),
-                                        self.slots, self.assign, params.search_radius_m, params.min_dots)  # fmt: skip
-            verdict, rid, conf = kern.robot_verdicts(table, self.id_of_code, params.max_residual_m,
-                                                     params.residual_scale_m, params.min_confidence)  # fmt: skip
-            for r in np.flatnonzero(verdict != kern.V_REJECT):
-                row, robot_id = table[r], int(rid[r])
-                if verdict[r] == kern.V_READ_MISSING:
+                                        self.slots, self.assign, params.search_radius_m, params.min_dots,
+                                        self.id_of_code, params.max_residual_m, params.residual_scale_m,
+                                        params.min_confidence)  # fmt: skip
+            for r in np.flatnonzero(table[:, kern.M_VERDICT] != kern.V_REJECT):
+                row, robot_id = table[r], int(table[r, kern.M_ID])
+                if row[kern.M_VERDICT] == kern.V_READ_MISSING:
                     robot_id = self._complete(row, z, geo.camera, is_pink)
                     if robot_id < 0:
                         continue
                 pixel = regions.centroid[c_idx[r]]
-                found.append(RobotDetection(team, robot_id, float(row[kern.M_X]), float(row[kern.M_Y]),
-                                            math.remainder(float(row[kern.M_THETA]), 2.0 * math.pi), float(conf[r]),
-                                            (float(pixel[0]), float(pixel[1]))))  # fmt: skip
+                heading = math.remainder(float(row[kern.M_THETA]), 2.0 * math.pi)
+                found.append(RobotDetection(team, robot_id, float(row[kern.M_X]), float(row[kern.M_Y]), heading,
+                                            float(row[kern.M_CONF]), (float(pixel[0]), float(pixel[1]))))  # fmt: skip
         return merge_duplicates(found, params.duplicate_distance_m)
 
     def _complete(self, row: NDArray[np.float64], z: float, camera: CameraModel,

@@ -668,7 +668,8 @@ class GameState:
                  for k, i in enumerate(infos)]  # fmt: skip
         return cls(t, _COMMANDS[cmd], None if team < 0 else TEAMS[team & 1], sb, sy, bool(blue_neg), placement,
                    bool(ready), _STAGES[stage], stage_left, counter, command_t, action_left,
-                   None if nxt < 0 else _COMMANDS[nxt], None if nxt_team < 0 else TEAMS[nxt_team & 1], *teams)  # fmt: skip
+                   None if nxt < 0 else _COMMANDS[nxt], None if nxt_team < 0 else TEAMS[nxt_team & 1],
+                   *teams)  # fmt: skip
 
 
 _GAME_CODEC = _Codec(f"{_GAME.size}s", _TEAM_INFO, _CARD_TIME)

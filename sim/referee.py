@@ -156,6 +156,34 @@ class Referee:
             self.command_t = self.t
         self.command, self.for_team, self.ready = command, for_team, ready
 
+    def give(self, command: str, for_team: Team | None = None, ready: bool = True) -> None:
+        """A command by hand (what a human referee or a scripted scene gives); restarts that need a
+        ball in place are :meth:`free_kick`, :meth:`start_placement` and :meth:`start_penalty`."""
+        self._restart = None
+        self._clear_special()
+        self._set(command, for_team, ready)
+
+    def free_kick(self, team: Team, spot: tuple[float, float]) -> Teleport:
+        """A free kick for ``team`` with the ball put at ``spot`` (the teleport to carry out)."""
+        self.give("stop")
+        self._start_restart("free_kick_by_referee", team, spot, spot)
+        teleport = self._take_teleports()
+        assert teleport is not None
+        return teleport
+
+    def start_placement(self, team: Team, target: tuple[float, float]) -> None:
+        """Ball placement by ``team`` to ``target`` now, a free kick for it to follow."""
+        self.give("stop")
+        self._start_restart("free_kick", team, target, target)
+
+    def start_penalty(self, team: Team) -> Teleport:
+        """A penalty kick for ``team``: the ball on the mark (the teleport to carry out), prepared."""
+        self.give("stop")
+        self._start_restart("penalty", team, self._spot("penalty", team, (0.0, 0.0)), (0.0, 0.0))
+        teleport = self._take_teleports()
+        assert teleport is not None
+        return teleport
+
     def _in_play(self) -> bool:
         return self.command in ("normal", "force_start") or (self.command == "penalty" and self.ready)
 
@@ -219,6 +247,7 @@ class Referee:
                 self.contacts.append(e)
             elif isinstance(e, Kick):
                 self.kicks += 1
+                self.watch.kicked((e.team, e.id))
             elif isinstance(e, Goal) and self._restart is None and self._live():
                 scorer = self._scorer(e.x)
                 self.score[scorer] += 1
@@ -408,22 +437,22 @@ class Referee:
         return (own * 2.0 * r, y)
 
     def _count_robots(self, truth: GroundTruth) -> None:
-        """Too many robots: a team with more on the field than it may have; the extra go off."""
+        """Too many robots: a team with more on the field than it may have; the extra go off (a
+        robot sent off that came back first)."""
+        leaving = {(t, rid) for p in self._teleports for t, rid, *_ in p.robots}  # sent off this frame
         for team in TEAMS:
-            on = [r for r in truth.robots if r.team == team and (team, r.id) not in self.off
+            on = [r for r in truth.robots if r.team == team and (team, r.id) not in leaving
                   and self.field.in_field(r.x, r.y, -self.field.dims.boundary_width_m)]  # fmt: skip
             extra = len(on) - self.max_robots(team)
             if extra <= 0:
                 continue
-            ids = sorted((r.id for r in on), reverse=True)[:extra]
+            ids = sorted((r.id for r in on), key=lambda rid: ((team, rid) not in self.off, -rid))[:extra]
             self._call(GameEvent(self.t, "too_many_robots", team, ids[0], float(len(on)), float(self.max_robots(team)),
                                  "robots"))  # fmt: skip
             self._foul(team, None)
-            for rid in ids:
-                if (team, rid) not in self.off:
-                    self.off[(team, rid)] = False
-                    x, y = self._park((team, rid))
-                    self._teleport([(team, rid, x, y, 0.0)])
+            for rid in ids:  # off (its card's robot back for good, any other until the end)
+                x, y = self._park((team, rid))
+                self._teleport([(team, rid, x, y, 0.0)])
 
     # --- placement, penalty, stages ----------------------------------------------------------
     def _follow_placement(self, truth: GroundTruth) -> None:

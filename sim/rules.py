@@ -119,6 +119,12 @@ class FoulWatch:
         self._kicker_left = False  # ... and whether it let go of the ball since
         self._fast_ball_called = False
 
+    def kicked(self, kicker: Key) -> None:
+        """The simulator's kicker fired: a touch, however short (a kick can leave before a frame shows it)."""
+        self.touching.setdefault(kicker, _Touch((math.nan, math.nan), called=True))
+        self.last_touch = kicker
+        self._fast_ball_called = False
+
     def restart_taken(self, kicker: Key | None) -> None:
         """A kickoff or free kick was taken by ``kicker``: a second touch before another robot's is a foul."""
         self._restart_kicker = kicker
@@ -137,9 +143,10 @@ class FoulWatch:
             out += self._dribbling(gt)
             out += self._area_touches(gt, robots, new_touches, s)
             out += self._double_touch(gt, new_touches)
-            out += self._boundary(gt)
         else:
             self._restart_kicker = None
+        if s.command != "halt":  # the ball crosses the boundary after the line: play is already stopped
+            out += self._boundary(gt)
         if s.command == "stop" and gt.t - s.since >= self.p.stop_grace_s:
             out += self._stop(gt, robots)
         if s.command in ("free_kick", "kickoff") and s.for_team is not None and not s.in_play \
@@ -160,6 +167,8 @@ class FoulWatch:
         for k in list(self.touching):
             if k not in now:
                 del self.touching[k]
+                if k == self._restart_kicker:
+                    self._kicker_left = True
         for k in new:
             self.touching[k] = _Touch((b.x, b.y))
             self.last_touch = k

@@ -349,10 +349,14 @@ class Referee:
         self._set("stop", None)
         self._restart = (self.t + self.params.restart_delay_s, kind, team, spot)
 
+    def _attack_sign(self, team: Team) -> float:
+        """+1.0 when ``team`` attacks the goal at +x."""
+        return -float(self.blue_sign if team == "blue" else -self.blue_sign)
+
     def _spot(self, kind: str, team: Team, ball: tuple[float, float]) -> tuple[float, float]:
         if kind == "penalty":  # the mark in front of the goal ``team`` attacks
-            defended = -(self.blue_sign if team == "blue" else -self.blue_sign)
-            return (defended * (self.field.half_length - self.rules.penalty_mark_from_goal_m), 0.0)
+            attack = self._attack_sign(team)
+            return (attack * (self.field.half_length - self.rules.penalty_mark_from_goal_m), 0.0)
         return self.field.free_kick_spot(*ball, self.params.free_kick_distance_m)
 
     # --- fouls and cards ------------------------------------------------------------------------
@@ -480,7 +484,7 @@ class Referee:
 
     def _penalty_set(self, truth: GroundTruth, pen: _Penalty) -> bool:
         """Everyone but the kicker and the keeper ``penalty_behind_m`` behind the ball, the keeper on its line."""
-        attack = 1.0 if pen.mark[0] > 0 else -1.0
+        attack = self._attack_sign(pen.team)
         keeper = (_other(pen.team), self.rules.keepers.get(_other(pen.team), -1))
         ours = [r for r in truth.robots if r.team == pen.team and (r.team, r.id) not in self.off]
         kicker = min(ours, key=lambda r: math.hypot(r.x - pen.mark[0], r.y - pen.mark[1]), default=None)
@@ -506,7 +510,7 @@ class Referee:
             return
         assert pen.t_run is not None
         b = truth.ball
-        attack = 1.0 if pen.mark[0] > 0 else -1.0
+        attack = self._attack_sign(pen.team)
         moved = math.hypot(b.x - pen.mark[0], b.y - pen.mark[1]) > self.rules.ball_in_play_m
         took = self.t - pen.t_run
         if took > self.rules.penalty_time_s or (moved and (math.hypot(b.vx, b.vy) < 0.05 or b.vx * attack < -0.05)):

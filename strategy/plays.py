@@ -98,6 +98,7 @@ class Strategy:
         self.attacker = Attacker(pitch, params.kicking, params.passing, params.skills, params.obstacle_radius_m)
         self.frame = 0
         self.last_action: dict[int, str] = {}  # robot id -> "shot", "pass" or "clear": what its kick is for
+        self._placing: int | None = None  # the robot holding the ball it places
 
     def own_sign(self, game: GameState) -> float:
         """-1 when we defend the goal at negative x, else +1."""
@@ -155,7 +156,8 @@ class Strategy:
         others = {rid: it for rid, it in intents.items() if rid != carrier}
         others = keep_off_line(others, (ball.x, ball.y), target, f, gs, p.robot_radius_m)
         out = dict(keep_away(others, ball, f, own_sign, gs, p.robot_radius_m, kickoff=False, slow=False))
-        out[carrier] = place_ball(own[carrier], ball, target, p.skills, gs)
+        out[carrier], held = place_ball(own[carrier], ball, target, p.skills, gs, self._placing == carrier)
+        self._placing = carrier if held else None
         return out
 
     def _penalty(self, intents: dict[int, Intent], own: Mapping[int, RobotState], opp: list[RobotState],

@@ -94,6 +94,10 @@ def build_parser() -> argparse.ArgumentParser:
                    "and --set (its brain and tracker: planner, control, safety, tracker, strategy, team), "
                    "e.g. --opponent-set team.navigator=robox --opponent-set planner.planner=estar (repeatable)")
     p.add_argument("--seconds", type=_positive, default=30.0, help="match time in simulated seconds (default 30)")
+    p.add_argument("--rules", choices=("full", "basic"), default=None,
+                   help="full: the league's game controller and auto-referee (fouls, cards, placements by the teams, "
+                   "penalties, halves); basic: goals, balls out and restarts placed by the referee "
+                   "(default: sim.referee.rules, full)")
     p.add_argument("--division", choices=("A", "B"), default=None, help="field and team size (default: config)")
     p.add_argument("--perception", choices=("vision", "truth"), default="vision",
                    help="vision: our team sees the rendered images (default); truth: noisy true detections")
@@ -295,6 +299,7 @@ def _cmd_play(args: argparse.Namespace, stop: Interrupt) -> int:
     from cmdragons.tracking.filters import kalman
 
     overrides = list(args.set) + ([f"field.division={args.division}"] if args.division else [])
+    overrides += [f"sim.referee.rules={args.rules}"] if args.rules else []
     if args.opponent_set and args.opponent != "self":
         print(f"cmdragons play: --opponent-set configures a copy of our team: it needs --opponent self, "
               f"not {args.opponent}", file=sys.stderr)  # fmt: skip
@@ -402,6 +407,9 @@ def _finish_play(folder: Path, summary: dict[str, Any], args: argparse.Namespace
         f"{_plural(coll['own'], 'own collision')}; brain {brain:.2f} ms median"
         + _their_line(summary)
     )
+    rules = summary.get("rules")
+    if rules is not None and rules["rules"] == "full":
+        print("play: " + _rules_line(rules))
     for w in warnings:
         print(f"play: warning: {w}")
     if stop.requested:
@@ -410,6 +418,20 @@ def _finish_play(folder: Path, summary: dict[str, Any], args: argparse.Namespace
     files = ["run.mcap", "summary.json"] + (["match.mp4"] if args.video and (folder / "match.mp4").exists() else [])
     files += [report.name] if report is not None else []
     print(f"play: {', '.join(files)} -> {folder}")
+
+
+def _rules_line(rules: dict[str, Any]) -> str:
+    """The referee's calls per team: fouls by kind, cards, placements tried and succeeded."""
+    parts = []
+    for team, who in (("blue", "us"), ("yellow", "them")):
+        fouls = rules["fouls"][team]
+        kinds = ", ".join(f"{k.replace('_', ' ')} {n}" for k, n in fouls.items() if k != "total")
+        cards, placed = rules["cards"][team], rules["placements"][team]
+        median = f", median {placed['median_s']:.1f} s" if placed["median_s"] is not None else ""
+        parts.append(f"{team} ({who}) {_plural(fouls['total'], 'foul')}{f' ({kinds})' if kinds else ''}, "
+                     f"cards {cards['yellow']} yellow {cards['red']} red, placements {placed['succeeded']}/"
+                     f"{placed['tried']}{median}")  # fmt: skip
+    return "rules: " + "; ".join(parts)
 
 
 def _their_line(summary: dict[str, Any]) -> str:

@@ -30,6 +30,8 @@ __all__ = [
     "Contact",
     "DetectionFrame",
     "Event",
+    "GameEvent",
+    "GameEvents",
     "GameState",
     "Goal",
     "GroundTruth",
@@ -43,6 +45,7 @@ __all__ = [
     "SimEvents",
     "StageSummary",
     "TeamCommands",
+    "TeamInfo",
     "TeamReport",
     "Teleport",
     "Tick",
@@ -96,6 +99,11 @@ def _pixel(value: Any) -> tuple[float, float]:
 def _num(x: float) -> float | None:
     """JSON has no NaN: unknown numbers are written as null."""
     return None if math.isnan(x) else x
+
+
+def _finite(x: float) -> float | None:
+    """JSON has no infinity either: no limit is written as null."""
+    return x if math.isfinite(x) else None
 
 
 class _Codec:
@@ -507,43 +515,117 @@ class GroundTruth:
 
 # --- referee ------------------------------------------------------------------------------------
 
-_COMMANDS = ("halt", "stop", "kickoff", "free_kick", "normal")
-_GAME = struct.Struct("<dBbHHBdd")
+# the league's Referee commands, each (but halt, stop, normal start and force start) for one team:
+# kickoff = prepare kickoff (``ready`` once the normal start is given), penalty = prepare penalty (the
+# same), free_kick = direct free kick, normal = normal start with the ball in play
+_COMMANDS = ("halt", "stop", "kickoff", "free_kick", "normal", "force_start", "penalty", "timeout", "ball_placement")
+# the league's stages (pre-game and the breaks included); extra time is not played here
+_STAGES = ("pre_game", "first_half", "half_time", "second_half", "penalty_shootout", "post_game")
+_GAME = struct.Struct("<dBbHHBddBddIdbBb")
+_TEAM_INFO = np.dtype(
+    [("red_cards", "<u2"), ("yellow_cards", "<u2"), ("fouls", "<u2"), ("goalkeeper", "u1"), ("timeouts", "u1"),
+     ("timeout_time", "<f8"), ("placement_failures", "<u2"), ("can_place_ball", "u1"), ("max_robots", "u1")]
+)  # fmt: skip
+_CARD_TIME = np.dtype([("team", "u1"), ("left", "<f8")])
+
+
+@dataclass(frozen=True)
+class TeamInfo:
+    """One team as the league's Referee message has it (the score is the game state's own)."""
+
+    red_cards: int = 0
+    yellow_cards: int = 0  # given in the match so far
+    yellow_card_times_s: tuple[float, ...] = ()  # time left on each card still running (s)
+    fouls: int = 0
+    goalkeeper: int = 0  # the robot id the rules treat as the keeper
+    timeouts: int = 4  # timeouts left
+    timeout_time_s: float = 300.0  # timeout time left (s)
+    placement_failures: int = 0
+    can_place_ball: bool = True
+    max_robots: int = 11  # robots allowed on the field now (the division's count less the cards running)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"red_cards": self.red_cards, "yellow_cards": self.yellow_cards,
+                "yellow_card_times": list(self.yellow_card_times_s), "fouls": self.fouls,
+                "goalkeeper": self.goalkeeper, "timeouts": self.timeouts, "timeout_time": self.timeout_time_s,
+                "placement_failures": self.placement_failures, "can_place_ball": self.can_place_ball,
+                "max_robots": self.max_robots}  # fmt: skip
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Self:
+        return cls(int(d.get("red_cards", 0)), int(d.get("yellow_cards", 0)),
+                   tuple(float(v) for v in d.get("yellow_card_times", ())), int(d.get("fouls", 0)),
+                   int(d.get("goalkeeper", 0)), int(d.get("timeouts", 4)), _f(d, "timeout_time", 300.0),
+                   int(d.get("placement_failures", 0)), bool(d.get("can_place_ball", True)),
+                   int(d.get("max_robots", 11)))  # fmt: skip
 
 
 @dataclass(frozen=True)
 class GameState:
-    """The referee's word at time ``t``: the command in force and for which team, the score, which
-    goal blue defends, and where the ball is (to be) placed for a restart."""
+    """The referee's word at time ``t``, what the league's Referee message carries: the command in
+    force and for which team (``ready``: a kickoff's or penalty's normal start is given), the score,
+    which goal blue defends, the designated position (where the ball is, or is to be, placed for a
+    restart), the stage and its time left, the command's counter and time, the next command, the
+    time left for the current action (a restart to be taken, a placement), and each team's info."""
 
     t: float
-    command: str = "normal"  # one of halt, stop, kickoff, free_kick, normal
-    for_team: Team | None = None  # the team that takes the kickoff or free kick
+    command: str = "normal"  # one of _COMMANDS
+    for_team: Team | None = None  # the team the command is for (kickoff, free kick, penalty, placement, timeout)
     score_blue: int = 0
     score_yellow: int = 0
     blue_defends_negative_x: bool = True
-    placement: tuple[float, float] | None = None
+    placement: tuple[float, float] | None = None  # the designated position (field frame, m)
+    ready: bool = True  # kickoff or penalty: the normal start is given, the kicker may play the ball
+    stage: str = "first_half"  # one of _STAGES
+    stage_time_left_s: float = math.inf
+    command_counter: int = 0
+    command_t: float = 0.0  # when the command was given (s)
+    action_time_left_s: float = math.inf  # time left to take the restart or place the ball (s)
+    next_command: str | None = None  # what follows a placement or a stop, when known
+    next_for_team: Team | None = None
+    blue_team: TeamInfo = TeamInfo()
+    yellow_team: TeamInfo = TeamInfo()
 
     def __post_init__(self) -> None:
         if self.command not in _COMMANDS:
             raise MessageError(f"game command must be one of {', '.join(_COMMANDS)}, got {self.command!r}")
+        if self.next_command is not None and self.next_command not in _COMMANDS:
+            raise MessageError(f"next command must be one of {', '.join(_COMMANDS)}, got {self.next_command!r}")
+        if self.stage not in _STAGES:
+            raise MessageError(f"game stage must be one of {', '.join(_STAGES)}, got {self.stage!r}")
+
+    def team_info(self, team: Team) -> TeamInfo:
+        return self.blue_team if team == "blue" else self.yellow_team
 
     def to_dict(self) -> dict[str, Any]:
         return {"t": self.t, "command": self.command, "for_team": self.for_team,
                 "score": {"blue": self.score_blue, "yellow": self.score_yellow},
                 "blue_defends": "negative_x" if self.blue_defends_negative_x else "positive_x",
-                "placement": None if self.placement is None else list(self.placement)}  # fmt: skip
+                "placement": None if self.placement is None else list(self.placement),
+                "ready": self.ready, "stage": self.stage, "stage_time_left": _finite(self.stage_time_left_s),
+                "command_counter": self.command_counter, "command_t": self.command_t,
+                "action_time_left": _finite(self.action_time_left_s), "next_command": self.next_command,
+                "next_for_team": self.next_for_team,
+                "teams": {"blue": self.blue_team.to_dict(), "yellow": self.yellow_team.to_dict()}}  # fmt: skip
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> Self:
         try:
             team = d.get("for_team")
             placement = d.get("placement")
+            nxt = d.get("next_for_team")
+            teams = d.get("teams", {})
+            stage_left, action_left = d.get("stage_time_left", math.inf), d.get("action_time_left", math.inf)
             return cls(
                 _f(d, "t"), str(d.get("command", "normal")), None if team is None else _team(team),
                 int(d.get("score", {}).get("blue", 0)), int(d.get("score", {}).get("yellow", 0)),
                 d.get("blue_defends", "negative_x") == "negative_x",
                 None if placement is None else (float(placement[0]), float(placement[1])),
+                bool(d.get("ready", True)), str(d.get("stage", "first_half")),
+                math.inf if stage_left is None else float(stage_left), int(d.get("command_counter", 0)),
+                float(d.get("command_t", 0.0)), math.inf if action_left is None else float(action_left),
+                d.get("next_command"), None if nxt is None else _team(nxt),
+                TeamInfo.from_dict(teams.get("blue", {})), TeamInfo.from_dict(teams.get("yellow", {})),
             )  # fmt: skip
         except (KeyError, TypeError, AttributeError, ValueError, IndexError) as exc:
             raise MessageError(f"bad game state: {exc!r}") from None
@@ -551,19 +633,98 @@ class GameState:
     def encode(self) -> bytes:
         px, py = self.placement if self.placement is not None else (math.nan, math.nan)
         team = -1 if self.for_team is None else _team_code(self.for_team)
-        return _GAME.pack(self.t, _COMMANDS.index(self.command), team, self.score_blue, self.score_yellow,
-                          self.blue_defends_negative_x, px, py)  # fmt: skip
+        nxt = -1 if self.next_command is None else _COMMANDS.index(self.next_command)
+        nxt_team = -1 if self.next_for_team is None else _team_code(self.next_for_team)
+        head = _GAME.pack(self.t, _COMMANDS.index(self.command), team, self.score_blue, self.score_yellow,
+                          self.blue_defends_negative_x, px, py, self.ready, self.stage_time_left_s,
+                          self.action_time_left_s, self.command_counter, self.command_t, nxt,
+                          _STAGES.index(self.stage), nxt_team)  # fmt: skip
+        teams = (self.blue_team, self.yellow_team)
+        infos = np.array([(i.red_cards, i.yellow_cards, i.fouls, i.goalkeeper, i.timeouts, i.timeout_time_s,
+                           i.placement_failures, i.can_place_ball, i.max_robots) for i in teams],
+                         dtype=_TEAM_INFO)  # fmt: skip
+        cards = np.array([(k, left) for k, i in enumerate(teams) for left in i.yellow_card_times_s], dtype=_CARD_TIME)
+        return _GAME_CODEC.pack((head,), infos, cards)
 
     @classmethod
     def decode(cls, data: bytes | bytearray | memoryview) -> Self:
+        (head,), (infos, cards) = _GAME_CODEC.unpack(data)
         try:
-            t, cmd, team, sb, sy, blue_neg, px, py = _GAME.unpack(bytes(data))
+            (t, cmd, team, sb, sy, blue_neg, px, py, ready, stage_left, action_left, counter, command_t, nxt,
+             stage, nxt_team) = _GAME.unpack(head)  # fmt: skip
         except struct.error as exc:
             raise MessageError(f"game state is truncated or corrupt: {exc}") from None
-        if cmd >= len(_COMMANDS):
-            raise MessageError(f"unknown game command code {cmd}")
+        if cmd >= len(_COMMANDS) or nxt >= len(_COMMANDS):
+            raise MessageError(f"unknown game command code {max(cmd, nxt)}")
+        if stage >= len(_STAGES):
+            raise MessageError(f"unknown game stage code {stage}")
+        if len(infos) != 2:
+            raise MessageError("game state must hold the info of both teams")
         placement = None if math.isnan(px) else (px, py)
-        return cls(t, _COMMANDS[cmd], None if team < 0 else TEAMS[team & 1], sb, sy, bool(blue_neg), placement)
+        teams = [TeamInfo(int(i["red_cards"]), int(i["yellow_cards"]),
+                          tuple(float(c["left"]) for c in cards if int(c["team"]) == k), int(i["fouls"]),
+                          int(i["goalkeeper"]), int(i["timeouts"]), float(i["timeout_time"]),
+                          int(i["placement_failures"]), bool(i["can_place_ball"]), int(i["max_robots"]))
+                 for k, i in enumerate(infos)]  # fmt: skip
+        return cls(t, _COMMANDS[cmd], None if team < 0 else TEAMS[team & 1], sb, sy, bool(blue_neg), placement,
+                   bool(ready), _STAGES[stage], stage_left, counter, command_t, action_left,
+                   None if nxt < 0 else _COMMANDS[nxt], None if nxt_team < 0 else TEAMS[nxt_team & 1],
+                   *teams)  # fmt: skip
+
+
+_GAME_CODEC = _Codec(f"{_GAME.size}s", _TEAM_INFO, _CARD_TIME)
+
+
+@dataclass(frozen=True)
+class GameEvent:
+    """One call of the referee: a foul (``kind`` as the rules name it: "crash", "ball_too_fast", ...),
+    a card, a placement's end, a stage's change. ``team`` and ``robot``: who committed it (None when
+    no one); ``value`` the figure that broke the rule and ``limit`` the rule's, in ``unit``;
+    ``restart``: what play goes on with ("free_kick", "penalty", "" when the call does not change it)."""
+
+    t: float
+    kind: str
+    team: Team | None = None
+    robot: int | None = None
+    value: float = math.nan
+    limit: float = math.nan
+    unit: str = ""
+    restart: str = ""
+    for_team: Team | None = None  # the team the restart is for
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"t": self.t, "kind": self.kind, "team": self.team, "robot": self.robot, "value": _num(self.value),
+                "limit": _num(self.limit), "unit": self.unit, "restart": self.restart,
+                "for_team": self.for_team}  # fmt: skip
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Self:
+        try:
+            team, robot, for_team = d.get("team"), d.get("robot"), d.get("for_team")
+            return cls(_f(d, "t"), str(d["kind"]), None if team is None else _team(team),
+                       None if robot is None else int(robot), _f(d, "value", math.nan), _f(d, "limit", math.nan),
+                       str(d.get("unit", "")), str(d.get("restart", "")),
+                       None if for_team is None else _team(for_team))  # fmt: skip
+        except (KeyError, TypeError, ValueError) as exc:
+            raise MessageError(f"bad game event: {exc!r}") from None
+
+
+@dataclass(frozen=True)
+class GameEvents:
+    """The referee's calls of one frame (topic ``referee/events``)."""
+
+    t: float
+    events: tuple[GameEvent, ...] = ()
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"t": self.t, "events": [e.to_dict() for e in self.events]}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Self:
+        try:
+            return cls(_f(d, "t"), tuple(GameEvent.from_dict(e) for e in d.get("events", ())))
+        except (TypeError, AttributeError) as exc:
+            raise MessageError(f"bad game events: {exc!r}") from None
 
 
 # --- simulator events --------------------------------------------------------------------------

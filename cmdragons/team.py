@@ -69,6 +69,8 @@ class BrainParams(Validated):
     """configs/team.yaml ``brain``."""
 
     ball_clearance_m: float = setting(0.05, lo=0.0, hi=1.0)  # kept from the ball when it is an obstacle
+    # ... and in a stop, at their restarts and placements (rules: 0.5 m from the ball), this much
+    keep_away_clearance_m: float = setting(0.55, lo=0.0, hi=3.0)
     arrive_tolerance_m: float = setting(0.01, lo=0.0, hi=1.0)  # closer than this to the goal: no planning
     # a navigator's deadline per robot and frame: only the safety net of a stalled machine
     navigate_deadline_ms: float = setting(50.0, lo=0.01, hi=10000.0)
@@ -168,7 +170,7 @@ class Brain:
         safety (the loop ``cmdragons bench safety`` measures). Robots of ``intents`` must be ours and
         in ``world``."""
         t1 = time.perf_counter()
-        frame = self._frame(world)
+        frame = self._frame(world, game)
         index = {r.id: i for i, r in enumerate(world.robots) if r.team == self.team}
         commands = [self._navigate(frame, index[rid], intent, game) for rid, intent in sorted(intents.items())]
         t2 = time.perf_counter()
@@ -186,7 +188,14 @@ class Brain:
         self.times["safety"].append((t3 - t2) * 1e3)
         return safe
 
-    def _frame(self, world: WorldState) -> Frame:
+    def _ball_clearance(self, game: GameState) -> float:
+        """How far paths keep from the ball: the rules' distance where they ask for one."""
+        keep = game.command == "stop" or (game.command in ("kickoff", "free_kick", "ball_placement", "penalty")
+                                          and game.for_team != self.team)  # fmt: skip
+        b = self.params.brain
+        return b.keep_away_clearance_m if keep else b.ball_clearance_m
+
+    def _frame(self, world: WorldState, game: GameState) -> Frame:
         robots = world.robots
         xy = np.array([(r.x, r.y) for r in robots], dtype=np.float64).reshape(-1, 2)
         vel = np.array([(r.vx, r.vy) for r in robots], dtype=np.float64).reshape(-1, 2)
@@ -194,7 +203,7 @@ class Brain:
         ball = None
         if world.ball is not None:
             ball = np.array([[world.ball.x, world.ball.y,
-                              self.settings.field.ball.radius_m + self.params.brain.ball_clearance_m]])  # fmt: skip
+                              self.settings.field.ball.radius_m + self._ball_clearance(game)]])  # fmt: skip
         circles = np.column_stack([xy, np.full(len(xy), self.radius)])
         if ball is not None:
             circles, vel_all = np.vstack([circles, ball]), np.vstack([vel, np.zeros((1, 2))])

@@ -1,11 +1,20 @@
-"""Referee basics: score, kickoff after a goal, free kick after the ball leaves the field.
+"""The simulator's referee: the league's game controller and, with the full rules, its auto-referee.
 
-The referee turns the simulator's events into the game state and, after a short pause, asks for the
-ball to be placed for the restart (and, if configured, the robots in their kickoff formation), as an
-automatic ball placement would. It never touches the physics: what it wants placed it returns as a
-:class:`~cmdragons.messages.Teleport`, which the simulator carries out (in one process or across a
-network alike). Formations are given for the team defending the goal at -x and mirrored for the
-other team.
+Basic rules: score, kickoff after a goal, free kick after the ball leaves the field, the keeper's
+held ball; after a short pause the referee places the ball for the restart itself (and, if
+configured, the robots in their kickoff formation), as an automatic ball placement would.
+
+Full rules (the default) add what the league's game controller and auto-referees do: two halves with
+the sides changed between them, the fouls of :mod:`sim.rules` with the restart each leads to, a
+yellow card for every few fouls (a robot off for the card's time) and red cards, ball placement by
+the team that takes the free kick (within the rules' time and tolerance, else by the referee and the
+free kick to the other team), penalty kicks (prepared, started, over when scored, missed or timed
+out), and too many robots on the field. Every call is a :class:`~cmdragons.messages.GameEvent`.
+
+The referee never touches the physics: what it wants placed (a ball, a formation, a robot sent off
+or back) it returns as a :class:`~cmdragons.messages.Teleport`, which the simulator carries out (in
+one process or across a network alike). Formations are given for the team defending the goal at -x
+and mirrored for the other team.
 """
 
 from __future__ import annotations
@@ -15,9 +24,23 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Literal
 
+import numpy as np
+
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import TEAMS, Field, Team
-from cmdragons.messages import BallOut, Contact, Event, GameState, Goal, Kick, Teleport
+from cmdragons.messages import (
+    BallOut,
+    Contact,
+    Event,
+    GameEvent,
+    GameState,
+    Goal,
+    GroundTruth,
+    Kick,
+    TeamInfo,
+    Teleport,
+)
+from sim.rules import FOUL_RESTARTS, FoulWatch, RulesParams, Situation
 
 __all__ = ["Referee", "RefereeParams"]
 
@@ -34,6 +57,7 @@ _DEFAULT_FORMATIONS: dict[Literal["A", "B"], tuple[_Pose, ...]] = {
 @dataclass(frozen=True)
 class RefereeParams(Validated):
     enabled: bool = True  # off: no restarts, the ball bounces off the boundary walls
+    rules: Literal["full", "basic"] = "full"  # full: the league's game controller and auto-referee
     blue_defends: Literal["negative_x", "positive_x"] = "negative_x"
     restart_delay_s: float = setting(1.0, lo=0.0, hi=30.0)  # goal or out -> ball placed
     place_robots_on_goal: bool = True  # put both teams in their kickoff formation after a goal
@@ -44,10 +68,43 @@ class RefereeParams(Validated):
     formations: Mapping[Literal["A", "B"], tuple[tuple[float, float, float], ...]] = field(
         default_factory=lambda: dict(_DEFAULT_FORMATIONS)
     )
+    figures: RulesParams = RulesParams()  # the league's figures for the full rules
+    park_distance_m: float = setting(3.0, lo=0.5, hi=50.0)  # robots sent off wait this far outside the boundary
+
+
+Key = tuple[Team, int]
+_LIVE = ("normal", "force_start", "kickoff", "free_kick")  # commands with the ball in play or about to be
+
+
+def _other(team: Team) -> Team:
+    return "yellow" if team == "blue" else "blue"
+
+
+@dataclass
+class _Placement:
+    team: Team
+    target: tuple[float, float]
+    t_start: float
+
+
+@dataclass
+class _Penalty:
+    team: Team  # the kicking team
+    t_start: float  # prepared since
+    mark: tuple[float, float]
+    t_run: float | None = None  # the normal start's time
+
+
+@dataclass
+class _Card:
+    team: Team
+    robot: int
+    left_s: float
 
 
 class Referee:
-    """Keeps the score and the game state; restarts play by asking for teleports."""
+    """Keeps the score and the game state; restarts play by asking for teleports; with the full
+    rules also the stages, fouls, cards, placements and penalties."""
 
     def __init__(self, field: Field, robot_keys: Sequence[tuple[Team, int]], params: RefereeParams) -> None:
         self.field = field
@@ -58,14 +115,88 @@ class Referee:
         self.balls_out = 0
         self.kicks = 0
         self.contacts: list[Contact] = []
-        self.command: Literal["kickoff", "free_kick", "normal", "stop"] = "kickoff"
+        self.command: str = "kickoff"
         self.for_team: Team | None = "blue"
+        self.ready = True
         self.t = 0.0
         self._restart: tuple[float, str, Team, tuple[float, float]] | None = None
         self._restart_ball: tuple[float, float] | None = (0.0, 0.0)
         self._restart_t = 0.0  # when the restart in force was given
         self._in_area_since: float | None = None  # normal play with the ball in a defense area since
         self.keeper_held_ball = 0
+        # the full rules
+        self.full = params.enabled and params.rules == "full"
+        self.rules = params.figures
+        self.stage = "first_half"
+        self._stage_end = self.rules.half_s if self.full else math.inf
+        self.command_counter = 0
+        self.command_t = 0.0
+        self.watch = FoulWatch(field, self.rules)
+        self.events: list[GameEvent] = []  # every call of the match
+        self.new_events: list[GameEvent] = []  # the calls of the last frame
+        self.fouls: dict[Team, int] = {"blue": 0, "yellow": 0}
+        self.yellow_cards: dict[Team, int] = {"blue": 0, "yellow": 0}
+        self.red_cards: dict[Team, int] = {"blue": 0, "yellow": 0}
+        self.cards: list[_Card] = []  # yellow cards running
+        self.off: dict[Key, bool] = {}  # robots off the field: True for a red card (for good)
+        self.placement: _Placement | None = None
+        self.placements: dict[Team, dict[str, int]] = {t: {"tried": 0, "succeeded": 0} for t in TEAMS}
+        self.placement_s: dict[Team, list[float]] = {"blue": [], "yellow": []}
+        self.placement_failures: dict[Team, int] = {"blue": 0, "yellow": 0}
+        self.penalty: _Penalty | None = None
+        self.penalties: dict[Team, dict[str, int]] = {t: {"taken": 0, "scored": 0} for t in TEAMS}
+        self._last_t = 0.0
+        self._teleports: list[Teleport] = []
+
+    # --- commands ---------------------------------------------------------------------------
+    def _set(self, command: str, for_team: Team | None, ready: bool = True) -> None:
+        """Give a command (its counter and time move when it changes)."""
+        if (command, for_team, ready) != (self.command, self.for_team, self.ready):
+            self.command_counter += 1
+            self.command_t = self.t
+        self.command, self.for_team, self.ready = command, for_team, ready
+
+    def give(self, command: str, for_team: Team | None = None, ready: bool = True) -> None:
+        """A command by hand (what a human referee or a scripted scene gives); restarts that need a
+        ball in place are :meth:`free_kick`, :meth:`start_placement` and :meth:`start_penalty`."""
+        self._restart = None
+        self._clear_special()
+        self._set(command, for_team, ready)
+
+    def free_kick(self, team: Team, spot: tuple[float, float]) -> Teleport:
+        """A free kick for ``team`` with the ball put at ``spot`` (the teleport to carry out)."""
+        self.give("stop")
+        self._start_restart("free_kick_by_referee", team, spot, spot)
+        teleport = self._take_teleports()
+        assert teleport is not None
+        return teleport
+
+    def start_placement(self, team: Team, target: tuple[float, float]) -> None:
+        """Ball placement by ``team`` to ``target`` now, a free kick for it to follow."""
+        self.give("stop")
+        self._start_restart("free_kick", team, target, target)
+
+    def start_penalty(self, team: Team) -> Teleport:
+        """A penalty kick for ``team``: the ball on the mark (the teleport to carry out), prepared."""
+        self.give("stop")
+        self._start_restart("penalty", team, self._spot("penalty", team, (0.0, 0.0)), (0.0, 0.0))
+        teleport = self._take_teleports()
+        assert teleport is not None
+        return teleport
+
+    def _in_play(self) -> bool:
+        return self.command in ("normal", "force_start") or (self.command == "penalty" and self.ready)
+
+    def _live(self) -> bool:
+        """Do goals and balls out count now? (Basic rules: whenever no restart is pending.)"""
+        return not self.full or self.command in _LIVE or (self.command == "penalty" and self.ready)
+
+    def _team_count(self, team: Team) -> int:
+        return sum(1 for t, _ in self.robot_keys if t == team)
+
+    def max_robots(self, team: Team) -> int:
+        """Robots ``team`` may have on the field now: its count less the cards running."""
+        return self._team_count(team) - sum(1 for k, red in self.off.items() if k[0] == team)
 
     def formation(self, team: Team) -> list[tuple[float, float, float]]:
         """Kickoff poses of ``team``'s robots in the field frame."""
@@ -86,69 +217,337 @@ class Referee:
         return out
 
     def kickoff_setup(self, kicking_team: Team = "blue") -> Teleport:
-        """Both teams in formation, ball on the centre spot, kickoff for ``kicking_team``."""
+        """Both teams in formation, ball on the centre spot, kickoff for ``kicking_team`` (robots
+        sent off stay off)."""
         robots = []
         for team in TEAMS:
             ids = [rid for t, rid in self.robot_keys if t == team]
-            robots += [(team, rid, x, y, th) for rid, (x, y, th) in zip(ids, self.formation(team), strict=False)]
-        self.command, self.for_team = "kickoff", kicking_team
+            robots += [(team, rid, x, y, th) for rid, (x, y, th) in zip(ids, self.formation(team), strict=False)
+                       if (team, rid) not in self.off]  # fmt: skip
+        self._set("kickoff", kicking_team)
         self._restart_ball = (0.0, 0.0)
         self._restart_t = self.t
         return Teleport(self.t, tuple(robots), (0.0, 0.0))
 
-    def observe(self, t: float, events: Sequence[Event], ball_xy: tuple[float, float]) -> Teleport | None:
-        """Take one frame's events at time ``t`` with the ball at ``ball_xy`` (field frame, m);
-        returns what a restart due now wants placed, or None."""
+    # --- one frame --------------------------------------------------------------------------
+    def observe(self, t: float, events: Sequence[Event], ball_xy: tuple[float, float],
+                truth: GroundTruth | None = None) -> Teleport | None:  # fmt: skip
+        """Take one frame's events at time ``t`` with the ball at ``ball_xy`` (field frame, m) and,
+        for the full rules, the true state ``truth`` the auto-referee judges; returns what a restart
+        due now wants placed, or None."""
         self.t = t
+        self.new_events = []
         if not self.params.enabled:
             self.contacts += [e for e in events if isinstance(e, Contact)]
             self.kicks += sum(isinstance(e, Kick) for e in events)
             return None
+        dt, self._last_t = t - self._last_t, t
         for e in events:
             if isinstance(e, Contact):
                 self.contacts.append(e)
             elif isinstance(e, Kick):
                 self.kicks += 1
-            elif isinstance(e, Goal) and self._restart is None:
-                self.score[e.scoring_team] += 1
-                conceding: Team = "yellow" if e.scoring_team == "blue" else "blue"
-                self.command, self.for_team = "stop", None
-                self._restart = (t + self.params.restart_delay_s, "kickoff", conceding, (0.0, 0.0))
-            elif isinstance(e, BallOut) and self._restart is None:
+                self.watch.kicked((e.team, e.id))
+            elif isinstance(e, Goal) and self._restart is None and self._live():
+                scorer = self._scorer(e.x)
+                self.score[scorer] += 1
+                if self.command == "penalty" and self.for_team == scorer:
+                    self.penalties[scorer]["scored"] += 1
+                self._clear_special()
+                self._set("stop", None)
+                self._restart = (t + self.params.restart_delay_s, "kickoff", _other(scorer), (0.0, 0.0))
+            elif isinstance(e, BallOut) and self._restart is None and self._live():
                 self.balls_out += 1
                 taker: Team = "yellow" if e.last_touch == "blue" else "blue"
                 if e.last_touch is None:  # nobody touched it: the team defending that half
                     taker = "blue" if (e.x < 0) == (self.blue_sign < 0) else "yellow"
                 spot = self.field.free_kick_spot(e.x, e.y, self.params.free_kick_distance_m)
-                self.command, self.for_team = "stop", None
+                self._clear_special()
+                self._set("stop", None)
                 self._restart = (t + self.params.restart_delay_s, "free_kick", taker, spot)
+        if self.full and truth is not None:
+            self._judge(truth)
+            self._follow_placement(truth)
+            self._follow_penalty(truth)
+            self._follow_cards(dt, truth)
+            self._follow_stage()
         self._check_keeper_held_ball(t, ball_xy)
-        teleport = None
         if self._restart is not None and t >= self._restart[0]:
             _, kind, team, spot = self._restart
             self._restart = None
-            if kind == "kickoff" and self.params.place_robots_on_goal:
-                teleport = self.kickoff_setup(team)
-            else:
-                teleport = Teleport(t, (), spot)
-                self.command, self.for_team = ("kickoff" if kind == "kickoff" else "free_kick"), team
-                self._restart_ball = spot
-                self._restart_t = t
-            ball_xy = teleport.ball if teleport.ball is not None else ball_xy
+            self._start_restart(kind, team, spot, ball_xy)
+        teleport = self._take_teleports()
+        if teleport is not None and teleport.ball is not None:
+            ball_xy = teleport.ball
         # a restart is taken once the ball moved: normal play; not taken in time, play goes on anyway
         if self.command in ("kickoff", "free_kick") and self._restart_ball is not None:
             bx, by = ball_xy
             moved = math.hypot(bx - self._restart_ball[0], by - self._restart_ball[1]) > 0.05
-            if moved or t - self._restart_t > self.params.restart_timeout_s:
-                self.command, self.for_team, self._restart_ball = "normal", None, None
+            if moved:
+                self._set("normal", None)
+                self._restart_ball = None
+                self.watch.restart_taken(self.watch.last_touch)
+            elif t - self._restart_t > self.params.restart_timeout_s:
+                self._set("force_start" if self.full else "normal", None)
+                self._restart_ball = None
         return teleport
+
+    def _scorer(self, x: float) -> Team:
+        """The team attacking the goal at the side of ``x``."""
+        defender: Team = "blue" if (x < 0) == (self.blue_sign < 0) else "yellow"
+        return _other(defender)
+
+    def _clear_special(self) -> None:
+        self.placement = None
+        self.penalty = None
+
+    def _teleport(self, robots: Sequence[tuple[Team, int, float, float, float]] = (),
+                  ball: tuple[float, float] | None = None) -> None:  # fmt: skip
+        self._teleports.append(Teleport(self.t, tuple(robots), ball))
+
+    def _take_teleports(self) -> Teleport | None:
+        """This frame's teleports as one (robots in order, the last ball)."""
+        if not self._teleports:
+            return None
+        parts, self._teleports = self._teleports, []
+        if len(parts) == 1:
+            return parts[0]
+        ball = next((p.ball for p in reversed(parts) if p.ball is not None), None)
+        return Teleport(self.t, tuple(r for p in parts for r in p.robots), ball)
+
+    def _start_restart(self, kind: str, team: Team, spot: tuple[float, float], ball_xy: tuple[float, float]) -> None:
+        t = self.t
+        if kind == "kickoff" and self.params.place_robots_on_goal:
+            self._teleports.append(self.kickoff_setup(team))
+        elif kind == "free_kick" and self.full and self._can_place(team):
+            self._set("ball_placement", team)
+            self.placement = _Placement(team, spot, t)
+            self.placements[team]["tried"] += 1
+        elif kind == "penalty":
+            self._teleport(ball=spot)
+            self._set("penalty", team, ready=False)
+            self.penalty = _Penalty(team, t, spot)
+            self.penalties[team]["taken"] += 1
+        else:
+            placed = kind == "placed_free_kick"
+            if not placed:
+                self._teleport(ball=spot)
+            self._set("kickoff" if kind == "kickoff" else "free_kick", team)
+            self._restart_ball = ball_xy if placed else spot
+            self._restart_t = t
+
+    def _can_place(self, team: Team) -> bool:
+        return self.placement_failures[team] < self.rules.placement_failures_max
+
+    def _call(self, event: GameEvent) -> None:
+        self.events.append(event)
+        self.new_events.append(event)
+
+    def _award(self, kind: str, team: Team, spot: tuple[float, float]) -> None:
+        """Stop play; after the restart delay ``kind`` ("free_kick", "penalty") for ``team`` at ``spot``."""
+        self._clear_special()
+        self._set("stop", None)
+        self._restart = (self.t + self.params.restart_delay_s, kind, team, spot)
+
+    def _attack_sign(self, team: Team) -> float:
+        """+1.0 when ``team`` attacks the goal at +x."""
+        return -float(self.blue_sign if team == "blue" else -self.blue_sign)
+
+    def _spot(self, kind: str, team: Team, ball: tuple[float, float]) -> tuple[float, float]:
+        if kind == "penalty":  # the mark in front of the goal ``team`` attacks
+            attack = self._attack_sign(team)
+            return (attack * (self.field.half_length - self.rules.penalty_mark_from_goal_m), 0.0)
+        return self.field.free_kick_spot(*ball, self.params.free_kick_distance_m)
+
+    # --- fouls and cards ------------------------------------------------------------------------
+    def _judge(self, truth: GroundTruth) -> None:
+        situation = Situation(self.command, self.for_team, self.command_t, self.blue_sign, self._in_play())
+        for ev in self.watch.judge(truth, situation):
+            self._call(ev)
+            if ev.team is not None:
+                self._foul(ev.team, ev.robot)
+            if ev.restart and ev.for_team is not None and self._restart is None and self._in_play():
+                self._award(ev.restart, ev.for_team, self._spot(ev.restart, ev.for_team, (truth.ball.x, truth.ball.y)))
+        self._count_robots(truth)
+
+    def _foul(self, team: Team, robot: int | None) -> None:
+        """One more foul for ``team``: every ``fouls_per_yellow_card`` one gives a yellow card."""
+        self.fouls[team] += 1
+        if self.fouls[team] % self.rules.fouls_per_yellow_card == 0:
+            self.card(team, robot)
+
+    def card(self, team: Team, robot: int | None = None) -> None:
+        """A yellow card for ``team`` (the ``red_card_yellow_cards``-th running at once: a red one):
+        a robot goes off, the fouling one unless it is the keeper."""
+        running = sum(1 for c in self.cards if c.team == team)
+        red = self.rules.red_card_yellow_cards > 0 and running + 1 >= self.rules.red_card_yellow_cards
+        off = self._robot_to_remove(team, robot)
+        if red:
+            self.red_cards[team] += 1
+            self._call(GameEvent(self.t, "red_card", team, off, unit="for the match"))
+        else:
+            self.yellow_cards[team] += 1
+            self.cards.append(_Card(team, -1 if off is None else off, self.rules.yellow_card_s))
+            self._call(GameEvent(self.t, "yellow_card", team, off, self.rules.yellow_card_s, unit="s"))
+        if off is not None:
+            self._send_off((team, off), red)
+
+    def _robot_to_remove(self, team: Team, robot: int | None) -> int | None:
+        on = [rid for t, rid in self.robot_keys if t == team and (t, rid) not in self.off]
+        keeper = self.rules.keepers.get(team, -1)
+        if robot is not None and robot in on and robot != keeper:
+            return robot
+        field_players = [rid for rid in on if rid != keeper]
+        return max(field_players) if field_players else (max(on) if on else None)
+
+    def _park(self, key: Key) -> tuple[float, float]:
+        """Where a robot off the field waits: outside the boundary, beyond the cameras' view."""
+        k = self.robot_keys.index(key)
+        side = -1.0 if key[0] == "blue" else 1.0
+        y = side * (self.field.boundary_half_width + self.params.park_distance_m)
+        return (-self.field.half_length + 0.4 * k, y)
+
+    def _send_off(self, key: Key, red: bool) -> None:
+        self.off[key] = red
+        x, y = self._park(key)
+        self._teleport([(key[0], key[1], x, y, 0.0)])
+
+    def _follow_cards(self, dt: float, truth: GroundTruth) -> None:
+        """Cards run while the game is not halted; a robot whose card ran out comes back at the
+        halfway line, by the touch line, on a free spot."""
+        if self.command == "halt":
+            return
+        for c in list(self.cards):
+            c.left_s -= dt
+            if c.left_s > 0.0:
+                continue
+            self.cards.remove(c)
+            key = (c.team, c.robot)
+            if self.off.get(key) is False:
+                del self.off[key]
+                x, y = self._entry_spot(truth, c.team)
+                self._teleport([(c.team, c.robot, x, y, 0.0)])
+                self._call(GameEvent(self.t, "yellow_card_over", c.team, c.robot))
+
+    def _entry_spot(self, truth: GroundTruth, team: Team) -> tuple[float, float]:
+        side = -1.0 if team == "blue" else 1.0
+        own = self.blue_sign if team == "blue" else -self.blue_sign
+        r = self.field.league.robot.radius_m
+        y = side * (self.field.half_width - 2.0 * r)
+        for k in range(40):  # along the touch line into our half until free
+            x = own * (2.0 * r) * (k + 1)
+            if all(math.hypot(o.x - x, o.y - y) > 4.0 * r for o in truth.robots):
+                return (x, y)
+        return (own * 2.0 * r, y)
+
+    def _count_robots(self, truth: GroundTruth) -> None:
+        """Too many robots: a team with more on the field than it may have; the extra go off (a
+        robot sent off that came back first)."""
+        leaving = {(t, rid) for p in self._teleports for t, rid, *_ in p.robots}  # sent off this frame
+        for team in TEAMS:
+            on = [r for r in truth.robots if r.team == team and (team, r.id) not in leaving
+                  and self.field.in_field(r.x, r.y, -self.field.dims.boundary_width_m)]  # fmt: skip
+            extra = len(on) - self.max_robots(team)
+            if extra <= 0:
+                continue
+            ids = sorted((r.id for r in on), key=lambda rid: ((team, rid) not in self.off, -rid))[:extra]
+            self._call(GameEvent(self.t, "too_many_robots", team, ids[0], float(len(on)), float(self.max_robots(team)),
+                                 "robots"))  # fmt: skip
+            self._foul(team, None)
+            for rid in ids:  # off (its card's robot back for good, any other until the end)
+                x, y = self._park((team, rid))
+                self._teleport([(team, rid, x, y, 0.0)])
+
+    # --- placement, penalty, stages ----------------------------------------------------------
+    def _follow_placement(self, truth: GroundTruth) -> None:
+        """A placement succeeds when the ball rests within the tolerance of the designated position
+        with the placing team's robots clear of it; it fails when the time is up."""
+        pl = self.placement
+        if pl is None or self.command != "ball_placement":
+            return
+        r, b = self.rules, truth.ball
+        off = math.hypot(b.x - pl.target[0], b.y - pl.target[1])
+        clear = self.field.league.robot.radius_m + self.field.league.ball.radius_m + r.placement_clear_m
+        cleared = all(math.hypot(o.x - b.x, o.y - b.y) >= clear for o in truth.robots if o.team == pl.team)
+        took = self.t - pl.t_start
+        if off <= r.placement_tolerance_m and math.hypot(b.vx, b.vy) <= r.placement_rest_m_s and cleared:
+            self.placements[pl.team]["succeeded"] += 1
+            self.placement_s[pl.team].append(took)
+            self._call(GameEvent(self.t, "placement_succeeded", pl.team, None, took, r.placement_time_s, "s"))
+            self._award("placed_free_kick", pl.team, pl.target)
+        elif took > r.placement_time_s:
+            self.placement_failures[pl.team] += 1
+            self._call(GameEvent(self.t, "placement_failed", pl.team, None, off, r.placement_tolerance_m, "m",
+                                 "free_kick", _other(pl.team)))  # fmt: skip
+            self._teleport(ball=pl.target)  # the referee places it
+            self._award("placed_free_kick", _other(pl.team), pl.target)
+
+    def _penalty_set(self, truth: GroundTruth, pen: _Penalty) -> bool:
+        """Everyone but the kicker and the keeper ``penalty_behind_m`` behind the ball, the keeper on its line."""
+        attack = self._attack_sign(pen.team)
+        keeper = (_other(pen.team), self.rules.keepers.get(_other(pen.team), -1))
+        ours = [r for r in truth.robots if r.team == pen.team and (r.team, r.id) not in self.off]
+        kicker = min(ours, key=lambda r: math.hypot(r.x - pen.mark[0], r.y - pen.mark[1]), default=None)
+        for o in truth.robots:
+            key = (o.team, o.id)
+            if key in self.off or o is kicker:
+                continue
+            if key == keeper:
+                if abs(abs(o.x) - self.field.half_length) > self.field.league.robot.radius_m:
+                    return False
+            elif (o.x - pen.mark[0]) * attack > -self.rules.penalty_behind_m:
+                return False
+        return True
+
+    def _follow_penalty(self, truth: GroundTruth) -> None:
+        pen = self.penalty
+        if pen is None or self.command != "penalty":
+            return
+        if not self.ready:
+            if self.t - pen.t_start >= self.rules.prepare_timeout_s or self._penalty_set(truth, pen):
+                pen.t_run = self.t
+                self._set("penalty", pen.team, ready=True)
+            return
+        assert pen.t_run is not None
+        b = truth.ball
+        attack = self._attack_sign(pen.team)
+        moved = math.hypot(b.x - pen.mark[0], b.y - pen.mark[1]) > self.rules.ball_in_play_m
+        took = self.t - pen.t_run
+        if took > self.rules.penalty_time_s or (moved and (math.hypot(b.vx, b.vy) < 0.05 or b.vx * attack < -0.05)):
+            self._call(GameEvent(self.t, "penalty_over", pen.team, None, took, self.rules.penalty_time_s, "s",
+                                 "free_kick", _other(pen.team)))  # fmt: skip
+            self._award("free_kick", _other(pen.team), self._spot("free_kick", pen.team, (b.x, b.y)))
+
+    def _follow_stage(self) -> None:
+        """Halves, half time (halted) and the end; the sides change for the second half, where the
+        team that did not kick off first kicks off."""
+        if self.t < self._stage_end:
+            return
+        r = self.rules
+        if self.stage == "first_half" and r.half_time_s > 0.0:
+            self.stage, self._stage_end = "half_time", self.t + r.half_time_s
+            self._restart = None
+            self._clear_special()
+            self._set("halt", None)
+        elif self.stage in ("first_half", "half_time"):
+            self.stage, self._stage_end = "second_half", self.t + r.half_s
+            self.blue_sign = -1 if self.blue_sign > 0 else 1
+            self._restart = None
+            self._clear_special()
+            self._teleports.append(self.kickoff_setup("yellow"))
+        elif self.stage == "second_half":
+            self.stage, self._stage_end = "post_game", math.inf
+            self._restart = None
+            self._clear_special()
+            self._set("halt", None)
+        self._call(GameEvent(self.t, f"stage_{self.stage}"))
 
     def _check_keeper_held_ball(self, t: float, ball_xy: tuple[float, float]) -> None:
         """Rules (keeper held ball): the ball in a defense area for ``keeper_held_ball_s`` of normal
         play gives the other team a free kick at the nearest legal spot."""
         bx, by = ball_xy
         side = self.field.in_defense_area(bx, by)
-        if self.command != "normal" or self._restart is not None or not side:
+        if self.command not in ("normal", "force_start") or self._restart is not None or not side:
             self._in_area_since = None
             return
         if self._in_area_since is None:
@@ -156,14 +555,76 @@ class Referee:
         elif t - self._in_area_since >= self.params.keeper_held_ball_s:
             self._in_area_since = None
             self.keeper_held_ball += 1
-            taker: Team = "yellow" if side == self.blue_sign else "blue"
+            holder: Team = "blue" if side == self.blue_sign else "yellow"
+            taker = _other(holder)
             spot = self.field.free_kick_spot(bx, by, self.params.free_kick_distance_m)
-            self.command, self.for_team = "stop", None
-            self._restart = (t + self.params.restart_delay_s, "free_kick", taker, spot)
+            if self.full:
+                self._call(GameEvent(t, "keeper_held_ball", holder, self.rules.keepers.get(holder),
+                                     self.params.keeper_held_ball_s, self.params.keeper_held_ball_s, "s",
+                                     "free_kick", taker))  # fmt: skip
+                self._foul(holder, self.rules.keepers.get(holder))
+            self._award("free_kick", taker, spot)
+
+    # --- out --------------------------------------------------------------------------------
+    def _action_left(self) -> float:
+        t, r = self.t, self.rules
+        if self.command == "ball_placement" and self.placement is not None:
+            return r.placement_time_s - (t - self.placement.t_start)
+        if self.command in ("kickoff", "free_kick"):
+            return self.params.restart_timeout_s - (t - self._restart_t)
+        if self.command == "penalty" and self.penalty is not None:
+            if self.penalty.t_run is None:
+                return r.prepare_timeout_s - (t - self.penalty.t_start)
+            return r.penalty_time_s - (t - self.penalty.t_run)
+        return math.inf
+
+    def _next(self) -> tuple[str | None, Team | None]:
+        if self._restart is None:
+            return None, None
+        _, kind, team, _ = self._restart
+        if kind == "free_kick" and self.full and self._can_place(team):
+            return "ball_placement", team
+        return ("free_kick" if kind == "placed_free_kick" else kind), team
+
+    def team_info(self, team: Team) -> TeamInfo:
+        r = self.rules
+        return TeamInfo(
+            red_cards=self.red_cards[team], yellow_cards=self.yellow_cards[team],
+            yellow_card_times_s=tuple(max(0.0, c.left_s) for c in self.cards if c.team == team),
+            fouls=self.fouls[team], goalkeeper=r.keepers.get(team, 0), timeouts=r.timeouts,
+            timeout_time_s=r.timeout_total_s, placement_failures=self.placement_failures[team],
+            can_place_ball=self.full and self._can_place(team), max_robots=self.max_robots(team),
+        )  # fmt: skip
 
     def state(self) -> GameState:
+        placement = self._restart[3] if self._restart else self._restart_ball
+        if self.placement is not None:
+            placement = self.placement.target
+        elif self.penalty is not None:
+            placement = self.penalty.mark
+        nxt, nxt_team = self._next()
         return GameState(
             t=self.t, command=self.command, for_team=self.for_team, score_blue=self.score["blue"],
             score_yellow=self.score["yellow"], blue_defends_negative_x=self.blue_sign < 0,
-            placement=self._restart[3] if self._restart else self._restart_ball,
+            placement=placement, ready=self.ready, stage=self.stage,
+            stage_time_left_s=self._stage_end - self.t, command_counter=self.command_counter,
+            command_t=self.command_t, action_time_left_s=self._action_left(), next_command=nxt,
+            next_for_team=nxt_team, blue_team=self.team_info("blue"), yellow_team=self.team_info("yellow"),
         )  # fmt: skip
+
+    def summary(self) -> dict[str, object]:
+        """The rules' figures of the match: fouls per team by kind, cards, placements, penalties."""
+        by_kind: dict[str, dict[str, int]] = {t: {} for t in TEAMS}
+        for e in self.events:
+            if e.team is not None and e.kind in FOUL_RESTARTS:
+                by_kind[e.team][e.kind] = by_kind[e.team].get(e.kind, 0) + 1
+        return {
+            "rules": self.params.rules if self.params.enabled else "off",
+            "game_stage": self.stage,
+            "fouls": {t: {"total": self.fouls[t], **dict(sorted(by_kind[t].items()))} for t in TEAMS},
+            "cards": {t: {"yellow": self.yellow_cards[t], "red": self.red_cards[t]} for t in TEAMS},
+            "placements": {t: {**self.placements[t],
+                               "median_s": float(np.median(self.placement_s[t])) if self.placement_s[t] else None}
+                           for t in TEAMS},
+            "penalties": {t: dict(self.penalties[t]) for t in TEAMS},
+        }  # fmt: skip

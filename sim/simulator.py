@@ -6,6 +6,7 @@ ground truth; ``advance(commands)`` sends commands at that instant and steps one
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
@@ -64,7 +65,9 @@ class Simulator:
         self.world.blue_defends = -1 if params.referee.blue_defends == "negative_x" else 1
         self.referee: Referee | None = None
         if referee:
-            self.referee = Referee(self.world.field, self.world.robot_keys(), params.referee)
+            # scripted robots place no balls and know no fouls: the referee of ``cmdragons sim`` keeps the basics
+            basic = dataclasses.replace(params.referee, rules="basic")
+            self.referee = Referee(self.world.field, self.world.robot_keys(), basic)
             self.world.apply(self.referee.kickoff_setup("blue"))
         self.cameras = list(cameras)
         seeds = np.random.SeedSequence(self.seed).spawn(len(self.cameras) + 1)

@@ -1,9 +1,13 @@
 """Game states and set plays: what the rules ask of our robots outside normal play.
 
-Halt: everyone stands. Stop: every robot at least ``stop_distance_m`` from the ball and slow.
-Their kickoff or free kick: the same distance (at a kickoff also in our half, outside the centre
-circle). Our kickoff: everyone but the kicker in our half, outside the centre circle. No ball
-seen yet: a defensive shape in our half. Field frame, metres, radians.
+Halt (and a timeout): everyone stands. Stop: every robot at least ``stop_distance_m`` from the ball
+and slow. Their kickoff or free kick: the same distance (at a kickoff also in our half, outside the
+centre circle). Our kickoff: everyone but the kicker in our half, outside the centre circle. Ball
+placement: ours, the robot nearest the ball carries it to the designated position, lets go and
+backs off, the others keep away from ball and target; theirs, everyone keeps off the line from the
+ball to the target. Penalty: the taker behind the ball, then its shot at the goal's far side;
+their keeper aside, everyone else the rules' distance behind the ball; our keeper on its goal line
+until the normal start. No ball seen yet: a defensive shape in our half. Field frame, metres, radians.
 """
 
 from __future__ import annotations
@@ -16,9 +20,22 @@ from dataclasses import dataclass
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, Team
 from cmdragons.messages import BallState, GameState, RobotState
-from strategy.skills import Intent
+from strategy.skills import Intent, SkillParams, goalie_block, kick_to
 
-__all__ = ["GameStateParams", "halt", "hold_shape", "keep_away", "our_kickoff", "own_goal_sign", "restart_rules"]
+__all__ = [
+    "GameStateParams",
+    "behind_ball",
+    "halt",
+    "hold_shape",
+    "keep_away",
+    "keep_off_line",
+    "keeper_on_line",
+    "our_kickoff",
+    "own_goal_sign",
+    "penalty_shot",
+    "place_ball",
+    "restart_rules",
+]
 
 
 @dataclass(frozen=True)
@@ -32,6 +49,21 @@ class GameStateParams(Validated):
     hold_row_m: float = setting(0.4, lo=0.0, hi=3.0)  # ... its rows this far apart
     hold_rows: int = setting(3, lo=1, hi=11)
     hold_spacing_m: float = setting(0.6, lo=0.0, hi=3.0)  # ... its robots this far apart across the field
+    placement_done_m: float = setting(0.04, lo=0.0, hi=0.5)  # placing: the ball this near the target: let go
+    placement_near_m: float = setting(0.1, lo=0.0, hi=0.5)  # ... and once let go, not taken again within this
+    placement_back_m: float = setting(0.2, lo=0.0, hi=2.0)  # ... back off to this gap from the ball
+    placement_back_speed_m_s: float = setting(0.5, lo=0.05, hi=5.0)  # ... this slowly
+    placement_carry_speed_m_s: float = setting(0.6, lo=0.05, hi=5.0)  # carrying the ball on the dribbler
+    placement_take_speed_m_s: float = setting(0.3, lo=0.05, hi=5.0)  # ... driving onto it this slowly ...
+    placement_take_m: float = setting(0.3, lo=0.0, hi=2.0)  # ... from this far (face to ball centre) ...
+    placement_press_m: float = setting(0.03, lo=0.0, hi=0.1)  # ... aiming this far into it
+    placement_grip_m: float = setting(0.015, lo=0.001, hi=0.1)  # the ball this near the face's middle: held
+    placement_rest_m_s: float = setting(0.05, lo=0.0, hi=1.0)  # let go only of a ball this slow
+    placement_line_m: float = setting(0.65, lo=0.5, hi=3.0)  # rule: 0.5 m off the placement's line, plus margin
+    penalty_behind_m: float = setting(1.2, lo=1.0, hi=5.0)  # rule: 1 m behind the ball at a penalty, plus margin
+    penalty_aim_share: float = setting(0.7, lo=0.0, hi=1.0)  # the taker aims this share of the half goal aside
+    penalty_keeper_share: float = setting(0.6, lo=0.0, hi=1.0)  # our keeper's centre this share of its radius
+    # inside the goal line while the penalty is prepared (the rules: touching the line)
 
 
 def own_goal_sign(team: Team, game: GameState) -> float:
@@ -128,3 +160,107 @@ def restart_rules(intents: Mapping[int, Intent], game: GameState, ours: bool, ba
     if game.command == "kickoff" and ours:
         out = our_kickoff(out, pitch, own_sign, p, radius, kicker)
     return out
+
+
+def _capsule_push(x: float, y: float, a: tuple[float, float], b: tuple[float, float],
+                  d_min: float) -> tuple[float, float]:  # fmt: skip
+    """(x, y) moved out of the capsule of radius ``d_min`` round the segment a-b, the short way."""
+    ax, ay = a
+    dx, dy = b[0] - ax, b[1] - ay
+    length2 = dx * dx + dy * dy
+    u = 0.0 if length2 < 1e-12 else max(0.0, min(1.0, ((x - ax) * dx + (y - ay) * dy) / length2))
+    qx, qy = ax + u * dx, ay + u * dy
+    ox, oy = x - qx, y - qy
+    d = math.hypot(ox, oy)
+    if d >= d_min:
+        return x, y
+    if d < 1e-6:  # on the line: step to its left
+        n = math.hypot(dx, dy)
+        ox, oy, d = (-dy / n, dx / n, 1.0) if n > 1e-9 else (1.0, 0.0, 1.0)
+    return qx + ox / d * d_min, qy + oy / d * d_min
+
+
+def keep_off_line(intents: Mapping[int, Intent], start: tuple[float, float], end: tuple[float, float], pitch: Field,
+                  p: GameStateParams, radius: float) -> dict[int, Intent]:  # fmt: skip
+    """Every target ``placement_line_m`` (plus the robot's radius) off the segment from the ball
+    ``start`` to the placement's target ``end``, on the field (across the line when the field's
+    edge leaves no room on the near side)."""
+    d_min = p.placement_line_m + radius
+    lim_x, lim_y = pitch.half_length - radius, pitch.half_width - radius
+    out = {}
+    for rid, it in intents.items():
+        x, y = _capsule_push(it.x, it.y, start, end, d_min)
+        if abs(x) > lim_x or abs(y) > lim_y:
+            # mirror through the line: the far side
+            cx, cy = _capsule_push(2.0 * x - it.x, 2.0 * y - it.y, start, end, d_min)
+            x, y = (cx, cy) if abs(cx) <= lim_x and abs(cy) <= lim_y else (x, y)
+        x, y = max(-lim_x, min(lim_x, x)), max(-lim_y, min(lim_y, y))
+        out[rid] = Intent(x, y, it.theta, avoid_ball=True, allow_own_defense=it.allow_own_defense,
+                          max_speed_m_s=it.max_speed_m_s)  # fmt: skip
+    return out
+
+
+def place_ball(robot: RobotState, ball: BallState, target: tuple[float, float], skills: SkillParams,
+               p: GameStateParams, held: bool = False) -> tuple[Intent, bool]:  # fmt: skip
+    """Ball placement by one robot: take the ball on the dribbler from where the robot stands (no
+    going round it: a ball by the line or past it is pulled back), carry it without turning until
+    it lies within ``placement_done_m`` of ``target``, let go, and back off slowly to
+    ``placement_back_m`` from it. ``held``: the ball was held the frame before (it stays held until
+    it is ``dribble_hold_m`` off the face: a ball in the robot's mouth is seen late); returns the
+    intent and whether the ball is held now."""
+    off = math.hypot(ball.x - target[0], ball.y - target[1])
+    contact = skills.contact_m
+    c, s = math.cos(robot.theta), math.sin(robot.theta)
+    # held: the ball against the middle of the face (tighter than the dribble skill's test: a carry
+    # that starts without the grip walks away from the ball)
+    face_gap = math.hypot(ball.x - (robot.x + c * contact), ball.y - (robot.y + s * contact))
+    on_face = face_gap < p.placement_grip_m or (held and face_gap < skills.dribble_hold_m)
+    resting = math.hypot(ball.vx, ball.vy) < p.placement_rest_m_s
+    if (off <= p.placement_done_m and resting) or (off <= p.placement_near_m and not on_face):
+        away = math.atan2(robot.y - ball.y, robot.x - ball.x)
+        reach = contact + p.placement_back_m
+        return Intent(ball.x + reach * math.cos(away), ball.y + reach * math.sin(away), robot.theta,
+                      max_speed_m_s=p.placement_back_speed_m_s), False  # fmt: skip
+    if on_face:  # carry: the robot where the ball lies on the target, facing as it does
+        return Intent(target[0] - c * contact, target[1] - s * contact, robot.theta, dribbler=skills.hold_dribbler,
+                      avoid_ball=False, max_speed_m_s=p.placement_carry_speed_m_s), True  # fmt: skip
+    heading = math.atan2(ball.y - robot.y, ball.x - robot.x)
+    near = math.hypot(ball.x - robot.x, ball.y - robot.y) < contact + p.placement_take_m
+    reach = contact - p.placement_press_m  # a little into the ball: the face meets it before the robot stops
+    return Intent(ball.x - math.cos(heading) * reach, ball.y - math.sin(heading) * reach, heading,
+                  dribbler=skills.hold_dribbler, avoid_ball=False,
+                  max_speed_m_s=p.placement_take_speed_m_s if near else None), False  # fmt: skip
+
+
+def behind_ball(intents: Mapping[int, Intent], ball: BallState, attack_sign: float, pitch: Field,
+                p: GameStateParams, radius: float) -> dict[int, Intent]:  # fmt: skip
+    """A penalty's rule for everyone but the taker and the defending keeper: ``penalty_behind_m``
+    behind the ball (toward the kicking team's own goal), on the field."""
+    limit = ball.x - attack_sign * (p.penalty_behind_m + radius)
+    lim_x = pitch.half_length - radius
+    out = {}
+    for rid, it in intents.items():
+        x = it.x if (it.x - limit) * attack_sign <= 0.0 else limit
+        out[rid] = dataclasses.replace(it, x=max(-lim_x, min(lim_x, x)), kick_speed=0.0, avoid_ball=True)
+    return out
+
+
+def penalty_shot(robot: RobotState, ball: BallState, attack_sign: float, keeper: RobotState | None, pitch: Field,
+                 skills: SkillParams, p: GameStateParams, ready: bool) -> Intent:  # fmt: skip
+    """The taker: behind the ball facing the goal while the penalty is prepared; at the normal
+    start a shot at the side of the goal the keeper leaves open."""
+    side = -math.copysign(1.0, keeper.y) if keeper is not None and abs(keeper.y) > 1e-3 else 1.0
+    aim = (attack_sign * pitch.half_length, side * pitch.goal_half_width * p.penalty_aim_share)
+    if ready:
+        return kick_to(robot, ball, aim, skills.max_kick_m_s, skills)
+    heading = math.atan2(aim[1] - ball.y, aim[0] - ball.x)
+    wait = skills.contact_m + skills.approach_distance_m
+    return Intent(ball.x - wait * math.cos(heading), ball.y - wait * math.sin(heading), heading)
+
+
+def keeper_on_line(ball: BallState, pitch: Field, own_sign: float, skills: SkillParams,
+                   p: GameStateParams) -> Intent:  # fmt: skip
+    """Our keeper while their penalty is prepared: touching the goal line, across from the ball."""
+    block = goalie_block(ball, pitch, own_sign, skills)
+    x = own_sign * (pitch.half_length - p.penalty_keeper_share * skills.robot_radius_m)
+    return dataclasses.replace(block, x=x)

@@ -23,7 +23,19 @@ from cmdragons.geometry import Field, Team
 from cmdragons.messages import BallState, GameState, RobotState, WorldState
 from strategy.defense import DefenseParams, defender_slots, goalie
 from strategy.evaluation import PassParams
-from strategy.game_states import GameStateParams, halt, hold_shape, keep_away, own_goal_sign, restart_rules
+from strategy.game_states import (
+    GameStateParams,
+    behind_ball,
+    halt,
+    hold_shape,
+    keep_away,
+    keep_off_line,
+    keeper_on_line,
+    own_goal_sign,
+    penalty_shot,
+    place_ball,
+    restart_rules,
+)
 from strategy.kicking import Attacker, KickKind, KickParams
 from strategy.passing import PassPlay, PassPlayParams
 from strategy.roles import Objective, Role, RoleAssigner, RoleKind, RoleParams
@@ -86,6 +98,7 @@ class Strategy:
         self.attacker = Attacker(pitch, params.kicking, params.passing, params.skills, params.obstacle_radius_m)
         self.frame = 0
         self.last_action: dict[int, str] = {}  # robot id -> "shot", "pass" or "clear": what its kick is for
+        self._placing: int | None = None  # the robot holding the ball it places
 
     def own_sign(self, game: GameState) -> float:
         """-1 when we defend the goal at negative x, else +1."""
@@ -111,14 +124,62 @@ class Strategy:
             return {}
         own_sign = self.own_sign(game)
         ball = world.ball
-        if game.command == "halt":
+        if game.command in ("halt", "timeout"):
             return halt(own)
         if ball is None:
             return hold_shape(own, self.field, own_sign, self.p.game_states)
         intents = self._normal(world.t, own, opp, ball, own_sign)
+        ours = game.for_team == self.team
+        if game.command == "ball_placement" and game.placement is not None:
+            return self._placement(intents, own, ball, game.placement, ours, own_sign)
+        if game.command == "penalty":
+            return self._penalty(intents, own, opp, ball, game.ready, ours, own_sign)
         kicker = next((rid for rid, role in self.roles.roles.items() if role == ATTACKER), None)
-        return restart_rules(intents, game, game.for_team == self.team, ball, self.field, own_sign,
-                             self.p.game_states, self.p.robot_radius_m, kicker)  # fmt: skip
+        if game.command == "kickoff" and not game.ready:
+            kicker = None  # prepared, not started: nobody plays the ball yet
+        return restart_rules(intents, game, ours, ball, self.field, own_sign, self.p.game_states,
+                             self.p.robot_radius_m, kicker)  # fmt: skip
+
+    def _role_robot(self, role: Role) -> int | None:
+        return next((rid for rid, r in self.roles.roles.items() if r == role), None)
+
+    def _placement(self, intents: dict[int, Intent], own: Mapping[int, RobotState], ball: BallState,
+                   target: tuple[float, float], ours: bool, own_sign: float) -> dict[int, Intent]:  # fmt: skip
+        """Ball placement: ours, the robot nearest the ball (the goalie only when alone) places it
+        and the others keep off its way; theirs, everyone keeps off the line to the target."""
+        p, f, gs = self.p, self.field, self.p.game_states
+        if not ours:
+            return keep_off_line(intents, (ball.x, ball.y), target, f, gs, p.robot_radius_m)
+        goalie_id = self._role_robot(GOALIE)
+        players = [rid for rid in own if rid != goalie_id] or list(own)
+        carrier = min(players, key=lambda rid: math.hypot(own[rid].x - ball.x, own[rid].y - ball.y))
+        others = {rid: it for rid, it in intents.items() if rid != carrier}
+        others = keep_off_line(others, (ball.x, ball.y), target, f, gs, p.robot_radius_m)
+        out = dict(keep_away(others, ball, f, own_sign, gs, p.robot_radius_m, kickoff=False, slow=False))
+        out[carrier], held = place_ball(own[carrier], ball, target, p.skills, gs, self._placing == carrier)
+        self._placing = carrier if held else None
+        return out
+
+    def _penalty(self, intents: dict[int, Intent], own: Mapping[int, RobotState], opp: list[RobotState],
+                 ball: BallState, ready: bool, ours: bool, own_sign: float) -> dict[int, Intent]:  # fmt: skip
+        """A penalty kick: ours, the taker shoots at the normal start, everyone else behind the
+        ball; theirs, our keeper on its line until the normal start, everyone else behind the ball."""
+        p, f, gs = self.p, self.field, self.p.game_states
+        goalie_id = self._role_robot(GOALIE)
+        if ours:
+            attack = -own_sign
+            players = [rid for rid in own if rid != goalie_id] or list(own)
+            taker = min(players, key=lambda rid: math.hypot(own[rid].x - ball.x, own[rid].y - ball.y))
+            keeper = min(opp, key=lambda r: abs(r.x - attack * f.half_length) + abs(r.y), default=None)
+            out = behind_ball({rid: it for rid, it in intents.items() if rid != taker}, ball, attack, f, gs,
+                              p.robot_radius_m)  # fmt: skip
+            out[taker] = penalty_shot(own[taker], ball, attack, keeper, f, p.skills, gs, ready)
+            return out
+        out = behind_ball({rid: it for rid, it in intents.items() if rid != goalie_id}, ball, own_sign, f, gs,
+                          p.robot_radius_m)  # fmt: skip
+        if goalie_id is not None:
+            out[goalie_id] = intents[goalie_id] if ready else keeper_on_line(ball, f, own_sign, p.skills, gs)
+        return out
 
     def _objectives(self, own: Mapping[int, RobotState], ball: BallState, own_sign: float,
                     defenders: Mapping[Role, Intent]) -> list[Objective]:  # fmt: skip

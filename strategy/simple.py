@@ -2,23 +2,33 @@
 
 Its lowest id keeps goal (and clears a ball at rest in its area), the robot nearest the ball goes
 behind it and shoots at the goal's centre, the others hold a shape in their half that follows the
-ball sideways. It keeps the rules' distance in a stop and at our restarts. A sparring partner for
+ball sideways. It keeps the rules' distance in a stop and at our restarts, places the ball with its
+chaser, keeps off the line of our placements, and takes and defends penalties the plain way (its
+chaser shoots, its goalie blocks). Robots sent off the field it leaves alone. A sparring partner for
 matches and benchmarks, not a team.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, Team, wrap_angle
-from cmdragons.messages import GameState, RobotCommand, WorldState
+from cmdragons.messages import BallState, GameState, RobotCommand, RobotState, WorldState
 from strategy.defense import ball_to_clear, clear_target
 from strategy.evaluation import clearest_direction
-from strategy.game_states import keep_away, own_goal_sign
+from strategy.game_states import (
+    behind_ball,
+    keep_away,
+    keep_off_line,
+    keeper_on_line,
+    own_goal_sign,
+    penalty_shot,
+    place_ball,
+)
 from strategy.plays import StrategyParams
 from strategy.skills import Intent, goalie_block, kick_to
 
@@ -53,14 +63,17 @@ def steer(team: Team, rid: int, x: float, y: float, theta: float, it: Intent, p:
 class SimpleTeam:
     def __init__(self, team: Team, pitch: Field, params: SimpleTeamParams, strategy: StrategyParams) -> None:
         self.team, self.field, self.p, self.sp = team, pitch, params, strategy
+        self._placing: int | None = None  # the robot holding the ball it places
 
     def commands(self, world: WorldState, game: GameState) -> list[RobotCommand]:
-        own = sorted((r for r in world.robots if r.team == self.team), key=lambda r: r.id)
+        f = self.field
+        # robots off the field (a card's) are out of play
+        on = [r for r in world.robots if r.team == self.team and f.in_field(r.x, r.y, -f.dims.boundary_width_m)]
+        own = sorted(on, key=lambda r: r.id)
         ball = world.ball
-        if not own or ball is None or game.command == "halt":
+        if not own or ball is None or game.command in ("halt", "timeout"):
             return [RobotCommand(self.team, r.id) for r in own]
         own_sign = own_goal_sign(self.team, game)
-        f = self.field
         goal = (-own_sign * f.half_length, 0.0)
         goalie = own[0]
         intents: dict[int, Intent] = {goalie.id: goalie_block(ball, f, own_sign, self.sp.skills)}
@@ -85,7 +98,34 @@ class SimpleTeam:
                 y = ball.y * self.p.shape_follow_share + (k - (len(others) - 1) / 2) * self.p.shape_spacing_m
                 intents[r.id] = Intent(x, y, math.atan2(ball.y - y, ball.x - x))
         ours = game.for_team == self.team
+        gs, radius = self.sp.game_states, self.sp.robot_radius_m
         if game.command == "stop" or (game.command in ("kickoff", "free_kick") and not ours):
-            intents = keep_away(intents, ball, f, own_sign, self.sp.game_states, self.sp.robot_radius_m,
-                                game.command == "kickoff", game.command == "stop")  # fmt: skip
+            intents = keep_away(intents, ball, f, own_sign, gs, radius, game.command == "kickoff",
+                                game.command == "stop")  # fmt: skip
+        elif game.command == "ball_placement" and game.placement is not None:
+            intents = keep_off_line(intents, (ball.x, ball.y), game.placement, f, gs, radius)
+            if ours and field_players:
+                intents[chaser.id], held = place_ball(chaser, ball, game.placement, self.sp.skills, gs,
+                                                      self._placing == chaser.id)  # fmt: skip
+                self._placing = chaser.id if held else None
+        elif game.command == "penalty":
+            intents = self._penalty(intents, own, world, ball, game.ready, ours, own_sign)
         return [steer(self.team, r.id, r.x, r.y, r.theta, intents[r.id], self.p) for r in own]
+
+    def _penalty(self, intents: dict[int, Intent], own: list[RobotState], world: WorldState, ball: BallState,
+                 ready: bool, ours: bool, own_sign: float) -> dict[int, Intent]:  # fmt: skip
+        """Its chaser takes the penalty, everyone else behind the ball; defending, its goalie on the line."""
+        f, gs, radius = self.field, self.sp.game_states, self.sp.robot_radius_m
+        goalie = own[0]
+        if ours:
+            taker = min(own[1:] or own, key=lambda r: math.hypot(r.x - ball.x, r.y - ball.y))
+            attack = -own_sign
+            keeper = min((r for r in world.robots if r.team != self.team),
+                         key=lambda r: abs(r.x - attack * f.half_length) + abs(r.y), default=None)  # fmt: skip
+            out = behind_ball({k: v for k, v in intents.items() if k != taker.id}, ball, attack, f, gs, radius)
+            shot = penalty_shot(taker, ball, attack, keeper, f, self.sp.skills, gs, ready)
+            out[taker.id] = replace(shot, kick_speed=min(shot.kick_speed, self.p.shot_speed_m_s))
+            return out
+        out = behind_ball({k: v for k, v in intents.items() if k != goalie.id}, ball, own_sign, f, gs, radius)
+        out[goalie.id] = intents[goalie.id] if ready else keeper_on_line(ball, f, own_sign, self.sp.skills, gs)
+        return out

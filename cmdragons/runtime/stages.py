@@ -8,6 +8,7 @@ Topics (what each stage reads -> writes):
     events             SimEvents            sim -> referee, statistics
     teleport           Teleport             referee -> sim
     referee            GameState            referee -> brains, opponent, statistics
+    referee/events     GameEvents           referee -> logs (its calls: fouls, cards, placements)
     detections/<id>    DetectionFrame       vision/<id> -> trackers
     perception/<team>  DetectionFrame       truth perception/<team> -> tracker/<team>
     world/<team>       WorldState           tracker/<team> -> team/<team>
@@ -36,6 +37,7 @@ from cmdragons.messages import (
     CameraFrame,
     Contact,
     DetectionFrame,
+    GameEvents,
     GameState,
     GroundTruth,
     Kick,
@@ -288,21 +290,28 @@ class SimpleOpponentStage(_PlayingStage):
 
 
 class RefereeStage(BaseStage):
-    """The simulator's referee: the frame's events -> the game state (and a restart's teleport)."""
+    """The simulator's referee: the frame's events (and, for the full rules, the true state the
+    auto-referee judges) -> the game state, the frame's calls and a restart's teleport."""
 
     name = "referee"
-    inputs = ("events",)
+    inputs = ("truth", "events")
 
     def __init__(self, referee: Referee) -> None:
         self.referee = referee
+        self._truth: GroundTruth | None = None
 
     def start(self, publish: Publish) -> None:
         publish("teleport", self.referee.kickoff_setup("blue"))
         publish("referee", self.referee.state())
 
     def on_message(self, topic: str, message: Any, publish: Publish) -> None:
+        if topic == "truth":
+            self._truth = message
+            return
         ev: SimEvents = message
-        teleport = self.referee.observe(ev.t, ev.events, ev.ball_xy)
+        teleport = self.referee.observe(ev.t, ev.events, ev.ball_xy, self._truth)
+        if self.referee.new_events:
+            publish("referee/events", GameEvents(ev.t, tuple(self.referee.new_events)))
         if teleport is not None:
             publish("teleport", teleport)
         publish("referee", self.referee.state())
@@ -311,7 +320,7 @@ class RefereeStage(BaseStage):
         r = self.referee
         publish(f"summary/{self.name}", StageSummary(self.name, {
             "score": dict(r.score), "kicks": r.kicks, "balls_out": r.balls_out,
-            "keeper_held_ball": r.keeper_held_ball, "robot_contacts": len(r.contacts)}))  # fmt: skip
+            "keeper_held_ball": r.keeper_held_ball, "robot_contacts": len(r.contacts), **r.summary()}))  # fmt: skip
 
 
 class StatsStage(BaseStage):

@@ -13,6 +13,8 @@ from cmdragons.messages import (
     BallState,
     BallTruth,
     DetectionFrame,
+    GameEvent,
+    GameEvents,
     GameState,
     GroundTruth,
     MessageError,
@@ -20,6 +22,7 @@ from cmdragons.messages import (
     RobotDetection,
     RobotState,
     RobotTruth,
+    TeamInfo,
     WorldState,
 )
 
@@ -39,15 +42,26 @@ TRUTH = GroundTruth(
 )  # fmt: skip
 COMMAND = RobotCommand("yellow", 4, 1.0, -0.5, 2.0, 3.5, True, 0.5)
 GAME = GameState(3.0, "free_kick", "yellow", 2, 1, False, (1.0, -2.8))
+# everything the league's Referee message carries: a placement for blue, a card running for yellow
+RULES_GAME = GameState(
+    41.5, "ball_placement", "blue", 1, 0, True, (-2.0, 1.5), ready=True, stage="second_half",
+    stage_time_left_s=187.25, command_counter=17, command_t=40.0, action_time_left_s=28.5,
+    next_command="free_kick", next_for_team="blue",
+    blue_team=TeamInfo(fouls=2, goalkeeper=1, placement_failures=1, max_robots=6),
+    yellow_team=TeamInfo(red_cards=1, yellow_cards=2, yellow_card_times_s=(75.5, 3.25), fouls=6, goalkeeper=0,
+                         timeouts=3, timeout_time_s=120.0, can_place_ball=False, max_robots=3),
+)
+EVENTS = GameEvents(12.0, (GameEvent(11.98, "crash", "yellow", 4, 1.61, 1.5, "m/s", "free_kick", "blue"),
+                           GameEvent(12.0, "placement_succeeded", "blue", None, 7.5, 30.0, "s")))
 
 
-@pytest.mark.parametrize("msg", [DET, WORLD, TRUTH, COMMAND, GAME], ids=lambda m: type(m).__name__)
+@pytest.mark.parametrize("msg", [DET, WORLD, TRUTH, COMMAND, GAME, RULES_GAME, EVENTS], ids=lambda m: type(m).__name__)
 def test_dict_round_trip_through_json(msg: object) -> None:
     d = json.loads(json.dumps(msg.to_dict()))  # type: ignore[attr-defined]
     assert type(msg).from_dict(d) == msg  # type: ignore[attr-defined]
 
 
-@pytest.mark.parametrize("msg", [DET, WORLD, GAME], ids=lambda m: type(m).__name__)
+@pytest.mark.parametrize("msg", [DET, WORLD, GAME, RULES_GAME], ids=lambda m: type(m).__name__)
 def test_binary_round_trip(msg: object) -> None:
     back = type(msg).decode(msg.encode())  # type: ignore[attr-defined]
     assert _close(back.to_dict(), msg.to_dict())  # type: ignore[attr-defined]

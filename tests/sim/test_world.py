@@ -192,7 +192,7 @@ def judge(ref: Referee, w: World, events: list[Any]) -> None:
 
 def test_goal_counted_and_kickoff_restart() -> None:
     w = make_world(blue=1, yellow=1)
-    ref = Referee(w.field, w.robot_keys(), RefereeParams())
+    ref = Referee(w.field, w.robot_keys(), RefereeParams(rules="basic"))
     w.place_ball(3.5, 0.1, vx=4.0)
     events = []
     for _ in range(120):
@@ -209,7 +209,7 @@ def test_goal_counted_and_kickoff_restart() -> None:
 
 def test_ball_out_gives_a_free_kick_at_a_legal_spot() -> None:
     w = make_world(blue=1, yellow=1)
-    ref = Referee(w.field, w.robot_keys(), RefereeParams())
+    ref = Referee(w.field, w.robot_keys(), RefereeParams(rules="basic"))
     w.place_robot("yellow", 0, 1.0, 2.0, math.pi / 2)
     w.place_ball(1.0, 2.0 + FRONT + 0.005)
     events = []
@@ -226,7 +226,7 @@ def test_ball_out_gives_a_free_kick_at_a_legal_spot() -> None:
 
 def test_ball_held_in_a_defense_area_gives_the_other_team_a_free_kick() -> None:
     w = make_world(blue=1, yellow=1)
-    ref = Referee(w.field, w.robot_keys(), RefereeParams(keeper_held_ball_s=2.0, restart_delay_s=0.5))
+    ref = Referee(w.field, w.robot_keys(), RefereeParams(rules="basic", keeper_held_ball_s=2.0, restart_delay_s=0.5))
     ref.command, ref.for_team = "normal", None
     w.place_ball(4.2, 0.3)  # at rest in the defense area at +x: yellow defends it
     for _ in range(round(1.9 * 60)):

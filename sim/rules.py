@@ -1,0 +1,336 @@
+"""The auto-referee: the league's fouls, seen on the simulator's true state frame by frame.
+
+Each foul is a small named check over the truth (field frame, metres, seconds); :class:`FoulWatch`
+keeps what the checks need across frames (who touches the ball and since where, which robots are in
+contact and since when, who was called already) and answers each frame with the fouls it saw, as
+:class:`~cmdragons.messages.GameEvent` values carrying the figure that broke the rule. What a foul
+leads to (a free kick, a penalty, a card) the game controller (:mod:`sim.referee`) decides.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+from cmdragons.config import Validated, setting
+from cmdragons.geometry import Field, Team
+from cmdragons.messages import GameEvent, GroundTruth, RobotTruth
+
+__all__ = ["FOUL_RESTARTS", "FoulWatch", "RulesParams", "Situation"]
+
+Key = tuple[Team, int]
+
+# what each foul leads to: a free kick (or a penalty kick) for the other team, or nothing but the count
+FOUL_RESTARTS: dict[str, str] = {
+    "crash": "free_kick", "crash_drawn": "", "pushing": "free_kick", "ball_too_fast": "free_kick",
+    "excessive_dribbling": "free_kick", "attacker_in_defense_area": "free_kick",
+    "defender_in_defense_area": "penalty", "double_touch": "free_kick", "stop_speed": "", "stop_distance": "",
+    "kick_point_distance": "", "keeper_held_ball": "free_kick", "boundary_crossing": "free_kick",
+    "too_many_robots": "",
+}  # fmt: skip
+
+
+@dataclass(frozen=True)
+class RulesParams(Validated):
+    """The league's figures (configs/sim.yaml referee.rules; each key names its rule there)."""
+
+    half_s: float = setting(300.0, lo=1.0, hi=3600.0)
+    half_time_s: float = setting(300.0, lo=0.0, hi=3600.0)
+    timeouts: int = setting(4, lo=0, hi=20)
+    timeout_total_s: float = setting(300.0, lo=0.0, hi=3600.0)
+    stop_speed_m_s: float = setting(1.5, lo=0.1, hi=10.0)
+    stop_distance_m: float = setting(0.5, lo=0.0, hi=5.0)
+    stop_grace_s: float = setting(2.0, lo=0.0, hi=30.0)
+    ball_speed_limit_m_s: float = setting(6.5, lo=0.1, hi=20.0)
+    crash_speed_m_s: float = setting(1.5, lo=0.1, hi=10.0)
+    crash_drawn_m_s: float = setting(0.3, lo=0.0, hi=10.0)
+    push_distance_m: float = setting(0.2, lo=0.01, hi=5.0)
+    dribble_distance_m: float = setting(1.0, lo=0.1, hi=20.0)
+    kick_point_distance_m: float = setting(0.5, lo=0.0, hi=5.0)
+    kick_point_grace_s: float = setting(1.0, lo=0.0, hi=30.0)
+    ball_in_play_m: float = setting(0.05, lo=0.001, hi=1.0)
+    placement_time_s: float = setting(30.0, lo=1.0, hi=600.0)
+    placement_tolerance_m: float = setting(0.15, lo=0.01, hi=2.0)
+    placement_clear_m: float = setting(0.05, lo=0.0, hi=2.0)
+    placement_rest_m_s: float = setting(0.1, lo=0.0, hi=5.0)
+    placement_failures_max: int = setting(5, lo=1, hi=100)
+    fouls_per_yellow_card: int = setting(3, lo=1, hi=100)
+    yellow_card_s: float = setting(120.0, lo=1.0, hi=3600.0)
+    red_card_yellow_cards: int = setting(3, lo=0, hi=100)
+    prepare_timeout_s: float = setting(10.0, lo=0.0, hi=600.0)
+    penalty_mark_from_goal_m: float = setting(6.0, lo=0.5, hi=20.0)
+    penalty_behind_m: float = setting(1.0, lo=0.0, hi=10.0)
+    penalty_time_s: float = setting(10.0, lo=0.5, hi=600.0)
+    touch_margin_m: float = setting(0.015, lo=0.0, hi=0.2)
+    contact_margin_m: float = setting(0.01, lo=0.0, hi=0.2)
+    keepers: Mapping[Team, int] = field(default_factory=lambda: {"blue": 0, "yellow": 0})
+
+
+@dataclass(frozen=True)
+class Situation:
+    """What the checks need of the game controller this frame."""
+
+    command: str
+    for_team: Team | None
+    since: float  # when the command was given (s)
+    blue_sign: int  # -1: blue defends the goal at -x
+    in_play: bool  # the ball is in play (normal play, or a restart taken)
+
+
+@dataclass
+class _Touch:
+    start: tuple[float, float]  # where the ball was when the robot took it
+    called: bool = False
+
+
+@dataclass
+class _Contact:
+    t: float
+    normal: tuple[float, float]  # unit vector from a to b at first touch
+    a0: tuple[float, float]
+    b0: tuple[float, float]
+    pushed: bool = False
+
+
+def _team_sign(team: Team, blue_sign: int) -> int:
+    """The side of the goal ``team`` defends: -1 for -x."""
+    return blue_sign if team == "blue" else -blue_sign
+
+
+def _other(team: Team) -> Team:
+    return "yellow" if team == "blue" else "blue"
+
+
+class FoulWatch:
+    """Frame-by-frame foul detection on the true state."""
+
+    def __init__(self, pitch: Field, params: RulesParams) -> None:
+        self.field, self.p = pitch, params
+        self.robot_r = pitch.league.robot.radius_m
+        self.ball_r = pitch.league.ball.radius_m
+        self.touching: dict[Key, _Touch] = {}
+        self.last_touch: Key | None = None
+        self._prev: dict[Key, RobotTruth] = {}
+        self._contacts: dict[tuple[Key, Key], _Contact] = {}
+        self._called: set[tuple[str, Key]] = set()  # once per robot per stop or restart
+        self._called_since = -math.inf
+        self._restart_kicker: Key | None = None  # a restart's kicker until another robot touched the ball
+        self._kicker_left = False  # ... and whether it let go of the ball since
+        self._fast_ball_called = False
+
+    def kicked(self, kicker: Key) -> None:
+        """The simulator's kicker fired: a touch, however short (a kick can leave before a frame shows it)."""
+        self.touching.setdefault(kicker, _Touch((math.nan, math.nan), called=True))
+        self.last_touch = kicker
+        self._fast_ball_called = False
+
+    def restart_taken(self, kicker: Key | None) -> None:
+        """A kickoff or free kick was taken by ``kicker``: a second touch before another robot's is a foul."""
+        self._restart_kicker = kicker
+        self._kicker_left = False
+
+    def judge(self, gt: GroundTruth, s: Situation) -> list[GameEvent]:
+        if s.since != self._called_since:
+            self._called, self._called_since = set(), s.since
+        robots = [r for r in gt.robots if self.field.in_field(r.x, r.y, -self.field.dims.boundary_width_m)]
+        out: list[GameEvent] = []
+        new_touches = self._touches(gt, robots)
+        if s.command != "halt":
+            out += self._crashes(gt, robots)
+        if s.in_play:
+            out += self._ball_too_fast(gt)
+            out += self._dribbling(gt)
+            out += self._area_touches(gt, robots, new_touches, s)
+            out += self._double_touch(gt, new_touches)
+        else:
+            self._restart_kicker = None
+        if s.command != "halt":  # the ball crosses the boundary after the line: play is already stopped
+            out += self._boundary(gt)
+        if s.command == "stop" and gt.t - s.since >= self.p.stop_grace_s:
+            out += self._stop(gt, robots)
+        if s.command in ("free_kick", "kickoff") and s.for_team is not None and not s.in_play \
+                and gt.t - s.since >= self.p.kick_point_grace_s:  # fmt: skip
+            out += self._kick_point(gt, robots, _other(s.for_team))
+        self._prev = {(r.team, r.id): r for r in robots}
+        return out
+
+    # --- ball touches -------------------------------------------------------------------------
+    def _touches(self, gt: GroundTruth, robots: list[RobotTruth]) -> list[Key]:
+        """Which robots touch the ball now (its centre within their radius plus the ball's and a
+        margin, the ball on the ground); returns those that started touching it this frame."""
+        b = gt.ball
+        reach = self.robot_r + self.ball_r + self.p.touch_margin_m
+        now = {(r.team, r.id) for r in robots if b.z < 2.0 * self.ball_r + 0.05
+               and math.hypot(r.x - b.x, r.y - b.y) < reach}  # fmt: skip
+        new = [k for k in sorted(now) if k not in self.touching]
+        for k in list(self.touching):
+            if k not in now:
+                del self.touching[k]
+                if k == self._restart_kicker:
+                    self._kicker_left = True
+        for k in new:
+            self.touching[k] = _Touch((b.x, b.y))
+            self.last_touch = k
+            self._fast_ball_called = False
+        return new
+
+    def _event(self, t: float, kind: str, key: Key | None, value: float, limit: float, unit: str) -> GameEvent:
+        restart = FOUL_RESTARTS[kind]
+        team = None if key is None else key[0]
+        return GameEvent(t, kind, team, None if key is None else key[1], value, limit, unit, restart,
+                         _other(team) if restart and team is not None else None)  # fmt: skip
+
+    def _once(self, kind: str, key: Key) -> bool:
+        """True the first time ``kind`` is called on ``key`` since the command changed."""
+        if (kind, key) in self._called:
+            return False
+        self._called.add((kind, key))
+        return True
+
+    # --- the checks -----------------------------------------------------------------------------
+    def _crashes(self, gt: GroundTruth, robots: list[RobotTruth]) -> list[GameEvent]:
+        """Crash: two robots of different teams meet faster than ``crash_speed_m_s`` (their closing
+        speed the frame before contact); the faster along the line is at fault, both when their
+        speeds differ by less than ``crash_drawn_m_s``. Pushing: an opponent shoved more than
+        ``push_distance_m`` while in contact."""
+        out = []
+        touch = 2.0 * self.robot_r + self.p.contact_margin_m
+        blue = [r for r in robots if r.team == "blue"]
+        yellow = [r for r in robots if r.team == "yellow"]
+        seen = set()
+        for a in blue:
+            for b in yellow:
+                dx, dy = b.x - a.x, b.y - a.y
+                d = math.hypot(dx, dy)
+                ka, kb = (a.team, a.id), (b.team, b.id)
+                pair = (ka, kb)
+                if d >= touch or d < 1e-9:
+                    continue
+                seen.add(pair)
+                n = (dx / d, dy / d)
+                c = self._contacts.get(pair)
+                if c is None:
+                    pa, pb = self._prev.get(ka, a), self._prev.get(kb, b)
+                    sa = pa.vx * n[0] + pa.vy * n[1]  # a's speed toward b
+                    sb = -(pb.vx * n[0] + pb.vy * n[1])  # b's speed toward a
+                    self._contacts[pair] = c = _Contact(gt.t, n, (a.x, a.y), (b.x, b.y))
+                    closing = sa + sb
+                    if closing > self.p.crash_speed_m_s:
+                        if abs(sa - sb) < self.p.crash_drawn_m_s:
+                            out += [self._event(gt.t, "crash_drawn", k, closing, self.p.crash_speed_m_s, "m/s")
+                                    for k in (ka, kb)]  # fmt: skip
+                        else:
+                            out.append(self._event(gt.t, "crash", ka if sa > sb else kb, closing,
+                                                   self.p.crash_speed_m_s, "m/s"))  # fmt: skip
+                    continue
+                if c.pushed:
+                    continue
+                nx, ny = c.normal
+                b_moved = (b.x - c.b0[0]) * nx + (b.y - c.b0[1]) * ny  # b driven away from a
+                a_moved = -((a.x - c.a0[0]) * nx + (a.y - c.a0[1]) * ny)  # a driven away from b
+                if b_moved > self.p.push_distance_m and a_moved < 0.0:
+                    c.pushed = True
+                    out.append(self._event(gt.t, "pushing", ka, b_moved, self.p.push_distance_m, "m"))
+                elif a_moved > self.p.push_distance_m and b_moved < 0.0:
+                    c.pushed = True
+                    out.append(self._event(gt.t, "pushing", kb, a_moved, self.p.push_distance_m, "m"))
+        for pair in list(self._contacts):
+            if pair not in seen:
+                del self._contacts[pair]
+        return out
+
+    def _ball_too_fast(self, gt: GroundTruth) -> list[GameEvent]:
+        """Ball speed over ``ball_speed_limit_m_s``: the last robot to touch it is at fault (once a touch)."""
+        b = gt.ball
+        speed = math.sqrt(b.vx * b.vx + b.vy * b.vy + b.vz * b.vz)
+        if speed <= self.p.ball_speed_limit_m_s or self._fast_ball_called or self.last_touch is None:
+            return []
+        self._fast_ball_called = True
+        return [self._event(gt.t, "ball_too_fast", self.last_touch, speed, self.p.ball_speed_limit_m_s, "m/s")]
+
+    def _dribbling(self, gt: GroundTruth) -> list[GameEvent]:
+        """A robot in touch with the ball all the way since it took it, the ball now farther than
+        ``dribble_distance_m`` from where it was then."""
+        out = []
+        for k, touch in self.touching.items():
+            d = math.hypot(gt.ball.x - touch.start[0], gt.ball.y - touch.start[1])
+            if d > self.p.dribble_distance_m and not touch.called:
+                touch.called = True
+                out.append(self._event(gt.t, "excessive_dribbling", k, d, self.p.dribble_distance_m, "m"))
+        return out
+
+    def _area_touches(self, gt: GroundTruth, robots: list[RobotTruth], new: list[Key],
+                      s: Situation) -> list[GameEvent]:  # fmt: skip
+        """A robot that starts touching the ball inside the opponent's defense area (the ball in
+        it); a robot other than the keeper touching it with its centre inside its own."""
+        out = []
+        by_key = {(r.team, r.id): r for r in robots}
+        side = self.field.in_defense_area(gt.ball.x, gt.ball.y)
+        for k in new:
+            r = by_key[k]
+            own = _team_sign(k[0], s.blue_sign)
+            if side and side != own:
+                out.append(self._event(gt.t, "attacker_in_defense_area", k, 0.0, 0.0, ""))
+            elif k[1] != self.p.keepers.get(k[0], -1) and self.field.in_defense_area(r.x, r.y) == own:
+                depth = self.field.half_length - abs(r.x)
+                out.append(self._event(gt.t, "defender_in_defense_area", k, depth, self.field.dims.defense_depth_m,
+                                       "m from the goal line"))  # fmt: skip
+        return out
+
+    def _double_touch(self, gt: GroundTruth, new: list[Key]) -> list[GameEvent]:
+        """After a restart its kicker touches the ball again before any other robot did."""
+        kicker = self._restart_kicker
+        if kicker is None:
+            return []
+        if kicker not in self.touching:
+            self._kicker_left = True
+        others = [k for k in new if k != kicker]
+        if others:
+            self._restart_kicker = None
+            return []
+        if kicker in new and self._kicker_left:
+            self._restart_kicker = None
+            return [self._event(gt.t, "double_touch", kicker, 2.0, 1.0, "touches")]
+        return []
+
+    def _boundary(self, gt: GroundTruth) -> list[GameEvent]:
+        """The ball past the boundary walls (chipped out of the field's enclosure)."""
+        b, f = gt.ball, self.field
+        if abs(b.x) <= f.boundary_half_length and abs(b.y) <= f.boundary_half_width:
+            return []
+        key = self.last_touch
+        if key is None or not self._once("boundary_crossing", key):
+            return []
+        beyond = max(abs(b.x) - f.boundary_half_length, abs(b.y) - f.boundary_half_width)
+        return [self._event(gt.t, "boundary_crossing", key, beyond, 0.0, "m past the boundary")]
+
+    def _gap(self, r: RobotTruth, gt: GroundTruth) -> float:
+        """From the robot's body to the ball's centre (m)."""
+        return math.hypot(r.x - gt.ball.x, r.y - gt.ball.y) - self.robot_r
+
+    def _stop(self, gt: GroundTruth, robots: list[RobotTruth]) -> list[GameEvent]:
+        """In a stop (after ``stop_grace_s``): faster than ``stop_speed_m_s`` or nearer the ball than
+        ``stop_distance_m``; once per robot and stop."""
+        out = []
+        for r in robots:
+            k = (r.team, r.id)
+            speed = math.hypot(r.vx, r.vy)
+            if speed > self.p.stop_speed_m_s and self._once("stop_speed", k):
+                out.append(self._event(gt.t, "stop_speed", k, speed, self.p.stop_speed_m_s, "m/s"))
+            gap = self._gap(r, gt)
+            if gap < self.p.stop_distance_m and self._once("stop_distance", k):
+                out.append(self._event(gt.t, "stop_distance", k, gap, self.p.stop_distance_m, "m"))
+        return out
+
+    def _kick_point(self, gt: GroundTruth, robots: list[RobotTruth], defending: Team) -> list[GameEvent]:
+        """At the other team's kickoff or free kick, a robot nearer the ball than ``kick_point_distance_m``."""
+        out = []
+        for r in robots:
+            k = (r.team, r.id)
+            if r.team != defending:
+                continue
+            gap = self._gap(r, gt)
+            if gap < self.p.kick_point_distance_m and self._once("kick_point_distance", k):
+                out.append(self._event(gt.t, "kick_point_distance", k, gap, self.p.kick_point_distance_m, "m"))
+        return out

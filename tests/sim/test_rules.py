@@ -1,0 +1,303 @@
+"""The auto-referee: each foul in a scripted scene is called with its figure and restart, and the
+clean counterpart of the scene is not; cards send robots off and back; placements end in time or not."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable
+
+import pytest
+
+from cmdragons.geometry import LeagueParams
+from cmdragons.messages import GameEvent, RobotCommand
+from sim.referee import Referee, RefereeParams
+from sim.rules import RulesParams
+from sim.world import BallParams, DribblerParams, KickerParams, PhysicsParams, RobotParams, World
+
+LEAGUE = LeagueParams()
+FRONT = LEAGUE.robot.front_distance_m + LEAGUE.ball.radius_m
+R = LEAGUE.robot.radius_m
+Commands = Callable[[int], list[RobotCommand]]
+
+
+def scene(blue: int = 2, yellow: int = 2, brake: float = 6.0, **figures: object) -> tuple[World, Referee]:
+    """Robots parked apart along the bottom touch line, the ball at rest mid-field; full rules in normal play."""
+    w = World(LEAGUE, PhysicsParams(), RobotParams(command_latency_s=0.0, max_brake_m_s2=brake), BallParams(),
+              KickerParams(), DribblerParams(),
+              robots_per_team={"blue": blue, "yellow": yellow})  # fmt: skip
+    for i, (team, rid) in enumerate(w.robot_keys()):
+        w.place_robot(team, rid, -3.5 + 1.0 * i, -2.6, 0.0)
+    w.place_ball(0.0, 1.5)
+    ref = Referee(w.field, w.robot_keys(), RefereeParams(figures=RulesParams(**figures)))  # type: ignore[arg-type]
+    ref.give("normal")
+    return w, ref
+
+
+def play(w: World, ref: Referee, seconds: float, commands: Commands | None = None) -> list[GameEvent]:
+    """The referee judges every frame on the truth; the world carries out its teleports."""
+    calls: list[GameEvent] = []
+    for k in range(round(seconds * 60)):
+        events = w.step_frame(commands(k) if commands else [])
+        teleport = ref.observe(w.t, events, tuple(w.ball_body.position), w.ground_truth())
+        calls += ref.new_events
+        if teleport is not None:
+            w.apply(teleport)
+    return calls
+
+
+def kinds(calls: list[GameEvent]) -> list[str]:
+    return [c.kind for c in calls]
+
+
+def drive(team: str, rid: int, vx: float = 0.0, vy: float = 0.0, until: int = 10**9, **kw: object) -> Commands:
+    return lambda k: [RobotCommand(team, rid, vx, vy, **kw) if k < until else RobotCommand(team, rid)]  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(("speed", "called"), [(2.5, True), (0.8, False)])
+def test_crash_faster_than_the_limit_is_the_faster_robots_foul(speed: float, called: bool) -> None:
+    w, ref = scene()
+    w.place_robot("blue", 0, -1.0, 0.0, 0.0)
+    w.place_robot("yellow", 0, 0.0, 0.0, math.pi)
+    calls = play(w, ref, 1.0, drive("blue", 0, vx=speed, until=40))
+    crashes = [c for c in calls if c.kind == "crash"]
+    assert bool(crashes) == called
+    if called:
+        c = crashes[0]
+        assert (c.team, c.robot, c.restart, c.for_team) == ("blue", 0, "free_kick", "yellow")
+        assert c.value > 1.5 and c.limit == 1.5
+        assert ref.command == "stop"  # then the free kick (placed by yellow)
+
+
+@pytest.mark.parametrize(("push_s", "called"), [(1.2, True), (0.15, False)])
+def test_pushing_an_opponent_farther_than_the_limit(push_s: float, called: bool) -> None:
+    w, ref = scene(brake=1.0)  # the pushed robot's brakes weaker than the pusher's drive
+    w.place_robot("blue", 0, -0.5, 0.0, 0.0)
+    w.place_robot("yellow", 0, -0.5 + 2 * R + 0.005, 0.0, math.pi)
+    calls = play(w, ref, 2.0, drive("blue", 0, vx=0.5, until=round(push_s * 60)))
+    assert "crash" not in kinds(calls)  # slow: no crash
+    pushes = [c for c in calls if c.kind == "pushing"]
+    assert bool(pushes) == called
+    if called:
+        assert (pushes[0].team, pushes[0].robot, pushes[0].restart) == ("blue", 0, "free_kick")
+        assert pushes[0].value > 0.2
+
+
+@pytest.mark.parametrize(("speed", "called"), [(8.0, True), (5.0, False)])
+def test_ball_faster_than_the_limit_after_a_touch(speed: float, called: bool) -> None:
+    w, ref = scene()
+    w.place_robot("blue", 1, -1.0, 0.0, 0.0)
+    w.place_ball(-1.0 + FRONT + 0.003, 0.0)
+    play(w, ref, 0.2, drive("blue", 1, vx=0.2, until=6))  # blue touches it ...
+    # ... and it leaves at the speed of a kicker stronger than the simulator's (which stops at 6.5 m/s)
+    w.place_ball(*w.ball_body.position, vx=speed)
+    calls = play(w, ref, 0.1)
+    fast = [c for c in calls if c.kind == "ball_too_fast"]
+    assert bool(fast) == called
+    if called:
+        assert (fast[0].team, fast[0].robot, fast[0].restart, fast[0].for_team) == ("blue", 1, "free_kick", "yellow")
+        assert fast[0].value == pytest.approx(8.0, abs=0.3)
+
+
+@pytest.mark.parametrize(("seconds", "called"), [(3.2, True), (1.2, False)])
+def test_dribbling_the_ball_farther_than_the_limit(seconds: float, called: bool) -> None:
+    w, ref = scene()
+    w.place_robot("blue", 1, -2.0, 0.0, 0.0)
+    w.place_ball(-2.0 + FRONT + 0.002, 0.0)
+    calls = play(w, ref, seconds, drive("blue", 1, vx=0.5, dribbler=1.0))
+    assert w.holding("blue", 1)
+    dribbles = [c for c in calls if c.kind == "excessive_dribbling"]
+    assert bool(dribbles) == called
+    if called:
+        assert dribbles[0].value > 1.0 and dribbles[0].restart == "free_kick"
+
+
+@pytest.mark.parametrize(("ball_x", "called"), [(4.1, True), (3.0, False)])
+def test_attacker_touching_the_ball_in_the_opponents_defense_area(ball_x: float, called: bool) -> None:
+    w, ref = scene()  # blue defends -x: the area at +x is yellow's
+    w.place_robot("blue", 1, ball_x - 0.4, 0.3, 0.0)
+    w.place_ball(ball_x, 0.3)
+    calls = play(w, ref, 1.0, drive("blue", 1, vx=0.6, until=40))
+    fouls = [c for c in calls if c.kind == "attacker_in_defense_area"]
+    assert bool(fouls) == called
+    if called:
+        assert (fouls[0].team, fouls[0].robot, fouls[0].restart, fouls[0].for_team) == \
+            ("blue", 1, "free_kick", "yellow")  # fmt: skip
+
+
+@pytest.mark.parametrize(("rid", "called"), [(1, True), (0, False)])  # 0: the keeper may
+def test_defender_in_its_own_defense_area_at_the_ball_gives_a_penalty(rid: int, called: bool) -> None:
+    w, ref = scene()
+    w.place_robot("blue", rid, -4.3, 0.0, 0.0)
+    w.place_ball(-4.3 + FRONT + 0.05, 0.0)
+    calls = play(w, ref, 1.5, drive("blue", rid, vx=0.5, until=20))
+    fouls = [c for c in calls if c.kind == "defender_in_defense_area"]
+    assert bool(fouls) == called
+    if called:
+        assert (fouls[0].restart, fouls[0].for_team) == ("penalty", "yellow")
+        assert ref.command == "penalty" and ref.for_team == "yellow" and not ref.ready  # the restart came
+        assert tuple(w.ball_body.position) == pytest.approx((-4.5 + 6.0, 0.0))  # on the mark, 6 m out
+
+
+@pytest.mark.parametrize(("again", "called"), [(True, True), (False, False)])
+def test_double_touch_after_a_free_kick(again: bool, called: bool) -> None:
+    w, ref = scene()
+    w.apply(ref.free_kick("blue", (0.0, 0.0)))
+    w.place_robot("blue", 1, -FRONT - 0.05, 0.0, 0.0)
+
+    def commands(k: int) -> list[RobotCommand]:
+        if k < 30:  # kick it away, stand, then drive after it again (or not)
+            return [RobotCommand("blue", 1, vx=0.5, kick_speed=1.5)]
+        return [RobotCommand("blue", 1, vx=1.5 if again and k > 60 else 0.0)]
+
+    calls = play(w, ref, 2.5, commands)
+    doubles = [c for c in calls if c.kind == "double_touch"]
+    assert bool(doubles) == called
+    if called:
+        assert (doubles[0].team, doubles[0].robot, doubles[0].for_team) == ("blue", 1, "yellow")
+
+
+@pytest.mark.parametrize(("speed", "called"), [(2.0, True), (1.0, False)])
+def test_robot_too_fast_in_a_stop(speed: float, called: bool) -> None:
+    w, ref = scene()
+    ref.give("stop")
+    w.place_robot("yellow", 1, -3.0, 0.5, 0.0)
+    calls = play(w, ref, 3.0, drive("yellow", 1, vx=speed))
+    fouls = [c for c in calls if c.kind == "stop_speed"]
+    assert bool(fouls) == called
+    if called:
+        assert fouls[0].t >= 2.0  # after the rules' time to slow down
+        assert fouls[0].value == pytest.approx(2.0, abs=0.1) and fouls[0].restart == ""
+        assert ref.command == "stop"  # counted, play stays stopped
+
+
+@pytest.mark.parametrize(("gap", "called"), [(0.3, True), (0.8, False)])
+def test_robot_too_close_to_the_ball_in_a_stop(gap: float, called: bool) -> None:
+    w, ref = scene()
+    ref.give("stop")
+    w.place_robot("yellow", 1, 0.0 - gap - R, 1.5, 0.0)
+    calls = play(w, ref, 2.5)
+    fouls = [c for c in calls if c.kind == "stop_distance"]
+    assert bool(fouls) == called
+    if called:
+        assert fouls[0].team == "yellow" and fouls[0].value == pytest.approx(gap, abs=0.01)
+
+
+@pytest.mark.parametrize(("gap", "called"), [(0.3, True), (0.8, False)])
+def test_defender_too_close_at_a_free_kick(gap: float, called: bool) -> None:
+    w, ref = scene()
+    w.apply(ref.free_kick("blue", (1.0, 1.0)))
+    w.place_robot("yellow", 1, 1.0 + gap + R, 1.0, math.pi)
+    calls = play(w, ref, 1.5)
+    fouls = [c for c in calls if c.kind == "kick_point_distance"]
+    assert bool(fouls) == called
+    if called:
+        assert fouls[0].team == "yellow" and fouls[0].value == pytest.approx(gap, abs=0.01)
+
+
+@pytest.mark.parametrize(("seconds", "called"), [(2.5, True), (1.5, False)])
+def test_keeper_holding_the_ball(seconds: float, called: bool) -> None:
+    w, ref = scene()
+    ref = Referee(w.field, w.robot_keys(), RefereeParams(keeper_held_ball_s=2.0))
+    ref.give("normal")
+    w.place_ball(-4.2, 0.3)  # at rest in blue's area
+    calls = play(w, ref, seconds)
+    held = [c for c in calls if c.kind == "keeper_held_ball"]
+    assert bool(held) == called
+    if called:
+        assert (held[0].team, held[0].restart, held[0].for_team) == ("blue", "free_kick", "yellow")
+
+
+@pytest.mark.parametrize(("beyond", "called"), [(0.5, True), (-0.5, False)])
+def test_ball_over_the_boundary(beyond: float, called: bool) -> None:
+    w, ref = scene()
+    w.place_robot("blue", 1, 1.0, 2.0, math.pi / 2)
+    w.place_ball(1.0, 2.0 + FRONT + 0.002)
+    play(w, ref, 0.2, drive("blue", 1, vy=0.3))  # blue touches it last ...
+    w.place_ball(1.0, w.field.boundary_half_width + beyond)  # ... and it flies over the wall (or not)
+    calls = play(w, ref, 0.1)
+    fouls = [c for c in calls if c.kind == "boundary_crossing"]
+    assert bool(fouls) == called
+    if called:
+        assert (fouls[0].team, fouls[0].robot) == ("blue", 1)
+
+
+def test_every_third_foul_is_a_yellow_card_that_sends_a_robot_off_for_its_time() -> None:
+    w, ref = scene(blue=3, yellow=1, yellow_card_s=2.0)
+    ref.give("stop")
+    for i, x in enumerate((-3.0, -2.5, -2.0)):
+        w.place_robot("blue", i, x, -2.0, math.pi / 2)
+    # three robots too fast in the stop: three fouls, a card; a robot but the keeper goes off
+    calls = play(w, ref, 2.5, lambda k: [RobotCommand("blue", i, vy=2.0) for i in (0, 1, 2)])
+    cards = [c for c in calls if c.kind == "yellow_card"]
+    assert ref.fouls["blue"] == 3 and len(cards) == 1 and cards[0].team == "blue"
+    off = cards[0].robot
+    assert off is not None and off != 0  # never the keeper
+    x, y = tuple(w.robots[w.robot_keys().index(("blue", off))].body.position)
+    assert y < -w.field.boundary_half_width  # parked outside the boundary
+    assert ref.state().blue_team.max_robots == 2 and len(ref.state().blue_team.yellow_card_times_s) == 1
+    calls = play(w, ref, 2.0)
+    assert "yellow_card_over" in kinds(calls) and ref.state().blue_team.max_robots == 3
+    x, y = tuple(w.robots[w.robot_keys().index(("blue", off))].body.position)
+    assert w.field.in_field(x, y)  # back on, by the touch line
+
+
+@pytest.mark.parametrize(("back_on", "called"), [(True, True), (False, False)])
+def test_too_many_robots(back_on: bool, called: bool) -> None:
+    w, ref = scene(blue=3, yellow=1, yellow_card_s=60.0)
+    ref.card("blue", 2)
+    play(w, ref, 0.1)
+    if back_on:  # the robot sent off drives back on the field
+        w.place_robot("blue", 2, 0.0, -1.0, 0.0)
+    calls = play(w, ref, 0.5)
+    fouls = [c for c in calls if c.kind == "too_many_robots"]
+    assert bool(fouls) == called
+    if called:
+        assert fouls[0].value == 3 and fouls[0].limit == 2
+
+
+def test_the_third_card_running_at_once_is_red() -> None:
+    w, ref = scene(blue=4, yellow=1)
+    for _ in range(3):
+        ref.card("blue")
+    assert ref.yellow_cards["blue"] == 2 and ref.red_cards["blue"] == 1
+    assert ref.state().blue_team.max_robots == 1
+
+
+@pytest.mark.parametrize(("carry", "succeeded"), [(True, True), (False, False)])
+def test_ball_placement_succeeds_in_tolerance_and_fails_when_time_is_up(carry: bool, succeeded: bool) -> None:
+    w, ref = scene(placement_time_s=8.0)
+    target = (1.0, 0.0)
+    ref.start_placement("blue", target)
+    w.place_ball(0.0, 0.0)
+    w.place_robot("blue", 1, -FRONT - 0.002, 0.0, 0.0)
+
+    def commands(k: int) -> list[RobotCommand]:
+        if not carry:
+            return []
+        if k < 60 * 5:  # scripted: carry the ball along x on the dribbler, hold it there ...
+            bx = w.ball_body.position.x
+            return [RobotCommand("blue", 1, vx=0.4 if target[0] - bx > 0.03 else 0.0, dribbler=1.0)]
+        # ... then let go and back off
+        return [RobotCommand("blue", 1, vx=-0.3)] if k < 60 * 6 else [RobotCommand("blue", 1)]
+
+    calls = play(w, ref, 9.0, commands)
+    if succeeded:
+        done = [c for c in calls if c.kind == "placement_succeeded"]
+        assert done and done[0].team == "blue" and done[0].value <= 8.0
+        assert ref.placements["blue"] == {"tried": 1, "succeeded": 1}
+    else:
+        failed = [c for c in calls if c.kind == "placement_failed"]
+        assert failed and failed[0].for_team == "yellow"
+        assert tuple(w.ball_body.position) == pytest.approx(target)  # the referee placed it
+        assert ref.placement_failures["blue"] == 1
+
+
+def test_basic_rules_call_no_fouls() -> None:
+    w, _ = scene()
+    ref = Referee(w.field, w.robot_keys(), dataclasses.replace(RefereeParams(), rules="basic"))
+    ref.give("normal")
+    w.place_robot("blue", 0, -1.0, 0.0, 0.0)
+    w.place_robot("yellow", 0, 0.0, 0.0, math.pi)
+    calls = play(w, ref, 1.0, drive("blue", 0, vx=2.5, until=40))
+    assert calls == []

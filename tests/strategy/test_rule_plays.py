@@ -1,0 +1,134 @@
+"""Our team under the full rules, in the simulator with the referee judging every frame: ball
+placement from five positions in the rules' time and tolerance, a penalty scored against a still
+keeper, our keeper stopping a penalty kicked at its body, and a 30 s stop kept at the rules' speed
+and distance every frame. The brain plays on the true state (no cameras) through its own planning,
+control and safety."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+
+from cmdragons.messages import BallState, GameEvent, RobotCommand, RobotState, WorldState
+from cmdragons.runtime.settings import load_settings
+from cmdragons.team import Brain
+from sim.referee import Referee
+from sim.world import World
+
+SETTINGS = load_settings(Path(__file__).resolve().parents[2] / "configs")
+RULES = SETTINGS.sim.referee.figures
+R = SETTINGS.field.robot.radius_m
+
+
+def scene(blue: int, yellow: int) -> tuple[World, Referee, Brain]:
+    s = SETTINGS.sim
+    # the brain sees the truth of now: the robots act on their commands at once (no latency to predict through)
+    robot = dataclasses.replace(s.robot, command_latency_s=0.0)
+    w = World(SETTINGS.field, s.physics, robot, s.ball, s.kicker, s.dribbler,
+              robots_per_team={"blue": blue, "yellow": yellow})  # fmt: skip
+    ref = Referee(w.field, w.robot_keys(), s.referee)
+    w.apply(ref.kickoff_setup("blue"))
+    return w, ref, Brain("blue", SETTINGS)
+
+
+def play(w: World, ref: Referee, brain: Brain, seconds: float,
+         theirs: Callable[[int], list[RobotCommand]] | None = None,
+         until: Callable[[list[GameEvent]], bool] | None = None,
+         each: Callable[[World, Referee], None] | None = None) -> list[GameEvent]:  # fmt: skip
+    calls: list[GameEvent] = []
+    for k in range(round(seconds * 60)):
+        truth = w.ground_truth()
+        b = truth.ball
+        world = WorldState(truth.t, BallState(b.x, b.y, b.vx, b.vy), tuple(
+            RobotState(r.team, r.id, r.x, r.y, r.theta, r.vx, r.vy, r.omega) for r in truth.robots
+            if w.field.in_field(r.x, r.y, -w.field.dims.boundary_width_m)), truth.frame_number)  # fmt: skip
+        commands = brain.step(world, ref.state()) + (theirs(k) if theirs else [])
+        events = w.step_frame(commands)
+        teleport = ref.observe(w.t, events, tuple(w.ball_body.position), w.ground_truth())
+        calls += ref.new_events
+        if teleport is not None:
+            w.apply(teleport)
+        if each is not None:
+            each(w, ref)
+        if until is not None and until(calls):
+            break
+    return calls
+
+
+@pytest.mark.parametrize(("ball", "target"), [
+    ((-2.0, 2.6), (-2.0, 2.8)),  # out by the touch line: a short way
+    ((3.0, -1.0), (1.0, 0.5)),  # across, the robots' side
+    ((-3.0, 0.0), (-1.5, -2.0)),  # toward a corner
+    ((0.5, 2.5), (2.5, 2.8)),  # along the touch line
+    ((1.5, -2.5), (-0.5, -1.0)),  # back toward our half
+])  # fmt: skip
+def test_ball_placement_ends_in_tolerance_in_time(ball: tuple[float, float], target: tuple[float, float]) -> None:
+    w, ref, brain = scene(blue=3, yellow=1)
+    w.place_ball(*ball)
+    ref.start_placement("blue", target)
+    calls = play(w, ref, brain, RULES.placement_time_s + 1.0,
+                 until=lambda c: any(e.kind.startswith("placement_") for e in c))  # fmt: skip
+    done = [e for e in calls if e.kind == "placement_succeeded"]
+    assert done, [e.kind for e in calls]
+    assert done[0].value <= RULES.placement_time_s
+    x, y = w.ball_body.position
+    assert math.hypot(x - target[0], y - target[1]) <= RULES.placement_tolerance_m
+    assert not [e for e in calls if e.team == "blue" and e.kind not in ("placement_succeeded",)]  # no foul
+
+
+def test_penalty_scores_against_a_still_keeper() -> None:
+    w, ref, brain = scene(blue=3, yellow=1)
+    w.place_robot("yellow", 0, w.field.half_length - 0.5 * R, 0.0, math.pi)  # on its goal line, still
+    w.apply(ref.start_penalty("blue"))
+    calls = play(w, ref, brain, RULES.prepare_timeout_s + RULES.penalty_time_s,
+                 until=lambda c: ref.score["blue"] > 0 or any(e.kind == "penalty_over" for e in c))  # fmt: skip
+    assert ref.score == {"blue": 1, "yellow": 0}, [e.kind for e in calls]
+    assert ref.penalties["blue"] == {"taken": 1, "scored": 1}
+
+
+def test_our_keeper_stops_a_penalty_kicked_at_its_body() -> None:
+    w, ref, brain = scene(blue=3, yellow=1)
+    w.apply(ref.start_penalty("yellow"))
+    mark = tuple(w.ball_body.position)
+    w.place_robot("yellow", 0, mark[0] + 0.6, 0.0, math.pi)
+
+    def kicker(k: int) -> list[RobotCommand]:
+        # prepared: wait; started: drive through the ball at the goal's centre, where our keeper stands
+        if not ref.ready:
+            return [RobotCommand("yellow", 0)]
+        return [RobotCommand("yellow", 0, vx=-0.8, kick_speed=4.0)]
+
+    calls = play(w, ref, brain, RULES.prepare_timeout_s + RULES.penalty_time_s, theirs=kicker,
+                 until=lambda c: any(e.kind == "penalty_over" for e in c) or ref.score["yellow"] > 0)  # fmt: skip
+    assert ref.score["yellow"] == 0, [e.kind for e in calls]
+    assert any(e.kind == "penalty_over" for e in calls)
+    assert any(e.kind for e in calls) and ref.kicks >= 1
+
+
+def test_stop_keeps_every_robot_away_from_the_ball_and_slow_every_frame() -> None:
+    w, ref, brain = scene(blue=6, yellow=0)
+    ball = (0.5, 0.5)
+    w.place_ball(*ball)
+    for k in range(6):  # all around the ball, inside the rules' distance
+        a = k * math.pi / 3
+        w.place_robot("blue", k, ball[0] + (0.25 + R) * math.cos(a), ball[1] + (0.25 + R) * math.sin(a), a + math.pi)
+    ref.give("stop")
+    worst = {"speed": 0.0, "gap": math.inf}
+
+    def check(w: World, ref: Referee) -> None:
+        truth = w.ground_truth()
+        bx, by = truth.ball.x, truth.ball.y
+        for r in truth.robots:
+            worst["speed"] = max(worst["speed"], math.hypot(r.vx, r.vy))
+            if truth.t >= RULES.stop_grace_s:
+                worst["gap"] = min(worst["gap"], math.hypot(r.x - bx, r.y - by) - R)
+
+    calls = play(w, ref, brain, 30.0, each=check)
+    assert worst["speed"] < RULES.stop_speed_m_s
+    assert worst["gap"] >= RULES.stop_distance_m
+    assert not [e for e in calls if e.kind.startswith("stop_")]
+    assert ref.command == "stop"

@@ -136,6 +136,18 @@ def _weight(ax: float, ay: float, mx: float, my: float, cfg: PotentialConfig) ->
 
 
 @njit(cache=True)
+def _wall(inner: np.ndarray, side: int, px: float, py: float) -> tuple[float, float, float]:
+    # wall ``side`` (0 x0, 1 x1, 2 y0, 3 y1) of the C-space box: its clearance and the unit normal away from it
+    if side == 0:
+        return px - inner[0], 1.0, 0.0
+    if side == 1:
+        return inner[2] - px, -1.0, 0.0
+    if side == 2:
+        return py - inner[1], 0.0, 1.0
+    return inner[3] - py, 0.0, -1.0
+
+
+@njit(cache=True)
 def potential(
     obs: np.ndarray, inner: np.ndarray, px: float, py: float, gx: float, gy: float, mx: float, my: float,
     cfg: PotentialConfig,
@@ -165,14 +177,7 @@ def potential(
         ex += w * du * ax
         ey += w * du * ay
     for side in range(4):
-        if side == 0:
-            d, ax, ay = px - inner[0], 1.0, 0.0
-        elif side == 1:
-            d, ax, ay = inner[2] - px, -1.0, 0.0
-        elif side == 2:
-            d, ax, ay = py - inner[1], 0.0, 1.0
-        else:
-            d, ax, ay = inner[3] - py, 0.0, -1.0
+        d, ax, ay = _wall(inner, side, px, py)
         if d > cfg.influence:
             continue
         w = _weight(ax, ay, mx, my, cfg)
@@ -388,3 +393,35 @@ def evade_vector(px: float, py: float, objects: np.ndarray, cfg: EvadeConfig) ->
         sx += k * nx
         sy += k * ny
     return _saturate(sx, sy)
+
+
+@njit(cache=True)
+def _stop_speed(c: float, margin: float, decel: float, dt: float) -> float:
+    # the speed toward an obstacle at clearance c that still stops margin short of it, braking at
+    # decel from the end of one period of dt at that speed
+    room = max(c - margin, 0.0)
+    return max(math.sqrt(decel * decel * dt * dt + 2.0 * decel * room) - decel * dt, 0.0)
+
+
+@njit(cache=True)
+def brake_guard(
+    obs: np.ndarray, inner: np.ndarray, px: float, py: float, wx: float, wy: float, margin: float, decel: float,
+    dt: float,
+) -> tuple[float, float]:  # fmt: skip
+    """The velocity (wx, wy) with its component toward each obstacle and wall cut to the speed that
+    still stops ``margin`` short of it (:func:`_stop_speed`), obstacle after obstacle; the
+    components sideways and away stay."""
+    for side in range(4):
+        c, ax, ay = _wall(inner, side, px, py)
+        closing = -(wx * ax + wy * ay)
+        cap = _stop_speed(c, margin, decel, dt)
+        if closing > cap:
+            wx, wy = wx + (closing - cap) * ax, wy + (closing - cap) * ay
+    for j in range(obs.shape[0]):
+        c = obstacle_clearance(obs, j, px, py)
+        ax, ay = _away(obs, j, px, py)
+        closing = -(wx * ax + wy * ay)
+        cap = _stop_speed(c, margin, decel, dt)
+        if closing > cap:
+            wx, wy = wx + (closing - cap) * ax, wy + (closing - cap) * ay
+    return wx, wy

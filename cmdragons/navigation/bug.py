@@ -103,6 +103,7 @@ class BugNavigator(ReactiveNavigator):
         self.circled = False  # Bug1: back at the hit point once
         self._last: Point | None = None
         self._heuristic = math.inf  # tangent bug: the best distance via an endpoint so far
+        self._overshoot = 0.0  # m the hit point lies off the level line followed
 
     def restart(self, start: Point, goal: Point) -> None:
         self.start = start
@@ -128,13 +129,14 @@ class BugNavigator(ReactiveNavigator):
             return self._tangent(cw, here, goal, c, gx, gy)
         dgx, dgy = toward(here, goal, 1.0)
         if c <= p.follow_clearance_m and dgx * gx + dgy * gy < 0.0:  # hit: the goal lies into the obstacle
-            self._begin_follow(here, goal)
+            self._begin_follow(here, goal, c)
             ux, uy = boundary_direction(c, gx, gy, p.follow_clearance_m, p.correction_gain_1_m, self.side)
             return ux * p.follow_speed_m_s, uy * p.follow_speed_m_s
         return toward(here, goal, self.cruise(here, goal))
 
-    def _begin_follow(self, here: Point, goal: Point) -> None:
+    def _begin_follow(self, here: Point, goal: Point, c: float) -> None:
         self._clear_follow()
+        self._overshoot = abs(c - self.params.follow_clearance_m)
         self.status = NavStatus.FOLLOWING
         self.hit = self._last = here
         self.nearest, self.nearest_d = here, math.dist(here, goal)
@@ -147,7 +149,8 @@ class BugNavigator(ReactiveNavigator):
         p = self.params
         assert self.hit is not None
         d = math.dist(here, goal)
-        back = self.followed > p.min_follow_m and math.dist(here, self.hit) < p.leave_tolerance_m
+        # back at the hit point: the level line passes within the hit's overshoot of it
+        back = self.followed > p.min_follow_m and math.dist(here, self.hit) < p.leave_tolerance_m + self._overshoot
         if self.variant == "bug2":
             if self.followed > p.min_follow_m and d < math.dist(self.hit, goal) - p.leave_tolerance_m \
                     and _to_line(here, self.start, goal) < p.m_line_tolerance_m \
@@ -222,7 +225,7 @@ class BugNavigator(ReactiveNavigator):
         if best is None or best_h > self._heuristic - t.progress_m or c <= self.params.follow_clearance_m:
             # the heuristic distance stops falling (or the robot touches the boundary): follow it
             if best is None or best_h > self._heuristic - t.progress_m:
-                self._begin_follow(here, goal)
+                self._begin_follow(here, goal, c)
                 p = self.params
                 ux, uy = boundary_direction(c, gx, gy, p.follow_clearance_m, p.correction_gain_1_m, self.side)
                 return ux * p.follow_speed_m_s, uy * p.follow_speed_m_s

@@ -115,8 +115,10 @@ class CurvatureVelocityNavigator(ReactiveNavigator):
         vmax = self.control.motion.max_speed_m_s
         brake = self.control.motion.max_brake_m_s2
         best, best_f = None, -math.inf
+        # a robot already nearer than the margin may still move away from it
+        keep = min(p.margin_m, max(cw.clearance(*here) - 1e-3, 0.0))
         for kappa in self.kappas:
-            d = K.march(cw.obs, cw.inner, here[0], here[1], theta, float(kappa), p.horizon_m, p.margin_m, 1e-3)
+            d = K.march(cw.obs, cw.inner, here[0], here[1], theta, float(kappa), p.horizon_m, keep, 1e-3)
             v_ok = math.sqrt(2.0 * brake * d)
             for i in range(1, p.speeds + 1):
                 v = top * i / p.speeds

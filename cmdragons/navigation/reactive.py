@@ -9,8 +9,8 @@ profile). Three things are the same for every one of them:
 * the **final approach**: within ``handover_m`` of the goal with the straight way there free, the
   trajectory navigator's own profile takes over and stops on the goal (or drives through it) at the
   arrival heading; the reactive methods only say where to go, not how to stop on a point;
-* the **brake guard**: the component of the wanted velocity toward the nearest obstacle is held to
-  the speed that still stops ``brake_margin_m`` short of it (sideways and away stay free);
+* the **brake guard**: the component of the wanted velocity toward each obstacle and wall is held
+  to the speed that still stops ``brake_margin_m`` short of it (sideways and away stay free);
 * the **limits**: the velocity reachable from the last command within one period in the
   acceleration set A(v), under the speed limit or the arrival's cap; omega is the heading profile's.
 
@@ -29,6 +29,7 @@ from cmdragons.config import Validated, setting
 from cmdragons.control._kernels import limit_velocity
 from cmdragons.control.motion import ControlParams
 from cmdragons.messages import RobotState
+from cmdragons.navigation import _kernels as K
 from cmdragons.navigation.base import STOP, Arrival, NavStatus, VelocityCommand
 from cmdragons.navigation.trajectory import TrajectoryNavigator, TrajectoryParams
 from cmdragons.planning.termination import Termination
@@ -118,13 +119,23 @@ class ReactiveNavigator:
         _, _, omega = self.follow.command(robot, world, termination)  # the heading's profile
         start = self.follow.start_state(robot)
         motion = self.follow.target(robot)[1].motion
-        wx, wy = self._guard(cw, here, wx, wy, motion.max_brake_m_s2)
+        # a turned velocity changes at the smaller of the two: the guard must hold while turning too
+        wx, wy = K.brake_guard(cw.obs, cw.inner, here[0], here[1], wx, wy, self.reactive.brake_margin_m,
+                               min(motion.max_accel_m_s2, motion.max_brake_m_s2), motion.period_s)  # fmt: skip
         top = motion.max_speed_m_s * (1.0 - 1e-9)  # a hair under: the step toward it must not round above
         speed = math.hypot(wx, wy)
         if speed > top:
             wx, wy = wx * top / speed, wy * top / speed
+        decel = min(motion.max_accel_m_s2, motion.max_brake_m_s2)
         vx, vy = limit_velocity(start.vx, start.vy, wx, wy, top, motion.max_accel_m_s2, motion.max_brake_m_s2,
                                 motion.period_s)  # fmt: skip
+        gx, gy = K.brake_guard(cw.obs, cw.inner, here[0], here[1], vx, vy, self.reactive.brake_margin_m, decel,
+                               motion.period_s)  # fmt: skip
+        if (gx, gy) != (vx, vy):  # the step toward the wanted velocity closes too fast: brake along the normals
+            bx, by = K.brake_guard(cw.obs, cw.inner, here[0], here[1], start.vx, start.vy,
+                                   self.reactive.brake_margin_m, decel, motion.period_s)  # fmt: skip
+            vx, vy = limit_velocity(start.vx, start.vy, bx, by, top, motion.max_accel_m_s2, motion.max_brake_m_s2,
+                                    motion.period_s)  # fmt: skip
         return float(vx), float(vy), omega
 
     # --- for the methods -------------------------------------------------------------------------
@@ -145,12 +156,3 @@ class ReactiveNavigator:
         cap = self.arrival.max_speed_m_s
         top = m.max_speed_m_s if cap is None else min(m.max_speed_m_s, cap)
         return min(top, math.sqrt(2.0 * m.max_brake_m_s2 * math.dist(here, goal)))
-
-    def _guard(self, cw: CompiledWorld, here: tuple[float, float], wx: float, wy: float,
-               brake: float) -> tuple[float, float]:  # fmt: skip
-        c, gx, gy = cw.clearance_gradient(*here)
-        closing = -(wx * gx + wy * gy)  # the speed toward the nearest obstacle
-        cap = math.sqrt(2.0 * brake * max(c - self.reactive.brake_margin_m, 0.0))
-        if closing > cap:
-            wx, wy = wx + (closing - cap) * gx, wy + (closing - cap) * gy
-        return wx, wy

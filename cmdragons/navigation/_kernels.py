@@ -239,7 +239,8 @@ class HistogramConfig(NamedTuple):
 def polar_histogram(obs: np.ndarray, inner: np.ndarray, px: float, py: float, cfg: HistogramConfig) -> np.ndarray:
     """The primary polar histogram (Borenstein and Koren 1991; VFH+, Ulrich and Borenstein 1998):
     the histogram grid's occupied cells (certainty 1 where the cell's centre lies in an obstacle of
-    the world as compiled, or beyond the walls) within ``window`` of the robot, each adding
+    the world as compiled, or beyond the walls: clearance <= 0, a box's inside reading 0 compiled
+    without a radius) within ``window`` of the robot, each adding
     c^2 (a - b d) with a - b window = 0 (a = 1) to its sector, or with ``enlarge`` to every sector
     within the enlargement angle of it."""
     n = cfg.sectors
@@ -253,7 +254,7 @@ def polar_histogram(obs: np.ndarray, inner: np.ndarray, px: float, py: float, cf
                 continue
             cx = px + k * cfg.cell
             d = math.hypot(cx - px, cy - py)
-            if d > cfg.window or clearance(obs, inner, cx, cy) >= 0.0:
+            if d > cfg.window or clearance(obs, inner, cx, cy) > 0.0:
                 continue
             m = 1.0 - d / cfg.window
             beta = math.atan2(cy - py, cx - px)
@@ -289,7 +290,7 @@ def turning_limits(
             cx = px + k * cfg.cell
             if (i == 0 and k == 0) or math.hypot(cx - px, cy - py) > cfg.window:
                 continue
-            if clearance(obs, inner, cx, cy) >= 0.0:
+            if clearance(obs, inner, cx, cy) > 0.0:
                 continue
             b = math.atan2(cy - py, cx - px) - theta
             b = (b + math.pi) % (2.0 * math.pi) - math.pi

@@ -57,14 +57,7 @@ def least_clearance(world: CollisionWorld, xs: np.ndarray) -> float:
     return min(cw.clearance(float(p[0]), float(p[1])) for p in xs)
 
 
-# a known failure, kept strict so that a fix shows: VFH+ halts head-on at the box (its chosen
-# valley border points into the brake guard)
-OPEN = {"vfh_plus": "VFH+ halts facing the box"}
-
-
-@pytest.mark.parametrize(
-    "name", [pytest.param(n, marks=pytest.mark.xfail(strict=True, reason=OPEN[n])) if n in OPEN else n
-             for n in REACTIVE])  # fmt: skip
+@pytest.mark.parametrize("name", REACTIVE)
 def test_every_reactive_navigator_passes_a_convex_obstacle_to_its_goal(name: str) -> None:
     # one disc (a robot) and one box on the line: each method reaches the goal without touching them
     world = CollisionWorld(BOUNDS, np.array([(0.0, 0.05, 0.09)]), boxes=np.array([(1.2, -0.4, 1.4, 0.2)]))
@@ -271,3 +264,30 @@ def test_the_movement_model_finds_a_curve_and_a_jittery_track_s_variance() -> No
         b = jitter.update(pos + rng.normal(0.0, 0.01, (1, 2)), vel)
     assert abs(a[0, 4] - omega) < 0.01  # the turn rate, rad/s
     assert a[0, 6] < 0.01 < b[0, 6]  # the noisy track's cross-track variance is the larger
+
+
+def test_polar_histogram_counts_the_cells_inside_discs_and_boxes() -> None:
+    # the primary histogram against a plain-numpy one over the same cells: a cell is occupied when its
+    # centre lies in a disc or a box (a box's inside counts as much as a disc's)
+    discs, boxes = np.array([(0.5, 0.4, 0.2)]), np.array([(-0.9, -0.5, -0.5, 0.3), (0.2, -0.8, 0.9, -0.6)])
+    cw = CollisionWorld(BOUNDS, discs, boxes=boxes).compile(0.0)
+    px, py = 0.013, -0.021
+    for enlarge in (0.0, 0.14):
+        cfg = K.HistogramConfig(1.0, 0.05, 72, enlarge)
+        ks = np.arange(-20, 21)
+        cx, cy = (px + ks * 0.05)[None, :], (py + ks * 0.05)[:, None]
+        cx, cy = np.broadcast_to(cx, (41, 41)).ravel(), np.broadcast_to(cy, (41, 41)).ravel()
+        d = np.hypot(cx - px, cy - py)
+        inside = np.hypot(cx - 0.5, cy - 0.4) < 0.2
+        for x0, y0, x1, y1 in boxes:
+            inside |= (cx > x0) & (cx < x1) & (cy > y0) & (cy < y1)
+        keep = inside & (d <= 1.0) & (d > 0.0)
+        ref = np.zeros(72)
+        for x, y, r in zip(cx[keep], cy[keep], d[keep], strict=True):
+            beta = math.atan2(y - py, x - px)
+            gam = math.asin(min(1.0, enlarge / r)) if enlarge > 0.0 else 0.0
+            for s in range(int(math.floor((beta - gam + math.pi) / (2 * math.pi / 72))),
+                           int(math.floor((beta + gam + math.pi) / (2 * math.pi / 72))) + 1):  # fmt: skip
+                ref[s % 72] += 1.0 - r / 1.0
+        assert np.allclose(K.polar_histogram(cw.obs, cw.inner, px, py, cfg), ref, atol=1e-9)
+        assert ref[int((math.pi + math.pi) / (2 * math.pi / 72)) % 72] > 1.0  # the box at -x is in it

@@ -33,10 +33,20 @@ from cmdragons.navigation import (
     NAVIGATORS,
     Arrival,
     BandParams,
+    BugParams,
+    CurvatureParams,
     DynamicWindowParams,
+    EscapeEvadeParams,
+    ExtendedFieldParams,
+    LaneParams,
     Navigator,
+    PotentialFieldParams,
+    ReactiveParams,
     RoboxParams,
+    TangentBugParams,
     TrajectoryParams,
+    VFHParams,
+    VFHPlusParams,
     make_navigator,
 )
 from cmdragons.planning import (
@@ -86,6 +96,16 @@ class TeamParams(Validated):
     dynamic_window: DynamicWindowParams = DynamicWindowParams()
     elastic_band: BandParams = BandParams()  # the Robox stack's band
     robox: RoboxParams = RoboxParams()
+    reactive: ReactiveParams = ReactiveParams()  # shared by the reactive navigators below
+    potential_field: PotentialFieldParams = PotentialFieldParams()
+    extended_potential_field: ExtendedFieldParams = ExtendedFieldParams()
+    bug: BugParams = BugParams()  # bug1, bug2, tangent_bug
+    tangent_bug: TangentBugParams = TangentBugParams()
+    vfh: VFHParams = VFHParams()
+    vfh_plus: VFHPlusParams = VFHPlusParams()
+    curvature_velocity: CurvatureParams = CurvatureParams()
+    lane_curvature: LaneParams = LaneParams()
+    escape_evade: EscapeEvadeParams = EscapeEvadeParams()
     brain: BrainParams = BrainParams()
     simple_opponent: SimpleTeamParams = SimpleTeamParams()
 

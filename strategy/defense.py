@@ -1,4 +1,5 @@
-"""Our goal's defense: the goalie (blocking, or clearing a ball at rest in our area) and the
+"""Our goal's defense: the goalie (blocking, or clearing a ball at rest in our area; with
+``goalie_reflex`` the escape/evade reflex of seed 003 turned round toward a shot's line) and the
 defenders' slots on the edge of our defense area. Field frame, metres, radians."""
 
 from __future__ import annotations
@@ -12,9 +13,10 @@ import numpy as np
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field
 from cmdragons.messages import BallState, RobotState
+from cmdragons.navigation.escape_evade import EscapeEvadeParams, reflex
 from strategy.skills import Intent, SkillParams, goalie_block, kick_to
 
-__all__ = ["DefenseParams", "ball_to_clear", "clear_target", "defender_slots", "goalie"]
+__all__ = ["DefenseParams", "ball_to_clear", "clear_target", "defender_slots", "goalie", "goalie_reflex"]
 
 
 @dataclass(frozen=True)
@@ -25,6 +27,9 @@ class DefenseParams(Validated):
     clear_depth_share: float = setting(0.5, lo=0.0, hi=1.0)  # ... toward this share of their half deep
     clear_width_share: float = setting(0.6, lo=0.0, hi=1.0)  # ... and this share of the half width out, its side
     clear_kick_m_s: float = setting(4.0, lo=0.1, hi=10.0)  # ... kicked this fast
+    goalie_reflex: bool = setting(False)  # the goalie's escape/evade reflex toward a shot's line
+    goalie_reflex_gain_s: float = setting(0.3, lo=0.0, hi=5.0)  # its vector (m/s) times this: the step (m)
+    goalie_reflex_evade: EscapeEvadeParams = EscapeEvadeParams()  # the reflex's vectors (the ball the object)
 
 
 def defender_slots(p: DefenseParams) -> list[float]:
@@ -52,4 +57,29 @@ def goalie(robot: RobotState, ball: BallState, pitch: Field, own_sign: float, p:
     if ball_to_clear(ball, pitch, own_sign, p):
         intent = kick_to(robot, ball, clear_target(ball, pitch, own_sign, p), p.clear_kick_m_s, skills)
         return dataclasses.replace(intent, allow_own_defense=True), True
-    return goalie_block(ball, pitch, own_sign, skills), False
+    intent = goalie_block(ball, pitch, own_sign, skills)
+    if p.goalie_reflex:
+        intent = goalie_reflex(intent, robot, ball, pitch, own_sign, p, skills)
+    return intent, False
+
+
+def goalie_reflex(intent: Intent, robot: RobotState, ball: BallState, pitch: Field, own_sign: float,
+                  p: DefenseParams, skills: SkillParams) -> Intent:  # fmt: skip
+    """The escape/evade reflex (seed 003 §5.1) turned round for the goalie: while the ball runs at
+    our goal line, blocking's point moves along the goalie's line toward the ball's path by
+    ``goalie_reflex_gain_s`` times the part along the line of the fused vector at the goalie (the
+    vector pushes off the path; the goalie goes the other way), never past the path nor a post."""
+    if ball.vx * own_sign <= 0.0:
+        return intent
+    t = (intent.x - ball.x) / ball.vx
+    if t <= 0.0:
+        return intent
+    path_y = ball.y + ball.vy * t  # where the ball's path crosses the goalie's line
+    objects = np.array([[ball.x, ball.y, ball.vx, ball.vy, 0.0, 0.0, 0.0]])
+    _, ry = reflex((robot.x, robot.y), objects, p.goalie_reflex_evade)
+    step, gap = -p.goalie_reflex_gain_s * ry, path_y - intent.y
+    if step * gap <= 0.0:
+        return intent  # nothing repels, or not toward the path (blocking's point on it already)
+    half = pitch.goal_half_width - skills.robot_radius_m * skills.goalie_post_share
+    y = min(max(intent.y + math.copysign(min(abs(step), abs(gap)), step), -half), half)
+    return dataclasses.replace(intent, y=y, theta=math.atan2(ball.y - y, ball.x - intent.x))

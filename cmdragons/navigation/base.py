@@ -19,6 +19,7 @@ radians; it never commands beyond the robot's limits (configs/control.yaml ``mot
 from __future__ import annotations
 
 from dataclasses import dataclass
+from enum import Enum
 from typing import Protocol
 
 from numpy.typing import ArrayLike
@@ -27,10 +28,22 @@ from cmdragons.messages import RobotState
 from cmdragons.planning.termination import Termination
 from cmdragons.planning.world import CollisionWorld
 
-__all__ = ["STOP", "Arrival", "Navigator", "VelocityCommand"]
+__all__ = ["STOP", "Arrival", "NavStatus", "Navigator", "VelocityCommand"]
 
 VelocityCommand = tuple[float, float, float]  # vx, vy (field frame, m/s), omega (rad/s)
 STOP: VelocityCommand = (0.0, 0.0, 0.0)
+
+
+class NavStatus(Enum):
+    """What a reactive navigator reports about its last command (a value, never an exception)."""
+
+    IDLE = "idle"  # no goal
+    MOVING = "moving"  # on its way by its own method
+    FOLLOWING = "following"  # bug methods: following an obstacle's boundary
+    ARRIVING = "arriving"  # the last stretch: the trajectory navigator's approach to the goal
+    LOCAL_MINIMUM = "local_minimum"  # potential fields: stuck where the forces cancel (it stops)
+    ESCAPING = "escaping"  # potential fields: leaving a local minimum along the NF1 path
+    BLOCKED = "blocked"  # the method finds no way to the goal (it stops)
 
 
 @dataclass(frozen=True)

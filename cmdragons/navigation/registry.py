@@ -1,6 +1,8 @@
 """Navigator registry: ``team.navigator`` in configs/team.yaml picks one of :data:`NAVIGATORS`; each
 navigator has its config section there (``team.trajectory``, ``team.dynamic_window``, ``team.robox`` with
-``team.elastic_band``).
+``team.elastic_band``; the reactive methods ``team.reactive`` and their own: ``potential_field``,
+``extended_potential_field``, ``bug``, ``tangent_bug``, ``vfh``, ``vfh_plus``, ``curvature_velocity``,
+``lane_curvature``, ``escape_evade``).
 
 A new navigator is one module, one line here and one config section (a field of
 :class:`cmdragons.team.TeamParams` named like its registry key).
@@ -13,9 +15,14 @@ from typing import Any
 
 from cmdragons.control.motion import ControlParams
 from cmdragons.navigation.base import Navigator
+from cmdragons.navigation.bug import BugNavigator
+from cmdragons.navigation.curvature_velocity import CurvatureVelocityNavigator
 from cmdragons.navigation.dynamic_window import DynamicWindowNavigator
+from cmdragons.navigation.escape_evade import EscapeEvadeNavigator
+from cmdragons.navigation.potential_field import PotentialFieldNavigator
 from cmdragons.navigation.robox import RoboxNavigator
 from cmdragons.navigation.trajectory import TrajectoryNavigator
+from cmdragons.navigation.vfh import VFHNavigator
 from cmdragons.planning.world import CollisionParams
 
 __all__ = ["NAVIGATORS", "make_navigator"]
@@ -30,6 +37,26 @@ NAVIGATORS: dict[str, Factory] = {
                                                                               s.trajectory),  # fmt: skip
     "robox": lambda s, control, r, collision: RoboxNavigator(s.robox, s.elastic_band, s.dynamic_window, control, r,
                                                              collision, s.trajectory),  # fmt: skip
+    # the reactive methods of the lecture notes (navigation/reactive.py: the shared section ``reactive``)
+    "potential_field": lambda s, control, r, collision: PotentialFieldNavigator(
+        s.potential_field, s.reactive, control, r, collision, s.trajectory),
+    "extended_potential_field": lambda s, control, r, collision: PotentialFieldNavigator(
+        s.potential_field, s.reactive, control, r, collision, s.trajectory, s.extended_potential_field),
+    "bug1": lambda s, control, r, collision: BugNavigator("bug1", s.bug, s.reactive, control, r, collision,
+                                                          s.trajectory),  # fmt: skip
+    "bug2": lambda s, control, r, collision: BugNavigator("bug2", s.bug, s.reactive, control, r, collision,
+                                                          s.trajectory),  # fmt: skip
+    "tangent_bug": lambda s, control, r, collision: BugNavigator("tangent_bug", s.bug, s.reactive, control, r,
+                                                                 collision, s.trajectory, s.tangent_bug),  # fmt: skip
+    "vfh": lambda s, control, r, collision: VFHNavigator(s.vfh, s.reactive, control, r, collision, s.trajectory),
+    "vfh_plus": lambda s, control, r, collision: VFHNavigator(s.vfh, s.reactive, control, r, collision, s.trajectory,
+                                                              s.vfh_plus),  # fmt: skip
+    "curvature_velocity": lambda s, control, r, collision: CurvatureVelocityNavigator(
+        s.curvature_velocity, s.reactive, control, r, collision, s.trajectory),
+    "lane_curvature": lambda s, control, r, collision: CurvatureVelocityNavigator(
+        s.curvature_velocity, s.reactive, control, r, collision, s.trajectory, s.lane_curvature),
+    "escape_evade": lambda s, control, r, collision: EscapeEvadeNavigator(s.escape_evade, s.reactive, control, r,
+                                                                          collision, s.trajectory),  # fmt: skip
 }
 
 

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import dataclasses
+import math
+
 import pytest
 
 from cmdragons.geometry import Field, LeagueParams
@@ -45,3 +48,26 @@ def test_otherwise_the_goalie_blocks(at: str, v: tuple[float, float]) -> None:
     intent, clears = goalie(robot, ball, FIELD, own_sign, P, SkillParams())
     assert not clears and intent.kick_speed == 0.0
     assert abs(intent.y) <= FIELD.goal_half_width  # between the posts
+
+
+@pytest.mark.parametrize("own_sign", [-1.0, 1.0])
+def test_the_goalie_s_reflex_moves_it_toward_a_slow_shot_s_line(own_sign: float) -> None:
+    # a shot too slow for the goalie to meet on its line (under goalie_shot_speed_m_s): blocking alone
+    # stands on the line from the ball to the goal's centre; the reflex steps toward the ball's path
+    skills = SkillParams()
+    goal_x = own_sign * FIELD.half_length
+    line_x = goal_x - own_sign * skills.goalie_depth_m
+    bx, by, path_y = goal_x - own_sign * (FIELD.dims.defense_depth_m + 0.3), 0.35, -0.15
+    t = 3.0  # s to the goalie's line
+    ball = BallState(bx, by, (line_x - bx) / t, (path_y - by) / t)
+    assert math.hypot(ball.vx, ball.vy) < skills.goalie_shot_speed_m_s and not ball_to_clear(ball, FIELD, own_sign, P)
+    robot = RobotState("blue", 0, line_x, 0.0, 0.0)
+    on_p = dataclasses.replace(P, goalie_reflex=True, goalie_reflex_gain_s=1.0)
+    off, _ = goalie(robot, ball, FIELD, own_sign, P, skills)
+    on, clears = goalie(robot, ball, FIELD, own_sign, on_p, skills)
+    assert not clears and on.x == off.x
+    assert path_y - 1e-12 <= on.y < off.y - 0.02  # toward the ball's path from blocking's point, not past it
+    # a ball going away from our goal: no reflex
+    away = BallState(bx, by, -ball.vx, ball.vy)
+    assert goalie(robot, away, FIELD, own_sign, on_p, skills)[0] == \
+        goalie(robot, away, FIELD, own_sign, P, skills)[0]  # fmt: skip

@@ -224,15 +224,15 @@ def _cmd_sim(args: argparse.Namespace, stop: Interrupt) -> int:
                 if recorder is not None:
                     recorder.write(frame.frame_number, frame.images, frame.truth)
                 g = frame.game if frame.game is not None else GameState(frame.t_capture)
-                log.write("/truth", frame.t_capture, frame.truth.to_dict())
-                log.write("/referee", frame.t_capture, g.to_dict())
+                log.write("/truth", frame.t_capture, frame.truth)
+                log.write("/referee", frame.t_capture, g)
                 commands = script.commands(sim.world.snapshot())
                 for team in TEAMS:
                     mine = tuple(c for c in commands if c.team == team)
                     log.write(f"/commands/{team}", frame.t_capture,
-                              TeamCommands(team, frame.frame_number, frame.t_capture, mine).to_dict())  # fmt: skip
+                              TeamCommands(team, frame.frame_number, frame.t_capture, mine))  # fmt: skip
                 events = tuple(sim.advance(commands))
-                log.write("/events", sim.t, SimEvents(frame.frame_number, sim.t, sim.ball_xy(), events).to_dict())
+                log.write("/events", sim.t, SimEvents(frame.frame_number, sim.t, sim.ball_xy(), events))
                 if i % 15 == 0 or i == n_frames - 1:
                     progress.update(task, completed=i + 1,
                                     info=f"t={sim.t:6.2f}s  blue {g.score_blue}:{g.score_yellow} yellow")  # fmt: skip

@@ -1,8 +1,8 @@
 """What crosses stage and process boundaries.
 
 Every message is a frozen dataclass with ``to_dict``/``from_dict`` (the JSONL forms of DESIGN.md:
-metres, radians, team as "blue"/"yellow") and ``encode``/``decode``, a compact binary form for the
-bus: a fixed little-endian header followed by packed rows (numpy structured arrays).
+metres, radians, team as "blue"/"yellow"). Their protobuf forms, for the bus and the logs, are
+the runtime's (:mod:`cmdragons.runtime.wire`).
 """
 
 from __future__ import annotations
@@ -11,10 +11,9 @@ import base64
 import binascii
 import dataclasses
 import math
-import struct
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any, ClassVar, Self
+from typing import Any, Self
 
 import numpy as np
 from numpy.typing import NDArray
@@ -55,13 +54,6 @@ class MessageError(ValueError):
     """A message that cannot be decoded or read from its dict form."""
 
 
-def _team_code(team: str) -> int:
-    try:
-        return TEAMS.index(team)  # type: ignore[arg-type,unused-ignore]
-    except ValueError:
-        raise MessageError(f"team must be 'blue' or 'yellow', got {team!r}") from None
-
-
 def _team(team: Any) -> Team:
     if team not in TEAMS:
         raise MessageError(f"team must be 'blue' or 'yellow', got {team!r}")
@@ -98,41 +90,6 @@ def _num(x: float) -> float | None:
     return None if math.isnan(x) else x
 
 
-class _Codec:
-    """Header struct + one structured array per list field."""
-
-    def __init__(self, header: str, *rows: np.dtype[Any]) -> None:
-        self.header = struct.Struct("<" + header)
-        self.rows = rows
-
-    def pack(self, head: Sequence[Any], *tables: NDArray[Any]) -> bytes:
-        parts = [self.header.pack(*head)]
-        for table in tables:
-            parts.append(struct.pack("<I", len(table)))
-            parts.append(table.tobytes())
-        return b"".join(parts)
-
-    def unpack(self, data: bytes | bytearray | memoryview) -> tuple[tuple[Any, ...], list[NDArray[Any]]]:
-        buf = memoryview(data).cast("B")
-        try:
-            head = self.header.unpack_from(buf, 0)
-            off = self.header.size
-            tables = []
-            for dt in self.rows:
-                (n,) = struct.unpack_from("<I", buf, off)
-                off += 4
-                size = n * dt.itemsize
-                if off + size > len(buf):
-                    raise MessageError("message is truncated")
-                tables.append(np.frombuffer(buf[off : off + size], dtype=dt).copy())
-                off += size
-        except struct.error as exc:
-            raise MessageError(f"message is truncated or corrupt: {exc}") from None
-        if off != len(buf):
-            raise MessageError(f"message has {len(buf) - off} trailing bytes")
-        return head, tables
-
-
 # --- detections ------------------------------------------------------------------------------
 
 
@@ -158,13 +115,6 @@ class RobotDetection:
     pixel: tuple[float, float]
 
 
-_BALL_DET = np.dtype([("x", "<f8"), ("y", "<f8"), ("confidence", "<f4"), ("u", "<f4"), ("v", "<f4"), ("sigma", "<f4")])
-_ROBOT_DET = np.dtype(
-    [("team", "u1"), ("id", "u1"), ("x", "<f8"), ("y", "<f8"), ("theta", "<f4"),
-     ("confidence", "<f4"), ("u", "<f4"), ("v", "<f4")]
-)  # fmt: skip
-
-
 @dataclass(frozen=True)
 class DetectionFrame:
     """One camera frame's detections: the content of an SSL-Vision detection packet."""
@@ -175,8 +125,6 @@ class DetectionFrame:
     t_sent: float
     balls: tuple[BallDetection, ...] = ()
     robots: tuple[RobotDetection, ...] = ()
-
-    _codec: ClassVar[_Codec] = _Codec("Hqdd", _BALL_DET, _ROBOT_DET)
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -218,27 +166,6 @@ class DetectionFrame:
         except (KeyError, TypeError, AttributeError) as exc:
             raise MessageError(f"bad detection frame: {exc!r}") from None
 
-    def encode(self) -> bytes:
-        balls = np.array([(b.x, b.y, b.confidence, *b.pixel, b.sigma_m) for b in self.balls], dtype=_BALL_DET)
-        robots = np.array(
-            [(_team_code(r.team), r.id, r.x, r.y, r.theta, r.confidence, *r.pixel) for r in self.robots],
-            dtype=_ROBOT_DET,
-        )
-        return self._codec.pack((self.camera_id, self.frame_number, self.t_capture, self.t_sent), balls, robots)
-
-    @classmethod
-    def decode(cls, data: bytes | bytearray | memoryview) -> Self:
-        (cam, frame, t_capture, t_sent), (balls, robots) = cls._codec.unpack(data)
-        return cls(
-            cam, frame, t_capture, t_sent,
-            tuple(BallDetection(float(b["x"]), float(b["y"]), float(b["confidence"]), (float(b["u"]), float(b["v"])),
-                                float(b["sigma"])) for b in balls),
-            tuple(RobotDetection(TEAMS[int(r["team"]) & 1], int(r["id"]), float(r["x"]), float(r["y"]),
-                                 float(r["theta"]), float(r["confidence"]), (float(r["u"]), float(r["v"])))
-                  for r in robots),
-        )  # fmt: skip
-
-
 # --- tracked world state ----------------------------------------------------------------------
 
 
@@ -265,13 +192,6 @@ class RobotState:
     visible: bool = True
 
 
-_BALL_STATE = np.dtype([("x", "<f8"), ("y", "<f8"), ("vx", "<f4"), ("vy", "<f4"), ("visible", "u1")])
-_ROBOT_STATE = np.dtype(
-    [("team", "u1"), ("id", "u1"), ("visible", "u1"), ("x", "<f8"), ("y", "<f8"), ("theta", "<f4"),
-     ("vx", "<f4"), ("vy", "<f4"), ("omega", "<f4")]
-)  # fmt: skip
-
-
 @dataclass(frozen=True)
 class WorldState:
     """The tracker's estimate at time ``t`` (s); ``ball`` is None until a ball was ever seen."""
@@ -280,8 +200,6 @@ class WorldState:
     ball: BallState | None
     robots: tuple[RobotState, ...] = ()
     frame_number: int = 0  # the camera frame the state was estimated from
-
-    _codec: ClassVar[_Codec] = _Codec("dq", _BALL_STATE, _ROBOT_STATE)
 
     def robot(self, team: Team, robot_id: int) -> RobotState | None:
         for r in self.robots:
@@ -317,38 +235,7 @@ class WorldState:
         except (KeyError, TypeError, AttributeError) as exc:
             raise MessageError(f"bad world state: {exc!r}") from None
 
-    def encode(self) -> bytes:
-        b = self.ball
-        balls = np.array([] if b is None else [(b.x, b.y, b.vx, b.vy, b.visible)], dtype=_BALL_STATE)
-        robots = np.array(
-            [(_team_code(r.team), r.id, r.visible, r.x, r.y, r.theta, r.vx, r.vy, r.omega) for r in self.robots],
-            dtype=_ROBOT_STATE,
-        )
-        return self._codec.pack((self.t, self.frame_number), balls, robots)
-
-    @classmethod
-    def decode(cls, data: bytes | bytearray | memoryview) -> Self:
-        (t, frame), (balls, robots) = cls._codec.unpack(data)
-        ball = None
-        if len(balls):
-            b = balls[0]
-            ball = BallState(float(b["x"]), float(b["y"]), float(b["vx"]), float(b["vy"]), bool(b["visible"]))
-        return cls(
-            float(t), ball,
-            tuple(RobotState(TEAMS[int(r["team"]) & 1], int(r["id"]), float(r["x"]), float(r["y"]),
-                             float(r["theta"]), float(r["vx"]), float(r["vy"]), float(r["omega"]),
-                             bool(r["visible"])) for r in robots),
-            int(frame),
-        )  # fmt: skip
-
-
 # --- commands ----------------------------------------------------------------------------------
-
-
-_COMMAND = np.dtype(
-    [("team", "u1"), ("id", "u1"), ("chip", "u1"), ("dribbler", "<f4"), ("vx", "<f4"), ("vy", "<f4"),
-     ("omega", "<f4"), ("kick_speed", "<f4")]
-)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -379,27 +266,6 @@ class RobotCommand:
         except (KeyError, TypeError, AttributeError) as exc:
             raise MessageError(f"bad robot command: {exc!r}") from None
 
-    @staticmethod
-    def encode_many(commands: Sequence[RobotCommand]) -> bytes:
-        table = np.array(
-            [(_team_code(c.team), c.id, c.chip, c.dribbler, c.vx, c.vy, c.omega, c.kick_speed) for c in commands],
-            dtype=_COMMAND,
-        )
-        return _COMMANDS_CODEC.pack((), table)
-
-    @classmethod
-    def decode_many(cls, data: bytes | bytearray | memoryview) -> list[RobotCommand]:
-        _, (table,) = _COMMANDS_CODEC.unpack(data)
-        return [
-            cls(TEAMS[int(r["team"]) & 1], int(r["id"]), float(r["vx"]), float(r["vy"]), float(r["omega"]),
-                float(r["kick_speed"]), bool(r["chip"]), float(r["dribbler"]))
-            for r in table
-        ]  # fmt: skip
-
-
-_COMMANDS_CODEC = _Codec("", _COMMAND)
-
-
 # --- ground truth (simulator only) -----------------------------------------------------------
 
 
@@ -429,13 +295,6 @@ class RobotTruth:
     pixels: Mapping[int, tuple[float, float]] = field(default_factory=dict)
 
 
-_BALL_TRUTH = np.dtype([("x", "<f8"), ("y", "<f8"), ("z", "<f8"), ("vx", "<f8"), ("vy", "<f8"), ("vz", "<f8")])
-_ROBOT_TRUTH = np.dtype(
-    [("team", "u1"), ("id", "u1"), ("x", "<f8"), ("y", "<f8"), ("theta", "<f8"), ("vx", "<f8"),
-     ("vy", "<f8"), ("omega", "<f8")]
-)  # fmt: skip
-
-
 @dataclass(frozen=True)
 class GroundTruth:
     """The simulator's true state for one camera frame (what vision, tracking and safety are
@@ -445,8 +304,6 @@ class GroundTruth:
     t: float
     ball: BallTruth
     robots: tuple[RobotTruth, ...] = ()
-
-    _codec: ClassVar[_Codec] = _Codec("qd", _BALL_TRUTH, _ROBOT_TRUTH)
 
     def to_dict(self) -> dict[str, Any]:
         b = self.ball
@@ -481,34 +338,9 @@ class GroundTruth:
         except (KeyError, TypeError, AttributeError, ValueError) as exc:
             raise MessageError(f"bad ground truth: {exc!r}") from None
 
-    def encode(self) -> bytes:
-        """The state only (pixel truth stays in the JSONL and MCAP logs)."""
-        b = self.ball
-        balls = np.array([(b.x, b.y, b.z, b.vx, b.vy, b.vz)], dtype=_BALL_TRUTH)
-        robots = np.array(
-            [(_team_code(r.team), r.id, r.x, r.y, r.theta, r.vx, r.vy, r.omega) for r in self.robots],
-            dtype=_ROBOT_TRUTH,
-        )
-        return self._codec.pack((self.frame_number, self.t), balls, robots)
-
-    @classmethod
-    def decode(cls, data: bytes | bytearray | memoryview) -> Self:
-        (frame, t), (balls, robots) = cls._codec.unpack(data)
-        if len(balls) != 1:
-            raise MessageError("ground truth must hold exactly one ball")
-        b = balls[0]
-        return cls(
-            int(frame), float(t),
-            BallTruth(float(b["x"]), float(b["y"]), float(b["z"]), float(b["vx"]), float(b["vy"]), float(b["vz"])),
-            tuple(RobotTruth(TEAMS[int(r["team"]) & 1], int(r["id"]), float(r["x"]), float(r["y"]),
-                             float(r["theta"]), float(r["vx"]), float(r["vy"]), float(r["omega"])) for r in robots),
-        )  # fmt: skip
-
-
 # --- referee ------------------------------------------------------------------------------------
 
 _COMMANDS = ("halt", "stop", "kickoff", "free_kick", "normal")
-_GAME = struct.Struct("<dBbHHBdd")
 
 
 @dataclass(frozen=True)
@@ -547,24 +379,6 @@ class GameState:
             )  # fmt: skip
         except (KeyError, TypeError, AttributeError, ValueError, IndexError) as exc:
             raise MessageError(f"bad game state: {exc!r}") from None
-
-    def encode(self) -> bytes:
-        px, py = self.placement if self.placement is not None else (math.nan, math.nan)
-        team = -1 if self.for_team is None else _team_code(self.for_team)
-        return _GAME.pack(self.t, _COMMANDS.index(self.command), team, self.score_blue, self.score_yellow,
-                          self.blue_defends_negative_x, px, py)  # fmt: skip
-
-    @classmethod
-    def decode(cls, data: bytes | bytearray | memoryview) -> Self:
-        try:
-            t, cmd, team, sb, sy, blue_neg, px, py = _GAME.unpack(bytes(data))
-        except struct.error as exc:
-            raise MessageError(f"game state is truncated or corrupt: {exc}") from None
-        if cmd >= len(_COMMANDS):
-            raise MessageError(f"unknown game command code {cmd}")
-        placement = None if math.isnan(px) else (px, py)
-        return cls(t, _COMMANDS[cmd], None if team < 0 else TEAMS[team & 1], sb, sy, bool(blue_neg), placement)
-
 
 # --- simulator events --------------------------------------------------------------------------
 

@@ -5,7 +5,7 @@
   thinks.
 - No stage package (vision, sim, strategy and the algorithm packages under cmdragons/) imports the
   composition: the runtime, the team's brain, the benchmarks or the command line.
-- Heavy I/O libraries stay in the packages that own them: zenoh in the runtime, pymunk in sim/,
+- Heavy I/O libraries stay in the packages that own them: zenoh and protobuf in the runtime, pymunk in sim/,
   mcap in the runtime's log, PyAV in the video module, OpenCV's video files in the modules that read
   or write recordings and videos.
 """
@@ -28,6 +28,8 @@ OWNERS: dict[str, tuple[str, ...]] = {
     "pymunk": ("sim",),
     "mcap": ("cmdragons.runtime",),
     "mcap_protobuf": ("cmdragons.runtime",),
+    "google": ("cmdragons.runtime",),  # protobuf
+    "foxglove_schemas_protobuf": ("cmdragons.runtime",),
     "av": ("cmdragons.videoio",),
     "matplotlib": ("cmdragons.runtime", "cmdragons.bench"),
 }

@@ -423,7 +423,7 @@ class LoggerStage(BaseStage):
         if any(topic_matches(p, topic) for p in self.skip):
             return
         self._t = message_time(message, self._t)
-        self.log.write("/" + topic, self._t, message.to_dict())
+        self.log.write("/" + topic, self._t, message)
 
 
 class SummaryCollector(BaseStage):

@@ -289,6 +289,7 @@ def _cmd_play(args: argparse.Namespace, stop: Interrupt) -> int:
     from cmdragons.runtime.match import OURS, Match
     from cmdragons.runtime.overlay import MatchVideoStage
     from cmdragons.runtime.report import pyplot
+    from cmdragons.runtime.scene import SceneStage
     from cmdragons.runtime.settings import load_settings, load_team_settings
     from cmdragons.runtime.stages import LoggerStage, Tap
     from cmdragons.runtime.warmup import CompileWatch
@@ -307,7 +308,10 @@ def _cmd_play(args: argparse.Namespace, stop: Interrupt) -> int:
     fps = settings.sim.physics.frame_rate_hz
     n_frames = max(1, round(args.seconds * fps))
     game = [GameState(0.0)]  # the referee's latest word, for the progress bar
-    extra: list[Stage] = [LoggerStage(log), Tap("progress", ("referee",), lambda _topic, g: game.__setitem__(0, g))]
+    scene = SceneStage(log, settings.field_geometry(), settings.field.robot.radius_m, settings.field.robot.height_m,
+                       settings.field.ball.radius_m)  # fmt: skip
+    extra: list[Stage] = [LoggerStage(log), scene,
+                          Tap("progress", ("referee",), lambda _topic, g: game.__setitem__(0, g))]  # fmt: skip
     video = None
     if args.video:
         video = MatchVideoStage(folder / "match.mp4", args.view, OURS, settings.camera_models(),

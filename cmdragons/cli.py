@@ -17,6 +17,8 @@ from typing import Any, NoReturn
 
 import numpy as np
 
+from cmdragons.cli_runtime import add_parsers as add_runtime_parsers
+from cmdragons.cli_runtime import cmd_log, cmd_node, play_distributed
 from cmdragons.config import ConfigError
 from cmdragons.runtime.interrupt import Interrupt
 from cmdragons.runtime.log import OutputError
@@ -104,6 +106,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--overwrite", action="store_true", help="let --out replace the run already in that folder")
     p.add_argument("--seed", type=_seed, default=None, help="override sim.seed (0 .. 2**63-1)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument("--distributed", action="store_true",
+                   help="every part as its own process on zenoh (loopback, configs/runtime.yaml), in lock-step")
 
     p = sub.add_parser(
         "vision", help="detect ball and robots in camera frames (also: vision calibrate ..., vision tune ...)",
@@ -130,6 +134,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--maps", metavar="DIR", default=None,
                    help="grid: a folder of Moving AI .map files with their .map.scen "
                    "(default ../shared/benchdata/moving_ai)")
+    add_runtime_parsers(sub, _common)
     return parser
 
 
@@ -153,8 +158,14 @@ def main(argv: Sequence[str] | None = None) -> int:
                 return _cmd_sim(args, stop)
             if args.command == "bench":
                 return _cmd_bench(args)
+            if args.command == "play" and args.distributed:
+                return play_distributed(args, stop)
             if args.command == "play":
                 return _cmd_play(args, stop)
+            if args.command == "node":
+                return cmd_node(args, stop)
+            if args.command == "log":
+                return cmd_log(args)
             if args.command == "vision":
                 return _cmd_vision(args)
         except ConfigError as exc:

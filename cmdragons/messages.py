@@ -34,6 +34,7 @@ __all__ = [
     "GroundTruth",
     "Kick",
     "MessageError",
+    "NodeControl",
     "RobotCommand",
     "RobotDetection",
     "RobotReport",
@@ -680,3 +681,22 @@ class StageSummary:
             return cls(str(d["stage"]), dict(d.get("figures", {})))
         except (KeyError, TypeError, ValueError) as exc:
             raise MessageError(f"bad stage summary: {exc!r}") from None
+
+
+@dataclass(frozen=True)
+class NodeControl:
+    """The distributed runtime's own word between nodes: a node says it is ``ready``; the match's
+    clock tells every node to ``start``, ``summarize`` or ``stop``."""
+
+    node: str
+    command: str
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"node": self.node, "command": self.command}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Self:
+        try:
+            return cls(str(d["node"]), str(d["command"]))
+        except (KeyError, TypeError) as exc:
+            raise MessageError(f"bad node control: {exc!r}") from None

@@ -8,7 +8,10 @@ from typing import Any
 
 from cmdragons.config import Validated, setting
 
-__all__ = ["RuntimeParams", "ZenohParams"]
+__all__ = ["ROLES", "RuntimeParams", "ZenohParams"]
+
+# the nodes of a distributed match (cmdragons/runtime/distributed.py says what each runs)
+ROLES = ("sim", "vision", "team", "opponent", "referee", "log")
 
 _LOOPBACK = "tcp/127.0.0.1:"
 
@@ -56,6 +59,7 @@ class RuntimeParams(Validated):
     peer_timeout_s: float = setting(5.0, lo=0.1, hi=600.0)  # a node that heard nothing this long says so
     drop_report_interval_s: float = setting(1.0, lo=0.01, hi=60.0)  # undecodable messages: one line at most this often
     start_timeout_s: float = setting(60.0, lo=1.0, hi=3600.0)  # the match starts once every node is up, or gives up
+    settle_s: float = setting(0.5, lo=0.0, hi=60.0)  # every node up: subscriptions reach every publisher in this
 
     def __post_init__(self) -> None:
         super().__post_init__()

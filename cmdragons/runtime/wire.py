@@ -40,6 +40,7 @@ from cmdragons.messages import (
     GroundTruth,
     Kick,
     MessageError,
+    NodeControl,
     RobotCommand,
     RobotDetection,
     RobotReport,
@@ -376,6 +377,8 @@ CODECS: dict[type[Any], Codec] = {c.message: c for c in (
     Codec(TeamReport, pb.TeamReport, _report_to, _report_from),
     Codec(Timing, pb.Timing, _timing_to, _timing_from),
     Codec(StageSummary, pb.StageSummary, _summary_to, _summary_from),
+    Codec(NodeControl, pb.NodeControl, lambda c: pb.NodeControl(node=c.node, command=c.command),
+          lambda m: NodeControl(m.node, m.command)),
 )}  # fmt: skip
 _BY_NAME: dict[str, Codec] = {c.proto.DESCRIPTOR.full_name: c for c in CODECS.values()}
 
@@ -397,6 +400,7 @@ TOPICS: tuple[tuple[str, type[Any]], ...] = (
     ("report/*", TeamReport),
     ("timing/*", Timing),
     ("summary/*", StageSummary),
+    ("control/*", NodeControl),
 )
 
 

@@ -107,13 +107,14 @@ class ZenohTransport:
     def publish(self, topic: str, message: Any) -> None:
         if self._handlers(topic):
             self._queue.put((topic, wire.canonical(message), False))
-        pub = self._publisher(topic)
         data = wire.encode(message)
         zp = self.params.zenoh
-        if zp.shared_memory and len(data) >= zp.shm_min_bytes:
-            pub.put(self._in_shared_memory(data))
-        else:
-            pub.put(data)
+        payload = self._in_shared_memory(data) if zp.shared_memory and len(data) >= zp.shm_min_bytes else data
+        # the session's put, not a publisher declared now: a new publisher drops what it is given until
+        # it learnt who subscribes, the session routes by what it knows already
+        z = self._zenoh
+        self.session.put(f"{self.prefix}/{topic}", payload, congestion_control=z.CongestionControl.BLOCK,
+                         allowed_destination=z.Locality.REMOTE)  # fmt: skip
 
     def _in_shared_memory(self, data: bytes) -> Any:
         from zenoh import shm

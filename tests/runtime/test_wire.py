@@ -43,6 +43,7 @@ EXACT: list[Any] = [
     msg.Tick(12),
     msg.Timing("team/blue", 3, {"plan": 1.5, "safety": 0.25}),
     msg.StageSummary("referee", {"score": {"blue": 1, "yellow": 0}, "kicks": 3, "ratio": 0.5}),
+    msg.NodeControl("team", "ready"),
     msg.CameraFrame(0, 3, 0.05, np.arange(4 * 5 * 3, dtype=np.uint8).reshape(4, 5, 3)),
 ]  # fmt: skip
 REPORT = msg.TeamReport(

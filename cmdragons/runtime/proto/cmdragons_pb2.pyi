@@ -307,3 +307,11 @@ class StageSummary(_message.Message):
     stage: str
     figures_json: str
     def __init__(self, stage: _Optional[str] = ..., figures_json: _Optional[str] = ...) -> None: ...
+
+class NodeControl(_message.Message):
+    __slots__ = ("node", "command")
+    NODE_FIELD_NUMBER: _ClassVar[int]
+    COMMAND_FIELD_NUMBER: _ClassVar[int]
+    node: str
+    command: str
+    def __init__(self, node: _Optional[str] = ..., command: _Optional[str] = ...) -> None: ...

@@ -104,7 +104,7 @@ def cmd_node(args: argparse.Namespace, stop: Interrupt) -> int:
                 log.close()
             transport.close()
             if router is not None:
-                router.close()
+                router.close()  # type: ignore[no-untyped-call]
 
 
 def play_distributed(args: argparse.Namespace, stop: Interrupt) -> int:
@@ -156,7 +156,7 @@ def play_distributed(args: argparse.Namespace, stop: Interrupt) -> int:
                     child.wait(timeout=5)
             if transport is not None:
                 transport.close()
-            router.close()
+            router.close()  # type: ignore[no-untyped-call]
 
 
 def cmd_log(args: argparse.Namespace) -> int:

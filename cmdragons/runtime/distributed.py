@@ -155,6 +155,8 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
     summaries = SummaryCollector()
     bus.add(Tap("control:ready", ("control/*",), lambda _t, c: ready.add(c.node) if c.command == "ready" else None))
     bus.add(Tap("clock:referee", ("referee",), lambda _t, _g: judged.__setitem__(0, judged[0] + 1)))
+    placed = [0]  # the referee's teleports so far (the kickoff formation first)
+    bus.add(Tap("clock:teleport", ("teleport",), lambda _t, _g: placed.__setitem__(0, placed[0] + 1)))
     for stage in [*stages, *extra, summaries]:
         bus.add(stage)
     sim_stage = next(s for s in stages if isinstance(s, SimStage))
@@ -176,8 +178,8 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
     transport.wait_for(lambda: False, params.settle_s)  # declarations propagate: nothing of frame 0 is lost
     _control(transport, "clock", "start")
     bus.start()
-    if not transport.wait_for(lambda: judged[0] >= 1, params.start_timeout_s):
-        raise TimeoutError("the referee node did not give the kickoff")
+    if not transport.wait_for(lambda: judged[0] >= 1 and placed[0] >= 1, 5.0):
+        raise TimeoutError(f"the referee node did not give the kickoff (referee {judged[0]}, teleport {placed[0]})")
     fps = spec.settings.sim.physics.frame_rate_hz
     n = max(1, round(seconds * fps))
     frame_ms: list[float] = []

@@ -66,15 +66,13 @@ def _log_stages(spec: Any, folder: Path) -> tuple[Any, list[Any]]:
 
 
 def cmd_node(args: argparse.Namespace, stop: Interrupt) -> int:
-    import zenoh
-
     from cmdragons.runtime.distributed import node_roles, run_clock, run_node, write_summary
     from cmdragons.runtime.log import run_folder
-    from cmdragons.runtime.zenoh_transport import ZenohTransport
+    from cmdragons.runtime.zenoh_transport import ZenohTransport, open_router
 
     spec = _spec(args)
     params = spec.settings.runtime
-    router = zenoh.open(params.zenoh.config("router")) if args.router else None
+    router = open_router(params) if args.router else None
     transport = ZenohTransport(params, args.role)
     log = None
     try:
@@ -104,17 +102,15 @@ def cmd_node(args: argparse.Namespace, stop: Interrupt) -> int:
                 log.close()
             transport.close()
             if router is not None:
-                router.close()  # type: ignore[no-untyped-call]
+                router.close()
 
 
 def play_distributed(args: argparse.Namespace, stop: Interrupt) -> int:
     """``cmdragons play --distributed``: a router here, every other node as its own process (spawned,
     never forked after zenoh opened), the clock here; Ctrl-C stops them all."""
-    import zenoh
-
     from cmdragons.runtime.distributed import node_roles, run_clock, write_summary
     from cmdragons.runtime.log import run_folder
-    from cmdragons.runtime.zenoh_transport import ZenohTransport
+    from cmdragons.runtime.zenoh_transport import ZenohTransport, open_router
 
     spec = _spec(args)
     params = spec.settings.runtime
@@ -124,7 +120,7 @@ def play_distributed(args: argparse.Namespace, stop: Interrupt) -> int:
     for s in args.set:
         common += ["--set", s]
     common += ["--opponent", spec.opponent, "--perception", spec.perception, "--seed", str(spec.seed)]
-    router = zenoh.open(params.zenoh.config("router"))
+    router = open_router(params)
     children: list[subprocess.Popen[bytes]] = []
     transport = None
     try:
@@ -156,31 +152,22 @@ def play_distributed(args: argparse.Namespace, stop: Interrupt) -> int:
                     child.wait(timeout=5)
             if transport is not None:
                 transport.close()
-            router.close()  # type: ignore[no-untyped-call]
+            router.close()
 
 
 def cmd_log(args: argparse.Namespace) -> int:
     """``cmdragons log info LOG.mcap``: topics with their schemas and counts, the duration, the summary."""
-    from mcap.reader import make_reader
+    from cmdragons.runtime.log import LogError, log_info
 
     path = Path(args.path)
     if not path.is_file():
         print(f"cmdragons log: {path}: no such file; give a run's run.mcap", file=sys.stderr)
         return 2
     try:
-        with path.open("rb") as f:
-            summary = make_reader(f).get_summary()
-    except Exception as exc:  # mcap raises several kinds on a file that is not MCAP
-        print(f"cmdragons log: {path}: not an MCAP log ({type(exc).__name__}: {exc})", file=sys.stderr)
+        print("\n".join(log_info(path)))
+    except LogError as exc:
+        print(f"cmdragons log: {exc}", file=sys.stderr)
         return 2
-    if summary is None or summary.statistics is None:
-        print(f"cmdragons log: {path}: the log has no summary (an unfinished run?)", file=sys.stderr)
-        return 2
-    st = summary.statistics
-    print(f"{path}: {st.message_count} messages, {(st.message_end_time - st.message_start_time) / 1e9:.2f} s")
-    for cid, ch in sorted(summary.channels.items(), key=lambda kv: kv[1].topic):
-        schema = summary.schemas.get(ch.schema_id)
-        print(f"  {ch.topic:28s} {st.channel_message_counts.get(cid, 0):7d}  {schema.name if schema else '-'}")
     run_summary = path.parent / "summary.json"
     if run_summary.exists():
         d = json.loads(run_summary.read_text())

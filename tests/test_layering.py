@@ -21,7 +21,8 @@ ROOT = Path(__file__).resolve().parents[1]
 FLOOR = {"cmdragons.config", "cmdragons.geometry", "cmdragons.messages", "cmdragons.camera", "cmdragons.recording",
          "cmdragons.videoio", "cmdragons._kernels"}
 PROJECT = ("cmdragons", "vision", "strategy", "sim")
-COMPOSITION = ("cmdragons.runtime", "cmdragons.team", "cmdragons.bench", "cmdragons.cli", "cmdragons.cli_vision")
+COMPOSITION = ("cmdragons.runtime", "cmdragons.team", "cmdragons.bench", "cmdragons.cli", "cmdragons.cli_vision",
+               "cmdragons.cli_runtime")
 # library -> the module prefixes allowed to import it
 OWNERS: dict[str, tuple[str, ...]] = {
     "zenoh": ("cmdragons.runtime",),

@@ -18,7 +18,8 @@ from typing import Any, BinaryIO
 
 from mcap.writer import CompressionType, Writer
 
-__all__ = ["RUN_FILES", "LogError", "OutputError", "RunLog", "check_writable_file", "read_log", "run_folder"]
+__all__ = ["RUN_FILES", "LogError", "OutputError", "RunLog", "check_writable_file", "log_info", "read_log",
+           "run_folder"]
 
 # what a run writes into its folder (globs): a folder holding one of these holds a run
 RUN_FILES = ("run.mcap", "summary.json", "match.mp4", "match_cameras.mp4", "report.png", "detections.jsonl",
@@ -204,3 +205,24 @@ def read_log(path: str | Path, topics: Collection[str] | None = None,
                 yield channel.topic, m.log_time / 1e9, message
     except (McapError, DecodeError, MessageError, OSError, struct.error, ValueError) as exc:
         raise LogError(f"{path}: not a readable log ({exc})") from None
+
+
+def log_info(path: str | Path) -> list[str]:
+    """Lines about an MCAP log: message count and duration, then per topic its count and schema.
+    :class:`LogError` for a file that is not a finished MCAP log."""
+    from mcap.exceptions import McapError
+    from mcap.reader import make_reader
+
+    try:
+        with open(path, "rb") as f:
+            summary = make_reader(f).get_summary()
+    except (McapError, OSError, struct.error, ValueError) as exc:
+        raise LogError(f"{path}: not an MCAP log ({exc})") from None
+    if summary is None or summary.statistics is None:
+        raise LogError(f"{path}: the log has no summary (an unfinished run?)")
+    st = summary.statistics
+    lines = [f"{path}: {st.message_count} messages, {(st.message_end_time - st.message_start_time) / 1e9:.2f} s"]
+    for cid, ch in sorted(summary.channels.items(), key=lambda kv: kv[1].topic):
+        schema = summary.schemas.get(ch.schema_id)
+        lines.append(f"  {ch.topic:28s} {st.channel_message_counts.get(cid, 0):7d}  {schema.name if schema else '-'}")
+    return lines

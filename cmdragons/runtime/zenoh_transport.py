@@ -28,7 +28,14 @@ from cmdragons.runtime import wire
 from cmdragons.runtime.bus import Handler, topic_matches
 from cmdragons.runtime.params import RuntimeParams
 
-__all__ = ["ZenohTransport", "key_expr"]
+__all__ = ["ZenohTransport", "key_expr", "open_router"]
+
+
+def open_router(params: RuntimeParams) -> Any:
+    """A zenoh router session on the configured endpoint (the nodes are its clients); close it."""
+    import zenoh
+
+    return zenoh.open(params.zenoh.config("router"))
 
 
 def key_expr(prefix: str, pattern: str) -> str:

@@ -17,6 +17,8 @@ from typing import Any, NoReturn
 
 import numpy as np
 
+from cmdragons.cli_runtime import add_parsers as add_runtime_parsers
+from cmdragons.cli_runtime import cmd_log, cmd_node, play_distributed
 from cmdragons.config import ConfigError
 from cmdragons.runtime.interrupt import Interrupt
 from cmdragons.runtime.log import OutputError
@@ -108,6 +110,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--overwrite", action="store_true", help="let --out replace the run already in that folder")
     p.add_argument("--seed", type=_seed, default=None, help="override sim.seed (0 .. 2**63-1)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument("--distributed", action="store_true",
+                   help="every part as its own process on zenoh (loopback, configs/runtime.yaml), in lock-step")
 
     p = sub.add_parser(
         "vision", help="detect ball and robots in camera frames (also: vision calibrate ..., vision tune ...)",
@@ -134,6 +138,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--maps", metavar="DIR", default=None,
                    help="grid: a folder of Moving AI .map files with their .map.scen "
                    "(default ../shared/benchdata/moving_ai)")
+    add_runtime_parsers(sub, _common)
     return parser
 
 
@@ -157,8 +162,14 @@ def main(argv: Sequence[str] | None = None) -> int:
                 return _cmd_sim(args, stop)
             if args.command == "bench":
                 return _cmd_bench(args)
+            if args.command == "play" and args.distributed:
+                return play_distributed(args, stop)
             if args.command == "play":
                 return _cmd_play(args, stop)
+            if args.command == "node":
+                return cmd_node(args, stop)
+            if args.command == "log":
+                return cmd_log(args)
             if args.command == "vision":
                 return _cmd_vision(args)
         except ConfigError as exc:
@@ -228,15 +239,15 @@ def _cmd_sim(args: argparse.Namespace, stop: Interrupt) -> int:
                 if recorder is not None:
                     recorder.write(frame.frame_number, frame.images, frame.truth)
                 g = frame.game if frame.game is not None else GameState(frame.t_capture)
-                log.write("/truth", frame.t_capture, frame.truth.to_dict())
-                log.write("/referee", frame.t_capture, g.to_dict())
+                log.write("/truth", frame.t_capture, frame.truth)
+                log.write("/referee", frame.t_capture, g)
                 commands = script.commands(sim.world.snapshot())
                 for team in TEAMS:
                     mine = tuple(c for c in commands if c.team == team)
                     log.write(f"/commands/{team}", frame.t_capture,
-                              TeamCommands(team, frame.frame_number, frame.t_capture, mine).to_dict())  # fmt: skip
+                              TeamCommands(team, frame.frame_number, frame.t_capture, mine))  # fmt: skip
                 events = tuple(sim.advance(commands))
-                log.write("/events", sim.t, SimEvents(frame.frame_number, sim.t, sim.ball_xy(), events).to_dict())
+                log.write("/events", sim.t, SimEvents(frame.frame_number, sim.t, sim.ball_xy(), events))
                 if i % 15 == 0 or i == n_frames - 1:
                     progress.update(task, completed=i + 1,
                                     info=f"t={sim.t:6.2f}s  blue {g.score_blue}:{g.score_yellow} yellow")  # fmt: skip
@@ -293,6 +304,7 @@ def _cmd_play(args: argparse.Namespace, stop: Interrupt) -> int:
     from cmdragons.runtime.match import OURS, Match
     from cmdragons.runtime.overlay import MatchVideoStage
     from cmdragons.runtime.report import pyplot
+    from cmdragons.runtime.scene import SceneStage
     from cmdragons.runtime.settings import load_settings, load_team_settings
     from cmdragons.runtime.stages import LoggerStage, Tap
     from cmdragons.runtime.warmup import CompileWatch
@@ -312,7 +324,10 @@ def _cmd_play(args: argparse.Namespace, stop: Interrupt) -> int:
     fps = settings.sim.physics.frame_rate_hz
     n_frames = max(1, round(args.seconds * fps))
     game = [GameState(0.0)]  # the referee's latest word, for the progress bar
-    extra: list[Stage] = [LoggerStage(log), Tap("progress", ("referee",), lambda _topic, g: game.__setitem__(0, g))]
+    scene = SceneStage(log, settings.field_geometry(), settings.field.robot.radius_m, settings.field.robot.height_m,
+                       settings.field.ball.radius_m)  # fmt: skip
+    extra: list[Stage] = [LoggerStage(log), scene,
+                          Tap("progress", ("referee",), lambda _topic, g: game.__setitem__(0, g))]  # fmt: skip
     video = None
     if args.video:
         video = MatchVideoStage(folder / "match.mp4", args.view, OURS, settings.camera_models(),

@@ -1,8 +1,8 @@
 """What crosses stage and process boundaries.
 
 Every message is a frozen dataclass with ``to_dict``/``from_dict`` (the JSONL forms of DESIGN.md:
-metres, radians, team as "blue"/"yellow") and ``encode``/``decode``, a compact binary form for the
-bus: a fixed little-endian header followed by packed rows (numpy structured arrays).
+metres, radians, team as "blue"/"yellow"). Their protobuf forms, for the bus and the logs, are
+the runtime's (:mod:`cmdragons.runtime.wire`).
 """
 
 from __future__ import annotations
@@ -11,10 +11,9 @@ import base64
 import binascii
 import dataclasses
 import math
-import struct
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any, ClassVar, Self
+from typing import Any, Self
 
 import numpy as np
 from numpy.typing import NDArray
@@ -37,6 +36,7 @@ __all__ = [
     "GroundTruth",
     "Kick",
     "MessageError",
+    "NodeControl",
     "RobotCommand",
     "RobotDetection",
     "RobotReport",
@@ -56,13 +56,6 @@ __all__ = [
 
 class MessageError(ValueError):
     """A message that cannot be decoded or read from its dict form."""
-
-
-def _team_code(team: str) -> int:
-    try:
-        return TEAMS.index(team)  # type: ignore[arg-type,unused-ignore]
-    except ValueError:
-        raise MessageError(f"team must be 'blue' or 'yellow', got {team!r}") from None
 
 
 def _team(team: Any) -> Team:
@@ -106,41 +99,6 @@ def _finite(x: float) -> float | None:
     return x if math.isfinite(x) else None
 
 
-class _Codec:
-    """Header struct + one structured array per list field."""
-
-    def __init__(self, header: str, *rows: np.dtype[Any]) -> None:
-        self.header = struct.Struct("<" + header)
-        self.rows = rows
-
-    def pack(self, head: Sequence[Any], *tables: NDArray[Any]) -> bytes:
-        parts = [self.header.pack(*head)]
-        for table in tables:
-            parts.append(struct.pack("<I", len(table)))
-            parts.append(table.tobytes())
-        return b"".join(parts)
-
-    def unpack(self, data: bytes | bytearray | memoryview) -> tuple[tuple[Any, ...], list[NDArray[Any]]]:
-        buf = memoryview(data).cast("B")
-        try:
-            head = self.header.unpack_from(buf, 0)
-            off = self.header.size
-            tables = []
-            for dt in self.rows:
-                (n,) = struct.unpack_from("<I", buf, off)
-                off += 4
-                size = n * dt.itemsize
-                if off + size > len(buf):
-                    raise MessageError("message is truncated")
-                tables.append(np.frombuffer(buf[off : off + size], dtype=dt).copy())
-                off += size
-        except struct.error as exc:
-            raise MessageError(f"message is truncated or corrupt: {exc}") from None
-        if off != len(buf):
-            raise MessageError(f"message has {len(buf) - off} trailing bytes")
-        return head, tables
-
-
 # --- detections ------------------------------------------------------------------------------
 
 
@@ -166,13 +124,6 @@ class RobotDetection:
     pixel: tuple[float, float]
 
 
-_BALL_DET = np.dtype([("x", "<f8"), ("y", "<f8"), ("confidence", "<f4"), ("u", "<f4"), ("v", "<f4"), ("sigma", "<f4")])
-_ROBOT_DET = np.dtype(
-    [("team", "u1"), ("id", "u1"), ("x", "<f8"), ("y", "<f8"), ("theta", "<f4"),
-     ("confidence", "<f4"), ("u", "<f4"), ("v", "<f4")]
-)  # fmt: skip
-
-
 @dataclass(frozen=True)
 class DetectionFrame:
     """One camera frame's detections: the content of an SSL-Vision detection packet."""
@@ -183,8 +134,6 @@ class DetectionFrame:
     t_sent: float
     balls: tuple[BallDetection, ...] = ()
     robots: tuple[RobotDetection, ...] = ()
-
-    _codec: ClassVar[_Codec] = _Codec("Hqdd", _BALL_DET, _ROBOT_DET)
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -226,27 +175,6 @@ class DetectionFrame:
         except (KeyError, TypeError, AttributeError) as exc:
             raise MessageError(f"bad detection frame: {exc!r}") from None
 
-    def encode(self) -> bytes:
-        balls = np.array([(b.x, b.y, b.confidence, *b.pixel, b.sigma_m) for b in self.balls], dtype=_BALL_DET)
-        robots = np.array(
-            [(_team_code(r.team), r.id, r.x, r.y, r.theta, r.confidence, *r.pixel) for r in self.robots],
-            dtype=_ROBOT_DET,
-        )
-        return self._codec.pack((self.camera_id, self.frame_number, self.t_capture, self.t_sent), balls, robots)
-
-    @classmethod
-    def decode(cls, data: bytes | bytearray | memoryview) -> Self:
-        (cam, frame, t_capture, t_sent), (balls, robots) = cls._codec.unpack(data)
-        return cls(
-            cam, frame, t_capture, t_sent,
-            tuple(BallDetection(float(b["x"]), float(b["y"]), float(b["confidence"]), (float(b["u"]), float(b["v"])),
-                                float(b["sigma"])) for b in balls),
-            tuple(RobotDetection(TEAMS[int(r["team"]) & 1], int(r["id"]), float(r["x"]), float(r["y"]),
-                                 float(r["theta"]), float(r["confidence"]), (float(r["u"]), float(r["v"])))
-                  for r in robots),
-        )  # fmt: skip
-
-
 # --- tracked world state ----------------------------------------------------------------------
 
 
@@ -273,13 +201,6 @@ class RobotState:
     visible: bool = True
 
 
-_BALL_STATE = np.dtype([("x", "<f8"), ("y", "<f8"), ("vx", "<f4"), ("vy", "<f4"), ("visible", "u1")])
-_ROBOT_STATE = np.dtype(
-    [("team", "u1"), ("id", "u1"), ("visible", "u1"), ("x", "<f8"), ("y", "<f8"), ("theta", "<f4"),
-     ("vx", "<f4"), ("vy", "<f4"), ("omega", "<f4")]
-)  # fmt: skip
-
-
 @dataclass(frozen=True)
 class WorldState:
     """The tracker's estimate at time ``t`` (s); ``ball`` is None until a ball was ever seen."""
@@ -288,8 +209,6 @@ class WorldState:
     ball: BallState | None
     robots: tuple[RobotState, ...] = ()
     frame_number: int = 0  # the camera frame the state was estimated from
-
-    _codec: ClassVar[_Codec] = _Codec("dq", _BALL_STATE, _ROBOT_STATE)
 
     def robot(self, team: Team, robot_id: int) -> RobotState | None:
         for r in self.robots:
@@ -325,38 +244,7 @@ class WorldState:
         except (KeyError, TypeError, AttributeError) as exc:
             raise MessageError(f"bad world state: {exc!r}") from None
 
-    def encode(self) -> bytes:
-        b = self.ball
-        balls = np.array([] if b is None else [(b.x, b.y, b.vx, b.vy, b.visible)], dtype=_BALL_STATE)
-        robots = np.array(
-            [(_team_code(r.team), r.id, r.visible, r.x, r.y, r.theta, r.vx, r.vy, r.omega) for r in self.robots],
-            dtype=_ROBOT_STATE,
-        )
-        return self._codec.pack((self.t, self.frame_number), balls, robots)
-
-    @classmethod
-    def decode(cls, data: bytes | bytearray | memoryview) -> Self:
-        (t, frame), (balls, robots) = cls._codec.unpack(data)
-        ball = None
-        if len(balls):
-            b = balls[0]
-            ball = BallState(float(b["x"]), float(b["y"]), float(b["vx"]), float(b["vy"]), bool(b["visible"]))
-        return cls(
-            float(t), ball,
-            tuple(RobotState(TEAMS[int(r["team"]) & 1], int(r["id"]), float(r["x"]), float(r["y"]),
-                             float(r["theta"]), float(r["vx"]), float(r["vy"]), float(r["omega"]),
-                             bool(r["visible"])) for r in robots),
-            int(frame),
-        )  # fmt: skip
-
-
 # --- commands ----------------------------------------------------------------------------------
-
-
-_COMMAND = np.dtype(
-    [("team", "u1"), ("id", "u1"), ("chip", "u1"), ("dribbler", "<f4"), ("vx", "<f4"), ("vy", "<f4"),
-     ("omega", "<f4"), ("kick_speed", "<f4")]
-)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -387,27 +275,6 @@ class RobotCommand:
         except (KeyError, TypeError, AttributeError) as exc:
             raise MessageError(f"bad robot command: {exc!r}") from None
 
-    @staticmethod
-    def encode_many(commands: Sequence[RobotCommand]) -> bytes:
-        table = np.array(
-            [(_team_code(c.team), c.id, c.chip, c.dribbler, c.vx, c.vy, c.omega, c.kick_speed) for c in commands],
-            dtype=_COMMAND,
-        )
-        return _COMMANDS_CODEC.pack((), table)
-
-    @classmethod
-    def decode_many(cls, data: bytes | bytearray | memoryview) -> list[RobotCommand]:
-        _, (table,) = _COMMANDS_CODEC.unpack(data)
-        return [
-            cls(TEAMS[int(r["team"]) & 1], int(r["id"]), float(r["vx"]), float(r["vy"]), float(r["omega"]),
-                float(r["kick_speed"]), bool(r["chip"]), float(r["dribbler"]))
-            for r in table
-        ]  # fmt: skip
-
-
-_COMMANDS_CODEC = _Codec("", _COMMAND)
-
-
 # --- ground truth (simulator only) -----------------------------------------------------------
 
 
@@ -437,13 +304,6 @@ class RobotTruth:
     pixels: Mapping[int, tuple[float, float]] = field(default_factory=dict)
 
 
-_BALL_TRUTH = np.dtype([("x", "<f8"), ("y", "<f8"), ("z", "<f8"), ("vx", "<f8"), ("vy", "<f8"), ("vz", "<f8")])
-_ROBOT_TRUTH = np.dtype(
-    [("team", "u1"), ("id", "u1"), ("x", "<f8"), ("y", "<f8"), ("theta", "<f8"), ("vx", "<f8"),
-     ("vy", "<f8"), ("omega", "<f8")]
-)  # fmt: skip
-
-
 @dataclass(frozen=True)
 class GroundTruth:
     """The simulator's true state for one camera frame (what vision, tracking and safety are
@@ -453,8 +313,6 @@ class GroundTruth:
     t: float
     ball: BallTruth
     robots: tuple[RobotTruth, ...] = ()
-
-    _codec: ClassVar[_Codec] = _Codec("qd", _BALL_TRUTH, _ROBOT_TRUTH)
 
     def to_dict(self) -> dict[str, Any]:
         b = self.ball
@@ -489,30 +347,6 @@ class GroundTruth:
         except (KeyError, TypeError, AttributeError, ValueError) as exc:
             raise MessageError(f"bad ground truth: {exc!r}") from None
 
-    def encode(self) -> bytes:
-        """The state only (pixel truth stays in the JSONL and MCAP logs)."""
-        b = self.ball
-        balls = np.array([(b.x, b.y, b.z, b.vx, b.vy, b.vz)], dtype=_BALL_TRUTH)
-        robots = np.array(
-            [(_team_code(r.team), r.id, r.x, r.y, r.theta, r.vx, r.vy, r.omega) for r in self.robots],
-            dtype=_ROBOT_TRUTH,
-        )
-        return self._codec.pack((self.frame_number, self.t), balls, robots)
-
-    @classmethod
-    def decode(cls, data: bytes | bytearray | memoryview) -> Self:
-        (frame, t), (balls, robots) = cls._codec.unpack(data)
-        if len(balls) != 1:
-            raise MessageError("ground truth must hold exactly one ball")
-        b = balls[0]
-        return cls(
-            int(frame), float(t),
-            BallTruth(float(b["x"]), float(b["y"]), float(b["z"]), float(b["vx"]), float(b["vy"]), float(b["vz"])),
-            tuple(RobotTruth(TEAMS[int(r["team"]) & 1], int(r["id"]), float(r["x"]), float(r["y"]),
-                             float(r["theta"]), float(r["vx"]), float(r["vy"]), float(r["omega"])) for r in robots),
-        )  # fmt: skip
-
-
 # --- referee ------------------------------------------------------------------------------------
 
 # the league's Referee commands, each (but halt, stop, normal start and force start) for one team:
@@ -521,12 +355,6 @@ class GroundTruth:
 _COMMANDS = ("halt", "stop", "kickoff", "free_kick", "normal", "force_start", "penalty", "timeout", "ball_placement")
 # the league's stages (pre-game and the breaks included); extra time is not played here
 _STAGES = ("pre_game", "first_half", "half_time", "second_half", "penalty_shootout", "post_game")
-_GAME = struct.Struct("<dBbHHBddBddIdbBb")
-_TEAM_INFO = np.dtype(
-    [("red_cards", "<u2"), ("yellow_cards", "<u2"), ("fouls", "<u2"), ("goalkeeper", "u1"), ("timeouts", "u1"),
-     ("timeout_time", "<f8"), ("placement_failures", "<u2"), ("can_place_ball", "u1"), ("max_robots", "u1")]
-)  # fmt: skip
-_CARD_TIME = np.dtype([("team", "u1"), ("left", "<f8")])
 
 
 @dataclass(frozen=True)
@@ -629,50 +457,6 @@ class GameState:
             )  # fmt: skip
         except (KeyError, TypeError, AttributeError, ValueError, IndexError) as exc:
             raise MessageError(f"bad game state: {exc!r}") from None
-
-    def encode(self) -> bytes:
-        px, py = self.placement if self.placement is not None else (math.nan, math.nan)
-        team = -1 if self.for_team is None else _team_code(self.for_team)
-        nxt = -1 if self.next_command is None else _COMMANDS.index(self.next_command)
-        nxt_team = -1 if self.next_for_team is None else _team_code(self.next_for_team)
-        head = _GAME.pack(self.t, _COMMANDS.index(self.command), team, self.score_blue, self.score_yellow,
-                          self.blue_defends_negative_x, px, py, self.ready, self.stage_time_left_s,
-                          self.action_time_left_s, self.command_counter, self.command_t, nxt,
-                          _STAGES.index(self.stage), nxt_team)  # fmt: skip
-        teams = (self.blue_team, self.yellow_team)
-        infos = np.array([(i.red_cards, i.yellow_cards, i.fouls, i.goalkeeper, i.timeouts, i.timeout_time_s,
-                           i.placement_failures, i.can_place_ball, i.max_robots) for i in teams],
-                         dtype=_TEAM_INFO)  # fmt: skip
-        cards = np.array([(k, left) for k, i in enumerate(teams) for left in i.yellow_card_times_s], dtype=_CARD_TIME)
-        return _GAME_CODEC.pack((head,), infos, cards)
-
-    @classmethod
-    def decode(cls, data: bytes | bytearray | memoryview) -> Self:
-        (head,), (infos, cards) = _GAME_CODEC.unpack(data)
-        try:
-            (t, cmd, team, sb, sy, blue_neg, px, py, ready, stage_left, action_left, counter, command_t, nxt,
-             stage, nxt_team) = _GAME.unpack(head)  # fmt: skip
-        except struct.error as exc:
-            raise MessageError(f"game state is truncated or corrupt: {exc}") from None
-        if cmd >= len(_COMMANDS) or nxt >= len(_COMMANDS):
-            raise MessageError(f"unknown game command code {max(cmd, nxt)}")
-        if stage >= len(_STAGES):
-            raise MessageError(f"unknown game stage code {stage}")
-        if len(infos) != 2:
-            raise MessageError("game state must hold the info of both teams")
-        placement = None if math.isnan(px) else (px, py)
-        teams = [TeamInfo(int(i["red_cards"]), int(i["yellow_cards"]),
-                          tuple(float(c["left"]) for c in cards if int(c["team"]) == k), int(i["fouls"]),
-                          int(i["goalkeeper"]), int(i["timeouts"]), float(i["timeout_time"]),
-                          int(i["placement_failures"]), bool(i["can_place_ball"]), int(i["max_robots"]))
-                 for k, i in enumerate(infos)]  # fmt: skip
-        return cls(t, _COMMANDS[cmd], None if team < 0 else TEAMS[team & 1], sb, sy, bool(blue_neg), placement,
-                   bool(ready), _STAGES[stage], stage_left, counter, command_t, action_left,
-                   None if nxt < 0 else _COMMANDS[nxt], None if nxt_team < 0 else TEAMS[nxt_team & 1],
-                   *teams)  # fmt: skip
-
-
-_GAME_CODEC = _Codec(f"{_GAME.size}s", _TEAM_INFO, _CARD_TIME)
 
 
 @dataclass(frozen=True)
@@ -1027,3 +811,22 @@ class StageSummary:
             return cls(str(d["stage"]), dict(d.get("figures", {})))
         except (KeyError, TypeError, ValueError) as exc:
             raise MessageError(f"bad stage summary: {exc!r}") from None
+
+
+@dataclass(frozen=True)
+class NodeControl:
+    """The distributed runtime's own word between nodes: a node says it is ``ready``; the match's
+    clock tells every node to ``start``, ``summarize`` or ``stop``."""
+
+    node: str
+    command: str
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"node": self.node, "command": self.command}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Self:
+        try:
+            return cls(str(d["node"]), str(d["command"]))
+        except (KeyError, TypeError) as exc:
+            raise MessageError(f"bad node control: {exc!r}") from None

@@ -5,7 +5,7 @@
   thinks.
 - No stage package (vision, sim, strategy and the algorithm packages under cmdragons/) imports the
   composition: the runtime, the team's brain, the benchmarks or the command line.
-- Heavy I/O libraries stay in the packages that own them: zenoh in the runtime, pymunk in sim/,
+- Heavy I/O libraries stay in the packages that own them: zenoh and protobuf in the runtime, pymunk in sim/,
   mcap in the runtime's log, PyAV in the video module, OpenCV's video files in the modules that read
   or write recordings and videos.
 """
@@ -21,13 +21,16 @@ ROOT = Path(__file__).resolve().parents[1]
 FLOOR = {"cmdragons.config", "cmdragons.geometry", "cmdragons.messages", "cmdragons.camera", "cmdragons.recording",
          "cmdragons.videoio", "cmdragons._kernels"}
 PROJECT = ("cmdragons", "vision", "strategy", "sim")
-COMPOSITION = ("cmdragons.runtime", "cmdragons.team", "cmdragons.bench", "cmdragons.cli", "cmdragons.cli_vision")
+COMPOSITION = ("cmdragons.runtime", "cmdragons.team", "cmdragons.bench", "cmdragons.cli", "cmdragons.cli_vision",
+               "cmdragons.cli_runtime")
 # library -> the module prefixes allowed to import it
 OWNERS: dict[str, tuple[str, ...]] = {
     "zenoh": ("cmdragons.runtime",),
     "pymunk": ("sim",),
     "mcap": ("cmdragons.runtime",),
     "mcap_protobuf": ("cmdragons.runtime",),
+    "google": ("cmdragons.runtime",),  # protobuf
+    "foxglove_schemas_protobuf": ("cmdragons.runtime",),
     "av": ("cmdragons.videoio",),
     "matplotlib": ("cmdragons.runtime", "cmdragons.bench"),
 }

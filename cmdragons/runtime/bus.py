@@ -5,7 +5,10 @@ no stage reads another's attributes. The bus subscribes each stage to its input 
 :class:`Transport` and times every call into it. The transport is the seam to a distributed runtime:
 :class:`InProcessTransport` delivers in lock-step, first published first delivered, each message to
 its subscribers in the order they subscribed, so the same inputs give the same run byte for byte; a
-networked transport implements the same three calls and no stage changes.
+networked transport (:mod:`cmdragons.runtime.zenoh_transport`) implements the same calls and no
+stage changes. Either delivers a message as it comes off the wire
+(:func:`cmdragons.runtime.wire.canonical`: detections, world states and commands in the league's
+32-bit floats), so a stage sees the same inputs whichever process its peers run in.
 
 Topic patterns: an exact topic (``world/blue``), a prefix ending in ``/*`` (``detections/*`` matches
 ``detections/0`` and ``detections/1``), or ``*`` for every topic.
@@ -51,12 +54,15 @@ class InProcessTransport:
     """Lock-step delivery in one process: a FIFO of published messages, delivered on :meth:`spin`."""
 
     def __init__(self) -> None:
+        from cmdragons.runtime.wire import canonical
+
+        self._canonical = canonical
         self._queue: deque[tuple[str, Any]] = deque()
         self._subs: list[tuple[str, Handler]] = []
         self._routes: dict[str, list[Handler]] = {}
 
     def publish(self, topic: str, message: Any) -> None:
-        self._queue.append((topic, message))
+        self._queue.append((topic, self._canonical(message)))
 
     def subscribe(self, pattern: str, handler: Handler) -> None:
         self._subs.append((pattern, handler))

@@ -1,21 +1,25 @@
 """Run logs: ``logs/<time>-<command>/`` with an MCAP file of every message and a summary.json.
 
-MCAP channels carry JSON (the ``to_dict`` forms); log times are the simulation's capture times,
-so the same config and seed give the same log, byte for byte.
+MCAP channels carry protobuf, each with its schema (the bus's wire form,
+:mod:`cmdragons.runtime.wire`, and Foxglove's scene messages), so Foxglove opens a log as it is; log
+times are the simulation's capture times, so the same config and seed give the same log, byte for
+byte. :func:`read_log` reads one back as our messages.
 """
 
 from __future__ import annotations
 
 import datetime as _dt
-import json
 import os
 import shutil
+import struct
+from collections.abc import Collection, Iterator
 from pathlib import Path
 from typing import Any, BinaryIO
 
 from mcap.writer import CompressionType, Writer
 
-__all__ = ["RUN_FILES", "OutputError", "RunLog", "check_writable_file", "run_folder"]
+__all__ = ["RUN_FILES", "LogError", "OutputError", "RunLog", "check_writable_file", "log_info", "read_log",
+           "run_folder"]
 
 # what a run writes into its folder (globs): a folder holding one of these holds a run
 RUN_FILES = ("run.mcap", "summary.json", "match.mp4", "match_cameras.mp4", "report.png", "detections.jsonl",
@@ -101,30 +105,47 @@ def check_writable_file(path: str | Path, option: str) -> Path:
     return p
 
 
+class LogError(Exception):
+    """A log that cannot be read (not MCAP, truncated, or a message without a known schema)."""
+
+
 class RunLog:
-    """An MCAP recording of JSON messages on named topics."""
+    """An MCAP recording of protobuf messages on named topics, each channel with its schema."""
 
     def __init__(self, path: str | Path) -> None:
+        from cmdragons.runtime import wire
+
+        self._wire = wire
         self.path = Path(path)
         self._file: BinaryIO = open(self.path, "wb")  # noqa: SIM115
         self._writer = Writer(self._file, compression=CompressionType.ZSTD)
         self._writer.start(profile="", library="cmdragons")
         self._channels: dict[str, int] = {}
+        self._schemas: dict[str, int] = {}
         self._sequence = 0
 
-    def write(self, topic: str, t: float, message: dict[str, Any]) -> None:
+    def write(self, topic: str, t: float, message: Any) -> None:
+        """One of the bus's messages at time ``t`` (s)."""
+        self.write_proto(topic, t, self._wire.to_proto(message))
+
+    def write_proto(self, topic: str, t: float, proto: Any) -> None:
+        """A protobuf message at time ``t`` (s) (a channel's first message fixes its schema)."""
         channel = self._channels.get(topic)
         if channel is None:
-            schema = self._writer.register_schema(
-                name=topic.strip("/").replace("/", "."), encoding="jsonschema",
-                data=json.dumps({"type": "object"}).encode(),
-            )  # fmt: skip
-            channel = self._writer.register_channel(topic=topic, message_encoding="json", schema_id=schema)
-            self._channels[topic] = channel
+            channel = self._channels[topic] = self._writer.register_channel(
+                topic=topic, message_encoding="protobuf", schema_id=self._schema(proto))
         ns = max(0, int(round(t * 1e9)))
         self._sequence += 1
-        data = json.dumps(message, separators=(",", ":")).encode()
-        self._writer.add_message(channel_id=channel, log_time=ns, data=data, publish_time=ns, sequence=self._sequence)
+        self._writer.add_message(channel_id=channel, log_time=ns, data=proto.SerializeToString(deterministic=True),
+                                 publish_time=ns, sequence=self._sequence)  # fmt: skip
+
+    def _schema(self, proto: Any) -> int:
+        from mcap_protobuf.schema import register_schema
+
+        name = proto.DESCRIPTOR.full_name
+        if name not in self._schemas:
+            self._schemas[name] = register_schema(self._writer, type(proto))
+        return self._schemas[name]
 
     def close(self) -> None:
         if not self._file.closed:
@@ -136,3 +157,72 @@ class RunLog:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+def read_log(path: str | Path, topics: Collection[str] | None = None,
+             start_s: float | None = None) -> Iterator[tuple[str, float, Any]]:  # fmt: skip
+    """``(topic, t, message)`` for every message of an MCAP log in log-time order, ``t`` in s: our
+    messages for the bus's schemas, the protobuf objects for the rest (Foxglove's scene); only
+    ``topics`` if given, only from ``start_s`` on if given. :class:`LogError` for a file that is not
+    a readable log."""
+    from google.protobuf import message_factory
+    from google.protobuf.descriptor_pb2 import FileDescriptorSet
+    from google.protobuf.descriptor_pool import DescriptorPool
+    from google.protobuf.message import DecodeError
+    from mcap.exceptions import McapError
+    from mcap.reader import make_reader
+
+    from cmdragons.messages import MessageError
+    from cmdragons.runtime import wire
+
+    known = {c.proto.DESCRIPTOR.full_name: c for c in wire.CODECS.values()}
+    classes: dict[int, Any] = {}
+
+    def message_class(schema: Any) -> Any:
+        """Our generated class for the bus's schemas, else one built from the log's own schema."""
+        if schema.id not in classes:
+            if schema.encoding != "protobuf":
+                raise LogError(f"{path}: schema {schema.name} is {schema.encoding}, not protobuf (an older log?)")
+            if schema.name in known:
+                classes[schema.id] = known[schema.name].proto
+            else:
+                pool = DescriptorPool()
+                for fd in FileDescriptorSet.FromString(schema.data).file:
+                    pool.Add(fd)
+                classes[schema.id] = message_factory.GetMessageClass(pool.FindMessageTypeByName(schema.name))
+        return classes[schema.id]
+
+    start_ns = None if start_s is None else int(round(start_s * 1e9))
+    try:
+        with open(path, "rb") as f:
+            reader = make_reader(f)
+            for schema, channel, m in reader.iter_messages(topics=None if topics is None else list(topics),
+                                                           start_time=start_ns, log_time_order=True):  # fmt: skip
+                if schema is None:
+                    raise LogError(f"{path}: topic {channel.topic} has no schema")
+                proto = message_class(schema).FromString(m.data)
+                message = wire.from_proto(proto) if schema.name in known else proto
+                yield channel.topic, m.log_time / 1e9, message
+    except (McapError, DecodeError, MessageError, OSError, struct.error, ValueError) as exc:
+        raise LogError(f"{path}: not a readable log ({exc})") from None
+
+
+def log_info(path: str | Path) -> list[str]:
+    """Lines about an MCAP log: message count and duration, then per topic its count and schema.
+    :class:`LogError` for a file that is not a finished MCAP log."""
+    from mcap.exceptions import McapError
+    from mcap.reader import make_reader
+
+    try:
+        with open(path, "rb") as f:
+            summary = make_reader(f).get_summary()
+    except (McapError, OSError, struct.error, ValueError) as exc:
+        raise LogError(f"{path}: not an MCAP log ({exc})") from None
+    if summary is None or summary.statistics is None:
+        raise LogError(f"{path}: the log has no summary (an unfinished run?)")
+    st = summary.statistics
+    lines = [f"{path}: {st.message_count} messages, {(st.message_end_time - st.message_start_time) / 1e9:.2f} s"]
+    for cid, ch in sorted(summary.channels.items(), key=lambda kv: kv[1].topic):
+        schema = summary.schemas.get(ch.schema_id)
+        lines.append(f"  {ch.topic:28s} {st.channel_message_counts.get(cid, 0):7d}  {schema.name if schema else '-'}")
+    return lines

@@ -47,7 +47,8 @@ from sim.referee import Referee
 from sim.simulator import Simulator
 from strategy.simple import SimpleTeam
 
-__all__ = ["OURS", "THEIRS", "Match", "Opponent", "Perception", "truth_world", "wiring"]
+__all__ = ["OURS", "THEIRS", "Match", "Opponent", "Perception", "match_summary", "summary_stages", "truth_world",
+           "wiring"]
 
 Opponent = Literal["simple", "self", "none"]
 Perception = Literal["vision", "truth"]
@@ -167,33 +168,47 @@ class Match:
     def summary(self) -> dict[str, Any]:
         """The figures of the match so far, gathered from the stages' summaries on the bus."""
         self.bus.summarize()
-        f = self._summaries.figures
-        sim, referee, stats = f["sim"], f["referee"], f[f"stats/{OURS}"]
-        open_pairs = [{a[0], b[0]} for a, b in sim["open_contacts"]]
-        cycle = {k: {"median": float(np.median(v)), "p95": float(np.percentile(v, 95))}
-                 for k, v in self.stage_ms.items() if v}  # fmt: skip
-        cycle.update(f["timing"].get(f"team/{OURS}", {}))  # the brain's parts
-        return {
-            "score": referee["score"],
-            "shots": stats["shots"],
-            "passes": stats["passes"],
-            "collisions": {"own": stats["collisions"]["own"] + sum(p == {OURS} for p in open_pairs),
-                           "opponent": stats["collisions"]["opponent"] + sum(p == {OURS, THEIRS} for p in open_pairs)},
-            "cycle_ms": cycle,
-            "seconds": sim["seconds"],
-            "seed": self.seed,
-            "opponent": self.opponent,
-            "perception": self.perception,
-            "kicks": referee["kicks"],
-            "balls_out": referee["balls_out"],
-            "command_faults": sim["command_faults"],
-            "tracker": f[f"tracker/{OURS}"],
-            "rules": {k: referee[k] for k in ("rules", "game_stage", "fouls", "cards", "placements", "penalties")},
-            **({"opponent_team": self._their_figures(f, open_pairs)} if self.opponent == "self" else {}),
-        }  # fmt: skip
+        return match_summary(self._summaries.figures, self.stage_ms, self.seed, self.opponent, self.perception)
 
-    def _their_figures(self, f: dict[str, Any], open_pairs: list[set[str]]) -> dict[str, Any]:
-        """The copy of our team's own figures: shots, passes, collisions among its robots."""
-        stats = f[f"stats/{THEIRS}"]
-        return {"shots": stats["shots"], "passes": stats["passes"],
-                "collisions": {"own": stats["collisions"]["own"] + sum(p == {THEIRS} for p in open_pairs)}}  # fmt: skip
+
+
+def summary_stages(opponent: Opponent) -> set[str]:
+    """The stages whose summaries :func:`match_summary` reads."""
+    return {"sim", "referee", f"stats/{OURS}", "timing", f"tracker/{OURS}"} | (
+        {f"stats/{THEIRS}"} if opponent == "self" else set())
+
+
+def match_summary(f: dict[str, Any], stage_ms: dict[str, list[float]], seed: int, opponent: Opponent,
+                  perception: Perception) -> dict[str, Any]:  # fmt: skip
+    """summary.json's figures from every stage's summary (``f``: stage name -> figures) and the
+    per-frame stage times (ms) the runtime measured."""
+    sim, referee, stats = f["sim"], f["referee"], f[f"stats/{OURS}"]
+    open_pairs = [{a[0], b[0]} for a, b in sim["open_contacts"]]
+    cycle = {k: {"median": float(np.median(v)), "p95": float(np.percentile(v, 95))}
+             for k, v in stage_ms.items() if v}  # fmt: skip
+    cycle.update(f["timing"].get(f"team/{OURS}", {}))  # the brain's parts
+    return {
+        "score": referee["score"],
+        "shots": stats["shots"],
+        "passes": stats["passes"],
+        "collisions": {"own": stats["collisions"]["own"] + sum(p == {OURS} for p in open_pairs),
+                       "opponent": stats["collisions"]["opponent"] + sum(p == {OURS, THEIRS} for p in open_pairs)},
+        "cycle_ms": cycle,
+        "seconds": sim["seconds"],
+        "seed": seed,
+        "opponent": opponent,
+        "perception": perception,
+        "kicks": referee["kicks"],
+        "balls_out": referee["balls_out"],
+        "command_faults": sim["command_faults"],
+        "tracker": f[f"tracker/{OURS}"],
+        "rules": {k: referee[k] for k in ("rules", "game_stage", "fouls", "cards", "placements", "penalties")},
+        **({"opponent_team": _their_figures(f, open_pairs)} if opponent == "self" else {}),
+    }  # fmt: skip
+
+
+def _their_figures(f: dict[str, Any], open_pairs: list[set[str]]) -> dict[str, Any]:
+    """The copy of our team's own figures: shots, passes, collisions among its robots."""
+    stats = f[f"stats/{THEIRS}"]
+    return {"shots": stats["shots"], "passes": stats["passes"],
+            "collisions": {"own": stats["collisions"]["own"] + sum(p == {THEIRS} for p in open_pairs)}}  # fmt: skip

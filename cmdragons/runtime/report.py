@@ -10,7 +10,6 @@ and passes over time, the robots' traces, and the stage timings of summary.json.
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -47,7 +46,7 @@ class RunData:
 
 def load_run(path: str | Path, ours: str = "blue") -> RunData:
     """Read ``run.mcap`` (see the module docstring)."""
-    from mcap.reader import make_reader
+    from cmdragons.runtime.log import read_log
 
     run = RunData(ours=ours)
     times: list[float] = []
@@ -56,45 +55,44 @@ def load_run(path: str | Path, ours: str = "blue") -> RunData:
     world_frames, ball_visible = 0, 0
     robot_visible: dict[int, int] = {}
     actions: dict[int, str] = {}  # our robots' actions as the latest report had them
-    with open(path, "rb") as f:
-        for _, channel, message in make_reader(f).iter_messages():
-            d = json.loads(message.data)
-            topic = channel.topic
-            if topic == "/truth":
-                t = float(d["t"])
-                times.append(t)
-                b = d["ball"]
-                balls.append((b["x"], b["y"]))
-                near, holder = _POSSESSION_M, None
-                for r in d["robots"]:
-                    traces.setdefault((r["team"], r["id"]), []).append((t, r["x"], r["y"]))
-                    dist = math.hypot(r["x"] - b["x"], r["y"] - b["y"])
-                    if dist < near:
-                        near, holder = dist, r["team"]
-                run.possession.append(holder)
-            elif topic == f"/world/{ours}":
-                world_frames += 1
-                if d.get("ball") is not None and d["ball"].get("visible", True):
-                    ball_visible += 1
-                for r in d["robots"]:
-                    if r["team"] == ours and r.get("visible", True):
-                        robot_visible[r["id"]] = robot_visible.get(r["id"], 0) + 1
-            elif topic == f"/report/{ours}":
-                actions = {int(k): str(v) for k, v in d.get("actions", {}).items()}
-            elif topic == "/referee":
-                s = d["score"]
-                if not run.score_t or run.score_t[-1][1:] != (s["blue"], s["yellow"]):
-                    run.score_t.append((float(d["t"]), s["blue"], s["yellow"]))
-            elif topic == "/events":
-                for e in d.get("events", ()):
-                    if e.get("type") == "kick":
-                        if e.get("team") == ours:
-                            e = {**e, "action": actions.get(int(e["id"]))}  # what the strategy meant it for
-                        if balls:
-                            e = {**e, "x": balls[-1][0], "y": balls[-1][1]}
-                        run.kicks.append(e)
-                    elif e.get("type") == "goal":
-                        run.goals.append(e)
+    topics = {"/truth", f"/world/{ours}", f"/report/{ours}", "/referee", "/events"}
+    for topic, _t, message in read_log(path, topics):
+        d = message.to_dict()
+        if topic == "/truth":
+            t = float(d["t"])
+            times.append(t)
+            b = d["ball"]
+            balls.append((b["x"], b["y"]))
+            near, holder = _POSSESSION_M, None
+            for r in d["robots"]:
+                traces.setdefault((r["team"], r["id"]), []).append((t, r["x"], r["y"]))
+                dist = math.hypot(r["x"] - b["x"], r["y"] - b["y"])
+                if dist < near:
+                    near, holder = dist, r["team"]
+            run.possession.append(holder)
+        elif topic == f"/world/{ours}":
+            world_frames += 1
+            if d.get("ball") is not None and d["ball"].get("visible", True):
+                ball_visible += 1
+            for r in d["robots"]:
+                if r["team"] == ours and r.get("visible", True):
+                    robot_visible[r["id"]] = robot_visible.get(r["id"], 0) + 1
+        elif topic == f"/report/{ours}":
+            actions = {int(k): str(v) for k, v in d.get("actions", {}).items()}
+        elif topic == "/referee":
+            s = d["score"]
+            if not run.score_t or run.score_t[-1][1:] != (s["blue"], s["yellow"]):
+                run.score_t.append((float(d["t"]), s["blue"], s["yellow"]))
+        elif topic == "/events":
+            for e in d.get("events", ()):
+                if e.get("type") == "kick":
+                    if e.get("team") == ours:
+                        e = {**e, "action": actions.get(int(e["id"]))}  # what the strategy meant it for
+                    if balls:
+                        e = {**e, "x": balls[-1][0], "y": balls[-1][1]}
+                    run.kicks.append(e)
+                elif e.get("type") == "goal":
+                    run.goals.append(e)
     run.t = np.array(times)
     run.ball = np.array(balls).reshape(-1, 2)
     run.traces = {k: np.array(v) for k, v in traces.items()}

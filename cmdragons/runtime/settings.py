@@ -18,6 +18,7 @@ from cmdragons.config import ConfigError, apply_override, default_config_dir, lo
 from cmdragons.control.motion import ControlParams
 from cmdragons.geometry import Field, LeagueParams
 from cmdragons.planning.registry import PlannerParams
+from cmdragons.runtime.params import RuntimeParams
 from cmdragons.safety.registry import SafetyParams
 from cmdragons.team import TeamParams
 from cmdragons.tracking.tracker import TrackerParams
@@ -38,6 +39,7 @@ CONCERNS: dict[str, type] = {
     "strategy": StrategyParams,
     "team": TeamParams,
     "vision": VisionParams,
+    "runtime": RuntimeParams,
 }
 
 # the concerns a team may have its own of in a match (its brain and its tracker); the field, the
@@ -58,6 +60,7 @@ class Settings:
     strategy: StrategyParams
     team: TeamParams
     vision: VisionParams
+    runtime: RuntimeParams
 
     def field_geometry(self) -> Field:
         return Field(self.field)

@@ -120,8 +120,18 @@ class SimStage(BaseStage):
         if not self.teams:
             self._advance(publish)
 
+    def advance_without_missing(self, publish: Publish) -> list[Team]:
+        """Step the frame in progress with the commands that came (a team that is silent keeps its
+        robots' last commands until the robots' own command timeout brakes them); the teams that
+        were missing. Nothing happens between frames."""
+        if self.frame_number < 0:
+            return []
+        missing = [t for t in self.teams if t not in self._commands]
+        self._advance(publish)
+        return missing
+
     def _advance(self, publish: Publish) -> None:
-        commands = [c for t in self.teams for c in self._commands[t].commands]
+        commands = [c for t in self.teams if t in self._commands for c in self._commands[t].commands]
         self._commands = {}
         events = self.sim.advance(commands)
         publish("events", SimEvents(self.frame_number, self.sim.t, self.sim.ball_xy(), tuple(events)))
@@ -423,7 +433,7 @@ class LoggerStage(BaseStage):
     inputs = ("*",)
 
     def __init__(self, log: RunLog, images: bool = False,
-                 skip: Sequence[str] = ("clock", "timing/*", "summary/timing")) -> None:  # fmt: skip
+                 skip: Sequence[str] = ("clock", "control/*", "timing/*", "summary/timing")) -> None:  # fmt: skip
         self.log = log
         self.skip = tuple(skip) + (() if images else ("camera/*",))
         self._t = 0.0
@@ -432,7 +442,7 @@ class LoggerStage(BaseStage):
         if any(topic_matches(p, topic) for p in self.skip):
             return
         self._t = message_time(message, self._t)
-        self.log.write("/" + topic, self._t, message.to_dict())
+        self.log.write("/" + topic, self._t, message)
 
 
 class SummaryCollector(BaseStage):

@@ -25,22 +25,22 @@ from cmdragons.runtime.report import load_run, run_warnings, write_report
 
 
 def write_log(path: Path, frames: int, ball_visible_every: int, robot_1_visible: bool) -> None:
-    """A play log as the match's bus writes it (the messages' own dict forms)."""
+    """A play log as the match's bus writes it."""
     with RunLog(path) as log:
         for i in range(frames):
             t = i / 60
             robots = tuple(RobotTruth("blue", k, -1.0 + k, 0.0, 0.0, 0.0, 0.0, 0.0) for k in (0, 1)) + (
                 RobotTruth("yellow", 0, 2.0, 0.5, 0.0, 0.0, 0.0, 0.0),)  # fmt: skip
             ball_truth = BallTruth(-0.9 + 0.01 * i, 0.0, 0.0215, 0.0, 0.0)
-            log.write("/truth", t, GroundTruth(i, t, ball_truth, robots).to_dict())
-            log.write("/referee", t, GameState(t, score_blue=int(i > frames // 2)).to_dict())
+            log.write("/truth", t, GroundTruth(i, t, ball_truth, robots))
+            log.write("/referee", t, GameState(t, score_blue=int(i > frames // 2)))
             seen = (RobotState("blue", 0, -1.0, 0.0, 0.0),) + ((RobotState("blue", 1, 0.0, 0.0, 0.0),)
                                                                if robot_1_visible else ())  # fmt: skip
             ball = BallState(0.0, 0.0, 0.0, 0.0, visible=i % ball_visible_every == 0)
-            log.write("/world/blue", t, WorldState(t, ball, seen, i).to_dict())
-            log.write("/report/blue", t, TeamReport("blue", i, t, actions={0: "shot"}).to_dict())
+            log.write("/world/blue", t, WorldState(t, ball, seen, i))
+            log.write("/report/blue", t, TeamReport("blue", i, t, actions={0: "shot"}))
             kicks = (Kick(t, "blue", 0, 3.0, False),) if i == 30 else ()
-            log.write("/events", t, SimEvents(i, t, (0.0, 0.0), kicks).to_dict())
+            log.write("/events", t, SimEvents(i, t, (0.0, 0.0), kicks))
 
 
 def test_ball_seldom_and_a_robot_never_seen_are_warned(tmp_path: Path) -> None:

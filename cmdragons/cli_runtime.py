@@ -1,0 +1,177 @@
+"""The distributed runtime's commands: ``cmdragons node ROLE``, ``cmdragons play --distributed`` and
+``cmdragons log info LOG.mcap``. Zenoh is imported only here and in the runtime, when one of these
+runs, so the embedded ``cmdragons play`` never loads it."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from cmdragons.runtime.interrupt import Interrupt
+
+__all__ = ["add_parsers", "cmd_log", "cmd_node", "play_distributed"]
+
+
+def _match_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--opponent", choices=("simple", "self", "none"), default="simple",
+                   help="as cmdragons play: every node of a match must be given the same")  # fmt: skip
+    p.add_argument("--perception", choices=("vision", "truth"), default="vision", help="as cmdragons play")
+    p.add_argument("--seed", type=int, default=None, help="override sim.seed (every node the same)")
+
+
+def add_parsers(sub: Any, common: Callable[[argparse.ArgumentParser], None]) -> None:
+    from cmdragons.runtime.params import ROLES
+
+    p = sub.add_parser("node", help="run one part of a match as a process on zenoh (see configs/runtime.yaml)")
+    common(p)
+    p.add_argument("role", choices=ROLES, help="which part: " + ", ".join(ROLES))
+    _match_args(p)
+    p.add_argument("--seconds", type=float, default=30.0, help="sim: match time in simulated seconds (default 30)")
+    p.add_argument("--realtime", action="store_true", help="sim: free-running at the wall clock (real hardware)")
+    p.add_argument("--router", action="store_true", help="sim: also be the zenoh router the other nodes connect to")
+    p.add_argument("--roles", default=None,
+                   help="sim: the nodes to wait for, comma-separated (default: all a match needs, log included)")
+    p.add_argument("--out", metavar="DIR", default=None, help="log and sim: the run folder (default logs/<time>-play)")
+    p.add_argument("--overwrite", action="store_true", help="let --out replace the run already in that folder")
+
+    p = sub.add_parser("log", help="about a run's MCAP log: cmdragons log info LOG.mcap")
+    p.add_argument("action", choices=("info",))
+    p.add_argument("path", metavar="LOG.mcap")
+
+
+def _spec(args: argparse.Namespace) -> Any:
+    from cmdragons.runtime.distributed import MatchSpec
+    from cmdragons.runtime.settings import load_settings
+
+    settings = load_settings(args.config, args.set)
+    seed = settings.sim.seed if args.seed is None else args.seed
+    return MatchSpec(settings, args.opponent, args.perception, seed)
+
+
+def _log_stages(spec: Any, folder: Path) -> tuple[Any, list[Any]]:
+    from cmdragons.runtime.log import RunLog
+    from cmdragons.runtime.scene import SceneStage
+    from cmdragons.runtime.stages import LoggerStage
+
+    s = spec.settings
+    log = RunLog(folder / "run.mcap")
+    scene = SceneStage(log, s.field_geometry(), s.field.robot.radius_m, s.field.robot.height_m, s.field.ball.radius_m)
+    return log, [LoggerStage(log), scene]
+
+
+def cmd_node(args: argparse.Namespace, stop: Interrupt) -> int:
+    from cmdragons.runtime.distributed import node_roles, run_clock, run_node, write_summary
+    from cmdragons.runtime.log import run_folder
+    from cmdragons.runtime.zenoh_transport import ZenohTransport, open_router
+
+    spec = _spec(args)
+    params = spec.settings.runtime
+    router = open_router(params) if args.router else None
+    transport = ZenohTransport(params, args.role)
+    log = None
+    try:
+        with stop.soft():
+            if args.role == "sim":
+                roles = args.roles.split(",") if args.roles else node_roles(spec.opponent, log=True)
+                # the log node may share the folder (and have made run.mcap in it already)
+                folder = Path(args.out) if args.out else run_folder("play")
+                folder.mkdir(parents=True, exist_ok=True)
+                summary = run_clock(spec, transport, args.seconds, ["sim", *roles], realtime=args.realtime,
+                                    should_stop=lambda: stop.requested)  # fmt: skip
+                summary["interrupted"] = stop.requested
+                write_summary(folder, summary)
+                s = summary.get("score", {})
+                print(f"node sim: {summary.get('frames', 0)} frames, score blue {s.get('blue')}:{s.get('yellow')} "
+                      f"yellow, {summary.get('realtime_factor')}x real time -> {folder}")  # fmt: skip
+                return stop.exit_code
+            extra: list[Any] = []
+            if args.role == "log":
+                folder = run_folder("play", args.out, overwrite=args.overwrite)
+                log, extra = _log_stages(spec, folder)
+            code = run_node(args.role, spec, transport, extra, should_stop=lambda: stop.requested)
+            return stop.exit_code or code
+    finally:
+        with stop.shield():
+            if log is not None:
+                log.close()
+            transport.close()
+            if router is not None:
+                router.close()
+
+
+def play_distributed(args: argparse.Namespace, stop: Interrupt) -> int:
+    """``cmdragons play --distributed``: a router here, every other node as its own process (spawned,
+    never forked after zenoh opened), the clock here; Ctrl-C stops them all."""
+    from cmdragons.runtime.distributed import node_roles, run_clock, write_summary
+    from cmdragons.runtime.log import run_folder
+    from cmdragons.runtime.zenoh_transport import ZenohTransport, open_router
+
+    spec = _spec(args)
+    params = spec.settings.runtime
+    folder = run_folder("play", args.out, overwrite=args.overwrite)
+    roles = node_roles(spec.opponent, log=True)
+    common = ["--config", args.config] if args.config else []
+    for s in args.set:
+        common += ["--set", s]
+    common += ["--opponent", spec.opponent, "--perception", spec.perception, "--seed", str(spec.seed)]
+    router = open_router(params)
+    children: list[subprocess.Popen[bytes]] = []
+    transport = None
+    try:
+        for role in roles:
+            if role != "sim":
+                extra = ["--out", str(folder)] if role == "log" else []
+                children.append(subprocess.Popen([sys.executable, "-m", "cmdragons.cli", "node", role, *common,
+                                                  *extra]))  # fmt: skip
+        transport = ZenohTransport(params, "sim")
+        wall0 = time.perf_counter()
+        with stop.soft():
+            summary = run_clock(spec, transport, args.seconds, roles, should_stop=lambda: stop.requested)
+        summary["interrupted"] = stop.requested
+        summary["distributed"] = True
+        summary["nodes"] = roles
+        write_summary(folder, summary)
+        s = summary.get("score", {})
+        print(f"play --distributed: {len(roles)} nodes, {summary.get('frames', 0)} frames in "
+              f"{time.perf_counter() - wall0:.1f} s ({summary.get('realtime_factor')}x real time), score blue "
+              f"{s.get('blue')}:{s.get('yellow')} yellow -> {folder}")  # fmt: skip
+        return stop.exit_code
+    finally:
+        with stop.shield():
+            for child in children:
+                try:
+                    child.wait(timeout=10)
+                except subprocess.TimeoutExpired:
+                    child.terminate()
+                    child.wait(timeout=5)
+            if transport is not None:
+                transport.close()
+            router.close()
+
+
+def cmd_log(args: argparse.Namespace) -> int:
+    """``cmdragons log info LOG.mcap``: topics with their schemas and counts, the duration, the summary."""
+    from cmdragons.runtime.log import LogError, log_info
+
+    path = Path(args.path)
+    if not path.is_file():
+        print(f"cmdragons log: {path}: no such file; give a run's run.mcap", file=sys.stderr)
+        return 2
+    try:
+        print("\n".join(log_info(path)))
+    except LogError as exc:
+        print(f"cmdragons log: {exc}", file=sys.stderr)
+        return 2
+    run_summary = path.parent / "summary.json"
+    if run_summary.exists():
+        d = json.loads(run_summary.read_text())
+        s = d.get("score", {})
+        print(f"summary: score blue {s.get('blue')}:{s.get('yellow')} yellow, seed {d.get('seed')}, "
+              f"{d.get('seconds')} s, kicks {d.get('kicks')}, shots {d.get('shots')}")  # fmt: skip
+    return 0

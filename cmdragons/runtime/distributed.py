@@ -1,0 +1,241 @@
+"""A match as processes on zenoh: the same stages as the embedded match, one node per part.
+
+Nodes (``cmdragons node ROLE``) and the stages of :func:`~cmdragons.runtime.match.wiring` each runs:
+
+    sim       the simulator and its cameras, and the match's clock (below)
+    vision    vision per camera (or the truth perception of ``--perception truth``)
+    team      our tracker, our brain, our statistics and the brain's timings
+    opponent  the simple team on the truth, or the copy of our team with its own tracker
+    referee   the referee
+    log       run.mcap: every topic and Foxglove's scene
+
+The clock runs in the sim node. Lock-step (the default): every node says it is ready
+(``control/ready``), the clock says ``start`` (the referee's kickoff), then per frame it ticks, the
+simulator captures, waits for every playing team's commands for that frame, steps, and the clock
+waits for the referee's word on the frame before the next tick. So each stage gets its inputs in the
+order the embedded match gives them, and the same seed plays the same match. A team silent for
+``lockstep_wait_s`` is stepped without (its robots brake by their own command timeout), and a node
+that comes back rejoins at the next frame. Free-running (``realtime``): the clock ticks at the frame
+rate of the wall clock and never waits, as real robots would not.
+
+Every node builds the whole wiring from the same config and seed and keeps its own stages, so all
+nodes agree on what the others are without asking.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any, TextIO
+
+from cmdragons.messages import NodeControl, Tick
+from cmdragons.runtime.bus import Bus, Stage
+from cmdragons.runtime.match import OURS, THEIRS, Opponent, Perception, match_summary, summary_stages, wiring
+from cmdragons.runtime.params import ROLES
+from cmdragons.runtime.settings import Settings
+from cmdragons.runtime.stages import SimStage, SummaryCollector, Tap
+from cmdragons.runtime.zenoh_transport import ZenohTransport
+
+__all__ = ["ROLES", "MatchSpec", "node_roles", "role_of", "run_clock", "run_node"]
+
+
+
+def role_of(stage: str) -> str:
+    """The node a stage of the wiring runs in."""
+    if stage == "sim":
+        return "sim"
+    if stage.startswith(("vision/", "perception/")):
+        return "vision"
+    if stage in (f"tracker/{OURS}", f"team/{OURS}", f"stats/{OURS}", "timing"):
+        return "team"
+    if stage.startswith("opponent/") or stage in (f"tracker/{THEIRS}", f"team/{THEIRS}", f"stats/{THEIRS}"):
+        return "opponent"
+    if stage == "referee":
+        return "referee"
+    raise ValueError(f"no node runs stage {stage!r}")
+
+
+def node_roles(opponent: Opponent, log: bool) -> list[str]:
+    """The nodes a match needs (no opponent node against nobody; the log node when logging)."""
+    return [r for r in ROLES if (r != "opponent" or opponent != "none") and (r != "log" or log)]
+
+
+class MatchSpec:
+    """What every node of one match agrees on: the settings, the opponent, the perception, the seed."""
+
+    def __init__(self, settings: Settings, opponent: Opponent, perception: Perception, seed: int,
+                 opponent_settings: Settings | None = None) -> None:  # fmt: skip
+        self.settings = settings
+        self.opponent: Opponent = opponent
+        self.perception: Perception = perception
+        self.seed = seed
+        self.opponent_settings = opponent_settings
+
+    def stages(self, role: str) -> tuple[Any, list[Stage], list[str]]:
+        """The simulator object and the stages of ``role``, built as the embedded match builds them,
+        and the names of every node's stages."""
+        import dataclasses
+
+        from sim.simulator import Simulator
+
+        params = self.settings.sim
+        if self.opponent == "none":
+            params = dataclasses.replace(params, robots_per_team={**params.robots_per_team, THEIRS: 0})
+        render = role == "sim" and self.perception == "vision"
+        sim = Simulator(self.settings.field, self.settings.camera_models(), params, seed=self.seed, render=render,
+                        referee=False)  # fmt: skip
+        every = wiring(self.settings, sim, self.opponent, self.perception, sim.seed, self.opponent_settings)
+        return sim, [s for s in every if role_of(s.name) == role], [s.name for s in every]
+
+
+def _control(transport: ZenohTransport, node: str, command: str) -> None:
+    transport.publish(f"control/{node}", NodeControl(node, command))
+
+
+def run_node(role: str, spec: MatchSpec, transport: ZenohTransport, extra: Sequence[Stage] = (),
+             err: TextIO | None = None, should_stop: Callable[[], bool] = lambda: False) -> int:  # fmt: skip
+    """Run one node (not the sim: :func:`run_clock`) until the clock says stop; 0, or 1 when it
+    never started (stopped first)."""
+    err = err if err is not None else sys.stderr
+    params = spec.settings.runtime
+    stages = spec.stages(role)[1] if role != "log" else []
+    bus = Bus(transport)
+    commands: list[str] = []
+    bus.add(Tap(f"control:{role}", ("control/clock",), lambda _t, c: commands.append(c.command)))
+    for stage in [*stages, *extra]:
+        bus.add(stage)
+    started = time.monotonic()
+    last_ready = -1.0
+    warned = started
+    while "start" not in commands and not should_stop():  # say so until the clock hears it
+        now = time.monotonic()
+        if now - last_ready >= 0.25:
+            _control(transport, role, "ready")
+            last_ready = now
+        if now - warned >= params.peer_timeout_s:
+            print(f"node {role}: no match clock on cmdragons/{params.field_name} for {now - started:.0f} s: is the "
+                  f"sim node running and connected to {params.zenoh.router}?", file=err)  # fmt: skip
+            warned = now
+        transport.spin(0.05)
+    if "start" not in commands:
+        return 1
+    bus.start()
+    done = 0
+    while not should_stop():
+        transport.spin(0.05)
+        while done < len(commands):
+            command = commands[done]
+            done += 1
+            if command == "summarize":
+                bus.summarize()
+            elif command == "stop":
+                return 0
+        if time.monotonic() - transport.last_received > params.peer_timeout_s:
+            print(f"node {role}: nothing from the other nodes for {params.peer_timeout_s:.0f} s: is the sim node "
+                  "still running?", file=err)  # fmt: skip
+            transport.last_received = time.monotonic()
+    return 0
+
+
+def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles: Sequence[str],
+              realtime: bool = False, extra: Sequence[Stage] = (), err: TextIO | None = None,
+              should_stop: Callable[[], bool] = lambda: False,
+              on_frame: Callable[[int], None] | None = None) -> dict[str, Any]:  # fmt: skip
+    """The sim node: waits for ``roles`` to be ready, starts them, runs ``seconds`` of the match and
+    returns the summary (as the embedded match's, gathered over the bus); tells every node to stop."""
+    err = err if err is not None else sys.stderr
+    params = spec.settings.runtime
+    sim, stages, _ = spec.stages("sim")
+    bus = Bus(transport)
+    ready: set[str] = set()
+    judged = [0]  # the referee's words so far
+    summaries = SummaryCollector()
+    bus.add(Tap("control:ready", ("control/*",), lambda _t, c: ready.add(c.node) if c.command == "ready" else None))
+    bus.add(Tap("clock:referee", ("referee",), lambda _t, _g: judged.__setitem__(0, judged[0] + 1)))
+    placed = [0]  # the referee's teleports so far (the kickoff formation first)
+    bus.add(Tap("clock:teleport", ("teleport",), lambda _t, _g: placed.__setitem__(0, placed[0] + 1)))
+    for stage in [*stages, *extra, summaries]:
+        bus.add(stage)
+    sim_stage = next(s for s in stages if isinstance(s, SimStage))
+    others = [r for r in roles if r != "sim"]
+    t0 = time.monotonic()
+    warned = t0
+    while not ready >= set(others):
+        if should_stop():
+            return {}
+        now = time.monotonic()
+        if now - t0 > params.start_timeout_s:
+            raise TimeoutError(f"nodes {', '.join(sorted(set(others) - ready))} did not come up within "
+                               f"{params.start_timeout_s:.0f} s (runtime.start_timeout_s)")  # fmt: skip
+        if now - warned >= params.peer_timeout_s:
+            print(f"sim: waiting for nodes {', '.join(sorted(set(others) - ready))} on {params.zenoh.router}",
+                  file=err)  # fmt: skip
+            warned = now
+        transport.spin(0.05)
+    transport.wait_for(lambda: False, params.settle_s)  # declarations propagate: nothing of frame 0 is lost
+    _control(transport, "clock", "start")
+    bus.start()
+    if not transport.wait_for(lambda: judged[0] >= 1 and placed[0] >= 1, 5.0):
+        raise TimeoutError(f"the referee node did not give the kickoff (referee {judged[0]}, teleport {placed[0]})")
+    fps = spec.settings.sim.physics.frame_rate_hz
+    n = max(1, round(seconds * fps))
+    frame_ms: list[float] = []
+    silent = 0
+    wall0 = time.perf_counter()
+    for i in range(n):
+        if should_stop():
+            break
+        f0 = time.perf_counter()
+        before = judged[0]
+        bus.publish("clock", Tick(i))
+        transport.spin()
+        if realtime:
+            _pace(transport, wall0 + (i + 1) / fps)
+            sim_stage.advance_without_missing(transport.publish)
+            transport.spin()
+        else:
+            waited = time.monotonic()
+            while judged[0] == before:
+                transport.spin(0.01)
+                if time.monotonic() - waited > params.lockstep_wait_s:
+                    missing = sim_stage.advance_without_missing(transport.publish)
+                    if missing:
+                        silent += 1
+                        print(f"sim: frame {i}: no commands from {', '.join(missing)} within "
+                              f"{params.lockstep_wait_s} s: stepped without", file=err)  # fmt: skip
+                    waited = time.monotonic()
+        frame_ms.append((time.perf_counter() - f0) * 1e3)
+        if on_frame is not None:
+            on_frame(i)
+    wall = time.perf_counter() - wall0
+    wanted = {s for s in summary_stages(spec.opponent) if role_of(s) in roles}
+    _control(transport, "clock", "summarize")
+    bus.summarize()
+    if not transport.wait_for(lambda: wanted <= set(summaries.figures), params.start_timeout_s):
+        raise TimeoutError(f"no summary from {', '.join(sorted(wanted - set(summaries.figures)))}")
+    _control(transport, "clock", "stop")
+    transport.spin(0.2)
+    f = summaries.figures
+    if summary_stages(spec.opponent) <= set(f):
+        summary = match_summary(f, {"frame": frame_ms}, sim.seed, spec.opponent, spec.perception)
+    else:  # a node of the match was not there: what the others said
+        summary = {"seed": sim.seed, "opponent": spec.opponent, "perception": spec.perception,
+                   "missing_nodes": sorted(set(node_roles(spec.opponent, log=False)) - set(roles)),
+                   "score": f["referee"]["score"], "command_faults": f["sim"]["command_faults"]}  # fmt: skip
+    summary.update(frames=len(frame_ms), wall_seconds=round(wall, 3), frames_stepped_without_a_team=silent,
+                   realtime_factor=round(sim.t / wall, 2) if wall > 0 else None,
+                   dropped_messages=transport.dropped)  # fmt: skip
+    return summary
+
+
+def _pace(transport: ZenohTransport, until: float) -> None:
+    """Deliver what comes until the wall clock reaches ``until`` (perf_counter s)."""
+    while (left := until - time.perf_counter()) > 0:
+        transport.spin(min(left, 0.005))
+
+
+def write_summary(folder: Path, summary: dict[str, Any]) -> None:
+    (folder / "summary.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")

@@ -1,0 +1,207 @@
+"""The bus over eclipse-zenoh: the second :class:`~cmdragons.runtime.bus.Transport`, for stages in
+separate processes (or machines).
+
+A topic ``t`` is the key ``cmdragons/<field>/t``; a pattern ``p/*`` is ``cmdragons/<field>/p/**``.
+Messages go as protobuf (:mod:`cmdragons.runtime.wire`); payloads from ``shm_min_bytes`` on (camera
+frames) are written into zenoh's shared memory, so a same-host subscriber maps them instead of
+copying them through a socket. Publishers block rather than drop when a link is congested: a
+lock-step match must lose nothing.
+
+Zenoh delivers on its own threads; this transport only queues there. :meth:`ZenohTransport.spin`
+decodes and delivers in the calling thread, first received first delivered, each message to its
+handlers in subscription order, as the in-process transport does. A node's own messages reach its
+own stages without the network (as :func:`~cmdragons.runtime.wire.canonical` makes them, so they
+equal what a remote stage gets). A message that does not decode is counted (:attr:`dropped`),
+reported on stderr at most once per ``drop_report_interval_s``, and dropped.
+"""
+
+from __future__ import annotations
+
+import queue
+import sys
+import time
+from collections.abc import Callable
+from typing import Any, TextIO
+
+from cmdragons.messages import MessageError
+from cmdragons.runtime import wire
+from cmdragons.runtime.bus import Handler, topic_matches
+from cmdragons.runtime.params import RuntimeParams
+
+__all__ = ["ZenohTransport", "key_expr", "open_router"]
+
+
+def open_router(params: RuntimeParams) -> Any:
+    """A zenoh router session on the configured endpoint (the nodes are its clients); close it."""
+    import zenoh
+
+    return zenoh.open(params.zenoh.config("router"))
+
+
+def key_expr(prefix: str, pattern: str) -> str:
+    """The zenoh key expression of a topic pattern under ``prefix`` (``cmdragons/<field>``)."""
+    if pattern == "*":
+        return f"{prefix}/**"
+    if pattern.endswith("/*"):
+        return f"{prefix}/{pattern[:-2]}/**"
+    return f"{prefix}/{pattern}"
+
+
+def _subsumes(a: str, b: str) -> bool:
+    """Whether every topic of pattern ``b`` is a topic of pattern ``a``."""
+    if a == "*":
+        return True
+    if a.endswith("/*"):
+        return b.startswith(a[:-1])
+    return a == b
+
+
+class ZenohTransport:
+    """Publish, subscribe and deliver over one zenoh session (a client of the configured router).
+
+    ``session``: an open zenoh session to use (closed by the caller), else one is opened from
+    ``params`` and closed by :meth:`close`. ``name``: who this is, in reports."""
+
+    def __init__(self, params: RuntimeParams, name: str = "node", session: Any = None,
+                 err: TextIO | None = None) -> None:  # fmt: skip
+        import zenoh
+
+        self._zenoh = zenoh
+        self.params = params
+        self.name = name
+        self.prefix = f"cmdragons/{params.field_name}"
+        self._own = session is None
+        self.session = zenoh.open(params.zenoh.config("client")) if session is None else session
+        self._queue: queue.SimpleQueue[tuple[str, Any, bool]] = queue.SimpleQueue()
+        self._subs: list[tuple[str, Handler]] = []
+        self._routes: dict[str, list[Handler]] = {}
+        self._declared: dict[str, Any] = {}  # pattern -> zenoh subscriber (no two overlap)
+        self._pubs: dict[str, Any] = {}
+        self._shm: Any = None
+        self.dropped = 0
+        self.received = 0
+        self.last_received = time.monotonic()
+        self._err = err if err is not None else sys.stderr
+        self._dropped_reported = 0
+        self._last_report = -float("inf")
+
+    # --- subscribing -------------------------------------------------------------------------
+
+    def subscribe(self, pattern: str, handler: Handler) -> None:
+        self._subs.append((pattern, handler))
+        self._routes.clear()
+        patterns = {p for p, _ in self._subs}
+        wanted = {p for p in patterns if not any(q != p and _subsumes(q, p) for q in patterns)}
+        for p in [p for p in self._declared if p not in wanted]:
+            self._declared.pop(p).undeclare()
+        for p in sorted(wanted - set(self._declared)):
+            self._declared[p] = self.session.declare_subscriber(
+                key_expr(self.prefix, p), self._receive, allowed_origin=self._zenoh.Locality.REMOTE)
+
+    def _receive(self, sample: Any) -> None:
+        """Zenoh's thread: queue the raw payload (decoded in :meth:`spin`)."""
+        topic = str(sample.key_expr)[len(self.prefix) + 1 :]
+        self._queue.put((topic, sample.payload.to_bytes(), True))
+
+    def _handlers(self, topic: str) -> list[Handler]:
+        hs = self._routes.get(topic)
+        if hs is None:
+            hs = self._routes[topic] = [h for p, h in self._subs if topic_matches(p, topic)]
+        return hs
+
+    # --- publishing -----------------------------------------------------------------------------
+
+    def publish(self, topic: str, message: Any) -> None:
+        if self._handlers(topic):
+            self._queue.put((topic, wire.canonical(message), False))
+        data = wire.encode(message)
+        zp = self.params.zenoh
+        payload = self._in_shared_memory(data) if zp.shared_memory and len(data) >= zp.shm_min_bytes else data
+        # the session's put, not a publisher declared now: a new publisher drops what it is given until
+        # it learnt who subscribes, the session routes by what it knows already
+        z = self._zenoh
+        self.session.put(f"{self.prefix}/{topic}", payload, congestion_control=z.CongestionControl.BLOCK,
+                         allowed_destination=z.Locality.REMOTE)  # fmt: skip
+
+    def _in_shared_memory(self, data: bytes) -> Any:
+        from zenoh import shm
+
+        if self._shm is None:
+            self._shm = shm.ShmProvider.default_backend(self.params.zenoh.shm_pool_mb << 20)
+        buf = self._shm.alloc(len(data), policy=shm.BlockOn(shm.GarbageCollect()))
+        buf[:] = data
+        return buf
+
+    def has_subscribers(self, topic: str) -> bool:
+        """Whether a remote subscriber matches ``topic`` now (a peer is there to hear it)."""
+        return bool(self._publisher(topic).matching_status.matching)
+
+    def _publisher(self, topic: str) -> Any:
+        pub = self._pubs.get(topic)
+        if pub is None:
+            z = self._zenoh
+            pub = self._pubs[topic] = self.session.declare_publisher(
+                f"{self.prefix}/{topic}", congestion_control=z.CongestionControl.BLOCK,
+                allowed_destination=z.Locality.REMOTE)  # fmt: skip
+        return pub
+
+    # --- delivering ------------------------------------------------------------------------------
+
+    def spin(self, timeout_s: float = 0.0) -> int:
+        """Deliver what has come, waiting up to ``timeout_s`` for the first message; returns how many
+        deliveries were made."""
+        n = 0
+        try:
+            item = self._queue.get(timeout=timeout_s) if timeout_s > 0 else self._queue.get_nowait()
+        except queue.Empty:
+            return 0
+        while True:
+            n += self._deliver(*item)
+            try:
+                item = self._queue.get_nowait()
+            except queue.Empty:
+                return n
+
+    def _deliver(self, topic: str, payload: Any, remote: bool) -> int:
+        handlers = self._handlers(topic)
+        if remote:
+            self.received += 1
+            self.last_received = time.monotonic()
+            if not handlers:
+                return 0
+            try:
+                payload = wire.decode(topic, payload)
+            except MessageError as exc:
+                self._drop(exc)
+                return 0
+        for handler in handlers:
+            handler(topic, payload)
+        return len(handlers)
+
+    def _drop(self, exc: MessageError) -> None:
+        self.dropped += 1
+        now = time.monotonic()
+        if now - self._last_report >= self.params.drop_report_interval_s:
+            new = self.dropped - self._dropped_reported
+            print(f"{self.name}: dropped {new} undecodable message{'s' * (new != 1)} ({exc})", file=self._err)
+            self._dropped_reported, self._last_report = self.dropped, now
+
+    def wait_for(self, done: Callable[[], bool], timeout_s: float, poll_s: float = 0.05) -> bool:
+        """Spin until ``done()`` or ``timeout_s`` passed; whether it is done."""
+        end = time.monotonic() + timeout_s
+        while not done():
+            left = end - time.monotonic()
+            if left <= 0:
+                return False
+            self.spin(min(poll_s, left))
+        return True
+
+    def close(self) -> None:
+        for sub in self._declared.values():
+            sub.undeclare()
+        for pub in self._pubs.values():
+            pub.undeclare()
+        self._declared.clear()
+        self._pubs.clear()
+        if self._own:
+            self.session.close()

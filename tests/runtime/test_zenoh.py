@@ -1,0 +1,105 @@
+"""The zenoh transport on loopback: the default config stays on this machine; messages arrive as
+the wire carries them; garbage is counted and dropped."""
+
+from __future__ import annotations
+
+import dataclasses
+import io
+import socket
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from cmdragons import messages as msg
+from cmdragons.runtime import wire
+from cmdragons.runtime.params import RuntimeParams, ZenohParams
+from cmdragons.runtime.settings import load_settings
+
+SETTINGS = load_settings(Path(__file__).resolve().parents[2] / "configs")
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+def loopback_params(field_name: str = "test") -> RuntimeParams:
+    """The default runtime config on a free loopback port (tests run side by side)."""
+    z = dataclasses.replace(SETTINGS.runtime.zenoh, router=f"tcp/127.0.0.1:{free_port()}")
+    return dataclasses.replace(SETTINGS.runtime, zenoh=z, field_name=field_name)
+
+
+@pytest.fixture
+def router() -> Iterator[RuntimeParams]:
+    import zenoh
+
+    params = loopback_params()
+    session = zenoh.open(params.zenoh.config("router"))
+    try:
+        yield params
+    finally:
+        session.close()
+
+
+@pytest.mark.parametrize("role", ["router", "client"])
+def test_the_default_config_stays_on_loopback_without_multicast(role: str) -> None:
+    cfg = SETTINGS.runtime.zenoh.session(role)
+    assert cfg["scouting"]["multicast"]["enabled"] is False and cfg["scouting"]["gossip"]["enabled"] is False
+    endpoints = cfg["listen"]["endpoints"] + cfg["connect"]["endpoints"]
+    assert endpoints and all(e.startswith("tcp/127.0.0.1:") for e in endpoints)
+    with pytest.raises(ValueError, match="network: true"):
+        ZenohParams(router="tcp/10.0.0.1:7447")
+
+
+def _transports(params: RuntimeParams, n: int, err: Any = None) -> list[Any]:
+    from cmdragons.runtime.zenoh_transport import ZenohTransport
+
+    return [ZenohTransport(params, f"node{k}", err=err) for k in range(n)]
+
+
+def test_messages_arrive_as_the_wire_carries_them_locally_and_remotely(router: RuntimeParams) -> None:
+    a, b = _transports(router, 2)
+    try:
+        got: dict[str, list[Any]] = {"a": [], "b": []}
+        a.subscribe("detections/*", lambda t, m: got["a"].append((t, m)))
+        b.subscribe("detections/*", lambda t, m: got["b"].append((t, m)))
+        b.subscribe("camera/*", lambda t, m: got["b"].append((t, m)))
+        assert a.wait_for(lambda: a.has_subscribers("camera/0/frame"), 10.0)
+        det = msg.DetectionFrame(0, 1, 0.1, 0.1, (msg.BallDetection(0.123456789, 1.0, 0.9, (1.0, 2.0)),))
+        image = np.random.default_rng(0).integers(0, 255, (120, 160, 3), dtype=np.uint8)  # 57 KB: shared memory
+        a.publish("detections/0", det)
+        a.publish("camera/0/frame", msg.CameraFrame(0, 1, 0.1, image))
+        a.spin()
+        assert b.wait_for(lambda: len(got["b"]) == 2, 10.0)
+        assert got["a"] == [("detections/0", wire.canonical(det))]
+        assert got["b"][0] == ("detections/0", wire.canonical(det)) and got["b"][0][1] != det  # 32-bit mm
+        assert got["b"][1][0] == "camera/0/frame" and np.array_equal(got["b"][1][1].image, image)
+    finally:
+        for t in (a, b):
+            t.close()
+
+
+def test_garbage_is_counted_dropped_and_reported_once(router: RuntimeParams) -> None:
+    import zenoh
+
+    err = io.StringIO()
+    (b,) = _transports(router, 1, err=err)
+    raw = zenoh.open(router.zenoh.config("client"))
+    try:
+        got: list[Any] = []
+        b.subscribe("referee", lambda _t, m: got.append(m))
+        pub = raw.declare_publisher(f"cmdragons/{router.field_name}/referee")
+        assert b.wait_for(lambda: bool(pub.matching_status.matching), 10.0)
+        for _ in range(5):
+            pub.put(b"\xff\x00garbage")
+        pub.put(wire.encode(msg.GameState(1.0, "stop")))
+        assert b.wait_for(lambda: len(got) == 1, 10.0)
+        assert got == [msg.GameState(1.0, "stop")] and b.dropped == 5
+        assert err.getvalue().count("dropped") == 1  # reported once within the interval
+    finally:
+        raw.close()
+        b.close()

@@ -1192,3 +1192,154 @@ def astar(
             prev[v] = u
             heapq.heappush(heap, (nd + math.hypot(pts[v, 0] - gx, pts[v, 1] - gy), v))
     return g, prev
+
+
+# --- generic graph search (road maps and cell decompositions) ---------------------------------------
+SEARCH_BFS = 0  # first in, first out: the fewest edges
+SEARCH_DFS = 1  # last in, first out: the first path found
+SEARCH_BEST_FIRST = 2  # greedy: the node nearest to the goal first (straight-line distance)
+SEARCH_DIJKSTRA = 3  # the lowest cost from the source first
+SEARCH_ASTAR = 4  # cost from the source plus the straight-line distance to the goal
+
+FRONTIER_HEAD = 0  # slots of a search's ``counters``: the frontier's first entry (first in, first out),
+FRONTIER_SIZE = 1  # one past its last entry (or the heap's size),
+EXPANDED = 2  # the nodes expanded so far
+
+
+@njit(cache=True)
+def _heap_push(key: np.ndarray, node: np.ndarray, size: int, k: float, v: int) -> int:
+    i = size
+    key[i], node[i] = k, v
+    while i > 0:
+        parent = (i - 1) >> 1
+        if key[parent] <= key[i]:
+            break
+        key[i], key[parent] = key[parent], key[i]
+        node[i], node[parent] = node[parent], node[i]
+        i = parent
+    return size + 1
+
+
+@njit(cache=True)
+def _heap_pop(key: np.ndarray, node: np.ndarray, size: int) -> tuple[int, int]:
+    """Remove the least key's node; returns (node, new size)."""
+    top = node[0]
+    size -= 1
+    key[0], node[0] = key[size], node[size]
+    i = 0
+    while True:
+        a, b, m = 2 * i + 1, 2 * i + 2, i
+        if a < size and key[a] < key[m]:
+            m = a
+        if b < size and key[b] < key[m]:
+            m = b
+        if m == i:
+            break
+        key[i], key[m] = key[m], key[i]
+        node[i], node[m] = node[m], node[i]
+        i = m
+    return top, size
+
+
+@njit(cache=True)
+def graph_search(
+    pts: np.ndarray, indptr: np.ndarray, adj: np.ndarray, w: np.ndarray, dst: int, mode: int,
+    g: np.ndarray, prev: np.ndarray, closed: np.ndarray, fkey: np.ndarray, fnode: np.ndarray,
+    counters: np.ndarray, max_expand: int,
+) -> int:  # fmt: skip
+    """Run a graph search over a CSR graph (nodes ``pts`` (n, 2) in metres, node u's edges
+    ``adj[indptr[u]:indptr[u + 1]]`` with lengths ``w``) until ``dst`` is expanded, the frontier is
+    empty or ``max_expand`` more nodes have been expanded. The state lives in the arrays the caller
+    made (:func:`cmdragons.planning.graphsearch.search`): ``g`` the cost from the source along
+    ``prev``, ``closed`` the expanded nodes, the frontier ``fkey``/``fnode`` (a binary heap for the
+    ordered modes, a queue or a stack for breadth- and depth-first) and ``counters`` (FRONTIER_HEAD,
+    FRONTIER_SIZE, EXPANDED), so that a search resumes where it stopped. ``mode`` is one of the
+    SEARCH_* constants. Returns 1 when ``dst`` was reached, 0 when the frontier ran empty, -1 when
+    the expansion budget stopped it."""
+    gx, gy = pts[dst, 0], pts[dst, 1]
+    head, size = counters[FRONTIER_HEAD], counters[FRONTIER_SIZE]
+    ordered = mode == SEARCH_BEST_FIRST or mode == SEARCH_DIJKSTRA or mode == SEARCH_ASTAR
+    expanded = 0
+    outcome = 0
+    while head < size:
+        if expanded >= max_expand:
+            outcome = -1
+            break
+        if ordered:
+            u, size = _heap_pop(fkey, fnode, size)
+        elif mode == SEARCH_BFS:
+            u = fnode[head]
+            head += 1
+        else:
+            size -= 1
+            u = fnode[size]
+        if closed[u]:
+            continue
+        closed[u] = True
+        expanded += 1
+        if u == dst:
+            outcome = 1
+            break
+        for e in range(indptr[u], indptr[u + 1]):
+            v = adj[e]
+            if closed[v]:
+                continue
+            nd = g[u] + w[e]
+            if mode == SEARCH_DIJKSTRA or mode == SEARCH_ASTAR:
+                if nd >= g[v]:
+                    continue
+                g[v], prev[v] = nd, u
+                k = nd + (math.hypot(pts[v, 0] - gx, pts[v, 1] - gy) if mode == SEARCH_ASTAR else 0.0)
+                size = _heap_push(fkey, fnode, size, k, v)
+            elif mode == SEARCH_DFS:
+                g[v], prev[v] = nd, u  # the latest push is popped first: its parent is the tree's
+                fnode[size] = v
+                size += 1
+            elif g[v] == np.inf:  # breadth- and best-first: a node's parent is the one that found it
+                g[v], prev[v] = nd, u
+                if mode == SEARCH_BFS:
+                    fnode[size] = v
+                    size += 1
+                else:
+                    size = _heap_push(fkey, fnode, size, math.hypot(pts[v, 0] - gx, pts[v, 1] - gy), v)
+    counters[FRONTIER_HEAD], counters[FRONTIER_SIZE] = head, size
+    counters[EXPANDED] += expanded
+    return outcome
+
+
+@njit(cache=True)
+def grid_graph(free: np.ndarray, x0: float, y0: float, res: float, connectivity: int) -> tuple[
+        np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    """The connectivity graph of a uniform grid's free cells (``free`` (ny, nx), cell (i, k) centred at
+    x0 + (k + 1/2) res, y0 + (i + 1/2) res): 4 or 8 neighbours, edges weighted by the centres'
+    distance. Returns (node of each cell or -1 (ny, nx), centres (n, 2), CSR indptr, adj, lengths)."""
+    ny, nx = free.shape
+    node = -np.ones((ny, nx), dtype=np.int64)
+    n = 0
+    for i in range(ny):
+        for k in range(nx):
+            if free[i, k]:
+                node[i, k] = n
+                n += 1
+    pts = np.empty((n, 2))
+    di = np.array([0, 1, 0, -1, 1, 1, -1, -1])
+    dk = np.array([1, 0, -1, 0, 1, -1, 1, -1])
+    indptr = np.zeros(n + 1, dtype=np.int64)
+    adj = np.empty(n * connectivity, dtype=np.int64)
+    w = np.empty(n * connectivity)
+    diag = math.sqrt(2.0) * res
+    m = 0
+    for i in range(ny):
+        for k in range(nx):
+            u = node[i, k]
+            if u < 0:
+                continue
+            pts[u, 0], pts[u, 1] = x0 + (k + 0.5) * res, y0 + (i + 0.5) * res
+            for d in range(connectivity):
+                ii, kk = i + di[d], k + dk[d]
+                if 0 <= ii < ny and 0 <= kk < nx and node[ii, kk] >= 0:
+                    adj[m] = node[ii, kk]
+                    w[m] = res if d < 4 else diag
+                    m += 1
+            indptr[u + 1] = m
+    return node, pts, indptr, adj[:m], w[:m]

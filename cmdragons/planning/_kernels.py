@@ -1205,74 +1205,135 @@ FRONTIER_HEAD = 0  # slots of a search's ``counters``: the frontier's first entr
 FRONTIER_SIZE = 1  # one past its last entry (or the heap's size),
 EXPANDED = 2  # the nodes expanded so far
 
+# the neighbours of a grid cell (row, column), in the order both the grid graph and the grid search
+# take them: the four sides, then the four corners
+GRID_DI = np.array([0, 1, 0, -1, 1, 1, -1, -1])
+GRID_DK = np.array([1, 0, -1, 0, 1, -1, 1, -1])
 
-@njit(cache=True)
+
+HEAP_ARITY = 4  # children per heap node: a shallower heap than a binary one, and its children side by side
+
+
+@njit(cache=True, inline="always")
 def _heap_push(key: np.ndarray, node: np.ndarray, size: int, k: float, v: int) -> int:
-    i = size
-    key[i], node[i] = k, v
-    while i > 0:
-        parent = (i - 1) >> 1
-        if key[parent] <= key[i]:
+    """Push node v with key k on the 4-ary min-heap key/node[:size]; returns the new size (a node
+    may be in it more than once: a search skips the stale entries of expanded nodes)."""
+    j = size
+    while j > 0:
+        parent = (j - 1) // HEAP_ARITY
+        if key[parent] <= k:
             break
-        key[i], key[parent] = key[parent], key[i]
-        node[i], node[parent] = node[parent], node[i]
-        i = parent
+        key[j], node[j] = key[parent], node[parent]  # the hole moves up, the parent down
+        j = parent
+    key[j], node[j] = k, v
     return size + 1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _heap_pop(key: np.ndarray, node: np.ndarray, size: int) -> tuple[int, int]:
     """Remove the least key's node; returns (node, new size)."""
     top = node[0]
     size -= 1
-    key[0], node[0] = key[size], node[size]
+    k, v = key[size], node[size]  # the last entry fills the hole that sinks from the root
     i = 0
     while True:
-        a, b, m = 2 * i + 1, 2 * i + 2, i
-        if a < size and key[a] < key[m]:
-            m = a
-        if b < size and key[b] < key[m]:
-            m = b
-        if m == i:
+        first = HEAP_ARITY * i + 1
+        if first >= size:
             break
-        key[i], key[m] = key[m], key[i]
-        node[i], node[m] = node[m], node[i]
+        m, km = first, key[first]
+        for c in range(first + 1, min(first + HEAP_ARITY, size)):
+            if key[c] < km:
+                m, km = c, key[c]
+        if km >= k:
+            break
+        key[i], node[i] = km, node[m]
         i = m
+    key[i], node[i] = k, v
     return top, size
+
+
+@njit(cache=True, inline="always")
+def _to_goal(dx: float, dy: float, octile: bool) -> float:
+    """The heuristic distance over (dx, dy) to the goal: the straight line, or on a grid of axis and
+    diagonal moves the octile distance (the unobstructed shortest path there, tighter)."""
+    dx, dy = abs(dx), abs(dy)
+    if octile:
+        return max(dx, dy) + (math.sqrt(2.0) - 1.0) * min(dx, dy)
+    return math.hypot(dx, dy)
+
+
+@njit(cache=True, inline="always")
+def _pop(mode: int, fkey: np.ndarray, fnode: np.ndarray, head: int, size: int) -> tuple[int, int, int]:
+    """The frontier's next node by ``mode``: (node, head, size)."""
+    if mode == SEARCH_BFS:
+        return fnode[head], head + 1, size
+    if mode == SEARCH_DFS:
+        return fnode[size - 1], head, size - 1
+    u, size = _heap_pop(fkey, fnode, size)
+    return u, head, size
+
+
+@njit(cache=True, inline="always")
+def _reach(mode: int, v: int, u: int, nd: float, dx: float, dy: float, octile: bool, g: np.ndarray,
+           prev: np.ndarray, fkey: np.ndarray, fnode: np.ndarray, size: int) -> int:  # fmt: skip
+    """Node u reaches its neighbour v at cost ``nd``: record it and put v on the frontier as ``mode``
+    does ((dx, dy): v's offset from the goal, for the heuristic). Returns the frontier's new size."""
+    if mode == SEARCH_DIJKSTRA or mode == SEARCH_ASTAR:
+        if nd >= g[v]:
+            return size
+        g[v], prev[v] = nd, u
+        return _heap_push(fkey, fnode, size, nd + (_to_goal(dx, dy, octile) if mode == SEARCH_ASTAR else 0.0), v)
+    if mode == SEARCH_DFS:
+        g[v], prev[v] = nd, u  # the latest push is popped first: its parent is the tree's
+        fnode[size] = v
+        return size + 1
+    if g[v] != np.inf:  # breadth- and best-first: a node's parent is the one that found it
+        return size
+    g[v], prev[v] = nd, u
+    if mode == SEARCH_BFS:
+        fnode[size] = v
+        return size + 1
+    return _heap_push(fkey, fnode, size, _to_goal(dx, dy, octile), v)
 
 
 @njit(cache=True)
 def graph_search(
-    pts: np.ndarray, indptr: np.ndarray, adj: np.ndarray, w: np.ndarray, dst: int, mode: int,
-    g: np.ndarray, prev: np.ndarray, closed: np.ndarray, fkey: np.ndarray, fnode: np.ndarray,
-    counters: np.ndarray, max_expand: int,
+    pts: np.ndarray, indptr: np.ndarray, adj: np.ndarray, w: np.ndarray, free: np.ndarray, res: float,
+    connectivity: int, dst: int, mode: int, octile: bool, g: np.ndarray, prev: np.ndarray, closed: np.ndarray,
+    fkey: np.ndarray, fnode: np.ndarray, counters: np.ndarray, max_expand: int,
 ) -> int:  # fmt: skip
-    """Run a graph search over a CSR graph (nodes ``pts`` (n, 2) in metres, node u's edges
-    ``adj[indptr[u]:indptr[u + 1]]`` with lengths ``w``) until ``dst`` is expanded, the frontier is
-    empty or ``max_expand`` more nodes have been expanded. The state lives in the arrays the caller
-    made (:func:`cmdragons.planning.graphsearch.search`): ``g`` the cost from the source along
-    ``prev``, ``closed`` the expanded nodes, the frontier ``fkey``/``fnode`` (a binary heap for the
-    ordered modes, a queue or a stack for breadth- and depth-first) and ``counters`` (FRONTIER_HEAD,
-    FRONTIER_SIZE, EXPANDED), so that a search resumes where it stopped. ``mode`` is one of the
-    SEARCH_* constants. Returns 1 when ``dst`` was reached, 0 when the frontier ran empty, -1 when
-    the expansion budget stopped it."""
-    gx, gy = pts[dst, 0], pts[dst, 1]
+    """Run a graph search until ``dst`` is expanded, the frontier is empty or ``max_expand`` more
+    nodes have been expanded, over either graph:
+
+    * a CSR graph (``free`` empty): nodes ``pts`` (n, 2) in metres, node u's edges
+      ``adj[indptr[u]:indptr[u + 1]]`` with lengths ``w``; ``octile``: the heuristic of a grid graph
+      (:func:`_to_goal`);
+    * a uniform grid (``free`` (ny, nx), the other graph arrays empty): the graph :func:`grid_graph`
+      makes of it, without building it: node i * nx + k is cell (i, k), its neighbours the free
+      cells around it in the order GRID_DI/GRID_DK (``connectivity`` of them), at ``res`` or its
+      diagonal; the heuristic is the octile distance.
+
+    The state lives in the arrays the caller made (:func:`cmdragons.planning.graphsearch.search`):
+    ``g`` the cost from the source along ``prev``, ``closed`` the expanded nodes, the frontier
+    ``fkey``/``fnode`` (a heap for the ordered modes, a queue or a stack for breadth- and
+    depth-first) and ``counters`` (FRONTIER_HEAD, FRONTIER_SIZE, EXPANDED), so that a search resumes
+    where it stopped. ``mode`` is one of the SEARCH_* constants. Returns 1 when ``dst`` was reached,
+    0 when the frontier ran empty, -1 when the expansion budget stopped it."""
+    grid = free.shape[0] > 0
+    ny, nx = free.shape
+    if grid:
+        gx, gy = (dst % nx) * res, (dst // nx) * res
+    else:
+        gx, gy = pts[dst, 0], pts[dst, 1]
     head, size = counters[FRONTIER_HEAD], counters[FRONTIER_SIZE]
-    ordered = mode == SEARCH_BEST_FIRST or mode == SEARCH_DIJKSTRA or mode == SEARCH_ASTAR
+    diag = math.sqrt(2.0) * res
     expanded = 0
     outcome = 0
     while head < size:
         if expanded >= max_expand:
             outcome = -1
             break
-        if ordered:
-            u, size = _heap_pop(fkey, fnode, size)
-        elif mode == SEARCH_BFS:
-            u = fnode[head]
-            head += 1
-        else:
-            size -= 1
-            u = fnode[size]
+        u, head, size = _pop(mode, fkey, fnode, head, size)
         if closed[u]:
             continue
         closed[u] = True
@@ -1280,28 +1341,24 @@ def graph_search(
         if u == dst:
             outcome = 1
             break
-        for e in range(indptr[u], indptr[u + 1]):
-            v = adj[e]
-            if closed[v]:
-                continue
-            nd = g[u] + w[e]
-            if mode == SEARCH_DIJKSTRA or mode == SEARCH_ASTAR:
-                if nd >= g[v]:
+        gu = g[u]
+        if grid:
+            ui, uk = u // nx, u % nx
+            for d in range(connectivity):
+                i, k = ui + GRID_DI[d], uk + GRID_DK[d]
+                if i < 0 or i >= ny or k < 0 or k >= nx or not free[i, k]:
                     continue
-                g[v], prev[v] = nd, u
-                k = nd + (math.hypot(pts[v, 0] - gx, pts[v, 1] - gy) if mode == SEARCH_ASTAR else 0.0)
-                size = _heap_push(fkey, fnode, size, k, v)
-            elif mode == SEARCH_DFS:
-                g[v], prev[v] = nd, u  # the latest push is popped first: its parent is the tree's
-                fnode[size] = v
-                size += 1
-            elif g[v] == np.inf:  # breadth- and best-first: a node's parent is the one that found it
-                g[v], prev[v] = nd, u
-                if mode == SEARCH_BFS:
-                    fnode[size] = v
-                    size += 1
-                else:
-                    size = _heap_push(fkey, fnode, size, math.hypot(pts[v, 0] - gx, pts[v, 1] - gy), v)
+                v = i * nx + k
+                if closed[v]:
+                    continue
+                size = _reach(mode, v, u, gu + (res if d < 4 else diag), k * res - gx, i * res - gy, True, g, prev,
+                              fkey, fnode, size)  # fmt: skip
+        else:
+            for e in range(indptr[u], indptr[u + 1]):
+                v = adj[e]
+                if closed[v]:
+                    continue
+                size = _reach(mode, v, u, gu + w[e], pts[v, 0] - gx, pts[v, 1] - gy, octile, g, prev, fkey, fnode, size)
     counters[FRONTIER_HEAD], counters[FRONTIER_SIZE] = head, size
     counters[EXPANDED] += expanded
     return outcome
@@ -1322,8 +1379,7 @@ def grid_graph(free: np.ndarray, x0: float, y0: float, res: float, connectivity:
                 node[i, k] = n
                 n += 1
     pts = np.empty((n, 2))
-    di = np.array([0, 1, 0, -1, 1, 1, -1, -1])
-    dk = np.array([1, 0, -1, 0, 1, -1, 1, -1])
+    di, dk = GRID_DI, GRID_DK
     indptr = np.zeros(n + 1, dtype=np.int64)
     adj = np.empty(n * connectivity, dtype=np.int64)
     w = np.empty(n * connectivity)

@@ -71,7 +71,7 @@ def grid_graph(free: NDArray[np.bool_], x0: float, y0: float, resolution_m: floa
     """The connectivity graph of the free cells of a uniform grid (cell (i, k) centred at
     x0 + (k + 1/2) res, y0 + (i + 1/2) res)."""
     _node, pts, indptr, adj, w = K.grid_graph(np.ascontiguousarray(free), x0, y0, resolution_m, connectivity)
-    return Graph(pts, indptr, adj, w)
+    return Graph(pts, indptr, adj, w, octile=True)
 
 
 @dataclass(frozen=True, eq=False)

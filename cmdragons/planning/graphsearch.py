@@ -9,15 +9,19 @@ their length, held as CSR arrays; every road map (Voronoi, visibility) and every
 * ``dfs``: the first route depth-first finds (any route; the least cost only by chance);
 * ``best_first``: greedy on the straight-line distance to the goal (fast, not optimal);
 * ``dijkstra`` and ``astar``: the least-cost route (A*'s straight-line heuristic is admissible and
-  consistent on graphs whose edge weights are at least the distance of their ends).
+  consistent on graphs whose edge weights are at least the distance of their ends; on a grid graph
+  of axis and diagonal moves it takes the octile distance, which is too).
 
 Work (a termination's unit): nodes expanded. The search runs in chunks of ``chunk`` expansions
 (:func:`cmdragons.planning._kernels.graph_search`), checking the termination between them.
+:func:`grid_search` is the same search on a uniform grid's graph without building it (the cells'
+neighbours found by index), for large grids.
 """
 
 from __future__ import annotations
 
 import enum
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -27,7 +31,7 @@ from cmdragons.planning import _kernels as K
 from cmdragons.planning.termination import Termination
 from cmdragons.planning.world import CompiledWorld
 
-__all__ = ["SEARCHES", "Graph", "SearchResult", "SearchStatus", "link_point", "search"]
+__all__ = ["SEARCHES", "Graph", "SearchResult", "SearchStatus", "grid_search", "link_point", "search"]
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -40,6 +44,11 @@ SEARCHES: dict[str, int] = {
     "astar": K.SEARCH_ASTAR,
 }
 CHUNK = 4096  # expansions between two termination checks
+# the kernel's arrays of the graph it is not searching (a CSR graph or a grid)
+_NO_GRID = np.zeros((0, 0), dtype=np.bool_)
+_NO_POINTS = np.zeros((0, 2))
+_NO_INDEX = np.zeros(0, dtype=np.int64)
+_NO_WEIGHTS = np.zeros(0)
 
 
 @dataclass(frozen=True, eq=False)
@@ -51,6 +60,9 @@ class Graph:
     indptr: IntArray
     adj: IntArray
     w: FloatArray
+    # a grid graph of axis and diagonal moves (weights their lengths): A* and best-first take the
+    # octile distance to the goal, the unobstructed shortest path there, for the straight line
+    octile: bool = False
 
     @property
     def n(self) -> int:
@@ -89,7 +101,7 @@ class Graph:
         back = indptr[nodes + 1] - 1
         adj[back], w[back] = n, lengths
         adj[indptr[n] :], w[indptr[n] :] = nodes, lengths
-        return Graph(np.vstack([self.pts, [point]]), indptr, adj, w)
+        return Graph(np.vstack([self.pts, [point]]), indptr, adj, w, self.octile)
 
 
 class SearchStatus(enum.Enum):
@@ -109,32 +121,75 @@ class SearchResult:
     expanded: int
 
 
+class _Frontier:
+    """The state of one search: costs, parents, expanded marks and the frontier arrays (sized for
+    ``n`` nodes and ``m`` directed edges), as the kernels take them."""
+
+    def __init__(self, n: int, m: int, src: int, mode: int) -> None:
+        self.g = np.full(n, np.inf)
+        self.prev = -np.ones(n, dtype=np.int64)
+        self.closed = np.zeros(n, dtype=np.bool_)
+        size = m + 1  # lazy deletion: every edge pushes at most once, the source once
+        self.key, self.node = np.empty(size), np.empty(size, dtype=np.int64)
+        self.counters = np.zeros(3, dtype=np.int64)
+        self.g[src], self.key[0], self.node[0], self.counters[K.FRONTIER_SIZE] = 0.0, 0.0, src, 1
+        self.mode = mode
+
+    @property
+    def expanded(self) -> int:
+        return int(self.counters[K.EXPANDED])
+
+    def run(self, step: Callable[[int], int], dst: int, termination: Termination, work_done: float,
+            chunk: int) -> SearchResult:  # fmt: skip
+        """Call the kernel ``step(max_expand)`` in chunks until it ends or ``termination`` stops it."""
+        while True:
+            left = termination.work_left(work_done + self.expanded, chunk)
+            if left <= 0 or termination.expired():
+                return SearchResult(SearchStatus.STOPPED, np.zeros(0, np.int64), np.inf, self.expanded)
+            outcome = step(left)
+            if outcome == 1:
+                route: IntArray = K.route_to(self.prev, dst)
+                return SearchResult(SearchStatus.FOUND, route, float(self.g[dst]), self.expanded)
+            if outcome == 0:
+                return SearchResult(SearchStatus.UNREACHABLE, np.zeros(0, np.int64), np.inf, self.expanded)
+
+
+def _mode(method: str) -> int:
+    if method not in SEARCHES:
+        raise ValueError(f"unknown graph search {method!r}; known: {', '.join(SEARCHES)}")
+    return SEARCHES[method]
+
+
 def search(graph: Graph, src: int, dst: int, method: str, termination: Termination, work_done: float = 0.0,
            chunk: int = CHUNK) -> SearchResult:  # fmt: skip
     """Search ``graph`` from node ``src`` to node ``dst`` by ``method`` (a key of :data:`SEARCHES`)
     until ``termination`` (work: nodes expanded, counted on from ``work_done``)."""
-    if method not in SEARCHES:
-        raise ValueError(f"unknown graph search {method!r}; known: {', '.join(SEARCHES)}")
-    n = graph.n
-    g = np.full(n, np.inf)
-    prev = -np.ones(n, dtype=np.int64)
-    closed = np.zeros(n, dtype=np.bool_)
-    size = len(graph.adj) + 1  # every edge pushes at most once, the source once
-    fkey, fnode = np.empty(size), np.empty(size, dtype=np.int64)
-    counters = np.zeros(3, dtype=np.int64)
-    g[src], fkey[0], fnode[0], counters[K.FRONTIER_SIZE] = 0.0, 0.0, src, 1
-    mode = SEARCHES[method]
-    while True:
-        left = termination.work_left(work_done + counters[K.EXPANDED], chunk)
-        if left <= 0 or termination.expired():
-            return SearchResult(SearchStatus.STOPPED, np.zeros(0, np.int64), np.inf, int(counters[K.EXPANDED]))
-        outcome = K.graph_search(graph.pts, graph.indptr, graph.adj, graph.w, dst, mode, g, prev, closed, fkey,
-                                 fnode, counters, left)  # fmt: skip
-        if outcome == 1:
-            route: IntArray = K.route_to(prev, dst)
-            return SearchResult(SearchStatus.FOUND, route, float(g[dst]), int(counters[K.EXPANDED]))
-        if outcome == 0:
-            return SearchResult(SearchStatus.UNREACHABLE, np.zeros(0, np.int64), np.inf, int(counters[K.EXPANDED]))
+    f = _Frontier(graph.n, len(graph.adj), src, _mode(method))
+
+    def step(left: int) -> int:
+        return int(K.graph_search(graph.pts, graph.indptr, graph.adj, graph.w, _NO_GRID, 1.0, 0, dst, f.mode,
+                                  graph.octile, f.g, f.prev, f.closed, f.key, f.node, f.counters, left))  # fmt: skip
+
+    return f.run(step, dst, termination, work_done, chunk)
+
+
+def grid_search(free: NDArray[np.bool_], start: tuple[int, int], goal: tuple[int, int], method: str,
+                termination: Termination, resolution_m: float = 1.0, connectivity: int = 8,
+                chunk: int = CHUNK) -> SearchResult:  # fmt: skip
+    """:func:`search` on the connectivity graph of a uniform grid's free cells (``free`` (ny, nx),
+    cells (row, column), ``resolution_m`` apart, 4 or 8 neighbours; the heuristic the octile
+    distance), without building the graph: the same search as over
+    :func:`cmdragons.planning.cells.grid_graph`, faster. ``route`` is cell indices row * nx + column."""
+    grid = np.ascontiguousarray(free, dtype=np.bool_)
+    ny, nx = grid.shape
+    src, dst = start[0] * nx + start[1], goal[0] * nx + goal[1]
+    f = _Frontier(ny * nx, connectivity * ny * nx, src, _mode(method))
+
+    def step(left: int) -> int:
+        return int(K.graph_search(_NO_POINTS, _NO_INDEX, _NO_INDEX, _NO_WEIGHTS, grid, resolution_m, connectivity, dst,
+                                  f.mode, True, f.g, f.prev, f.closed, f.key, f.node, f.counters, left))  # fmt: skip
+
+    return f.run(step, dst, termination, work_done=0.0, chunk=chunk)
 
 
 def link_point(cw: CompiledWorld, pts: FloatArray, point: tuple[float, float], k: int,

@@ -19,14 +19,13 @@ from cmdragons.planning import (
     PlanProblem,
     PlanStatus,
     budget,
-    deadline,
     field_world,
     make_planner,
     never,
 )
 from cmdragons.planning.cells import grid_graph, quadtree, uniform_cells
 from cmdragons.planning.cspace import free_space
-from cmdragons.planning.graphsearch import SEARCHES, Graph, SearchStatus, search
+from cmdragons.planning.graphsearch import SEARCHES, Graph, SearchStatus, grid_search, search
 from cmdragons.planning.trapezoidal import trapezoids
 from tests.planning.conftest import problem, ring, wall_with_gap
 
@@ -136,7 +135,7 @@ def test_each_road_map_finds_the_gap_with_each_search(name: str, method: str, fi
     section = getattr(params, name)
     params = type(params)(**{name: type(section)(**{**section.__dict__, "search": method})})
     prob = problem(wall_with_gap(field), (-3.0, -1.0), (3.0, -1.0))
-    result = make_planner(params, name=name).solve(prob, deadline(5.0))
+    result = make_planner(params, name=name).solve(prob, never())
     assert result.status is PlanStatus.SOLVED, result.stats
     assert prob.compiled().path_free(result.path)
     np.testing.assert_allclose([result.path[0], result.path[-1]], [prob.start, prob.goal])
@@ -145,7 +144,7 @@ def test_each_road_map_finds_the_gap_with_each_search(name: str, method: str, fi
 @pytest.mark.parametrize("name", ROADMAPS)
 def test_each_road_map_reports_no_path_into_a_closed_ring(name: str, field: Field) -> None:
     prob = problem(field_world(field, ring((1.0, 0.5), 0.45, 16)), (-3.0, -1.0), (1.0, 0.5))
-    assert make_planner(PlannerParams(), name=name).solve(prob, deadline(5.0)).status is PlanStatus.NO_PATH
+    assert make_planner(PlannerParams(), name=name).solve(prob, never()).status is PlanStatus.NO_PATH
 
 
 def min_clearance(prob: PlanProblem, path: np.ndarray, step_m: float = 0.01) -> float:
@@ -161,8 +160,8 @@ def test_the_voronoi_road_keeps_more_clearance_than_the_visibility_graph(field: 
     # a column of robots with open gaps between start and goal, both far from everything
     robots = [(0.0, y) for y in np.arange(-2.4, 2.5, 0.8)] + [(-1.0, 0.5), (1.2, -0.6)]
     prob = problem(field_world(field, robots), (-2.5, 0.2), (2.5, -0.1))
-    vor = make_planner(PlannerParams(), name="voronoi").solve(prob, deadline(5.0))
-    vis = make_planner(PlannerParams(), name="visgraph").solve(prob, deadline(5.0))
+    vor = make_planner(PlannerParams(), name="voronoi").solve(prob, never())
+    vis = make_planner(PlannerParams(), name="visgraph").solve(prob, never())
     assert vor.status is PlanStatus.SOLVED and vis.status is PlanStatus.SOLVED
     assert min_clearance(prob, vis.path) < 0.01  # the shortest path grazes the robots
     assert min_clearance(prob, vor.path) > 0.15  # the road runs midway through the 0.44 m gaps
@@ -208,3 +207,19 @@ def test_approximate_cells_are_wholly_free(kind: str, field: Field) -> None:
     pts = np.stack(np.broadcast_arrays(xs[:, :, None], ys[:, None, :]), axis=-1).reshape(-1, 2)
     clearance, _ = cw.clearance_gradients(pts)
     assert clearance.min() >= -1e-9
+
+
+@pytest.mark.parametrize("connectivity", [4, 8])
+def test_the_grid_search_is_the_search_over_the_grid_graph(connectivity: int) -> None:
+    free = np.random.default_rng(7).random((30, 45)) > 0.3
+    cells = np.argwhere(free)
+    graph = grid_graph(free, 0.0, 0.0, 0.1, connectivity)
+    for a, b in ((0, len(cells) - 1), (10, 500), (77, 3)):
+        start, goal = (int(cells[a][0]), int(cells[a][1])), (int(cells[b][0]), int(cells[b][1]))
+        for method in SEARCHES:
+            on_graph = search(graph, a, b, method, never())
+            on_grid = grid_search(free, start, goal, method, never(), 0.1, connectivity)
+            assert on_grid.status is on_graph.status
+            assert on_grid.cost == pytest.approx(on_graph.cost, rel=1e-12, abs=1e-12), method
+            if method in ("bfs", "dfs"):  # no heuristic: the same order, the same route
+                np.testing.assert_array_equal(np.argwhere(free.ravel())[:, 0][on_graph.route], on_grid.route)

@@ -127,10 +127,10 @@ class _Frontier:
 
     def __init__(self, n: int, m: int, src: int, mode: int) -> None:
         self.g = np.full(n, np.inf)
-        self.prev = -np.ones(n, dtype=np.int64)
+        self.prev = -np.ones(n, dtype=np.int32)
         self.closed = np.zeros(n, dtype=np.bool_)
-        size = m + 1  # lazy deletion: every edge pushes at most once, the source once
-        self.key, self.node = np.empty(size), np.empty(size, dtype=np.int64)
+        size = m + 1  # lazy deletion: every edge pushes at most once, the source once (int32 nodes: < 2**31)
+        self.key, self.node = np.empty(size), np.empty(size, dtype=np.int32)
         self.counters = np.zeros(3, dtype=np.int64)
         self.g[src], self.key[0], self.node[0], self.counters[K.FRONTIER_SIZE] = 0.0, 0.0, src, 1
         self.mode = mode

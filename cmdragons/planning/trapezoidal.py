@@ -129,7 +129,8 @@ def portal_graph(cells: Trapezoids) -> Graph:
 
 
 class TrapezoidalPlanner(GraphPlanner):
-    """Exact trapezoidal cell decomposition, built from each query's world. Stateless."""
+    """Exact trapezoidal cell decomposition, built from each query's world. Nothing lives across
+    queries (the cells are kept only while the query links its start and goal to them)."""
 
     name = "trapezoidal"
 

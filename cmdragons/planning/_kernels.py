@@ -1308,10 +1308,10 @@ def graph_search(
     * a CSR graph (``free`` empty): nodes ``pts`` (n, 2) in metres, node u's edges
       ``adj[indptr[u]:indptr[u + 1]]`` with lengths ``w``; ``octile``: the heuristic of a grid graph
       (:func:`_to_goal`);
-    * a uniform grid (``free`` (ny, nx), the other graph arrays empty): the graph :func:`grid_graph`
-      makes of it, without building it: node i * nx + k is cell (i, k), its neighbours the free
-      cells around it in the order GRID_DI/GRID_DK (``connectivity`` of them), at ``res`` or its
-      diagonal; the heuristic is the octile distance.
+    * a uniform grid (``free`` (ny, nx) with a border of blocked cells all round, the other graph
+      arrays empty): the graph :func:`grid_graph` makes of it, without building it: node i * nx + k
+      is cell (i, k), its neighbours the free cells around it in the order GRID_DI/GRID_DK
+      (``connectivity`` of them), at ``res`` or its diagonal; the heuristic is the octile distance.
 
     The state lives in the arrays the caller made (:func:`cmdragons.planning.graphsearch.search`):
     ``g`` the cost from the source along ``prev``, ``closed`` the expanded nodes, the frontier
@@ -1321,6 +1321,8 @@ def graph_search(
     0 when the frontier ran empty, -1 when the expansion budget stopped it."""
     grid = free.shape[0] > 0
     ny, nx = free.shape
+    cells = free.ravel()
+    step = GRID_DI * nx + GRID_DK  # a neighbour's offset in the flat grid
     if grid:
         gx, gy = (dst % nx) * res, (dst // nx) * res
     else:
@@ -1345,14 +1347,11 @@ def graph_search(
         if grid:
             ui, uk = u // nx, u % nx
             for d in range(connectivity):
-                i, k = ui + GRID_DI[d], uk + GRID_DK[d]
-                if i < 0 or i >= ny or k < 0 or k >= nx or not free[i, k]:
+                v = u + step[d]  # the blocked border keeps every neighbour of a free cell inside the grid
+                if not cells[v] or closed[v]:
                     continue
-                v = i * nx + k
-                if closed[v]:
-                    continue
-                size = _reach(mode, v, u, gu + (res if d < 4 else diag), k * res - gx, i * res - gy, True, g, prev,
-                              fkey, fnode, size)  # fmt: skip
+                size = _reach(mode, v, u, gu + (res if d < 4 else diag), (uk + GRID_DK[d]) * res - gx,
+                              (ui + GRID_DI[d]) * res - gy, True, g, prev, fkey, fnode, size)  # fmt: skip
         else:
             for e in range(indptr[u], indptr[u + 1]):
                 v = adj[e]

@@ -180,16 +180,20 @@ def grid_search(free: NDArray[np.bool_], start: tuple[int, int], goal: tuple[int
     cells (row, column), ``resolution_m`` apart, 4 or 8 neighbours; the heuristic the octile
     distance), without building the graph: the same search as over
     :func:`cmdragons.planning.cells.grid_graph`, faster. ``route`` is cell indices row * nx + column."""
-    grid = np.ascontiguousarray(free, dtype=np.bool_)
-    ny, nx = grid.shape
-    src, dst = start[0] * nx + start[1], goal[0] * nx + goal[1]
-    f = _Frontier(ny * nx, connectivity * ny * nx, src, _mode(method))
+    ny, nx = free.shape
+    grid = np.zeros((ny + 2, nx + 2), dtype=np.bool_)  # a blocked border: no neighbour falls outside
+    grid[1:-1, 1:-1] = free
+    width = nx + 2
+    src, dst = (start[0] + 1) * width + start[1] + 1, (goal[0] + 1) * width + goal[1] + 1
+    f = _Frontier(grid.size, connectivity * grid.size, src, _mode(method))
 
     def step(left: int) -> int:
         return int(K.graph_search(_NO_POINTS, _NO_INDEX, _NO_INDEX, _NO_WEIGHTS, grid, resolution_m, connectivity, dst,
                                   f.mode, True, f.g, f.prev, f.closed, f.key, f.node, f.counters, left))  # fmt: skip
 
-    return f.run(step, dst, termination, work_done=0.0, chunk=chunk)
+    found = f.run(step, dst, termination, work_done=0.0, chunk=chunk)
+    route = (found.route // width - 1) * nx + found.route % width - 1  # back to the unbordered grid's cells
+    return SearchResult(found.status, route, found.cost, found.expanded)
 
 
 def link_point(cw: CompiledWorld, pts: FloatArray, point: tuple[float, float], k: int,

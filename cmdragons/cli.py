@@ -138,6 +138,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--maps", metavar="DIR", default=None,
                    help="grid: a folder of Moving AI .map files with their .map.scen "
                    "(default ../shared/benchdata/moving_ai)")
+    p.add_argument("--figures", metavar="DIR", default=None,
+                   help="navigation: the folder of the PNGs of each method's paths (default logs/bench-navigation)")
     add_runtime_parsers(sub, _common)
     return parser
 
@@ -548,10 +550,14 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     if args.json:
         check_writable_file(args.json, "--json")  # before the bench: its rows are not lost at the end
     options = {k: getattr(args, k) for k in OPTIONS.get(args.suite, ()) if getattr(args, k) is not None}
-    for k in ("maps",):
+    for k in ("maps", "figures"):
         if getattr(args, k) is not None and k not in OPTIONS.get(args.suite, ()):
-            print(f"cmdragons bench: --{k} is for the grid suite, not {args.suite}", file=sys.stderr)
+            owner = next(suite for suite, keys in OPTIONS.items() if k in keys)
+            print(f"cmdragons bench: --{k} is for the {owner} suite, not {args.suite}", file=sys.stderr)
             return 2
+    if args.figures is not None and Path(args.figures).exists() and not Path(args.figures).is_dir():
+        print(f"cmdragons bench: --figures {args.figures} is a file, not a folder", file=sys.stderr)
+        return 2
     try:
         rows = SUITES[args.suite](settings, args.quick, **options)
     except FileNotFoundError as exc:  # a suite's input data (the grid suite's maps) is not there

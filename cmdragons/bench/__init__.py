@@ -41,8 +41,9 @@ SUITES: dict[str, Suite] = {
     "vision": _lazy("cmdragons.bench.vision"),
     "grid": _lazy("cmdragons.bench.grid"),
     "robox": _lazy("cmdragons.bench.robox"),
+    "navigation": _lazy("cmdragons.bench.navigation"),
 }
-OPTIONS: dict[str, tuple[str, ...]] = {"grid": ("maps",)}  # the options each suite takes
+OPTIONS: dict[str, tuple[str, ...]] = {"grid": ("maps",), "navigation": ("figures",)}  # the options each suite takes
 
 
 TABLE_WIDTH = 100  # columns: a bench table fits a standard terminal

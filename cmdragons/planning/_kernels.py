@@ -1192,3 +1192,209 @@ def astar(
             prev[v] = u
             heapq.heappush(heap, (nd + math.hypot(pts[v, 0] - gx, pts[v, 1] - gy), v))
     return g, prev
+
+
+# --- generic graph search (road maps and cell decompositions) ---------------------------------------
+SEARCH_BFS = 0  # first in, first out: the fewest edges
+SEARCH_DFS = 1  # last in, first out: the first path found
+SEARCH_BEST_FIRST = 2  # greedy: the node nearest to the goal first (straight-line distance)
+SEARCH_DIJKSTRA = 3  # the lowest cost from the source first
+SEARCH_ASTAR = 4  # cost from the source plus the straight-line distance to the goal
+
+FRONTIER_HEAD = 0  # slots of a search's ``counters``: the frontier's first entry (first in, first out),
+FRONTIER_SIZE = 1  # one past its last entry (or the heap's size),
+EXPANDED = 2  # the nodes expanded so far
+
+# the neighbours of a grid cell (row, column), in the order both the grid graph and the grid search
+# take them: the four sides, then the four corners
+GRID_DI = np.array([0, 1, 0, -1, 1, 1, -1, -1])
+GRID_DK = np.array([1, 0, -1, 0, 1, -1, 1, -1])
+
+
+HEAP_ARITY = 4  # children per heap node: a shallower heap than a binary one, and its children side by side
+
+
+@njit(cache=True, inline="always")
+def _heap_push(key: np.ndarray, node: np.ndarray, size: int, k: float, v: int) -> int:
+    """Push node v with key k on the 4-ary min-heap key/node[:size]; returns the new size (a node
+    may be in it more than once: a search skips the stale entries of expanded nodes)."""
+    j = size
+    while j > 0:
+        parent = (j - 1) // HEAP_ARITY
+        if key[parent] <= k:
+            break
+        key[j], node[j] = key[parent], node[parent]  # the hole moves up, the parent down
+        j = parent
+    key[j], node[j] = k, v
+    return size + 1
+
+
+@njit(cache=True, inline="always")
+def _heap_pop(key: np.ndarray, node: np.ndarray, size: int) -> tuple[int, int]:
+    """Remove the least key's node; returns (node, new size)."""
+    top = node[0]
+    size -= 1
+    k, v = key[size], node[size]  # the last entry fills the hole that sinks from the root
+    i = 0
+    while True:
+        first = HEAP_ARITY * i + 1
+        if first >= size:
+            break
+        m, km = first, key[first]
+        for c in range(first + 1, min(first + HEAP_ARITY, size)):
+            if key[c] < km:
+                m, km = c, key[c]
+        if km >= k:
+            break
+        key[i], node[i] = km, node[m]
+        i = m
+    key[i], node[i] = k, v
+    return top, size
+
+
+@njit(cache=True, inline="always")
+def _to_goal(dx: float, dy: float, octile: bool) -> float:
+    """The heuristic distance over (dx, dy) to the goal: the straight line, or on a grid of axis and
+    diagonal moves the octile distance (the unobstructed shortest path there, tighter)."""
+    dx, dy = abs(dx), abs(dy)
+    if octile:
+        return max(dx, dy) + (math.sqrt(2.0) - 1.0) * min(dx, dy)
+    return math.hypot(dx, dy)
+
+
+@njit(cache=True, inline="always")
+def _pop(mode: int, fkey: np.ndarray, fnode: np.ndarray, head: int, size: int) -> tuple[int, int, int]:
+    """The frontier's next node by ``mode``: (node, head, size)."""
+    if mode == SEARCH_BFS:
+        return fnode[head], head + 1, size
+    if mode == SEARCH_DFS:
+        return fnode[size - 1], head, size - 1
+    u, size = _heap_pop(fkey, fnode, size)
+    return u, head, size
+
+
+@njit(cache=True, inline="always")
+def _reach(mode: int, v: int, u: int, nd: float, dx: float, dy: float, octile: bool, g: np.ndarray,
+           prev: np.ndarray, fkey: np.ndarray, fnode: np.ndarray, size: int) -> int:  # fmt: skip
+    """Node u reaches its neighbour v at cost ``nd``: record it and put v on the frontier as ``mode``
+    does ((dx, dy): v's offset from the goal, for the heuristic). Returns the frontier's new size."""
+    if mode == SEARCH_DIJKSTRA or mode == SEARCH_ASTAR:
+        if nd >= g[v]:
+            return size
+        g[v], prev[v] = nd, u
+        return _heap_push(fkey, fnode, size, nd + (_to_goal(dx, dy, octile) if mode == SEARCH_ASTAR else 0.0), v)
+    if mode == SEARCH_DFS:
+        g[v], prev[v] = nd, u  # the latest push is popped first: its parent is the tree's
+        fnode[size] = v
+        return size + 1
+    if g[v] != np.inf:  # breadth- and best-first: a node's parent is the one that found it
+        return size
+    g[v], prev[v] = nd, u
+    if mode == SEARCH_BFS:
+        fnode[size] = v
+        return size + 1
+    return _heap_push(fkey, fnode, size, _to_goal(dx, dy, octile), v)
+
+
+@njit(cache=True)
+def graph_search(
+    pts: np.ndarray, indptr: np.ndarray, adj: np.ndarray, w: np.ndarray, free: np.ndarray, res: float,
+    connectivity: int, dst: int, mode: int, octile: bool, g: np.ndarray, prev: np.ndarray, closed: np.ndarray,
+    fkey: np.ndarray, fnode: np.ndarray, counters: np.ndarray, max_expand: int,
+) -> int:  # fmt: skip
+    """Run a graph search until ``dst`` is expanded, the frontier is empty or ``max_expand`` more
+    nodes have been expanded, over either graph:
+
+    * a CSR graph (``free`` empty): nodes ``pts`` (n, 2) in metres, node u's edges
+      ``adj[indptr[u]:indptr[u + 1]]`` with lengths ``w``; ``octile``: the heuristic of a grid graph
+      (:func:`_to_goal`);
+    * a uniform grid (``free`` (ny, nx) with a border of blocked cells all round, the other graph
+      arrays empty): the graph :func:`grid_graph` makes of it, without building it: node i * nx + k
+      is cell (i, k), its neighbours the free cells around it in the order GRID_DI/GRID_DK
+      (``connectivity`` of them), at ``res`` or its diagonal; the heuristic is the octile distance.
+
+    The state lives in the arrays the caller made (:func:`cmdragons.planning.graphsearch.search`):
+    ``g`` the cost from the source along ``prev``, ``closed`` the expanded nodes, the frontier
+    ``fkey``/``fnode`` (a heap for the ordered modes, a queue or a stack for breadth- and
+    depth-first) and ``counters`` (FRONTIER_HEAD, FRONTIER_SIZE, EXPANDED), so that a search resumes
+    where it stopped. ``mode`` is one of the SEARCH_* constants. Returns 1 when ``dst`` was reached,
+    0 when the frontier ran empty, -1 when the expansion budget stopped it."""
+    grid = free.shape[0] > 0
+    ny, nx = free.shape
+    cells = free.ravel()
+    step = GRID_DI * nx + GRID_DK  # a neighbour's offset in the flat grid
+    if grid:
+        gx, gy = (dst % nx) * res, (dst // nx) * res
+    else:
+        gx, gy = pts[dst, 0], pts[dst, 1]
+    head, size = counters[FRONTIER_HEAD], counters[FRONTIER_SIZE]
+    diag = math.sqrt(2.0) * res
+    expanded = 0
+    outcome = 0
+    while head < size:
+        if expanded >= max_expand:
+            outcome = -1
+            break
+        u, head, size = _pop(mode, fkey, fnode, head, size)
+        if closed[u]:
+            continue
+        closed[u] = True
+        expanded += 1
+        if u == dst:
+            outcome = 1
+            break
+        gu = g[u]
+        if grid:
+            ui, uk = u // nx, u % nx
+            for d in range(connectivity):
+                v = u + step[d]  # the blocked border keeps every neighbour of a free cell inside the grid
+                if not cells[v] or closed[v]:
+                    continue
+                size = _reach(mode, v, u, gu + (res if d < 4 else diag), (uk + GRID_DK[d]) * res - gx,
+                              (ui + GRID_DI[d]) * res - gy, True, g, prev, fkey, fnode, size)  # fmt: skip
+        else:
+            for e in range(indptr[u], indptr[u + 1]):
+                v = adj[e]
+                if closed[v]:
+                    continue
+                size = _reach(mode, v, u, gu + w[e], pts[v, 0] - gx, pts[v, 1] - gy, octile, g, prev, fkey, fnode, size)
+    counters[FRONTIER_HEAD], counters[FRONTIER_SIZE] = head, size
+    counters[EXPANDED] += expanded
+    return outcome
+
+
+@njit(cache=True)
+def grid_graph(free: np.ndarray, x0: float, y0: float, res: float, connectivity: int) -> tuple[
+        np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    """The connectivity graph of a uniform grid's free cells (``free`` (ny, nx), cell (i, k) centred at
+    x0 + (k + 1/2) res, y0 + (i + 1/2) res): 4 or 8 neighbours, edges weighted by the centres'
+    distance. Returns (node of each cell or -1 (ny, nx), centres (n, 2), CSR indptr, adj, lengths)."""
+    ny, nx = free.shape
+    node = -np.ones((ny, nx), dtype=np.int64)
+    n = 0
+    for i in range(ny):
+        for k in range(nx):
+            if free[i, k]:
+                node[i, k] = n
+                n += 1
+    pts = np.empty((n, 2))
+    di, dk = GRID_DI, GRID_DK
+    indptr = np.zeros(n + 1, dtype=np.int64)
+    adj = np.empty(n * connectivity, dtype=np.int64)
+    w = np.empty(n * connectivity)
+    diag = math.sqrt(2.0) * res
+    m = 0
+    for i in range(ny):
+        for k in range(nx):
+            u = node[i, k]
+            if u < 0:
+                continue
+            pts[u, 0], pts[u, 1] = x0 + (k + 0.5) * res, y0 + (i + 0.5) * res
+            for d in range(connectivity):
+                ii, kk = i + di[d], k + dk[d]
+                if 0 <= ii < ny and 0 <= kk < nx and node[ii, kk] >= 0:
+                    adj[m] = node[ii, kk]
+                    w[m] = res if d < 4 else diag
+                    m += 1
+            indptr[u + 1] = m
+    return node, pts, indptr, adj[:m], w[:m]

@@ -11,12 +11,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from cmdragons.config import Validated, setting
+from cmdragons.planning.cells import QuadtreeParams, QuadtreePlanner, UniformCellsParams, UniformCellsPlanner
 from cmdragons.planning.errt import ERRTParams, ERRTPlanner
 from cmdragons.planning.gridplan import EStarParams, EStarPlanner, GridParams, NF1Params, NF1Planner
 from cmdragons.planning.prm import DynamicPRMParams, DynamicPRMPlanner
 from cmdragons.planning.problem import Planner
 from cmdragons.planning.termination import Termination, budget, deadline
+from cmdragons.planning.trapezoidal import TrapezoidalParams, TrapezoidalPlanner
 from cmdragons.planning.visgraph import VisGraphParams, VisibilityGraphPlanner
+from cmdragons.planning.voronoi import VoronoiParams, VoronoiPlanner
 from cmdragons.planning.world import CollisionParams
 
 __all__ = ["PLANNERS", "PlannerParams", "make_planner", "make_termination"]
@@ -28,6 +31,10 @@ PLANNERS: dict[str, Callable[[PlannerParams, np.random.Generator], Planner]] = {
     "visgraph": lambda p, rng: VisibilityGraphPlanner(p.visgraph, rng),
     "estar": lambda p, rng: EStarPlanner(p.estar, p.grid, rng),
     "nf1": lambda p, rng: NF1Planner(p.nf1, p.grid, rng),
+    "voronoi": lambda p, rng: VoronoiPlanner(p.voronoi, rng),
+    "trapezoidal": lambda p, rng: TrapezoidalPlanner(p.trapezoidal, rng),
+    "uniform_cells": lambda p, rng: UniformCellsPlanner(p.uniform_cells, rng),
+    "quadtree": lambda p, rng: QuadtreePlanner(p.quadtree, rng),
 }
 
 
@@ -48,6 +55,10 @@ class PlannerParams(Validated):
     grid: GridParams = GridParams()  # the cost grid of estar and nf1
     estar: EStarParams = EStarParams()
     nf1: NF1Params = NF1Params()
+    voronoi: VoronoiParams = VoronoiParams()
+    trapezoidal: TrapezoidalParams = TrapezoidalParams()
+    uniform_cells: UniformCellsParams = UniformCellsParams()
+    quadtree: QuadtreeParams = QuadtreeParams()
 
 
 def make_planner(params: PlannerParams, robot_id: int = 0, name: str | None = None) -> Planner:

@@ -30,7 +30,8 @@ from cmdragons.planning.scenes import random_scene
 from tests.planning.conftest import RADIUS_M, problem, ring, wall_with_gap
 
 NAMES = sorted(PLANNERS)
-FINITE = ("visgraph", "estar", "nf1")  # their work is finite: a hard scene ends before any deadline
+# their work is finite: a hard scene ends before any deadline
+FINITE = ("visgraph", "estar", "nf1", "voronoi", "trapezoidal", "uniform_cells", "quadtree")
 GENEROUS_S = 5.0  # deadline for scenes that must be solved: far beyond any planner's need
 
 

@@ -235,7 +235,8 @@ def _toolbox_plan_ms(planner: str, free: NDArray[np.bool_], goal_xy: tuple[int, 
         import roboticstoolbox
     except ImportError:
         return None
-    p = getattr(roboticstoolbox, planner)((~free).astype(int), **kwargs)
+    # by keyword: D*'s first argument is a cost map (free cells would cost nothing), not the occupancy grid
+    p = getattr(roboticstoolbox, planner)(occgrid=(~free).astype(int), **kwargs)
     t0 = time.perf_counter()
     p.plan(goal=goal_xy)
     return (time.perf_counter() - t0) * 1e3

@@ -1215,40 +1215,41 @@ HEAP_ARITY = 4  # children per heap node: a shallower heap than a binary one, an
 
 
 @njit(cache=True, inline="always")
-def _heap_push(key: np.ndarray, node: np.ndarray, size: int, k: float, v: int) -> int:
-    """Push node v with key k on the 4-ary min-heap key/node[:size]; returns the new size (a node
-    may be in it more than once: a search skips the stale entries of expanded nodes)."""
+def _heap_push(heap: np.ndarray, size: int, k: float, v: int) -> int:
+    """Push node v with key k on the 4-ary min-heap ``heap[:size]`` of (key, node) rows (the node a
+    float, exact below 2**53: key and node in one cache line); returns the new size (a node may be
+    in it more than once: a search skips the stale entries of expanded nodes)."""
     j = size
     while j > 0:
         parent = (j - 1) // HEAP_ARITY
-        if key[parent] <= k:
+        if heap[parent, 0] <= k:
             break
-        key[j], node[j] = key[parent], node[parent]  # the hole moves up, the parent down
+        heap[j, 0], heap[j, 1] = heap[parent, 0], heap[parent, 1]  # the hole moves up, the parent down
         j = parent
-    key[j], node[j] = k, v
+    heap[j, 0], heap[j, 1] = k, v
     return size + 1
 
 
 @njit(cache=True, inline="always")
-def _heap_pop(key: np.ndarray, node: np.ndarray, size: int) -> tuple[int, int]:
+def _heap_pop(heap: np.ndarray, size: int) -> tuple[int, int]:
     """Remove the least key's node; returns (node, new size)."""
-    top = node[0]
+    top = int(heap[0, 1])
     size -= 1
-    k, v = key[size], node[size]  # the last entry fills the hole that sinks from the root
+    k, v = heap[size, 0], heap[size, 1]  # the last entry fills the hole that sinks from the root
     i = 0
     while True:
         first = HEAP_ARITY * i + 1
         if first >= size:
             break
-        m, km = first, key[first]
+        m, km = first, heap[first, 0]
         for c in range(first + 1, min(first + HEAP_ARITY, size)):
-            if key[c] < km:
-                m, km = c, key[c]
+            if heap[c, 0] < km:
+                m, km = c, heap[c, 0]
         if km >= k:
             break
-        key[i], node[i] = km, node[m]
+        heap[i, 0], heap[i, 1] = km, heap[m, 1]
         i = m
-    key[i], node[i] = k, v
+    heap[i, 0], heap[i, 1] = k, v
     return top, size
 
 
@@ -1263,44 +1264,44 @@ def _to_goal(dx: float, dy: float, octile: bool) -> float:
 
 
 @njit(cache=True, inline="always")
-def _pop(mode: int, fkey: np.ndarray, fnode: np.ndarray, head: int, size: int) -> tuple[int, int, int]:
+def _pop(mode: int, frontier: np.ndarray, head: int, size: int) -> tuple[int, int, int]:
     """The frontier's next node by ``mode``: (node, head, size)."""
     if mode == SEARCH_BFS:
-        return fnode[head], head + 1, size
+        return int(frontier[head, 1]), head + 1, size
     if mode == SEARCH_DFS:
-        return fnode[size - 1], head, size - 1
-    u, size = _heap_pop(fkey, fnode, size)
+        return int(frontier[size - 1, 1]), head, size - 1
+    u, size = _heap_pop(frontier, size)
     return u, head, size
 
 
 @njit(cache=True, inline="always")
 def _reach(mode: int, v: int, u: int, nd: float, dx: float, dy: float, octile: bool, g: np.ndarray,
-           prev: np.ndarray, fkey: np.ndarray, fnode: np.ndarray, size: int) -> int:  # fmt: skip
+           prev: np.ndarray, frontier: np.ndarray, size: int) -> int:  # fmt: skip
     """Node u reaches its neighbour v at cost ``nd``: record it and put v on the frontier as ``mode``
     does ((dx, dy): v's offset from the goal, for the heuristic). Returns the frontier's new size."""
     if mode == SEARCH_DIJKSTRA or mode == SEARCH_ASTAR:
         if nd >= g[v]:
             return size
         g[v], prev[v] = nd, u
-        return _heap_push(fkey, fnode, size, nd + (_to_goal(dx, dy, octile) if mode == SEARCH_ASTAR else 0.0), v)
+        return _heap_push(frontier, size, nd + (_to_goal(dx, dy, octile) if mode == SEARCH_ASTAR else 0.0), v)
     if mode == SEARCH_DFS:
         g[v], prev[v] = nd, u  # the latest push is popped first: its parent is the tree's
-        fnode[size] = v
+        frontier[size, 1] = v
         return size + 1
     if g[v] != np.inf:  # breadth- and best-first: a node's parent is the one that found it
         return size
     g[v], prev[v] = nd, u
     if mode == SEARCH_BFS:
-        fnode[size] = v
+        frontier[size, 1] = v
         return size + 1
-    return _heap_push(fkey, fnode, size, _to_goal(dx, dy, octile), v)
+    return _heap_push(frontier, size, _to_goal(dx, dy, octile), v)
 
 
 @njit(cache=True)
 def graph_search(
     pts: np.ndarray, indptr: np.ndarray, adj: np.ndarray, w: np.ndarray, free: np.ndarray, res: float,
     connectivity: int, dst: int, mode: int, octile: bool, g: np.ndarray, prev: np.ndarray, closed: np.ndarray,
-    fkey: np.ndarray, fnode: np.ndarray, counters: np.ndarray, max_expand: int,
+    frontier: np.ndarray, counters: np.ndarray, max_expand: int,
 ) -> int:  # fmt: skip
     """Run a graph search until ``dst`` is expanded, the frontier is empty or ``max_expand`` more
     nodes have been expanded, over either graph:
@@ -1315,8 +1316,8 @@ def graph_search(
 
     The state lives in the arrays the caller made (:func:`cmdragons.planning.graphsearch.search`):
     ``g`` the cost from the source along ``prev``, ``closed`` the expanded nodes, the frontier
-    ``fkey``/``fnode`` (a heap for the ordered modes, a queue or a stack for breadth- and
-    depth-first) and ``counters`` (FRONTIER_HEAD, FRONTIER_SIZE, EXPANDED), so that a search resumes
+    ``frontier`` of (key, node) rows (a heap for the ordered modes, a queue or a stack of its nodes
+    for breadth- and depth-first) and ``counters`` (FRONTIER_HEAD, FRONTIER_SIZE, EXPANDED), so that a search resumes
     where it stopped. ``mode`` is one of the SEARCH_* constants. Returns 1 when ``dst`` was reached,
     0 when the frontier ran empty, -1 when the expansion budget stopped it."""
     grid = free.shape[0] > 0
@@ -1335,7 +1336,7 @@ def graph_search(
         if expanded >= max_expand:
             outcome = -1
             break
-        u, head, size = _pop(mode, fkey, fnode, head, size)
+        u, head, size = _pop(mode, frontier, head, size)
         if closed[u]:
             continue
         closed[u] = True
@@ -1351,13 +1352,13 @@ def graph_search(
                 if not cells[v] or closed[v]:
                     continue
                 size = _reach(mode, v, u, gu + (res if d < 4 else diag), (uk + GRID_DK[d]) * res - gx,
-                              (ui + GRID_DI[d]) * res - gy, True, g, prev, fkey, fnode, size)  # fmt: skip
+                              (ui + GRID_DI[d]) * res - gy, True, g, prev, frontier, size)  # fmt: skip
         else:
             for e in range(indptr[u], indptr[u + 1]):
                 v = adj[e]
                 if closed[v]:
                     continue
-                size = _reach(mode, v, u, gu + w[e], pts[v, 0] - gx, pts[v, 1] - gy, octile, g, prev, fkey, fnode, size)
+                size = _reach(mode, v, u, gu + w[e], pts[v, 0] - gx, pts[v, 1] - gy, octile, g, prev, frontier, size)
     counters[FRONTIER_HEAD], counters[FRONTIER_SIZE] = head, size
     counters[EXPANDED] += expanded
     return outcome

@@ -127,12 +127,12 @@ class _Frontier:
 
     def __init__(self, n: int, m: int, src: int, mode: int) -> None:
         self.g = np.full(n, np.inf)
-        self.prev = -np.ones(n, dtype=np.int32)
+        self.prev = np.full(n, -1, dtype=np.int32)
         self.closed = np.zeros(n, dtype=np.bool_)
         size = m + 1  # lazy deletion: every edge pushes at most once, the source once (int32 nodes: < 2**31)
-        self.key, self.node = np.empty(size), np.empty(size, dtype=np.int32)
+        self.frontier = np.empty((size, 2))  # (key, node) rows
         self.counters = np.zeros(3, dtype=np.int64)
-        self.g[src], self.key[0], self.node[0], self.counters[K.FRONTIER_SIZE] = 0.0, 0.0, src, 1
+        self.g[src], self.frontier[0], self.counters[K.FRONTIER_SIZE] = 0.0, (0.0, src), 1
         self.mode = mode
 
     @property
@@ -168,7 +168,7 @@ def search(graph: Graph, src: int, dst: int, method: str, termination: Terminati
 
     def step(left: int) -> int:
         return int(K.graph_search(graph.pts, graph.indptr, graph.adj, graph.w, _NO_GRID, 1.0, 0, dst, f.mode,
-                                  graph.octile, f.g, f.prev, f.closed, f.key, f.node, f.counters, left))  # fmt: skip
+                                  graph.octile, f.g, f.prev, f.closed, f.frontier, f.counters, left))  # fmt: skip
 
     return f.run(step, dst, termination, work_done, chunk)
 
@@ -189,7 +189,7 @@ def grid_search(free: NDArray[np.bool_], start: tuple[int, int], goal: tuple[int
 
     def step(left: int) -> int:
         return int(K.graph_search(_NO_POINTS, _NO_INDEX, _NO_INDEX, _NO_WEIGHTS, grid, resolution_m, connectivity, dst,
-                                  f.mode, True, f.g, f.prev, f.closed, f.key, f.node, f.counters, left))  # fmt: skip
+                                  f.mode, True, f.g, f.prev, f.closed, f.frontier, f.counters, left))  # fmt: skip
 
     found = f.run(step, dst, termination, work_done=0.0, chunk=chunk)
     route = (found.route // width - 1) * nx + found.route % width - 1  # back to the unbordered grid's cells

@@ -84,7 +84,7 @@ def test_a_speed_cap_is_kept(name: str) -> None:
     nav.set_plan(np.array([(0.0, 0.0), (3.0, 0.0)]), Arrival(0.0, max_speed_m_s=1.0))
     robot = RobotState("blue", 0, 0.0, 0.0, 0.0, 1.0, 0.0)
     for _ in range(30):
-        vx, vy, _ = nav.command(robot, field_world(FIELD), deadline(1.0))
+        vx, vy, _ = nav.command(robot, field_world(FIELD), deadline(60.0))
         assert math.hypot(vx, vy) <= 1.0 + 1e-9
 
 
@@ -96,6 +96,6 @@ def test_no_work_allowed_is_the_stop(name: str) -> None:
     world = field_world(FIELD)
     assert nav.command(robot, world, budget(0)) == STOP
     assert nav.command(robot, world, deadline(-1.0)) == STOP
-    assert nav.command(robot, world, deadline(1.0)) != STOP
+    assert nav.command(robot, world, deadline(60.0)) != STOP
     with pytest.raises(KeyError, match="unknown navigator"):
         make_navigator("magic", TeamParams(), CONTROL, RADIUS)

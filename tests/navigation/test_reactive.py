@@ -44,7 +44,7 @@ def run(nav_name: str, world_at: Callable[[int], CollisionWorld], start: tuple[f
     xs, statuses = [], []
     for k in range(round(seconds / DT)):
         robot = RobotState("blue", 0, x, y, th, vx, vy, 0.0)
-        vx, vy, om = nav.command(robot, world_at(k), deadline(1.0))
+        vx, vy, om = nav.command(robot, world_at(k), deadline(60.0))
         nav.sent(vx, vy)
         x, y, th = x + vx * DT, y + vy * DT, th + om * DT
         xs.append((x, y))

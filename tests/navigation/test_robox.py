@@ -47,7 +47,7 @@ def run(obstacle_path: list[tuple[float, float]], plan: list[tuple[float, float]
         row = w.snapshot().robots[0]
         robot = RobotState("blue", 0, *(float(v) for v in row[2:8]))
         nav.set_plan(np.array(plan), Arrival(0.0))  # the same plan every frame, as a planner that keeps it
-        vx, vy, omega = nav.command(robot, field_world(FIELD, [(ox, oy)]), deadline(1.0))
+        vx, vy, omega = nav.command(robot, field_world(FIELD, [(ox, oy)]), deadline(60.0))
         nav.sent(vx, vy)
         w.step_frame([RobotCommand("blue", 0, vx, vy, omega)])
         ours.append(w.snapshot().robots[0][2:4].copy())

@@ -22,8 +22,8 @@ def test_a_repaired_plan_is_the_plan_of_a_fresh_field(field: Field) -> None:
         circles = base.circles.copy()
         circles[3, 0] += dx
         prob = problem(base.with_circles(circles, base.velocities), (-3.0, -1.0), (3.0, -1.0))
-        repaired = kept.solve(prob, deadline(5.0) | budget(10**7))
-        fresh = make_planner(params, name="estar").solve(prob, deadline(5.0) | budget(10**7))
+        repaired = kept.solve(prob, deadline(60.0) | budget(10**7))
+        fresh = make_planner(params, name="estar").solve(prob, deadline(60.0) | budget(10**7))
         assert repaired.status is PlanStatus.SOLVED and fresh.status is PlanStatus.SOLVED
         assert repaired.stats["repaired"] is (i > 0) and fresh.stats["repaired"] is False
         np.testing.assert_allclose(repaired.path, fresh.path, atol=1e-9)

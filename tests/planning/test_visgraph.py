@@ -23,7 +23,7 @@ BOUNDS = (-5.0, -5.0, 5.0, 5.0)
 
 def solve(world: CollisionWorld, start: tuple[float, float], goal: tuple[float, float], radius: float):  # type: ignore[no-untyped-def]
     prob = PlanProblem(start, goal, radius, world)
-    return prob, VisibilityGraphPlanner(VisGraphParams()).solve(prob, deadline(1.0))
+    return prob, VisibilityGraphPlanner(VisGraphParams()).solve(prob, deadline(60.0))
 
 
 @pytest.mark.parametrize(("r_obstacle", "radius", "d"), [(0.09, 0.09, 2.0), (0.5, 0.09, 1.0), (0.3, 0.0, 3.0)])

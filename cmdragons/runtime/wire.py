@@ -461,6 +461,8 @@ TOPICS: tuple[tuple[str, type[Any]], ...] = (
     ("referee/events", GameEvents),
     ("detections/*", DetectionFrame),
     ("perception/*", DetectionFrame),
+    ("ssl/vision/sent", Tick),  # our SSL-Vision packets of a frame are out
+    ("ssl/vision/*", DetectionFrame),  # detections that came as SSL-Vision packets
     ("world/*", WorldState),
     ("commands/*", TeamCommands),
     ("report/*", TeamReport),

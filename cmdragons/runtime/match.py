@@ -78,9 +78,14 @@ def wiring(settings: Settings, sim: Simulator, opponent: Opponent, perception: P
         sigmas = (t.ball.measurement_sigma_m, t.robot.measurement_sigma_m, t.robot.measurement_sigma_rad)
         stages += [TruthPerceptionStage(team, sigmas, seed + k) for k, team in enumerate(brains)]
         topics = {team: [f"perception/{team}"] for team in brains}
+    referee_topic = "referee"
+    if settings.protocols.referee.send or settings.protocols.referee.source == "game_controller":
+        referee_stages, referee_topic = _ssl_referee_stages(settings, brains)
+        stages += referee_stages
     for team in brains:
         own = opponent_settings if team == THEIRS and opponent_settings is not None else settings
-        stages += [TrackerStage(team, Tracker(own.tracker), topics[team]), TeamStage(team, Brain(team, own))]
+        stages += [TrackerStage(team, Tracker(own.tracker), topics[team]),
+                   TeamStage(team, Brain(team, own), referee_topic)]  # fmt: skip
     if opponent == "simple":
         simple = SimpleTeam(THEIRS, settings.field_geometry(), settings.team.simple_opponent, settings.strategy)
         stages.append(SimpleOpponentStage(THEIRS, simple))
@@ -107,6 +112,21 @@ def _ssl_vision_stages(settings: Settings, sim: Simulator, topics: dict[Team, li
         for team in topics:
             topics[team] = [f"ssl/vision/{i}" for i in ids]
     return stages
+
+
+def _ssl_referee_stages(settings: Settings, brains: list[Team]) -> tuple[list[Stage], str]:
+    """Our referee's word as the league's Referee packets (``protocols.referee.send``) and our
+    brains on a game controller's packets (``protocols.referee.source: game_controller``); the
+    referee topic the brains read."""
+    from cmdragons.runtime.ssl.stages import RefereeInStage, RefereeOutStage
+
+    p = settings.protocols
+    stages: list[Stage] = [RefereeOutStage(p)] if p.referee.send else []
+    if p.referee.source == "simulator":
+        return stages, "referee"
+    moved_m = settings.sim.referee.figures.ball_in_play_m
+    stages.append(RefereeInStage(p, f"world/{brains[0]}", moved_m))
+    return stages, "referee/gc"
 
 
 # per-frame timings of the summary: name -> the bus timing keys summed into it

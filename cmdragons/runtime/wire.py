@@ -458,6 +458,7 @@ TOPICS: tuple[tuple[str, type[Any]], ...] = (
     ("events", SimEvents),
     ("teleport", Teleport),
     ("referee", GameState),
+    ("referee/gc", GameState),  # the game controller's word, from its Referee packets
     ("referee/events", GameEvents),
     ("detections/*", DetectionFrame),
     ("perception/*", DetectionFrame),

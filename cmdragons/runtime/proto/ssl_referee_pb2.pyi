@@ -1,4 +1,3 @@
-from cmdragons.runtime.proto import ssl_tracked_pb2 as _ssl_tracked_pb2
 from google.protobuf.internal import containers as _containers
 from google.protobuf.internal import enum_type_wrapper as _enum_type_wrapper
 from google.protobuf import descriptor as _descriptor
@@ -9,7 +8,7 @@ from typing import ClassVar as _ClassVar, Optional as _Optional, Union as _Union
 DESCRIPTOR: _descriptor.FileDescriptor
 
 class Referee(_message.Message):
-    __slots__ = ("packet_timestamp", "stage", "stage_time_left", "command", "command_counter", "command_timestamp", "yellow", "blue", "designated_position", "blue_team_on_positive_half", "next_command", "current_action_time_remaining", "source_identifier", "status_message", "ball_in_play", "command_for_team")
+    __slots__ = ("packet_timestamp", "stage", "stage_time_left", "command", "command_counter", "command_timestamp", "yellow", "blue", "designated_position", "blue_team_on_positive_half", "next_command", "current_action_time_remaining", "source_identifier", "status_message", "ball_in_play", "started")
     class Stage(int, metaclass=_enum_type_wrapper.EnumTypeWrapper):
         __slots__ = ()
         NORMAL_FIRST_HALF_PRE: _ClassVar[Referee.Stage]
@@ -137,7 +136,7 @@ class Referee(_message.Message):
     SOURCE_IDENTIFIER_FIELD_NUMBER: _ClassVar[int]
     STATUS_MESSAGE_FIELD_NUMBER: _ClassVar[int]
     BALL_IN_PLAY_FIELD_NUMBER: _ClassVar[int]
-    COMMAND_FOR_TEAM_FIELD_NUMBER: _ClassVar[int]
+    STARTED_FIELD_NUMBER: _ClassVar[int]
     packet_timestamp: int
     stage: Referee.Stage
     stage_time_left: int
@@ -153,5 +152,5 @@ class Referee(_message.Message):
     source_identifier: str
     status_message: str
     ball_in_play: bool
-    command_for_team: _ssl_tracked_pb2.Team
-    def __init__(self, packet_timestamp: _Optional[int] = ..., stage: _Optional[_Union[Referee.Stage, str]] = ..., stage_time_left: _Optional[int] = ..., command: _Optional[_Union[Referee.Command, str]] = ..., command_counter: _Optional[int] = ..., command_timestamp: _Optional[int] = ..., yellow: _Optional[_Union[Referee.TeamInfo, _Mapping]] = ..., blue: _Optional[_Union[Referee.TeamInfo, _Mapping]] = ..., designated_position: _Optional[_Union[Referee.Point, _Mapping]] = ..., blue_team_on_positive_half: _Optional[bool] = ..., next_command: _Optional[_Union[Referee.Command, str]] = ..., current_action_time_remaining: _Optional[int] = ..., source_identifier: _Optional[str] = ..., status_message: _Optional[str] = ..., ball_in_play: _Optional[bool] = ..., command_for_team: _Optional[_Union[_ssl_tracked_pb2.Team, str]] = ...) -> None: ...
+    started: Referee.Command
+    def __init__(self, packet_timestamp: _Optional[int] = ..., stage: _Optional[_Union[Referee.Stage, str]] = ..., stage_time_left: _Optional[int] = ..., command: _Optional[_Union[Referee.Command, str]] = ..., command_counter: _Optional[int] = ..., command_timestamp: _Optional[int] = ..., yellow: _Optional[_Union[Referee.TeamInfo, _Mapping]] = ..., blue: _Optional[_Union[Referee.TeamInfo, _Mapping]] = ..., designated_position: _Optional[_Union[Referee.Point, _Mapping]] = ..., blue_team_on_positive_half: _Optional[bool] = ..., next_command: _Optional[_Union[Referee.Command, str]] = ..., current_action_time_remaining: _Optional[int] = ..., source_identifier: _Optional[str] = ..., status_message: _Optional[str] = ..., ball_in_play: _Optional[bool] = ..., started: _Optional[_Union[Referee.Command, str]] = ...) -> None: ...

@@ -2,6 +2,8 @@
 
     ssl/vision_out   detections/<id> -> SSL_WrapperPacket multicast; ssl/vision/sent (Tick) per frame
     ssl/vision_in    SSL_WrapperPacket multicast -> ssl/vision/<id> (DetectionFrame)
+    ssl/referee_out  referee (GameState) -> Referee multicast
+    ssl/referee_in   Referee multicast -> referee/gc (GameState); world/<team>: the ball taken into play
 
 ``ssl/vision_in`` runs free (on every ``clock`` tick it publishes what came since) when the packets
 come from outside; fed by our own ``ssl/vision_out`` in the same match it runs in lock-step: on each
@@ -12,6 +14,7 @@ not in the config and a packet already seen are counted and dropped with a line 
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Sequence
 from typing import Any, TextIO
@@ -19,10 +22,11 @@ from typing import Any, TextIO
 from cmdragons.messages import DetectionFrame, MessageError, StageSummary, Tick
 from cmdragons.runtime.bus import BaseStage, Publish
 from cmdragons.runtime.ssl.params import ProtocolParams
+from cmdragons.runtime.ssl.referee import RefereeReader, referee_packet
 from cmdragons.runtime.ssl.udp import DropLog, MulticastReceiver, MulticastSender
 from cmdragons.runtime.ssl.vision import VisionGeometry, decode_wrapper, detection_packet
 
-__all__ = ["SocketStage", "VisionInStage", "VisionOutStage", "close_sockets"]
+__all__ = ["RefereeInStage", "RefereeOutStage", "SocketStage", "VisionInStage", "VisionOutStage", "close_sockets"]
 
 
 class SocketStage(BaseStage):
@@ -150,6 +154,77 @@ class VisionInStage(SocketStage):
             "packets": self.received, "detections": self.detections, "geometry_packets": self.geometry_packets,
             "dropped": dict(sorted(self.drops.counts.items())), "frames_late": self.late,
             "field_m": None if g is None else [g.field_length_m, g.field_width_m]}))  # fmt: skip
+
+    def close(self) -> None:
+        self.receiver.close()
+
+
+class RefereeOutStage(SocketStage):
+    """Our referee's game state as the league's Referee message, multicast."""
+
+    name = "ssl/referee_out"
+    inputs = ("referee",)
+
+    def __init__(self, params: ProtocolParams) -> None:
+        r = params.referee
+        self.sender = MulticastSender(r.group, r.port, params.interface, params.ttl)
+        self.source = r.source_identifier
+
+    def on_message(self, topic: str, message: Any, publish: Publish) -> None:
+        self.sender.send(referee_packet(message, self.source))
+
+    def summarize(self, publish: Publish) -> None:
+        publish(f"summary/{self.name}", StageSummary(self.name, {"packets": self.sender.sent}))
+
+    def close(self) -> None:
+        self.sender.close()
+
+
+class RefereeInStage(SocketStage):
+    """A game controller's Referee packets from multicast -> ``referee/gc`` game states, on every
+    clock tick each packet that came since. On
+    ``world_topic`` it watches the ball: once a kickoff's or penalty's restart is taken (the ball
+    ``moved_m`` from the designated position), play is normal."""
+
+    name = "ssl/referee_in"
+
+    def __init__(self, params: ProtocolParams, world_topic: str, moved_m: float,
+                 err: TextIO | None = None) -> None:  # fmt: skip
+        r = params.referee
+        self.receiver = MulticastReceiver(r.group, r.port, params.interface, params.receive_buffer_bytes,
+                                          params.max_datagram_bytes)  # fmt: skip
+        self.inputs = ("clock", world_topic)
+        self.moved_m = moved_m
+        self.reader = RefereeReader()
+        self.drops = DropLog(f"referee {r.group}:{r.port}", params.drop_report_interval_s, err)
+        self.received = 0
+        self._last: bytes | None = None
+
+    def on_message(self, topic: str, message: Any, publish: Publish) -> None:
+        if topic == "clock":
+            for data in self.receiver.drain():
+                self._take(data, publish)
+            return
+        g, b = self.reader.last, message.ball
+        taking = g is not None and g.command in ("kickoff", "penalty") and g.ready and g.placement is not None
+        if taking and b is not None and self._last is not None and g is not None and g.placement is not None \
+                and math.hypot(b.x - g.placement[0], b.y - g.placement[1]) > self.moved_m:  # fmt: skip
+            self.reader.ball_moved()
+            publish("referee/gc", self.reader.read(self._last))
+
+    def _take(self, data: bytes, publish: Publish) -> None:
+        self.received += 1
+        try:
+            game = self.reader.read(data)
+        except MessageError as exc:
+            self.drops.drop("undecodable", f"{len(data)} bytes, {exc}")
+            return
+        self._last = data
+        publish("referee/gc", game)
+
+    def summarize(self, publish: Publish) -> None:
+        publish(f"summary/{self.name}", StageSummary(self.name, {
+            "packets": self.received, "dropped": dict(sorted(self.drops.counts.items()))}))  # fmt: skip
 
     def close(self) -> None:
         self.receiver.close()

@@ -352,6 +352,7 @@ def _cmd_play(args: argparse.Namespace, stop: Interrupt) -> int:
 
         compile_s = _compile_kernels(args, overrides, images, prepare)
         match = built[0] if built else build()
+        built[:] = [match]
         started = time.time()
         with _progress(not args.no_progress) as progress, stop.soft():
             task = progress.add_task("play", total=n_frames, info="")
@@ -372,6 +373,8 @@ def _cmd_play(args: argparse.Namespace, stop: Interrupt) -> int:
     finally:
         with stop.shield():
             watch.stop()
+            for m in built:
+                m.close()
             log.close()
             if video is not None:
                 video.close()

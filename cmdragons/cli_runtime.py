@@ -40,9 +40,12 @@ def add_parsers(sub: Any, common: Callable[[argparse.ArgumentParser], None]) -> 
     p.add_argument("--out", metavar="DIR", default=None, help="log and sim: the run folder (default logs/<time>-play)")
     p.add_argument("--overwrite", action="store_true", help="let --out replace the run already in that folder")
 
-    p = sub.add_parser("log", help="about a run's MCAP log: cmdragons log info LOG.mcap")
-    p.add_argument("action", choices=("info",))
-    p.add_argument("path", metavar="LOG.mcap")
+    p = sub.add_parser("log", help="about a log: cmdragons log info LOG; cmdragons log convert IN OUT "
+                       "(league log <-> MCAP)")
+    p.add_argument("action", choices=("info", "convert"))
+    p.add_argument("path", metavar="LOG", help="a run's run.mcap or a league log (.log, .log.gz)")
+    p.add_argument("out", metavar="OUT", nargs="?", default=None,
+                   help="convert: the file to write (a league log from an MCAP log, an MCAP log from a league log)")
 
 
 def _spec(args: argparse.Namespace) -> Any:
@@ -155,14 +158,58 @@ def play_distributed(args: argparse.Namespace, stop: Interrupt) -> int:
             router.close()
 
 
+def _league_log(args: argparse.Namespace, path: Path) -> int:
+    """``log info`` of a league log (records per type, time span) and ``log convert`` both ways."""
+    from cmdragons.runtime.log import LogError
+    from cmdragons.runtime.ssl.convert import is_league_log, league_to_mcap, mcap_to_league
+    from cmdragons.runtime.ssl.logfile import LogFileError, LogReader, MessageType
+
+    try:
+        if args.action == "convert":
+            if args.out is None:
+                print("cmdragons log: convert needs the file to write: cmdragons log convert IN OUT", file=sys.stderr)
+                return 2
+            if is_league_log(path):
+                counts, cut = league_to_mcap(path, args.out)
+                print(f"log convert: {path} -> {args.out}: " + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())))
+                if cut is not None:
+                    print(f"cmdragons log: warning: {cut}", file=sys.stderr)
+            else:
+                n = mcap_to_league(path, args.out)
+                print(f"log convert: {path} -> {args.out}: {n} records (SSL-Vision and Referee packets)")
+            return 0
+        reader = LogReader(path)
+        kinds: dict[str, int] = {}
+        first = last = None
+        for r in reader:
+            name = MessageType(r.type).name if r.type in MessageType._value2member_map_ else f"type {r.type}"
+            kinds[name] = kinds.get(name, 0) + 1
+            first = r.receive_time_ns if first is None else first
+            last = r.receive_time_ns
+        span = (last - first) / 1e9 if first is not None and last is not None else 0.0
+        print(f"{path}: {reader.records} records, {span:.2f} s" + (", indexed" if reader.index is not None else ""))
+        for name, n in sorted(kinds.items()):
+            print(f"  {name:28s} {n:7d}")
+        if reader.truncated is not None:
+            print(f"cmdragons log: warning: {reader.truncated}", file=sys.stderr)
+        return 0
+    except (LogFileError, LogError, OSError) as exc:
+        print(f"cmdragons log: {exc}", file=sys.stderr)
+        return 2
+
+
 def cmd_log(args: argparse.Namespace) -> int:
-    """``cmdragons log info LOG.mcap``: topics with their schemas and counts, the duration, the summary."""
+    """``cmdragons log info LOG``: an MCAP log's topics with their schemas and counts, the duration,
+    the summary; a league log's records. ``cmdragons log convert IN OUT``: league <-> MCAP."""
     from cmdragons.runtime.log import LogError, log_info
+    from cmdragons.runtime.ssl.convert import is_league_log
 
     path = Path(args.path)
     if not path.is_file():
-        print(f"cmdragons log: {path}: no such file; give a run's run.mcap", file=sys.stderr)
+        print(f"cmdragons log: {path}: no such file; give a run's run.mcap or a league log", file=sys.stderr)
         return 2
+    if args.action == "convert" or is_league_log(path):
+        return _league_log(args, path)
     try:
         print("\n".join(log_info(path)))
     except LogError as exc:

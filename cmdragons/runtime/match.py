@@ -72,14 +72,20 @@ def wiring(settings: Settings, sim: Simulator, opponent: Opponent, perception: P
 
         stages += [VisionStage(m.id, VisionPipeline(settings.vision, settings.field, m)) for m in sim.cameras]
         topics = {team: [f"detections/{m.id}" for m in sim.cameras] for team in brains}
+        stages += _ssl_vision_stages(settings, sim, topics)
     else:
         t = settings.tracker  # the noise vision measures: the tracker's measurement model
         sigmas = (t.ball.measurement_sigma_m, t.robot.measurement_sigma_m, t.robot.measurement_sigma_rad)
         stages += [TruthPerceptionStage(team, sigmas, seed + k) for k, team in enumerate(brains)]
         topics = {team: [f"perception/{team}"] for team in brains}
+    referee_topic = "referee"
+    if settings.protocols.referee.send or settings.protocols.referee.source == "game_controller":
+        referee_stages, referee_topic = _ssl_referee_stages(settings, brains)
+        stages += referee_stages
     for team in brains:
         own = opponent_settings if team == THEIRS and opponent_settings is not None else settings
-        stages += [TrackerStage(team, Tracker(own.tracker), topics[team]), TeamStage(team, Brain(team, own))]
+        stages += [TrackerStage(team, Tracker(own.tracker), topics[team]),
+                   TeamStage(team, Brain(team, own), referee_topic)]  # fmt: skip
     if opponent == "simple":
         simple = SimpleTeam(THEIRS, settings.field_geometry(), settings.team.simple_opponent, settings.strategy)
         stages.append(SimpleOpponentStage(THEIRS, simple))
@@ -89,10 +95,44 @@ def wiring(settings: Settings, sim: Simulator, opponent: Opponent, perception: P
     return stages
 
 
+def _ssl_vision_stages(settings: Settings, sim: Simulator, topics: dict[Team, list[str]]) -> list[Stage]:
+    """Our vision as SSL-Vision packets (``protocols.vision.send``) and our trackers on SSL-Vision
+    packets (``protocols.perception: ssl_vision``; in lock-step with our own packets when we send
+    them). ``topics`` (each team's detection topics) is changed to the packets' for the latter."""
+    from cmdragons.runtime.ssl.stages import VisionInStage, VisionOutStage
+    from cmdragons.runtime.ssl.vision import geometry_packet
+
+    p = settings.protocols
+    ids = [m.id for m in sim.cameras]
+    stages: list[Stage] = []
+    if p.vision.send:
+        stages.append(VisionOutStage(p, ids, geometry_packet(settings.field_geometry(), list(sim.cameras))))
+    if p.perception == "ssl_vision":
+        stages.append(VisionInStage(p, ids, lockstep=p.vision.send))
+        for team in topics:
+            topics[team] = [f"ssl/vision/{i}" for i in ids]
+    return stages
+
+
+def _ssl_referee_stages(settings: Settings, brains: list[Team]) -> tuple[list[Stage], str]:
+    """Our referee's word as the league's Referee packets (``protocols.referee.send``) and our
+    brains on a game controller's packets (``protocols.referee.source: game_controller``); the
+    referee topic the brains read."""
+    from cmdragons.runtime.ssl.stages import RefereeInStage, RefereeOutStage
+
+    p = settings.protocols
+    stages: list[Stage] = [RefereeOutStage(p)] if p.referee.send else []
+    if p.referee.source == "simulator":
+        return stages, "referee"
+    moved_m = settings.sim.referee.figures.ball_in_play_m
+    stages.append(RefereeInStage(p, f"world/{brains[0]}", moved_m))
+    return stages, "referee/gc"
+
+
 # per-frame timings of the summary: name -> the bus timing keys summed into it
 _TIMINGS: dict[str, tuple[str, ...]] = {
     "render": ("sim:clock",),
-    "vision": ("vision/*", "perception/blue"),
+    "vision": ("vision/*", "perception/blue", "ssl/*"),
     "tracker": ("tracker/blue",),
     "brain": ("team/blue",),
     "physics_and_opponent": ("sim:commands/*", "sim:teleport", "referee", "opponent/*", "tracker/yellow",
@@ -170,6 +210,12 @@ class Match:
         self.bus.summarize()
         return match_summary(self._summaries.figures, self.stage_ms, self.seed, self.opponent, self.perception)
 
+    def close(self) -> None:
+        """Close what the stages hold open (the league protocols' sockets)."""
+        from cmdragons.runtime.ssl.stages import close_sockets
+
+        close_sockets(self.bus.stages)
+
 
 
 def summary_stages(opponent: Opponent) -> set[str]:
@@ -204,6 +250,7 @@ def match_summary(f: dict[str, Any], stage_ms: dict[str, list[float]], seed: int
         "tracker": f[f"tracker/{OURS}"],
         "rules": {k: referee[k] for k in ("rules", "game_stage", "fouls", "cards", "placements", "penalties")},
         **({"opponent_team": _their_figures(f, open_pairs)} if opponent == "self" else {}),
+        **({"protocols": protocols} if (protocols := {k: v for k, v in f.items() if k.startswith("ssl/")}) else {}),
     }  # fmt: skip
 
 

@@ -19,6 +19,7 @@ from cmdragons.control.motion import ControlParams
 from cmdragons.geometry import Field, LeagueParams
 from cmdragons.planning.registry import PlannerParams
 from cmdragons.runtime.params import RuntimeParams
+from cmdragons.runtime.ssl.params import ProtocolParams
 from cmdragons.safety.registry import SafetyParams
 from cmdragons.team import TeamParams
 from cmdragons.tracking.tracker import TrackerParams
@@ -40,6 +41,7 @@ CONCERNS: dict[str, type] = {
     "team": TeamParams,
     "vision": VisionParams,
     "runtime": RuntimeParams,
+    "protocols": ProtocolParams,
 }
 
 # the concerns a team may have its own of in a match (its brain and its tracker); the field, the
@@ -61,6 +63,7 @@ class Settings:
     team: TeamParams
     vision: VisionParams
     runtime: RuntimeParams
+    protocols: ProtocolParams
 
     def field_geometry(self) -> Field:
         return Field(self.field)

@@ -8,6 +8,7 @@ Topics (what each stage reads -> writes):
     events             SimEvents            sim -> referee, statistics
     teleport           Teleport             referee -> sim
     referee            GameState            referee -> brains, opponent, statistics
+    referee/gc         GameState            a game controller's Referee packets -> brains (referee.source)
     referee/events     GameEvents           referee -> logs (its calls: fouls, cards, placements)
     detections/<id>    DetectionFrame       vision/<id> -> trackers
     perception/<team>  DetectionFrame       truth perception/<team> -> tracker/<team>
@@ -221,14 +222,15 @@ class _PlayingStage(BaseStage, ABC):
     """A team that plays: keeps the referee's latest word and answers each of its world inputs
     with that frame's commands (:meth:`play`)."""
 
-    def __init__(self, name: str, team: Team, world_topic: str) -> None:
+    def __init__(self, name: str, team: Team, world_topic: str, referee_topic: str = "referee") -> None:
         self.name = name
-        self.inputs = (world_topic, "referee")
+        self.inputs = (world_topic, referee_topic)
+        self.referee_topic = referee_topic
         self.team = team
         self.game = GameState(0.0)
 
     def on_message(self, topic: str, message: Any, publish: Publish) -> None:
-        if topic == "referee":
+        if topic == self.referee_topic:
             self.game = message
             return
         world, commands = self.play(message)
@@ -247,8 +249,8 @@ class TeamStage(_PlayingStage):
     """One team's brain: world state and game state -> that frame's commands, its report and its
     parts' times."""
 
-    def __init__(self, team: Team, brain: Brain) -> None:
-        super().__init__(f"team/{team}", team, f"world/{team}")
+    def __init__(self, team: Team, brain: Brain, referee_topic: str = "referee") -> None:
+        super().__init__(f"team/{team}", team, f"world/{team}", referee_topic)
         self.brain = brain
         self._heat: tuple[Any, Any] | None = None  # the pass evaluation last sent
 

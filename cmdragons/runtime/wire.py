@@ -458,9 +458,12 @@ TOPICS: tuple[tuple[str, type[Any]], ...] = (
     ("events", SimEvents),
     ("teleport", Teleport),
     ("referee", GameState),
+    ("referee/gc", GameState),  # the game controller's word, from its Referee packets
     ("referee/events", GameEvents),
     ("detections/*", DetectionFrame),
     ("perception/*", DetectionFrame),
+    ("ssl/vision/sent", Tick),  # our SSL-Vision packets of a frame are out
+    ("ssl/vision/*", DetectionFrame),  # detections that came as SSL-Vision packets
     ("world/*", WorldState),
     ("commands/*", TeamCommands),
     ("report/*", TeamReport),

@@ -188,7 +188,8 @@ class Match:
             "balls_out": referee["balls_out"],
             "command_faults": sim["command_faults"],
             "tracker": f[f"tracker/{OURS}"],
-            "rules": {k: referee[k] for k in ("rules", "game_stage", "fouls", "cards", "placements", "penalties")},
+            "rules": {k: referee[k] for k in ("rules", "game_stage", "fouls", "cards", "placements", "penalties",
+                                                       "shootout")},
             **({"opponent_team": self._their_figures(f, open_pairs)} if self.opponent == "self" else {}),
         }  # fmt: skip
 

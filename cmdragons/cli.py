@@ -58,6 +58,12 @@ def _positive(text: str) -> float:
     return value
 
 
+def _count(text: str) -> int:
+    if not (text.isdigit() and 1 <= int(text) <= 1000):
+        raise argparse.ArgumentTypeError(f"must be a whole number 1 to 1000, got {text!r}")
+    return int(text)
+
+
 def _common(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--config", metavar="DIR", default=None, help="config folder (default: ./configs)")
     parser.add_argument(
@@ -134,6 +140,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--maps", metavar="DIR", default=None,
                    help="grid: a folder of Moving AI .map files with their .map.scen "
                    "(default ../shared/benchdata/moving_ai)")
+    p.add_argument("--opponent", choices=("simple", "self"), default=None,
+                   help="play: the opponent (default simple; self: our team in the other colour, for the foul counts)")
+    p.add_argument("--matches", metavar="N", type=_count, default=None,
+                   help="play: this many seeded matches (default 10, --quick 2)")
+    p.add_argument("--half", metavar="S", type=_positive, default=None,
+                   help="play: halves of S seconds (default the rules' 300, --quick 30)")
     return parser
 
 
@@ -428,9 +440,12 @@ def _rules_line(rules: dict[str, Any]) -> str:
         kinds = ", ".join(f"{k.replace('_', ' ')} {n}" for k, n in fouls.items() if k != "total")
         cards, placed = rules["cards"][team], rules["placements"][team]
         median = f", median {placed['median_s']:.1f} s" if placed["median_s"] is not None else ""
+        cut = f", {placed['cut_short']} cut short" if placed.get("cut_short") else ""
+        shot = rules.get("shootout", {}).get(team, {})
+        shootout = f", shootout {shot['scored']}/{shot['taken']}" if shot.get("taken") else ""
         parts.append(f"{team} ({who}) {_plural(fouls['total'], 'foul')}{f' ({kinds})' if kinds else ''}, "
                      f"cards {cards['yellow']} yellow {cards['red']} red, placements {placed['succeeded']}/"
-                     f"{placed['tried']}{median}")  # fmt: skip
+                     f"{placed['tried']}{median}{cut}{shootout}")  # fmt: skip
     return "rules: " + "; ".join(parts)
 
 
@@ -533,10 +548,11 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     if args.json:
         check_writable_file(args.json, "--json")  # before the bench: its rows are not lost at the end
     options = {k: getattr(args, k) for k in OPTIONS.get(args.suite, ()) if getattr(args, k) is not None}
-    for k in ("maps",):
-        if getattr(args, k) is not None and k not in OPTIONS.get(args.suite, ()):
-            print(f"cmdragons bench: --{k} is for the grid suite, not {args.suite}", file=sys.stderr)
-            return 2
+    for suite, keys in OPTIONS.items():
+        for k in keys:
+            if getattr(args, k) is not None and k not in OPTIONS.get(args.suite, ()):
+                print(f"cmdragons bench: --{k} is for the {suite} suite, not {args.suite}", file=sys.stderr)
+                return 2
     try:
         rows = SUITES[args.suite](settings, args.quick, **options)
     except FileNotFoundError as exc:  # a suite's input data (the grid suite's maps) is not there

@@ -42,7 +42,8 @@ SUITES: dict[str, Suite] = {
     "grid": _lazy("cmdragons.bench.grid"),
     "robox": _lazy("cmdragons.bench.robox"),
 }
-OPTIONS: dict[str, tuple[str, ...]] = {"grid": ("maps",)}  # the options each suite takes
+# the options each suite takes
+OPTIONS: dict[str, tuple[str, ...]] = {"grid": ("maps",), "play": ("opponent", "matches", "half")}
 
 
 TABLE_WIDTH = 100  # columns: a bench table fits a standard terminal

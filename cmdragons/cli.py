@@ -60,6 +60,12 @@ def _positive(text: str) -> float:
     return value
 
 
+def _count(text: str) -> int:
+    if not (text.isdigit() and 1 <= int(text) <= 1000):
+        raise argparse.ArgumentTypeError(f"must be a whole number 1 to 1000, got {text!r}")
+    return int(text)
+
+
 def _common(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--config", metavar="DIR", default=None, help="config folder (default: ./configs)")
     parser.add_argument(
@@ -140,6 +146,12 @@ def build_parser() -> argparse.ArgumentParser:
                    "(default ../shared/benchdata/moving_ai)")
     p.add_argument("--figures", metavar="DIR", default=None,
                    help="navigation: the folder of the PNGs of each method's paths (default logs/bench-navigation)")
+    p.add_argument("--opponent", choices=("simple", "self"), default=None,
+                   help="play: the opponent (default simple; self: our team in the other colour, for the foul counts)")
+    p.add_argument("--matches", metavar="N", type=_count, default=None,
+                   help="play: this many seeded matches (default 10, --quick 2)")
+    p.add_argument("--half", metavar="S", type=_positive, default=None,
+                   help="play: halves of S seconds (default the rules' 300, --quick 30)")
     add_runtime_parsers(sub, _common)
     return parser
 
@@ -448,9 +460,12 @@ def _rules_line(rules: dict[str, Any]) -> str:
         kinds = ", ".join(f"{k.replace('_', ' ')} {n}" for k, n in fouls.items() if k != "total")
         cards, placed = rules["cards"][team], rules["placements"][team]
         median = f", median {placed['median_s']:.1f} s" if placed["median_s"] is not None else ""
+        cut = f", {placed['cut_short']} cut short" if placed.get("cut_short") else ""
+        shot = rules.get("shootout", {}).get(team, {})
+        shootout = f", shootout {shot['scored']}/{shot['taken']}" if shot.get("taken") else ""
         parts.append(f"{team} ({who}) {_plural(fouls['total'], 'foul')}{f' ({kinds})' if kinds else ''}, "
                      f"cards {cards['yellow']} yellow {cards['red']} red, placements {placed['succeeded']}/"
-                     f"{placed['tried']}{median}")  # fmt: skip
+                     f"{placed['tried']}{median}{cut}{shootout}")  # fmt: skip
     return "rules: " + "; ".join(parts)
 
 
@@ -553,11 +568,11 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     if args.json:
         check_writable_file(args.json, "--json")  # before the bench: its rows are not lost at the end
     options = {k: getattr(args, k) for k in OPTIONS.get(args.suite, ()) if getattr(args, k) is not None}
-    for k in ("maps", "figures"):
-        if getattr(args, k) is not None and k not in OPTIONS.get(args.suite, ()):
-            owner = next(suite for suite, keys in OPTIONS.items() if k in keys)
-            print(f"cmdragons bench: --{k} is for the {owner} suite, not {args.suite}", file=sys.stderr)
-            return 2
+    for suite, keys in OPTIONS.items():
+        for k in keys:
+            if getattr(args, k) is not None and k not in OPTIONS.get(args.suite, ()):
+                print(f"cmdragons bench: --{k} is for the {suite} suite, not {args.suite}", file=sys.stderr)
+                return 2
     if args.figures is not None and Path(args.figures).exists() and not Path(args.figures).is_dir():
         print(f"cmdragons bench: --figures {args.figures} is a file, not a folder", file=sys.stderr)
         return 2

@@ -71,7 +71,8 @@ __all__ = ["Brain", "BrainParams", "RobotPlan", "TeamParams"]
 
 
 # which defense areas a robot must keep out of: both, or only the one at x of the sign given
-_DEFENSE_SIDES: tuple[tuple[str, bool | Literal[-1, 1]], ...] = (("both", True), ("+x", 1), ("-x", -1))
+_DEFENSE_SIDES: tuple[tuple[str, bool | Literal[-1, 1]], ...] = (("both", True), ("+x", 1), ("-x", -1),
+                                                                  ("none", False))
 
 
 @dataclass(frozen=True)
@@ -233,14 +234,16 @@ class Brain:
 
     def _robot_world(self, frame: Frame, i: int, it: Intent, game: GameState) -> CollisionWorld:
         """The frame's world as robot ``i`` must avoid it: without itself, without the ball unless its
-        intent avoids it, without our own defense area when it may enter it."""
+        intent avoids it, without our own defense area (or both) when it may enter it."""
         circles = np.ones(len(frame.world.circles), dtype=np.bool_)
         circles[i] = False
         if frame.has_ball and not it.avoid_ball:
             circles[-1] = False
         # the goalie may enter our own area: keep only the opponent's (at x of sign -own_sign)
         key = "both"
-        if it.allow_own_defense:
+        if it.allow_any_defense:
+            key = "none"
+        elif it.allow_own_defense:
             key = "+x" if self.strategy.own_sign(game) < 0 else "-x"
         return frame.world.subset(circles, self._boxes[key])
 

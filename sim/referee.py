@@ -140,11 +140,16 @@ class Referee:
         self.cards: list[_Card] = []  # yellow cards running
         self.off: dict[Key, bool] = {}  # robots off the field: True for a red card (for good)
         self.placement: _Placement | None = None
-        self.placements: dict[Team, dict[str, int]] = {t: {"tried": 0, "succeeded": 0} for t in TEAMS}
+        # tried: placements that ended (succeeded, or failed when the time ran out); cut short: ended by the
+        # end of a half (or of the match) first, neither success nor failure (the game controller counts
+        # a failure only when a placement fails)
+        self.placements: dict[Team, dict[str, int]] = {t: {"tried": 0, "succeeded": 0, "cut_short": 0} for t in TEAMS}
         self.placement_s: dict[Team, list[float]] = {"blue": [], "yellow": []}
         self.placement_failures: dict[Team, int] = {"blue": 0, "yellow": 0}
         self.penalty: _Penalty | None = None
         self.penalties: dict[Team, dict[str, int]] = {t: {"taken": 0, "scored": 0} for t in TEAMS}
+        # the penalty shootout's kicks (they decide a drawn match; the match's score stays as it was)
+        self.shootout: dict[Team, dict[str, int]] = {t: {"taken": 0, "scored": 0} for t in TEAMS}
         self._last_t = 0.0
         self._teleports: list[Teleport] = []
 
@@ -250,6 +255,11 @@ class Referee:
                 self.watch.kicked((e.team, e.id))
             elif isinstance(e, Goal) and self._restart is None and self._live():
                 scorer = self._scorer(e.x)
+                if self.stage == "penalty_shootout":
+                    if self.for_team == scorer:
+                        self.shootout[scorer]["scored"] += 1
+                    self._next_shootout_kick()
+                    continue
                 self.score[scorer] += 1
                 if self.command == "penalty" and self.for_team == scorer:
                     self.penalties[scorer]["scored"] += 1
@@ -258,6 +268,9 @@ class Referee:
                 self._restart = (t + self.params.restart_delay_s, "kickoff", _other(scorer), (0.0, 0.0))
             elif isinstance(e, BallOut) and self._restart is None and self._live():
                 self.balls_out += 1
+                if self.stage == "penalty_shootout":  # the kick missed
+                    self._next_shootout_kick()
+                    continue
                 taker: Team = "yellow" if e.last_touch == "blue" else "blue"
                 if e.last_touch is None:  # nobody touched it: the team defending that half
                     taker = "blue" if (e.x < 0) == (self.blue_sign < 0) else "yellow"
@@ -322,12 +335,11 @@ class Referee:
         elif kind == "free_kick" and self.full and self._can_place(team):
             self._set("ball_placement", team)
             self.placement = _Placement(team, spot, t)
-            self.placements[team]["tried"] += 1
         elif kind == "penalty":
             self._teleport(ball=spot)
             self._set("penalty", team, ready=False)
             self.penalty = _Penalty(team, t, spot)
-            self.penalties[team]["taken"] += 1
+            (self.shootout if self.stage == "penalty_shootout" else self.penalties)[team]["taken"] += 1
         else:
             placed = kind == "placed_free_kick"
             if not placed:
@@ -344,7 +356,11 @@ class Referee:
         self.new_events.append(event)
 
     def _award(self, kind: str, team: Team, spot: tuple[float, float]) -> None:
-        """Stop play; after the restart delay ``kind`` ("free_kick", "penalty") for ``team`` at ``spot``."""
+        """Stop play; after the restart delay ``kind`` ("free_kick", "penalty") for ``team`` at ``spot``
+        (in a penalty shootout: its next kick, this one over)."""
+        if self.stage == "penalty_shootout":
+            self._next_shootout_kick()
+            return
         self._clear_special()
         self._set("stop", None)
         self._restart = (self.t + self.params.restart_delay_s, kind, team, spot)
@@ -471,11 +487,13 @@ class Referee:
         cleared = all(math.hypot(o.x - b.x, o.y - b.y) >= clear for o in truth.robots if o.team == pl.team)
         took = self.t - pl.t_start
         if off <= r.placement_tolerance_m and math.hypot(b.vx, b.vy) <= r.placement_rest_m_s and cleared:
+            self.placements[pl.team]["tried"] += 1
             self.placements[pl.team]["succeeded"] += 1
             self.placement_s[pl.team].append(took)
             self._call(GameEvent(self.t, "placement_succeeded", pl.team, None, took, r.placement_time_s, "s"))
             self._award("placed_free_kick", pl.team, pl.target)
         elif took > r.placement_time_s:
+            self.placements[pl.team]["tried"] += 1
             self.placement_failures[pl.team] += 1
             self._call(GameEvent(self.t, "placement_failed", pl.team, None, off, r.placement_tolerance_m, "m",
                                  "free_kick", _other(pl.team)))  # fmt: skip
@@ -514,9 +532,13 @@ class Referee:
         moved = math.hypot(b.x - pen.mark[0], b.y - pen.mark[1]) > self.rules.ball_in_play_m
         took = self.t - pen.t_run
         if took > self.rules.penalty_time_s or (moved and (math.hypot(b.vx, b.vy) < 0.05 or b.vx * attack < -0.05)):
+            shootout = self.stage == "penalty_shootout"
             self._call(GameEvent(self.t, "penalty_over", pen.team, None, took, self.rules.penalty_time_s, "s",
-                                 "free_kick", _other(pen.team)))  # fmt: skip
-            self._award("free_kick", _other(pen.team), self._spot("free_kick", pen.team, (b.x, b.y)))
+                                 "" if shootout else "free_kick", None if shootout else _other(pen.team)))  # fmt: skip
+            if shootout:
+                self._next_shootout_kick()
+            else:
+                self._award("free_kick", _other(pen.team), self._spot("free_kick", pen.team, (b.x, b.y)))
 
     def _follow_stage(self) -> None:
         """Halves, half time (halted) and the end; the sides change for the second half, where the
@@ -524,6 +546,8 @@ class Referee:
         if self.t < self._stage_end:
             return
         r = self.rules
+        if self.placement is not None and self.command == "ball_placement":
+            self.placements[self.placement.team]["cut_short"] += 1
         if self.stage == "first_half" and r.half_time_s > 0.0:
             self.stage, self._stage_end = "half_time", self.t + r.half_time_s
             self._restart = None
@@ -535,12 +559,38 @@ class Referee:
             self._restart = None
             self._clear_special()
             self._teleports.append(self.kickoff_setup("yellow"))
-        elif self.stage == "second_half":
-            self.stage, self._stage_end = "post_game", math.inf
-            self._restart = None
-            self._clear_special()
-            self._set("halt", None)
+        elif self.stage == "second_half" and r.shootout_kicks > 0 and (
+                r.shootout_always or self.score["blue"] == self.score["yellow"]):
+            self.stage, self._stage_end = "penalty_shootout", math.inf
+            self._call(GameEvent(self.t, f"stage_{self.stage}"))
+            self._next_shootout_kick()
+            return
+        elif self.stage in ("second_half", "penalty_shootout"):
+            self._end_match()
         self._call(GameEvent(self.t, f"stage_{self.stage}"))
+
+    def _end_match(self) -> None:
+        self.stage, self._stage_end = "post_game", math.inf
+        self._restart = None
+        self._clear_special()
+        self._set("halt", None)
+
+    def _next_shootout_kick(self) -> None:
+        """The shootout's next kick after the restart delay: the teams in turn (yellow first: blue kicked
+        off the match), ``shootout_kicks`` each, then (a drawn match's shootout) one each until one
+        team scored more of an equal number; then the game is over."""
+        self._clear_special()
+        self._set("stop", None)
+        r, done = self.rules, self.shootout
+        taken = {t: done[t]["taken"] for t in TEAMS}
+        even = taken["blue"] == taken["yellow"]
+        decided = even and done["blue"]["scored"] != done["yellow"]["scored"]
+        if even and taken["blue"] >= r.shootout_kicks and (r.shootout_always or decided):
+            self._end_match()
+            self._call(GameEvent(self.t, f"stage_{self.stage}"))
+            return
+        team: Team = "yellow" if even else "blue"
+        self._restart = (self.t + self.params.restart_delay_s, "penalty", team, self._spot("penalty", team, (0.0, 0.0)))
 
     def _check_keeper_held_ball(self, t: float, ball_xy: tuple[float, float]) -> None:
         """Rules (keeper held ball): the ball in a defense area for ``keeper_held_ball_s`` of normal
@@ -612,6 +662,11 @@ class Referee:
             next_for_team=nxt_team, blue_team=self.team_info("blue"), yellow_team=self.team_info("yellow"),
         )  # fmt: skip
 
+    def _under_way(self, team: Team) -> int:
+        """1 while ``team``'s placement is under way (a match that ends now cuts it short), else 0."""
+        pl = self.placement
+        return int(pl is not None and pl.team == team and self.command == "ball_placement")
+
     def summary(self) -> dict[str, object]:
         """The rules' figures of the match: fouls per team by kind, cards, placements, penalties."""
         by_kind: dict[str, dict[str, int]] = {t: {} for t in TEAMS}
@@ -623,8 +678,9 @@ class Referee:
             "game_stage": self.stage,
             "fouls": {t: {"total": self.fouls[t], **dict(sorted(by_kind[t].items()))} for t in TEAMS},
             "cards": {t: {"yellow": self.yellow_cards[t], "red": self.red_cards[t]} for t in TEAMS},
-            "placements": {t: {**self.placements[t],
+            "placements": {t: {**self.placements[t], "cut_short": self.placements[t]["cut_short"] + self._under_way(t),
                                "median_s": float(np.median(self.placement_s[t])) if self.placement_s[t] else None}
                            for t in TEAMS},
             "penalties": {t: dict(self.penalties[t]) for t in TEAMS},
+            "shootout": {t: dict(self.shootout[t]) for t in TEAMS},
         }  # fmt: skip

@@ -62,6 +62,8 @@ class RulesParams(Validated):
     penalty_mark_from_goal_m: float = setting(6.0, lo=0.5, hi=20.0)
     penalty_behind_m: float = setting(1.0, lo=0.0, hi=10.0)
     penalty_time_s: float = setting(10.0, lo=0.5, hi=600.0)
+    shootout_kicks: int = setting(0, lo=0, hi=100)  # penalty shootout after a drawn match: kicks per team; 0: none
+    shootout_always: bool = False  # the shootout after any match (a benchmark's), its kicks only
     touch_margin_m: float = setting(0.015, lo=0.0, hi=0.2)
     contact_margin_m: float = setting(0.01, lo=0.0, hi=0.2)
     keepers: Mapping[Team, int] = field(default_factory=lambda: {"blue": 0, "yellow": 0})
@@ -190,10 +192,12 @@ class FoulWatch:
 
     # --- the checks -----------------------------------------------------------------------------
     def _crashes(self, gt: GroundTruth, robots: list[RobotTruth]) -> list[GameEvent]:
-        """Crash: two robots of different teams meet faster than ``crash_speed_m_s`` (their closing
-        speed the frame before contact); the faster along the line is at fault, both when their
-        speeds differ by less than ``crash_drawn_m_s``. Pushing: an opponent shoved more than
-        ``push_distance_m`` while in contact."""
+        """Crash: two robots of different teams meet faster than ``crash_speed_m_s`` (the difference
+        of their velocities the frame before contact, along the line between them); the faster robot
+        (its own speed) is at fault, both when their speeds differ by less than ``crash_drawn_m_s``
+        (the rules: "the faster robot committed a foul; if the absolute robot speed difference is
+        less than 0.3 m/s, both"). Pushing: an opponent shoved more than ``push_distance_m`` while in
+        contact."""
         out = []
         touch = 2.0 * self.robot_r + self.p.contact_margin_m
         blue = [r for r in robots if r.team == "blue"]
@@ -217,11 +221,12 @@ class FoulWatch:
                     self._contacts[pair] = c = _Contact(gt.t, n, (a.x, a.y), (b.x, b.y))
                     closing = sa + sb
                     if closing > self.p.crash_speed_m_s:
-                        if abs(sa - sb) < self.p.crash_drawn_m_s:
+                        va, vb = math.hypot(pa.vx, pa.vy), math.hypot(pb.vx, pb.vy)
+                        if abs(va - vb) < self.p.crash_drawn_m_s:
                             out += [self._event(gt.t, "crash_drawn", k, closing, self.p.crash_speed_m_s, "m/s")
                                     for k in (ka, kb)]  # fmt: skip
                         else:
-                            out.append(self._event(gt.t, "crash", ka if sa > sb else kb, closing,
+                            out.append(self._event(gt.t, "crash", ka if va > vb else kb, closing,
                                                    self.p.crash_speed_m_s, "m/s"))  # fmt: skip
                     continue
                 if c.pushed:

@@ -220,15 +220,16 @@ def place_ball(robot: RobotState, ball: BallState, target: tuple[float, float], 
         away = math.atan2(robot.y - ball.y, robot.x - ball.x)
         reach = contact + p.placement_back_m
         return Intent(ball.x + reach * math.cos(away), ball.y + reach * math.sin(away), robot.theta,
-                      max_speed_m_s=p.placement_back_speed_m_s), False  # fmt: skip
+                      allow_any_defense=True, max_speed_m_s=p.placement_back_speed_m_s), False  # fmt: skip
     if on_face:  # carry: the robot where the ball lies on the target, facing as it does
         return Intent(target[0] - c * contact, target[1] - s * contact, robot.theta, dribbler=skills.hold_dribbler,
-                      avoid_ball=False, max_speed_m_s=p.placement_carry_speed_m_s), True  # fmt: skip
+                      avoid_ball=False, allow_any_defense=True,
+                      max_speed_m_s=p.placement_carry_speed_m_s), True  # fmt: skip
     heading = math.atan2(ball.y - robot.y, ball.x - robot.x)
     near = math.hypot(ball.x - robot.x, ball.y - robot.y) < contact + p.placement_take_m
     reach = contact - p.placement_press_m  # a little into the ball: the face meets it before the robot stops
     return Intent(ball.x - math.cos(heading) * reach, ball.y - math.sin(heading) * reach, heading,
-                  dribbler=skills.hold_dribbler, avoid_ball=False,
+                  dribbler=skills.hold_dribbler, avoid_ball=False, allow_any_defense=True,
                   max_speed_m_s=p.placement_take_speed_m_s if near else None), False  # fmt: skip
 
 

@@ -98,6 +98,7 @@ class Intent:
     dribbler: float = 0.0
     avoid_ball: bool = True  # the ball is an obstacle for planning
     allow_own_defense: bool = False  # the goalie may enter our defense area
+    allow_any_defense: bool = False  # both defense areas open (placing a ball that lies in or by one)
     max_speed_m_s: float | None = None  # None: the robot's limit
     final_speed_m_s: float = 0.0  # arrive moving (driving through the ball)
 

@@ -43,7 +43,9 @@ SUITES: dict[str, Suite] = {
     "robox": _lazy("cmdragons.bench.robox"),
     "navigation": _lazy("cmdragons.bench.navigation"),
 }
-OPTIONS: dict[str, tuple[str, ...]] = {"grid": ("maps",), "navigation": ("figures",)}  # the options each suite takes
+# the options each suite takes
+OPTIONS: dict[str, tuple[str, ...]] = {"grid": ("maps",), "navigation": ("figures",),
+                                       "play": ("opponent", "matches", "half")}
 
 
 TABLE_WIDTH = 100  # columns: a bench table fits a standard terminal

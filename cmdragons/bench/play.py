@@ -6,34 +6,80 @@ moves, is not simulated), the sides changed between them. Rows per match (goals 
 shots, passes, own collisions, fouls and cards per team, our placements tried and succeeded, stage
 times), a totals row (matches won, drawn, lost; pass completion; own collisions; our fouls by kind,
 per match; placements succeeded and their median time), and the brain's cycle time (tracker to
-commands) for 6 and 11 robots. ``--quick`` plays two matches of two 30 s halves.
+commands) for 6 and 11 robots; a penalty shootout of ``SHOOTOUT_KICKS`` kicks each way (ours against their
+keeper, theirs against ours: scored and saved), played as a shootout after two halves of a second.
+``--quick`` plays two matches of two 30 s halves and a shootout of 3 kicks each.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import sys
 import time
 from typing import Any
 
 import numpy as np
 
+from cmdragons.messages import GameState
+from cmdragons.runtime.bus import BaseStage, Publish
 from cmdragons.runtime.match import Match
 from cmdragons.runtime.settings import Settings
 
-__all__ = ["run"]
+__all__ = ["SHOOTOUT_KICKS", "run"]
+
+SHOOTOUT_KICKS = 10  # penalty kicks each way in the bench's shootout (the issue's measure)
+_SHOOTOUT_HALF_S = 1.0  # the halves before the shootout: as short as the rules' figures allow
 
 
-def _halves(settings: Settings, half_s: float) -> Settings:
-    """Full rules, halves of ``half_s`` and no half-time break to wait out."""
+def _halves(settings: Settings, half_s: float, shootout_kicks: int = 0) -> Settings:
+    """Full rules, halves of ``half_s`` and no half-time break to wait out; with ``shootout_kicks`` a
+    shootout of that many kicks each after the match, whatever its score."""
     ref = settings.sim.referee
-    ref = dataclasses.replace(ref, rules="full", figures=dataclasses.replace(ref.figures, half_s=half_s,
-                                                                               half_time_s=0.0))  # fmt: skip
+    figures = dataclasses.replace(ref.figures, half_s=half_s, half_time_s=0.0, shootout_kicks=shootout_kicks,
+                                  shootout_always=shootout_kicks > 0)  # fmt: skip
+    ref = dataclasses.replace(ref, rules="full", figures=figures)
     return dataclasses.replace(settings, sim=dataclasses.replace(settings.sim, referee=ref))
 
 
-def _match_row(settings: Settings, seed: int, seconds: float) -> dict[str, Any]:
+class _StageWatch(BaseStage):
+    """The game's stage as the referee last published it."""
+
+    name = "bench/stage"
+    inputs = ("referee",)
+
+    def __init__(self) -> None:
+        self.stage = ""
+
+    def on_message(self, topic: str, message: GameState, publish: Publish) -> None:
+        self.stage = message.stage
+
+
+def _shootout_row(settings: Settings, kicks: int, seed: int) -> dict[str, Any]:
+    """A penalty shootout of ``kicks`` each way against the simple opponent (cameras): ours scored
+    against their keeper, theirs saved by ours."""
+    watch = _StageWatch()
+    m = Match(_halves(settings, _SHOOTOUT_HALF_S, kicks), "simple", "vision", seed=seed, extra=[watch])
+    r = settings.sim.referee
+    # the longest a kick can take: the restart delay, the preparing and the kicker's time
+    per_kick = r.restart_delay_s + r.figures.prepare_timeout_s + r.figures.penalty_time_s
+    limit = round((2.0 * _SHOOTOUT_HALF_S + 2 * kicks * per_kick + 2.0) * settings.sim.physics.frame_rate_hz)
     wall = time.perf_counter()
-    m = Match(settings, "simple", "vision", seed=seed)
+    for _ in range(limit):
+        m.step()
+        if watch.stage == "post_game":
+            break
+    wall = time.perf_counter() - wall
+    s = m.summary()
+    shot = s["rules"]["shootout"]
+    ours, theirs = shot["blue"], shot["yellow"]
+    return {"name": f"shootout_{kicks}_each_seed_{seed}", "taken_ours": ours["taken"], "scored_ours": ours["scored"],
+            "taken_theirs": theirs["taken"], "saved_ours": theirs["taken"] - theirs["scored"],
+            "finished": watch.stage == "post_game", "seconds": s["seconds"], "realtime_factor": s["seconds"] / wall}
+
+
+def _match_row(settings: Settings, seed: int, seconds: float, opponent: str) -> dict[str, Any]:
+    wall = time.perf_counter()
+    m = Match(settings, opponent, "vision", seed=seed)  # type: ignore[arg-type]
     s = m.run(seconds)
     wall = time.perf_counter() - wall
     c = s["cycle_ms"]
@@ -57,6 +103,7 @@ def _match_row(settings: Settings, seed: int, seconds: float) -> dict[str, Any]:
         "yellow_cards_theirs": rules["cards"]["yellow"]["yellow"],
         "placements_tried": placed["tried"],
         "placements_succeeded": placed["succeeded"],
+        "placements_cut_short": placed["cut_short"],
         "placement_median_s": placed["median_s"],
         "brain_median_ms": c["brain"]["median"],
         "brain_p95_ms": c["brain"]["p95"],
@@ -94,12 +141,20 @@ def _brain_cycle(settings: Settings, division: str, seconds: float) -> dict[str,
             "tracker_median_ms": float(np.median(tracker))}  # fmt: skip
 
 
-def run(settings: Settings, quick: bool) -> list[dict[str, Any]]:
-    seeds = [1, 2] if quick else list(range(1, 11))
-    half = 30.0 if quick else settings.sim.referee.figures.half_s
+def run(settings: Settings, quick: bool, opponent: str | None = None, matches: int | None = None,
+        half: float | None = None) -> list[dict[str, Any]]:
+    """The suite's rows. ``opponent``: "simple" (default) or "self" (our team in the other colour:
+    the matches and their fouls only); ``matches``, ``half``: how many and how long (seconds)."""
+    opponent = opponent or "simple"
+    seeds = list(range(1, (matches or (2 if quick else 10)) + 1))
+    half = half or (30.0 if quick else settings.sim.referee.figures.half_s)
     seconds = 2.0 * half
     rules = _halves(settings, half)
-    rows = [_match_row(rules, seed, seconds) for seed in seeds]
+    rows = []
+    for k, seed in enumerate(seeds):
+        print(f"bench play: match {k + 1} of {len(seeds)} (seed {seed}, 2 x {half:g} s, against {opponent}) ...",
+              file=sys.stderr, flush=True)  # fmt: skip
+        rows.append(_match_row(rules, seed, seconds, opponent))
     won = sum(r["goals_for"] > r["goals_against"] for r in rows)
     tried_placing = sum(r["placements_tried"] for r in rows)
     placed = sum(r["placements_succeeded"] for r in rows)
@@ -116,8 +171,16 @@ def run(settings: Settings, quick: bool) -> list[dict[str, Any]]:
         "fouls_ours_by_kind": _kinds_text(_sum_kinds([r.pop("_kinds") for r in rows])),
         "cards_ours": sum(r["yellow_cards_ours"] + r["red_cards_ours"] for r in rows),
         "placements_succeeded_share": placed / tried_placing if tried_placing else float("nan"),
+        "placements_succeeded": placed, "placements_tried": tried_placing,
+        "placements_cut_short": sum(r["placements_cut_short"] for r in rows),
+        "placement_median_of_matches_s": float(np.median(times)) if (times := [r["placement_median_s"] for r in rows
+                                                                    if r["placement_median_s"] is not None]) else None,
         "realtime_factor": float(np.median([r["realtime_factor"] for r in rows])),
     })  # fmt: skip
+    if opponent == "self":
+        return rows
+    print("bench play: penalty shootout ...", file=sys.stderr, flush=True)
+    rows.append(_shootout_row(settings, 3 if quick else SHOOTOUT_KICKS, seeds[0]))
     rows.append(_brain_cycle(settings, "B", 10.0 if quick else 30.0))
     rows.append(_brain_cycle(settings, "A", 10.0 if quick else 30.0))
     return rows

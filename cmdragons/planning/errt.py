@@ -293,7 +293,9 @@ class ERRTPlanner:
             along = cache_points if cache_points is not None else path
             self.cache.add(K.resample(along, self.params.waypoint_spacing_m)[1:-1])
         self.last_path = path
-        self.last_goal = ends.goal
+        if cache:  # a plan reused keeps the goal it was made for: a goal creeping less than the tolerance
+            # a frame (a robot following a pushed ball) would otherwise drag it along, the path left behind
+            self.last_goal = ends.goal
         now = time.perf_counter()
         stats["search_ms"] = (now - self._t_search) * 1e3
         stats["ms"] = (now - t0) * 1e3

@@ -248,7 +248,8 @@ def match_summary(f: dict[str, Any], stage_ms: dict[str, list[float]], seed: int
         "balls_out": referee["balls_out"],
         "command_faults": sim["command_faults"],
         "tracker": f[f"tracker/{OURS}"],
-        "rules": {k: referee[k] for k in ("rules", "game_stage", "fouls", "cards", "placements", "penalties")},
+        "rules": {k: referee[k] for k in ("rules", "game_stage", "fouls", "cards", "placements", "penalties",
+                                           "shootout")},
         **({"opponent_team": _their_figures(f, open_pairs)} if opponent == "self" else {}),
         **({"protocols": protocols} if (protocols := {k: v for k, v in f.items() if k.startswith("ssl/")}) else {}),
     }  # fmt: skip

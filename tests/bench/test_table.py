@@ -31,3 +31,11 @@ def test_wide_table_fits_and_cuts_nothing(capsys: pytest.CaptureFixture[str]) ->
     for k in range(14):
         assert f"metric {k}" in out and f"{1000 + k}" in out
     assert "pip install 'cmdragons[bench]'" in out
+
+
+def test_play_options_are_refused_for_another_suite(capsys: pytest.CaptureFixture[str]) -> None:
+    from cmdragons.cli import main
+
+    assert main(["bench", "sim", "--matches", "2"]) == 2
+    err = capsys.readouterr().err
+    assert err.strip() == "cmdragons bench: --matches is for the play suite, not sim"

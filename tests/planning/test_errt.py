@@ -76,6 +76,20 @@ def test_a_new_goal_is_planned_afresh(field: Field) -> None:
     np.testing.assert_array_equal(other.path[-1], (3.0, 2.0))
 
 
+def test_a_goal_creeping_below_the_tolerance_each_call_is_not_left_behind(field: Field) -> None:
+    # the goal moves 0.6 of the tolerance a call (a robot following a ball it pushes): each call is
+    # within the tolerance of the last, but the plan must follow the goal, not the goal it was made for
+    world = wall_with_gap(field)
+    errt = planner()
+    step = 0.6 * errt.params.goal_tolerance_m
+    goal = np.array([3.0, -1.0])
+    for _ in range(100):
+        result = errt.solve(problem(world, (-3.0, -1.0), tuple(goal)), within(1.0))  # type: ignore[arg-type]
+        assert result.status is PlanStatus.SOLVED
+        assert np.hypot(*(result.path[-1] - goal)) <= errt.params.goal_tolerance_m
+        goal += (0.0, step)
+
+
 @pytest.mark.parametrize(
     "variant",
     [

@@ -9,10 +9,10 @@ from collections.abc import Callable
 
 import pytest
 
-from cmdragons.geometry import LeagueParams
-from cmdragons.messages import GameEvent, RobotCommand
+from cmdragons.geometry import Field, LeagueParams
+from cmdragons.messages import BallTruth, GameEvent, GroundTruth, RobotCommand, RobotTruth
 from sim.referee import Referee, RefereeParams
-from sim.rules import RulesParams
+from sim.rules import FoulWatch, RulesParams, Situation
 from sim.world import BallParams, DribblerParams, KickerParams, PhysicsParams, RobotParams, World
 
 LEAGUE = LeagueParams()
@@ -67,6 +67,27 @@ def test_crash_faster_than_the_limit_is_the_faster_robots_foul(speed: float, cal
         assert (c.team, c.robot, c.restart, c.for_team) == ("blue", 0, "free_kick", "yellow")
         assert c.value > 1.5 and c.limit == 1.5
         assert ref.command == "stop"  # then the free kick (placed by yellow)
+
+
+@pytest.mark.parametrize(("blue_v", "yellow_v", "called"), [
+    ((0.0, 1.6), (-1.7, 0.0), ["crash_drawn", "crash_drawn"]),  # blue across the line, as fast: both at fault
+    ((0.0, 2.5), (-1.7, 0.0), ["crash:blue"]),  # blue faster on the ground though yellow closes
+    ((0.4, 0.0), (-1.7, 0.0), ["crash:yellow"]),
+    ((0.0, 2.5), (-1.0, 0.0), []),  # closing at 1 m/s along the line: no crash
+])  # fmt: skip
+def test_crash_fault_goes_by_the_robots_own_speeds(blue_v: tuple[float, float], yellow_v: tuple[float, float],
+                                                    called: list[str]) -> None:  # fmt: skip
+    # the rules: the velocity difference along the line decides a crash, the robots' own speeds whose it is
+    watch = FoulWatch(Field(LEAGUE), RulesParams())
+    situation = Situation("normal", None, 0.0, -1, True)
+    ball = BallTruth(2.0, 2.0, 0.0, 0.0, 0.0)
+    calls = []
+    for k, gap in enumerate((0.3, 2 * R)):  # apart, then touching
+        robots = (RobotTruth("blue", 0, 0.0, 0.0, 0.0, *blue_v, 0.0),
+                  RobotTruth("yellow", 0, gap, 0.0, math.pi, *yellow_v, 0.0))
+        calls += watch.judge(GroundTruth(k, k / 60.0, ball, robots), situation)
+    got = [c.kind if c.kind == "crash_drawn" else f"{c.kind}:{c.team}" for c in calls if c.kind.startswith("crash")]
+    assert got == called
 
 
 @pytest.mark.parametrize(("push_s", "called"), [(1.2, True), (0.15, False)])
@@ -285,12 +306,25 @@ def test_ball_placement_succeeds_in_tolerance_and_fails_when_time_is_up(carry: b
     if succeeded:
         done = [c for c in calls if c.kind == "placement_succeeded"]
         assert done and done[0].team == "blue" and done[0].value <= 8.0
-        assert ref.placements["blue"] == {"tried": 1, "succeeded": 1}
+        assert ref.placements["blue"] == {"tried": 1, "succeeded": 1, "cut_short": 0}
     else:
         failed = [c for c in calls if c.kind == "placement_failed"]
         assert failed and failed[0].for_team == "yellow"
         assert tuple(w.ball_body.position) == pytest.approx(target)  # the referee placed it
         assert ref.placement_failures["blue"] == 1
+        assert ref.placements["blue"] == {"tried": 1, "succeeded": 0, "cut_short": 0}
+
+
+def test_a_placement_the_end_of_a_half_cuts_short_is_neither_tried_nor_failed() -> None:
+    w, ref = scene(half_s=3.0, half_time_s=0.0)
+    ref.start_placement("blue", (1.0, 0.0))  # nobody carries the ball: the half ends first
+    calls = play(w, ref, 3.5)
+    assert "stage_second_half" in kinds(calls) and not [k for k in kinds(calls) if k.startswith("placement_")]
+    assert ref.placements["blue"] == {"tried": 0, "succeeded": 0, "cut_short": 1}
+    assert ref.placement_failures["blue"] == 0
+    ref.start_placement("blue", (1.0, 0.0))  # and one the match's end finds under way
+    placed = ref.summary()["placements"]
+    assert isinstance(placed, dict) and placed["blue"]["cut_short"] == 2 and placed["blue"]["tried"] == 0
 
 
 def test_basic_rules_call_no_fouls() -> None:
@@ -301,3 +335,37 @@ def test_basic_rules_call_no_fouls() -> None:
     w.place_robot("yellow", 0, 0.0, 0.0, math.pi)
     calls = play(w, ref, 1.0, drive("blue", 0, vx=2.5, until=40))
     assert calls == []
+
+
+def test_a_penalty_shootout_alternates_its_kicks_and_ends_the_game() -> None:
+    w, ref = scene(half_s=1.0, half_time_s=0.0, shootout_kicks=2, shootout_always=True, prepare_timeout_s=0.5,
+                   penalty_time_s=3.0)  # fmt: skip
+    takers: list[str] = []
+    scored = {"n": 0}
+
+    def commands(k: int) -> list[RobotCommand]:
+        # yellow's first kick: the ball sent into the goal past the still keeper at the normal start
+        # (nobody moves otherwise; the mark lies in the kicking team's own half)
+        pen = ref.penalty
+        if pen is not None and ref.ready and pen.team == "yellow" and not scored["n"]:
+            w.place_ball(pen.mark[0], pen.mark[1], vx=-6.0 * math.copysign(1.0, pen.mark[0]), vy=0.35)
+            scored["n"] = 1
+        if pen is not None and (not takers or takers[-1][1] != pen.t_start):
+            takers.append((pen.team, pen.t_start))  # type: ignore[arg-type]
+        return []
+
+    calls = play(w, ref, 2.0 + 4 * (1.0 + 0.5 + 3.0) + 2.0, commands)
+    assert "stage_penalty_shootout" in kinds(calls) and kinds(calls)[-1] == "stage_post_game"
+    assert [t for t, _ in takers] == ["yellow", "blue", "yellow", "blue"]  # type: ignore[misc]
+    assert ref.shootout == {"blue": {"taken": 2, "scored": 0}, "yellow": {"taken": 2, "scored": 1}}
+    assert ref.score == {"blue": 0, "yellow": 0}  # the match's score stays
+    assert ref.command == "halt" and ref.stage == "post_game"
+
+
+def test_no_shootout_after_a_match_decided_or_unconfigured() -> None:
+    for figures in ({"shootout_kicks": 0}, {"shootout_kicks": 5}):
+        w, ref = scene(half_s=1.0, half_time_s=0.0, **figures)
+        if figures["shootout_kicks"]:
+            ref.score["blue"] = 1  # decided: no shootout even when configured
+        calls = play(w, ref, 2.5)
+        assert "stage_penalty_shootout" not in kinds(calls) and ref.stage == "post_game"

@@ -1,5 +1,6 @@
 """Our team under the full rules, in the simulator with the referee judging every frame: ball
-placement from five positions in the rules' time and tolerance, a penalty scored against a still
+placement in the rules' time and tolerance from thirteen scenes (by the lines, in a corner, out of
+a defense area, the target behind the robot, an opponent by the ball or the target), a penalty scored against a still
 keeper, our keeper stopping a penalty kicked at its body, and a 30 s stop kept at the rules' speed
 and distance every frame. The brain plays on the true state (no cameras) through its own planning,
 control and safety."""
@@ -59,15 +60,30 @@ def play(w: World, ref: Referee, brain: Brain, seconds: float,
     return calls
 
 
-@pytest.mark.parametrize(("ball", "target"), [
-    ((-2.0, 2.6), (-2.0, 2.8)),  # out by the touch line: a short way
-    ((3.0, -1.0), (1.0, 0.5)),  # across, the robots' side
-    ((-3.0, 0.0), (-1.5, -2.0)),  # toward a corner
-    ((0.5, 2.5), (2.5, 2.8)),  # along the touch line
-    ((1.5, -2.5), (-0.5, -1.0)),  # back toward our half
+Pose = tuple[int, float, float, float]
+
+
+@pytest.mark.parametrize(("ball", "target", "ours", "theirs"), [
+    ((-2.0, 2.6), (-2.0, 2.8), (), ()),  # out by the touch line: a short way
+    ((3.0, -1.0), (1.0, 0.5), (), ()),  # across, the robots' side
+    ((-3.0, 0.0), (-1.5, -2.0), (), ()),  # toward a corner
+    ((0.5, 2.5), (2.5, 2.8), (), ()),  # along the touch line
+    ((1.5, -2.5), (-0.5, -1.0), (), ()),  # back toward our half
+    ((4.4, 2.9), (3.5, 2.0), (), ()),  # out of the far corner
+    ((4.6, 1.2), (4.3, 1.0), (), ()),  # past the goal line, by their defense area
+    ((-4.4, 0.7), (-3.0, 0.0), (), ()),  # out of our own defense area
+    ((4.3, -2.8), (4.3, 2.8), (), ()),  # corner to corner
+    ((0.0, 0.0), (-1.5, 0.0), ((1, -0.5, 0.0, 0.0),), ()),  # the target behind the placing robot
+    ((2.0, 0.0), (0.0, 0.0), ((1, 1.0, 0.0, 0.0),), ()),  # ... the robot between ball and target
+    ((1.0, 0.5), (2.0, 1.5), (), ((0, 1.0, 0.25, math.pi / 2),)),  # an opponent by the ball
+    ((-1.0, -1.0), (1.0, 1.0), (), ((0, 1.0, 1.3, 0.0),)),  # an opponent by the target
 ])  # fmt: skip
-def test_ball_placement_ends_in_tolerance_in_time(ball: tuple[float, float], target: tuple[float, float]) -> None:
+def test_ball_placement_ends_in_tolerance_in_time(ball: tuple[float, float], target: tuple[float, float],
+                                                  ours: tuple[Pose, ...], theirs: tuple[Pose, ...]) -> None:
     w, ref, brain = scene(blue=3, yellow=1)
+    for team, poses in (("blue", ours), ("yellow", theirs)):
+        for rid, x, y, theta in poses:
+            w.place_robot(team, rid, x, y, theta)
     w.place_ball(*ball)
     ref.start_placement("blue", target)
     calls = play(w, ref, brain, RULES.placement_time_s + 1.0,

@@ -28,7 +28,17 @@ from cmdragons.estimation.models import (
 from cmdragons.estimation.simulate import Sighting
 from cmdragons.geometry import wrap_angle
 
-__all__ = ["EKFLocalisation", "EKFSlam", "Lander", "ParticleLocalisation", "lander_filter", "nees", "simulate_lander"]
+__all__ = [
+    "EKFLocalisation",
+    "EKFSlam",
+    "Lander",
+    "ParticleLocalisation",
+    "lander_filter",
+    "nees",
+    "particle_estimate",
+    "pose_error",
+    "simulate_lander",
+]
 
 FloatArray = NDArray[np.float64]
 
@@ -39,7 +49,8 @@ def nees(error: ArrayLike, cov: ArrayLike) -> float:
     return float(e @ np.linalg.solve(np.asarray(cov, dtype=np.float64), e))
 
 
-def _pose_error(estimate: ArrayLike, truth: ArrayLike) -> FloatArray:
+def pose_error(estimate: ArrayLike, truth: ArrayLike) -> FloatArray:
+    """estimate - truth of two poses (x, y, theta), the heading difference wrapped to [-pi, pi)."""
     e = np.asarray(estimate, dtype=np.float64) - np.asarray(truth, dtype=np.float64)
     e[2] = wrap_angle(float(e[2]))
     return e
@@ -159,7 +170,7 @@ class EKFLocalisation:
             self.ekf.x[2, 0] = wrap_angle(float(self.ekf.x[2, 0]))
 
     def nees(self, truth: ArrayLike) -> float:
-        return nees(_pose_error(self.pose, truth), self.cov)
+        return nees(pose_error(self.pose, truth), self.cov)
 
 
 # --- EKF-SLAM -----------------------------------------------------------------------------------
@@ -231,10 +242,21 @@ class EKFSlam:
 
     def nees(self, truth: ArrayLike) -> float:
         """The pose's NEES."""
-        return nees(_pose_error(self.pose, truth), self.pose_cov)
+        return nees(pose_error(self.pose, truth), self.pose_cov)
 
 
 # --- particle filter localisation ---------------------------------------------------------------
+
+
+def particle_estimate(particles: ArrayLike, weights: ArrayLike) -> tuple[FloatArray, FloatArray]:
+    """The weighted mean pose of particles (n, 3) (the heading's circular mean) and their weighted
+    covariance about it (headings wrapped); ``weights`` sum to 1."""
+    p, w = np.asarray(particles, dtype=np.float64), np.asarray(weights, dtype=np.float64)
+    theta = math.atan2(float(np.sum(w * np.sin(p[:, 2]))), float(np.sum(w * np.cos(p[:, 2]))))
+    mean = np.array([float(np.sum(w * p[:, 0])), float(np.sum(w * p[:, 1])), theta])
+    e = p - mean
+    e[:, 2] = wrap_angle(e[:, 2])
+    return mean, np.asarray((w[:, None] * e).T @ e, dtype=np.float64)
 
 
 class ParticleLocalisation:
@@ -286,15 +308,11 @@ class ParticleLocalisation:
 
     @property
     def pose(self) -> FloatArray:
-        w, p = self.weights, self.particles
-        theta = math.atan2(float(np.sum(w * np.sin(p[:, 2]))), float(np.sum(w * np.cos(p[:, 2]))))
-        return np.array([float(np.sum(w * p[:, 0])), float(np.sum(w * p[:, 1])), theta])
+        return particle_estimate(self.particles, self.weights)[0]
 
     @property
     def cov(self) -> FloatArray:
-        e = self.particles - self.pose
-        e[:, 2] = wrap_angle(e[:, 2])
-        return np.asarray((self.weights[:, None] * e).T @ e, dtype=np.float64)
+        return particle_estimate(self.particles, self.weights)[1]
 
     def nees(self, truth: ArrayLike) -> float:
-        return nees(_pose_error(self.pose, truth), self.cov)
+        return nees(pose_error(self.pose, truth), self.cov)

@@ -42,9 +42,14 @@ class Run:
 def simulate_run(seed: int = 0, steps: int = 600, dt_s: float = 0.1, n_landmarks: int = 20,
                  area_m: float = 20.0, speed_m_s: float = 1.5, max_range_m: float = 8.0,
                  odometry_sigma: tuple[float, float, float] = (0.02, 0.01, 0.005),
-                 sensor_sigma: tuple[float, float] = (0.1, 0.01)) -> Run:  # fmt: skip
+                 sensor_sigma: tuple[float, float] = (0.1, 0.01),
+                 max_sightings: int | None = None) -> Run:  # fmt: skip
     """The vehicle circles the area's centre at radius ``area_m / 3``, wobbling, among landmarks
-    scattered over the square area."""
+    scattered over the square area. ``max_sightings``: at most that many sightings a step, drawn
+    at random among the landmarks in range (one, as the Robotics Toolbox's RangeBearingSensor
+    reports); None: every landmark in range."""
+    if max_sightings is not None and max_sightings < 1:
+        raise ValueError(f"max_sightings must be at least 1 or None, got {max_sightings}")
     rng = np.random.default_rng(seed)
     landmarks = rng.uniform(-area_m / 2, area_m / 2, size=(n_landmarks, 2))
     radius = area_m / 3
@@ -64,5 +69,8 @@ def simulate_run(seed: int = 0, steps: int = 600, dt_s: float = 0.1, n_landmarks
             z = observe(pose, lm)
             if z[0] <= max_range_m:
                 seen.append(Sighting(i, z + rng.normal(0.0, sensor_sigma)))
+        if max_sightings is not None and len(seen) > max_sightings:
+            keep = np.sort(rng.choice(len(seen), size=max_sightings, replace=False))
+            seen = [seen[j] for j in keep]
         sightings.append(seen)
     return Run(dt_s, landmarks, np.array(truth), odometry, sightings, q, r)

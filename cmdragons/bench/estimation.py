@@ -8,8 +8,9 @@ sighting a step of a landmark drawn at random among those in range (what the too
 ``RangeBearingSensor`` reports). The toolbox's filters are driven with that run's data: its
 ``Bicycle`` model (whose odometry model, x' = x + (d cos θ, d sin θ, Δθ), is our x ⊕ (d, 0, Δθ))
 replays our odometry and truth, and its ``RangeBearingSensor``, on a ``LandmarkMap`` of our
-landmarks, replays our sightings. Both get the same start, start covariance, noise covariances and
-(for the particle filters) the same number of particles from the same start distribution.
+landmarks, replays our sightings. Both get the same start (off the truth by a draw from its
+covariance), start covariance, noise covariances and (for the particle filters) the same number of
+particles from the same start distribution.
 
 Per method and implementation: the RMS position error over the run (m), the mean pose NEES (3 for a
 consistent filter), the fraction of steps whose NEES lies inside its chi-square (3 degrees of
@@ -46,7 +47,7 @@ from cmdragons.estimation.filters import (
 from cmdragons.estimation.simulate import Run, simulate_run
 from cmdragons.runtime.settings import Settings
 
-__all__ = ["METHODS", "TARGET_ERROR_RATIO", "Trace", "bench_run", "ours", "run", "toolbox"]
+__all__ = ["METHODS", "TARGET_ERROR_RATIO", "Trace", "bench_run", "ours", "run", "start_estimate", "toolbox"]
 
 FloatArray = NDArray[np.float64]
 
@@ -65,6 +66,12 @@ MISSING = "roboticstoolbox-python not installed (pip install -e '.[bench]')"
 def bench_run(steps: int) -> Run:
     """The seeded run every filter of the bench sees."""
     return simulate_run(seed=SEED, steps=steps, odometry_sigma=ODOMETRY_SIGMA, max_sightings=1)
+
+
+def start_estimate(run: Run) -> FloatArray:
+    """Every filter's start: the true start off by a draw from ``START_COV`` (a filter told by its
+    start covariance that it is unsure must be wrong by about that much, or its NEES reads low)."""
+    return np.asarray(run.truth[0] + np.random.default_rng(SEED).multivariate_normal(np.zeros(3), START_COV))
 
 
 @dataclass(frozen=True)
@@ -101,7 +108,7 @@ def _trace(run: Run, step: Callable[[int], None], estimate: Callable[[], tuple[F
 
 def ours(method: str, run: Run) -> Trace:
     """Our filter ``method`` over ``run``."""
-    x0 = run.truth[0]
+    x0 = start_estimate(run)
     f: EKFLocalisation | EKFSlam | ParticleLocalisation
     if method == "ekf_localisation":
         f = EKFLocalisation(run.landmarks, x0, START_COV, run.sensor_cov)
@@ -173,12 +180,12 @@ def toolbox(method: str, run: Run) -> Trace:
     v = np.diag([run.odometry_cov[0, 0], run.odometry_cov[2, 2]])
     if method in ("ekf_localisation", "ekf_slam"):
         kwargs = {"map": lmap} if method == "ekf_localisation" else {}
-        ekf = EKF(robot=(vehicle, v), sensor=(sensor, run.sensor_cov), P0=START_COV, x0=run.truth[0],
+        ekf = EKF(robot=(vehicle, v), sensor=(sensor, run.sensor_cov), P0=START_COV, x0=start_estimate(run),
                   animate=False, history=False, **kwargs)  # fmt: skip
         ekf.init()
         return _trace(run, lambda k: ekf.step(), lambda: (ekf.x_est, ekf.P_est[:3, :3]))
     sd, sth = math.sqrt(run.odometry_cov[0, 0]), math.sqrt(run.odometry_cov[2, 2])
-    start = np.random.default_rng(SEED).multivariate_normal(run.truth[0], START_COV, size=PARTICLES)
+    start = np.random.default_rng(SEED + 1).multivariate_normal(start_estimate(run), START_COV, size=PARTICLES)
     pf = ParticleFilter(vehicle, sensor, R=np.diag([sd, sd, sth]) ** 2, L=run.sensor_cov, nparticles=PARTICLES,
                         seed=SEED, x0=start, animate=False, history=False)  # fmt: skip
     pf._init(x0=start)  # what its run() does first; stepping it ourselves times each step

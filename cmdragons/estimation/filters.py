@@ -24,6 +24,8 @@ from cmdragons.estimation.models import (
     observation_to_landmark_jacobians,
     observe,
     observe_jacobians,
+    velocity_steer,
+    velocity_steer_jacobians,
 )
 from cmdragons.estimation.simulate import Sighting
 from cmdragons.geometry import wrap_angle
@@ -31,6 +33,7 @@ from cmdragons.geometry import wrap_angle
 __all__ = [
     "EKFLocalisation",
     "EKFSlam",
+    "EKFSteered",
     "Lander",
     "ParticleLocalisation",
     "lander_filter",
@@ -124,17 +127,23 @@ def simulate_lander(lander: Lander, seed: int = 0, altitude_m: float = 10000.0, 
 
 
 class _OdometryEKF(ExtendedKalmanFilter):  # type: ignore[misc]
-    """filterpy's EKF with the odometry motion model: x' = x (+) u, F = J1, Q = J2 U J2^T."""
+    """filterpy's EKF with a vehicle motion model of the pose (the state's first three entries):
+    the odometry model x' = x (+) u (F = J1, Q = J2 U J2^T), or any other by its Jacobians."""
 
-    def predict_odometry(self, u: FloatArray, u_cov: FloatArray, pose_slice: slice = slice(0, 3)) -> None:
-        pose = self.x[pose_slice, 0]
+    def predict_odometry(self, u: FloatArray, u_cov: FloatArray) -> None:
+        pose = self.x[:3, 0]
         j1, j2 = compose_jacobians(pose, u)
+        self.predict_pose(compose(pose, u), j1, j2, u_cov)
+
+    def predict_pose(self, new_pose: FloatArray, f_pose: FloatArray, f_u: FloatArray, u_cov: FloatArray) -> None:
+        """The pose moved to ``new_pose`` by a model with Jacobians ``f_pose`` (3, 3) and ``f_u``
+        (3, m) of its noisy input of covariance ``u_cov`` (m, m); the rest of the state stays."""
         n = self.x.shape[0]
         f = np.eye(n)
-        f[pose_slice, pose_slice] = j1
+        f[:3, :3] = f_pose
         q = np.zeros((n, n))
-        q[pose_slice, pose_slice] = j2 @ u_cov @ j2.T
-        self.x[pose_slice, 0] = compose(pose, u)
+        q[:3, :3] = f_u @ u_cov @ f_u.T
+        self.x[:3, 0] = new_pose
         self.F, self.Q = f, q
         self.P = f @ self.P @ f.T + q  # type: ignore[has-type]
         self.x_prior, self.P_prior = self.x.copy(), self.P.copy()
@@ -171,6 +180,27 @@ class EKFLocalisation:
 
     def nees(self, truth: ArrayLike) -> float:
         return nees(pose_error(self.pose, truth), self.cov)
+
+
+class EKFSteered(EKFLocalisation):
+    """EKF localisation of a velocity-steered vehicle (notes §6.1-6.2): predicted from its
+    odometry's measured speed and steering angle through :func:`velocity_steer` (the measurement
+    noise carried into the pose by the model's Jacobian), corrected by sightings of known landmarks."""
+
+    def __init__(self, landmarks: ArrayLike, start: ArrayLike, start_cov: ArrayLike, sensor_cov: ArrayLike,
+                 dt_s: float, wheelbase_m: float) -> None:  # fmt: skip
+        if dt_s <= 0.0 or wheelbase_m <= 0.0:
+            raise ValueError(f"dt_s and wheelbase_m must be positive, got {dt_s} and {wheelbase_m}")
+        super().__init__(landmarks, start, start_cov, sensor_cov)
+        self.dt_s, self.wheelbase_m = dt_s, wheelbase_m
+
+    def predict(self, odometry: ArrayLike, odometry_cov: ArrayLike) -> None:
+        """``odometry``: the measured speed (m/s) and steering angle (rad) over the step;
+        ``odometry_cov`` their (2, 2) covariance."""
+        pose, u = self.ekf.x[:3, 0].copy(), np.asarray(odometry, dtype=np.float64)
+        fx, fu = velocity_steer_jacobians(pose, u, self.dt_s, self.wheelbase_m)
+        self.ekf.predict_pose(velocity_steer(pose, u, self.dt_s, self.wheelbase_m), fx, fu,
+                              np.asarray(odometry_cov, dtype=np.float64))  # fmt: skip
 
 
 # --- EKF-SLAM -----------------------------------------------------------------------------------

@@ -42,6 +42,7 @@ SUITES: dict[str, Suite] = {
     "grid": _lazy("cmdragons.bench.grid"),
     "robox": _lazy("cmdragons.bench.robox"),
     "navigation": _lazy("cmdragons.bench.navigation"),
+    "estimation": _lazy("cmdragons.bench.estimation"),
 }
 # the options each suite takes
 OPTIONS: dict[str, tuple[str, ...]] = {"grid": ("maps",), "navigation": ("figures",),

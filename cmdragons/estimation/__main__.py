@@ -1,4 +1,4 @@
-"""``python -m cmdragons.estimation [lander|localise|slam|particle ...]``: run the worked examples
+"""``python -m cmdragons.estimation [lander|steer|localise|slam|particle ...]``: run the worked examples
 of docs/estimation.md on their simulated runs and print how each filter did."""
 
 from __future__ import annotations
@@ -9,14 +9,16 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from cmdragons.estimation.filters import EKFLocalisation, EKFSlam, Lander, ParticleLocalisation, simulate_lander
-from cmdragons.estimation.simulate import simulate_run
+from cmdragons.estimation import filters
+from cmdragons.estimation.filters import EKFLocalisation, EKFSlam, ParticleLocalisation
+from cmdragons.estimation.simulate import simulate_run, simulate_steered_run
 
-EXAMPLES = ("lander", "localise", "slam", "particle")
+EXAMPLES = ("lander", "steer", "localise", "slam", "particle")
+WHEELBASE_M = 0.5  # the steered example's vehicle
 
 
 def _lander() -> str:
-    run = simulate_lander(Lander(), seed=1)
+    run = filters.simulate_lander(filters.Lander(), seed=1)
     late = slice(len(run["t"]) // 4, None)
     radar = float(np.sqrt(np.mean((run["radar"][late] - run["altitude"][late]) ** 2)))
     est = float(np.sqrt(np.mean((run["est_altitude"][late] - run["altitude"][late]) ** 2)))
@@ -27,11 +29,15 @@ def _lander() -> str:
 
 
 def _pose_filters(name: str) -> str:
-    run = simulate_run(seed=0, steps=600)
+    steered = name == "steer"
+    run = simulate_steered_run(seed=0, steps=600, wheelbase_m=WHEELBASE_M) if steered else simulate_run(seed=0)
     p0 = np.diag([0.01, 0.01, 0.001])
     x0 = run.truth[0]
-    if name == "localise":
-        f: EKFLocalisation | EKFSlam | ParticleLocalisation = EKFLocalisation(run.landmarks, x0, p0, run.sensor_cov)
+    if steered:
+        f: EKFLocalisation | EKFSlam | ParticleLocalisation = filters.EKFSteered(run.landmarks, x0, p0, run.sensor_cov,
+                                                                         run.dt_s, WHEELBASE_M)  # fmt: skip
+    elif name == "localise":
+        f = EKFLocalisation(run.landmarks, x0, p0, run.sensor_cov)
     elif name == "slam":
         f = EKFSlam(len(run.landmarks), x0, p0, run.sensor_cov)
     else:

@@ -24,11 +24,24 @@ from cmdragons.estimation.models import (
     observation_to_landmark_jacobians,
     observe,
     observe_jacobians,
+    velocity_steer,
+    velocity_steer_jacobians,
 )
 from cmdragons.estimation.simulate import Sighting
 from cmdragons.geometry import wrap_angle
 
-__all__ = ["EKFLocalisation", "EKFSlam", "Lander", "ParticleLocalisation", "lander_filter", "nees", "simulate_lander"]
+__all__ = [
+    "EKFLocalisation",
+    "EKFSlam",
+    "EKFSteered",
+    "Lander",
+    "ParticleLocalisation",
+    "lander_filter",
+    "nees",
+    "particle_estimate",
+    "pose_error",
+    "simulate_lander",
+]
 
 FloatArray = NDArray[np.float64]
 
@@ -39,7 +52,8 @@ def nees(error: ArrayLike, cov: ArrayLike) -> float:
     return float(e @ np.linalg.solve(np.asarray(cov, dtype=np.float64), e))
 
 
-def _pose_error(estimate: ArrayLike, truth: ArrayLike) -> FloatArray:
+def pose_error(estimate: ArrayLike, truth: ArrayLike) -> FloatArray:
+    """estimate - truth of two poses (x, y, theta), the heading difference wrapped to [-pi, pi)."""
     e = np.asarray(estimate, dtype=np.float64) - np.asarray(truth, dtype=np.float64)
     e[2] = wrap_angle(float(e[2]))
     return e
@@ -113,17 +127,23 @@ def simulate_lander(lander: Lander, seed: int = 0, altitude_m: float = 10000.0, 
 
 
 class _OdometryEKF(ExtendedKalmanFilter):  # type: ignore[misc]
-    """filterpy's EKF with the odometry motion model: x' = x (+) u, F = J1, Q = J2 U J2^T."""
+    """filterpy's EKF with a vehicle motion model of the pose (the state's first three entries):
+    the odometry model x' = x (+) u (F = J1, Q = J2 U J2^T), or any other by its Jacobians."""
 
-    def predict_odometry(self, u: FloatArray, u_cov: FloatArray, pose_slice: slice = slice(0, 3)) -> None:
-        pose = self.x[pose_slice, 0]
+    def predict_odometry(self, u: FloatArray, u_cov: FloatArray) -> None:
+        pose = self.x[:3, 0]
         j1, j2 = compose_jacobians(pose, u)
+        self.predict_pose(compose(pose, u), j1, j2, u_cov)
+
+    def predict_pose(self, new_pose: FloatArray, f_pose: FloatArray, f_u: FloatArray, u_cov: FloatArray) -> None:
+        """The pose moved to ``new_pose`` by a model with Jacobians ``f_pose`` (3, 3) and ``f_u``
+        (3, m) of its noisy input of covariance ``u_cov`` (m, m); the rest of the state stays."""
         n = self.x.shape[0]
         f = np.eye(n)
-        f[pose_slice, pose_slice] = j1
+        f[:3, :3] = f_pose
         q = np.zeros((n, n))
-        q[pose_slice, pose_slice] = j2 @ u_cov @ j2.T
-        self.x[pose_slice, 0] = compose(pose, u)
+        q[:3, :3] = f_u @ u_cov @ f_u.T
+        self.x[:3, 0] = new_pose
         self.F, self.Q = f, q
         self.P = f @ self.P @ f.T + q  # type: ignore[has-type]
         self.x_prior, self.P_prior = self.x.copy(), self.P.copy()
@@ -159,7 +179,28 @@ class EKFLocalisation:
             self.ekf.x[2, 0] = wrap_angle(float(self.ekf.x[2, 0]))
 
     def nees(self, truth: ArrayLike) -> float:
-        return nees(_pose_error(self.pose, truth), self.cov)
+        return nees(pose_error(self.pose, truth), self.cov)
+
+
+class EKFSteered(EKFLocalisation):
+    """EKF localisation of a velocity-steered vehicle (notes §6.1-6.2): predicted from its
+    odometry's measured speed and steering angle through :func:`velocity_steer` (the measurement
+    noise carried into the pose by the model's Jacobian), corrected by sightings of known landmarks."""
+
+    def __init__(self, landmarks: ArrayLike, start: ArrayLike, start_cov: ArrayLike, sensor_cov: ArrayLike,
+                 dt_s: float, wheelbase_m: float) -> None:  # fmt: skip
+        if dt_s <= 0.0 or wheelbase_m <= 0.0:
+            raise ValueError(f"dt_s and wheelbase_m must be positive, got {dt_s} and {wheelbase_m}")
+        super().__init__(landmarks, start, start_cov, sensor_cov)
+        self.dt_s, self.wheelbase_m = dt_s, wheelbase_m
+
+    def predict(self, odometry: ArrayLike, odometry_cov: ArrayLike) -> None:
+        """``odometry``: the measured speed (m/s) and steering angle (rad) over the step;
+        ``odometry_cov`` their (2, 2) covariance."""
+        pose, u = self.ekf.x[:3, 0].copy(), np.asarray(odometry, dtype=np.float64)
+        fx, fu = velocity_steer_jacobians(pose, u, self.dt_s, self.wheelbase_m)
+        self.ekf.predict_pose(velocity_steer(pose, u, self.dt_s, self.wheelbase_m), fx, fu,
+                              np.asarray(odometry_cov, dtype=np.float64))  # fmt: skip
 
 
 # --- EKF-SLAM -----------------------------------------------------------------------------------
@@ -231,10 +272,21 @@ class EKFSlam:
 
     def nees(self, truth: ArrayLike) -> float:
         """The pose's NEES."""
-        return nees(_pose_error(self.pose, truth), self.pose_cov)
+        return nees(pose_error(self.pose, truth), self.pose_cov)
 
 
 # --- particle filter localisation ---------------------------------------------------------------
+
+
+def particle_estimate(particles: ArrayLike, weights: ArrayLike) -> tuple[FloatArray, FloatArray]:
+    """The weighted mean pose of particles (n, 3) (the heading's circular mean) and their weighted
+    covariance about it (headings wrapped); ``weights`` sum to 1."""
+    p, w = np.asarray(particles, dtype=np.float64), np.asarray(weights, dtype=np.float64)
+    theta = math.atan2(float(np.sum(w * np.sin(p[:, 2]))), float(np.sum(w * np.cos(p[:, 2]))))
+    mean = np.array([float(np.sum(w * p[:, 0])), float(np.sum(w * p[:, 1])), theta])
+    e = p - mean
+    e[:, 2] = wrap_angle(e[:, 2])
+    return mean, np.asarray((w[:, None] * e).T @ e, dtype=np.float64)
 
 
 class ParticleLocalisation:
@@ -286,15 +338,11 @@ class ParticleLocalisation:
 
     @property
     def pose(self) -> FloatArray:
-        w, p = self.weights, self.particles
-        theta = math.atan2(float(np.sum(w * np.sin(p[:, 2]))), float(np.sum(w * np.cos(p[:, 2]))))
-        return np.array([float(np.sum(w * p[:, 0])), float(np.sum(w * p[:, 1])), theta])
+        return particle_estimate(self.particles, self.weights)[0]
 
     @property
     def cov(self) -> FloatArray:
-        e = self.particles - self.pose
-        e[:, 2] = wrap_angle(e[:, 2])
-        return np.asarray((self.weights[:, None] * e).T @ e, dtype=np.float64)
+        return particle_estimate(self.particles, self.weights)[1]
 
     def nees(self, truth: ArrayLike) -> float:
-        return nees(_pose_error(self.pose, truth), self.cov)
+        return nees(pose_error(self.pose, truth), self.cov)

@@ -3,7 +3,8 @@
 Poses are (x, y, theta): metres, radians, in a fixed world frame. Odometry reports the pose change
 in the vehicle's own frame since the last report; poses compose with the head-to-tail operator
 ``compose`` (x1 (+) x2) and its inverse ``invert`` ((-) x). The sensor measures range and bearing to
-point landmarks, the bearing relative to the vehicle's heading.
+point landmarks, the bearing relative to the vehicle's heading. A velocity-steered vehicle (notes
+§6.1, a front-wheel-steered car) moves by its speed and steering angle instead (``velocity_steer``).
 """
 
 from __future__ import annotations
@@ -23,6 +24,8 @@ __all__ = [
     "observe_jacobians",
     "observation_to_landmark",
     "observation_to_landmark_jacobians",
+    "velocity_steer",
+    "velocity_steer_jacobians",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -88,3 +91,25 @@ def observation_to_landmark_jacobians(pose: ArrayLike, z: ArrayLike) -> tuple[Fl
     gx = np.array([[1.0, 0.0, -r * s], [0.0, 1.0, r * c]])
     gz = np.array([[c, -r * s], [s, r * c]])
     return gx, gz
+
+
+def velocity_steer(pose: ArrayLike, control: ArrayLike, dt_s: float, wheelbase_m: float) -> FloatArray:
+    """The velocity steer model: the pose after ``dt_s`` of driving at speed ``v`` (m/s) with the
+    front wheel steered ``phi`` (rad) from the heading, the wheels ``wheelbase_m`` apart:
+    x' = x + dt v cos(theta + phi), y' = y + dt v sin(theta + phi), theta' = theta + dt v sin(phi) / L."""
+    x, y, t = np.asarray(pose, dtype=np.float64)
+    v, phi = np.asarray(control, dtype=np.float64)
+    return np.array([x + dt_s * v * math.cos(t + phi), y + dt_s * v * math.sin(t + phi),
+                     wrap_angle(t + dt_s * v * math.sin(phi) / wheelbase_m)])  # fmt: skip
+
+
+def velocity_steer_jacobians(pose: ArrayLike, control: ArrayLike, dt_s: float,
+                             wheelbase_m: float) -> tuple[FloatArray, FloatArray]:  # fmt: skip
+    """d velocity_steer / d pose (3, 3) and d velocity_steer / d (v, phi) (3, 2)."""
+    _, _, t = np.asarray(pose, dtype=np.float64)
+    v, phi = np.asarray(control, dtype=np.float64)
+    c, s = math.cos(t + phi), math.sin(t + phi)
+    fx = np.array([[1.0, 0.0, -dt_s * v * s], [0.0, 1.0, dt_s * v * c], [0.0, 0.0, 1.0]])
+    fu = np.array([[dt_s * c, -dt_s * v * s], [dt_s * s, dt_s * v * c],
+                   [dt_s * math.sin(phi) / wheelbase_m, dt_s * v * math.cos(phi) / wheelbase_m]])  # fmt: skip
+    return fx, fu

@@ -9,7 +9,14 @@ import numpy as np
 import pytest
 from scipy.stats import chi2
 
-from cmdragons.estimation.filters import EKFLocalisation, EKFSlam, Lander, ParticleLocalisation, simulate_lander
+from cmdragons.estimation.filters import (
+    EKFLocalisation,
+    EKFSlam,
+    EKFSteered,
+    Lander,
+    ParticleLocalisation,
+    simulate_lander,
+)
 from cmdragons.estimation.models import (
     compose,
     compose_jacobians,
@@ -18,8 +25,10 @@ from cmdragons.estimation.models import (
     observation_to_landmark_jacobians,
     observe,
     observe_jacobians,
+    velocity_steer,
+    velocity_steer_jacobians,
 )
-from cmdragons.estimation.simulate import simulate_run
+from cmdragons.estimation.simulate import simulate_run, simulate_steered_run
 
 
 def numeric_jacobian(f, x: np.ndarray, eps: float = 1e-6) -> np.ndarray:  # type: ignore[no-untyped-def]
@@ -47,6 +56,18 @@ def test_model_jacobians_match_finite_differences() -> None:
     gx, gz = observation_to_landmark_jacobians(a, z)
     assert np.allclose(gx, numeric_jacobian(lambda x: observation_to_landmark(x, z), a), atol=1e-6)
     assert np.allclose(gz, numeric_jacobian(lambda x: observation_to_landmark(a, x), z), atol=1e-6)
+    u, dt, wheelbase = np.array([1.5, 0.3]), 0.1, 0.5
+    fx, fu = velocity_steer_jacobians(a, u, dt, wheelbase)
+    assert np.allclose(fx, numeric_jacobian(lambda x: velocity_steer(x, u, dt, wheelbase), a), atol=1e-6)
+    assert np.allclose(fu, numeric_jacobian(lambda x: velocity_steer(a, x, dt, wheelbase), u), atol=1e-6)
+
+
+@pytest.mark.parametrize(("phi", "turn"), [(0.0, 0.0), (0.3, 1.5 * math.sin(0.3) / 0.5)])
+def test_the_velocity_steer_model_drives_straight_and_turns_at_v_sin_phi_over_l(phi: float, turn: float) -> None:
+    p = velocity_steer([1.0, 2.0, 0.5], [1.5, phi], 0.1, 0.5)
+    assert p[2] == pytest.approx(0.5 + 0.1 * turn, abs=1e-12)  # rad
+    assert math.hypot(p[0] - 1.0, p[1] - 2.0) == pytest.approx(0.15, abs=1e-12)  # m, along theta + phi
+    assert math.atan2(p[1] - 2.0, p[0] - 1.0) == pytest.approx(0.5 + phi, abs=1e-12)
 
 
 def test_the_lander_filter_beats_its_radar_and_is_consistent() -> None:
@@ -88,6 +109,31 @@ def test_ekf_localisation_nees_lies_within_its_chi_square_bounds() -> None:
     inside = np.mean((mean_nees >= lo) & (mean_nees <= hi))
     assert inside >= 0.9, (inside, lo, hi, float(np.mean(mean_nees)))
     assert float(np.median(errors)) < 0.1
+
+
+def test_the_steered_vehicle_ekf_is_consistent_and_beats_dead_reckoning() -> None:
+    # the NEES averaged over N runs within the 95% bounds of chi2(3N)/N, as for EKF localisation
+    n_runs, steps, wheelbase = 20, 300, 0.5
+    totals = np.zeros(steps)
+    errors, dead_reckoned = [], []
+    for seed in range(n_runs):
+        run = simulate_steered_run(seed=seed, steps=steps, wheelbase_m=wheelbase)
+        x0, p0 = _start(run, seed)
+        ekf = EKFSteered(run.landmarks, x0, p0, run.sensor_cov, run.dt_s, wheelbase)
+        alone = x0
+        for k in range(steps):
+            ekf.predict(run.odometry[k], run.odometry_cov)
+            ekf.update(run.sightings[k])
+            alone = velocity_steer(alone, run.odometry[k], run.dt_s, wheelbase)
+            totals[k] += ekf.nees(run.truth[k + 1])
+            errors.append(math.dist(ekf.pose[:2], run.truth[k + 1][:2]))
+            dead_reckoned.append(math.dist(alone[:2], run.truth[k + 1][:2]))
+    mean_nees = totals / n_runs
+    lo, hi = chi2.ppf([0.025, 0.975], 3 * n_runs) / n_runs
+    inside = np.mean((mean_nees >= lo) & (mean_nees <= hi))
+    assert inside >= 0.9, (inside, lo, hi, float(np.mean(mean_nees)))
+    assert float(np.median(errors)) < 0.05  # m
+    assert float(np.median(errors)) < 0.1 * float(np.median(dead_reckoned))
 
 
 def test_ekf_slam_maps_the_landmarks_and_keeps_the_pose_consistent() -> None:

@@ -32,10 +32,21 @@ __all__ = ["ZenohTransport", "key_expr", "open_router"]
 
 
 def open_router(params: RuntimeParams) -> Any:
-    """A zenoh router session on the configured endpoint (the nodes are its clients); close it."""
+    """A zenoh router session on the configured endpoint (the nodes are its clients); close it.
+    An endpoint already taken (another distributed run, another zenoh router) is a ConfigError
+    naming the setting that moves it."""
     import zenoh
 
-    return zenoh.open(params.zenoh.config("router"))
+    from cmdragons.config import ConfigError
+
+    try:
+        return zenoh.open(params.zenoh.config("router"))
+    except zenoh.ZError as exc:
+        if "in use" not in str(exc):
+            raise
+        raise ConfigError("runtime.yaml", "zenoh.router", f"{params.zenoh.router} is in use (another distributed "
+                          "run or zenoh router?): stop it, or choose another port with --set "
+                          "runtime.zenoh.router=tcp/127.0.0.1:PORT") from None
 
 
 def key_expr(prefix: str, pattern: str) -> str:

@@ -131,3 +131,17 @@ def test_more_sources_than_cameras_is_one_line_before_any_work(tmp_path: Path,
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "3 sources but only 2 camera model(s)" in err[0], err
     assert not (tmp_path / "v" / "detections.jsonl").exists() or not (tmp_path / "v" / "detections.jsonl").read_text()
+
+
+def test_a_distributed_play_on_a_taken_router_port_says_so(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    import socket
+
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        router = f"runtime.zenoh.router=tcp/127.0.0.1:{port}"
+        code, _, err = run(["play", "--distributed", "--perception", "truth", "--seconds", "1", "--out",
+                            str(tmp_path / "run"), "--set", router], capsys)  # fmt: skip
+    assert code == 2
+    assert err.strip().count("\n") == 0 and f"127.0.0.1:{port} is in use" in err and "--set runtime.zenoh.router" in err

@@ -18,7 +18,7 @@ from typing import Any, NoReturn
 import numpy as np
 
 from cmdragons.cli_runtime import add_parsers as add_runtime_parsers
-from cmdragons.cli_runtime import cmd_log, cmd_node, play_distributed
+from cmdragons.cli_runtime import cmd_log, cmd_node, cmd_replay, play_distributed
 from cmdragons.config import ConfigError
 from cmdragons.runtime.interrupt import Interrupt
 from cmdragons.runtime.log import OutputError
@@ -172,6 +172,8 @@ def main(argv: Sequence[str] | None = None) -> int:
                 return cmd_node(args, stop)
             if args.command == "log":
                 return cmd_log(args)
+            if args.command == "replay":
+                return cmd_replay(args, stop)
             if args.command == "vision":
                 return _cmd_vision(args)
         except ConfigError as exc:
@@ -187,7 +189,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     return 2
 
 
-def _progress(enabled: bool):  # type: ignore[no-untyped-def]
+def _progress(enabled: bool, counts: bool = True):  # type: ignore[no-untyped-def]
+    """A progress bar with a task's description, ``info`` field and times; ``counts``: "done/total"."""
     from rich.progress import (
         BarColumn,
         MofNCompleteColumn,
@@ -198,8 +201,9 @@ def _progress(enabled: bool):  # type: ignore[no-untyped-def]
     )
 
     return Progress(
-        TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(), TextColumn("{task.fields[info]}"),
-        TimeElapsedColumn(), TimeRemainingColumn(), disable=not enabled, transient=False,
+        TextColumn("[bold]{task.description}"), BarColumn(), *([MofNCompleteColumn()] if counts else []),
+        TextColumn("{task.fields[info]}"), TimeElapsedColumn(), TimeRemainingColumn(), disable=not enabled,
+        transient=False,
     )  # fmt: skip
 
 

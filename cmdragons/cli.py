@@ -89,8 +89,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("play", help="play a match in the simulator; our team sees only the camera images")
     _common(p)
-    p.add_argument("--opponent", choices=("simple", "self", "none"), default="simple",
-                   help="the built-in simple team (on the true state), a copy of our team, or nobody")
+    p.add_argument("--opponent", choices=("simple", "self", "none", "outside"), default="simple",
+                   help="the built-in simple team (on the true state), a copy of our team, nobody, or (with "
+                   "--distributed) a team outside on commands/yellow (examples/outside_team.py)")
     p.add_argument("--opponent-set", metavar="KEY=VALUE", action="append", default=[],
                    help="with --opponent self: override one value of the copy's own config, on top of --config "
                    "and --set (its brain and tracker: planner, control, safety, tracker, strategy, team), "
@@ -166,6 +167,9 @@ def main(argv: Sequence[str] | None = None) -> int:
                 return _cmd_bench(args)
             if args.command == "play" and args.distributed:
                 return play_distributed(args, stop)
+            if args.command == "play" and args.opponent == "outside":
+                print("cmdragons play: --opponent outside plays over zenoh: add --distributed", file=sys.stderr)
+                return 2
             if args.command == "play":
                 return _cmd_play(args, stop)
             if args.command == "node":

@@ -20,7 +20,7 @@ __all__ = ["add_parsers", "cmd_log", "cmd_node", "cmd_replay", "play_distributed
 
 
 def _match_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--opponent", choices=("simple", "self", "none"), default="simple",
+    p.add_argument("--opponent", choices=("simple", "self", "none", "outside"), default="simple",
                    help="as cmdragons play: every node of a match must be given the same")  # fmt: skip
     p.add_argument("--perception", choices=("vision", "truth"), default="vision", help="as cmdragons play")
     p.add_argument("--seed", type=int, default=None, help="override sim.seed (every node the same)")
@@ -97,15 +97,31 @@ def _log_stages(spec: Any, folder: Path) -> tuple[Any, list[Any]]:
     return log, [LoggerStage(log), scene]
 
 
+def _connect(params: Any, name: str, router: bool, command: str) -> tuple[Any, Any] | None:
+    """The router session (when ``router``) and ``name``'s transport; None once the error (no
+    router there, or the endpoint taken) is said on one line."""
+    from cmdragons.runtime.zenoh_transport import RouterError, ZenohTransport, open_router
+
+    session = None
+    try:
+        session = open_router(params) if router else None
+        return session, ZenohTransport(params, name)
+    except RouterError as exc:
+        if session is not None:
+            session.close()
+        print(f"cmdragons {command}: {exc}", file=sys.stderr)
+        return None
+
+
 def cmd_node(args: argparse.Namespace, stop: Interrupt) -> int:
     from cmdragons.runtime.distributed import node_roles, run_clock, run_node, write_summary
     from cmdragons.runtime.log import run_folder
-    from cmdragons.runtime.zenoh_transport import ZenohTransport, open_router
-
     spec = _spec(args)
     params = spec.settings.runtime
-    router = open_router(params) if args.router else None
-    transport = ZenohTransport(params, args.role)
+    connected = _connect(params, args.role, args.router, f"node {args.role}")
+    if connected is None:
+        return 2
+    router, transport = connected
     log = None
     try:
         with stop.soft():
@@ -142,7 +158,6 @@ def play_distributed(args: argparse.Namespace, stop: Interrupt) -> int:
     never forked after zenoh opened), the clock here; Ctrl-C stops them all."""
     from cmdragons.runtime.distributed import node_roles, run_clock, write_summary
     from cmdragons.runtime.log import run_folder
-    from cmdragons.runtime.zenoh_transport import ZenohTransport, open_router
 
     spec = _spec(args)
     params = spec.settings.runtime
@@ -152,16 +167,17 @@ def play_distributed(args: argparse.Namespace, stop: Interrupt) -> int:
     for s in args.set:
         common += ["--set", s]
     common += ["--opponent", spec.opponent, "--perception", spec.perception, "--seed", str(spec.seed)]
-    router = open_router(params)
+    connected = _connect(params, "sim", True, "play")
+    if connected is None:
+        return 2
+    router, transport = connected
     children: list[subprocess.Popen[bytes]] = []
-    transport = None
     try:
         for role in roles:
             if role != "sim":
                 extra = ["--out", str(folder)] if role == "log" else []
                 children.append(subprocess.Popen([sys.executable, "-m", "cmdragons.cli", "node", role, *common,
                                                   *extra]))  # fmt: skip
-        transport = ZenohTransport(params, "sim")
         wall0 = time.perf_counter()
         with stop.soft():
             summary = run_clock(spec, transport, args.seconds, roles, should_stop=lambda: stop.requested)
@@ -182,8 +198,7 @@ def play_distributed(args: argparse.Namespace, stop: Interrupt) -> int:
                 except subprocess.TimeoutExpired:
                     child.terminate()
                     child.wait(timeout=5)
-            if transport is not None:
-                transport.close()
+            transport.close()
             router.close()
 
 
@@ -211,13 +226,10 @@ def cmd_log(args: argparse.Namespace) -> int:
 
 def cmd_replay(args: argparse.Namespace, stop: Interrupt) -> int:
     """``cmdragons replay LOG.mcap``: the log's messages on zenoh again, paced as recorded."""
-    import zenoh
-
     from cmdragons.cli import _progress
     from cmdragons.runtime.log import LogError
     from cmdragons.runtime.replay import replay, replay_span
     from cmdragons.runtime.settings import load_settings
-    from cmdragons.runtime.zenoh_transport import ZenohTransport, open_router
 
     path = Path(args.path)
     if not path.is_file():
@@ -229,17 +241,11 @@ def cmd_replay(args: argparse.Namespace, stop: Interrupt) -> int:
         print(f"cmdragons replay: {exc}", file=sys.stderr)
         return 2
     params = load_settings(args.config, args.set).runtime
-    router = transport = None
+    connected = _connect(params, "replay", args.router, "replay")
+    if connected is None:
+        return 2
+    router, transport = connected
     try:
-        try:
-            router = open_router(params) if args.router else None
-            transport = ZenohTransport(params, "replay")
-        except zenoh.ZError:
-            print(f"cmdragons replay: {'cannot listen on' if args.router else 'no zenoh router at'} "
-                  f"{params.zenoh.router} (runtime.zenoh.router): "
-                  f"{'is a router running there already?' if args.router else 'add --router, or start one'}",
-                  file=sys.stderr)  # fmt: skip
-            return 2
         wait = [r for r in args.wait.split(",") if r] if args.wait else []
         span = last - first - args.start
         with _progress(not args.no_progress, counts=False) as progress, stop.soft():
@@ -262,8 +268,7 @@ def cmd_replay(args: argparse.Namespace, stop: Interrupt) -> int:
         return 2
     finally:
         with stop.shield():
-            if transport is not None:
-                transport.close()
+            transport.close()
             if router is not None:
                 router.close()
     cut = f", interrupted by {stop.signal}" if result.interrupted else ""

@@ -59,8 +59,9 @@ def role_of(stage: str) -> str:
 
 
 def node_roles(opponent: Opponent, log: bool) -> list[str]:
-    """The nodes a match needs (no opponent node against nobody; the log node when logging)."""
-    return [r for r in ROLES if (r != "opponent" or opponent != "none") and (r != "log" or log)]
+    """The nodes a match needs (no opponent node against nobody or a team outside; the log node
+    when logging)."""
+    return [r for r in ROLES if (r != "opponent" or opponent in ("simple", "self")) and (r != "log" or log)]
 
 
 class MatchSpec:

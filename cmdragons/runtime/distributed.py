@@ -154,7 +154,15 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
     ready: set[str] = set()
     judged = [0]  # the referee's words so far
     summaries = SummaryCollector()
-    bus.add(Tap("control:ready", ("control/*",), lambda _t, c: ready.add(c.node) if c.command == "ready" else None))
+    started = [False]
+
+    def on_control(_topic: str, c: NodeControl) -> None:
+        if c.command == "ready":
+            if started[0]:  # a node started again mid-match: it plays on from the next frame
+                _control(transport, "clock", "start")
+            ready.add(c.node)
+
+    bus.add(Tap("control:ready", ("control/*",), on_control))
     bus.add(Tap("clock:referee", ("referee",), lambda _t, _g: judged.__setitem__(0, judged[0] + 1)))
     placed = [0]  # the referee's teleports so far (the kickoff formation first)
     bus.add(Tap("clock:teleport", ("teleport",), lambda _t, _g: placed.__setitem__(0, placed[0] + 1)))
@@ -178,6 +186,7 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
         transport.spin(0.05)
     transport.wait_for(lambda: False, params.settle_s)  # declarations propagate: nothing of frame 0 is lost
     _control(transport, "clock", "start")
+    started[0] = True
     bus.start()
     if not transport.wait_for(lambda: judged[0] >= 1 and placed[0] >= 1, 5.0):
         raise TimeoutError(f"the referee node did not give the kickoff (referee {judged[0]}, teleport {placed[0]})")

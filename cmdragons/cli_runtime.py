@@ -156,7 +156,7 @@ def cmd_node(args: argparse.Namespace, stop: Interrupt) -> int:
 def play_distributed(args: argparse.Namespace, stop: Interrupt) -> int:
     """``cmdragons play --distributed``: a router here, every other node as its own process (spawned,
     never forked after zenoh opened), the clock here; Ctrl-C stops them all."""
-    from cmdragons.runtime.distributed import node_roles, run_clock, write_summary
+    from cmdragons.runtime.distributed import node_roles, run_clock, wait_for_processes, write_summary
     from cmdragons.runtime.log import run_folder
 
     spec = _spec(args)
@@ -192,12 +192,7 @@ def play_distributed(args: argparse.Namespace, stop: Interrupt) -> int:
         return stop.exit_code
     finally:
         with stop.shield():
-            for child in children:
-                try:
-                    child.wait(timeout=10)
-                except subprocess.TimeoutExpired:
-                    child.terminate()
-                    child.wait(timeout=5)
+            wait_for_processes(children)
             transport.close()
             router.close()
 

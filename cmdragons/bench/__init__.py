@@ -42,6 +42,7 @@ SUITES: dict[str, Suite] = {
     "grid": _lazy("cmdragons.bench.grid"),
     "robox": _lazy("cmdragons.bench.robox"),
     "navigation": _lazy("cmdragons.bench.navigation"),
+    "runtime": _lazy("cmdragons.bench.runtime"),
 }
 OPTIONS: dict[str, tuple[str, ...]] = {"grid": ("maps",), "navigation": ("figures",)}  # the options each suite takes
 

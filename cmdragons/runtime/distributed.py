@@ -39,7 +39,8 @@ from cmdragons.runtime.settings import Settings
 from cmdragons.runtime.stages import SimStage, SummaryCollector, Tap
 from cmdragons.runtime.zenoh_transport import ZenohTransport
 
-__all__ = ["ROLES", "MatchSpec", "node_roles", "role_of", "run_clock", "run_node"]
+__all__ = ["ROLES", "MatchSpec", "node_roles", "role_of", "run_clock", "run_node", "wait_for_processes",
+           "write_summary"]
 
 
 
@@ -245,6 +246,18 @@ def _pace(transport: ZenohTransport, until: float) -> None:
     """Deliver what comes until the wall clock reaches ``until`` (perf_counter s)."""
     while (left := until - time.perf_counter()) > 0:
         transport.spin(min(left, 0.005))
+
+
+def wait_for_processes(children: Sequence[Any], timeout_s: float = 10.0) -> None:
+    """Wait for node processes told to stop; one that does not end within ``timeout_s`` is ended."""
+    import subprocess
+
+    for child in children:
+        try:
+            child.wait(timeout=timeout_s)
+        except subprocess.TimeoutExpired:
+            child.terminate()
+            child.wait(timeout=5)
 
 
 def write_summary(folder: Path, summary: dict[str, Any]) -> None:

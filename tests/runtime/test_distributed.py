@@ -177,3 +177,34 @@ def test_a_killed_team_node_rejoins_and_the_match_goes_on(router: Any) -> None:
     assert after == list(range(after[0], frames[-1] + 1)) and len(after) >= 30
     assert result["frames"] == len(frames) and result["frames_stepped_without_a_team"] >= 30
     assert result["command_faults"]["timed_out"] > 0  # the watchdog braked blue while it was gone
+
+
+def test_free_running_real_time_steps_every_frame_at_the_wall_clock(router: Any) -> None:
+    import dataclasses
+
+    from cmdragons.runtime.zenoh_transport import ZenohTransport
+
+    settings = dataclasses.replace(SETTINGS, runtime=router)
+    spec = MatchSpec(settings, "simple", "truth", SEED)
+    roles = node_roles("simple", log=False)
+    stop = threading.Event()
+    threads = _nodes(spec, [r for r in roles if r != "sim"], stop)
+    commands: list[Any] = []
+    truth: list[Any] = []
+    clock = ZenohTransport(router, "sim")
+    taps = [Tap("rec:commands", ("commands/*",), lambda _t, c: commands.append(c)),
+            Tap("rec:truth", ("truth",), lambda _t, g: truth.append(g))]  # fmt: skip
+    try:
+        summary = run_clock(spec, clock, SECONDS, roles, realtime=True, extra=taps)
+    finally:
+        stop.set()
+        for th in threads:
+            th.join(10)
+        clock.close()
+    n = round(SECONDS * SETTINGS.sim.physics.frame_rate_hz)
+    assert summary["frames"] == n and [g.frame_number for g in truth] == list(range(truth[0].frame_number, n))
+    assert summary["realtime_factor"] <= 1.01  # paced by the wall clock, never ahead of it
+    # it never waits for a team, yet both teams' commands came
+    assert summary["frames_stepped_without_a_team"] == 0 and {c.team for c in commands} == {"blue", "yellow"}
+    # the simple opponent's robots drive (ours: see the README's runtime notes on free-running)
+    assert any(math.hypot(r.vx, r.vy) > 0.1 for g in truth for r in g.robots if r.team == "yellow")

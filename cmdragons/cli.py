@@ -18,7 +18,7 @@ from typing import Any, NoReturn
 import numpy as np
 
 from cmdragons.cli_runtime import add_parsers as add_runtime_parsers
-from cmdragons.cli_runtime import cmd_log, cmd_node, play_distributed
+from cmdragons.cli_runtime import cmd_log, cmd_node, cmd_replay, play_distributed
 from cmdragons.config import ConfigError
 from cmdragons.runtime.interrupt import Interrupt
 from cmdragons.runtime.log import OutputError
@@ -95,8 +95,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("play", help="play a match in the simulator; our team sees only the camera images")
     _common(p)
-    p.add_argument("--opponent", choices=("simple", "self", "none"), default="simple",
-                   help="the built-in simple team (on the true state), a copy of our team, or nobody")
+    p.add_argument("--opponent", choices=("simple", "self", "none", "outside"), default="simple",
+                   help="the built-in simple team (on the true state), a copy of our team, nobody, or (with "
+                   "--distributed) a team outside on commands/yellow (examples/outside_team.py)")
     p.add_argument("--opponent-set", metavar="KEY=VALUE", action="append", default=[],
                    help="with --opponent self: override one value of the copy's own config, on top of --config "
                    "and --set (its brain and tracker: planner, control, safety, tracker, strategy, team), "
@@ -178,12 +179,17 @@ def main(argv: Sequence[str] | None = None) -> int:
                 return _cmd_bench(args)
             if args.command == "play" and args.distributed:
                 return play_distributed(args, stop)
+            if args.command == "play" and args.opponent == "outside":
+                print("cmdragons play: --opponent outside plays over zenoh: add --distributed", file=sys.stderr)
+                return 2
             if args.command == "play":
                 return _cmd_play(args, stop)
             if args.command == "node":
                 return cmd_node(args, stop)
             if args.command == "log":
                 return cmd_log(args)
+            if args.command == "replay":
+                return cmd_replay(args, stop)
             if args.command == "vision":
                 return _cmd_vision(args)
         except ConfigError as exc:
@@ -199,7 +205,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     return 2
 
 
-def _progress(enabled: bool):  # type: ignore[no-untyped-def]
+def _progress(enabled: bool, counts: bool = True):  # type: ignore[no-untyped-def]
+    """A progress bar with a task's description, ``info`` field and times; ``counts``: "done/total"."""
     from rich.progress import (
         BarColumn,
         MofNCompleteColumn,
@@ -210,8 +217,9 @@ def _progress(enabled: bool):  # type: ignore[no-untyped-def]
     )
 
     return Progress(
-        TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(), TextColumn("{task.fields[info]}"),
-        TimeElapsedColumn(), TimeRemainingColumn(), disable=not enabled, transient=False,
+        TextColumn("[bold]{task.description}"), BarColumn(), *([MofNCompleteColumn()] if counts else []),
+        TextColumn("{task.fields[info]}"), TimeElapsedColumn(), TimeRemainingColumn(), disable=not enabled,
+        transient=False,
     )  # fmt: skip
 
 

@@ -1,11 +1,12 @@
-"""The distributed runtime's commands: ``cmdragons node ROLE``, ``cmdragons play --distributed`` and
-``cmdragons log info LOG.mcap``. Zenoh is imported only here and in the runtime, when one of these
-runs, so the embedded ``cmdragons play`` never loads it."""
+"""The distributed runtime's commands: ``cmdragons node ROLE``, ``cmdragons play --distributed``,
+``cmdragons replay LOG.mcap`` and ``cmdragons log info LOG.mcap``. Zenoh is imported only here and
+in the runtime, when one of these runs, so the embedded ``cmdragons play`` never loads it."""
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import subprocess
 import sys
 import time
@@ -15,14 +16,31 @@ from typing import Any
 
 from cmdragons.runtime.interrupt import Interrupt
 
-__all__ = ["add_parsers", "cmd_log", "cmd_node", "play_distributed"]
+__all__ = ["add_parsers", "cmd_log", "cmd_node", "cmd_replay", "play_distributed"]
 
 
 def _match_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--opponent", choices=("simple", "self", "none"), default="simple",
+    p.add_argument("--opponent", choices=("simple", "self", "none", "outside"), default="simple",
                    help="as cmdragons play: every node of a match must be given the same")  # fmt: skip
     p.add_argument("--perception", choices=("vision", "truth"), default="vision", help="as cmdragons play")
     p.add_argument("--seed", type=int, default=None, help="override sim.seed (every node the same)")
+
+
+def _non_negative(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not (value >= 0 and math.isfinite(value)):
+        raise argparse.ArgumentTypeError(f"must be 0 or more, got {text}")
+    return value
+
+
+def _speed(text: str) -> float:
+    value = _non_negative(text)
+    if value == 0:
+        raise argparse.ArgumentTypeError("must be above 0")
+    return value
 
 
 def add_parsers(sub: Any, common: Callable[[argparse.ArgumentParser], None]) -> None:
@@ -39,6 +57,20 @@ def add_parsers(sub: Any, common: Callable[[argparse.ArgumentParser], None]) -> 
                    help="sim: the nodes to wait for, comma-separated (default: all a match needs, log included)")
     p.add_argument("--out", metavar="DIR", default=None, help="log and sim: the run folder (default logs/<time>-play)")
     p.add_argument("--overwrite", action="store_true", help="let --out replace the run already in that folder")
+
+    p = sub.add_parser("replay", help="publish a run's MCAP log on zenoh again (for a team node, a viewer, ...)")
+    common(p)
+    p.add_argument("path", metavar="LOG.mcap")
+    p.add_argument("--from", dest="start", type=_non_negative, default=0.0, metavar="S",
+                   help="start S seconds into the log (default 0)")  # fmt: skip
+    p.add_argument("--speed", type=_speed, default=1.0, metavar="X",
+                   help="X times the log's pace (default 1: as recorded)")  # fmt: skip
+    p.add_argument("--skip", action="append", default=[], metavar="TOPIC",
+                   help="leave out a topic or pattern (repeatable), e.g. --skip 'commands/blue' for a live blue team")
+    p.add_argument("--wait", default=None, metavar="ROLES",
+                   help="wait for these nodes to be ready first, comma-separated (e.g. team)")
+    p.add_argument("--router", action="store_true", help="also be the zenoh router the other nodes connect to")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
     p = sub.add_parser("log", help="about a log: cmdragons log info LOG; cmdragons log convert IN OUT "
                        "(league log <-> MCAP)")
@@ -68,15 +100,31 @@ def _log_stages(spec: Any, folder: Path) -> tuple[Any, list[Any]]:
     return log, [LoggerStage(log), scene]
 
 
+def _connect(params: Any, name: str, router: bool, command: str) -> tuple[Any, Any] | None:
+    """The router session (when ``router``) and ``name``'s transport; None once the error (no
+    router there, or the endpoint taken) is said on one line."""
+    from cmdragons.runtime.zenoh_transport import RouterError, ZenohTransport, open_router
+
+    session = None
+    try:
+        session = open_router(params) if router else None
+        return session, ZenohTransport(params, name)
+    except RouterError as exc:
+        if session is not None:
+            session.close()
+        print(f"cmdragons {command}: {exc}", file=sys.stderr)
+        return None
+
+
 def cmd_node(args: argparse.Namespace, stop: Interrupt) -> int:
     from cmdragons.runtime.distributed import node_roles, run_clock, run_node, write_summary
     from cmdragons.runtime.log import run_folder
-    from cmdragons.runtime.zenoh_transport import ZenohTransport, open_router
-
     spec = _spec(args)
     params = spec.settings.runtime
-    router = open_router(params) if args.router else None
-    transport = ZenohTransport(params, args.role)
+    connected = _connect(params, args.role, args.router, f"node {args.role}")
+    if connected is None:
+        return 2
+    router, transport = connected
     log = None
     try:
         with stop.soft():
@@ -111,9 +159,8 @@ def cmd_node(args: argparse.Namespace, stop: Interrupt) -> int:
 def play_distributed(args: argparse.Namespace, stop: Interrupt) -> int:
     """``cmdragons play --distributed``: a router here, every other node as its own process (spawned,
     never forked after zenoh opened), the clock here; Ctrl-C stops them all."""
-    from cmdragons.runtime.distributed import node_roles, run_clock, write_summary
+    from cmdragons.runtime.distributed import node_roles, run_clock, wait_for_processes, write_summary
     from cmdragons.runtime.log import run_folder
-    from cmdragons.runtime.zenoh_transport import ZenohTransport, open_router
 
     spec = _spec(args)
     params = spec.settings.runtime
@@ -123,16 +170,17 @@ def play_distributed(args: argparse.Namespace, stop: Interrupt) -> int:
     for s in args.set:
         common += ["--set", s]
     common += ["--opponent", spec.opponent, "--perception", spec.perception, "--seed", str(spec.seed)]
-    router = open_router(params)
+    connected = _connect(params, "sim", True, "play")
+    if connected is None:
+        return 2
+    router, transport = connected
     children: list[subprocess.Popen[bytes]] = []
-    transport = None
     try:
         for role in roles:
             if role != "sim":
                 extra = ["--out", str(folder)] if role == "log" else []
                 children.append(subprocess.Popen([sys.executable, "-m", "cmdragons.cli", "node", role, *common,
                                                   *extra]))  # fmt: skip
-        transport = ZenohTransport(params, "sim")
         wall0 = time.perf_counter()
         with stop.soft():
             summary = run_clock(spec, transport, args.seconds, roles, should_stop=lambda: stop.requested)
@@ -147,14 +195,8 @@ def play_distributed(args: argparse.Namespace, stop: Interrupt) -> int:
         return stop.exit_code
     finally:
         with stop.shield():
-            for child in children:
-                try:
-                    child.wait(timeout=10)
-                except subprocess.TimeoutExpired:
-                    child.terminate()
-                    child.wait(timeout=5)
-            if transport is not None:
-                transport.close()
+            wait_for_processes(children)
+            transport.close()
             router.close()
 
 
@@ -222,3 +264,56 @@ def cmd_log(args: argparse.Namespace) -> int:
         print(f"summary: score blue {s.get('blue')}:{s.get('yellow')} yellow, seed {d.get('seed')}, "
               f"{d.get('seconds')} s, kicks {d.get('kicks')}, shots {d.get('shots')}")  # fmt: skip
     return 0
+
+
+def cmd_replay(args: argparse.Namespace, stop: Interrupt) -> int:
+    """``cmdragons replay LOG.mcap``: the log's messages on zenoh again, paced as recorded."""
+    from cmdragons.cli import _progress
+    from cmdragons.runtime.log import LogError
+    from cmdragons.runtime.replay import replay, replay_span
+    from cmdragons.runtime.settings import load_settings
+
+    path = Path(args.path)
+    if not path.is_file():
+        print(f"cmdragons replay: {path}: no such file; give a run's run.mcap", file=sys.stderr)
+        return 2
+    try:
+        first, last = replay_span(path, args.start)
+    except LogError as exc:
+        print(f"cmdragons replay: {exc}", file=sys.stderr)
+        return 2
+    params = load_settings(args.config, args.set).runtime
+    connected = _connect(params, "replay", args.router, "replay")
+    if connected is None:
+        return 2
+    router, transport = connected
+    try:
+        wait = [r for r in args.wait.split(",") if r] if args.wait else []
+        span = last - first - args.start
+        with _progress(not args.no_progress, counts=False) as progress, stop.soft():
+            task = progress.add_task("replay", total=max(span, 1e-9), info="")
+            shown = [0.0]
+
+            def show(t: float, n: int) -> None:
+                if t - shown[0] >= 0.25 or t >= last:
+                    shown[0] = t
+                    done = t - first - args.start
+                    progress.update(task, completed=done, info=f"{done:.1f}/{span:.1f} s, {n} messages")
+
+            if not wait:  # nobody to wait for: let the subscribers' declarations reach us first
+                transport.wait_for(lambda: stop.requested, params.settle_s)
+            result = replay(path, transport, args.start, args.speed, skip=args.skip, wait_for=wait,
+                            wait_timeout_s=params.start_timeout_s, should_stop=lambda: stop.requested,
+                            on_progress=show)  # fmt: skip
+    except (LogError, TimeoutError) as exc:
+        print(f"cmdragons replay: {exc}", file=sys.stderr)
+        return 2
+    finally:
+        with stop.shield():
+            transport.close()
+            if router is not None:
+                router.close()
+    cut = f", interrupted by {stop.signal}" if result.interrupted else ""
+    print(f"replay: {result.messages} messages, log time {result.first_s - first:.2f} .. {result.last_s - first:.2f} s "
+          f"at {args.speed:g}x on cmdragons/{params.field_name}{cut}")  # fmt: skip
+    return stop.exit_code

@@ -39,7 +39,8 @@ from cmdragons.runtime.settings import Settings
 from cmdragons.runtime.stages import SimStage, SummaryCollector, Tap
 from cmdragons.runtime.zenoh_transport import ZenohTransport
 
-__all__ = ["ROLES", "MatchSpec", "node_roles", "role_of", "run_clock", "run_node"]
+__all__ = ["ROLES", "MatchSpec", "node_roles", "role_of", "run_clock", "run_node", "wait_for_processes",
+           "write_summary"]
 
 
 
@@ -59,8 +60,9 @@ def role_of(stage: str) -> str:
 
 
 def node_roles(opponent: Opponent, log: bool) -> list[str]:
-    """The nodes a match needs (no opponent node against nobody; the log node when logging)."""
-    return [r for r in ROLES if (r != "opponent" or opponent != "none") and (r != "log" or log)]
+    """The nodes a match needs (no opponent node against nobody or a team outside; the log node
+    when logging)."""
+    return [r for r in ROLES if (r != "opponent" or opponent in ("simple", "self")) and (r != "log" or log)]
 
 
 class MatchSpec:
@@ -153,7 +155,15 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
     ready: set[str] = set()
     judged = [0]  # the referee's words so far
     summaries = SummaryCollector()
-    bus.add(Tap("control:ready", ("control/*",), lambda _t, c: ready.add(c.node) if c.command == "ready" else None))
+    started = [False]
+
+    def on_control(_topic: str, c: NodeControl) -> None:
+        if c.command == "ready":
+            if started[0]:  # a node started again mid-match: it plays on from the next frame
+                _control(transport, "clock", "start")
+            ready.add(c.node)
+
+    bus.add(Tap("control:ready", ("control/*",), on_control))
     bus.add(Tap("clock:referee", ("referee",), lambda _t, _g: judged.__setitem__(0, judged[0] + 1)))
     placed = [0]  # the referee's teleports so far (the kickoff formation first)
     bus.add(Tap("clock:teleport", ("teleport",), lambda _t, _g: placed.__setitem__(0, placed[0] + 1)))
@@ -177,6 +187,7 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
         transport.spin(0.05)
     transport.wait_for(lambda: False, params.settle_s)  # declarations propagate: nothing of frame 0 is lost
     _control(transport, "clock", "start")
+    started[0] = True
     bus.start()
     if not transport.wait_for(lambda: judged[0] >= 1 and placed[0] >= 1, 5.0):
         raise TimeoutError(f"the referee node did not give the kickoff (referee {judged[0]}, teleport {placed[0]})")
@@ -235,6 +246,18 @@ def _pace(transport: ZenohTransport, until: float) -> None:
     """Deliver what comes until the wall clock reaches ``until`` (perf_counter s)."""
     while (left := until - time.perf_counter()) > 0:
         transport.spin(min(left, 0.005))
+
+
+def wait_for_processes(children: Sequence[Any], timeout_s: float = 10.0) -> None:
+    """Wait for node processes told to stop; one that does not end within ``timeout_s`` is ended."""
+    import subprocess
+
+    for child in children:
+        try:
+            child.wait(timeout=timeout_s)
+        except subprocess.TimeoutExpired:
+            child.terminate()
+            child.wait(timeout=5)
 
 
 def write_summary(folder: Path, summary: dict[str, Any]) -> None:

@@ -18,8 +18,8 @@ from typing import Any, BinaryIO
 
 from mcap.writer import CompressionType, Writer
 
-__all__ = ["RUN_FILES", "LogError", "OutputError", "RunLog", "check_writable_file", "log_info", "read_log",
-           "run_folder"]
+__all__ = ["RUN_FILES", "LogError", "OutputError", "RunLog", "check_writable_file", "log_channels", "log_info",
+           "log_span", "read_log", "run_folder"]
 
 # what a run writes into its folder (globs): a folder holding one of these holds a run
 RUN_FILES = ("run.mcap", "summary.json", "match.mp4", "match_cameras.mp4", "report.png", "detections.jsonl",
@@ -197,7 +197,7 @@ def read_log(path: str | Path, topics: Collection[str] | None = None,
         with open(path, "rb") as f:
             reader = make_reader(f)
             for schema, channel, m in reader.iter_messages(topics=None if topics is None else list(topics),
-                                                           start_time=start_ns, log_time_order=True):  # fmt: skip
+                                                           starting_at=start_ns, log_time_order=True):  # fmt: skip
                 if schema is None:
                     raise LogError(f"{path}: topic {channel.topic} has no schema")
                 proto = message_class(schema).FromString(m.data)
@@ -207,9 +207,8 @@ def read_log(path: str | Path, topics: Collection[str] | None = None,
         raise LogError(f"{path}: not a readable log ({exc})") from None
 
 
-def log_info(path: str | Path) -> list[str]:
-    """Lines about an MCAP log: message count and duration, then per topic its count and schema.
-    :class:`LogError` for a file that is not a finished MCAP log."""
+def _summary(path: str | Path) -> Any:
+    """The summary section of a finished MCAP log (with its statistics); :class:`LogError` else."""
     from mcap.exceptions import McapError
     from mcap.reader import make_reader
 
@@ -220,6 +219,27 @@ def log_info(path: str | Path) -> list[str]:
         raise LogError(f"{path}: not an MCAP log ({exc})") from None
     if summary is None or summary.statistics is None:
         raise LogError(f"{path}: the log has no summary (an unfinished run?)")
+    return summary
+
+
+def log_span(path: str | Path) -> tuple[float, float]:
+    """The log times (s) of a log's first and last message; :class:`LogError` for a file that is
+    not a finished MCAP log, or one without messages."""
+    st = _summary(path).statistics
+    if st.message_count == 0:
+        raise LogError(f"{path}: the log holds no messages")
+    return st.message_start_time / 1e9, st.message_end_time / 1e9
+
+
+def log_channels(path: str | Path) -> list[Any]:
+    """A finished MCAP log's channels (each with its ``topic``); :class:`LogError` else."""
+    return list(_summary(path).channels.values())
+
+
+def log_info(path: str | Path) -> list[str]:
+    """Lines about an MCAP log: message count and duration, then per topic its count and schema.
+    :class:`LogError` for a file that is not a finished MCAP log."""
+    summary = _summary(path)
     st = summary.statistics
     lines = [f"{path}: {st.message_count} messages, {(st.message_end_time - st.message_start_time) / 1e9:.2f} s"]
     for cid, ch in sorted(summary.channels.items(), key=lambda kv: kv[1].topic):

@@ -50,7 +50,7 @@ from strategy.simple import SimpleTeam
 __all__ = ["OURS", "THEIRS", "Match", "Opponent", "Perception", "match_summary", "summary_stages", "truth_world",
            "wiring"]
 
-Opponent = Literal["simple", "self", "none"]
+Opponent = Literal["simple", "self", "none", "outside"]
 Perception = Literal["vision", "truth"]
 OURS: Team = "blue"
 THEIRS: Team = "yellow"
@@ -67,6 +67,9 @@ def wiring(settings: Settings, sim: Simulator, opponent: Opponent, perception: P
         RefereeStage(Referee(sim.world.field, sim.world.robot_keys(), settings.sim.referee)),
     ]
     brains: list[Team] = [OURS, THEIRS] if opponent == "self" else [OURS]
+    # who is given detections: our team, its copy, or a team outside (``outside``: its own client on
+    # the bus, commands on commands/yellow; the runtime runs nothing of it)
+    seeing: list[Team] = [OURS, THEIRS] if opponent in ("self", "outside") else [OURS]
     if perception == "vision":
         from vision.pipeline import VisionPipeline  # imported here: truth runs need no vision
 
@@ -76,7 +79,7 @@ def wiring(settings: Settings, sim: Simulator, opponent: Opponent, perception: P
     else:
         t = settings.tracker  # the noise vision measures: the tracker's measurement model
         sigmas = (t.ball.measurement_sigma_m, t.robot.measurement_sigma_m, t.robot.measurement_sigma_rad)
-        stages += [TruthPerceptionStage(team, sigmas, seed + k) for k, team in enumerate(brains)]
+        stages += [TruthPerceptionStage(team, sigmas, seed + k) for k, team in enumerate(seeing)]
         topics = {team: [f"perception/{team}"] for team in brains}
     referee_topic = "referee"
     if settings.protocols.referee.send or settings.protocols.referee.source == "game_controller":

@@ -28,25 +28,31 @@ from cmdragons.runtime import wire
 from cmdragons.runtime.bus import Handler, topic_matches
 from cmdragons.runtime.params import RuntimeParams
 
-__all__ = ["ZenohTransport", "key_expr", "open_router"]
+__all__ = ["RouterError", "ZenohTransport", "key_expr", "open_router"]
+
+
+class RouterError(Exception):
+    """The configured router cannot be listened on (another is there) or reached (none is)."""
+
+
+def _open(params: RuntimeParams, role: str) -> Any:
+    import zenoh
+
+    try:
+        return zenoh.open(params.zenoh.config(role))
+    except zenoh.ZError:
+        endpoint = params.zenoh.router
+        if role == "router":
+            raise RouterError(f"cannot listen on {endpoint} (runtime.zenoh.router): is a router running there "
+                              "already?") from None  # fmt: skip
+        raise RouterError(f"no zenoh router at {endpoint} (runtime.zenoh.router): start the match (or a node "
+                          "with --router) first") from None  # fmt: skip
 
 
 def open_router(params: RuntimeParams) -> Any:
     """A zenoh router session on the configured endpoint (the nodes are its clients); close it.
-    An endpoint already taken (another distributed run, another zenoh router) is a ConfigError
-    naming the setting that moves it."""
-    import zenoh
-
-    from cmdragons.config import ConfigError
-
-    try:
-        return zenoh.open(params.zenoh.config("router"))
-    except zenoh.ZError as exc:
-        if "in use" not in str(exc):
-            raise
-        raise ConfigError("runtime.yaml", "zenoh.router", f"{params.zenoh.router} is in use (another distributed "
-                          "run or zenoh router?): stop it, or choose another port with --set "
-                          "runtime.zenoh.router=tcp/127.0.0.1:PORT") from None
+    :class:`RouterError` when the endpoint is taken."""
+    return _open(params, "router")
 
 
 def key_expr(prefix: str, pattern: str) -> str:
@@ -71,7 +77,8 @@ class ZenohTransport:
     """Publish, subscribe and deliver over one zenoh session (a client of the configured router).
 
     ``session``: an open zenoh session to use (closed by the caller), else one is opened from
-    ``params`` and closed by :meth:`close`. ``name``: who this is, in reports."""
+    ``params`` and closed by :meth:`close` (:class:`RouterError` when no router is there).
+    ``name``: who this is, in reports."""
 
     def __init__(self, params: RuntimeParams, name: str = "node", session: Any = None,
                  err: TextIO | None = None) -> None:  # fmt: skip
@@ -82,7 +89,7 @@ class ZenohTransport:
         self.name = name
         self.prefix = f"cmdragons/{params.field_name}"
         self._own = session is None
-        self.session = zenoh.open(params.zenoh.config("client")) if session is None else session
+        self.session = _open(params, "client") if session is None else session
         self._queue: queue.SimpleQueue[tuple[str, Any, bool]] = queue.SimpleQueue()
         self._subs: list[tuple[str, Handler]] = []
         self._routes: dict[str, list[Handler]] = {}

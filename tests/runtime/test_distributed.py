@@ -1,11 +1,15 @@
 """The match as nodes on zenoh (loopback): lock-step equals the embedded match; a silent team is
-stepped without and its robots brake; a node that comes back rejoins."""
+stepped without and its robots brake; a team node killed and started again rejoins."""
 
 from __future__ import annotations
 
 import math
+import subprocess
+import sys
 import threading
-from collections.abc import Iterator
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -17,6 +21,7 @@ from tests.runtime.test_zenoh import SETTINGS, loopback_params
 
 SECONDS = 1.0
 SEED = 7
+ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture
@@ -104,3 +109,102 @@ def test_a_silent_team_is_stepped_without_and_its_robots_brake(router: Any) -> N
     # never commanded: the watchdog holds them (braked, at rest) while the opponent plays
     assert blue and all(math.hypot(r.vx, r.vy) < 0.05 for r in blue)
     assert any(math.hypot(r.vx, r.vy) > 0.1 for tr in truth for r in tr.robots if r.team == "yellow")
+
+
+def _team_process(router: Any) -> subprocess.Popen[bytes]:
+    """``cmdragons node team`` as its own process on the test's router."""
+    return subprocess.Popen([sys.executable, "-m", "cmdragons.cli", "node", "team", "--perception", "truth",
+                             "--seed", str(SEED), "--set", f"runtime.zenoh.router={router.zenoh.router}",
+                             "--set", f"runtime.field_name={router.field_name}"], cwd=ROOT)  # fmt: skip
+
+
+def _until(done: Callable[[], bool], what: str, timeout_s: float = 120.0) -> None:
+    """Wait for ``done()`` (a guard against a hang, not a measure of speed)."""
+    end = time.monotonic() + timeout_s
+    while not done():
+        assert time.monotonic() < end, f"never: {what}"
+        time.sleep(0.02)
+
+
+def test_a_killed_team_node_rejoins_and_the_match_goes_on(router: Any) -> None:
+    import dataclasses
+
+    from cmdragons.runtime.zenoh_transport import ZenohTransport
+
+    settings = dataclasses.replace(SETTINGS, runtime=dataclasses.replace(router, lockstep_wait_s=0.05))
+    spec = MatchSpec(settings, "simple", "truth", SEED)
+    roles = node_roles("simple", log=False)
+    stop = threading.Event()
+    threads = _nodes(spec, [r for r in roles if r not in ("sim", "team")], stop)
+    commands: list[int] = []  # the frames blue answered
+    frames: list[int] = []
+    enough = threading.Event()  # the restarted node answered long enough: end the match
+    clock = ZenohTransport(settings.runtime, "sim")
+    taps = [Tap("rec:commands", ("commands/blue",), lambda _t, c: commands.append(c.frame_number)),
+            Tap("rec:truth", ("truth",), lambda _t, g: frames.append(g.frame_number))]  # fmt: skip
+    result: dict[str, Any] = {}
+
+    def match() -> None:
+        result.update(run_clock(spec, clock, 60.0, roles, extra=taps, should_stop=enough.is_set))
+
+    team = _team_process(router)
+    runner = threading.Thread(target=match, daemon=True)
+    try:
+        runner.start()
+        _until(lambda: len(commands) >= 20, "the first team node's commands")
+        team.kill()
+        team.wait(10)
+        killed_at = frames[-1]
+        _until(lambda: frames[-1] >= killed_at + 30, "frames stepped without the team")
+        restarted_at = frames[-1]
+        team = _team_process(router)
+        _until(lambda: sum(f > restarted_at for f in commands) >= 30, "the restarted team node's commands")
+        enough.set()
+        runner.join(60)
+    finally:
+        enough.set()
+        stop.set()
+        team.kill()
+        team.wait(10)
+        for th in threads:
+            th.join(10)
+        clock.close()
+    assert not runner.is_alive() and result, "the match did not end"
+    gap = [f for f in frames if killed_at < f <= restarted_at]
+    assert gap and not set(gap) & set(commands)  # nobody answered while the node was gone
+    after = sorted(f for f in commands if f > restarted_at)
+    # once back, blue answers every frame to the end, in lock-step again
+    assert after == list(range(after[0], frames[-1] + 1)) and len(after) >= 30
+    assert result["frames"] == len(frames) and result["frames_stepped_without_a_team"] >= 30
+    assert result["command_faults"]["timed_out"] > 0  # the watchdog braked blue while it was gone
+
+
+def test_free_running_real_time_steps_every_frame_at_the_wall_clock(router: Any) -> None:
+    import dataclasses
+
+    from cmdragons.runtime.zenoh_transport import ZenohTransport
+
+    settings = dataclasses.replace(SETTINGS, runtime=router)
+    spec = MatchSpec(settings, "simple", "truth", SEED)
+    roles = node_roles("simple", log=False)
+    stop = threading.Event()
+    threads = _nodes(spec, [r for r in roles if r != "sim"], stop)
+    commands: list[Any] = []
+    truth: list[Any] = []
+    clock = ZenohTransport(router, "sim")
+    taps = [Tap("rec:commands", ("commands/*",), lambda _t, c: commands.append(c)),
+            Tap("rec:truth", ("truth",), lambda _t, g: truth.append(g))]  # fmt: skip
+    try:
+        summary = run_clock(spec, clock, SECONDS, roles, realtime=True, extra=taps)
+    finally:
+        stop.set()
+        for th in threads:
+            th.join(10)
+        clock.close()
+    n = round(SECONDS * SETTINGS.sim.physics.frame_rate_hz)
+    assert summary["frames"] == n and [g.frame_number for g in truth] == list(range(truth[0].frame_number, n))
+    assert summary["realtime_factor"] <= 1.01  # paced by the wall clock, never ahead of it
+    # it never waits for a team, yet both teams' commands came
+    assert summary["frames_stepped_without_a_team"] == 0 and {c.team for c in commands} == {"blue", "yellow"}
+    # the simple opponent's robots drive (ours: see the README's runtime notes on free-running)
+    assert any(math.hypot(r.vx, r.vy) > 0.1 for g in truth for r in g.robots if r.team == "yellow")

@@ -20,7 +20,8 @@ ap.add_argument("--router", default="tcp/127.0.0.1:7447", help="the match's zeno
 ap.add_argument("--field", default="main", help="the key space's <field> (runtime.field_name)")
 ap.add_argument("--speed", type=float, default=1.0, help="driving speed (m/s)")
 args = ap.parse_args()
-# a client of the router only: no listening socket, no multicast scouting (never a bare zenoh.Config())
+# a client of the router only: no listening socket, no multicast scouting (zenoh's defaults would
+# listen on every interface and scout by multicast)
 config = {"mode": "client", "connect": {"endpoints": [args.router]}, "listen": {"endpoints": []},
           "scouting": {"multicast": {"enabled": False}, "gossip": {"enabled": False}}}  # fmt: skip
 seen: dict[str | int, tuple[float, float]] = {}  # the latest position of the ball and each robot, any camera (mm)

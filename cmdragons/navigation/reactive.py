@@ -20,6 +20,7 @@ Work (the termination's unit): one step of the method per frame.
 from __future__ import annotations
 
 import math
+from abc import ABC, abstractmethod
 from dataclasses import dataclass
 
 import numpy as np
@@ -55,7 +56,7 @@ def toward(here: tuple[float, float], goal: tuple[float, float], speed: float) -
     return (goal[0] - here[0]) / d * speed, (goal[1] - here[1]) / d * speed
 
 
-class ReactiveNavigator:
+class ReactiveNavigator(ABC):
     """The base of the reactive navigators: a subclass implements :meth:`want` (and :meth:`restart`
     for its own state)."""
 
@@ -140,15 +141,17 @@ class ReactiveNavigator:
 
     # --- for the methods -------------------------------------------------------------------------
     def restart(self, start: tuple[float, float], goal: tuple[float, float]) -> None:
-        """A new goal: forget what the method learnt on the way to the last one."""
+        """A new goal: forget what the method learnt on the way to the last one (by default,
+        a method that keeps nothing between goals, nothing)."""
+        return None
 
     def hands_over(self) -> bool:
         """Whether the trajectory's approach may take the last stretch this frame."""
         return True
 
+    @abstractmethod
     def want(self, robot: RobotState, cw: CompiledWorld, goal: tuple[float, float]) -> tuple[float, float]:
         """The velocity (m/s, field frame) the method wants this frame; it may set :attr:`status`."""
-        raise NotImplementedError
 
     def cruise(self, here: tuple[float, float], goal: tuple[float, float]) -> float:
         """The speed (m/s) that still stops on the goal from here, under the limit and the cap."""

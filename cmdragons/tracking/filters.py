@@ -25,7 +25,6 @@ from typing import Any, cast
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.linalg import block_diag
 
 from cmdragons.config import Validated, derived, setting
 
@@ -505,8 +504,8 @@ class SteadyUpdates:
             return ok
         key = tuple(f._steady_epoch for f in taken)
         if key != self._gain_key:
-            self._gain = block_diag(*[f.kf.K for f in taken])
-            self._h = block_diag(*[f.kf.H for f in taken])
+            self._gain = _block_diag([f.kf.K for f in taken])
+            self._h = _block_diag([f.kf.H for f in taken])
             self._gain_key = key
         xs = kalman().update_steadystate(x[ok].ravel(), (x[ok, :3] + y[ok]).ravel(), self._gain, self._h)
         n = x.shape[1]
@@ -515,6 +514,18 @@ class SteadyUpdates:
             f.kf.x = xs[i * n : (i + 1) * n]
             f._pending_update = False
         return ok
+
+
+def _block_diag(blocks: Sequence[Vec]) -> Vec:
+    """The blocks along the diagonal of one zero matrix (scipy.linalg.block_diag's result, without
+    its per-call checks: the tracker builds one for every set of detections a camera takes)."""
+    out = np.zeros((sum(b.shape[0] for b in blocks), sum(b.shape[1] for b in blocks)))
+    r = c = 0
+    for b in blocks:
+        out[r : r + b.shape[0], c : c + b.shape[1]] = b
+        r += b.shape[0]
+        c += b.shape[1]
+    return out
 
 
 def predicted_states(filters: Sequence[RobotFilter], t: float,

@@ -507,7 +507,7 @@ def _compile_kernels(args: argparse.Namespace, overrides: Sequence[str], images:
             counted[0] = n
             progress.update(task, info=f"{n} kernels, now {name}")
 
-        seconds = warm_up(args.config, overrides, args.opponent, images, show, meanwhile)
+        seconds = warm_up(args.config, overrides, images, show, meanwhile)
         progress.update(task, total=1, completed=1, info=f"{counted[0]} kernels in {seconds:.0f} s, cached")
     if args.no_progress:
         print(f"{args.command}: compiled {counted[0]} kernels in {seconds:.0f} s (cached for next time)",

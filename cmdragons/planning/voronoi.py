@@ -18,7 +18,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.spatial import Voronoi
 
 from cmdragons.config import setting
 from cmdragons.planning.cspace import boundary_points
@@ -41,6 +40,8 @@ def voronoi_roads(cw: CompiledWorld, params: VoronoiParams) -> tuple[Graph, dict
     """The road graph: the free ridges of the generalised Voronoi diagram, their vertices as nodes
     (only those on a road)."""
     pts, labels = boundary_points(cw, params.sample_step_m, params.quad_segs)
+    from scipy.spatial import Voronoi  # here: the planners' registry is imported by every run, scipy.spatial costs 0.2 s
+
     vor = Voronoi(pts)
     rv = np.asarray(vor.ridge_vertices, dtype=np.int64)
     rp = np.asarray(vor.ridge_points, dtype=np.int64)

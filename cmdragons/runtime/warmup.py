@@ -19,16 +19,15 @@ Nothing here changes a match: the throwaway objects have their own random genera
 
 from __future__ import annotations
 
-import json
 import math
 import os
-import subprocess
-import sys
+import signal
 import threading
 import time
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from types import TracebackType
-from typing import Any
+from typing import Any, TextIO
 
 __all__ = ["CompileWatch", "cold_kernels", "warm_up"]
 
@@ -113,7 +112,7 @@ def _kernel_name(ev: Any) -> str:
     return f"{fn.__module__.rsplit('.', 2)[-2]}.{fn.__name__}"
 
 
-def warm_up(config: str | None, overrides: Sequence[str], opponent: str, images: bool,
+def warm_up(config: str | None, overrides: Sequence[str], images: bool,
             on_progress: Callable[[int, str], None], meanwhile: Callable[[], None] | None = None) -> float:  # fmt: skip
     """Compile the play's kernels now (see the module docstring); returns the wall seconds it took.
     ``on_progress(kernels compiled so far, last kernel's name)`` is called from this thread and a
@@ -129,18 +128,13 @@ def warm_up(config: str | None, overrides: Sequence[str], opponent: str, images:
             done[0] += 1
             on_progress(done[0], name)
 
-    children = []
-    for part in ("planning", "motion", "render") if images else ("planning", "motion"):
-        spec = json.dumps({"part": part, "config": config, "set": list(overrides), "opponent": opponent})
-        children.append(subprocess.Popen(
-            [sys.executable, "-m", "cmdragons.runtime.warmup", spec], stdout=subprocess.PIPE,
-            stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL, text=True,
-        ))  # fmt: skip
+    children = [_fork(part, config, overrides) for part in (("planning", "motion", "render") if images
+                                                              else ("planning", "motion"))]
 
-    def read(child: subprocess.Popen[str]) -> None:
-        assert child.stdout is not None
-        for line in child.stdout:
-            tick(line.strip())
+    def read(child: _Child) -> None:
+        with os.fdopen(child.fd, encoding="utf-8") as lines:
+            for line in lines:
+                tick(line.strip())
 
     readers = [threading.Thread(target=read, args=(c,), daemon=True) for c in children]
     for r in readers:
@@ -152,17 +146,48 @@ def warm_up(config: str | None, overrides: Sequence[str], opponent: str, images:
             if meanwhile is not None:  # after vision: the children have cached the world's kernels by now
                 meanwhile()
         for c in children:
-            c.wait()
+            os.waitpid(c.pid, 0)
+            c.done = True
         for r in readers:
             r.join()
     finally:
         for c in children:
-            if c.poll() is None:
-                c.terminate()
-                c.wait()
-            if c.stdout is not None:
-                c.stdout.close()
+            if not c.done:
+                os.kill(c.pid, signal.SIGKILL)
+                os.waitpid(c.pid, 0)
     return time.perf_counter() - t0
+
+
+@dataclass
+class _Child:
+    pid: int
+    fd: int  # the read end of the pipe the child names its kernels on
+    done: bool = False
+
+
+def _fork(part: str, config: str | None, overrides: Sequence[str]) -> _Child:
+    """A child process compiling ``part`` (see :func:`_child`). Forked, not spawned: it starts with
+    every module this process has imported (a spawned one spent a second or two of a core importing
+    them again), and this process opens no zenoh session and runs no other thread that a compile
+    could need: numba compiles nothing here before the children are forked."""
+    r, w = os.pipe()
+    pid = os.fork()
+    if pid == 0:
+        code = 1
+        try:
+            os.close(r)
+            for sig in (signal.SIGINT, signal.SIGTERM):  # the parent's handlers only set flags
+                signal.signal(sig, signal.SIG_DFL)
+            quiet = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(quiet, 1)
+            os.dup2(quiet, 2)
+            with os.fdopen(w, "w", encoding="utf-8") as out:
+                _child({"part": part, "config": config, "set": list(overrides)}, out)
+            code = 0
+        finally:
+            os._exit(code)  # no atexit handlers, no flushing of the parent's buffers
+    os.close(w)
+    return _Child(pid, r)
 
 
 def _warm_vision(config: str | None, overrides: Sequence[str]) -> None:
@@ -190,14 +215,15 @@ def _warm_vision(config: str | None, overrides: Sequence[str]) -> None:
         VisionPipeline(settings.vision, settings.field, r.model).process(image, 0, 0.0)
 
 
-def _child(spec: dict[str, Any]) -> None:
-    """A child of :func:`warm_up`: compile one part, printing each kernel's name as it starts."""
+def _child(spec: dict[str, Any], out: TextIO) -> None:
+    """A child of :func:`warm_up`: compile one part, writing each kernel's name to ``out`` as it starts."""
     from cmdragons.runtime.settings import load_settings
 
     settings = load_settings(spec["config"], spec["set"])
 
     def say(name: str) -> None:
-        print(name, flush=True)
+        out.write(name + "\n")
+        out.flush()
 
     with CompileWatch(say):
         if spec["part"] == "render":
@@ -264,6 +290,3 @@ def _warm_planner(settings: Any) -> None:
     for start in ((-2.0, -1.0), (-1.9, -1.0), (0.0, -0.6)):
         planner.solve(PlanProblem(start, (2.0, -1.0), radius, world), deadline(0.5))
 
-
-if __name__ == "__main__":
-    _child(json.loads(sys.argv[1]))

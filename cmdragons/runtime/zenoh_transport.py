@@ -105,7 +105,8 @@ class ZenohTransport:
 
     # --- subscribing -------------------------------------------------------------------------
 
-    def subscribe(self, pattern: str, handler: Handler) -> None:
+    def subscribe(self, pattern: str, handler: Handler, lane: str | None = None) -> None:
+        # every handler runs in spin's thread, in order (one stage a process, mostly): no lanes here
         self._subs.append((pattern, handler))
         self._routes.clear()
         patterns = {p for p, _ in self._subs}

@@ -13,7 +13,7 @@ import sys
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any, NoReturn
+from typing import TYPE_CHECKING, Any, NoReturn
 
 import numpy as np
 
@@ -22,6 +22,9 @@ from cmdragons.cli_runtime import cmd_log, cmd_node, cmd_replay, play_distribute
 from cmdragons.config import ConfigError
 from cmdragons.runtime.interrupt import Interrupt
 from cmdragons.runtime.log import OutputError
+
+if TYPE_CHECKING:
+    from cmdragons.runtime.report import RunData
 
 __all__ = ["main"]
 
@@ -325,7 +328,7 @@ def _cmd_play(args: argparse.Namespace, stop: Interrupt) -> int:
     from cmdragons.runtime.log import RunLog, run_folder
     from cmdragons.runtime.match import OURS, Match
     from cmdragons.runtime.overlay import MatchVideoStage
-    from cmdragons.runtime.report import pyplot
+    from cmdragons.runtime.report import ReportStage, pyplot
     from cmdragons.runtime.scene import SceneStage
     from cmdragons.runtime.settings import load_settings, load_team_settings
     from cmdragons.runtime.stages import LoggerStage, Tap
@@ -348,7 +351,8 @@ def _cmd_play(args: argparse.Namespace, stop: Interrupt) -> int:
     game = [GameState(0.0)]  # the referee's latest word, for the progress bar
     scene = SceneStage(log, settings.field_geometry(), settings.field.robot.radius_m, settings.field.robot.height_m,
                        settings.field.ball.radius_m)  # fmt: skip
-    extra: list[Stage] = [LoggerStage(log), scene,
+    report = ReportStage(OURS)
+    extra: list[Stage] = [LoggerStage(log), scene, report,
                           Tap("progress", ("referee",), lambda _topic, g: game.__setitem__(0, g))]  # fmt: skip
     video = None
     if args.video:
@@ -407,7 +411,8 @@ def _cmd_play(args: argparse.Namespace, stop: Interrupt) -> int:
         run_wall = wall - watch.seconds
         summary["realtime_factor"] = round(summary["seconds"] / run_wall, 2) if run_wall > 0 else None
         geometry = settings.field_geometry()
-        _finish_play(folder, summary, args, stop, (geometry.half_length, geometry.half_width))
+        _finish_play(folder, report.collector.result(), summary, args, stop,
+                     (geometry.half_length, geometry.half_width))  # fmt: skip
     return stop.exit_code
 
 
@@ -421,13 +426,12 @@ def _plural(n: int, word: str, many: str | None = None) -> str:
     return f"{n} {word if n == 1 else (many or word + 's')}"
 
 
-def _finish_play(folder: Path, summary: dict[str, Any], args: argparse.Namespace, stop: Interrupt,
+def _finish_play(folder: Path, run: RunData, summary: dict[str, Any], args: argparse.Namespace, stop: Interrupt,
                  half_size_m: tuple[float, float]) -> None:  # fmt: skip
-    """summary.json (with its warnings), the match report and the summary lines; the last line
-    names the output folder."""
-    from cmdragons.runtime.report import load_run, run_warnings, write_report
+    """summary.json (with its warnings), the match report of ``run`` and the summary lines; the last
+    line names the output folder."""
+    from cmdragons.runtime.report import run_warnings, write_report
 
-    run = load_run(folder / "run.mcap")
     warnings = run_warnings(run, summary)
     summary["warnings"] = warnings
     (folder / "summary.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")

@@ -1,8 +1,9 @@
 """What a play run's own output says: read back from its MCAP log, checked, and drawn on one page.
 
-:func:`load_run` reads ``run.mcap`` (topics /truth, /world/<ours>, /referee, /events and
-/report/<ours>: the bus's own messages) into arrays, so that nothing here depends on the match
-loop. :func:`run_warnings` says what looks wrong (a ball or an
+:class:`RunCollector` gathers a run's figures from the bus's own messages (topics truth,
+world/<ours>, referee, events and report/<ours>) into arrays: as the match runs
+(:class:`ReportStage`, a subscriber like the logger) or from ``run.mcap`` afterwards
+(:func:`load_run`). :func:`run_warnings` says what looks wrong (a ball or an
 own robot vision never or seldom saw, commands the simulator clamped, a match slower than real
 time). :func:`write_report` draws the match report PNG with matplotlib: the shot map, possession
 and passes over time, the robots' traces, and the stage timings of summary.json.
@@ -18,7 +19,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["RunData", "load_run", "run_warnings", "write_report"]
+from cmdragons.runtime.bus import BaseStage, Publish
+
+__all__ = ["ReportStage", "RunCollector", "RunData", "load_run", "run_warnings", "write_report"]
 
 SELDOM = 0.5  # an object tracked as visible in fewer than this fraction of the frames is "seldom seen"
 _POSSESSION_M = 0.15  # a robot within this of the ball (centre to centre) has it
@@ -44,63 +47,94 @@ class RunData:
         return len(self.t)
 
 
+class RunCollector:
+    """Gathers a :class:`RunData` from the bus's messages as they come: a play's own stage
+    (:class:`ReportStage`) or a log read back (:func:`load_run`). ``topics``: what it reads."""
+
+    def __init__(self, ours: str = "blue") -> None:
+        self.ours = ours
+        self.topics = ("truth", f"world/{ours}", f"report/{ours}", "referee", "events")
+        self._run = RunData(ours=ours)
+        self._times: list[float] = []
+        self._balls: list[tuple[float, float]] = []
+        self._traces: dict[tuple[str, int], list[tuple[float, float, float]]] = {}
+        self._world_frames = 0
+        self._ball_visible = 0
+        self._robot_visible: dict[int, int] = {}
+        self._actions: dict[int, str] = {}  # our robots' actions as the latest report had them
+
+    def take(self, topic: str, message: Any) -> None:
+        """One message of ``topic`` (one of :attr:`topics`, without the log's leading slash)."""
+        run = self._run
+        if topic == "truth":
+            t, b = message.t, message.ball
+            self._times.append(t)
+            self._balls.append((b.x, b.y))
+            near, holder = _POSSESSION_M, None
+            for r in message.robots:
+                self._traces.setdefault((r.team, r.id), []).append((t, r.x, r.y))
+                dist = math.hypot(r.x - b.x, r.y - b.y)
+                if dist < near:
+                    near, holder = dist, r.team
+            run.possession.append(holder)
+        elif topic == f"world/{self.ours}":
+            self._world_frames += 1
+            if message.ball is not None and message.ball.visible:
+                self._ball_visible += 1
+            for r in message.robots:
+                if r.team == self.ours and r.visible:
+                    self._robot_visible[r.id] = self._robot_visible.get(r.id, 0) + 1
+        elif topic == f"report/{self.ours}":
+            self._actions = {int(k): str(v) for k, v in message.actions.items()}
+        elif topic == "referee":
+            score = (message.score_blue, message.score_yellow)
+            if not run.score_t or run.score_t[-1][1:] != score:
+                run.score_t.append((float(message.t), *score))
+        elif topic == "events" and message.events:
+            for e in message.to_dict()["events"]:
+                if e.get("type") == "kick":
+                    if e.get("team") == self.ours:
+                        e = {**e, "action": self._actions.get(int(e["id"]))}  # what the strategy meant it for
+                    if self._balls:
+                        e = {**e, "x": self._balls[-1][0], "y": self._balls[-1][1]}
+                    run.kicks.append(e)
+                elif e.get("type") == "goal":
+                    run.goals.append(e)
+
+    def result(self) -> RunData:
+        """The run so far."""
+        run, frames = self._run, self._world_frames
+        run.t = np.array(self._times)
+        run.ball = np.array(self._balls).reshape(-1, 2)
+        run.traces = {k: np.array(v) for k, v in self._traces.items()}
+        run.ball_seen = self._ball_visible / frames if frames else 0.0
+        run.robot_seen = {rid: self._robot_visible.get(rid, 0) / frames if frames else 0.0
+                          for team, rid in run.traces if team == self.ours}  # fmt: skip
+        return run
+
+
+class ReportStage(BaseStage):
+    """The match report's data gathered as the match runs (a subscriber: what :func:`load_run`
+    would read back from the log, without reading it)."""
+
+    name = "report"
+
+    def __init__(self, ours: str = "blue") -> None:
+        self.collector = RunCollector(ours)
+        self.inputs = self.collector.topics
+
+    def on_message(self, topic: str, message: Any, publish: Publish) -> None:
+        self.collector.take(topic, message)
+
+
 def load_run(path: str | Path, ours: str = "blue") -> RunData:
     """Read ``run.mcap`` (see the module docstring)."""
     from cmdragons.runtime.log import read_log
 
-    run = RunData(ours=ours)
-    times: list[float] = []
-    balls: list[tuple[float, float]] = []
-    traces: dict[tuple[str, int], list[tuple[float, float, float]]] = {}
-    world_frames, ball_visible = 0, 0
-    robot_visible: dict[int, int] = {}
-    actions: dict[int, str] = {}  # our robots' actions as the latest report had them
-    topics = {"/truth", f"/world/{ours}", f"/report/{ours}", "/referee", "/events"}
-    for topic, _t, message in read_log(path, topics):
-        d = message.to_dict()
-        if topic == "/truth":
-            t = float(d["t"])
-            times.append(t)
-            b = d["ball"]
-            balls.append((b["x"], b["y"]))
-            near, holder = _POSSESSION_M, None
-            for r in d["robots"]:
-                traces.setdefault((r["team"], r["id"]), []).append((t, r["x"], r["y"]))
-                dist = math.hypot(r["x"] - b["x"], r["y"] - b["y"])
-                if dist < near:
-                    near, holder = dist, r["team"]
-            run.possession.append(holder)
-        elif topic == f"/world/{ours}":
-            world_frames += 1
-            if d.get("ball") is not None and d["ball"].get("visible", True):
-                ball_visible += 1
-            for r in d["robots"]:
-                if r["team"] == ours and r.get("visible", True):
-                    robot_visible[r["id"]] = robot_visible.get(r["id"], 0) + 1
-        elif topic == f"/report/{ours}":
-            actions = {int(k): str(v) for k, v in d.get("actions", {}).items()}
-        elif topic == "/referee":
-            s = d["score"]
-            if not run.score_t or run.score_t[-1][1:] != (s["blue"], s["yellow"]):
-                run.score_t.append((float(d["t"]), s["blue"], s["yellow"]))
-        elif topic == "/events":
-            for e in d.get("events", ()):
-                if e.get("type") == "kick":
-                    if e.get("team") == ours:
-                        e = {**e, "action": actions.get(int(e["id"]))}  # what the strategy meant it for
-                    if balls:
-                        e = {**e, "x": balls[-1][0], "y": balls[-1][1]}
-                    run.kicks.append(e)
-                elif e.get("type") == "goal":
-                    run.goals.append(e)
-    run.t = np.array(times)
-    run.ball = np.array(balls).reshape(-1, 2)
-    run.traces = {k: np.array(v) for k, v in traces.items()}
-    run.ball_seen = ball_visible / world_frames if world_frames else 0.0
-    for team, rid in run.traces:
-        if team == ours:
-            run.robot_seen[rid] = robot_visible.get(rid, 0) / world_frames if world_frames else 0.0
-    return run
+    collector = RunCollector(ours)
+    for topic, _t, message in read_log(path, {"/" + t for t in collector.topics}):
+        collector.take(topic[1:], message)
+    return collector.result()
 
 
 def _seen(fraction: float) -> str | None:

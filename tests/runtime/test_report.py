@@ -1,4 +1,4 @@
-"""The match report and the summary's warnings, from a run's own MCAP log."""
+"""The match report and the summary's warnings, from a run's own MCAP log or gathered as the match runs."""
 
 from __future__ import annotations
 
@@ -6,6 +6,7 @@ import json
 from pathlib import Path
 
 import cv2
+import numpy as np
 import pytest
 
 from cmdragons.messages import (
@@ -21,7 +22,10 @@ from cmdragons.messages import (
     WorldState,
 )
 from cmdragons.runtime.log import RunLog
-from cmdragons.runtime.report import load_run, run_warnings, write_report
+from cmdragons.runtime.match import Match
+from cmdragons.runtime.report import ReportStage, load_run, run_warnings, write_report
+from cmdragons.runtime.settings import load_settings
+from cmdragons.runtime.stages import LoggerStage
 
 
 def write_log(path: Path, frames: int, ball_visible_every: int, robot_1_visible: bool) -> None:
@@ -76,3 +80,22 @@ def test_report_png_is_one_page(tmp_path: Path) -> None:
     path = write_report(load_run(tmp_path / "run.mcap"), summary, tmp_path / "report.png")
     img = cv2.imread(str(path))
     assert img is not None and img.shape == (1000, 1400, 3)
+
+
+def test_the_report_stage_gathers_what_the_log_reads_back(tmp_path: Path) -> None:
+    settings = load_settings(Path(__file__).resolve().parents[2] / "configs")
+    log = RunLog(tmp_path / "run.mcap")
+    report = ReportStage("blue")
+    Match(settings, "simple", "truth", seed=2, extra=[LoggerStage(log), report]).run(3.0)
+    log.close()
+    live, back = report.collector.result(), load_run(tmp_path / "run.mcap")
+    assert live.frames == back.frames == 180
+    np.testing.assert_array_equal(live.t, back.t)
+    np.testing.assert_array_equal(live.ball, back.ball)
+    assert live.traces.keys() == back.traces.keys()
+    for key, trace in live.traces.items():
+        np.testing.assert_array_equal(trace, back.traces[key])
+    assert (live.possession, live.kicks, live.goals, live.score_t) == (back.possession, back.kicks, back.goals,
+                                                                       back.score_t)  # fmt: skip
+    assert (live.ball_seen, live.robot_seen) == (back.ball_seen, back.robot_seen)
+    assert live.kicks  # the match kicked: the comparison covers the kick events

@@ -25,6 +25,7 @@ from cmdragons.runtime.log import OutputError
 
 if TYPE_CHECKING:
     from cmdragons.runtime.report import RunData
+    from cmdragons.runtime.settings import Settings
 
 __all__ = ["main"]
 
@@ -374,7 +375,7 @@ def _cmd_play(args: argparse.Namespace, stop: Interrupt) -> int:
             kalman()
             pyplot()
 
-        compile_s = _compile_kernels(args, overrides, images, prepare)
+        compile_s = _compile_kernels(args, settings, images, prepare)
         match = built[0] if built else build()
         built[:] = [match]
         started = time.time()
@@ -491,7 +492,7 @@ def _their_line(summary: dict[str, Any]) -> str:
             f"brain {brain:.2f} ms median")  # fmt: skip
 
 
-def _compile_kernels(args: argparse.Namespace, overrides: Sequence[str], images: bool,
+def _compile_kernels(args: argparse.Namespace, settings: Settings, images: bool,
                      meanwhile: Callable[[], None]) -> float:  # fmt: skip
     """Compile the play's numba kernels before the match when they have no cache yet, with a
     progress line, running ``meanwhile`` as it goes; returns the wall seconds it took (0 when every
@@ -511,7 +512,7 @@ def _compile_kernels(args: argparse.Namespace, overrides: Sequence[str], images:
             counted[0] = n
             progress.update(task, info=f"{n} kernels, now {name}")
 
-        seconds = warm_up(args.config, overrides, images, show, meanwhile)
+        seconds = warm_up(settings, images, show, meanwhile)
         progress.update(task, total=1, completed=1, info=f"{counted[0]} kernels in {seconds:.0f} s, cached")
     if args.no_progress:
         print(f"{args.command}: compiled {counted[0]} kernels in {seconds:.0f} s (cached for next time)",

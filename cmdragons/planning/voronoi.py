@@ -39,9 +39,10 @@ class VoronoiParams(GraphSearchParams):
 def voronoi_roads(cw: CompiledWorld, params: VoronoiParams) -> tuple[Graph, dict[str, Any]]:
     """The road graph: the free ridges of the generalised Voronoi diagram, their vertices as nodes
     (only those on a road)."""
-    pts, labels = boundary_points(cw, params.sample_step_m, params.quad_segs)
-    from scipy.spatial import Voronoi  # here: the planners' registry is imported by every run, scipy.spatial costs 0.2 s
+    # imported here: every run imports the planners' registry, and scipy.spatial costs it 0.2 s
+    from scipy.spatial import Voronoi
 
+    pts, labels = boundary_points(cw, params.sample_step_m, params.quad_segs)
     vor = Voronoi(pts)
     rv = np.asarray(vor.ridge_vertices, dtype=np.int64)
     rp = np.asarray(vor.ridge_points, dtype=np.int64)

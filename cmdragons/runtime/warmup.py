@@ -24,10 +24,13 @@ import os
 import signal
 import threading
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass
 from types import TracebackType
-from typing import Any, TextIO
+from typing import TYPE_CHECKING, Any, TextIO
+
+if TYPE_CHECKING:
+    from cmdragons.runtime.settings import Settings
 
 __all__ = ["CompileWatch", "cold_kernels", "warm_up"]
 
@@ -112,7 +115,7 @@ def _kernel_name(ev: Any) -> str:
     return f"{fn.__module__.rsplit('.', 2)[-2]}.{fn.__name__}"
 
 
-def warm_up(config: str | None, overrides: Sequence[str], images: bool,
+def warm_up(settings: Settings, images: bool,
             on_progress: Callable[[int, str], None], meanwhile: Callable[[], None] | None = None) -> float:  # fmt: skip
     """Compile the play's kernels now (see the module docstring); returns the wall seconds it took.
     ``on_progress(kernels compiled so far, last kernel's name)`` is called from this thread and a
@@ -128,8 +131,8 @@ def warm_up(config: str | None, overrides: Sequence[str], images: bool,
             done[0] += 1
             on_progress(done[0], name)
 
-    children = [_fork(part, config, overrides) for part in (("planning", "motion", "render") if images
-                                                              else ("planning", "motion"))]
+    children = [_fork(part, settings) for part in (("planning", "motion", "render") if images
+                                                   else ("planning", "motion"))]
 
     def read(child: _Child) -> None:
         with os.fdopen(child.fd, encoding="utf-8") as lines:
@@ -142,7 +145,7 @@ def warm_up(config: str | None, overrides: Sequence[str], images: bool,
     try:
         with CompileWatch(tick):
             if images:
-                _warm_vision(config, overrides)
+                _warm_vision(settings)
             if meanwhile is not None:  # after vision: the children have cached the world's kernels by now
                 meanwhile()
         for c in children:
@@ -165,7 +168,7 @@ class _Child:
     done: bool = False
 
 
-def _fork(part: str, config: str | None, overrides: Sequence[str]) -> _Child:
+def _fork(part: str, settings: Settings) -> _Child:
     """A child process compiling ``part`` (see :func:`_child`). Forked, not spawned: it starts with
     every module this process has imported (a spawned one spent a second or two of a core importing
     them again), and this process opens no zenoh session and runs no other thread that a compile
@@ -182,7 +185,7 @@ def _fork(part: str, config: str | None, overrides: Sequence[str]) -> _Child:
             os.dup2(quiet, 1)
             os.dup2(quiet, 2)
             with os.fdopen(w, "w", encoding="utf-8") as out:
-                _child({"part": part, "config": config, "set": list(overrides)}, out)
+                _child(part, settings, out)
             code = 0
         finally:
             os._exit(code)  # no atexit handlers, no flushing of the parent's buffers
@@ -190,18 +193,16 @@ def _fork(part: str, config: str | None, overrides: Sequence[str]) -> _Child:
     return _Child(pid, r)
 
 
-def _warm_vision(config: str | None, overrides: Sequence[str]) -> None:
+def _warm_vision(settings: Settings) -> None:
     """Vision on one throwaway frame of the first camera (the ball at the centre spot and robots in
     view: every kernel of the pipeline runs), drawn by the renderer's numpy reference (the compiled
     renderer is the other child's)."""
     import numpy as np
 
-    from cmdragons.runtime.settings import load_settings
     from sim import _kernels as kern
     from sim.simulator import Simulator
     from vision.pipeline import VisionPipeline
 
-    settings = load_settings(config, overrides)
     sim = Simulator(settings.field, settings.camera_models()[:1], settings.sim, seed=0)
     snap = sim.world.snapshot()
     robots = np.ascontiguousarray(snap.robots, dtype=np.float64).reshape(-1, 8)
@@ -215,22 +216,19 @@ def _warm_vision(config: str | None, overrides: Sequence[str]) -> None:
         VisionPipeline(settings.vision, settings.field, r.model).process(image, 0, 0.0)
 
 
-def _child(spec: dict[str, Any], out: TextIO) -> None:
+def _child(part: str, settings: Settings, out: TextIO) -> None:
     """A child of :func:`warm_up`: compile one part, writing each kernel's name to ``out`` as it starts."""
-    from cmdragons.runtime.settings import load_settings
-
-    settings = load_settings(spec["config"], spec["set"])
 
     def say(name: str) -> None:
         out.write(name + "\n")
         out.flush()
 
     with CompileWatch(say):
-        if spec["part"] == "render":
+        if part == "render":
             from sim.simulator import Simulator
 
             Simulator(settings.field, settings.camera_models(), settings.sim, seed=0).capture()
-        elif spec["part"] == "planning":
+        elif part == "planning":
             _warm_planner(settings)
         else:
             _warm_motion(settings)

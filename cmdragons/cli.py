@@ -596,7 +596,12 @@ def _cmd_bench(args: argparse.Namespace) -> int:
         return 2
     print_table(args.suite, rows)
     if args.json:
-        write_json(args.json, args.suite, rows)
+        try:
+            write_json(args.json, args.suite, rows)
+        except OSError as exc:  # checked before the bench; gone since (a folder removed, a full disk)
+            print(f"cmdragons bench: --json {args.json}: not written ({exc.strerror}); the table above has "
+                  "the rows", file=sys.stderr)  # fmt: skip
+            return 2
     return 0
 
 

@@ -100,8 +100,14 @@ def check_writable_file(path: str | Path, option: str) -> Path:
     except OSError as exc:
         raise OutputError(f"{option} {p}: cannot create its folder {p.parent} ({exc.strerror}); "
                           "give a writable path") from None  # fmt: skip
-    if not os.access(p.parent, os.W_OK | os.X_OK) or (p.exists() and not os.access(p, os.W_OK)):
-        raise OutputError(f"{option} {p}: not writable (permission denied); give a writable path")
+    existed = p.exists()
+    try:  # a real open, not os.access: root passes every permission check but still cannot write in /proc
+        with open(p, "a" if existed else "x"):
+            pass
+    except OSError as exc:
+        raise OutputError(f"{option} {p}: not writable ({exc.strerror}); give a writable path") from None
+    if not existed:
+        p.unlink()
     return p
 
 

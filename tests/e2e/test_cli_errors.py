@@ -45,6 +45,7 @@ CASES = [
     (["play", "--out", "/proc/no_such_folder"], ["cannot create the output folder", "--out DIR"]),
     (["bench", "sim", "--quick", "--json", "{file}/rows.json"], ["--json", "a_file is a file"]),
     (["bench", "sim", "--quick", "--json", "{tmp}"], ["--json", "is a folder", "file name"]),
+    (["bench", "sim", "--quick", "--json", "/proc/rows.json"], ["--json", "/proc/rows.json", "not writable"]),
     (["sim", "--snapshot", "{file}/last.png", "--out", "{tmp}/s"], ["--snapshot", "a_file is a file"]),
     (["sim", "--snapshot", "{tmp}/last.txt", "--out", "{tmp}/s"], ["--snapshot", "ending in .png"]),
     (["play", "--set", "sim.physics.substeps=[1"], ["sim.physics.substeps", "not valid YAML", "[1, 2]"]),

@@ -16,7 +16,14 @@ waits for the referee's word on the frame before the next tick. So each stage ge
 order the embedded match gives them, and the same seed plays the same match. A team silent for
 ``lockstep_wait_s`` is stepped without (its robots brake by their own command timeout), and a node
 that comes back rejoins at the next frame. Free-running (``realtime``): the clock ticks at the frame
-rate of the wall clock and never waits, as real robots would not.
+rate of the wall clock and never waits, as real robots would not; it says ``start_free_running``,
+and a node that falls behind then skips to the newest sensor messages, while commands that come
+late still reach the robots (:class:`~cmdragons.runtime.stages.SimStage`).
+
+Before it says it is ready, every node plays the first frames of a throwaway match
+(:func:`rehearse`): a stage's first frames cost seconds of one-time work (lazy imports, numba's
+cached kernels, the first plans) which a free-running match would otherwise spend with its robots
+standing.
 
 Every node builds the whole wiring from the same config and seed and keeps its own stages, so all
 nodes agree on what the others are without asking.
@@ -33,15 +40,19 @@ from typing import Any, TextIO
 
 from cmdragons.messages import NodeControl, Tick
 from cmdragons.runtime.bus import Bus, Stage
-from cmdragons.runtime.match import OURS, THEIRS, Opponent, Perception, match_summary, summary_stages, wiring
+from cmdragons.runtime.match import OURS, THEIRS, Match, Opponent, Perception, match_summary, summary_stages, wiring
 from cmdragons.runtime.params import ROLES
 from cmdragons.runtime.settings import Settings
 from cmdragons.runtime.stages import SimStage, SummaryCollector, Tap
-from cmdragons.runtime.zenoh_transport import ZenohTransport
+from cmdragons.runtime.zenoh_transport import LATEST_ONLY, ZenohTransport
 
-__all__ = ["ROLES", "MatchSpec", "node_roles", "role_of", "run_clock", "run_node", "wait_for_processes",
-           "write_summary"]
+__all__ = ["ROLES", "MatchSpec", "node_roles", "rehearse", "role_of", "run_clock", "run_node",
+           "wait_for_processes", "write_summary"]
 
+
+
+FREE_RUNNING = "start_free_running"  # the clock's start of a free-running match (lock-step: "start")
+STARTS = frozenset({"start", FREE_RUNNING})
 
 
 def role_of(stage: str) -> str:
@@ -93,6 +104,51 @@ class MatchSpec:
         return sim, [s for s in every if role_of(s.name) == role], [s.name for s in every]
 
 
+def rehearse(spec: MatchSpec, role: str) -> None:
+    """Play ``runtime.rehearsal_frames`` frames of a throwaway match with ``role``'s kind of stages
+    in this process: what a stage does only on its first frames (lazy imports such as the tracker's
+    filterpy, loading numba's cached kernels, the planners' first queries; seconds on a busy machine)
+    is done before the node says it is ready, so a free-running match does not start with its teams
+    a second behind. Throwaway: its own simulator, vision, trackers and brains, nothing published."""
+    frames = spec.settings.runtime.rehearsal_frames
+    if frames == 0 or role in ("referee", "log"):
+        return
+    settings = spec.settings
+    if role in ("team", "opponent"):  # trackers and brains on the truth: the same work as on detections
+        opponent: Opponent = spec.opponent if spec.opponent in ("simple", "self") else "none"
+        match = Match(settings, opponent, "truth", seed=spec.seed,
+                      opponent_settings=spec.opponent_settings if opponent == "self" else None)  # fmt: skip
+        for _ in range(frames):
+            match.step()
+        match.close()
+        return
+    from sim.simulator import Simulator
+
+    vision = spec.perception == "vision"
+    sim = Simulator(settings.field, settings.camera_models(), settings.sim, seed=spec.seed, render=vision,
+                    referee=False)  # fmt: skip
+    pipelines = []
+    if vision and role == "vision":
+        from vision.pipeline import VisionPipeline
+
+        pipelines = [VisionPipeline(settings.vision, settings.field, m) for m in sim.cameras]
+    for _ in range(frames):
+        frame = sim.capture()
+        for pipeline, (_, image) in zip(pipelines, sorted(frame.images.items()), strict=False):
+            pipeline.process(image, frame.frame_number, frame.t_capture)
+        sim.advance()
+
+
+def _settle_heap() -> None:
+    """Collect what start-up left behind and keep the objects alive now (settings, stages, modules)
+    out of later collections: Python's full collection walks every tracked object and, after a
+    node's imports and rehearsal, held a frame up for 0.1-0.2 s."""
+    import gc
+
+    gc.collect()
+    gc.freeze()
+
+
 def _control(transport: ZenohTransport, node: str, command: str) -> None:
     transport.publish(f"control/{node}", NodeControl(node, command))
 
@@ -103,16 +159,18 @@ def run_node(role: str, spec: MatchSpec, transport: ZenohTransport, extra: Seque
     never started (stopped first)."""
     err = err if err is not None else sys.stderr
     params = spec.settings.runtime
+    rehearse(spec, role)
     stages = spec.stages(role)[1] if role != "log" else []
     bus = Bus(transport)
     commands: list[str] = []
     bus.add(Tap(f"control:{role}", ("control/clock",), lambda _t, c: commands.append(c.command)))
     for stage in [*stages, *extra]:
         bus.add(stage)
+    _settle_heap()
     started = time.monotonic()
     last_ready = -1.0
     warned = started
-    while "start" not in commands and not should_stop():  # say so until the clock hears it
+    while not set(commands) & STARTS and not should_stop():  # say so until the clock hears it
         now = time.monotonic()
         if now - last_ready >= 0.25:
             _control(transport, role, "ready")
@@ -122,8 +180,11 @@ def run_node(role: str, spec: MatchSpec, transport: ZenohTransport, extra: Seque
                   f"sim node running and connected to {params.zenoh.router}?", file=err)  # fmt: skip
             warned = now
         transport.spin(0.05)
-    if "start" not in commands:
+    if not set(commands) & STARTS:
         return 1
+    # free-running: a stage that falls behind works on the newest sensor messages, as a real team
+    # does, instead of answering a backlog the robots no longer wait for; the logger keeps every one
+    transport.latest_only = LATEST_ONLY if FREE_RUNNING in commands and role != "log" else ()
     bus.start()
     done = 0
     while not should_stop():
@@ -150,6 +211,9 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
     returns the summary (as the embedded match's, gathered over the bus); tells every node to stop."""
     err = err if err is not None else sys.stderr
     params = spec.settings.runtime
+    rehearse(spec, "sim")
+    if spec.perception == "vision":  # camera frames go through shared memory
+        transport.reserve_shared_memory()
     sim, stages, _ = spec.stages("sim")
     bus = Bus(transport)
     ready: set[str] = set()
@@ -157,10 +221,12 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
     summaries = SummaryCollector()
     started = [False]
 
+    start = FREE_RUNNING if realtime else "start"
+
     def on_control(_topic: str, c: NodeControl) -> None:
         if c.command == "ready":
             if started[0]:  # a node started again mid-match: it plays on from the next frame
-                _control(transport, "clock", "start")
+                _control(transport, "clock", start)
             ready.add(c.node)
 
     bus.add(Tap("control:ready", ("control/*",), on_control))
@@ -169,6 +235,7 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
     bus.add(Tap("clock:teleport", ("teleport",), lambda _t, _g: placed.__setitem__(0, placed[0] + 1)))
     for stage in [*stages, *extra, summaries]:
         bus.add(stage)
+    _settle_heap()
     sim_stage = next(s for s in stages if isinstance(s, SimStage))
     others = [r for r in roles if r != "sim"]
     t0 = time.monotonic()
@@ -186,7 +253,7 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
             warned = now
         transport.spin(0.05)
     transport.wait_for(lambda: False, params.settle_s)  # declarations propagate: nothing of frame 0 is lost
-    _control(transport, "clock", "start")
+    _control(transport, "clock", start)
     started[0] = True
     bus.start()
     if not transport.wait_for(lambda: judged[0] >= 1 and placed[0] >= 1, 5.0):

@@ -28,7 +28,7 @@ from cmdragons.runtime import wire
 from cmdragons.runtime.bus import Handler, topic_matches
 from cmdragons.runtime.params import RuntimeParams
 
-__all__ = ["RouterError", "ZenohTransport", "key_expr", "open_router"]
+__all__ = ["LATEST_ONLY", "RouterError", "ZenohTransport", "key_expr", "open_router"]
 
 
 class RouterError(Exception):
@@ -53,6 +53,11 @@ def open_router(params: RuntimeParams) -> Any:
     """A zenoh router session on the configured endpoint (the nodes are its clients); close it.
     :class:`RouterError` when the endpoint is taken."""
     return _open(params, "router")
+
+
+# sensor streams: a stage that falls behind skips to the newest message of each topic instead of
+# working through a backlog (in lock-step one message of each waits at a time, so none is skipped)
+LATEST_ONLY: tuple[str, ...] = ("camera/*", "detections/*", "perception/*", "world/*")
 
 
 def key_expr(prefix: str, pattern: str) -> str:
@@ -97,6 +102,10 @@ class ZenohTransport:
         self._pubs: dict[str, Any] = {}
         self._shm: Any = None
         self.dropped = 0
+        self.superseded = 0  # messages a newer one of their topic overtook before delivery
+        # topic patterns of which only the newest waiting message is delivered (a stage that falls
+        # behind skips ahead, as a real team does; a logger keeps every message: ())
+        self.latest_only: tuple[str, ...] = ()
         self.received = 0
         self.last_received = time.monotonic()
         self._err = err if err is not None else sys.stderr
@@ -141,11 +150,18 @@ class ZenohTransport:
         self.session.put(f"{self.prefix}/{topic}", payload, congestion_control=z.CongestionControl.BLOCK,
                          allowed_destination=z.Locality.REMOTE)  # fmt: skip
 
+    def reserve_shared_memory(self) -> None:
+        """Make this node's shared-memory pool now (it is made on the first large payload otherwise,
+        which then waits 0.1-0.2 s)."""
+        if self._shm is None and self.params.zenoh.shared_memory:
+            from zenoh import shm
+
+            self._shm = shm.ShmProvider.default_backend(self.params.zenoh.shm_pool_mb << 20)
+
     def _in_shared_memory(self, data: bytes) -> Any:
         from zenoh import shm
 
-        if self._shm is None:
-            self._shm = shm.ShmProvider.default_backend(self.params.zenoh.shm_pool_mb << 20)
+        self.reserve_shared_memory()
         buf = self._shm.alloc(len(data), policy=shm.BlockOn(shm.GarbageCollect()))
         buf[:] = data
         return buf
@@ -167,14 +183,27 @@ class ZenohTransport:
 
     def spin(self, timeout_s: float = 0.0) -> int:
         """Deliver what has come, waiting up to ``timeout_s`` for the first message; returns how many
-        deliveries were made."""
+        deliveries were made. Of a topic under :attr:`latest_only` only the newest message that is
+        waiting is delivered; the older ones are counted (:attr:`superseded`) and dropped."""
         n = 0
         try:
             item = self._queue.get(timeout=timeout_s) if timeout_s > 0 else self._queue.get_nowait()
         except queue.Empty:
             return 0
         while True:
-            n += self._deliver(*item)
+            batch = [item]
+            while True:
+                try:
+                    batch.append(self._queue.get_nowait())
+                except queue.Empty:
+                    break
+            newest = {topic: i for i, (topic, _, remote) in enumerate(batch)
+                      if remote and any(topic_matches(p, topic) for p in self.latest_only)}  # fmt: skip
+            for i, (topic, payload, remote) in enumerate(batch):
+                if remote and newest.get(topic, i) != i:
+                    self.superseded += 1
+                    continue
+                n += self._deliver(topic, payload, remote)
             try:
                 item = self._queue.get_nowait()
             except queue.Empty:

@@ -181,12 +181,29 @@ def test_a_killed_team_node_rejoins_and_the_match_goes_on(router: Any) -> None:
     assert result["command_faults"]["timed_out"] > 0  # the watchdog braked blue while it was gone
 
 
-def test_free_running_real_time_steps_every_frame_at_the_wall_clock(router: Any) -> None:
+def _first_moving_frame(truth: list[Any], team: str, speed_m_s: float) -> int | None:
+    """The first frame of the simulator's truth in which a robot of ``team`` moves faster than
+    ``speed_m_s``."""
+    return next((g.frame_number for g in truth if any(math.hypot(r.vx, r.vy) > speed_m_s for r in g.robots
+                                                      if r.team == team)), None)  # fmt: skip
+
+
+# free-running: our robots may start this many frames later than in lock-step (a quarter second:
+# commands come a frame or two late when the team runs behind the wall clock)
+START_SLACK_FRAMES = 15
+
+
+def test_free_running_real_time_steps_every_frame_and_our_robots_drive_at_once(router: Any) -> None:
     import dataclasses
 
     from cmdragons.runtime.zenoh_transport import ZenohTransport
 
     settings = dataclasses.replace(SETTINGS, runtime=router)
+    lockstep: list[Any] = []
+    Match(settings, "simple", "truth", seed=SEED, extra=[Tap("rec", ("truth",), lambda _t, g: lockstep.append(g))]
+          ).run(SECONDS)  # fmt: skip
+    starts = _first_moving_frame(lockstep, "blue", 0.1)
+    assert starts is not None  # the reference: when our robots drive in lock-step
     spec = MatchSpec(settings, "simple", "truth", SEED)
     roles = node_roles("simple", log=False)
     stop = threading.Event()
@@ -208,5 +225,8 @@ def test_free_running_real_time_steps_every_frame_at_the_wall_clock(router: Any)
     assert summary["realtime_factor"] <= 1.01  # paced by the wall clock, never ahead of it
     # it never waits for a team, yet both teams' commands came
     assert summary["frames_stepped_without_a_team"] == 0 and {c.team for c in commands} == {"blue", "yellow"}
-    # the simple opponent's robots drive (ours: see the README's runtime notes on free-running)
+    # the simple opponent's robots drive, and ours from (nearly) the frame they do in lock-step: every
+    # node played its first frames before the match, and commands that come late still reach the robots
     assert any(math.hypot(r.vx, r.vy) > 0.1 for g in truth for r in g.robots if r.team == "yellow")
+    moving = _first_moving_frame(truth, "blue", 0.1)
+    assert moving is not None and moving <= starts + START_SLACK_FRAMES, (moving, starts)

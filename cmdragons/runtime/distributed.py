@@ -55,12 +55,12 @@ FREE_RUNNING = "start_free_running"  # the clock's start of a free-running match
 STARTS = frozenset({"start", FREE_RUNNING})
 
 
-def role_of(stage: str) -> str:
-    """The node a stage of the wiring runs in."""
+def role_of(stage: str, vision_with_sim: bool = False) -> str:
+    """The node a stage of the wiring runs in (``vision_with_sim``: vision in the sim node)."""
     if stage == "sim":
         return "sim"
     if stage.startswith(("vision/", "perception/")):
-        return "vision"
+        return "sim" if vision_with_sim else "vision"
     if stage in (f"tracker/{OURS}", f"team/{OURS}", f"stats/{OURS}", "timing"):
         return "team"
     if stage.startswith("opponent/") or stage in (f"tracker/{THEIRS}", f"team/{THEIRS}", f"stats/{THEIRS}"):
@@ -70,10 +70,11 @@ def role_of(stage: str) -> str:
     raise ValueError(f"no node runs stage {stage!r}")
 
 
-def node_roles(opponent: Opponent, log: bool) -> list[str]:
+def node_roles(opponent: Opponent, log: bool, vision_with_sim: bool = False) -> list[str]:
     """The nodes a match needs (no opponent node against nobody or a team outside; the log node
-    when logging)."""
-    return [r for r in ROLES if (r != "opponent" or opponent in ("simple", "self")) and (r != "log" or log)]
+    when logging; no vision node when vision runs in the sim node)."""
+    return [r for r in ROLES if (r != "opponent" or opponent in ("simple", "self")) and (r != "log" or log)
+            and (r != "vision" or not vision_with_sim)]  # fmt: skip
 
 
 class MatchSpec:
@@ -101,7 +102,12 @@ class MatchSpec:
         sim = Simulator(self.settings.field, self.settings.camera_models(), params, seed=self.seed, render=render,
                         referee=False)  # fmt: skip
         every = wiring(self.settings, sim, self.opponent, self.perception, sim.seed, self.opponent_settings)
-        return sim, [s for s in every if role_of(s.name) == role], [s.name for s in every]
+        placed = self.settings.runtime.vision_with_sim
+        return sim, [s for s in every if role_of(s.name, placed) == role], [s.name for s in every]
+
+    def roles(self, log: bool) -> list[str]:
+        """The nodes of this match (:func:`node_roles`)."""
+        return node_roles(self.opponent, log, self.settings.runtime.vision_with_sim)
 
 
 def rehearse(spec: MatchSpec, role: str) -> None:
@@ -211,8 +217,10 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
     returns the summary (as the embedded match's, gathered over the bus); tells every node to stop."""
     err = err if err is not None else sys.stderr
     params = spec.settings.runtime
-    rehearse(spec, "sim")
-    if spec.perception == "vision":  # camera frames go through shared memory
+    rehearse(spec, "vision" if params.vision_with_sim else "sim")  # (vision's rehearsal has the simulator's)
+    if params.vision_with_sim:
+        transport.local_only = ("camera/*",)  # vision is here: the frames stay in this process
+    elif spec.perception == "vision":  # camera frames go through shared memory
         transport.reserve_shared_memory()
     sim, stages, _ = spec.stages("sim")
     bus = Bus(transport)
@@ -289,7 +297,7 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
         if on_frame is not None:
             on_frame(i)
     wall = time.perf_counter() - wall0
-    wanted = {s for s in summary_stages(spec.opponent) if role_of(s) in roles}
+    wanted = {s for s in summary_stages(spec.opponent) if role_of(s, params.vision_with_sim) in roles}
     _control(transport, "clock", "summarize")
     bus.summarize()
     if not transport.wait_for(lambda: wanted <= set(summaries.figures), params.start_timeout_s):
@@ -301,7 +309,7 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
         summary = match_summary(f, {"frame": frame_ms}, sim.seed, spec.opponent, spec.perception)
     else:  # a node of the match was not there: what the others said
         summary = {"seed": sim.seed, "opponent": spec.opponent, "perception": spec.perception,
-                   "missing_nodes": sorted(set(node_roles(spec.opponent, log=False)) - set(roles)),
+                   "missing_nodes": sorted(set(spec.roles(log=False)) - set(roles)),
                    "score": f["referee"]["score"], "command_faults": f["sim"]["command_faults"]}  # fmt: skip
     summary.update(frames=len(frame_ms), wall_seconds=round(wall, 3), frames_stepped_without_a_team=silent,
                    realtime_factor=round(sim.t / wall, 2) if wall > 0 else None,

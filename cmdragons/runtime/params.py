@@ -61,6 +61,7 @@ class RuntimeParams(Validated):
     start_timeout_s: float = setting(60.0, lo=1.0, hi=3600.0)  # the match starts once every node is up, or gives up
     settle_s: float = setting(0.5, lo=0.0, hi=60.0)  # every node up: subscriptions reach every publisher in this
     rehearsal_frames: int = setting(12, lo=0, hi=600)  # frames of a throwaway match a node plays before it is ready
+    vision_with_sim: bool = False  # vision (or the truth perception) runs in the sim node; camera frames stay there
 
     def __post_init__(self) -> None:
         super().__post_init__()

@@ -4,7 +4,8 @@ separate processes (or machines).
 A topic ``t`` is the key ``cmdragons/<field>/t``; a pattern ``p/*`` is ``cmdragons/<field>/p/**``.
 Messages go as protobuf (:mod:`cmdragons.runtime.wire`); payloads from ``shm_min_bytes`` on (camera
 frames) are written into zenoh's shared memory, so a same-host subscriber maps them instead of
-copying them through a socket. Publishers block rather than drop when a link is congested: a
+copying them through a socket; a camera frame's image is copied once from its array into the
+buffer, beside the message's header (:func:`~cmdragons.runtime.wire.encode_chunks`). Publishers block rather than drop when a link is congested: a
 lock-step match must lose nothing.
 
 Zenoh delivers on its own threads; this transport only queues there. :meth:`ZenohTransport.spin`
@@ -106,6 +107,7 @@ class ZenohTransport:
         # topic patterns of which only the newest waiting message is delivered (a stage that falls
         # behind skips ahead, as a real team does; a logger keeps every message: ())
         self.latest_only: tuple[str, ...] = ()
+        self.local_only: tuple[str, ...] = ()  # topic patterns published to this process's stages only
         self.received = 0
         self.last_received = time.monotonic()
         self._err = err if err is not None else sys.stderr
@@ -141,9 +143,15 @@ class ZenohTransport:
     def publish(self, topic: str, message: Any) -> None:
         if self._handlers(topic):
             self._queue.put((topic, wire.canonical(message), False))
-        data = wire.encode(message)
+        if any(topic_matches(p, topic) for p in self.local_only):
+            return
+        chunks = wire.encode_chunks(message)
+        size = sum(len(c) for c in chunks)
         zp = self.params.zenoh
-        payload = self._in_shared_memory(data) if zp.shared_memory and len(data) >= zp.shm_min_bytes else data
+        if zp.shared_memory and size >= zp.shm_min_bytes:
+            payload = self._in_shared_memory(chunks, size)
+        else:
+            payload = chunks[0] if len(chunks) == 1 else b"".join(chunks)
         # the session's put, not a publisher declared now: a new publisher drops what it is given until
         # it learnt who subscribes, the session routes by what it knows already
         z = self._zenoh
@@ -158,12 +166,16 @@ class ZenohTransport:
 
             self._shm = shm.ShmProvider.default_backend(self.params.zenoh.shm_pool_mb << 20)
 
-    def _in_shared_memory(self, data: bytes) -> Any:
+    def _in_shared_memory(self, chunks: tuple[bytes, ...], size: int) -> Any:
+        """A shared-memory buffer holding ``chunks`` one after another (each copied once)."""
         from zenoh import shm
 
         self.reserve_shared_memory()
-        buf = self._shm.alloc(len(data), policy=shm.BlockOn(shm.GarbageCollect()))
-        buf[:] = data
+        buf = self._shm.alloc(size, policy=shm.BlockOn(shm.GarbageCollect()))
+        at = 0
+        for chunk in chunks:
+            buf[at : at + len(chunk)] = chunk
+            at += len(chunk)
         return buf
 
     def has_subscribers(self, topic: str) -> bool:

@@ -52,18 +52,27 @@ def _nodes(spec: MatchSpec, roles: list[str], stop: threading.Event) -> list[thr
     return threads
 
 
-def test_lock_step_nodes_play_the_embedded_match(router: Any) -> None:
+# small camera images keep a match through the cameras quick (vision finds less on them: the same
+# for both runs)
+SMALL_CAMERAS = ["cameras.auto.resolution_px=[160,120]", "cameras.auto.grid=[2,1]"]
+
+
+@pytest.mark.parametrize(("perception", "vision_with_sim"), [("truth", False), ("truth", True), ("vision", True)])
+def test_lock_step_nodes_play_the_embedded_match(router: Any, perception: Any, vision_with_sim: bool) -> None:
     import dataclasses
 
+    from cmdragons.runtime.settings import load_settings
     from cmdragons.runtime.zenoh_transport import ZenohTransport
 
-    settings = dataclasses.replace(SETTINGS, runtime=router)
+    base = SETTINGS if perception == "truth" else load_settings(ROOT / "configs", SMALL_CAMERAS)
+    settings = dataclasses.replace(base, runtime=dataclasses.replace(router, vision_with_sim=vision_with_sim))
     embedded: list[Any] = []
-    m = Match(settings, "simple", "truth", seed=SEED,
+    m = Match(settings, "simple", perception, seed=SEED,
               extra=[Tap("rec", ("commands/*", "referee"), lambda t, x: embedded.append((t, x)))])  # fmt: skip
     expected = m.run(SECONDS)
-    spec = MatchSpec(settings, "simple", "truth", m.seed)
-    roles = node_roles("simple", log=False)
+    spec = MatchSpec(settings, "simple", perception, m.seed)
+    roles = spec.roles(log=False)
+    assert ("vision" in roles) != vision_with_sim
     stop = threading.Event()
     threads = _nodes(spec, [r for r in roles if r != "sim"], stop)
     got: list[Any] = []

@@ -89,7 +89,8 @@ class _InProcessTicks(_TimesTicks, InProcessTransport):
 
 def _latency_tap(tick: list[float], latencies: list[float]) -> Tap:
     """A tap that times each frame from its tick to our team's commands for it arriving."""
-    return Tap("bench:commands", ("commands/blue",), lambda _t, _m: latencies.append((time.perf_counter() - tick[0]) * 1e3))
+    return Tap("bench:commands", ("commands/blue",),
+               lambda _t, _m: latencies.append((time.perf_counter() - tick[0]) * 1e3))
 
 
 def _zenoh_latencies(settings: Settings, seconds: float, vision_with_sim: bool) -> tuple[list[float], float]:
@@ -185,7 +186,7 @@ def _floor_row(settings: Settings, messages: int, size_bytes: int = 300) -> dict
         with zenoh.open(params.zenoh.config("client")) as session:
             back = threading.Event()
             session.declare_subscriber(f"{prefix}/pong", lambda _s: back.set())
-            ping = session.declare_publisher(f"{prefix}/ping")
+            ping: Any = session.declare_publisher(f"{prefix}/ping")  # (the stubs type matching_status wrongly)
             if not ready.wait(60.0):
                 raise TimeoutError("the echo process never came up")
             _until(lambda: bool(ping.matching_status.matching), 10.0, "the echo's subscriber")

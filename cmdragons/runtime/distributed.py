@@ -181,7 +181,7 @@ def run_node(role: str, spec: MatchSpec, transport: ZenohTransport, extra: Seque
         if now - last_ready >= 0.25:
             _control(transport, role, "ready")
             last_ready = now
-        if now - warned >= params.peer_timeout_s:
+        if now - warned >= params.peer_timeout_s and not commands:  # (the clock says when it waits for others)
             print(f"node {role}: no match clock on cmdragons/{params.field_name} for {now - started:.0f} s: is the "
                   f"sim node running and connected to {params.zenoh.router}?", file=err)  # fmt: skip
             warned = now
@@ -248,6 +248,7 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
     others = [r for r in roles if r != "sim"]
     t0 = time.monotonic()
     warned = t0
+    said = -1.0
     while not ready >= set(others):
         if should_stop():
             return {}
@@ -259,6 +260,9 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
             print(f"sim: waiting for nodes {', '.join(sorted(set(others) - ready))} on {params.zenoh.router}",
                   file=err)  # fmt: skip
             warned = now
+        if now - said >= 0.25:  # the nodes that are ready hear that the clock is there
+            _control(transport, "clock", "waiting")
+            said = now
         transport.spin(0.05)
     transport.wait_for(lambda: False, params.settle_s)  # declarations propagate: nothing of frame 0 is lost
     _control(transport, "clock", start)

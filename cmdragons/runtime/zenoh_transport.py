@@ -5,8 +5,8 @@ A topic ``t`` is the key ``cmdragons/<field>/t``; a pattern ``p/*`` is ``cmdrago
 Messages go as protobuf (:mod:`cmdragons.runtime.wire`); payloads from ``shm_min_bytes`` on (camera
 frames) are written into zenoh's shared memory, so a same-host subscriber maps them instead of
 copying them through a socket; a camera frame's image is copied once from its array into the
-buffer, beside the message's header (:func:`~cmdragons.runtime.wire.encode_chunks`). Publishers block rather than drop when a link is congested: a
-lock-step match must lose nothing.
+buffer, beside the message's header (:func:`~cmdragons.runtime.wire.encode_chunks`). Publishers
+block rather than drop when a link is congested: a lock-step match must lose nothing.
 
 Zenoh delivers on its own threads; this transport only queues there. :meth:`ZenohTransport.spin`
 decodes and delivers in the calling thread, first received first delivered, each message to its

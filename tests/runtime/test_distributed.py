@@ -239,3 +239,36 @@ def test_free_running_real_time_steps_every_frame_and_our_robots_drive_at_once(r
     assert any(math.hypot(r.vx, r.vy) > 0.1 for g in truth for r in g.robots if r.team == "yellow")
     moving = _first_moving_frame(truth, "blue", 0.1)
     assert moving is not None and moving <= starts + START_SLACK_FRAMES, (moving, starts)
+
+
+def test_a_node_without_a_clock_says_so_and_not_while_the_clock_waits_for_others(router: Any) -> None:
+    import dataclasses
+    import io
+
+    from cmdragons.messages import NodeControl
+    from cmdragons.runtime.zenoh_transport import ZenohTransport
+
+    params = dataclasses.replace(router, peer_timeout_s=0.2, rehearsal_frames=0)
+    spec = MatchSpec(dataclasses.replace(SETTINGS, runtime=params), "simple", "truth", SEED)
+    said = {}
+    for clock_there in (False, True):
+        err = io.StringIO()
+        node, clock = ZenohTransport(params, "referee"), ZenohTransport(params, "sim")
+        heard: list[str] = []
+        clock.subscribe("control/*", lambda _t, c, heard=heard: heard.append(c.node))
+        enough = lambda heard=heard: len(heard) >= 12  # noqa: E731
+        runner = threading.Thread(target=run_node, args=("referee", spec, node),
+                                  kwargs={"err": err, "should_stop": enough}, daemon=True)  # fmt: skip
+        try:
+            runner.start()
+            while runner.is_alive():  # the node says it is ready four times a second: 3 s in all
+                if clock_there:
+                    clock.publish("control/clock", NodeControl("clock", "waiting"))
+                clock.spin(0.05)
+            runner.join(10)
+        finally:
+            node.close()
+            clock.close()
+        said[clock_there] = err.getvalue()
+    assert "no match clock" in said[False] and "is the sim node running" in said[False]
+    assert said[True] == ""

@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import json
 import sys
+import threading
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -111,14 +112,17 @@ class MatchSpec:
 
 
 def rehearse(spec: MatchSpec, role: str) -> None:
-    """Play ``runtime.rehearsal_frames`` frames of a throwaway match with ``role``'s kind of stages
-    in this process: what a stage does only on its first frames (lazy imports such as the tracker's
-    filterpy, loading numba's cached kernels, the planners' first queries; seconds on a busy machine)
-    is done before the node says it is ready, so a free-running match does not start with its teams
-    a second behind. Throwaway: its own simulator, vision, trackers and brains, nothing published."""
+    """Play the first frames of a throwaway match with ``role``'s kind of stages in this process:
+    what a stage does only on its first frames (lazy imports such as the tracker's filterpy, loading
+    numba's cached kernels, the planners' first queries; seconds on a busy machine) is done before
+    the node says it is ready, so a free-running match does not start with its teams a second
+    behind. Trackers and brains play ``runtime.rehearsal_frames`` frames (their first plans come a
+    few frames in), the simulator and vision two (their kernels load on the first); the referee,
+    the logger and the simple opponent need none. Throwaway: its own simulator, vision, trackers
+    and brains, nothing published."""
     frames = spec.settings.runtime.rehearsal_frames
-    if frames == 0 or role in ("referee", "log"):
-        return
+    if frames == 0 or role in ("referee", "log") or (role == "opponent" and spec.opponent != "self"):
+        return  # (the simple opponent's first frame costs what its others do)
     settings = spec.settings
     if role in ("team", "opponent"):  # trackers and brains on the truth: the same work as on detections
         opponent: Opponent = spec.opponent if spec.opponent in ("simple", "self") else "none"
@@ -138,7 +142,7 @@ def rehearse(spec: MatchSpec, role: str) -> None:
         from vision.pipeline import VisionPipeline
 
         pipelines = [VisionPipeline(settings.vision, settings.field, m) for m in sim.cameras]
-    for _ in range(frames):
+    for _ in range(min(frames, 2)):  # the renderer's and vision's kernels load on the first frame
         frame = sim.capture()
         for pipeline, (_, image) in zip(pipelines, sorted(frame.images.items()), strict=False):
             pipeline.process(image, frame.frame_number, frame.t_capture)
@@ -217,7 +221,9 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
     returns the summary (as the embedded match's, gathered over the bus); tells every node to stop."""
     err = err if err is not None else sys.stderr
     params = spec.settings.runtime
-    rehearse(spec, "vision" if params.vision_with_sim else "sim")  # (vision's rehearsal has the simulator's)
+    # rehearsed while the clock waits for the nodes (and says so): (vision's rehearsal has the simulator's)
+    rehearsal = threading.Thread(target=rehearse, args=(spec, "vision" if params.vision_with_sim else "sim"))
+    rehearsal.start()
     if params.vision_with_sim:
         transport.local_only = ("camera/*",)  # vision is here: the frames stay in this process
     elif spec.perception == "vision":  # camera frames go through shared memory
@@ -243,20 +249,20 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
     bus.add(Tap("clock:teleport", ("teleport",), lambda _t, _g: placed.__setitem__(0, placed[0] + 1)))
     for stage in [*stages, *extra, summaries]:
         bus.add(stage)
-    _settle_heap()
     sim_stage = next(s for s in stages if isinstance(s, SimStage))
     others = [r for r in roles if r != "sim"]
     t0 = time.monotonic()
     warned = t0
     said = -1.0
-    while not ready >= set(others):
+    while not ready >= set(others) or rehearsal.is_alive():
         if should_stop():
+            rehearsal.join()
             return {}
         now = time.monotonic()
         if now - t0 > params.start_timeout_s:
             raise TimeoutError(f"nodes {', '.join(sorted(set(others) - ready))} did not come up within "
                                f"{params.start_timeout_s:.0f} s (runtime.start_timeout_s)")  # fmt: skip
-        if now - warned >= params.peer_timeout_s:
+        if now - warned >= params.peer_timeout_s and not ready >= set(others):
             print(f"sim: waiting for nodes {', '.join(sorted(set(others) - ready))} on {params.zenoh.router}",
                   file=err)  # fmt: skip
             warned = now
@@ -264,6 +270,7 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
             _control(transport, "clock", "waiting")
             said = now
         transport.spin(0.05)
+    _settle_heap()
     transport.wait_for(lambda: False, params.settle_s)  # declarations propagate: nothing of frame 0 is lost
     _control(transport, "clock", start)
     started[0] = True

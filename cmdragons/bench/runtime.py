@@ -152,56 +152,17 @@ def _latency_rows(settings: Settings, seconds: float, rounds: int) -> list[dict[
     return rows
 
 
-def _echo(config: str, prefix: str, ready: Any, done: Any) -> None:
-    """The far end of :func:`_floor_row` (its own process): every ping back as a pong."""
-    import zenoh
-
-    with zenoh.open(zenoh.Config.from_json5(config)) as session:
-        pong = session.declare_publisher(f"{prefix}/pong")
-        session.declare_subscriber(f"{prefix}/ping", lambda sample: pong.put(sample.payload))
-        ready.set()
-        done.wait(120.0)
-
-
 def _floor_row(settings: Settings, messages: int, size_bytes: int = 300) -> dict[str, Any]:
     """zenoh alone, no protobuf and no stage: a message of a command's size from one client to
     another process's client through the router, which answers at once from its callback; half
     the round trip is what one hop of the match cannot go below."""
-    import json
-    import multiprocessing
-
-    import zenoh
-
-    from cmdragons.runtime.zenoh_transport import open_router
+    from cmdragons.runtime.zenoh_transport import open_router, round_trips
 
     params = _loopback(settings.runtime)
-    prefix = f"cmdragons/{params.field_name}/floor"
     router = open_router(params)
-    ctx = multiprocessing.get_context("spawn")
-    ready, done = ctx.Event(), ctx.Event()
-    echo = ctx.Process(target=_echo, args=(json.dumps(params.zenoh.session("client")), prefix, ready, done))
-    echo.start()
-    rtt: list[float] = []
     try:
-        with zenoh.open(params.zenoh.config("client")) as session:
-            back = threading.Event()
-            session.declare_subscriber(f"{prefix}/pong", lambda _s: back.set())
-            ping: Any = session.declare_publisher(f"{prefix}/ping")  # (the stubs type matching_status wrongly)
-            if not ready.wait(60.0):
-                raise TimeoutError("the echo process never came up")
-            _until(lambda: bool(ping.matching_status.matching), 10.0, "the echo's subscriber")
-            time.sleep(0.2)  # its pong publisher's route reaches this session too
-            payload = bytes(size_bytes)
-            for _ in range(messages):
-                back.clear()
-                t0 = time.perf_counter()
-                ping.put(payload)
-                if back.wait(1.0):
-                    rtt.append((time.perf_counter() - t0) * 1e3)
-                time.sleep(0.002)
+        rtt = round_trips(params, messages, size_bytes)
     finally:
-        done.set()
-        echo.join(10)
         router.close()
     one_way = np.asarray(rtt[10:]) / 2
     return {"name": "zenoh_one_hop_floor", "messages": len(one_way), "bytes": size_bytes,

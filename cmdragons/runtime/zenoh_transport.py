@@ -29,7 +29,7 @@ from cmdragons.runtime import wire
 from cmdragons.runtime.bus import Handler, topic_matches
 from cmdragons.runtime.params import RuntimeParams
 
-__all__ = ["LATEST_ONLY", "RouterError", "ZenohTransport", "key_expr", "open_router"]
+__all__ = ["LATEST_ONLY", "RouterError", "ZenohTransport", "key_expr", "open_router", "round_trips"]
 
 
 class RouterError(Exception):
@@ -264,3 +264,58 @@ class ZenohTransport:
         self._pubs.clear()
         if self._own:
             self.session.close()
+
+
+def _echo(config: str, prefix: str, ready: Any, done: Any) -> None:
+    """The far end of :func:`round_trips` (its own process): every ping back as a pong."""
+    import zenoh
+
+    with zenoh.open(zenoh.Config.from_json5(config)) as session:
+        pong = session.declare_publisher(f"{prefix}/pong")
+        session.declare_subscriber(f"{prefix}/ping", lambda sample: pong.put(sample.payload))
+        ready.set()
+        done.wait(120.0)
+
+
+def round_trips(params: RuntimeParams, messages: int, size_bytes: int) -> list[float]:
+    """zenoh alone (no protobuf, no stage): ``messages`` payloads of ``size_bytes`` to a client in
+    another process (spawned), which puts each back from its callback; the round trips (ms). Both
+    are clients of the router of ``params`` (which must be open)."""
+    import json
+    import multiprocessing
+    import threading
+
+    import zenoh
+
+    prefix = f"cmdragons/{params.field_name}/floor"
+    ctx = multiprocessing.get_context("spawn")  # never fork a process that has zenoh open
+    ready, done = ctx.Event(), ctx.Event()
+    echo = ctx.Process(target=_echo, args=(json.dumps(params.zenoh.session("client")), prefix, ready, done))
+    echo.start()
+    rtt: list[float] = []
+    try:
+        with zenoh.open(params.zenoh.config("client")) as session:
+            back = threading.Event()
+            session.declare_subscriber(f"{prefix}/pong", lambda _s: back.set())
+            ping: Any = session.declare_publisher(f"{prefix}/ping")  # (the stubs type matching_status wrongly)
+            if not ready.wait(60.0):
+                raise TimeoutError("the echo process never came up")
+            for _ in range(500):  # its subscriber reaches this session
+                if ping.matching_status.matching:
+                    break
+                time.sleep(0.02)
+            else:
+                raise TimeoutError("the echo's subscriber never reached this session")
+            time.sleep(0.2)  # its pong publisher's route reaches this session too
+            payload = bytes(size_bytes)
+            for _ in range(messages):
+                back.clear()
+                t0 = time.perf_counter()
+                ping.put(payload)
+                if back.wait(1.0):
+                    rtt.append((time.perf_counter() - t0) * 1e3)
+                time.sleep(0.002)
+    finally:
+        done.set()
+        echo.join(10)
+    return rtt

@@ -157,3 +157,9 @@ def test_garbage_is_counted_dropped_and_reported_once(router: RuntimeParams) -> 
     finally:
         raw.close()
         b.close()
+
+
+def test_every_ping_of_the_floor_measure_comes_back(router: RuntimeParams) -> None:
+    from cmdragons.runtime.zenoh_transport import round_trips
+
+    assert len(round_trips(router, 20, 300)) == 20  # (what they take is bench runtime's, not a test's)

@@ -117,7 +117,7 @@ def _connect(params: Any, name: str, router: bool, command: str) -> tuple[Any, A
 
 
 def cmd_node(args: argparse.Namespace, stop: Interrupt) -> int:
-    from cmdragons.runtime.distributed import node_roles, run_clock, run_node, write_summary
+    from cmdragons.runtime.distributed import run_clock, run_node, write_summary
     from cmdragons.runtime.log import run_folder
     spec = _spec(args)
     params = spec.settings.runtime
@@ -129,7 +129,7 @@ def cmd_node(args: argparse.Namespace, stop: Interrupt) -> int:
     try:
         with stop.soft():
             if args.role == "sim":
-                roles = args.roles.split(",") if args.roles else node_roles(spec.opponent, log=True)
+                roles = args.roles.split(",") if args.roles else spec.roles(log=True)
                 # the log node may share the folder (and have made run.mcap in it already)
                 folder = Path(args.out) if args.out else run_folder("play")
                 folder.mkdir(parents=True, exist_ok=True)
@@ -159,13 +159,13 @@ def cmd_node(args: argparse.Namespace, stop: Interrupt) -> int:
 def play_distributed(args: argparse.Namespace, stop: Interrupt) -> int:
     """``cmdragons play --distributed``: a router here, every other node as its own process (spawned,
     never forked after zenoh opened), the clock here; Ctrl-C stops them all."""
-    from cmdragons.runtime.distributed import node_roles, run_clock, wait_for_processes, write_summary
+    from cmdragons.runtime.distributed import run_clock, wait_for_processes, write_summary
     from cmdragons.runtime.log import run_folder
 
     spec = _spec(args)
     params = spec.settings.runtime
     folder = run_folder("play", args.out, overwrite=args.overwrite)
-    roles = node_roles(spec.opponent, log=True)
+    roles = spec.roles(log=True)
     common = ["--config", args.config] if args.config else []
     for s in args.set:
         common += ["--set", s]

@@ -816,7 +816,8 @@ class StageSummary:
 @dataclass(frozen=True)
 class NodeControl:
     """The distributed runtime's own word between nodes: a node says it is ``ready``; the match's
-    clock tells every node to ``start``, ``summarize`` or ``stop``."""
+    clock says it is ``waiting`` for the others and tells every node to ``start`` (a free-running
+    match: ``start_free_running``), ``summarize`` or ``stop``."""
 
     node: str
     command: str

@@ -2,10 +2,16 @@
 
 - ``frame_to_command_<in_process or zenoh>``: the same seeded match (our team through the cameras
   against the simple opponent) embedded and as node processes in lock-step; per frame, the wall
-  time from the simulator's capture (the clock's tick delivered) to our team's commands arriving
-  at the simulator (median and p99 ms, the first frames left out), and the whole match's
-  real-time factor. Both play the same
-  frames, so the difference of the medians is what zenoh adds (``added_median_ms``).
+  time from the clock's tick (before the simulator renders the frame, so the zenoh side pays for
+  publishing the images) to our team's commands arriving at the simulator (median and p99 ms, the
+  first frames left out), and the whole match's real-time factor. Both play the same frames, so
+  the difference of the medians is what zenoh adds (``added_median_ms``). ``zenoh`` has vision in
+  its own node (a frame crosses three processes: images to vision, detections to the team,
+  commands to the simulator); ``zenoh_vision_with_sim`` has it in the sim node
+  (``runtime.vision_with_sim``: two crossings, the images stay where they are rendered).
+- ``zenoh_one_hop_floor``: zenoh alone (no protobuf, no stage), a command-sized message to a
+  client in another process and straight back through the router: half the round trip, what one
+  crossing cannot go below on this machine.
 - ``camera_frames_<shm or tcp>``: camera frames (one camera's BGR image, protobuf) from one zenoh
   client to another through a router, with and without shared memory: frames per second, MB/s.
 - ``team_node_recovery``: the team node's process killed mid-match and started again: seconds
@@ -13,7 +19,8 @@
   without the team meanwhile.
 
 Every session is on a free loopback port; the node processes load the default configs/ (a
-``--set`` given to the bench reaches the in-process parts only). ``--quick`` plays 2 s matches.
+``--set`` given to the bench reaches the in-process parts only). The three set-ups play in turn,
+twice (``--quick``: once, 2 s matches).
 """
 
 from __future__ import annotations
@@ -31,7 +38,8 @@ from typing import Any
 import numpy as np
 
 from cmdragons.messages import CameraFrame
-from cmdragons.runtime.distributed import MatchSpec, node_roles, run_clock, wait_for_processes
+from cmdragons.runtime.bus import InProcessTransport
+from cmdragons.runtime.distributed import MatchSpec, run_clock, wait_for_processes
 from cmdragons.runtime.match import Match
 from cmdragons.runtime.params import RuntimeParams
 from cmdragons.runtime.settings import Settings
@@ -57,53 +65,108 @@ def _node(role: str, params: RuntimeParams, opponent: str, perception: str) -> s
     return subprocess.Popen([sys.executable, "-m", "cmdragons.cli", "node", role, "--opponent", opponent,
                              "--perception", perception, "--seed", str(SEED),
                              "--set", f"runtime.zenoh.router={params.zenoh.router}",
-                             "--set", f"runtime.field_name={params.field_name}"])  # fmt: skip
+                             "--set", f"runtime.field_name={params.field_name}",
+                             "--set", f"runtime.vision_with_sim={str(params.vision_with_sim).lower()}"])  # fmt: skip
 
 
-def _latency_taps(latencies: list[float]) -> list[Tap]:
-    """Taps that time each frame from the tick's delivery to our team's commands for it."""
-    tick = [0.0]
+class _TimesTicks:
+    """A transport that notes the wall time (perf_counter s) at which the clock publishes each tick,
+    before the simulator renders the frame: in ``tick[0]``."""
 
-    def on_tick(_t: str, _m: Any) -> None:
-        tick[0] = time.perf_counter()
+    tick: list[float]
 
-    def on_commands(_t: str, _m: Any) -> None:
-        latencies.append((time.perf_counter() - tick[0]) * 1e3)
+    def publish(self, topic: str, message: Any) -> None:
+        if topic == "clock":
+            self.tick[0] = time.perf_counter()
+        super().publish(topic, message)  # type: ignore[misc]
 
-    return [Tap("bench:tick", ("clock",), on_tick), Tap("bench:commands", ("commands/blue",), on_commands)]
+
+class _InProcessTicks(_TimesTicks, InProcessTransport):
+    def __init__(self, tick: list[float]) -> None:
+        super().__init__()
+        self.tick = tick
 
 
-def _latency_rows(settings: Settings, seconds: float) -> list[dict[str, Any]]:
+def _latency_tap(tick: list[float], latencies: list[float]) -> Tap:
+    """A tap that times each frame from its tick to our team's commands for it arriving."""
+    return Tap("bench:commands", ("commands/blue",),
+               lambda _t, _m: latencies.append((time.perf_counter() - tick[0]) * 1e3))
+
+
+def _zenoh_latencies(settings: Settings, seconds: float, vision_with_sim: bool) -> tuple[list[float], float]:
+    """The bench's match as node processes on zenoh in lock-step: per frame tick -> commands (ms),
+    and the real-time factor. ``vision_with_sim``: vision in the sim node (no vision node)."""
     from cmdragons.runtime.zenoh_transport import ZenohTransport, open_router
 
-    embedded: list[float] = []
-    m = Match(settings, "simple", "vision", seed=SEED, extra=_latency_taps(embedded))
-    wall = time.perf_counter()
-    m.run(seconds)
-    embedded_rtf = m.sim.t / (time.perf_counter() - wall)
-    params = _loopback(settings.runtime)
+    class ZenohTicks(_TimesTicks, ZenohTransport):
+        pass
+
+    params = dataclasses.replace(_loopback(settings.runtime), vision_with_sim=vision_with_sim)
     spec = MatchSpec(dataclasses.replace(settings, runtime=params), "simple", "vision", SEED)
-    roles = node_roles("simple", log=False)
+    roles = spec.roles(log=False)
     router = open_router(params)
     children = [_node(r, params, "simple", "vision") for r in roles if r != "sim"]
-    clock = ZenohTransport(params, "sim")
-    zenoh_ms: list[float] = []
+    clock = ZenohTicks(params, "sim")
+    clock.tick = [0.0]
+    ms: list[float] = []
     try:
-        summary = run_clock(spec, clock, seconds, roles, extra=_latency_taps(zenoh_ms), err=io.StringIO())
+        summary = run_clock(spec, clock, seconds, roles, extra=[_latency_tap(clock.tick, ms)], err=io.StringIO())
     finally:
         wait_for_processes(children, 20.0)
         clock.close()
         router.close()
+    return ms, float(summary["realtime_factor"])
+
+
+def _embedded_latencies(settings: Settings, seconds: float) -> tuple[list[float], float]:
+    """The bench's match embedded: per frame tick -> commands (ms), and the real-time factor."""
+    ms: list[float] = []
+    tick = [0.0]
+    m = Match(settings, "simple", "vision", seed=SEED, extra=[_latency_tap(tick, ms)], transport=_InProcessTicks(tick))
+    wall = time.perf_counter()
+    m.run(seconds)
+    return ms, m.sim.t / (time.perf_counter() - wall)
+
+
+def _latency_rows(settings: Settings, seconds: float, rounds: int) -> list[dict[str, Any]]:
+    """The three set-ups in turn, ``rounds`` times (the machine's load drifts: each set-up meets
+    it alike), their frames pooled."""
+    setups: dict[str, Callable[[], tuple[list[float], float]]] = {
+        "in_process": lambda: _embedded_latencies(settings, seconds),
+        "zenoh": lambda: _zenoh_latencies(settings, seconds, vision_with_sim=False),
+        "zenoh_vision_with_sim": lambda: _zenoh_latencies(settings, seconds, vision_with_sim=True)}  # fmt: skip
+    pooled: dict[str, tuple[list[float], list[float]]] = {name: ([], []) for name in setups}
+    for _ in range(rounds):
+        for name, run_once in setups.items():
+            ms, rtf = run_once()
+            pooled[name][0].extend(ms[WARM_FRAMES:])  # the first frames load what each process imports lazily
+            pooled[name][1].append(rtf)
     rows = []
     medians, p99s = [], []
-    for name, ms, rtf in (("in_process", embedded, embedded_rtf), ("zenoh", zenoh_ms, summary["realtime_factor"])):
-        ms = ms[WARM_FRAMES:]  # the first frames load what each process imports lazily
+    for name, (ms, rtfs) in pooled.items():
         medians.append(float(np.median(ms)))
         p99s.append(float(np.percentile(ms, 99)))
         rows.append({"name": f"frame_to_command_{name}", "frames": len(ms), "median_ms": medians[-1],
                      "p99_ms": p99s[-1], "added_median_ms": medians[-1] - medians[0],
-                     "added_p99_ms": p99s[-1] - p99s[0], "realtime_factor": float(rtf)})  # fmt: skip
+                     "added_p99_ms": p99s[-1] - p99s[0], "realtime_factor": float(np.mean(rtfs))})  # fmt: skip
     return rows
+
+
+def _floor_row(settings: Settings, messages: int, size_bytes: int = 300) -> dict[str, Any]:
+    """zenoh alone, no protobuf and no stage: a message of a command's size from one client to
+    another process's client through the router, which answers at once from its callback; half
+    the round trip is what one hop of the match cannot go below."""
+    from cmdragons.runtime.zenoh_transport import open_router, round_trips
+
+    params = _loopback(settings.runtime)
+    router = open_router(params)
+    try:
+        rtt = round_trips(params, messages, size_bytes)
+    finally:
+        router.close()
+    one_way = np.asarray(rtt[10:]) / 2
+    return {"name": "zenoh_one_hop_floor", "messages": len(one_way), "bytes": size_bytes,
+            "median_ms": float(np.median(one_way)), "p99_ms": float(np.percentile(one_way, 99))}  # fmt: skip
 
 
 def _throughput_row(settings: Settings, shared_memory: bool, frames: int, limit_s: float) -> dict[str, Any]:
@@ -159,7 +222,7 @@ def _recovery_row(settings: Settings) -> dict[str, Any]:
 
     params = dataclasses.replace(_loopback(settings.runtime), lockstep_wait_s=0.05)
     spec = MatchSpec(dataclasses.replace(settings, runtime=params), "simple", "truth", SEED)
-    roles = node_roles("simple", log=False)
+    roles = spec.roles(log=False)
     router = open_router(params)
     others = [_node(r, params, "simple", "truth") for r in roles if r not in ("sim", "team")]
     team = _node("team", params, "simple", "truth")
@@ -198,7 +261,8 @@ def _recovery_row(settings: Settings) -> dict[str, Any]:
 
 def run(settings: Settings, quick: bool) -> list[dict[str, Any]]:
     seconds = 2.0 if quick else 6.0
-    rows = _latency_rows(settings, seconds)
+    rows = _latency_rows(settings, seconds, 1 if quick else 2)
+    rows.append(_floor_row(settings, 200 if quick else 1000))
     n = 120 if quick else 600
     rows += [_throughput_row(settings, shm, n, 10.0 if quick else 20.0) for shm in (True, False)]
     rows.append(_recovery_row(settings))

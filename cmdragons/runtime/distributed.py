@@ -16,7 +16,14 @@ waits for the referee's word on the frame before the next tick. So each stage ge
 order the embedded match gives them, and the same seed plays the same match. A team silent for
 ``lockstep_wait_s`` is stepped without (its robots brake by their own command timeout), and a node
 that comes back rejoins at the next frame. Free-running (``realtime``): the clock ticks at the frame
-rate of the wall clock and never waits, as real robots would not.
+rate of the wall clock and never waits, as real robots would not; it says ``start_free_running``,
+and a node that falls behind then skips to the newest sensor messages, while commands that come
+late still reach the robots (:class:`~cmdragons.runtime.stages.SimStage`).
+
+Before it says it is ready, every node plays the first frames of a throwaway match
+(:func:`rehearse`): a stage's first frames cost seconds of one-time work (lazy imports, numba's
+cached kernels, the first plans) which a free-running match would otherwise spend with its robots
+standing.
 
 Every node builds the whole wiring from the same config and seed and keeps its own stages, so all
 nodes agree on what the others are without asking.
@@ -26,6 +33,7 @@ from __future__ import annotations
 
 import json
 import sys
+import threading
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -33,23 +41,27 @@ from typing import Any, TextIO
 
 from cmdragons.messages import NodeControl, Tick
 from cmdragons.runtime.bus import Bus, Stage
-from cmdragons.runtime.match import OURS, THEIRS, Opponent, Perception, match_summary, summary_stages, wiring
+from cmdragons.runtime.match import OURS, THEIRS, Match, Opponent, Perception, match_summary, summary_stages, wiring
 from cmdragons.runtime.params import ROLES
 from cmdragons.runtime.settings import Settings
 from cmdragons.runtime.stages import SimStage, SummaryCollector, Tap
-from cmdragons.runtime.zenoh_transport import ZenohTransport
+from cmdragons.runtime.zenoh_transport import LATEST_ONLY, ZenohTransport
 
-__all__ = ["ROLES", "MatchSpec", "node_roles", "role_of", "run_clock", "run_node", "wait_for_processes",
-           "write_summary"]
+__all__ = ["ROLES", "MatchSpec", "node_roles", "rehearse", "role_of", "run_clock", "run_node",
+           "wait_for_processes", "write_summary"]
 
 
 
-def role_of(stage: str) -> str:
-    """The node a stage of the wiring runs in."""
+FREE_RUNNING = "start_free_running"  # the clock's start of a free-running match (lock-step: "start")
+STARTS = frozenset({"start", FREE_RUNNING})
+
+
+def role_of(stage: str, vision_with_sim: bool = False) -> str:
+    """The node a stage of the wiring runs in (``vision_with_sim``: vision in the sim node)."""
     if stage == "sim":
         return "sim"
     if stage.startswith(("vision/", "perception/")):
-        return "vision"
+        return "sim" if vision_with_sim else "vision"
     if stage in (f"tracker/{OURS}", f"team/{OURS}", f"stats/{OURS}", "timing"):
         return "team"
     if stage.startswith("opponent/") or stage in (f"tracker/{THEIRS}", f"team/{THEIRS}", f"stats/{THEIRS}"):
@@ -59,10 +71,11 @@ def role_of(stage: str) -> str:
     raise ValueError(f"no node runs stage {stage!r}")
 
 
-def node_roles(opponent: Opponent, log: bool) -> list[str]:
+def node_roles(opponent: Opponent, log: bool, vision_with_sim: bool = False) -> list[str]:
     """The nodes a match needs (no opponent node against nobody or a team outside; the log node
-    when logging)."""
-    return [r for r in ROLES if (r != "opponent" or opponent in ("simple", "self")) and (r != "log" or log)]
+    when logging; no vision node when vision runs in the sim node)."""
+    return [r for r in ROLES if (r != "opponent" or opponent in ("simple", "self")) and (r != "log" or log)
+            and (r != "vision" or not vision_with_sim)]  # fmt: skip
 
 
 class MatchSpec:
@@ -90,7 +103,60 @@ class MatchSpec:
         sim = Simulator(self.settings.field, self.settings.camera_models(), params, seed=self.seed, render=render,
                         referee=False)  # fmt: skip
         every = wiring(self.settings, sim, self.opponent, self.perception, sim.seed, self.opponent_settings)
-        return sim, [s for s in every if role_of(s.name) == role], [s.name for s in every]
+        placed = self.settings.runtime.vision_with_sim
+        return sim, [s for s in every if role_of(s.name, placed) == role], [s.name for s in every]
+
+    def roles(self, log: bool) -> list[str]:
+        """The nodes of this match (:func:`node_roles`)."""
+        return node_roles(self.opponent, log, self.settings.runtime.vision_with_sim)
+
+
+def rehearse(spec: MatchSpec, role: str) -> None:
+    """Play the first frames of a throwaway match with ``role``'s kind of stages in this process:
+    what a stage does only on its first frames (lazy imports such as the tracker's filterpy, loading
+    numba's cached kernels, the planners' first queries; seconds on a busy machine) is done before
+    the node says it is ready, so a free-running match does not start with its teams a second
+    behind. Trackers and brains play ``runtime.rehearsal_frames`` frames (their first plans come a
+    few frames in), the simulator and vision two (their kernels load on the first); the referee,
+    the logger and the simple opponent need none. Throwaway: its own simulator, vision, trackers
+    and brains, nothing published."""
+    frames = spec.settings.runtime.rehearsal_frames
+    if frames == 0 or role in ("referee", "log") or (role == "opponent" and spec.opponent != "self"):
+        return  # (the simple opponent's first frame costs what its others do)
+    settings = spec.settings
+    if role in ("team", "opponent"):  # trackers and brains on the truth: the same work as on detections
+        opponent: Opponent = spec.opponent if spec.opponent in ("simple", "self") else "none"
+        match = Match(settings, opponent, "truth", seed=spec.seed,
+                      opponent_settings=spec.opponent_settings if opponent == "self" else None)  # fmt: skip
+        for _ in range(frames):
+            match.step()
+        match.close()
+        return
+    from sim.simulator import Simulator
+
+    vision = spec.perception == "vision"
+    sim = Simulator(settings.field, settings.camera_models(), settings.sim, seed=spec.seed, render=vision,
+                    referee=False)  # fmt: skip
+    pipelines = []
+    if vision and role == "vision":
+        from vision.pipeline import VisionPipeline
+
+        pipelines = [VisionPipeline(settings.vision, settings.field, m) for m in sim.cameras]
+    for _ in range(min(frames, 2)):  # the renderer's and vision's kernels load on the first frame
+        frame = sim.capture()
+        for pipeline, (_, image) in zip(pipelines, sorted(frame.images.items()), strict=False):
+            pipeline.process(image, frame.frame_number, frame.t_capture)
+        sim.advance()
+
+
+def _settle_heap() -> None:
+    """Collect what start-up left behind and keep the objects alive now (settings, stages, modules)
+    out of later collections: Python's full collection walks every tracked object and, after a
+    node's imports and rehearsal, held a frame up for 0.1-0.2 s."""
+    import gc
+
+    gc.collect()
+    gc.freeze()
 
 
 def _control(transport: ZenohTransport, node: str, command: str) -> None:
@@ -103,27 +169,32 @@ def run_node(role: str, spec: MatchSpec, transport: ZenohTransport, extra: Seque
     never started (stopped first)."""
     err = err if err is not None else sys.stderr
     params = spec.settings.runtime
+    rehearse(spec, role)
     stages = spec.stages(role)[1] if role != "log" else []
     bus = Bus(transport)
     commands: list[str] = []
     bus.add(Tap(f"control:{role}", ("control/clock",), lambda _t, c: commands.append(c.command)))
     for stage in [*stages, *extra]:
         bus.add(stage)
+    _settle_heap()
     started = time.monotonic()
     last_ready = -1.0
     warned = started
-    while "start" not in commands and not should_stop():  # say so until the clock hears it
+    while not set(commands) & STARTS and not should_stop():  # say so until the clock hears it
         now = time.monotonic()
         if now - last_ready >= 0.25:
             _control(transport, role, "ready")
             last_ready = now
-        if now - warned >= params.peer_timeout_s:
+        if now - warned >= params.peer_timeout_s and not commands:  # (the clock says when it waits for others)
             print(f"node {role}: no match clock on cmdragons/{params.field_name} for {now - started:.0f} s: is the "
                   f"sim node running and connected to {params.zenoh.router}?", file=err)  # fmt: skip
             warned = now
         transport.spin(0.05)
-    if "start" not in commands:
+    if not set(commands) & STARTS:
         return 1
+    # free-running: a stage that falls behind works on the newest sensor messages, as a real team
+    # does, instead of answering a backlog the robots no longer wait for; the logger keeps every one
+    transport.latest_only = LATEST_ONLY if FREE_RUNNING in commands and role != "log" else ()
     bus.start()
     done = 0
     while not should_stop():
@@ -150,6 +221,13 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
     returns the summary (as the embedded match's, gathered over the bus); tells every node to stop."""
     err = err if err is not None else sys.stderr
     params = spec.settings.runtime
+    # rehearsed while the clock waits for the nodes (and says so): (vision's rehearsal has the simulator's)
+    rehearsal = threading.Thread(target=rehearse, args=(spec, "vision" if params.vision_with_sim else "sim"))
+    rehearsal.start()
+    if params.vision_with_sim:
+        transport.local_only = ("camera/*",)  # vision is here: the frames stay in this process
+    elif spec.perception == "vision":  # camera frames go through shared memory
+        transport.reserve_shared_memory()
     sim, stages, _ = spec.stages("sim")
     bus = Bus(transport)
     ready: set[str] = set()
@@ -157,10 +235,12 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
     summaries = SummaryCollector()
     started = [False]
 
+    start = FREE_RUNNING if realtime else "start"
+
     def on_control(_topic: str, c: NodeControl) -> None:
         if c.command == "ready":
             if started[0]:  # a node started again mid-match: it plays on from the next frame
-                _control(transport, "clock", "start")
+                _control(transport, "clock", start)
             ready.add(c.node)
 
     bus.add(Tap("control:ready", ("control/*",), on_control))
@@ -173,20 +253,26 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
     others = [r for r in roles if r != "sim"]
     t0 = time.monotonic()
     warned = t0
-    while not ready >= set(others):
+    said = -1.0
+    while not ready >= set(others) or rehearsal.is_alive():
         if should_stop():
+            rehearsal.join()
             return {}
         now = time.monotonic()
         if now - t0 > params.start_timeout_s:
             raise TimeoutError(f"nodes {', '.join(sorted(set(others) - ready))} did not come up within "
                                f"{params.start_timeout_s:.0f} s (runtime.start_timeout_s)")  # fmt: skip
-        if now - warned >= params.peer_timeout_s:
+        if now - warned >= params.peer_timeout_s and not ready >= set(others):
             print(f"sim: waiting for nodes {', '.join(sorted(set(others) - ready))} on {params.zenoh.router}",
                   file=err)  # fmt: skip
             warned = now
+        if now - said >= 0.25:  # the nodes that are ready hear that the clock is there
+            _control(transport, "clock", "waiting")
+            said = now
         transport.spin(0.05)
+    _settle_heap()
     transport.wait_for(lambda: False, params.settle_s)  # declarations propagate: nothing of frame 0 is lost
-    _control(transport, "clock", "start")
+    _control(transport, "clock", start)
     started[0] = True
     bus.start()
     if not transport.wait_for(lambda: judged[0] >= 1 and placed[0] >= 1, 5.0):
@@ -222,7 +308,7 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
         if on_frame is not None:
             on_frame(i)
     wall = time.perf_counter() - wall0
-    wanted = {s for s in summary_stages(spec.opponent) if role_of(s) in roles}
+    wanted = {s for s in summary_stages(spec.opponent) if role_of(s, params.vision_with_sim) in roles}
     _control(transport, "clock", "summarize")
     bus.summarize()
     if not transport.wait_for(lambda: wanted <= set(summaries.figures), params.start_timeout_s):
@@ -234,7 +320,7 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
         summary = match_summary(f, {"frame": frame_ms}, sim.seed, spec.opponent, spec.perception)
     else:  # a node of the match was not there: what the others said
         summary = {"seed": sim.seed, "opponent": spec.opponent, "perception": spec.perception,
-                   "missing_nodes": sorted(set(node_roles(spec.opponent, log=False)) - set(roles)),
+                   "missing_nodes": sorted(set(spec.roles(log=False)) - set(roles)),
                    "score": f["referee"]["score"], "command_faults": f["sim"]["command_faults"]}  # fmt: skip
     summary.update(frames=len(frame_ms), wall_seconds=round(wall, 3), frames_stepped_without_a_team=silent,
                    realtime_factor=round(sim.t / wall, 2) if wall > 0 else None,

@@ -26,7 +26,7 @@ class ZenohParams(Validated):
     network: bool = False  # allow endpoints off this machine (then router may name another host)
     multicast_scouting: bool = False  # UDP multicast discovery of peers: off, the router is named
     shared_memory: bool = True  # same-host payloads over shm_min_bytes go through zenoh's shared memory
-    shm_min_bytes: int = setting(4096, lo=0, hi=2**31)  # smaller payloads are copied (cheaper than a buffer)
+    shm_min_bytes: int = setting(65536, lo=0, hi=2**31)  # smaller payloads are copied (cheaper than a buffer)
     shm_pool_mb: int = setting(64, lo=1, hi=4096)  # each publishing node's shared-memory pool
 
     def __post_init__(self) -> None:
@@ -60,6 +60,8 @@ class RuntimeParams(Validated):
     drop_report_interval_s: float = setting(1.0, lo=0.01, hi=60.0)  # undecodable messages: one line at most this often
     start_timeout_s: float = setting(60.0, lo=1.0, hi=3600.0)  # the match starts once every node is up, or gives up
     settle_s: float = setting(0.5, lo=0.0, hi=60.0)  # every node up: subscriptions reach every publisher in this
+    rehearsal_frames: int = setting(12, lo=0, hi=600)  # frames of a throwaway match a node plays before it is ready
+    vision_with_sim: bool = False  # vision (or the truth perception) runs in the sim node; camera frames stay there
 
     def __post_init__(self) -> None:
         super().__post_init__()

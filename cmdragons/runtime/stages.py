@@ -90,7 +90,12 @@ def truth_world(gt: GroundTruth) -> WorldState:
 class SimStage(BaseStage):
     """The simulator with its cameras. On a tick it captures the frame (truth, then each camera's
     image); once every playing team's commands for that frame came, it steps the physics and
-    publishes the frame's events; teleports it carries out at once."""
+    publishes the frame's events; teleports it carries out at once.
+
+    Commands that answer an older frame (they came after that frame was stepped without them: a
+    team slower than the free-running clock, or silent past the lock-step wait) are what a real
+    robot's radio would get late: the newest of them is sent with the next step that has no
+    commands of its own frame from that team, once."""
 
     name = "sim"
     inputs = ("clock", "commands/*", "teleport")
@@ -100,16 +105,23 @@ class SimStage(BaseStage):
         self.teams = tuple(t for t in TEAMS if t in teams)
         self.frame_number = -1
         self._commands: dict[Team, TeamCommands] = {}
+        self._late: dict[Team, TeamCommands] = {}  # per team: the newest commands for an older frame
+        self._sent: dict[Team, int] = {}  # per team: the frame the commands last sent answered
 
     def on_message(self, topic: str, message: Any, publish: Publish) -> None:
         if topic == "clock":
             self._capture(publish)
         elif topic == "teleport":
             self.sim.teleport(message)
-        elif isinstance(message, TeamCommands) and message.frame_number == self.frame_number:
-            self._commands[message.team] = message
-            if all(t in self._commands for t in self.teams):
-                self._advance(publish)
+        elif isinstance(message, TeamCommands) and message.team in self.teams:
+            if message.frame_number == self.frame_number:
+                self._commands[message.team] = message
+                if all(t in self._commands for t in self.teams):
+                    self._advance(publish)
+            elif message.frame_number > self._sent.get(message.team, -1):
+                late = self._late.get(message.team)
+                if late is None or message.frame_number >= late.frame_number:
+                    self._late[message.team] = message
 
     def _capture(self, publish: Publish) -> None:
         frame = self.sim.capture()
@@ -132,7 +144,10 @@ class SimStage(BaseStage):
         return missing
 
     def _advance(self, publish: Publish) -> None:
-        commands = [c for t in self.teams if t in self._commands for c in self._commands[t].commands]
+        sent = {**self._late, **self._commands}
+        self._late = {}
+        commands = [c for t in self.teams if t in sent for c in sent[t].commands]
+        self._sent.update({t: tc.frame_number for t, tc in sent.items()})
         self._commands = {}
         events = self.sim.advance(commands)
         publish("events", SimEvents(self.frame_number, self.sim.t, self.sim.ball_xy(), tuple(events)))

@@ -64,8 +64,8 @@ from cmdragons.runtime.proto import ssl_detection_pb2 as det_pb
 from cmdragons.runtime.proto import ssl_simulation_control_pb2 as ctl_pb
 from cmdragons.runtime.proto import ssl_tracked_pb2 as trk_pb
 
-__all__ = ["CODECS", "LOSSY", "TOPICS", "Codec", "canonical", "decode", "encode", "from_proto", "message_type",
-           "to_proto"]  # fmt: skip
+__all__ = ["CODECS", "LOSSY", "TOPICS", "Codec", "canonical", "decode", "encode", "encode_chunks", "from_proto",
+           "message_type", "to_proto"]  # fmt: skip
 
 MM = 1000.0  # millimetres a metre: the league's vision speaks millimetres
 
@@ -361,6 +361,30 @@ def _camera_to(f: CameraFrame) -> Any:
                           height=h, encoding="bgr8", data=np.ascontiguousarray(f.image).tobytes())  # fmt: skip
 
 
+def _varint(n: int) -> bytes:
+    """``n`` as a protobuf varint (seven bits a byte, low bits first)."""
+    out = bytearray()
+    while n >= 0x80:
+        out.append(n & 0x7F | 0x80)
+        n >>= 7
+    out.append(n)
+    return bytes(out)
+
+
+_IMAGE_KEY = _varint(pb.CameraFrame.DESCRIPTOR.fields_by_name["data"].number << 3 | 2)  # length-delimited
+
+
+def _camera_chunks(f: CameraFrame) -> tuple[bytes, bytes]:
+    """A camera frame's protobuf bytes as two pieces, everything before the image and the image:
+    the image is the last field, so the two joined are :func:`encode`'s bytes, and a transport
+    copies the image once, into its buffer, instead of through a message and its serialisation."""
+    h, w = f.image.shape[:2]
+    head = pb.CameraFrame(camera_id=f.camera_id, frame_number=f.frame_number, t_capture=f.t_capture, width=w,
+                          height=h, encoding="bgr8")  # fmt: skip
+    image = np.ascontiguousarray(f.image).tobytes()
+    return head.SerializePartialToString(deterministic=True) + _IMAGE_KEY + _varint(len(image)), image
+
+
 def _camera_from(m: Any) -> CameraFrame:
     if m.encoding != "bgr8":
         raise MessageError(f"camera frame encoding must be bgr8, got {m.encoding!r}")
@@ -505,6 +529,14 @@ def from_proto(proto: Any) -> Any:
 def encode(message: Any) -> bytes:
     """The protobuf bytes of ``message``."""
     return to_proto(message).SerializeToString(deterministic=True)  # type: ignore[no-any-return]
+
+
+def encode_chunks(message: Any) -> tuple[bytes, ...]:
+    """The protobuf bytes of ``message`` in pieces whose concatenation is :func:`encode`'s: a camera
+    frame as its header and its image (copied once, from the array), anything else in one piece."""
+    if type(message) is CameraFrame:
+        return _camera_chunks(message)
+    return (encode(message),)
 
 
 def decode(topic: str, data: bytes | bytearray | memoryview) -> Any:

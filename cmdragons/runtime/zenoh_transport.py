@@ -4,8 +4,9 @@ separate processes (or machines).
 A topic ``t`` is the key ``cmdragons/<field>/t``; a pattern ``p/*`` is ``cmdragons/<field>/p/**``.
 Messages go as protobuf (:mod:`cmdragons.runtime.wire`); payloads from ``shm_min_bytes`` on (camera
 frames) are written into zenoh's shared memory, so a same-host subscriber maps them instead of
-copying them through a socket. Publishers block rather than drop when a link is congested: a
-lock-step match must lose nothing.
+copying them through a socket; a camera frame's image is copied once from its array into the
+buffer, beside the message's header (:func:`~cmdragons.runtime.wire.encode_chunks`). Publishers
+block rather than drop when a link is congested: a lock-step match must lose nothing.
 
 Zenoh delivers on its own threads; this transport only queues there. :meth:`ZenohTransport.spin`
 decodes and delivers in the calling thread, first received first delivered, each message to its
@@ -28,7 +29,7 @@ from cmdragons.runtime import wire
 from cmdragons.runtime.bus import Handler, topic_matches
 from cmdragons.runtime.params import RuntimeParams
 
-__all__ = ["RouterError", "ZenohTransport", "key_expr", "open_router"]
+__all__ = ["LATEST_ONLY", "RouterError", "ZenohTransport", "key_expr", "open_router", "round_trips"]
 
 
 class RouterError(Exception):
@@ -53,6 +54,11 @@ def open_router(params: RuntimeParams) -> Any:
     """A zenoh router session on the configured endpoint (the nodes are its clients); close it.
     :class:`RouterError` when the endpoint is taken."""
     return _open(params, "router")
+
+
+# sensor streams: a stage that falls behind skips to the newest message of each topic instead of
+# working through a backlog (in lock-step one message of each waits at a time, so none is skipped)
+LATEST_ONLY: tuple[str, ...] = ("camera/*", "detections/*", "perception/*", "world/*")
 
 
 def key_expr(prefix: str, pattern: str) -> str:
@@ -97,6 +103,11 @@ class ZenohTransport:
         self._pubs: dict[str, Any] = {}
         self._shm: Any = None
         self.dropped = 0
+        self.superseded = 0  # messages a newer one of their topic overtook before delivery
+        # topic patterns of which only the newest waiting message is delivered (a stage that falls
+        # behind skips ahead, as a real team does; a logger keeps every message: ())
+        self.latest_only: tuple[str, ...] = ()
+        self.local_only: tuple[str, ...] = ()  # topic patterns published to this process's stages only
         self.received = 0
         self.last_received = time.monotonic()
         self._err = err if err is not None else sys.stderr
@@ -133,22 +144,39 @@ class ZenohTransport:
     def publish(self, topic: str, message: Any) -> None:
         if self._handlers(topic):
             self._queue.put((topic, wire.canonical(message), False))
-        data = wire.encode(message)
+        if any(topic_matches(p, topic) for p in self.local_only):
+            return
+        chunks = wire.encode_chunks(message)
+        size = sum(len(c) for c in chunks)
         zp = self.params.zenoh
-        payload = self._in_shared_memory(data) if zp.shared_memory and len(data) >= zp.shm_min_bytes else data
+        if zp.shared_memory and size >= zp.shm_min_bytes:
+            payload = self._in_shared_memory(chunks, size)
+        else:
+            payload = chunks[0] if len(chunks) == 1 else b"".join(chunks)
         # the session's put, not a publisher declared now: a new publisher drops what it is given until
         # it learnt who subscribes, the session routes by what it knows already
         z = self._zenoh
         self.session.put(f"{self.prefix}/{topic}", payload, congestion_control=z.CongestionControl.BLOCK,
                          allowed_destination=z.Locality.REMOTE)  # fmt: skip
 
-    def _in_shared_memory(self, data: bytes) -> Any:
+    def reserve_shared_memory(self) -> None:
+        """Make this node's shared-memory pool now (it is made on the first large payload otherwise,
+        which then waits 0.1-0.2 s)."""
+        if self._shm is None and self.params.zenoh.shared_memory:
+            from zenoh import shm
+
+            self._shm = shm.ShmProvider.default_backend(self.params.zenoh.shm_pool_mb << 20)
+
+    def _in_shared_memory(self, chunks: tuple[bytes, ...], size: int) -> Any:
+        """A shared-memory buffer holding ``chunks`` one after another (each copied once)."""
         from zenoh import shm
 
-        if self._shm is None:
-            self._shm = shm.ShmProvider.default_backend(self.params.zenoh.shm_pool_mb << 20)
-        buf = self._shm.alloc(len(data), policy=shm.BlockOn(shm.GarbageCollect()))
-        buf[:] = data
+        self.reserve_shared_memory()
+        buf = self._shm.alloc(size, policy=shm.BlockOn(shm.GarbageCollect()))
+        at = 0
+        for chunk in chunks:
+            buf[at : at + len(chunk)] = chunk
+            at += len(chunk)
         return buf
 
     def has_subscribers(self, topic: str) -> bool:
@@ -168,14 +196,27 @@ class ZenohTransport:
 
     def spin(self, timeout_s: float = 0.0) -> int:
         """Deliver what has come, waiting up to ``timeout_s`` for the first message; returns how many
-        deliveries were made."""
+        deliveries were made. Of a topic under :attr:`latest_only` only the newest message that is
+        waiting is delivered; the older ones are counted (:attr:`superseded`) and dropped."""
         n = 0
         try:
             item = self._queue.get(timeout=timeout_s) if timeout_s > 0 else self._queue.get_nowait()
         except queue.Empty:
             return 0
         while True:
-            n += self._deliver(*item)
+            batch = [item]
+            while True:
+                try:
+                    batch.append(self._queue.get_nowait())
+                except queue.Empty:
+                    break
+            newest = {topic: i for i, (topic, _, remote) in enumerate(batch)
+                      if remote and any(topic_matches(p, topic) for p in self.latest_only)}  # fmt: skip
+            for i, (topic, payload, remote) in enumerate(batch):
+                if remote and newest.get(topic, i) != i:
+                    self.superseded += 1
+                    continue
+                n += self._deliver(topic, payload, remote)
             try:
                 item = self._queue.get_nowait()
             except queue.Empty:
@@ -224,3 +265,58 @@ class ZenohTransport:
         self._pubs.clear()
         if self._own:
             self.session.close()
+
+
+def _echo(config: str, prefix: str, ready: Any, done: Any) -> None:
+    """The far end of :func:`round_trips` (its own process): every ping back as a pong."""
+    import zenoh
+
+    with zenoh.open(zenoh.Config.from_json5(config)) as session:
+        pong = session.declare_publisher(f"{prefix}/pong")
+        session.declare_subscriber(f"{prefix}/ping", lambda sample: pong.put(sample.payload))
+        ready.set()
+        done.wait(120.0)
+
+
+def round_trips(params: RuntimeParams, messages: int, size_bytes: int) -> list[float]:
+    """zenoh alone (no protobuf, no stage): ``messages`` payloads of ``size_bytes`` to a client in
+    another process (spawned), which puts each back from its callback; the round trips (ms). Both
+    are clients of the router of ``params`` (which must be open)."""
+    import json
+    import multiprocessing
+    import threading
+
+    import zenoh
+
+    prefix = f"cmdragons/{params.field_name}/floor"
+    ctx = multiprocessing.get_context("spawn")  # never fork a process that has zenoh open
+    ready, done = ctx.Event(), ctx.Event()
+    echo = ctx.Process(target=_echo, args=(json.dumps(params.zenoh.session("client")), prefix, ready, done))
+    echo.start()
+    rtt: list[float] = []
+    try:
+        with zenoh.open(params.zenoh.config("client")) as session:
+            back = threading.Event()
+            session.declare_subscriber(f"{prefix}/pong", lambda _s: back.set())
+            ping: Any = session.declare_publisher(f"{prefix}/ping")  # (the stubs type matching_status wrongly)
+            if not ready.wait(60.0):
+                raise TimeoutError("the echo process never came up")
+            for _ in range(500):  # its subscriber reaches this session
+                if ping.matching_status.matching:
+                    break
+                time.sleep(0.02)
+            else:
+                raise TimeoutError("the echo's subscriber never reached this session")
+            time.sleep(0.2)  # its pong publisher's route reaches this session too
+            payload = bytes(size_bytes)
+            for _ in range(messages):
+                back.clear()
+                t0 = time.perf_counter()
+                ping.put(payload)
+                if back.wait(1.0):
+                    rtt.append((time.perf_counter() - t0) * 1e3)
+                time.sleep(0.002)
+    finally:
+        done.set()
+        echo.join(10)
+    return rtt

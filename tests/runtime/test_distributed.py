@@ -52,18 +52,27 @@ def _nodes(spec: MatchSpec, roles: list[str], stop: threading.Event) -> list[thr
     return threads
 
 
-def test_lock_step_nodes_play_the_embedded_match(router: Any) -> None:
+# small camera images keep a match through the cameras quick (vision finds less on them: the same
+# for both runs)
+SMALL_CAMERAS = ["cameras.auto.resolution_px=[160,120]", "cameras.auto.grid=[2,1]"]
+
+
+@pytest.mark.parametrize(("perception", "vision_with_sim"), [("truth", False), ("truth", True), ("vision", True)])
+def test_lock_step_nodes_play_the_embedded_match(router: Any, perception: Any, vision_with_sim: bool) -> None:
     import dataclasses
 
+    from cmdragons.runtime.settings import load_settings
     from cmdragons.runtime.zenoh_transport import ZenohTransport
 
-    settings = dataclasses.replace(SETTINGS, runtime=router)
+    base = SETTINGS if perception == "truth" else load_settings(ROOT / "configs", SMALL_CAMERAS)
+    settings = dataclasses.replace(base, runtime=dataclasses.replace(router, vision_with_sim=vision_with_sim))
     embedded: list[Any] = []
-    m = Match(settings, "simple", "truth", seed=SEED,
+    m = Match(settings, "simple", perception, seed=SEED,
               extra=[Tap("rec", ("commands/*", "referee"), lambda t, x: embedded.append((t, x)))])  # fmt: skip
     expected = m.run(SECONDS)
-    spec = MatchSpec(settings, "simple", "truth", m.seed)
-    roles = node_roles("simple", log=False)
+    spec = MatchSpec(settings, "simple", perception, m.seed)
+    roles = spec.roles(log=False)
+    assert ("vision" in roles) != vision_with_sim
     stop = threading.Event()
     threads = _nodes(spec, [r for r in roles if r != "sim"], stop)
     got: list[Any] = []
@@ -181,12 +190,29 @@ def test_a_killed_team_node_rejoins_and_the_match_goes_on(router: Any) -> None:
     assert result["command_faults"]["timed_out"] > 0  # the watchdog braked blue while it was gone
 
 
-def test_free_running_real_time_steps_every_frame_at_the_wall_clock(router: Any) -> None:
+def _first_moving_frame(truth: list[Any], team: str, speed_m_s: float) -> int | None:
+    """The first frame of the simulator's truth in which a robot of ``team`` moves faster than
+    ``speed_m_s``."""
+    return next((g.frame_number for g in truth if any(math.hypot(r.vx, r.vy) > speed_m_s for r in g.robots
+                                                      if r.team == team)), None)  # fmt: skip
+
+
+# free-running: our robots may start this many frames later than in lock-step (a quarter second:
+# commands come a frame or two late when the team runs behind the wall clock)
+START_SLACK_FRAMES = 15
+
+
+def test_free_running_real_time_steps_every_frame_and_our_robots_drive_at_once(router: Any) -> None:
     import dataclasses
 
     from cmdragons.runtime.zenoh_transport import ZenohTransport
 
     settings = dataclasses.replace(SETTINGS, runtime=router)
+    lockstep: list[Any] = []
+    Match(settings, "simple", "truth", seed=SEED, extra=[Tap("rec", ("truth",), lambda _t, g: lockstep.append(g))]
+          ).run(SECONDS)  # fmt: skip
+    starts = _first_moving_frame(lockstep, "blue", 0.1)
+    assert starts is not None  # the reference: when our robots drive in lock-step
     spec = MatchSpec(settings, "simple", "truth", SEED)
     roles = node_roles("simple", log=False)
     stop = threading.Event()
@@ -208,5 +234,41 @@ def test_free_running_real_time_steps_every_frame_at_the_wall_clock(router: Any)
     assert summary["realtime_factor"] <= 1.01  # paced by the wall clock, never ahead of it
     # it never waits for a team, yet both teams' commands came
     assert summary["frames_stepped_without_a_team"] == 0 and {c.team for c in commands} == {"blue", "yellow"}
-    # the simple opponent's robots drive (ours: see the README's runtime notes on free-running)
+    # the simple opponent's robots drive, and ours from (nearly) the frame they do in lock-step: every
+    # node played its first frames before the match, and commands that come late still reach the robots
     assert any(math.hypot(r.vx, r.vy) > 0.1 for g in truth for r in g.robots if r.team == "yellow")
+    moving = _first_moving_frame(truth, "blue", 0.1)
+    assert moving is not None and moving <= starts + START_SLACK_FRAMES, (moving, starts)
+
+
+def test_a_node_without_a_clock_says_so_and_not_while_the_clock_waits_for_others(router: Any) -> None:
+    import dataclasses
+    import io
+
+    from cmdragons.messages import NodeControl
+    from cmdragons.runtime.zenoh_transport import ZenohTransport
+
+    params = dataclasses.replace(router, peer_timeout_s=0.2, rehearsal_frames=0)
+    spec = MatchSpec(dataclasses.replace(SETTINGS, runtime=params), "simple", "truth", SEED)
+    said = {}
+    for clock_there in (False, True):
+        err = io.StringIO()
+        node, clock = ZenohTransport(params, "referee"), ZenohTransport(params, "sim")
+        heard: list[str] = []
+        clock.subscribe("control/*", lambda _t, c, heard=heard: heard.append(c.node))
+        enough = lambda heard=heard: len(heard) >= 12  # noqa: E731
+        runner = threading.Thread(target=run_node, args=("referee", spec, node),
+                                  kwargs={"err": err, "should_stop": enough}, daemon=True)  # fmt: skip
+        try:
+            runner.start()
+            while runner.is_alive():  # the node says it is ready four times a second: 3 s in all
+                if clock_there:
+                    clock.publish("control/clock", NodeControl("clock", "waiting"))
+                clock.spin(0.05)
+            runner.join(10)
+        finally:
+            node.close()
+            clock.close()
+        said[clock_there] = err.getvalue()
+    assert "no match clock" in said[False] and "is the sim node running" in said[False]
+    assert said[True] == ""

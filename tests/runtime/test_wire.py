@@ -172,3 +172,18 @@ def test_generated_modules_are_current(tmp_path: Path) -> None:
 def test_summary_figures_survive_as_json() -> None:
     s = msg.StageSummary("stats/blue", {"passes": {"tried": 2, "completed": 1}, "none": None})
     assert json.loads(wire.to_proto(s).figures_json) == s.figures
+
+
+@pytest.mark.parametrize("shape", [(768, 1024, 3), (120, 160, 3), (1, 1, 3)])
+def test_a_camera_frame_in_pieces_joins_to_its_protobuf_bytes(shape: tuple[int, int, int]) -> None:
+    image = np.random.default_rng(1).integers(0, 256, shape, dtype=np.uint8)
+    frame = msg.CameraFrame(3, 70_000, 12.5, image[:, ::-1])  # a view that is not contiguous
+    chunks = wire.encode_chunks(frame)
+    assert len(chunks) == 2 and b"".join(chunks) == wire.encode(frame)
+    back = wire.decode("camera/3/frame", b"".join(chunks))
+    assert np.array_equal(back.image, image[:, ::-1]) and back.frame_number == 70_000
+
+
+def test_other_messages_are_one_piece() -> None:
+    tick = msg.Tick(5)
+    assert wire.encode_chunks(tick) == (wire.encode(tick),)

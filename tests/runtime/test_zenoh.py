@@ -70,7 +70,7 @@ def test_messages_arrive_as_the_wire_carries_them_locally_and_remotely(router: R
         b.subscribe("camera/*", lambda t, m: got["b"].append((t, m)))
         assert a.wait_for(lambda: a.has_subscribers("camera/0/frame"), 10.0)
         det = msg.DetectionFrame(0, 1, 0.1, 0.1, (msg.BallDetection(0.123456789, 1.0, 0.9, (1.0, 2.0)),))
-        image = np.random.default_rng(0).integers(0, 255, (120, 160, 3), dtype=np.uint8)  # 57 KB: shared memory
+        image = np.random.default_rng(0).integers(0, 255, (160, 240, 3), dtype=np.uint8)  # 115 KB: shared memory
         a.publish("detections/0", det)
         a.publish("camera/0/frame", msg.CameraFrame(0, 1, 0.1, image))
         a.spin()
@@ -81,6 +81,60 @@ def test_messages_arrive_as_the_wire_carries_them_locally_and_remotely(router: R
     finally:
         for t in (a, b):
             t.close()
+
+
+@pytest.mark.parametrize("latest_only", [True, False])
+def test_a_receiver_behind_skips_to_the_newest_sensor_message_when_asked(router: RuntimeParams,
+                                                                        latest_only: bool) -> None:  # fmt: skip
+    import time
+
+    from cmdragons.runtime.zenoh_transport import LATEST_ONLY
+
+    a, b = _transports(router, 2)
+    b.latest_only = LATEST_ONLY if latest_only else ()
+    got: list[int] = []
+
+    def slow(_t: str, d: Any) -> None:  # a stage busy with the first frame while four more come
+        if not got:
+            time.sleep(0.5)
+        got.append(d.frame_number)
+
+    try:
+        b.subscribe("detections/*", slow)
+        b.subscribe("referee", lambda _t, _m: got.append(-1))
+        assert a.wait_for(lambda: a.has_subscribers("detections/0"), 10.0)
+        for i in range(5):
+            a.publish("detections/0", msg.DetectionFrame(0, i, i / 60, i / 60))
+        a.publish("referee", msg.GameState(1.0, "stop"))  # not a sensor stream: always delivered
+        assert b.wait_for(lambda: -1 in got and 4 in got, 10.0)
+    finally:
+        for t in (a, b):
+            t.close()
+    frames = [f for f in got if f >= 0]
+    assert frames == sorted(set(frames)) and frames[-1] == 4 and got.count(-1) == 1
+    if latest_only:  # of what waited (at least what came while the first was handled) only the newest
+        assert len(frames) + b.superseded == 5 and b.superseded >= 1 and len(frames) <= 2
+    else:
+        assert frames == [0, 1, 2, 3, 4] and b.superseded == 0
+
+
+def test_local_only_topics_reach_this_process_only(router: RuntimeParams) -> None:
+    a, b = _transports(router, 2)
+    a.local_only = ("camera/*",)
+    got: dict[str, list[str]] = {"a": [], "b": []}
+    try:
+        for name, t in (("a", a), ("b", b)):
+            t.subscribe("camera/*", lambda topic, _m, name=name: got[name].append(topic))
+            t.subscribe("clock", lambda topic, _m, name=name: got[name].append(topic))
+        assert a.wait_for(lambda: a.has_subscribers("clock"), 10.0)
+        a.publish("camera/0/frame", msg.CameraFrame(0, 1, 0.1, np.zeros((4, 4, 3), np.uint8)))
+        a.publish("clock", msg.Tick(1))
+        a.spin()
+        assert b.wait_for(lambda: "clock" in got["b"], 10.0)
+    finally:
+        for t in (a, b):
+            t.close()
+    assert got == {"a": ["camera/0/frame", "clock"], "b": ["clock"]}
 
 
 def test_garbage_is_counted_dropped_and_reported_once(router: RuntimeParams) -> None:
@@ -103,3 +157,9 @@ def test_garbage_is_counted_dropped_and_reported_once(router: RuntimeParams) -> 
     finally:
         raw.close()
         b.close()
+
+
+def test_every_ping_of_the_floor_measure_comes_back(router: RuntimeParams) -> None:
+    from cmdragons.runtime.zenoh_transport import round_trips
+
+    assert len(round_trips(router, 20, 300)) == 20  # (what they take is bench runtime's, not a test's)

@@ -47,7 +47,7 @@ def on_detections(sample: zenoh.Sample) -> None:
         d = math.hypot(dx, dy)
         v = min(args.speed, 2 * d) / max(d, 1e-6)  # slow down near the ball
         move = out.robot_commands.add(id=robot_id).move_command.global_velocity
-        move.x, move.y, move.angular = v * dx, v * dy, 0.0
+        move.vel_x, move.vel_y, move.vel_angular = v * dx, v * dy, 0.0
     session.put(f"cmdragons/{args.field}/commands/yellow", out.SerializeToString())
 
 

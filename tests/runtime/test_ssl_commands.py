@@ -8,8 +8,10 @@ from __future__ import annotations
 import io
 import math
 import shutil
+import signal
 import socket
 import subprocess
+import sys
 import time
 from typing import Any
 
@@ -332,3 +334,38 @@ def test_garbage_and_cut_packets_to_our_simulator_are_counted_and_dropped() -> N
     assert len(lines) == 3 and all("dropped a packet (undecodable" in ln for ln in lines)
     commands = [m for t, m in out if t == "commands/yellow"]
     assert len(commands) == 1 and [c.vx for c in commands[0].commands] == [pytest.approx(0.5)]
+
+
+def test_the_example_client_plays_yellow_in_our_simulator_over_the_leagues_protocols(udp_port: int) -> None:
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    control, yellow = _ports(2)
+    settings = load_settings(None, [f"protocols.vision.port={udp_port}", f"protocols.simulation.control_port={control}",
+                                    f"protocols.simulation.yellow_port={yellow}", "protocols.simulation.wait_s=1.0"])
+    client = subprocess.Popen([sys.executable, str(root / "examples" / "simulation_team.py"), "--vision-port",
+                               str(udp_port), "--port", str(yellow)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                              text=True)  # fmt: skip
+    truths: list[msg.GroundTruth] = []
+    match = None
+    try:
+        assert "simulation team: yellow" in (client.stdout.readline() if client.stdout else "")
+        tap = Tap("t", ("truth",), lambda _t, g: truths.append(g))
+        match = Match(settings, "simulation", "truth", seed=3, extra=[tap])
+        for _ in range(60):
+            match.step()
+        summary = match.summary()
+    finally:
+        if match is not None:
+            match.close()
+        client.send_signal(signal.SIGINT)
+        _, err = client.communicate(timeout=20)
+    assert client.returncode == 0 and "Traceback" not in err, err
+    figures = summary["protocols"]["ssl/simulation_in/yellow"]
+    assert figures["packets"] >= 55 and figures["frames_waited_out"] <= 2 and figures["dropped"] == {}
+
+    def ball_distance(gt: msg.GroundTruth) -> float:
+        d = [math.hypot(r.x - gt.ball.x, r.y - gt.ball.y) for r in gt.robots if r.team == "yellow"]
+        return sum(d) / len(d)
+
+    assert ball_distance(truths[-1]) < ball_distance(truths[0]) - 0.3

@@ -1,15 +1,20 @@
 """The protocol adapters: stages on the bus like any other, each between topics and UDP packets.
 
-    ssl/vision_out   detections/<id> -> SSL_WrapperPacket multicast; ssl/vision/sent (Tick) per frame
-    ssl/vision_in    SSL_WrapperPacket multicast -> ssl/vision/<id> (DetectionFrame)
-    ssl/referee_out  referee (GameState) -> Referee multicast
-    ssl/referee_in   Referee multicast -> referee/gc (GameState); world/<team>: the ball taken into play
+    ssl/vision_out             detections/<id> -> SSL_WrapperPacket multicast; ssl/vision/sent (Tick) per frame
+    ssl/vision_in              SSL_WrapperPacket multicast -> ssl/vision/<id> (DetectionFrame)
+    ssl/referee_out            referee (GameState) -> Referee multicast
+    ssl/referee_in             Referee multicast -> referee/gc (GameState); world/<team>: the ball taken into play
+    ssl/tracker_out/<team>     world/<team> -> TrackerWrapperPacket multicast
+    ssl/commands_out/<team>    commands/<team> (headings from world/<team>) -> grSim_Packet or RobotControl
+                               unicast; teleport -> SimulatorCommand
+    ssl/simulation_in/<team>   RobotControl and SimulatorCommand unicast, on each truth -> commands/<team>, teleport
 
 ``ssl/vision_in`` runs free (on every ``clock`` tick it publishes what came since) when the packets
 come from outside; fed by our own ``ssl/vision_out`` in the same match it runs in lock-step: on each
 ``ssl/vision/sent`` it waits (up to ``vision.wait_s``) until that frame's packet from every camera
 came, so the match plays the same as on the in-process path. Garbage, a packet cut short, a camera
-not in the config and a packet already seen are counted and dropped with a line on stderr.
+not in the config and a packet already seen are counted and dropped with a line on stderr (by every
+receiving stage: garbage and cut packets for the simulation protocol and the referee too).
 """
 
 from __future__ import annotations

@@ -67,6 +67,9 @@ def add_parsers(sub: Any, common: Callable[[argparse.ArgumentParser], None]) -> 
     p.add_argument("--out", metavar="DIR", default=None,
                    help="league log: the run folder for run.mcap and summary.json (default logs/<time>-replay)")
     p.add_argument("--overwrite", action="store_true", help="let --out replace the run already in that folder")
+    p.add_argument("--own", action="store_true",
+                   help="league log: a match our team played with this config; the tracker takes the brain's commands "
+                   "as the robots' control input, as in the match (without: the detections alone)")
     p.add_argument("--from", dest="start", type=_non_negative, default=0.0, metavar="S",
                    help="start S seconds into the log (default 0)")  # fmt: skip
     p.add_argument("--speed", type=_speed, default=1.0, metavar="X",
@@ -357,7 +360,7 @@ def _replay_league(args: argparse.Namespace, path: Path, stop: Interrupt) -> int
                 if n % 500 == 0:
                     progress.update(task, completed=n, info=f"{n} records")
 
-            result = replay_league_log(path, settings, args.team, extra=(LoggerStage(log),),
+            result = replay_league_log(path, settings, args.team, extra=(LoggerStage(log),), own=args.own,
                                        should_stop=lambda: stop.requested, on_record=show)  # fmt: skip
     except (LogFileError, LogError) as exc:
         print(f"cmdragons replay: {exc}", file=sys.stderr)
@@ -369,9 +372,10 @@ def _replay_league(args: argparse.Namespace, path: Path, stop: Interrupt) -> int
         else 0.0  # fmt: skip
     vision = result.figures.get("ssl/vision_in", {})
     tracker = result.figures.get(f"tracker/{args.team}", {})
-    summary = {"log": str(path), "team": args.team, "records": result.records, "cameras": result.cameras,
-               "seconds": round(span, 3), "truncated": result.truncated, "interrupted": result.interrupted,
-               "vision": vision, "referee": result.figures.get("ssl/referee_in", {}), "tracker": tracker}  # fmt: skip
+    summary = {"log": str(path), "team": args.team, "own": args.own, "records": result.records,
+               "cameras": result.cameras, "seconds": round(span, 3), "truncated": result.truncated,
+               "interrupted": result.interrupted, "vision": vision,
+               "referee": result.figures.get("ssl/referee_in", {}), "tracker": tracker}  # fmt: skip
     (folder / "summary.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
     dropped = vision.get("dropped", {})
     print(f"replay: {path}: {sum(result.records.values())} records over {span:.2f} s, cameras "

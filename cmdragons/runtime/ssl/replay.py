@@ -5,10 +5,13 @@ reads them from the network (:class:`~cmdragons.runtime.ssl.stages.VisionInStage
 queue instead of a socket: garbage, unknown cameras and duplicates are counted and dropped the
 same way), and each Referee packet to the same game-controller stage
 (:class:`~cmdragons.runtime.ssl.stages.RefereeInStage`, ``referee/gc``). Our tracker steps once
-every camera in the log has delivered a frame (a newer frame closes the one in progress), and our
-brain plays on its world states and the game controller's word, as fast as they come (the log's
-own times stay in the messages). Tracker packets, the 2010 vision format and unknown record types
-are counted and left out. A log cut off mid-record replays up to its last whole record.
+every camera in the log has delivered a frame (a newer frame closes the one in progress: cameras
+with counters of their own step it one by one), and our brain plays on its world states and the
+game controller's word, as fast as they come (the log's own times stay in the messages). The
+brain's commands go nowhere but the run's log, and into the tracker (as the robots' control
+input) only for a log of our own match (``own``). Tracker packets, the 2010 vision format and
+unknown record types are counted and left out. A log cut off mid-record replays up to its last
+whole record.
 """
 
 from __future__ import annotations
@@ -59,10 +62,13 @@ def camera_ids(path: str | Path) -> list[int]:
 
 
 def replay_league_log(path: str | Path, settings: Settings, team: Team = "blue", extra: tuple[Stage, ...] = (),
-                      should_stop: Callable[[], bool] = lambda: False,
+                      own: bool = False, should_stop: Callable[[], bool] = lambda: False,
                       on_record: Callable[[int, int], None] | None = None) -> LeagueReplay:  # fmt: skip
     """Play the league log at ``path`` into ``team``'s tracker and brain (``settings``); ``extra``:
-    more stages on the bus (a logger). ``on_record(receive_time_ns, n)`` after each record."""
+    more stages on the bus (a logger). ``own``: the log is of a match our team played (with these
+    settings): the tracker takes the brain's commands as the robots' control input, as it did in
+    the match; else it follows the robots by their detections alone (a real match's robots did not
+    follow our brain). ``on_record(receive_time_ns, n)`` after each record."""
     out = LeagueReplay(cameras=camera_ids(path))
     p = settings.protocols
     vision_q, referee_q = DatagramQueue(), DatagramQueue()
@@ -70,7 +76,7 @@ def replay_league_log(path: str | Path, settings: Settings, team: Team = "blue",
     stages: list[Stage] = [
         VisionInStage(p, out.cameras, lockstep=False, receiver=vision_q),
         RefereeInStage(p, world_topic, settings.sim.referee.figures.ball_in_play_m, receiver=referee_q),
-        TrackerStage(team, _tracker(settings), [f"ssl/vision/{c}" for c in out.cameras]),
+        TrackerStage(team, _tracker(settings), [f"ssl/vision/{c}" for c in out.cameras], take_commands=own),
         TeamStage(team, _brain(team, settings), "referee/gc"),
         *extra,
     ]

@@ -369,3 +369,36 @@ def test_the_example_client_plays_yellow_in_our_simulator_over_the_leagues_proto
         return sum(d) / len(d)
 
     assert ball_distance(truths[-1]) < ball_distance(truths[0]) - 0.3
+
+
+def test_garbage_answers_to_our_commands_are_counted_and_dropped() -> None:
+    from cmdragons.runtime.ssl.stages import CommandsOutStage
+
+    sim_port, control = _ports(2)
+    settings = load_settings(None, ["protocols.commands_to=simulation", f"protocols.simulation.blue_port={sim_port}",
+                                    f"protocols.simulation.control_port={control}"])  # fmt: skip
+    err = io.StringIO()
+    stage = CommandsOutStage(settings.protocols, "blue", CHIP, err=err)
+    stage.drops.interval_s = 0.0
+    peer = UdpEndpoint("127.0.0.1", sim_port)
+    try:
+        stage.on_message("commands/blue", COMMANDS, lambda _t, _m: None)
+        got = peer.receive(1.0)
+        assert got is not None
+        peer.send_to(b"\xff\x13garbage", got[1])
+        peer.send_to(sim_pb.RobotControlResponse(errors=[sim_pb.SimulatorError(code="x")]).SerializeToString(), got[1])
+        time.sleep(0.1)  # loopback delivery
+        stage.on_message("world/blue", WORLD, lambda _t, _m: None)
+    finally:
+        close_sockets([stage])
+        peer.close()
+    assert stage.drops.counts == {"undecodable": 1} and (stage.answers, stage.answer_errors) == (1, 1)
+    assert len(err.getvalue().strip().splitlines()) == 1 and "dropped a packet (undecodable" in err.getvalue()
+
+
+def test_the_simulation_opponent_is_for_the_embedded_match(capsys: pytest.CaptureFixture[str]) -> None:
+    from cmdragons.cli import main
+
+    assert main(["play", "--opponent", "simulation", "--distributed", "--seconds", "1"]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "leave out --distributed" in err

@@ -402,3 +402,10 @@ def test_the_simulation_opponent_is_for_the_embedded_match(capsys: pytest.Captur
     assert main(["play", "--opponent", "simulation", "--distributed", "--seconds", "1"]) == 2
     err = capsys.readouterr().err
     assert len(err.strip().splitlines()) == 1 and "leave out --distributed" in err
+
+
+def test_the_new_streams_default_off_and_to_the_leagues_ports() -> None:
+    p = load_settings().protocols
+    assert not p.tracker.send and p.commands_to == "none"
+    assert (p.grsim.address, p.grsim.port, p.grsim.vision_port) == ("127.0.0.1", 20011, 10020)
+    assert (p.simulation.address, p.simulation.port("blue"), p.simulation.port("yellow")) == ("127.0.0.1", 10301, 10302)

@@ -32,7 +32,9 @@ from cmdragons.runtime.ssl.commands import (
     read_robot_control,
     read_simulator_command,
     robot_control_packet,
+    robot_control_response,
     simulator_command_packet,
+    simulator_response,
     to_field,
 )
 from cmdragons.runtime.ssl.stages import SimulationInStage, TrackerOutStage, close_sockets
@@ -156,6 +158,10 @@ def test_every_message_sent_decodes_with_protoc() -> None:
     tp = msg.Teleport(0.0, (("yellow", 2, -1.0, 1.0, -2.0),), (0.25, 0.75))
     out = _protoc("ssl_simulator.proto", "SimulatorCommand", simulator_command_packet(tp))
     assert "teleport_ball" in out and "x: 0.25" in out and "team: YELLOW" in out and "present: true" in out
+    out = _protoc("ssl_simulator.proto", "RobotControlResponse", robot_control_response("yellow", [3], ["robot 4: no"]))
+    assert "unsupported_capability: SIMULATOR_CAPABILITY_MOVE_WHEEL_VELOCITY" in out and "team: YELLOW" in out
+    out = _protoc("ssl_simulator.proto", "SimulatorResponse", simulator_response(["config: not here"]))
+    assert "message: \"config: not here\"" in out
 
 
 def test_a_match_multicasts_its_world_states_as_tracker_packets(udp_port: int) -> None:

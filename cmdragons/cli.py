@@ -99,9 +99,11 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("play", help="play a match in the simulator; our team sees only the camera images")
     _common(p)
-    p.add_argument("--opponent", choices=("simple", "self", "none", "outside"), default="simple",
-                   help="the built-in simple team (on the true state), a copy of our team, nobody, or (with "
-                   "--distributed) a team outside on commands/yellow (examples/outside_team.py)")
+    p.add_argument("--opponent", choices=("simple", "self", "none", "outside", "simulation"), default="simple",
+                   help="the built-in simple team (on the true state), a copy of our team, nobody, (with "
+                   "--distributed) a team outside on commands/yellow (examples/outside_team.py), or a team outside "
+                   "over the league's simulation protocol (RobotControl to 127.0.0.1:10302, SimulatorCommand to "
+                   "10300; it sees SSL-Vision packets on 224.5.23.2:10006 and Referee packets on 224.5.23.1:10003)")
     p.add_argument("--opponent-set", metavar="KEY=VALUE", action="append", default=[],
                    help="with --opponent self: override one value of the copy's own config, on top of --config "
                    "and --set (its brain and tracker: planner, control, safety, tracker, strategy, team), "
@@ -181,6 +183,10 @@ def main(argv: Sequence[str] | None = None) -> int:
                 return _cmd_sim(args, stop)
             if args.command == "bench":
                 return _cmd_bench(args)
+            if args.command == "play" and args.distributed and args.opponent == "simulation":
+                print("cmdragons play: --opponent simulation plays in the embedded match: leave out --distributed",
+                      file=sys.stderr)  # fmt: skip
+                return 2
             if args.command == "play" and args.distributed:
                 return play_distributed(args, stop)
             if args.command == "play" and args.opponent == "outside":

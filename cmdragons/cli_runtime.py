@@ -58,9 +58,18 @@ def add_parsers(sub: Any, common: Callable[[argparse.ArgumentParser], None]) -> 
     p.add_argument("--out", metavar="DIR", default=None, help="log and sim: the run folder (default logs/<time>-play)")
     p.add_argument("--overwrite", action="store_true", help="let --out replace the run already in that folder")
 
-    p = sub.add_parser("replay", help="publish a run's MCAP log on zenoh again (for a team node, a viewer, ...)")
+    p = sub.add_parser("replay", help="publish a run's MCAP log on zenoh again (for a team node, a viewer, ...); "
+                       "a league log (.log, .log.gz) plays into our tracker and brain")
     common(p)
-    p.add_argument("path", metavar="LOG.mcap")
+    p.add_argument("path", metavar="LOG", help="a run's run.mcap, or a league log (SSL_LOG_FILE: .log or .log.gz)")
+    p.add_argument("--team", choices=("blue", "yellow"), default="blue",
+                   help="league log: the team our tracker and brain play (default blue)")
+    p.add_argument("--out", metavar="DIR", default=None,
+                   help="league log: the run folder for run.mcap and summary.json (default logs/<time>-replay)")
+    p.add_argument("--overwrite", action="store_true", help="let --out replace the run already in that folder")
+    p.add_argument("--own", action="store_true",
+                   help="league log: a match our team played with this config; the tracker takes the brain's commands "
+                   "as the robots' control input, as in the match (without: the detections alone)")
     p.add_argument("--from", dest="start", type=_non_negative, default=0.0, metavar="S",
                    help="start S seconds into the log (default 0)")  # fmt: skip
     p.add_argument("--speed", type=_speed, default=1.0, metavar="X",
@@ -272,11 +281,14 @@ def cmd_replay(args: argparse.Namespace, stop: Interrupt) -> int:
     from cmdragons.runtime.log import LogError
     from cmdragons.runtime.replay import replay, replay_span
     from cmdragons.runtime.settings import load_settings
+    from cmdragons.runtime.ssl.convert import is_league_log
 
     path = Path(args.path)
     if not path.is_file():
-        print(f"cmdragons replay: {path}: no such file; give a run's run.mcap", file=sys.stderr)
+        print(f"cmdragons replay: {path}: no such file; give a run's run.mcap or a league log", file=sys.stderr)
         return 2
+    if is_league_log(path):
+        return _replay_league(args, path, stop)
     try:
         first, last = replay_span(path, args.start)
     except LogError as exc:
@@ -316,4 +328,59 @@ def cmd_replay(args: argparse.Namespace, stop: Interrupt) -> int:
     cut = f", interrupted by {stop.signal}" if result.interrupted else ""
     print(f"replay: {result.messages} messages, log time {result.first_s - first:.2f} .. {result.last_s - first:.2f} s "
           f"at {args.speed:g}x on cmdragons/{params.field_name}{cut}")  # fmt: skip
+    return stop.exit_code
+
+
+def _replay_league(args: argparse.Namespace, path: Path, stop: Interrupt) -> int:
+    """``cmdragons replay match.log.gz``: the league log's vision and referee packets into our
+    tracker and brain, in-process and as fast as they go; run.mcap and summary.json."""
+    from cmdragons.cli import _progress
+    from cmdragons.runtime.log import LogError, RunLog, run_folder
+    from cmdragons.runtime.settings import load_settings
+    from cmdragons.runtime.ssl.logfile import LogFileError
+    from cmdragons.runtime.ssl.replay import replay_league_log
+    from cmdragons.runtime.stages import LoggerStage
+
+    zenoh_only = [name for name, given in (("--from", args.start != 0.0), ("--speed", args.speed != 1.0),
+                                           ("--skip", bool(args.skip)), ("--wait", args.wait is not None),
+                                           ("--router", args.router)) if given]  # fmt: skip
+    if zenoh_only:
+        print(f"cmdragons replay: {', '.join(zenoh_only)} are for MCAP logs on zenoh; a league log plays into our "
+              "tracker and brain as fast as it goes: leave them out", file=sys.stderr)  # fmt: skip
+        return 2
+    settings = load_settings(args.config, args.set)
+    folder = run_folder("replay", args.out, overwrite=args.overwrite)
+    log = RunLog(folder / "run.mcap")
+    total = path.stat().st_size
+    try:
+        with _progress(not args.no_progress) as progress, stop.soft():
+            task = progress.add_task("replay", total=None, info=f"{path.name} ({total / 1e6:.1f} MB)")
+
+            def show(_t_ns: int, n: int) -> None:
+                if n % 500 == 0:
+                    progress.update(task, completed=n, info=f"{n} records")
+
+            result = replay_league_log(path, settings, args.team, extra=(LoggerStage(log),), own=args.own,
+                                       should_stop=lambda: stop.requested, on_record=show)  # fmt: skip
+    except (LogFileError, LogError) as exc:
+        print(f"cmdragons replay: {exc}", file=sys.stderr)
+        return 2
+    finally:
+        with stop.shield():
+            log.close()
+    span = (result.last_ns - result.first_ns) / 1e9 if result.first_ns is not None and result.last_ns is not None \
+        else 0.0  # fmt: skip
+    vision = result.figures.get("ssl/vision_in", {})
+    tracker = result.figures.get(f"tracker/{args.team}", {})
+    summary = {"log": str(path), "team": args.team, "own": args.own, "records": result.records,
+               "cameras": result.cameras, "seconds": round(span, 3), "truncated": result.truncated,
+               "interrupted": result.interrupted, "vision": vision,
+               "referee": result.figures.get("ssl/referee_in", {}), "tracker": tracker}  # fmt: skip
+    (folder / "summary.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
+    dropped = vision.get("dropped", {})
+    print(f"replay: {path}: {sum(result.records.values())} records over {span:.2f} s, cameras "
+          f"{', '.join(map(str, result.cameras)) or 'none'}; {vision.get('detections', 0)} detections into the "
+          f"{args.team} tracker and brain" + (f", dropped {dropped}" if dropped else "") + f" -> {folder}")  # fmt: skip
+    if result.truncated is not None:
+        print(f"cmdragons replay: warning: {result.truncated}", file=sys.stderr)
     return stop.exit_code

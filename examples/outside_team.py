@@ -8,10 +8,10 @@ RobotControl on cmdragons/<field>/commands/yellow: each robot drives at the ball
 
 import argparse
 import json
-import math
 import time
 
 import zenoh
+from chase import chase, see
 
 from cmdragons.runtime.proto import ssl_detection_pb2, ssl_simulation_control_pb2, ssl_tracked_pb2
 
@@ -31,23 +31,13 @@ answered = -1  # the last camera frame answered
 def on_detections(sample: zenoh.Sample) -> None:
     global answered
     frame = ssl_detection_pb2.SSL_DetectionFrame.FromString(sample.payload.to_bytes())
-    if frame.balls:
-        seen["ball"] = (frame.balls[0].x, frame.balls[0].y)
-    seen.update({r.robot_id: (r.x, r.y) for r in frame.robots_yellow})
+    see(seen, frame)
     if frame.frame_number == answered:  # one answer a frame, on its first camera
         return
     answered = frame.frame_number
     out = ssl_simulation_control_pb2.RobotControl(team=ssl_tracked_pb2.YELLOW, frame_number=frame.frame_number,
                                                   t=frame.t_capture)  # fmt: skip
-    bx, by = seen.get("ball", (0.0, 0.0))
-    for robot_id, (x, y) in seen.items():
-        if robot_id == "ball":
-            continue
-        dx, dy = (bx - x) / 1000, (by - y) / 1000  # mm -> m
-        d = math.hypot(dx, dy)
-        v = min(args.speed, 2 * d) / max(d, 1e-6)  # slow down near the ball
-        move = out.robot_commands.add(id=robot_id).move_command.global_velocity
-        move.x, move.y, move.angular = v * dx, v * dy, 0.0
+    chase(out, seen, args.speed)
     session.put(f"cmdragons/{args.field}/commands/yellow", out.SerializeToString())
 
 

@@ -44,6 +44,7 @@ SUITES: dict[str, Suite] = {
     "navigation": _lazy("cmdragons.bench.navigation"),
     "estimation": _lazy("cmdragons.bench.estimation"),
     "runtime": _lazy("cmdragons.bench.runtime"),
+    "protocols": _lazy("cmdragons.bench.protocols"),
 }
 # the options each suite takes
 OPTIONS: dict[str, tuple[str, ...]] = {"grid": ("maps",), "navigation": ("figures",),

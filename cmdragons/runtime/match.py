@@ -50,7 +50,7 @@ from strategy.simple import SimpleTeam
 __all__ = ["OURS", "THEIRS", "Match", "Opponent", "Perception", "match_summary", "summary_stages", "truth_world",
            "wiring"]
 
-Opponent = Literal["simple", "self", "none", "outside"]
+Opponent = Literal["simple", "self", "none", "outside", "simulation"]
 Perception = Literal["vision", "truth"]
 OURS: Team = "blue"
 THEIRS: Team = "yellow"
@@ -68,27 +68,36 @@ def wiring(settings: Settings, sim: Simulator, opponent: Opponent, perception: P
     ]
     brains: list[Team] = [OURS, THEIRS] if opponent == "self" else [OURS]
     # who is given detections: our team, its copy, or a team outside (``outside``: its own client on
-    # the bus, commands on commands/yellow; the runtime runs nothing of it)
-    seeing: list[Team] = [OURS, THEIRS] if opponent in ("self", "outside") else [OURS]
+    # the bus, commands on commands/yellow; ``simulation``: over the league's simulation protocol,
+    # seeing SSL-Vision packets; the runtime runs nothing of it)
+    seeing: list[Team] = [OURS, THEIRS] if opponent in ("self", "outside", "simulation") else [OURS]
     if perception == "vision":
         from vision.pipeline import VisionPipeline  # imported here: truth runs need no vision
 
         stages += [VisionStage(m.id, VisionPipeline(settings.vision, settings.field, m)) for m in sim.cameras]
         topics = {team: [f"detections/{m.id}" for m in sim.cameras] for team in brains}
-        stages += _ssl_vision_stages(settings, sim, topics)
+        stages += _ssl_vision_stages(settings, sim, topics, outside=opponent == "simulation")
     else:
         t = settings.tracker  # the noise vision measures: the tracker's measurement model
         sigmas = (t.ball.measurement_sigma_m, t.robot.measurement_sigma_m, t.robot.measurement_sigma_rad)
         stages += [TruthPerceptionStage(team, sigmas, seed + k) for k, team in enumerate(seeing)]
         topics = {team: [f"perception/{team}"] for team in brains}
+        if opponent == "simulation":  # the outside team's noisy truth, as SSL-Vision packets
+            stages += _ssl_vision_stages(settings, sim, {}, outside=True, topics_out=[f"perception/{THEIRS}"])
     referee_topic = "referee"
-    if settings.protocols.referee.send or settings.protocols.referee.source == "game_controller":
-        referee_stages, referee_topic = _ssl_referee_stages(settings, brains)
+    p = settings.protocols
+    if p.referee.send or p.referee.source == "game_controller" or opponent == "simulation":
+        referee_stages, referee_topic = _ssl_referee_stages(settings, brains, send=opponent == "simulation")
         stages += referee_stages
+    if opponent == "simulation":
+        from cmdragons.runtime.ssl.stages import SimulationInStage
+
+        stages.append(SimulationInStage(p, THEIRS))
     for team in brains:
         own = opponent_settings if team == THEIRS and opponent_settings is not None else settings
         stages += [TrackerStage(team, Tracker(own.tracker), topics[team]),
                    TeamStage(team, Brain(team, own), referee_topic)]  # fmt: skip
+    stages += _ssl_out_stages(settings)
     if opponent == "simple":
         simple = SimpleTeam(THEIRS, settings.field_geometry(), settings.team.simple_opponent, settings.strategy)
         stages.append(SimpleOpponentStage(THEIRS, simple))
@@ -98,38 +107,59 @@ def wiring(settings: Settings, sim: Simulator, opponent: Opponent, perception: P
     return stages
 
 
-def _ssl_vision_stages(settings: Settings, sim: Simulator, topics: dict[Team, list[str]]) -> list[Stage]:
-    """Our vision as SSL-Vision packets (``protocols.vision.send``) and our trackers on SSL-Vision
-    packets (``protocols.perception: ssl_vision``; in lock-step with our own packets when we send
-    them). ``topics`` (each team's detection topics) is changed to the packets' for the latter."""
+def _ssl_vision_stages(settings: Settings, sim: Simulator, topics: dict[Team, list[str]], outside: bool = False,
+                       topics_out: list[str] | None = None) -> list[Stage]:  # fmt: skip
+    """Our vision as SSL-Vision packets (``protocols.vision.send``, or ``outside``: a team outside
+    sees them; ``topics_out``: the detection topics sent, default our cameras') and our trackers on
+    SSL-Vision packets (``protocols.perception: ssl_vision``; in lock-step with our own packets when
+    we send them). ``topics`` (each team's detection topics) is changed to the packets' for the
+    latter."""
     from cmdragons.runtime.ssl.stages import VisionInStage, VisionOutStage
     from cmdragons.runtime.ssl.vision import geometry_packet
 
     p = settings.protocols
     ids = [m.id for m in sim.cameras]
     stages: list[Stage] = []
-    if p.vision.send:
-        stages.append(VisionOutStage(p, ids, geometry_packet(settings.field_geometry(), list(sim.cameras))))
+    if p.vision.send or outside:
+        sent_ids = ids if topics_out is None else [0]
+        stages.append(VisionOutStage(p, sent_ids, geometry_packet(settings.field_geometry(), list(sim.cameras)),
+                                     topics_out))  # fmt: skip
+    if topics_out is not None:
+        return stages
     if p.perception == "ssl_vision":
-        stages.append(VisionInStage(p, ids, lockstep=p.vision.send))
+        stages.append(VisionInStage(p, ids, lockstep=p.vision.send or outside))
         for team in topics:
             topics[team] = [f"ssl/vision/{i}" for i in ids]
     return stages
 
 
-def _ssl_referee_stages(settings: Settings, brains: list[Team]) -> tuple[list[Stage], str]:
-    """Our referee's word as the league's Referee packets (``protocols.referee.send``) and our
-    brains on a game controller's packets (``protocols.referee.source: game_controller``); the
-    referee topic the brains read."""
+def _ssl_referee_stages(settings: Settings, brains: list[Team], send: bool = False) -> tuple[list[Stage], str]:
+    """Our referee's word as the league's Referee packets (``protocols.referee.send`` or ``send``)
+    and our brains on a game controller's packets (``protocols.referee.source: game_controller``);
+    the referee topic the brains read."""
     from cmdragons.runtime.ssl.stages import RefereeInStage, RefereeOutStage
 
     p = settings.protocols
-    stages: list[Stage] = [RefereeOutStage(p)] if p.referee.send else []
+    stages: list[Stage] = [RefereeOutStage(p)] if p.referee.send or send else []
     if p.referee.source == "simulator":
         return stages, "referee"
     moved_m = settings.sim.referee.figures.ball_in_play_m
     stages.append(RefereeInStage(p, f"world/{brains[0]}", moved_m))
     return stages, "referee/gc"
+
+
+def _ssl_out_stages(settings: Settings) -> list[Stage]:
+    """Our tracker's world state as tracker packets (``protocols.tracker.send``) and our team's
+    commands to a league simulator (``protocols.commands_to``)."""
+    p = settings.protocols
+    if not p.tracker.send and p.commands_to == "none":
+        return []
+    from cmdragons.runtime.ssl.stages import CommandsOutStage, TrackerOutStage
+
+    stages: list[Stage] = [TrackerOutStage(p, OURS)] if p.tracker.send else []
+    if p.commands_to != "none":
+        stages.append(CommandsOutStage(p, OURS, settings.sim.kicker.chip_angle_rad))
+    return stages
 
 
 # per-frame timings of the summary: name -> the bus timing keys summed into it

@@ -199,13 +199,15 @@ class TruthPerceptionStage(BaseStage):
 class TrackerStage(BaseStage):
     """One team's tracker: steps once every detection topic it reads has delivered the frame (a
     newer frame first closes the one in progress with what came), and takes its team's commands as
-    the robots' control input."""
+    the robots' control input (``take_commands``; not when the robots seen are driven by someone
+    else, as in a real match's log)."""
 
-    def __init__(self, team: Team, tracker: Tracker, detection_topics: Sequence[str]) -> None:
+    def __init__(self, team: Team, tracker: Tracker, detection_topics: Sequence[str],
+                 take_commands: bool = True) -> None:  # fmt: skip
         self.name = f"tracker/{team}"
         self.team = team
         self.detection_topics = tuple(detection_topics)
-        self.inputs = (*self.detection_topics, f"commands/{team}")
+        self.inputs = (*self.detection_topics, *((f"commands/{team}",) if take_commands else ()))
         self.tracker = tracker
         self._frame = -1
         self._pending: dict[str, DetectionFrame] = {}

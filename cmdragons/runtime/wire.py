@@ -65,7 +65,7 @@ from cmdragons.runtime.proto import ssl_simulation_control_pb2 as ctl_pb
 from cmdragons.runtime.proto import ssl_tracked_pb2 as trk_pb
 
 __all__ = ["CODECS", "LOSSY", "TOPICS", "Codec", "canonical", "decode", "encode", "encode_chunks", "from_proto",
-           "message_type", "to_proto"]  # fmt: skip
+           "message_type", "parse", "to_proto"]  # fmt: skip
 
 MM = 1000.0  # millimetres a metre: the league's vision speaks millimetres
 
@@ -152,7 +152,7 @@ def _world_from(m: Any) -> WorldState:
 def _command_to(c: RobotCommand, into: Any) -> Any:
     into.id = c.id
     v = into.move_command.global_velocity
-    v.x, v.y, v.angular = c.vx, c.vy, c.omega
+    v.vel_x, v.vel_y, v.vel_angular = c.vx, c.vy, c.omega
     into.kick_speed = c.kick_speed
     into.chip = c.chip
     into.dribbler_power = c.dribbler
@@ -165,7 +165,7 @@ def _command_from(m: Any, team: Team) -> RobotCommand:
         raise MessageError(f"robot {m.id}: only field-frame velocities (global_velocity) are understood, got {kind}")
     v = m.move_command.global_velocity
     chip = m.chip or (m.HasField("kick_angle") and m.kick_angle > 0.0)
-    return RobotCommand(team, m.id, v.x, v.y, v.angular, m.kick_speed, chip, m.dribbler_power)
+    return RobotCommand(team, m.id, v.vel_x, v.vel_y, v.vel_angular, m.kick_speed, chip, m.dribbler_power)
 
 
 def _commands_to(tc: TeamCommands) -> Any:
@@ -552,6 +552,22 @@ def decode(topic: str, data: bytes | bytearray | memoryview) -> Any:
         raise MessageError(f"{topic}: not a {codec.proto.DESCRIPTOR.full_name}: {exc}") from None
     except (ValueError, TypeError, KeyError) as exc:  # a required field missing, a value out of range
         raise MessageError(f"{topic}: bad {codec.proto.DESCRIPTOR.full_name}: {exc}") from None
+
+
+def parse(proto_type: Any, data: bytes) -> Any:
+    """``data`` parsed as a ``proto_type`` (a generated message class); :class:`MessageError` naming
+    the league's message for bytes that are not one (garbage, cut short, a required field missing)."""
+    from google.protobuf.message import DecodeError
+
+    m = proto_type()
+    name = proto_type.DESCRIPTOR.name
+    try:
+        m.ParseFromString(data)
+    except DecodeError as exc:
+        raise MessageError(f"not a {name}: {exc}") from None
+    if not m.IsInitialized():
+        raise MessageError(f"{name} with required fields missing: " + ", ".join(m.FindInitializationErrors()))
+    return m
 
 
 def canonical(message: Any) -> Any:

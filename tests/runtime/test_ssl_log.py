@@ -35,10 +35,16 @@ def test_a_log_written_reads_back(tmp_path: Path, name: str, index: bool) -> Non
     assert list(reader) == RECORDS and reader.truncated is None
     if index:
         assert reader.index is not None and reader.index[0] == 16 and len(reader.index) == len(RECORDS)
-        (index_at,) = struct.unpack(">q", raw[-8:])
+        # the league's layout: offsets, the distance back from the file's end, the marker
+        assert raw[-7:] == b"INDEXED"
+        (back,) = struct.unpack(">q", raw[-15:-7])
+        index_at = len(raw) - back
         for off, r in zip(reader.index, RECORDS, strict=True):
             assert raw[off + 16: off + 16 + len(r.payload)] == r.payload
-        assert struct.unpack(">i", raw[index_at + 8: index_at + 12])[0] == MessageType.INDEX_2021
+        t_ns, kind, size = struct.unpack(">qii", raw[index_at: index_at + 16])
+        assert (kind, size, index_at + 16 + size) == (MessageType.INDEX_2021, 8 * len(RECORDS) + 8 + 7, len(raw))
+        assert struct.unpack(f">{len(RECORDS)}q", raw[index_at + 16: index_at + 16 + 8 * len(RECORDS)]) == \
+            tuple(reader.index)  # fmt: skip
     else:
         assert reader.index is None
 

@@ -117,7 +117,7 @@ def test_commands_are_robot_control_with_field_frame_velocities() -> None:
     assert type(p).DESCRIPTOR.name == "RobotControl"
     c = p.robot_commands[0]
     assert c.move_command.WhichOneof("command") == "global_velocity"
-    assert (c.move_command.global_velocity.x, c.kick_speed, c.chip) == (1.0, 3.5, True)
+    assert (c.move_command.global_velocity.vel_x, c.kick_speed, c.chip) == (1.0, 3.5, True)
     # a plain RobotControl (no cmdragons fields) from outside names no team: refused, not guessed
     with pytest.raises(msg.MessageError):
         wire.from_proto(type(p)(robot_commands=[c]))

@@ -25,7 +25,7 @@ _sym_db = _symbol_database.Default()
 from cmdragons.runtime.proto import ssl_tracked_pb2 as cmdragons_dot_runtime_dot_proto_dot_ssl__tracked__pb2
 
 
-DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n4cmdragons/runtime/proto/ssl_simulation_control.proto\x12\x10\x63mdragons.league\x1a)cmdragons/runtime/proto/ssl_tracked.proto\"c\n\x11MoveWheelVelocity\x12\x13\n\x0b\x66ront_right\x18\x01 \x02(\x02\x12\x12\n\nback_right\x18\x02 \x02(\x02\x12\x11\n\tback_left\x18\x03 \x02(\x02\x12\x12\n\nfront_left\x18\x04 \x02(\x02\"C\n\x11MoveLocalVelocity\x12\x0f\n\x07\x66orward\x18\x01 \x02(\x02\x12\x0c\n\x04left\x18\x02 \x02(\x02\x12\x0f\n\x07\x61ngular\x18\x03 \x02(\x02\";\n\x12MoveGlobalVelocity\x12\t\n\x01x\x18\x01 \x02(\x02\x12\t\n\x01y\x18\x02 \x02(\x02\x12\x0f\n\x07\x61ngular\x18\x03 \x02(\x02\"\xdc\x01\n\x10RobotMoveCommand\x12=\n\x0ewheel_velocity\x18\x01 \x01(\x0b\x32#.cmdragons.league.MoveWheelVelocityH\x00\x12=\n\x0elocal_velocity\x18\x02 \x01(\x0b\x32#.cmdragons.league.MoveLocalVelocityH\x00\x12?\n\x0fglobal_velocity\x18\x03 \x01(\x0b\x32$.cmdragons.league.MoveGlobalVelocityH\x00\x42\t\n\x07\x63ommand\"\xba\x01\n\x0cRobotCommand\x12\n\n\x02id\x18\x01 \x02(\r\x12\x38\n\x0cmove_command\x18\x02 \x01(\x0b\x32\".cmdragons.league.RobotMoveCommand\x12\x12\n\nkick_speed\x18\x03 \x01(\x02\x12\x12\n\nkick_angle\x18\x04 \x01(\x02\x12\x16\n\x0e\x64ribbler_speed\x18\x05 \x01(\x02\x12\x0c\n\x04\x63hip\x18\x64 \x01(\x08\x12\x16\n\x0e\x64ribbler_power\x18\x65 \x01(\x02\"\x8d\x01\n\x0cRobotControl\x12\x36\n\x0erobot_commands\x18\x01 \x03(\x0b\x32\x1e.cmdragons.league.RobotCommand\x12$\n\x04team\x18\x64 \x01(\x0e\x32\x16.cmdragons.league.Team\x12\x14\n\x0c\x66rame_number\x18\x65 \x01(\r\x12\t\n\x01t\x18\x66 \x01(\x01')
+DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n4cmdragons/runtime/proto/ssl_simulation_control.proto\x12\x10\x63mdragons.league\x1a)cmdragons/runtime/proto/ssl_tracked.proto\"c\n\x11MoveWheelVelocity\x12\x13\n\x0b\x66ront_right\x18\x01 \x02(\x02\x12\x12\n\nback_right\x18\x02 \x02(\x02\x12\x11\n\tback_left\x18\x03 \x02(\x02\x12\x12\n\nfront_left\x18\x04 \x02(\x02\"C\n\x11MoveLocalVelocity\x12\x0f\n\x07\x66orward\x18\x01 \x02(\x02\x12\x0c\n\x04left\x18\x02 \x02(\x02\x12\x0f\n\x07\x61ngular\x18\x03 \x02(\x02\"G\n\x12MoveGlobalVelocity\x12\r\n\x05vel_x\x18\x01 \x02(\x02\x12\r\n\x05vel_y\x18\x02 \x02(\x02\x12\x13\n\x0bvel_angular\x18\x03 \x02(\x02\"\xdc\x01\n\x10RobotMoveCommand\x12=\n\x0ewheel_velocity\x18\x01 \x01(\x0b\x32#.cmdragons.league.MoveWheelVelocityH\x00\x12=\n\x0elocal_velocity\x18\x02 \x01(\x0b\x32#.cmdragons.league.MoveLocalVelocityH\x00\x12?\n\x0fglobal_velocity\x18\x03 \x01(\x0b\x32$.cmdragons.league.MoveGlobalVelocityH\x00\x42\t\n\x07\x63ommand\"\xbd\x01\n\x0cRobotCommand\x12\n\n\x02id\x18\x01 \x02(\r\x12\x38\n\x0cmove_command\x18\x02 \x01(\x0b\x32\".cmdragons.league.RobotMoveCommand\x12\x12\n\nkick_speed\x18\x03 \x01(\x02\x12\x15\n\nkick_angle\x18\x04 \x01(\x02:\x01\x30\x12\x16\n\x0e\x64ribbler_speed\x18\x05 \x01(\x02\x12\x0c\n\x04\x63hip\x18\x64 \x01(\x08\x12\x16\n\x0e\x64ribbler_power\x18\x65 \x01(\x02\"\x8d\x01\n\x0cRobotControl\x12\x36\n\x0erobot_commands\x18\x01 \x03(\x0b\x32\x1e.cmdragons.league.RobotCommand\x12$\n\x04team\x18\x64 \x01(\x0e\x32\x16.cmdragons.league.Team\x12\x14\n\x0c\x66rame_number\x18\x65 \x01(\r\x12\t\n\x01t\x18\x66 \x01(\x01')
 
 _globals = globals()
 _builder.BuildMessageAndEnumDescriptors(DESCRIPTOR, _globals)
@@ -37,11 +37,11 @@ if not _descriptor._USE_C_DESCRIPTORS:
   _globals['_MOVELOCALVELOCITY']._serialized_start=218
   _globals['_MOVELOCALVELOCITY']._serialized_end=285
   _globals['_MOVEGLOBALVELOCITY']._serialized_start=287
-  _globals['_MOVEGLOBALVELOCITY']._serialized_end=346
-  _globals['_ROBOTMOVECOMMAND']._serialized_start=349
-  _globals['_ROBOTMOVECOMMAND']._serialized_end=569
-  _globals['_ROBOTCOMMAND']._serialized_start=572
-  _globals['_ROBOTCOMMAND']._serialized_end=758
-  _globals['_ROBOTCONTROL']._serialized_start=761
-  _globals['_ROBOTCONTROL']._serialized_end=902
+  _globals['_MOVEGLOBALVELOCITY']._serialized_end=358
+  _globals['_ROBOTMOVECOMMAND']._serialized_start=361
+  _globals['_ROBOTMOVECOMMAND']._serialized_end=581
+  _globals['_ROBOTCOMMAND']._serialized_start=584
+  _globals['_ROBOTCOMMAND']._serialized_end=773
+  _globals['_ROBOTCONTROL']._serialized_start=776
+  _globals['_ROBOTCONTROL']._serialized_end=917
 # @@protoc_insertion_point(module_scope)

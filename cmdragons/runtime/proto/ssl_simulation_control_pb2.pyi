@@ -30,14 +30,14 @@ class MoveLocalVelocity(_message.Message):
     def __init__(self, forward: _Optional[float] = ..., left: _Optional[float] = ..., angular: _Optional[float] = ...) -> None: ...
 
 class MoveGlobalVelocity(_message.Message):
-    __slots__ = ("x", "y", "angular")
-    X_FIELD_NUMBER: _ClassVar[int]
-    Y_FIELD_NUMBER: _ClassVar[int]
-    ANGULAR_FIELD_NUMBER: _ClassVar[int]
-    x: float
-    y: float
-    angular: float
-    def __init__(self, x: _Optional[float] = ..., y: _Optional[float] = ..., angular: _Optional[float] = ...) -> None: ...
+    __slots__ = ("vel_x", "vel_y", "vel_angular")
+    VEL_X_FIELD_NUMBER: _ClassVar[int]
+    VEL_Y_FIELD_NUMBER: _ClassVar[int]
+    VEL_ANGULAR_FIELD_NUMBER: _ClassVar[int]
+    vel_x: float
+    vel_y: float
+    vel_angular: float
+    def __init__(self, vel_x: _Optional[float] = ..., vel_y: _Optional[float] = ..., vel_angular: _Optional[float] = ...) -> None: ...
 
 class RobotMoveCommand(_message.Message):
     __slots__ = ("wheel_velocity", "local_velocity", "global_velocity")

@@ -1,12 +1,24 @@
 from cmdragons.runtime.proto import ssl_tracked_pb2 as _ssl_tracked_pb2
 from cmdragons.runtime.proto import ssl_geometry_pb2 as _ssl_geometry_pb2
 from google.protobuf.internal import containers as _containers
+from google.protobuf.internal import enum_type_wrapper as _enum_type_wrapper
 from google.protobuf import descriptor as _descriptor
 from google.protobuf import message as _message
 from collections.abc import Iterable as _Iterable, Mapping as _Mapping
 from typing import ClassVar as _ClassVar, Optional as _Optional, Union as _Union
 
 DESCRIPTOR: _descriptor.FileDescriptor
+
+class SimulatorCapability(int, metaclass=_enum_type_wrapper.EnumTypeWrapper):
+    __slots__ = ()
+    SIMULATOR_CAPABILITY_UNKNOWN: _ClassVar[SimulatorCapability]
+    SIMULATOR_CAPABILITY_MOVE_WHEEL_VELOCITY: _ClassVar[SimulatorCapability]
+    SIMULATOR_CAPABILITY_MOVE_LOCAL_VELOCITY: _ClassVar[SimulatorCapability]
+    SIMULATOR_CAPABILITY_MOVE_GLOBAL_VELOCITY: _ClassVar[SimulatorCapability]
+SIMULATOR_CAPABILITY_UNKNOWN: SimulatorCapability
+SIMULATOR_CAPABILITY_MOVE_WHEEL_VELOCITY: SimulatorCapability
+SIMULATOR_CAPABILITY_MOVE_LOCAL_VELOCITY: SimulatorCapability
+SIMULATOR_CAPABILITY_MOVE_GLOBAL_VELOCITY: SimulatorCapability
 
 class TeleportBall(_message.Message):
     __slots__ = ("x", "y", "z", "vx", "vy", "vz", "teleport_safely", "roll", "by_force")
@@ -79,12 +91,14 @@ class SimulatorCommand(_message.Message):
     def __init__(self, control: _Optional[_Union[SimulatorControl, _Mapping]] = ..., config: _Optional[_Union[SimulatorConfig, _Mapping]] = ...) -> None: ...
 
 class SimulatorError(_message.Message):
-    __slots__ = ("code", "message")
+    __slots__ = ("code", "unsupported_capability", "message")
     CODE_FIELD_NUMBER: _ClassVar[int]
+    UNSUPPORTED_CAPABILITY_FIELD_NUMBER: _ClassVar[int]
     MESSAGE_FIELD_NUMBER: _ClassVar[int]
     code: str
+    unsupported_capability: SimulatorCapability
     message: str
-    def __init__(self, code: _Optional[str] = ..., message: _Optional[str] = ...) -> None: ...
+    def __init__(self, code: _Optional[str] = ..., unsupported_capability: _Optional[_Union[SimulatorCapability, str]] = ..., message: _Optional[str] = ...) -> None: ...
 
 class SimulatorResponse(_message.Message):
     __slots__ = ("errors",)
@@ -96,9 +110,9 @@ class RobotFeedback(_message.Message):
     __slots__ = ("id", "dribbler_ball_contact")
     ID_FIELD_NUMBER: _ClassVar[int]
     DRIBBLER_BALL_CONTACT_FIELD_NUMBER: _ClassVar[int]
-    id: int
+    id: _ssl_tracked_pb2.RobotId
     dribbler_ball_contact: bool
-    def __init__(self, id: _Optional[int] = ..., dribbler_ball_contact: _Optional[bool] = ...) -> None: ...
+    def __init__(self, id: _Optional[_Union[_ssl_tracked_pb2.RobotId, _Mapping]] = ..., dribbler_ball_contact: _Optional[bool] = ...) -> None: ...
 
 class RobotControlResponse(_message.Message):
     __slots__ = ("errors", "feedback")

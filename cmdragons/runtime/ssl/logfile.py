@@ -3,8 +3,10 @@
 A file is the 12 bytes ``SSL_LOG_FILE``, a big-endian int32 version (1), then records: int64 receive
 time (ns since the epoch), int32 message type, int32 payload size, the payload (the packet as it
 came: an SSL_WrapperPacket, a Referee message, a TrackerWrapperPacket). A name ending in ``.gz`` is
-gzip-compressed. A file may end with an index: a record of type ``INDEX_2021`` whose payload is the
-int64 offset of every record before it, then the int64 offset of that index record.
+gzip-compressed. A file may end with an index (the league's game-log description): a last record of
+type ``INDEX_2021`` (its time stamp irrelevant; we write 0) whose payload is the int64 offset of every
+record before it from the file's start, then the int64 distance from the file's end back to the
+index record's start, then the 7 bytes ``INDEXED``, so a reader can find it from the end.
 
 A file cut off mid-record (a recorder that was killed) reads up to its last whole record;
 :attr:`LogReader.truncated` then says where and what is missing, in one line.
@@ -27,6 +29,7 @@ VERSION = 1
 _RECORD = struct.Struct(">qii")  # receive time (ns), message type, payload size
 _VERSION = struct.Struct(">i")
 _OFFSET = struct.Struct(">q")
+INDEX_MARKER = b"INDEXED"
 
 
 class MessageType(IntEnum):
@@ -64,16 +67,24 @@ def write_log(path: str | Path, records: Iterable[LogRecord], index: bool = True
     with _open(path, "wb") as f:
         f.write(HEADER + _VERSION.pack(VERSION))
         at = len(HEADER) + _VERSION.size
-        last_ns = 0
         for r in records:
             offsets.append(at)
             f.write(_RECORD.pack(r.receive_time_ns, int(r.type), len(r.payload)) + r.payload)
             at += _RECORD.size + len(r.payload)
-            last_ns = r.receive_time_ns
         if index:
-            payload = b"".join(_OFFSET.pack(o) for o in offsets)
-            f.write(_RECORD.pack(last_ns, MessageType.INDEX_2021, len(payload)) + payload + _OFFSET.pack(at))
+            size = _OFFSET.size * (len(offsets) + 1) + len(INDEX_MARKER)
+            back = _RECORD.size + size  # from the file's end to the index record's start
+            payload = b"".join(_OFFSET.pack(o) for o in offsets) + _OFFSET.pack(back) + INDEX_MARKER
+            f.write(_RECORD.pack(0, MessageType.INDEX_2021, size) + payload)
     return len(offsets)
+
+
+def _index(payload: bytes) -> list[int] | None:
+    """The record offsets of an index record's payload; None when it is not one (no marker)."""
+    if not payload.endswith(INDEX_MARKER):
+        return None
+    n = (len(payload) - len(INDEX_MARKER)) // _OFFSET.size - 1
+    return [_OFFSET.unpack_from(payload, i * _OFFSET.size)[0] for i in range(max(n, 0))]
 
 
 class LogReader:
@@ -116,7 +127,7 @@ class LogReader:
                     self._cut(at, f"its payload has {len(payload)} of {size} bytes")
                     return
                 if kind == MessageType.INDEX_2021:
-                    self.index = [_OFFSET.unpack_from(payload, i)[0] for i in range(0, size - size % 8, 8)]
+                    self.index = _index(payload)
                     return
                 self.records += 1
                 yield LogRecord(t_ns, kind, payload)

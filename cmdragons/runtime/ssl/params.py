@@ -12,6 +12,8 @@ from cmdragons.config import Validated, setting
 
 __all__ = ["GrsimParams", "MulticastParams", "ProtocolParams", "SimulationParams"]
 
+CommandsTo = Literal["none", "grsim", "simulation"]
+
 _LOOPBACK = "127.0.0.1"
 
 
@@ -78,6 +80,12 @@ class SimulationParams(Validated):
     control_port: int = setting(10300, lo=1, hi=65535)
     blue_port: int = setting(10301, lo=1, hi=65535)
     yellow_port: int = setting(10302, lo=1, hi=65535)
+    dribbler_full_rpm: float = setting(10000.0, lo=1.0, hi=1e6)  # dribbler_speed (rpm) that is our full power (1)
+    wait_s: float = setting(0.05, lo=0.0, hi=60.0)  # our simulator: a frame without a new RobotControl waits this long
+
+    def port(self, team: str) -> int:
+        """The RobotControl port of ``team``."""
+        return self.blue_port if team == "blue" else self.yellow_port
 
 
 @dataclass(frozen=True)
@@ -89,6 +97,7 @@ class ProtocolParams(Validated):
     max_datagram_bytes: int = setting(65507, lo=1024, hi=65507)
     drop_report_interval_s: float = setting(1.0, lo=0.0, hi=3600.0)  # a dropped packet's log line at most this often
     perception: Literal["simulator", "ssl_vision"] = "simulator"  # ssl_vision: our tracker reads SSL-Vision packets
+    commands_to: CommandsTo = "none"  # our team's commands also go to grSim or a simulation-protocol simulator
     vision: VisionStreamParams = VisionStreamParams()
     tracker: TrackerStreamParams = TrackerStreamParams()
     referee: RefereeStreamParams = RefereeStreamParams()

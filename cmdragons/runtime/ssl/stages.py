@@ -1,32 +1,63 @@
 """The protocol adapters: stages on the bus like any other, each between topics and UDP packets.
 
-    ssl/vision_out   detections/<id> -> SSL_WrapperPacket multicast; ssl/vision/sent (Tick) per frame
-    ssl/vision_in    SSL_WrapperPacket multicast -> ssl/vision/<id> (DetectionFrame)
-    ssl/referee_out  referee (GameState) -> Referee multicast
-    ssl/referee_in   Referee multicast -> referee/gc (GameState); world/<team>: the ball taken into play
+    ssl/vision_out             detections/<id> -> SSL_WrapperPacket multicast; ssl/vision/sent (Tick) per frame
+    ssl/vision_in              SSL_WrapperPacket multicast -> ssl/vision/<id> (DetectionFrame)
+    ssl/referee_out            referee (GameState) -> Referee multicast
+    ssl/referee_in             Referee multicast -> referee/gc (GameState); world/<team>: the ball taken into play
+    ssl/tracker_out/<team>     world/<team> -> TrackerWrapperPacket multicast
+    ssl/commands_out/<team>    commands/<team> (headings from world/<team>) -> grSim_Packet or RobotControl
+                               unicast; teleport -> SimulatorCommand
+    ssl/simulation_in/<team>   RobotControl and SimulatorCommand unicast, on each truth -> commands/<team>, teleport
 
 ``ssl/vision_in`` runs free (on every ``clock`` tick it publishes what came since) when the packets
 come from outside; fed by our own ``ssl/vision_out`` in the same match it runs in lock-step: on each
 ``ssl/vision/sent`` it waits (up to ``vision.wait_s``) until that frame's packet from every camera
 came, so the match plays the same as on the in-process path. Garbage, a packet cut short, a camera
-not in the config and a packet already seen are counted and dropped with a line on stderr.
+not in the config and a packet already seen are counted and dropped with a line on stderr (by every
+receiving stage: garbage and cut packets for the simulation protocol and the referee too).
 """
 
 from __future__ import annotations
 
 import math
 import time
+import uuid
 from collections.abc import Sequence
-from typing import Any, TextIO
+from typing import Any, Protocol, TextIO
 
-from cmdragons.messages import DetectionFrame, MessageError, StageSummary, Tick
+from google.protobuf.message import DecodeError
+
+from cmdragons.geometry import Team
+from cmdragons.messages import DetectionFrame, GroundTruth, MessageError, RobotCommand, StageSummary, TeamCommands, Tick
 from cmdragons.runtime.bus import BaseStage, Publish
+from cmdragons.runtime.proto import ssl_simulator_pb2 as sim_pb
+from cmdragons.runtime.ssl.commands import (
+    grsim_packet,
+    read_robot_control,
+    read_simulator_command,
+    robot_control_packet,
+    robot_control_response,
+    simulator_command_packet,
+    simulator_response,
+)
 from cmdragons.runtime.ssl.params import ProtocolParams
 from cmdragons.runtime.ssl.referee import RefereeReader, referee_packet
-from cmdragons.runtime.ssl.udp import DropLog, MulticastReceiver, MulticastSender
+from cmdragons.runtime.ssl.tracker import tracker_packet
+from cmdragons.runtime.ssl.udp import DropLog, MulticastReceiver, MulticastSender, UdpEndpoint
 from cmdragons.runtime.ssl.vision import VisionGeometry, decode_wrapper, detection_packet
 
-__all__ = ["RefereeInStage", "RefereeOutStage", "SocketStage", "VisionInStage", "VisionOutStage", "close_sockets"]
+__all__ = ["CommandsOutStage", "RefereeInStage", "RefereeOutStage", "SimulationInStage", "SocketStage",
+           "TrackerOutStage", "VisionInStage", "VisionOutStage", "close_sockets"]  # fmt: skip
+
+
+class Receiver(Protocol):
+    """Where a receiving stage reads its datagrams: a socket, or a replay's queue."""
+
+    def receive(self, timeout_s: float = 0.0) -> bytes | None: ...
+
+    def drain(self) -> list[bytes]: ...
+
+    def close(self) -> None: ...
 
 
 class SocketStage(BaseStage):
@@ -49,9 +80,10 @@ class VisionOutStage(SocketStage):
 
     name = "ssl/vision_out"
 
-    def __init__(self, params: ProtocolParams, camera_ids: Sequence[int], geometry: bytes) -> None:
+    def __init__(self, params: ProtocolParams, camera_ids: Sequence[int], geometry: bytes,
+                 topics: Sequence[str] | None = None) -> None:  # fmt: skip
         v = params.vision
-        self.inputs = tuple(f"detections/{c}" for c in camera_ids)
+        self.inputs = tuple(topics) if topics is not None else tuple(f"detections/{c}" for c in camera_ids)
         self.camera_ids = tuple(camera_ids)
         self.sender = MulticastSender(v.group, v.port, params.interface, params.ttl)
         self.geometry = geometry
@@ -97,10 +129,10 @@ class VisionInStage(SocketStage):
     name = "ssl/vision_in"
 
     def __init__(self, params: ProtocolParams, camera_ids: Sequence[int], lockstep: bool,
-                 err: TextIO | None = None) -> None:  # fmt: skip
+                 err: TextIO | None = None, receiver: Receiver | None = None) -> None:  # fmt: skip
         v = params.vision
-        self.receiver = MulticastReceiver(v.group, v.port, params.interface, params.receive_buffer_bytes,
-                                          params.max_datagram_bytes)  # fmt: skip
+        self.receiver: Receiver = receiver if receiver is not None else MulticastReceiver(
+            v.group, v.port, params.interface, params.receive_buffer_bytes, params.max_datagram_bytes)  # fmt: skip
         self.camera_ids = frozenset(camera_ids)
         self.lockstep = lockstep
         self.wait_s = v.wait_s
@@ -189,10 +221,10 @@ class RefereeInStage(SocketStage):
     name = "ssl/referee_in"
 
     def __init__(self, params: ProtocolParams, world_topic: str, moved_m: float,
-                 err: TextIO | None = None) -> None:  # fmt: skip
+                 err: TextIO | None = None, receiver: Receiver | None = None) -> None:  # fmt: skip
         r = params.referee
-        self.receiver = MulticastReceiver(r.group, r.port, params.interface, params.receive_buffer_bytes,
-                                          params.max_datagram_bytes)  # fmt: skip
+        self.receiver: Receiver = receiver if receiver is not None else MulticastReceiver(
+            r.group, r.port, params.interface, params.receive_buffer_bytes, params.max_datagram_bytes)  # fmt: skip
         self.inputs = ("clock", world_topic)
         self.moved_m = moved_m
         self.reader = RefereeReader()
@@ -228,3 +260,170 @@ class RefereeInStage(SocketStage):
 
     def close(self) -> None:
         self.receiver.close()
+
+
+class TrackerOutStage(SocketStage):
+    """Our tracker's world state as the league's TrackerWrapperPacket (metres), multicast; one
+    ``uuid`` for the run."""
+
+    def __init__(self, params: ProtocolParams, team: Team) -> None:
+        t = params.tracker
+        self.name = f"ssl/tracker_out/{team}"
+        self.inputs = (f"world/{team}",)
+        self.sender = MulticastSender(t.group, t.port, params.interface, params.ttl)
+        self.uuid = str(uuid.uuid4())
+        self.source = t.source_name
+
+    def on_message(self, topic: str, message: Any, publish: Publish) -> None:
+        self.sender.send(tracker_packet(message, self.uuid, self.source))
+
+    def summarize(self, publish: Publish) -> None:
+        publish(f"summary/{self.name}", StageSummary(self.name, {"packets": self.sender.sent,
+                                                                 "bytes": self.sender.bytes}))  # fmt: skip
+
+    def close(self) -> None:
+        self.sender.close()
+
+
+class CommandsOutStage(SocketStage):
+    """Our team's commands to a league simulator: grSim (``grSim_Packet`` to ``grsim.address:port``)
+    or the simulation protocol (``RobotControl`` to the team's port, our referee's teleports as
+    ``SimulatorCommand`` to the control port). Velocities go in each robot's frame by its heading in
+    our tracker's latest world state. The simulators' answers are read and counted."""
+
+    def __init__(self, params: ProtocolParams, team: Team, chip_angle_rad: float, err: TextIO | None = None) -> None:
+        self.name = f"ssl/commands_out/{team}"
+        self.team = team
+        self.to = params.commands_to
+        sim = params.simulation
+        self.inputs = (f"world/{team}", f"commands/{team}", *(("teleport",) if self.to == "simulation" else ()))
+        self.endpoint = UdpEndpoint(sim.address if self.to == "simulation" else params.grsim.address)
+        self.peer = (params.grsim.address, params.grsim.port) if self.to == "grsim" else (sim.address,
+                                                                                           sim.port(team))  # fmt: skip
+        self.control = (sim.address, sim.control_port)
+        self.chip_angle_rad = chip_angle_rad
+        self.full_rpm = sim.dribbler_full_rpm
+        self.headings: dict[int, float] = {}
+        self.sent = self.teleports = self.answers = self.answer_errors = 0
+        self.drops = DropLog(f"{self.to} answers", params.drop_report_interval_s, err)
+
+    def on_message(self, topic: str, message: Any, publish: Publish) -> None:
+        if topic == "teleport":
+            self.endpoint.send_to(simulator_command_packet(message), self.control)
+            self.teleports += 1
+        elif isinstance(message, TeamCommands):
+            if self.to == "grsim":
+                data = grsim_packet(message, self.headings, self.chip_angle_rad)
+            else:
+                data = robot_control_packet(message, self.headings, self.chip_angle_rad, self.full_rpm)
+            self.endpoint.send_to(data, self.peer)
+            self.sent += 1
+        else:
+            self.headings = {r.id: r.theta for r in message.robots if r.team == self.team}
+        self._read_answers()
+
+    def _read_answers(self) -> None:
+        """The simulation protocol answers each packet (grSim does not): count them and their errors."""
+        while (got := self.endpoint.receive()) is not None:
+            data, _peer = got
+            answer = sim_pb.RobotControlResponse()
+            try:
+                answer.ParseFromString(data)
+            except DecodeError as exc:
+                self.drops.drop("undecodable", f"{len(data)} bytes, {exc}")
+                continue
+            self.answers += 1
+            self.answer_errors += len(answer.errors)
+
+    def summarize(self, publish: Publish) -> None:
+        publish(f"summary/{self.name}", StageSummary(self.name, {
+            "to": self.to, "packets": self.sent, "teleports": self.teleports, "answers": self.answers,
+            "answer_errors": self.answer_errors, "dropped": dict(sorted(self.drops.counts.items()))}))  # fmt: skip
+
+    def close(self) -> None:
+        self.endpoint.close()
+
+
+class SimulationInStage(SocketStage):
+    """Our simulator as a simulation-protocol simulator for ``team``: ``RobotControl`` on the team's
+    port (loopback) becomes that team's commands, ``SimulatorCommand`` teleports on the control
+    port become teleports. On each captured frame (``truth``) it takes what came since; a frame
+    with no new RobotControl waits up to ``simulation.wait_s`` for one (the match keeps pace with a
+    team that answers every frame). Local velocities turn into the field frame by the robot's true
+    heading. Each packet is answered (RobotControlResponse, SimulatorResponse); garbage and a
+    packet cut short are counted and dropped with a line on stderr."""
+
+    def __init__(self, params: ProtocolParams, team: Team, err: TextIO | None = None) -> None:
+        sim = params.simulation
+        self.name = f"ssl/simulation_in/{team}"
+        self.inputs = ("truth",)
+        self.team = team
+        self.robots = UdpEndpoint(sim.address, sim.port(team), params.max_datagram_bytes)
+        self.control = UdpEndpoint(sim.address, sim.control_port, params.max_datagram_bytes)
+        self.wait_s = sim.wait_s
+        self.full_rpm = sim.dribbler_full_rpm
+        self.drops = DropLog(f"simulation protocol {sim.address}:{sim.port(team)}/{sim.control_port}",
+                             params.drop_report_interval_s, err)  # fmt: skip
+        self.packets = self.teleports = self.frames_waited_out = 0
+        self.refused: dict[str, int] = {}
+
+    def on_message(self, topic: str, message: Any, publish: Publish) -> None:
+        gt: GroundTruth = message
+        where = {(r.team, r.id): (r.x, r.y, r.theta) for r in gt.robots}
+        while (got := self.control.receive()) is not None:
+            self._teleport(got, gt, where, publish)
+        headings = {r.id: r.theta for r in gt.robots if r.team == self.team}
+        latest: dict[int, RobotCommand] = {}
+        got = self.robots.receive()
+        if got is None and self.wait_s > 0:
+            got = self.robots.receive(self.wait_s)
+            self.frames_waited_out += got is None
+        while got is not None:
+            for c in self._commands(got, headings):
+                latest[c.id] = c
+            got = self.robots.receive()
+        publish(f"commands/{self.team}", TeamCommands(self.team, gt.frame_number, gt.t,
+                                                      tuple(latest[i] for i in sorted(latest))))  # fmt: skip
+
+    def _commands(self, got: tuple[bytes, tuple[str, int]], headings: dict[int, float]) -> tuple[RobotCommand, ...]:
+        data, peer = got
+        try:
+            read = read_robot_control(data, self.team, headings, self.full_rpm)
+        except MessageError as exc:
+            self.drops.drop("undecodable", f"{len(data)} bytes from {peer[0]}:{peer[1]}, {exc}")
+            return ()
+        self.packets += 1
+        for _, why in read.errors:
+            self._refuse(why)
+        self.robots.send_to(robot_control_response(self.team, [c.id for c in read.commands],
+                                                   [why for _, why in read.errors]), peer)  # fmt: skip
+        return read.commands
+
+    def _teleport(self, got: tuple[bytes, tuple[str, int]], gt: GroundTruth,
+                  where: dict[tuple[Team, int], tuple[float, float, float]], publish: Publish) -> None:  # fmt: skip
+        data, peer = got
+        try:
+            tp, refused = read_simulator_command(data, gt.t, where, (gt.ball.x, gt.ball.y))
+        except MessageError as exc:
+            self.drops.drop("undecodable", f"{len(data)} bytes from {peer[0]}:{peer[1]}, {exc}")
+            return
+        for why in refused:
+            self._refuse(why)
+        if tp is not None:
+            self.teleports += 1
+            publish("teleport", tp)
+        self.control.send_to(simulator_response(refused), peer)
+
+    def _refuse(self, why: str) -> None:
+        key = why.split(":")[0]
+        self.refused[key] = self.refused.get(key, 0) + 1
+
+    def summarize(self, publish: Publish) -> None:
+        publish(f"summary/{self.name}", StageSummary(self.name, {
+            "packets": self.packets, "teleports": self.teleports, "frames_waited_out": self.frames_waited_out,
+            "refused": dict(sorted(self.refused.items())),
+            "dropped": dict(sorted(self.drops.counts.items()))}))  # fmt: skip
+
+    def close(self) -> None:
+        self.robots.close()
+        self.control.close()

@@ -19,7 +19,7 @@ import sys
 import time
 from typing import TextIO
 
-__all__ = ["DropLog", "MulticastReceiver", "MulticastSender", "UdpEndpoint"]
+__all__ = ["DatagramQueue", "DropLog", "MulticastReceiver", "MulticastSender", "UdpEndpoint"]
 
 
 def _sockopt_reuse(sock: socket.socket) -> None:
@@ -89,6 +89,27 @@ class MulticastReceiver:
 
     def close(self) -> None:
         self.sock.close()
+
+
+class DatagramQueue:
+    """Datagrams handed in by the program (a log file's records) instead of a socket, with a
+    receiver's :meth:`receive` and :meth:`drain`: what a receiving stage reads in a replay."""
+
+    def __init__(self) -> None:
+        self._items: list[bytes] = []
+
+    def push(self, data: bytes) -> None:
+        self._items.append(data)
+
+    def receive(self, timeout_s: float = 0.0) -> bytes | None:
+        return self._items.pop(0) if self._items else None
+
+    def drain(self) -> list[bytes]:
+        out, self._items = self._items, []
+        return out
+
+    def close(self) -> None:
+        self._items = []
 
 
 class UdpEndpoint:

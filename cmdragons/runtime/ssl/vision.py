@@ -16,12 +16,11 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from google.protobuf.message import DecodeError
 from scipy.spatial.transform import Rotation
 
 from cmdragons.camera import CameraModel
 from cmdragons.geometry import BallShape, Field
-from cmdragons.messages import DetectionFrame, MessageError
+from cmdragons.messages import DetectionFrame
 from cmdragons.runtime import wire
 from cmdragons.runtime.proto import ssl_geometry_pb2 as geo_pb
 from cmdragons.runtime.proto import ssl_wrapper_pb2 as wrap_pb
@@ -171,13 +170,7 @@ def _camera_position(c: Any) -> tuple[float, float, float]:
 def decode_wrapper(data: bytes) -> tuple[DetectionFrame | None, VisionGeometry | None]:
     """The detections and the geometry of an SSL_WrapperPacket's bytes (either may be absent);
     :class:`MessageError` for bytes that are not one (garbage, cut short, a required field missing)."""
-    g = wrap_pb.SSL_WrapperPacket()
-    try:
-        g.ParseFromString(data)
-    except DecodeError as exc:
-        raise MessageError(f"not an SSL_WrapperPacket: {exc}") from None
-    if not g.IsInitialized():
-        raise MessageError("SSL_WrapperPacket with required fields missing: " + ", ".join(g.FindInitializationErrors()))
+    g = wire.parse(wrap_pb.SSL_WrapperPacket, data)
     det = wire.from_proto(g.detection) if g.HasField("detection") else None
     geo = geometry_of(g.geometry) if g.HasField("geometry") else None
     return det, geo

@@ -1,0 +1,187 @@
+"""Robot commands and teleports as the league's simulators take them, and back.
+
+grSim takes a ``grSim_Packet`` whose commands move each robot in its own frame (``veltangent``
+forward, ``velnormal`` to the left, m/s; ``velangular`` rad/s) and kick with a speed along the
+ground (``kickspeedx``) and up (``kickspeedz``); ``spinner`` turns the dribbler on. The simulation
+protocol takes a ``RobotControl`` per team (``move_command.local_velocity``: ``forward``, ``left``,
+``angular``; ``kick_speed`` m/s, ``kick_angle`` degrees, ``dribbler_speed`` rpm) and a
+``SimulatorCommand`` with teleports. Our commands are field-frame velocities: each goes into the
+robot's frame by its heading (the tracked one when we send, the true one in our simulator).
+A chip is our robots' own chip elevation (``sim.kicker.chip_angle_rad``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+from cmdragons.geometry import Team
+from cmdragons.messages import RobotCommand, TeamCommands, Teleport
+from cmdragons.runtime import wire
+from cmdragons.runtime.proto import grsim_pb2 as grsim_pb
+from cmdragons.runtime.proto import ssl_simulation_control_pb2 as ctl_pb
+from cmdragons.runtime.proto import ssl_simulator_pb2 as sim_pb
+from cmdragons.runtime.proto import ssl_tracked_pb2 as trk_pb
+
+__all__ = ["ReadCommands", "grsim_packet", "local_velocity", "read_robot_control", "read_simulator_command",
+           "robot_control_packet", "robot_control_response", "simulator_command_packet", "simulator_response",
+           "to_field"]  # fmt: skip
+
+_TEAM_PB = {"blue": trk_pb.BLUE, "yellow": trk_pb.YELLOW}
+_PB_TEAM: dict[int, Team] = {trk_pb.BLUE: "blue", trk_pb.YELLOW: "yellow"}
+_CHIP_MIN_DEG = 1.0  # a kick angle above this is a chip
+
+
+def local_velocity(vx: float, vy: float, theta: float) -> tuple[float, float]:
+    """Field-frame velocity (m/s) -> (forward, left) in the frame of a robot heading ``theta`` (rad)."""
+    c, s = math.cos(theta), math.sin(theta)
+    return c * vx + s * vy, -s * vx + c * vy
+
+
+def to_field(forward: float, left: float, theta: float) -> tuple[float, float]:
+    """(forward, left) in a robot's frame (m/s) -> field-frame velocity; :func:`local_velocity`'s inverse."""
+    c, s = math.cos(theta), math.sin(theta)
+    return c * forward - s * left, s * forward + c * left
+
+
+def _heading(headings: Mapping[int, float], rid: int) -> float:
+    """A robot's heading (rad); 0 for one not seen yet (its velocity then goes as if it faced +x)."""
+    return headings.get(rid, 0.0)
+
+
+def grsim_packet(tc: TeamCommands, headings: Mapping[int, float], chip_angle_rad: float) -> bytes:
+    """A ``grSim_Packet`` with ``tc``'s commands; ``headings``: robot id -> heading (rad)."""
+    p = grsim_pb.grSim_Packet()
+    cmds = p.commands
+    cmds.timestamp, cmds.isteamyellow = tc.t, tc.team == "yellow"
+    for c in tc.commands:
+        forward, left = local_velocity(c.vx, c.vy, _heading(headings, c.id))
+        angle = chip_angle_rad if c.chip else 0.0
+        cmds.robot_commands.add(id=c.id, kickspeedx=c.kick_speed * math.cos(angle),
+                                kickspeedz=c.kick_speed * math.sin(angle), veltangent=forward, velnormal=left,
+                                velangular=c.omega, spinner=c.dribbler > 0.0, wheelsspeed=False)  # fmt: skip
+    return p.SerializeToString(deterministic=True)  # type: ignore[no-any-return]
+
+
+def robot_control_packet(tc: TeamCommands, headings: Mapping[int, float], chip_angle_rad: float,
+                         dribbler_full_rpm: float) -> bytes:  # fmt: skip
+    """A ``RobotControl`` with ``tc``'s commands as local velocities, the league's fields only (a
+    simulator is told the team by the port)."""
+    m = ctl_pb.RobotControl()
+    for c in tc.commands:
+        r = m.robot_commands.add(id=c.id)
+        forward, left = local_velocity(c.vx, c.vy, _heading(headings, c.id))
+        v = r.move_command.local_velocity
+        v.forward, v.left, v.angular = forward, left, c.omega
+        r.kick_speed = c.kick_speed
+        r.kick_angle = math.degrees(chip_angle_rad) if c.chip else 0.0
+        r.dribbler_speed = c.dribbler * dribbler_full_rpm
+    return m.SerializeToString(deterministic=True)  # type: ignore[no-any-return]
+
+
+@dataclass(frozen=True)
+class ReadCommands:
+    """What a ``RobotControl`` said: the commands understood, and one line per command that was not."""
+
+    commands: tuple[RobotCommand, ...]
+    errors: tuple[tuple[int, str], ...]  # (robot id, why)
+
+
+def read_robot_control(data: bytes, team: Team, headings: Mapping[int, float],
+                       dribbler_full_rpm: float) -> ReadCommands:  # fmt: skip
+    """A ``RobotControl``'s bytes -> field-frame commands of ``team`` (local velocities turned by
+    ``headings``, rad); :class:`MessageError` for bytes that are not one. Wheel velocities are not
+    understood (the robot is left out, with the reason)."""
+    m = wire.parse(ctl_pb.RobotControl, data)
+    out: list[RobotCommand] = []
+    errors: list[tuple[int, str]] = []
+    for r in m.robot_commands:
+        kind = r.move_command.WhichOneof("command")
+        if kind == "local_velocity":
+            v = r.move_command.local_velocity
+            vx, vy = to_field(v.forward, v.left, _heading(headings, r.id))
+            omega = v.angular
+        elif kind == "global_velocity":
+            g = r.move_command.global_velocity
+            vx, vy, omega = g.vel_x, g.vel_y, g.vel_angular
+        elif kind is None:
+            vx = vy = omega = 0.0
+        else:
+            errors.append((r.id, f"robot {r.id}: {kind} is not simulated here; send local_velocity or global_velocity"))
+            continue
+        chip = r.kick_angle > _CHIP_MIN_DEG or r.chip
+        dribbler = r.dribbler_power if r.HasField("dribbler_power") else min(1.0, r.dribbler_speed / dribbler_full_rpm)
+        out.append(RobotCommand(team, r.id, vx, vy, omega, r.kick_speed, chip, max(0.0, dribbler)))
+    return ReadCommands(tuple(out), tuple(errors))
+
+
+def robot_control_response(team: Team, ids: list[int], errors: list[str]) -> bytes:
+    """The ``RobotControlResponse`` a simulator answers a ``RobotControl`` with."""
+    m = sim_pb.RobotControlResponse()
+    for e in errors:
+        m.errors.add(code="unsupported", unsupported_capability=sim_pb.SIMULATOR_CAPABILITY_MOVE_WHEEL_VELOCITY,
+                     message=e)  # fmt: skip
+    for i in ids:
+        m.feedback.add().id.CopyFrom(trk_pb.RobotId(id=i, team=_TEAM_PB[team]))
+    return m.SerializeToString(deterministic=True)  # type: ignore[no-any-return]
+
+
+def simulator_command_packet(tp: Teleport) -> bytes:
+    """A ``SimulatorCommand`` teleporting ``tp``'s robots (at rest) and ball (at rest, on the ground)."""
+    m = sim_pb.SimulatorCommand()
+    ctl = m.control
+    for team, rid, x, y, theta in tp.robots:
+        ctl.teleport_robot.add(id=trk_pb.RobotId(id=rid, team=_TEAM_PB[team]), x=x, y=y, orientation=theta, v_x=0.0,
+                               v_y=0.0, v_angular=0.0, present=True)  # fmt: skip
+    if tp.ball is not None:
+        ctl.teleport_ball.x, ctl.teleport_ball.y, ctl.teleport_ball.z = tp.ball[0], tp.ball[1], 0.0
+        ctl.teleport_ball.vx = ctl.teleport_ball.vy = ctl.teleport_ball.vz = 0.0
+    return m.SerializeToString(deterministic=True)  # type: ignore[no-any-return]
+
+
+def read_simulator_command(data: bytes, t: float, where: Mapping[tuple[Team, int], tuple[float, float, float]],
+                           ball: tuple[float, float]) -> tuple[Teleport | None, list[str]]:  # fmt: skip
+    """A ``SimulatorCommand``'s teleports as our :class:`Teleport` at time ``t`` (a coordinate left
+    out keeps the object's own: ``where`` (team, id) -> (x, y, theta) and ``ball`` now), and one
+    line per request not carried out (velocities, removing robots, configuration);
+    :class:`MessageError` for bytes that are not one."""
+    m = wire.parse(sim_pb.SimulatorCommand, data)
+    unsupported: list[str] = []
+    if m.HasField("config"):
+        unsupported.append("config: the simulator is configured by configs/, not over the protocol")
+    if not m.HasField("control"):
+        return None, unsupported
+    c = m.control
+    robots: list[tuple[Team, int, float, float, float]] = []
+    for r in c.teleport_robot:
+        team = _PB_TEAM.get(r.id.team)
+        key = (team, r.id.id) if team is not None else None
+        if key is None or key not in where:
+            unsupported.append(f"teleport_robot {r.id.id} of team code {r.id.team}: no such robot here")
+            continue
+        if r.HasField("present") and not r.present:
+            unsupported.append(f"teleport_robot {team} {r.id.id}: robots are not taken off the field here")
+            continue
+        x0, y0, th0 = where[key]
+        robots.append((key[0], key[1], r.x if r.HasField("x") else x0, r.y if r.HasField("y") else y0,
+                       r.orientation if r.HasField("orientation") else th0))  # fmt: skip
+    ball_at = None
+    if c.HasField("teleport_ball"):
+        b = c.teleport_ball
+        ball_at = (b.x if b.HasField("x") else ball[0], b.y if b.HasField("y") else ball[1])
+        if b.vx or b.vy or b.vz or b.z:
+            unsupported.append("teleport_ball: the ball is placed at rest on the ground here")
+    if c.HasField("simulation_speed"):
+        unsupported.append("simulation_speed: the match's pace is set by its runtime")
+    if not robots and ball_at is None:
+        return None, unsupported
+    return Teleport(t, tuple(robots), ball_at), unsupported
+
+
+def simulator_response(errors: list[str]) -> bytes:
+    """The ``SimulatorResponse`` a simulator answers a ``SimulatorCommand`` with."""
+    m = sim_pb.SimulatorResponse()
+    for e in errors:
+        m.errors.add(code="unsupported", message=e)
+    return m.SerializeToString(deterministic=True)  # type: ignore[no-any-return]

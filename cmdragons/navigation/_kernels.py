@@ -216,13 +216,14 @@ def march(
 
 @njit(cache=True)
 def ranges(
-    obs: np.ndarray, inner: np.ndarray, px: float, py: float, angles: np.ndarray, length: float, tol: float
-) -> np.ndarray:
+    obs: np.ndarray, inner: np.ndarray, px: float, py: float, angles: np.ndarray, length: float, threshold: float,
+    tol: float,
+) -> np.ndarray:  # fmt: skip
     """A simulated range sensor: :func:`march` along straight rays at ``angles`` (rad), at most
-    ``length`` (the sensor's range), to contact (clearance 0)."""
+    ``length`` (the sensor's range), until the clearance falls to ``threshold`` (0: contact)."""
     out = np.empty(angles.shape[0])
     for i in range(angles.shape[0]):
-        out[i] = march(obs, inner, px, py, angles[i], 0.0, length, 0.0, tol)
+        out[i] = march(obs, inner, px, py, angles[i], 0.0, length, threshold, tol)
     return out
 
 

@@ -27,7 +27,11 @@ the way it follows (a robot that meets the obstacle moving the other way turns r
   the heuristic stops falling (``progress_m``) the robot is at a local minimum and follows the
   boundary. d_followed is the least distance to the goal of the followed obstacle's sensed boundary
   (the rays that hit it without a discontinuity), d_reach that of the free space the sensor sees;
-  the robot leaves once d_reach < d_followed and drives for the point that gives d_reach.
+  the robot leaves once d_reach < d_followed and drives for the point that gives d_reach. The
+  sensor's rays end where the clearance falls to the band the robot keeps (the level line, or its
+  own clearance when inside it, less ``band_margin_m``): a gap the level line closes is closed to
+  the sensor, so no endpoint or d_reach point lies beyond a gap narrower than the band (the robot
+  would wedge in it between two obstacles).
 
 Coming back round to the hit point without a way to leave (Bug1 at its nearest point facing the
 obstacle, Bug2 and the tangent bug at the hit point): the goal cannot be reached, status
@@ -77,6 +81,9 @@ class TangentBugParams(Validated):
     rays: int = setting(90, lo=8, hi=3600)  # its directions, evenly over the full turn
     discontinuity_m: float = setting(0.3, lo=0.01, hi=10.0)  # neighbouring rays this different: an endpoint
     progress_m: float = setting(0.01, lo=0.0, hi=1.0)  # the heuristic distance must fall by this to keep going
+    # the rays end this far inside the level line followed (or the robot's own clearance, when less):
+    # a gap the level line closes is closed to the sensor too
+    band_margin_m: float = setting(0.002, lo=0.0, hi=0.5)
 
 
 def boundary_direction(c: float, gx: float, gy: float, level: float, gain: float, side: float) -> tuple[float, float]:
@@ -249,9 +256,9 @@ class BugNavigator(ReactiveNavigator):
                 self.status = NavStatus.BLOCKED  # the closest point of the obstacle faces it: enclosed
             return False
         # tangent bug: leave once the free space seen comes nearer the goal than the followed boundary
-        r = self._scan(cw, here)
-        self.nearest_d = min(self.nearest_d, self._d_followed(here, goal, r, gx, gy))
-        reach, point = self._d_reach(cw, here, goal, r)
+        r, inside = self._scan(cw, here, c)
+        self.nearest_d = min(self.nearest_d, self._d_followed(here, goal, r, inside, gx, gy))
+        reach, point = self._d_reach(cw, here, goal, r, inside)
         if reach < self.nearest_d - p.leave_tolerance_m:
             self.via = point
             return True
@@ -260,25 +267,33 @@ class BugNavigator(ReactiveNavigator):
         return False
 
     # --- the tangent bug's range sensor ----------------------------------------------------------
-    def _scan(self, cw: CompiledWorld, here: Point) -> np.ndarray:
-        return K.ranges(cw.obs, cw.inner, here[0], here[1], self.angles, self.tangent.sensor_range_m, 1e-3)
+    def _scan(self, cw: CompiledWorld, here: Point, c: float) -> tuple[np.ndarray, float]:
+        """The ranges of the rays, each to where the clearance falls to the band the robot keeps (the
+        level line, or the robot's clearance ``c`` when it is inside it, less ``band_margin_m``), and
+        how far that band lies inside the level line (m). Obstacles the level line runs round as one
+        are one to the sensor: a ray through a narrower gap than the band's stops at it."""
+        level = self.params.follow_clearance_m
+        band = max(min(c, level) - self.tangent.band_margin_m, 0.0)
+        r = K.ranges(cw.obs, cw.inner, here[0], here[1], self.angles, self.tangent.sensor_range_m, band, 1e-3)
+        return r, level - band
 
     def _sees(self, cw: CompiledWorld, here: Point, goal: Point, length: float) -> float:
         """How far (m) the straight way toward the goal keeps the level line's clearance, up to ``length``."""
         a = math.atan2(goal[1] - here[1], goal[0] - here[0])
         return K.march(cw.obs, cw.inner, here[0], here[1], a, 0.0, length, self.params.follow_clearance_m, 1e-3)
 
-    def _d_followed(self, here: Point, goal: Point, r: np.ndarray, gx: float, gy: float) -> float:
+    def _d_followed(self, here: Point, goal: Point, r: np.ndarray, inside: float, gx: float, gy: float) -> float:
         """The least distance to the goal of the followed obstacle's sensed boundary: the rays from the
         one toward the nearest obstacle on, each way, while they hit it without a discontinuity
-        (their points taken on the level line's side, as :meth:`_d_reach` takes them)."""
+        (their points taken on the level line, ``inside`` short of the ray's end, as :meth:`_d_reach`
+        takes them)."""
         t = self.tangent
         n = len(r)
         k0 = int(round((math.atan2(-gy, -gx) + math.pi) / (2.0 * math.pi) * n)) % n
         hit = r < t.sensor_range_m - 1e-6
         if not hit[k0]:
             return math.inf
-        s = np.maximum(r - self.params.follow_clearance_m, 0.0)
+        s = np.maximum(r - inside, 0.0)
         dist = np.hypot(here[0] + s * self.cos - goal[0], here[1] + s * self.sin - goal[1])
         best = float(dist[k0])
         for step in (1, -1):
@@ -291,15 +306,17 @@ class BugNavigator(ReactiveNavigator):
                 i = j
         return best
 
-    def _d_reach(self, cw: CompiledWorld, here: Point, goal: Point, r: np.ndarray) -> tuple[float, Point]:
-        """d_reach and its point: the free point the sensor sees nearest the goal (on each ray, short of
-        a hit by the level line's clearance; the straight way to the goal as far as it stays clear)."""
+    def _d_reach(self, cw: CompiledWorld, here: Point, goal: Point, r: np.ndarray,
+                 inside: float) -> tuple[float, Point]:  # fmt: skip
+        """d_reach and its point: the free point the sensor sees nearest the goal (on each ray, on the
+        level line's side of a hit, ``inside`` short of it; the straight way to the goal as far as it
+        stays clear)."""
         rng = self.tangent.sensor_range_m
         dg = math.dist(here, goal)
         s = self._sees(cw, here, goal, min(dg, rng))
         best_d, best = dg - s, (here[0] + (goal[0] - here[0]) * s / max(dg, 1e-12),
                                 here[1] + (goal[1] - here[1]) * s / max(dg, 1e-12))  # fmt: skip
-        top = np.where(r < rng - 1e-6, np.maximum(r - self.params.follow_clearance_m, 0.0), rng)
+        top = np.where(r < rng - 1e-6, np.maximum(r - inside, 0.0), rng)
         along = np.clip((goal[0] - here[0]) * self.cos + (goal[1] - here[1]) * self.sin, 0.0, top)
         xs, ys = here[0] + along * self.cos, here[1] + along * self.sin
         dist = np.hypot(xs - goal[0], ys - goal[1])
@@ -323,7 +340,7 @@ class BugNavigator(ReactiveNavigator):
             target = self.via
         else:
             # the endpoints of the boundary discontinuities nearer the goal than the robot
-            r = self._scan(cw, here)
+            r, _ = self._scan(cw, here, c)
             n = len(r)
             best, best_h = None, math.inf
             for i in range(n):

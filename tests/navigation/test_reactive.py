@@ -118,12 +118,14 @@ def reachable(world: CollisionWorld, start: tuple[float, float], goal: tuple[flo
     return bool(descend_nf1(nf1(free, cell(goal), 8), cell(start), 8))
 
 
-@pytest.mark.parametrize("seed", range(6))
-def test_bug2_reaches_the_goal_of_any_finite_obstacle_field(seed: int) -> None:
+# seeds 17, 33 and 58 have gaps narrower than the level line's band that the range sensor sees through
+@pytest.mark.parametrize(("name", "seed"), [("bug2", s) for s in range(6)]
+                         + [("tangent_bug", s) for s in (*range(6), 17, 33, 58)])  # fmt: skip
+def test_a_bug_method_reaches_the_goal_of_any_finite_obstacle_field(name: str, seed: int) -> None:
     world = random_field(seed)
     start, goal = (-2.5, 0.0), (2.5, 0.0)
     assert reachable(world, start, goal)
-    xs, statuses, _ = run("bug2", lambda k: world, start, goal, 40.0)
+    xs, statuses, _ = run(name, lambda k: world, start, goal, 40.0)
     assert math.dist(tuple(xs[-1]), goal) < 0.01, statuses[-1]
     assert least_clearance(world, xs) > -1e-6
 

@@ -54,6 +54,7 @@ give a row saying so.
 from __future__ import annotations
 
 import dataclasses
+import gc
 import math
 import statistics
 import sys
@@ -500,13 +501,21 @@ def _pyvisgraph_row(settings: Settings, fixed: list[NavScene], optimum: dict[str
 
 def _paired_ms(fns: list[Callable[[], Any]], repeats: int) -> list[float]:
     """Median ms of each of ``fns``, called in turn ``repeats`` times (so that a change of the
-    machine's load hits them alike)."""
+    machine's load hits them alike), the garbage collector held off while they run (as timeit
+    does: a collection of the whole bench's objects would land in whichever call set it off)."""
     times: list[list[float]] = [[] for _ in fns]
-    for _ in range(repeats):
-        for fn, out in zip(fns, times, strict=True):
-            t0 = time.perf_counter()
-            fn()
-            out.append((time.perf_counter() - t0) * 1e3)
+    was_on = gc.isenabled()
+    gc.collect()
+    gc.disable()
+    try:
+        for _ in range(repeats):
+            for fn, out in zip(fns, times, strict=True):
+                t0 = time.perf_counter()
+                fn()
+                out.append((time.perf_counter() - t0) * 1e3)
+    finally:
+        if was_on:
+            gc.enable()
     return [float(statistics.median(t)) for t in times]
 
 

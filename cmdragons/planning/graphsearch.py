@@ -217,14 +217,16 @@ class _GridFrontier:
         self.state.reshape(ny + 2, self.width)[1:-1, 1:-1] = free
         n = self.state.size
         self.connectivity = connectivity
+        # only what the search reads before it writes is filled: a cell's diagonal count and parent
+        # are read only once it is reached (its axis count not -1), and the route ends at the source
         self.ga = np.full(n, -1, dtype=np.int32)  # the cost in axis moves (-1: not reached) ...
-        self.gb = np.zeros(n, dtype=np.int32)  # ... and in diagonal ones
-        self.prev = np.full(n, -1, dtype=np.int32)
+        self.gb = np.empty(n, dtype=np.int32)  # ... and in diagonal ones
+        self.prev = np.empty(n, dtype=np.int32)
         size = connectivity * n + 1  # every edge pushes at most once, the source once
         self.key, self.node, self.nxt = np.empty(size), np.empty(size, dtype=np.int32), np.empty(size, dtype=np.int32)
         self.head = np.full(K.RADIX_BUCKETS, -1, dtype=np.int32)
         self.counters = np.zeros(3, dtype=np.int64)
-        self.ga[src], self.gb[src] = 0, 0
+        self.ga[src], self.gb[src], self.prev[src] = 0, 0, -1
         self.key[0], self.node[0], self.nxt[0], self.head[0] = 0.0, src, -1, 0
         self.counters[K.GRID_POOL] = 1
 

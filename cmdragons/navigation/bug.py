@@ -33,6 +33,10 @@ the way it follows (a robot that meets the obstacle moving the other way turns r
   the sensor, so no endpoint or d_reach point lies beyond a gap narrower than the band (the robot
   would wedge in it between two obstacles).
 
+:func:`bug2_path` is Bug2 as a whole path in one query on an occupancy grid (the robot stepping one
+cell to one of its eight neighbours), the way the Robotics Toolbox's ``Bug2`` runs it: the same
+method, cell by cell, for comparing the two on the same grids.
+
 Coming back round to the hit point without a way to leave (Bug1 at its nearest point facing the
 obstacle, Bug2 and the tangent bug at the hit point): the goal cannot be reached, status
 ``BLOCKED``.
@@ -40,11 +44,13 @@ obstacle, Bug2 and the tangent bug at the hit point): the goal cannot be reached
 
 from __future__ import annotations
 
+import enum
 import math
 from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
+from numpy.typing import NDArray
 
 from cmdragons.config import Validated, setting
 from cmdragons.control.motion import ControlParams
@@ -55,7 +61,8 @@ from cmdragons.navigation.reactive import ReactiveNavigator, ReactiveParams, tow
 from cmdragons.navigation.trajectory import TrajectoryParams
 from cmdragons.planning.world import CollisionParams, CompiledWorld
 
-__all__ = ["BugNavigator", "BugParams", "TangentBugParams", "boundary_direction"]
+__all__ = ["BugNavigator", "BugParams", "GridBug2", "GridBug2Status", "TangentBugParams", "boundary_direction",
+           "bug2_path"]
 
 Point = tuple[float, float]
 
@@ -71,6 +78,7 @@ class BugParams(Validated):
     m_line_tolerance_m: float = setting(0.03, lo=0.001, hi=1.0)  # Bug2: on the m-line within this
     leave_tolerance_m: float = setting(0.05, lo=0.001, hi=1.0)  # back at a point within this
     min_follow_m: float = setting(0.2, lo=0.0, hi=10.0)  # followed at least this far before leaving or circling
+    grid_max_steps: int = setting(200_000, lo=1, hi=100_000_000)  # bug2_path: cell moves at most
 
 
 @dataclass(frozen=True)
@@ -84,6 +92,44 @@ class TangentBugParams(Validated):
     # the rays end this far inside the level line followed (or the robot's own clearance, when less):
     # a gap the level line closes is closed to the sensor too
     band_margin_m: float = setting(0.002, lo=0.0, hi=0.5)
+
+
+class GridBug2Status(enum.Enum):
+    """How :func:`bug2_path` ended (a value, never an exception)."""
+
+    REACHED = K.BUG2_REACHED  # the path ends at the goal
+    BLOCKED = K.BUG2_BLOCKED  # round the obstacle back to the hit point: the goal cannot be reached
+    OUT_OF_STEPS = K.BUG2_OUT_OF_STEPS  # ``max_steps`` moves made without either
+    INVALID_START = K.BUG2_INVALID_START  # the start cell is occupied or off the grid
+    INVALID_GOAL = K.BUG2_INVALID_GOAL  # the goal cell is occupied or off the grid
+
+
+@dataclass(frozen=True)
+class GridBug2:
+    """:func:`bug2_path`'s answer: its status, the cells visited (k, 2) as (column, row), start
+    first, and the path's length in cells (a diagonal move sqrt 2)."""
+
+    status: GridBug2Status
+    cells: NDArray[np.int64]
+    length_cells: float
+
+
+def bug2_path(occupied: NDArray[np.bool_], start: tuple[int, int], goal: tuple[int, int],
+              params: BugParams | None = None) -> GridBug2:  # fmt: skip
+    """Bug2's whole path on the occupancy grid ``occupied`` (row = y) from cell ``start`` to cell
+    ``goal`` (each (column, row)), one cell a step (:func:`cmdragons.navigation._kernels.bug2_grid`:
+    along the m-line; round an obstacle it meets with it on the right (``params.side`` left) or
+    left, until on the m-line nearer the goal than the hit point; blocked when back round at the hit
+    point), at most ``params.grid_max_steps`` moves."""
+    p = params or BugParams()
+    grid = np.ascontiguousarray(occupied, dtype=np.bool_)
+    if grid.ndim != 2:
+        raise ValueError(f"occupied must be a 2-d grid, not of shape {grid.shape}")
+    status, cells = K.bug2_grid(grid, int(start[0]), int(start[1]), int(goal[0]), int(goal[1]),
+                                1 if p.side == "left" else -1, p.grid_max_steps)  # fmt: skip
+    steps = np.abs(np.diff(cells, axis=0)).sum(axis=1)
+    length = float(np.count_nonzero(steps == 1) + math.sqrt(2.0) * np.count_nonzero(steps == 2))
+    return GridBug2(GridBug2Status(int(status)), cells, length)
 
 
 def boundary_direction(c: float, gx: float, gy: float, level: float, gain: float, side: float) -> tuple[float, float]:

@@ -43,6 +43,7 @@ SUITES: dict[str, Suite] = {
     "robox": _lazy("cmdragons.bench.robox"),
     "navigation": _lazy("cmdragons.bench.navigation"),
     "estimation": _lazy("cmdragons.bench.estimation"),
+    "goalie": _lazy("cmdragons.bench.goalie"),
     "runtime": _lazy("cmdragons.bench.runtime"),
     "protocols": _lazy("cmdragons.bench.protocols"),
 }

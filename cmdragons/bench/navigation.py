@@ -33,6 +33,10 @@ What is measured:
   DistanceTransformPlanner, DstarPlanner and PRMPlanner beside our nf1, estar and prm, its Bug2
   beside our ``bug2`` navigator when one is registered, and pyvisgraph beside our visibility
   graph, each with its success rate and time and ours, and ``speedup`` (the peer's time over ours).
+  The ``bug2`` row times our navigator's whole drive at the control rate against the toolbox's walk
+  of the grid; ``peer/rtb_Bug2_path`` compares like with like: our Bug2 as a whole path in one
+  query on the same occupancy grid (:func:`~cmdragons.navigation.bug2_path`, one cell a step, as
+  the toolbox's), the two called in turn on each scene, with both paths' length and clearance.
   The grid peers get the scene as an occupancy grid of ``GRID_M`` cells (occupied where the robot's
   centre would touch an obstacle); their success is their own (a path returned). pyvisgraph gets
   the same polygons around the obstacles as the trapezoidal decomposition.
@@ -54,6 +58,8 @@ give a row saying so.
 from __future__ import annotations
 
 import dataclasses
+import functools
+import gc
 import math
 import statistics
 import sys
@@ -68,7 +74,7 @@ from numpy.typing import NDArray
 
 from cmdragons.geometry import Field
 from cmdragons.messages import RobotState
-from cmdragons.navigation import NAVIGATORS, Arrival, make_navigator
+from cmdragons.navigation import NAVIGATORS, Arrival, GridBug2Status, bug2_path, make_navigator
 from cmdragons.planning import (
     PLANNERS,
     CollisionWorld,
@@ -459,8 +465,49 @@ def _peer_rows(settings: Settings, suite: list[NavScene], optimum: dict[str, lis
             mine = _ours(record, our, fixed)
         rows.append(row | {"our_success_rate": mine["success_rate"], "our_ms": mine["plan_ms"],
                            "speedup": row["plan_ms"] / mine["plan_ms"], "ours": our})  # fmt: skip
+    if toolbox:
+        rows.append(_bug2_path_row(settings, fixed, optimum, 3 if quick else 5, paths))
     rows.append(_pyvisgraph_row(settings, fixed, optimum, _ours(record, "visgraph", fixed), paths))
     return rows
+
+
+def _bug2_path_row(settings: Settings, fixed: list[NavScene], optimum: dict[str, list[float]], repeats: int,
+                   paths: dict[str, dict[str, FloatArray]]) -> Row:  # fmt: skip
+    """Bug2 as a whole path in one query, ours (:func:`~cmdragons.navigation.bug2_path`) beside the
+    toolbox's ``Bug2``, on the same occupancy grid with the same start and goal cells, both stepping
+    one cell; the two called in turn ``repeats`` times per scene (median). Success: the path ends
+    at the goal (the toolbox's: a path returned)."""
+    radius = settings.field.robot.radius_m
+    theirs, ours = Tally(), Tally()
+    first = fixed[0]
+    occ, x0, y0 = occupancy(first, radius)
+    bug2_path(occ, _cell(first.start, x0, y0), _cell(first.goal, x0, y0), settings.team.bug)  # loads the kernel
+    for scene in fixed:
+        occ, x0, y0 = occupancy(scene, radius)
+        start, goal = _cell(scene.start, x0, y0), _cell(scene.goal, x0, y0)
+        problem = _problem(scene, radius, settings)
+        our_query = functools.partial(bug2_path, occ, start, goal, settings.team.bug)
+        their_query = functools.partial(_toolbox_planner, "Bug2", occ, start, goal, 0)
+        ours_ms, theirs_ms = _paired_ms([our_query, their_query], repeats)
+        found, cells = our_query(), their_query()
+        for tally, ms, ok, route, label in (
+                (ours, ours_ms, found.status is GridBug2Status.REACHED, found.cells, "bug2_path (grid)"),
+                (theirs, theirs_ms, cells is not None and len(cells) > 1, cells, "peer rtb Bug2 (grid)")):  # fmt: skip
+            tally.ms.append(ms)
+            tally.ok.append(ok)
+            if ok and route is not None:
+                path = np.vstack([[scene.start], _to_field(np.asarray(route, dtype=np.float64), x0, y0), [scene.goal]])
+                tally.ratio.append(path_length(path) / optimum[scene.name][0])
+                tally.clearance.append(min_clearance(problem, path))
+                tally.trap |= scene.name == "u_trap"
+                if scene.name in FIGURES and label.startswith("bug2"):
+                    paths.setdefault(scene.name, {})[label] = path
+    row = theirs.row("peer/rtb_Bug2_path", "plan_ms")
+    mine = ours.row("", "plan_ms")
+    return row | {"our_success_rate": mine["success_rate"], "our_ms": mine["plan_ms"],
+                  "speedup": row["plan_ms"] / mine["plan_ms"], "ours": "bug2_path",
+                  "our_trap": mine["trap"], "our_length_ratio": mine["length_ratio"],
+                  "our_clearance_m": mine["clearance_m"]}  # fmt: skip
 
 
 def _pyvisgraph_row(settings: Settings, fixed: list[NavScene], optimum: dict[str, list[float]], our: dict[str, float],
@@ -500,13 +547,21 @@ def _pyvisgraph_row(settings: Settings, fixed: list[NavScene], optimum: dict[str
 
 def _paired_ms(fns: list[Callable[[], Any]], repeats: int) -> list[float]:
     """Median ms of each of ``fns``, called in turn ``repeats`` times (so that a change of the
-    machine's load hits them alike)."""
+    machine's load hits them alike), the garbage collector held off while they run (as timeit
+    does: a collection of the whole bench's objects would land in whichever call set it off)."""
     times: list[list[float]] = [[] for _ in fns]
-    for _ in range(repeats):
-        for fn, out in zip(fns, times, strict=True):
-            t0 = time.perf_counter()
-            fn()
-            out.append((time.perf_counter() - t0) * 1e3)
+    was_on = gc.isenabled()
+    gc.collect()
+    gc.disable()
+    try:
+        for _ in range(repeats):
+            for fn, out in zip(fns, times, strict=True):
+                t0 = time.perf_counter()
+                fn()
+                out.append((time.perf_counter() - t0) * 1e3)
+    finally:
+        if was_on:
+            gc.enable()
     return [float(statistics.median(t)) for t in times]
 
 

@@ -291,10 +291,18 @@ def particle_estimate(particles: ArrayLike, weights: ArrayLike) -> tuple[FloatAr
 
 class ParticleLocalisation:
     """Monte Carlo localisation: particles moved by sampled odometry, weighted by the sightings'
-    likelihood, resampled systematically when the effective sample size drops below half."""
+    likelihood, resampled systematically when the effective sample size drops below half, and then
+    regularised (Musso, Oudjane and Le Gland 2001): each copy moved by a draw from a Gaussian kernel
+    of the cloud's covariance before resampling, scaled by ``bandwidth_share`` of the bandwidth that
+    is optimal for a Gaussian density, (4 / (n (d + 2)))^(1 / (d + 4)). Without it a sharp sighting
+    leaves a few distinct poses copied many times, whose spread understates the error (the filter
+    reads overconfident: mean NEES about 3.6 for 3 at 500 particles on the bench's run)."""
 
     def __init__(self, landmarks: ArrayLike, start: ArrayLike, start_cov: ArrayLike, sensor_cov: ArrayLike,
-                 n: int = 500, seed: int = 0) -> None:  # fmt: skip
+                 n: int = 500, seed: int = 0, bandwidth_share: float = 0.6) -> None:  # fmt: skip
+        if bandwidth_share < 0.0:
+            raise ValueError(f"bandwidth_share must be >= 0 (0: no regularisation), not {bandwidth_share}")
+        self.bandwidth_share = bandwidth_share
         self.rng = np.random.default_rng(seed)
         self.landmarks = np.asarray(landmarks, dtype=np.float64)
         self.particles = self.rng.multivariate_normal(np.asarray(start, dtype=np.float64),
@@ -330,11 +338,16 @@ class ParticleLocalisation:
             self._resample()
 
     def _resample(self) -> None:
-        n = len(self.particles)
+        n, d = self.particles.shape
+        _, cov = particle_estimate(self.particles, self.weights)
         positions = (self.rng.random() + np.arange(n)) / n
         idx = np.searchsorted(np.cumsum(self.weights), positions)
         self.particles = self.particles[np.minimum(idx, n - 1)]
         self.weights = np.full(n, 1.0 / n)
+        if self.bandwidth_share > 0.0:
+            h = self.bandwidth_share * (4.0 / (n * (d + 2))) ** (1.0 / (d + 4))
+            self.particles += self.rng.multivariate_normal(np.zeros(d), h * h * cov, size=n)
+            self.particles[:, 2] = wrap_angle(self.particles[:, 2])
 
     @property
     def pose(self) -> FloatArray:

@@ -6,7 +6,7 @@ reactive methods of the lecture notes: potential fields (plain and extended), Bu
 tangent bug, VFH, VFH+, the curvature velocity and lane curvature methods, escape and evade."""
 
 from cmdragons.navigation.base import STOP, Arrival, Navigator, NavStatus, VelocityCommand
-from cmdragons.navigation.bug import BugNavigator, BugParams, TangentBugParams
+from cmdragons.navigation.bug import BugNavigator, BugParams, GridBug2, GridBug2Status, TangentBugParams, bug2_path
 from cmdragons.navigation.curvature_velocity import CurvatureParams, CurvatureVelocityNavigator, LaneParams
 from cmdragons.navigation.dynamic_window import DynamicWindowNavigator, DynamicWindowParams
 from cmdragons.navigation.elastic_band import BandParams
@@ -32,6 +32,8 @@ __all__ = [
     "EscapeEvadeNavigator",
     "EscapeEvadeParams",
     "ExtendedFieldParams",
+    "GridBug2",
+    "GridBug2Status",
     "LaneParams",
     "MovementModel",
     "NavStatus",
@@ -49,6 +51,7 @@ __all__ = [
     "VFHParams",
     "VFHPlusParams",
     "VelocityCommand",
+    "bug2_path",
     "make_navigator",
     "reflex",
 ]

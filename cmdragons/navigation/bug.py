@@ -27,7 +27,15 @@ the way it follows (a robot that meets the obstacle moving the other way turns r
   the heuristic stops falling (``progress_m``) the robot is at a local minimum and follows the
   boundary. d_followed is the least distance to the goal of the followed obstacle's sensed boundary
   (the rays that hit it without a discontinuity), d_reach that of the free space the sensor sees;
-  the robot leaves once d_reach < d_followed and drives for the point that gives d_reach.
+  the robot leaves once d_reach < d_followed and drives for the point that gives d_reach. The
+  sensor's rays end where the clearance falls to the band the robot keeps (the level line, or its
+  own clearance when inside it, less ``band_margin_m``): a gap the level line closes is closed to
+  the sensor, so no endpoint or d_reach point lies beyond a gap narrower than the band (the robot
+  would wedge in it between two obstacles).
+
+:func:`bug2_path` is Bug2 as a whole path in one query on an occupancy grid (the robot stepping one
+cell to one of its eight neighbours), the way the Robotics Toolbox's ``Bug2`` runs it: the same
+method, cell by cell, for comparing the two on the same grids.
 
 Coming back round to the hit point without a way to leave (Bug1 at its nearest point facing the
 obstacle, Bug2 and the tangent bug at the hit point): the goal cannot be reached, status
@@ -36,11 +44,13 @@ obstacle, Bug2 and the tangent bug at the hit point): the goal cannot be reached
 
 from __future__ import annotations
 
+import enum
 import math
 from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
+from numpy.typing import NDArray
 
 from cmdragons.config import Validated, setting
 from cmdragons.control.motion import ControlParams
@@ -51,7 +61,8 @@ from cmdragons.navigation.reactive import ReactiveNavigator, ReactiveParams, tow
 from cmdragons.navigation.trajectory import TrajectoryParams
 from cmdragons.planning.world import CollisionParams, CompiledWorld
 
-__all__ = ["BugNavigator", "BugParams", "TangentBugParams", "boundary_direction"]
+__all__ = ["BugNavigator", "BugParams", "GridBug2", "GridBug2Status", "TangentBugParams", "boundary_direction",
+           "bug2_path"]
 
 Point = tuple[float, float]
 
@@ -67,6 +78,7 @@ class BugParams(Validated):
     m_line_tolerance_m: float = setting(0.03, lo=0.001, hi=1.0)  # Bug2: on the m-line within this
     leave_tolerance_m: float = setting(0.05, lo=0.001, hi=1.0)  # back at a point within this
     min_follow_m: float = setting(0.2, lo=0.0, hi=10.0)  # followed at least this far before leaving or circling
+    grid_max_steps: int = setting(200_000, lo=1, hi=100_000_000)  # bug2_path: cell moves at most
 
 
 @dataclass(frozen=True)
@@ -77,6 +89,47 @@ class TangentBugParams(Validated):
     rays: int = setting(90, lo=8, hi=3600)  # its directions, evenly over the full turn
     discontinuity_m: float = setting(0.3, lo=0.01, hi=10.0)  # neighbouring rays this different: an endpoint
     progress_m: float = setting(0.01, lo=0.0, hi=1.0)  # the heuristic distance must fall by this to keep going
+    # the rays end this far inside the level line followed (or the robot's own clearance, when less):
+    # a gap the level line closes is closed to the sensor too
+    band_margin_m: float = setting(0.002, lo=0.0, hi=0.5)
+
+
+class GridBug2Status(enum.Enum):
+    """How :func:`bug2_path` ended (a value, never an exception)."""
+
+    REACHED = K.BUG2_REACHED  # the path ends at the goal
+    BLOCKED = K.BUG2_BLOCKED  # round the obstacle back to the hit point: the goal cannot be reached
+    OUT_OF_STEPS = K.BUG2_OUT_OF_STEPS  # ``max_steps`` moves made without either
+    INVALID_START = K.BUG2_INVALID_START  # the start cell is occupied or off the grid
+    INVALID_GOAL = K.BUG2_INVALID_GOAL  # the goal cell is occupied or off the grid
+
+
+@dataclass(frozen=True)
+class GridBug2:
+    """:func:`bug2_path`'s answer: its status, the cells visited (k, 2) as (column, row), start
+    first, and the path's length in cells (a diagonal move sqrt 2)."""
+
+    status: GridBug2Status
+    cells: NDArray[np.int64]
+    length_cells: float
+
+
+def bug2_path(occupied: NDArray[np.bool_], start: tuple[int, int], goal: tuple[int, int],
+              params: BugParams | None = None) -> GridBug2:  # fmt: skip
+    """Bug2's whole path on the occupancy grid ``occupied`` (row = y) from cell ``start`` to cell
+    ``goal`` (each (column, row)), one cell a step (:func:`cmdragons.navigation._kernels.bug2_grid`:
+    along the m-line; round an obstacle it meets with it on the right (``params.side`` left) or
+    left, until on the m-line nearer the goal than the hit point; blocked when back round at the hit
+    point), at most ``params.grid_max_steps`` moves."""
+    p = params or BugParams()
+    grid = np.ascontiguousarray(occupied, dtype=np.bool_)
+    if grid.ndim != 2:
+        raise ValueError(f"occupied must be a 2-d grid, not of shape {grid.shape}")
+    status, cells = K.bug2_grid(grid, int(start[0]), int(start[1]), int(goal[0]), int(goal[1]),
+                                1 if p.side == "left" else -1, p.grid_max_steps)  # fmt: skip
+    steps = np.abs(np.diff(cells, axis=0)).sum(axis=1)
+    length = float(np.count_nonzero(steps == 1) + math.sqrt(2.0) * np.count_nonzero(steps == 2))
+    return GridBug2(GridBug2Status(int(status)), cells, length)
 
 
 def boundary_direction(c: float, gx: float, gy: float, level: float, gain: float, side: float) -> tuple[float, float]:
@@ -249,9 +302,9 @@ class BugNavigator(ReactiveNavigator):
                 self.status = NavStatus.BLOCKED  # the closest point of the obstacle faces it: enclosed
             return False
         # tangent bug: leave once the free space seen comes nearer the goal than the followed boundary
-        r = self._scan(cw, here)
-        self.nearest_d = min(self.nearest_d, self._d_followed(here, goal, r, gx, gy))
-        reach, point = self._d_reach(cw, here, goal, r)
+        r, inside = self._scan(cw, here, c)
+        self.nearest_d = min(self.nearest_d, self._d_followed(here, goal, r, inside, gx, gy))
+        reach, point = self._d_reach(cw, here, goal, r, inside)
         if reach < self.nearest_d - p.leave_tolerance_m:
             self.via = point
             return True
@@ -260,25 +313,33 @@ class BugNavigator(ReactiveNavigator):
         return False
 
     # --- the tangent bug's range sensor ----------------------------------------------------------
-    def _scan(self, cw: CompiledWorld, here: Point) -> np.ndarray:
-        return K.ranges(cw.obs, cw.inner, here[0], here[1], self.angles, self.tangent.sensor_range_m, 1e-3)
+    def _scan(self, cw: CompiledWorld, here: Point, c: float) -> tuple[np.ndarray, float]:
+        """The ranges of the rays, each to where the clearance falls to the band the robot keeps (the
+        level line, or the robot's clearance ``c`` when it is inside it, less ``band_margin_m``), and
+        how far that band lies inside the level line (m). Obstacles the level line runs round as one
+        are one to the sensor: a ray through a narrower gap than the band's stops at it."""
+        level = self.params.follow_clearance_m
+        band = max(min(c, level) - self.tangent.band_margin_m, 0.0)
+        r = K.ranges(cw.obs, cw.inner, here[0], here[1], self.angles, self.tangent.sensor_range_m, band, 1e-3)
+        return r, level - band
 
     def _sees(self, cw: CompiledWorld, here: Point, goal: Point, length: float) -> float:
         """How far (m) the straight way toward the goal keeps the level line's clearance, up to ``length``."""
         a = math.atan2(goal[1] - here[1], goal[0] - here[0])
         return K.march(cw.obs, cw.inner, here[0], here[1], a, 0.0, length, self.params.follow_clearance_m, 1e-3)
 
-    def _d_followed(self, here: Point, goal: Point, r: np.ndarray, gx: float, gy: float) -> float:
+    def _d_followed(self, here: Point, goal: Point, r: np.ndarray, inside: float, gx: float, gy: float) -> float:
         """The least distance to the goal of the followed obstacle's sensed boundary: the rays from the
         one toward the nearest obstacle on, each way, while they hit it without a discontinuity
-        (their points taken on the level line's side, as :meth:`_d_reach` takes them)."""
+        (their points taken on the level line, ``inside`` short of the ray's end, as :meth:`_d_reach`
+        takes them)."""
         t = self.tangent
         n = len(r)
         k0 = int(round((math.atan2(-gy, -gx) + math.pi) / (2.0 * math.pi) * n)) % n
         hit = r < t.sensor_range_m - 1e-6
         if not hit[k0]:
             return math.inf
-        s = np.maximum(r - self.params.follow_clearance_m, 0.0)
+        s = np.maximum(r - inside, 0.0)
         dist = np.hypot(here[0] + s * self.cos - goal[0], here[1] + s * self.sin - goal[1])
         best = float(dist[k0])
         for step in (1, -1):
@@ -291,15 +352,17 @@ class BugNavigator(ReactiveNavigator):
                 i = j
         return best
 
-    def _d_reach(self, cw: CompiledWorld, here: Point, goal: Point, r: np.ndarray) -> tuple[float, Point]:
-        """d_reach and its point: the free point the sensor sees nearest the goal (on each ray, short of
-        a hit by the level line's clearance; the straight way to the goal as far as it stays clear)."""
+    def _d_reach(self, cw: CompiledWorld, here: Point, goal: Point, r: np.ndarray,
+                 inside: float) -> tuple[float, Point]:  # fmt: skip
+        """d_reach and its point: the free point the sensor sees nearest the goal (on each ray, on the
+        level line's side of a hit, ``inside`` short of it; the straight way to the goal as far as it
+        stays clear)."""
         rng = self.tangent.sensor_range_m
         dg = math.dist(here, goal)
         s = self._sees(cw, here, goal, min(dg, rng))
         best_d, best = dg - s, (here[0] + (goal[0] - here[0]) * s / max(dg, 1e-12),
                                 here[1] + (goal[1] - here[1]) * s / max(dg, 1e-12))  # fmt: skip
-        top = np.where(r < rng - 1e-6, np.maximum(r - self.params.follow_clearance_m, 0.0), rng)
+        top = np.where(r < rng - 1e-6, np.maximum(r - inside, 0.0), rng)
         along = np.clip((goal[0] - here[0]) * self.cos + (goal[1] - here[1]) * self.sin, 0.0, top)
         xs, ys = here[0] + along * self.cos, here[1] + along * self.sin
         dist = np.hypot(xs - goal[0], ys - goal[1])
@@ -323,7 +386,7 @@ class BugNavigator(ReactiveNavigator):
             target = self.via
         else:
             # the endpoints of the boundary discontinuities nearer the goal than the robot
-            r = self._scan(cw, here)
+            r, _ = self._scan(cw, here, c)
             n = len(r)
             best, best_h = None, math.inf
             for i in range(n):

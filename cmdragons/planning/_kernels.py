@@ -1364,6 +1364,120 @@ def graph_search(
     return outcome
 
 
+# --- A* and Dijkstra on a uniform grid: exact keys in a radix heap ----------------------------------
+# On a grid of axis moves (1) and diagonal moves (sqrt 2) a cost is a + b sqrt 2 with whole a and b,
+# and so is the octile heuristic: the search keeps the two counts, so that equal keys are equal
+# floats and a key is never below the last one taken (the heuristic is consistent), which is what a
+# radix heap needs (Ahuja, Mehlhorn, Orlin and Tarjan 1990). Two different keys a + b sqrt 2 of a
+# grid under a million cells across lie at least 1e-7 apart, far beyond the floats' rounding, so
+# the floats' order is the keys' order.
+RADIX_BUCKETS = 65  # bucket 0: keys equal to the last one taken; bucket k: highest bit k differs
+GRID_LAST = 0  # slots of a grid search's ``counters``: the last key taken (its bits, as int64),
+GRID_POOL = 1  # entries used in the heap's pool,
+# (EXPANDED, slot 2, as for graph_search)
+
+
+@njit(cache=True, inline="always")
+def _bit_length(x: np.uint64) -> int:
+    """The number of bits of ``x`` (0 for 0)."""
+    n = 0
+    for shift in (32, 16, 8, 4, 2, 1):
+        if x >> np.uint64(shift):
+            x >>= np.uint64(shift)
+            n += shift
+    return n + int(x)
+
+
+@njit(cache=True, inline="always")
+def _radix_put(bits: np.ndarray, nxt: np.ndarray, head: np.ndarray, i: int, last: np.uint64) -> None:
+    """Link pool entry ``i`` (its key's bits ``bits[i]``) into its bucket for the last key ``last``."""
+    x = bits[i] ^ last
+    b = _bit_length(x) if x else 0
+    nxt[i] = head[b]
+    head[b] = i
+
+
+@njit(cache=True)
+def grid_astar(
+    state: np.ndarray, nx: int, dst: int, heuristic: bool, connectivity: int, ga: np.ndarray, gb: np.ndarray,
+    prev: np.ndarray, key: np.ndarray, node: np.ndarray, nxt: np.ndarray, head: np.ndarray, counters: np.ndarray,
+    max_expand: int,
+) -> int:  # fmt: skip
+    """A* (``heuristic``: the octile distance, consistent on 4 and 8 neighbours) or Dijkstra on the
+    graph :func:`graph_search` searches on a grid, in cell lengths, until ``dst`` is expanded, the
+    heap runs empty or ``max_expand`` more cells have been expanded.
+
+    ``state`` (flat, rows of ``nx`` with a blocked border all round): 1 for a free cell not yet
+    expanded, 0 for a blocked or expanded one. A cell's cost from the source is ``ga + gb * sqrt 2``
+    (axis and diagonal moves; ``ga`` -1: not reached), ``prev`` its parent. The heap's entries are a
+    pool of (``key``, ``node``) linked into ``head``'s buckets by ``nxt``; ``counters`` as GRID_*
+    and EXPANDED, so that a search resumes where it stopped. Keys equal to the last one taken sit
+    in bucket 0, taken last in first out: a move that keeps the key (straight toward the goal) is
+    expanded next. Returns 1 when ``dst`` was reached, 0 when the heap ran empty, -1 when the budget
+    stopped it."""
+    sq2 = math.sqrt(2.0)
+    bits = key.view(np.uint64)
+    gx, gy = dst % nx, dst // nx
+    last = np.uint64(counters[GRID_LAST])
+    pool = counters[GRID_POOL]
+    expanded = 0
+    outcome = 0
+    while True:
+        if head[0] < 0:  # the bucket of the least higher bit: its least key is the next last
+            b = 1
+            while b < RADIX_BUCKETS and head[b] < 0:
+                b += 1
+            if b == RADIX_BUCKETS:
+                break
+            i = head[b]
+            least = bits[i]
+            while i >= 0:
+                least = min(least, bits[i])
+                i = nxt[i]
+            last = least
+            i = head[b]
+            head[b] = -1
+            while i >= 0:  # every entry of the bucket moves to a lower one
+                after = nxt[i]
+                _radix_put(bits, nxt, head, i, last)
+                i = after
+        if expanded >= max_expand:
+            outcome = -1
+            break
+        i = head[0]
+        head[0] = nxt[i]
+        u = node[i]
+        if state[u] == 0:  # a stale entry of an expanded cell
+            continue
+        state[u] = 0
+        expanded += 1
+        if u == dst:
+            outcome = 1
+            break
+        au, bu = ga[u], gb[u]
+        ui = u // nx
+        uk = u - ui * nx
+        ex, ey = uk - gx, ui - gy
+        for d in range(connectivity):
+            v = u + GRID_DI[d] * nx + GRID_DK[d]  # the blocked border keeps it inside the grid
+            if state[v] == 0:
+                continue
+            a, b = (au + 1, bu) if d < 4 else (au, bu + 1)
+            if ga[v] >= 0 and a + b * sq2 >= ga[v] + gb[v] * sq2:
+                continue
+            ga[v], gb[v], prev[v] = a, b, u
+            ka, kb = a, b
+            if heuristic:  # the octile distance: |dx - dy| axis moves and min(dx, dy) diagonal ones
+                dx, dy = abs(ex + GRID_DK[d]), abs(ey + GRID_DI[d])
+                ka, kb = a + abs(dx - dy), b + min(dx, dy)
+            key[pool], node[pool] = ka + kb * sq2, v
+            _radix_put(bits, nxt, head, pool, last)
+            pool += 1
+    counters[GRID_LAST], counters[GRID_POOL] = np.int64(last), pool
+    counters[EXPANDED] += expanded
+    return outcome
+
+
 @njit(cache=True)
 def grid_graph(free: np.ndarray, x0: float, y0: float, res: float, connectivity: int) -> tuple[
         np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip

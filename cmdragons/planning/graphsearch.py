@@ -21,6 +21,7 @@ neighbours found by index), for large grids.
 from __future__ import annotations
 
 import enum
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -44,6 +45,7 @@ SEARCHES: dict[str, int] = {
     "astar": K.SEARCH_ASTAR,
 }
 CHUNK = 4096  # expansions between two termination checks
+GRID_CHUNK = 16384  # the same for Dijkstra and A* on a grid (about a millisecond of expansions)
 # the kernel's arrays of the graph it is not searching (a CSR graph or a grid)
 _NO_GRID = np.zeros((0, 0), dtype=np.bool_)
 _NO_POINTS = np.zeros((0, 2))
@@ -175,25 +177,75 @@ def search(graph: Graph, src: int, dst: int, method: str, termination: Terminati
 
 def grid_search(free: NDArray[np.bool_], start: tuple[int, int], goal: tuple[int, int], method: str,
                 termination: Termination, resolution_m: float = 1.0, connectivity: int = 8,
-                chunk: int = CHUNK) -> SearchResult:  # fmt: skip
+                chunk: int = GRID_CHUNK) -> SearchResult:  # fmt: skip
     """:func:`search` on the connectivity graph of a uniform grid's free cells (``free`` (ny, nx),
     cells (row, column), ``resolution_m`` apart, 4 or 8 neighbours; the heuristic the octile
     distance), without building the graph: the same search as over
-    :func:`cmdragons.planning.cells.grid_graph`, faster. ``route`` is cell indices row * nx + column."""
+    :func:`cmdragons.planning.cells.grid_graph`, faster. Dijkstra and A* count each cost in axis and
+    diagonal moves and keep the frontier in a radix heap (:func:`cmdragons.planning._kernels.grid_astar`);
+    the others run :func:`cmdragons.planning._kernels.graph_search` on the grid. ``route`` is cell
+    indices row * nx + column."""
     ny, nx = free.shape
-    grid = np.zeros((ny + 2, nx + 2), dtype=np.bool_)  # a blocked border: no neighbour falls outside
-    grid[1:-1, 1:-1] = free
+    mode = _mode(method)
     width = nx + 2
     src, dst = (start[0] + 1) * width + start[1] + 1, (goal[0] + 1) * width + goal[1] + 1
-    f = _Frontier(grid.size, connectivity * grid.size, src, _mode(method))
+    if mode in (K.SEARCH_DIJKSTRA, K.SEARCH_ASTAR):
+        found = _GridFrontier(free, src, connectivity).run(dst, mode == K.SEARCH_ASTAR, resolution_m, termination,
+                                                            chunk)  # fmt: skip
+    else:
+        grid = np.zeros((ny + 2, width), dtype=np.bool_)  # a blocked border: no neighbour falls outside
+        grid[1:-1, 1:-1] = free
+        f = _Frontier(grid.size, connectivity * grid.size, src, mode)
 
-    def step(left: int) -> int:
-        return int(K.graph_search(_NO_POINTS, _NO_INDEX, _NO_INDEX, _NO_WEIGHTS, grid, resolution_m, connectivity, dst,
-                                  f.mode, True, f.g, f.prev, f.closed, f.frontier, f.counters, left))  # fmt: skip
+        def step(left: int) -> int:
+            return int(K.graph_search(_NO_POINTS, _NO_INDEX, _NO_INDEX, _NO_WEIGHTS, grid, resolution_m, connectivity,
+                                      dst, f.mode, True, f.g, f.prev, f.closed, f.frontier, f.counters, left))  # fmt: skip
 
-    found = f.run(step, dst, termination, work_done=0.0, chunk=chunk)
+        found = f.run(step, dst, termination, work_done=0.0, chunk=chunk)
     route = (found.route // width - 1) * nx + found.route % width - 1  # back to the unbordered grid's cells
     return SearchResult(found.status, route, found.cost, found.expanded)
+
+
+class _GridFrontier:
+    """The state of one Dijkstra or A* search on a grid (with a blocked border), as
+    :func:`cmdragons.planning._kernels.grid_astar` takes it."""
+
+    def __init__(self, free: NDArray[np.bool_], src: int, connectivity: int) -> None:
+        ny, nx = free.shape
+        self.width = nx + 2
+        self.state = np.zeros((ny + 2) * self.width, dtype=np.uint8)  # 1: free and not expanded
+        self.state.reshape(ny + 2, self.width)[1:-1, 1:-1] = free
+        n = self.state.size
+        self.connectivity = connectivity
+        # only what the search reads before it writes is filled: a cell's diagonal count and parent
+        # are read only once it is reached (its axis count not -1), and the route ends at the source
+        self.ga = np.full(n, -1, dtype=np.int32)  # the cost in axis moves (-1: not reached) ...
+        self.gb = np.empty(n, dtype=np.int32)  # ... and in diagonal ones
+        self.prev = np.empty(n, dtype=np.int32)
+        size = connectivity * n + 1  # every edge pushes at most once, the source once
+        self.key, self.node, self.nxt = np.empty(size), np.empty(size, dtype=np.int32), np.empty(size, dtype=np.int32)
+        self.head = np.full(K.RADIX_BUCKETS, -1, dtype=np.int32)
+        self.counters = np.zeros(3, dtype=np.int64)
+        self.ga[src], self.gb[src], self.prev[src] = 0, 0, -1
+        self.key[0], self.node[0], self.nxt[0], self.head[0] = 0.0, src, -1, 0
+        self.counters[K.GRID_POOL] = 1
+
+    def run(self, dst: int, heuristic: bool, resolution_m: float, termination: Termination,
+            chunk: int) -> SearchResult:  # fmt: skip
+        """Call the kernel in chunks until it ends or ``termination`` stops it."""
+        while True:
+            expanded = int(self.counters[K.EXPANDED])
+            left = termination.work_left(expanded, chunk)
+            if left <= 0 or termination.expired():
+                return SearchResult(SearchStatus.STOPPED, np.zeros(0, np.int64), np.inf, expanded)
+            outcome = K.grid_astar(self.state, self.width, dst, heuristic, self.connectivity, self.ga, self.gb,
+                                   self.prev, self.key, self.node, self.nxt, self.head, self.counters, left)  # fmt: skip
+            expanded = int(self.counters[K.EXPANDED])
+            if outcome == 1:
+                cost = (float(self.ga[dst]) + float(self.gb[dst]) * math.sqrt(2.0)) * resolution_m
+                return SearchResult(SearchStatus.FOUND, K.route_to(self.prev, dst), cost, expanded)
+            if outcome == 0:
+                return SearchResult(SearchStatus.UNREACHABLE, np.zeros(0, np.int64), np.inf, expanded)
 
 
 def link_point(cw: CompiledWorld, pts: FloatArray, point: tuple[float, float], k: int,

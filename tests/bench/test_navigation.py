@@ -11,6 +11,7 @@ import pytest
 
 from cmdragons.bench.navigation import (
     MIN_CLEARANCE_M,
+    _bug2_path_row,
     _planner_rows,
     draw,
     drive,
@@ -66,6 +67,17 @@ def test_a_drive_is_the_same_for_the_same_scene(settings: Settings) -> None:
     assert a[0] == b[0] and a[3] == b[3]
     np.testing.assert_array_equal(a[1], b[1])
     assert np.hypot(*(a[1][-1] - a[1][0])) > 1.0  # it drove off toward the goal
+
+
+def test_the_whole_path_bug2_row_leaves_the_trap_beside_the_toolbox_s(settings: Settings) -> None:
+    pytest.importorskip("roboticstoolbox")
+    trap = u_trap(settings.field_geometry())
+    paths: dict[str, dict[str, np.ndarray]] = {}
+    _, optimum, _ = _planner_rows(settings, [trap], 1, 1, {}, lambda _: None)
+    row = _bug2_path_row(settings, [trap], optimum, 1, paths)
+    assert row["our_success_rate"] == 1.0 and row["our_trap"] == 1 and row["success_rate"] == 1.0
+    assert min(row["our_length_ratio"], row["length_ratio"]) >= 1.0 - 2e-3  # neither beats the optimum
+    np.testing.assert_allclose(paths["u_trap"]["bug2_path (grid)"][[0, -1]], [trap.start, trap.goal])
 
 
 def test_the_grid_astar_row_finds_the_least_cost() -> None:

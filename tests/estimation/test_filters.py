@@ -176,3 +176,32 @@ def test_particle_localisation_follows_the_vehicle(seed: int) -> None:
         ekf_err.append(math.dist(ekf.pose[:2], run.truth[k + 1][:2]))
     assert float(np.median(pf_err)) < 0.15
     assert float(np.median(pf_err)) < 2.0 * float(np.median(ekf_err)) + 0.02
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_the_regularised_particle_filter_is_consistent_on_the_bench_s_run(seed: int) -> None:
+    # the bench's run (one sighting a step, odometry noisy in distance and heading), 500 particles:
+    # the NEES of the cloud's covariance about 3 (chi-square, 3 dof) and inside its 95% interval
+    # about 95% of the steps; without the regularisation the same filter reads overconfident
+    from cmdragons.bench.estimation import ODOMETRY_SIGMA, START_COV
+
+    run = simulate_run(seed=seed, steps=1000, odometry_sigma=ODOMETRY_SIGMA, max_sightings=1)
+    x0 = run.truth[0] + np.random.default_rng(seed).multivariate_normal(np.zeros(3), START_COV)
+    lo, hi = chi2.ppf([0.025, 0.975], 3)
+    means = {}
+    for share in (0.6, 0.0):
+        pf = ParticleLocalisation(run.landmarks, x0, START_COV, run.sensor_cov, n=500, seed=seed,
+                                  bandwidth_share=share)  # fmt: skip
+        values, errors = [], []
+        for k in range(len(run.odometry)):
+            pf.predict(run.odometry[k], run.odometry_cov)
+            pf.update(run.sightings[k])
+            values.append(pf.nees(run.truth[k + 1]))
+            errors.append(math.dist(pf.pose[:2], run.truth[k + 1][:2]))
+        v = np.array(values)
+        means[share] = float(np.mean(v))
+        if share > 0.0:
+            assert 2.0 < means[share] < 3.5
+            assert float(np.mean((v >= lo) & (v <= hi))) >= 0.92
+            assert float(np.sqrt(np.mean(np.square(errors)))) < 0.05
+    assert means[0.0] > 3.3 and means[0.0] > means[0.6]

@@ -6,6 +6,8 @@ space exactly, and the approximate cells are wholly free."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 import shapely
@@ -226,3 +228,32 @@ def test_the_grid_search_is_the_search_over_the_grid_graph(connectivity: int) ->
             assert on_grid.cost == pytest.approx(on_graph.cost, rel=1e-12, abs=1e-12), method
             if method in ("bfs", "dfs"):  # no heuristic: the same order, the same route
                 np.testing.assert_array_equal(np.argwhere(free.ravel())[:, 0][on_graph.route], on_grid.route)
+
+
+@pytest.mark.parametrize("connectivity", [4, 8])
+def test_the_grid_search_resumes_in_chunks_and_stays_optimal(connectivity: int) -> None:
+    # Dijkstra and A* on the grid, stopped every few expansions and resumed, against Dijkstra over
+    # the built graph: the least cost every time (exact move counts and the radix heap lose nothing)
+    rng = np.random.default_rng(12)
+    free = rng.random((60, 80)) > 0.35
+    cells = np.argwhere(free)
+    graph = grid_graph(free, 0.0, 0.0, 0.05, connectivity)
+    for a, b in rng.integers(0, len(cells), (8, 2)):
+        best = search(graph, int(a), int(b), "dijkstra", never())
+        start, goal = (int(cells[a][0]), int(cells[a][1])), (int(cells[b][0]), int(cells[b][1]))
+        for method in ("dijkstra", "astar"):
+            whole = grid_search(free, start, goal, method, never(), 0.05, connectivity)
+            pieces = grid_search(free, start, goal, method, never(), 0.05, connectivity, chunk=3)
+            assert whole.status is pieces.status is best.status
+            if best.status is not SearchStatus.FOUND:
+                continue
+            assert whole.cost == pytest.approx(best.cost, rel=1e-12)
+            assert pieces.cost == pytest.approx(best.cost, rel=1e-12)
+            route = pieces.route
+            assert route[0] == start[0] * 80 + start[1] and route[-1] == goal[0] * 80 + goal[1]
+            steps = np.abs(np.diff(np.column_stack([route // 80, route % 80]), axis=0))
+            assert steps.max() <= 1 and steps.sum(axis=1).min() >= 1 and free.ravel()[route].all()
+            if connectivity == 4:
+                assert steps.sum(axis=1).max() == 1
+            length = np.sum(np.where(steps.sum(axis=1) == 2, math.sqrt(2.0), 1.0)) * 0.05
+            assert length == pytest.approx(best.cost, rel=1e-12)

@@ -198,8 +198,9 @@ def grid_search(free: NDArray[np.bool_], start: tuple[int, int], goal: tuple[int
         f = _Frontier(grid.size, connectivity * grid.size, src, mode)
 
         def step(left: int) -> int:
-            return int(K.graph_search(_NO_POINTS, _NO_INDEX, _NO_INDEX, _NO_WEIGHTS, grid, resolution_m, connectivity,
-                                      dst, f.mode, True, f.g, f.prev, f.closed, f.frontier, f.counters, left))  # fmt: skip
+            return int(K.graph_search(_NO_POINTS, _NO_INDEX, _NO_INDEX, _NO_WEIGHTS, grid, resolution_m,
+                                      connectivity, dst, f.mode, True, f.g, f.prev, f.closed, f.frontier,
+                                      f.counters, left))  # fmt: skip
 
         found = f.run(step, dst, termination, work_done=0.0, chunk=chunk)
     route = (found.route // width - 1) * nx + found.route % width - 1  # back to the unbordered grid's cells
@@ -238,8 +239,9 @@ class _GridFrontier:
             left = termination.work_left(expanded, chunk)
             if left <= 0 or termination.expired():
                 return SearchResult(SearchStatus.STOPPED, np.zeros(0, np.int64), np.inf, expanded)
-            outcome = K.grid_astar(self.state, self.width, dst, heuristic, self.connectivity, self.ga, self.gb,
-                                   self.prev, self.key, self.node, self.nxt, self.head, self.counters, left)  # fmt: skip
+            outcome = K.grid_astar(self.state, self.width, dst, heuristic, self.connectivity, self.ga,
+                                   self.gb, self.prev, self.key, self.node, self.nxt, self.head, self.counters,
+                                   left)  # fmt: skip
             expanded = int(self.counters[K.EXPANDED])
             if outcome == 1:
                 cost = (float(self.ga[dst]) + float(self.gb[dst]) * math.sqrt(2.0)) * resolution_m

@@ -488,7 +488,7 @@ def _write_span(o: NDArray[np.uint8], scratch: NDArray[np.float32], nz: NDArray[
         o[q] = min(max(v, 0), 255)
 
 
-@njit(cache=True, fastmath=True, nogil=True)  # nogil: the simulator renders its cameras in threads
+@njit(cache=True, fastmath=True)
 def _render_frame_kernel(
     out2: NDArray[np.uint8], bg2: NDArray[np.uint8], pool: NDArray[np.int8], noise_key: np.uint64, noise_on: bool,
     rays: NDArray[np.float32], foot: NDArray[np.float32], gain: NDArray[np.float32], cam: NDArray[np.float64],

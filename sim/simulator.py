@@ -9,7 +9,6 @@ from __future__ import annotations
 import dataclasses
 import time
 from collections.abc import Iterable, Sequence
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -79,7 +78,6 @@ class Simulator:
             if render else []
         )  # fmt: skip
         self.times = StageTimes()
-        self._pool: ThreadPoolExecutor | None = None
 
     @property
     def t(self) -> float:
@@ -96,16 +94,9 @@ class Simulator:
         ball_px: dict[int, tuple[float, float, float]] = {}
         robot_px: dict[tuple[Team, int], dict[int, tuple[float, float]]] = {}
         t0 = time.perf_counter()
-        if len(self.renderers) > 1:
-            # the cameras at once: the compositing kernel releases the GIL, and each renderer draws
-            # its noise from its own generator, so the images are the same as one after the other
-            if self._pool is None:
-                self._pool = ThreadPoolExecutor(len(self.renderers), thread_name_prefix="render")
-            rendered = list(self._pool.map(lambda r: r.render(snap), self.renderers))
-        else:
-            rendered = [r.render(snap) for r in self.renderers]
-        for renderer, (image, truth) in zip(self.renderers, rendered, strict=True):
+        for renderer in self.renderers:
             cam = renderer.model.id
+            image, truth = renderer.render(snap)
             images[cam] = image
             if truth.ball is not None:
                 ball_px[cam] = truth.ball

@@ -10,8 +10,6 @@ are the floor's (:func:`cmdragons._kernels.argsort_stable`, :func:`cmdragons._ke
 because numba compiles each use of
 ``np.zeros``, ``np.ones``, ``np.full``, ``np.arange``, ``np.argsort`` and ``np.median`` (per
 signature) anew, a tenth of a second to seconds each, for no run-time gain.
-
-The kernels release the GIL (``nogil``): a match sees its cameras in threads of their own.
 """
 
 from __future__ import annotations
@@ -55,7 +53,7 @@ def _bgr_row(src: np.ndarray, c0: np.ndarray, c1: np.ndarray, c2: np.ndarray) ->
         c0[j], c1[j], c2[j] = src[3 * j], src[3 * j + 1], src[3 * j + 2]
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True)
 def channels(image: np.ndarray, yuv: bool) -> np.ndarray:
     """The image (H, W, 3) BGR uint8 in YUV (``yuv``) or BGR, as ``classify`` computes it: the
     kernel side of :func:`vision.cmvision.convert_colour` (for the tests)."""
@@ -200,7 +198,7 @@ def classify(image: np.ndarray, yuv: bool, lut: np.ndarray, screen: np.ndarray, 
             counts[i] = n
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True)
 def _find(parent: np.ndarray, a: int) -> int:
     root = a
     while parent[root] != root:
@@ -212,7 +210,7 @@ def _find(parent: np.ndarray, a: int) -> int:
     return root
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True)
 def connect_runs(runs: np.ndarray, counts: np.ndarray, eight: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Flatten the per-row runs and join runs of one class that touch across neighbouring rows
     (4- or 8-connectivity) by union-find (thesis A.1.4).
@@ -272,7 +270,7 @@ def connect_runs(runs: np.ndarray, counts: np.ndarray, eight: bool) -> tuple[np.
     return flat, label, n_regions
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True)
 def region_stats(flat: np.ndarray, label: np.ndarray, n_regions: int) -> np.ndarray:
     """Per region: class, area, sums of u, v, u^2, v^2, uv and the bounding box (thesis A.1.5),
     from the runs in closed form (sums of integer ranges), u and v at pixel corners."""
@@ -310,7 +308,7 @@ def region_stats(flat: np.ndarray, label: np.ndarray, n_regions: int) -> np.ndar
 MERGE_CELL_PX = 16
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True)
 def _box_cells(lo: float, hi: float, n_cells: int) -> tuple[int, int]:
     """The range of grid cells (inclusive, clipped to the grid) that ``[lo, hi]`` (px) overlaps."""
     c0 = int(math.floor(lo / MERGE_CELL_PX)) if lo > 0.0 else 0
@@ -318,7 +316,7 @@ def _box_cells(lo: float, hi: float, n_cells: int) -> tuple[int, int]:
     return min(c0, n_cells - 1), min(c1, n_cells - 1)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True)
 def _file_boxes(stats: np.ndarray, nu: int, nv: int, slots: np.ndarray, items: np.ndarray) -> None:
     """Each region's index into every grid cell its bounding box overlaps (cells row by row, ``nu``
     per row): with no ``items``, count them per cell into ``slots``; else write them to
@@ -334,7 +332,7 @@ def _file_boxes(stats: np.ndarray, nu: int, nv: int, slots: np.ndarray, items: n
                 slots[c] += 1
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True)
 def _next_merge_candidate(stats: np.ndarray, i: int, after: int, rank: np.ndarray, alive: np.ndarray,
                           cell_start: np.ndarray, cell_items: np.ndarray, nu: int, nv: int,
                           max_gap_px: float) -> int:  # fmt: skip
@@ -360,7 +358,7 @@ def _next_merge_candidate(stats: np.ndarray, i: int, after: int, rank: np.ndarra
     return best
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True)
 def merge_regions(stats: np.ndarray, max_gap_px: float, min_density: float) -> np.ndarray:
     """Density-based merging (thesis A.1.6): two regions of one class whose bounding boxes are at
     most ``max_gap_px`` apart are joined when the joined region still fills at least
@@ -419,7 +417,7 @@ def merge_regions(stats: np.ndarray, max_gap_px: float, min_density: float) -> n
     return alive
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True)
 def region_rays(grid: np.ndarray, pixels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Ray (dx, dy) per metre of descent at each pixel position (n, 2), bilinear in the camera's
     per-pixel ray grid (H, W, 2) sampled at pixel centres; and the area (m^2 per px, per metre of
@@ -446,7 +444,7 @@ def region_rays(grid: np.ndarray, pixels: np.ndarray) -> tuple[np.ndarray, np.nd
     return rays, area
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True)
 def ball_centre(image: np.ndarray, box: np.ndarray, margin: int) -> tuple[float, float, float, float]:
     """The ball's sub-pixel centre (u, v at pixel centres) in ``image`` (H, W, 3) uint8 around its
     region's bounding box ``box`` (u0, v0, u1, v1 inclusive): the centroid of each pixel's ball
@@ -553,7 +551,7 @@ def _procrustes_sums(centre: np.ndarray, w_centre: float, obs: np.ndarray, w_obs
     return wsum, mox, moy, mtx, mty, cross, dot, spread
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True)
 def fit_pattern(centre: np.ndarray, w_centre: float, obs: np.ndarray, w_obs: np.ndarray,
                 slots: np.ndarray) -> tuple[float, float, float, float]:  # fmt: skip
     """Weighted least-squares rigid fit (2D Procrustes) of a pattern whose centre dot sits at the
@@ -571,7 +569,7 @@ def fit_pattern(centre: np.ndarray, w_centre: float, obs: np.ndarray, w_obs: np.
     return theta, px, py, np.sqrt(err / wsum)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True)
 def fit_score(centre: np.ndarray, w_centre: float, obs: np.ndarray, w_obs: np.ndarray, slots: np.ndarray) -> float:
     """What ranks the assignments of :func:`fit_pattern`, without its trigonometry: the weighted
     squared residual of the best rotation less the observations' own spread (the same for every
@@ -614,7 +612,7 @@ def _verdict(row: np.ndarray, id_of_code: np.ndarray, max_res: float, res_scale:
         row[M_VERDICT] = V_ROBOT
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True)
 def match_patterns(cxy: np.ndarray, cw: np.ndarray, dxy: np.ndarray, dw: np.ndarray, dpink: np.ndarray,
                    dgood: np.ndarray, slots: np.ndarray, assign: np.ndarray, search_r: float, min_dots: int,
                    id_of_code: np.ndarray, max_res: float, res_scale: float,
@@ -690,7 +688,7 @@ def match_patterns(cxy: np.ndarray, cw: np.ndarray, dxy: np.ndarray, dw: np.ndar
     return out
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True)
 def distinct_robots(xy: np.ndarray, conf: np.ndarray, key: np.ndarray, distance: float) -> np.ndarray:
     """Indices of the detections kept, most confident first (ties in index order): one of a key
     (team and id) already kept, or closer than ``distance`` to a kept one, is the same robot seen
@@ -719,7 +717,7 @@ def distinct_robots(xy: np.ndarray, conf: np.ndarray, key: np.ndarray, distance:
     return kept[:m]
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True)
 def ball_candidates(area: np.ndarray, moments: np.ndarray, bbox: np.ndarray, rays: np.ndarray,
                     pixel_area: np.ndarray, cam: np.ndarray, ball_radius: float, robot_xy: np.ndarray,
                     robot_z: np.ndarray, pattern_radius: float, min_area: float, max_area: float,

@@ -4,9 +4,7 @@ A stage takes messages from named topics and publishes messages to named topics,
 no stage reads another's attributes. The bus subscribes each stage to its input topics over a
 :class:`Transport` and times every call into it. The transport is the seam to a distributed runtime:
 :class:`InProcessTransport` delivers in lock-step, first published first delivered, each message to
-its subscribers in the order they subscribed, so the same inputs give the same run byte for byte
-(stages that share nothing with the others, a camera's vision, may run in threads of their own:
-what they publish still joins the queue in that order); a
+its subscribers in the order they subscribed, so the same inputs give the same run byte for byte; a
 networked transport (:mod:`cmdragons.runtime.zenoh_transport`) implements the same calls and no
 stage changes. Either delivers a message as it comes off the wire
 (:func:`cmdragons.runtime.wire.canonical`: detections, world states and commands in the league's
@@ -18,11 +16,9 @@ Topic patterns: an exact topic (``world/blue``), a prefix ending in ``/*`` (``de
 
 from __future__ import annotations
 
-import threading
 import time
 from collections import deque
 from collections.abc import Callable, Sequence
-from concurrent.futures import Future, ThreadPoolExecutor
 from typing import Any, Protocol
 
 __all__ = ["Bus", "InProcessTransport", "Publish", "Stage", "Transport", "topic_matches"]
@@ -45,10 +41,7 @@ class Transport(Protocol):
 
     def publish(self, topic: str, message: Any) -> None: ...
 
-    def subscribe(self, pattern: str, handler: Handler, lane: str | None = None) -> None:
-        """``lane``: handlers of one lane run one after another and may run beside other lanes and
-        the unlaned handlers (a transport is free to run them all in its own thread)."""
-        ...
+    def subscribe(self, pattern: str, handler: Handler) -> None: ...
 
     def spin(self) -> int:
         """Deliver what is pending (in-process: until nothing is); returns how many deliveries."""
@@ -58,84 +51,40 @@ class Transport(Protocol):
 
 
 class InProcessTransport:
-    """Lock-step delivery in one process: a FIFO of published messages, delivered on :meth:`spin`.
-
-    Each round delivers what the queue holds, every message to its subscribers in order, and then
-    queues what they published in that same order: exactly first published, first delivered. A
-    laned handler runs in its lane's thread beside the rest of the round (the two cameras' vision at
-    once: their kernels release the GIL); as nothing a round publishes is delivered before the next
-    round, the run is the same as one thread's."""
+    """Lock-step delivery in one process: a FIFO of published messages, delivered on :meth:`spin`."""
 
     def __init__(self) -> None:
         from cmdragons.runtime.wire import canonical
 
         self._canonical = canonical
         self._queue: deque[tuple[str, Any]] = deque()
-        self._subs: list[tuple[str, Handler, str | None]] = []
-        self._routes: dict[str, list[tuple[Handler, str | None]]] = {}
-        self._lanes: dict[str, ThreadPoolExecutor] = {}
-        self._local = threading.local()  # .out: where this thread's handler publishes to in a round
+        self._subs: list[tuple[str, Handler]] = []
+        self._routes: dict[str, list[Handler]] = {}
 
     def publish(self, topic: str, message: Any) -> None:
-        out = getattr(self._local, "out", None)
-        (self._queue if out is None else out).append((topic, self._canonical(message)))
+        self._queue.append((topic, self._canonical(message)))
 
-    def subscribe(self, pattern: str, handler: Handler, lane: str | None = None) -> None:
-        self._subs.append((pattern, handler, lane))
+    def subscribe(self, pattern: str, handler: Handler) -> None:
+        self._subs.append((pattern, handler))
         self._routes.clear()
-        if lane is not None and lane not in self._lanes:
-            self._lanes[lane] = ThreadPoolExecutor(1, thread_name_prefix=f"bus-{lane}")
 
-    def _handlers(self, topic: str) -> list[tuple[Handler, str | None]]:
+    def _handlers(self, topic: str) -> list[Handler]:
         hs = self._routes.get(topic)
         if hs is None:
-            hs = self._routes[topic] = [(h, lane) for p, h, lane in self._subs if topic_matches(p, topic)]
+            hs = self._routes[topic] = [h for p, h in self._subs if topic_matches(p, topic)]
         return hs
 
-    def _deliver(self, handler: Handler, topic: str, message: Any, out: list[tuple[str, Any]]) -> None:
-        self._local.out = out
-        try:
-            handler(topic, message)
-        finally:
-            self._local.out = None
-
     def spin(self) -> int:
-        if not self._lanes:  # one thread: deliver straight from the queue
-            n = 0
-            while self._queue:
-                topic, message = self._queue.popleft()
-                for handler, _ in self._handlers(topic):
-                    handler(topic, message)
-                    n += 1
-            return n
         n = 0
         while self._queue:
-            round_ = list(self._queue)
-            self._queue.clear()
-            outs: list[list[tuple[str, Any]]] = []
-            laned: list[Future[None]] = []
-            try:
-                for topic, message in round_:
-                    for handler, lane in self._handlers(topic):
-                        out: list[tuple[str, Any]] = []
-                        outs.append(out)
-                        if lane is None:
-                            self._deliver(handler, topic, message, out)
-                        else:
-                            laned.append(self._lanes[lane].submit(self._deliver, handler, topic, message, out))
-                        n += 1
-            finally:
-                for f in laned:
-                    f.result()
-            for out in outs:
-                self._queue.extend(out)
+            topic, message = self._queue.popleft()
+            for handler in self._handlers(topic):
+                handler(topic, message)
+                n += 1
         return n
 
     def close(self) -> None:
         self._queue.clear()
-        for pool in self._lanes.values():
-            pool.shutdown()
-        self._lanes.clear()
 
 
 class Stage(Protocol):
@@ -144,17 +93,13 @@ class Stage(Protocol):
     ``inputs``: the topic patterns it reads. ``start``: publish what it has before any input (a
     referee's first game state). ``on_message``: handle one input and publish the outputs.
     ``summarize``: publish its figures of the run so far (a :class:`~cmdragons.messages.StageSummary`
-    on ``summary/<name>``). ``concurrent``: it shares nothing with other stages, so its calls may
-    run in a thread of their own (:meth:`Transport.subscribe`'s lane)."""
+    on ``summary/<name>``)."""
 
     @property
     def name(self) -> str: ...
 
     @property
     def inputs(self) -> Sequence[str]: ...
-
-    @property
-    def concurrent(self) -> bool: ...
 
     def start(self, publish: Publish) -> None: ...
 
@@ -178,9 +123,8 @@ class Bus:
         if any(s.name == stage.name for s in self.stages):
             raise ValueError(f"two stages named {stage.name!r} on one bus")
         self.stages.append(stage)
-        lane = stage.name if stage.concurrent else None
         for pattern in stage.inputs:
-            self.transport.subscribe(pattern, self._timed(stage, pattern), lane)
+            self.transport.subscribe(pattern, self._timed(stage, pattern))
 
     def _timed(self, stage: Stage, pattern: str) -> Handler:
         times, name, publish = self.times, stage.name, self.transport.publish
@@ -226,7 +170,6 @@ class BaseStage:
 
     name: str = ""
     inputs: Sequence[str] = ()
-    concurrent: bool = False
 
     def start(self, publish: Publish) -> None:
         return None

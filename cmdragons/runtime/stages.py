@@ -160,10 +160,7 @@ class SimStage(BaseStage):
 
 
 class VisionStage(BaseStage):
-    """One camera's vision: image -> detections. Concurrent: its pipeline is its own, and its
-    kernels release the GIL, so the cameras are seen at once."""
-
-    concurrent = True
+    """One camera's vision: image -> detections."""
 
     def __init__(self, camera_id: int, pipeline: Any) -> None:
         self.name = f"vision/{camera_id}"

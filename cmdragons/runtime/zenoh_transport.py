@@ -116,8 +116,7 @@ class ZenohTransport:
 
     # --- subscribing -------------------------------------------------------------------------
 
-    def subscribe(self, pattern: str, handler: Handler, lane: str | None = None) -> None:
-        # every handler runs in spin's thread, in order (one stage a process, mostly): no lanes here
+    def subscribe(self, pattern: str, handler: Handler) -> None:
         self._subs.append((pattern, handler))
         self._routes.clear()
         patterns = {p for p, _ in self._subs}

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import hashlib
 import pickle
-import threading
 from pathlib import Path
 from typing import Any
 
@@ -58,41 +57,6 @@ def test_in_process_delivery_is_first_published_first_delivered_in_subscription_
     # both inputs are delivered (to a, then b) before what a published in answer to them
     assert seen == ["a<in:1", "b<in:1", "a<in:2", "b<in:2", "b<mid:1>a", "c<mid:1>a", "b<mid:2>a", "c<mid:2>a"]
     assert set(bus.take_times()) >= {"a", "b", "c", "a:in", "b:mid"}
-
-
-class Lane(BaseStage):
-    """Answers each input with one output, on its lane's thread when concurrent (and says which)."""
-
-    def __init__(self, name: str, inputs: tuple[str, ...], out: str, concurrent: bool) -> None:
-        self.name, self.inputs, self.out, self.concurrent = name, inputs, out, concurrent
-
-    def on_message(self, topic: str, message: Any, publish: Publish) -> None:
-        publish(self.out, f"{message}>{self.name}")
-        publish(self.out, f"{message}>{self.name}@{threading.current_thread().name.startswith('bus-')}")
-
-
-def _lanes_seen(concurrent: bool) -> list[str]:
-    seen: list[str] = []
-    bus = Bus(InProcessTransport())
-    bus.add(Lane("a", ("cam/0",), "det", concurrent))
-    bus.add(Lane("b", ("cam/1",), "det", concurrent))
-    bus.add(Lane("c", ("truth", "det"), "out", False))
-    bus.add(Relay("sink", ("det", "out"), "", seen))
-    for i in range(3):
-        bus.publish("truth", i)
-        bus.publish("cam/0", i)
-        bus.publish("cam/1", i)
-        bus.spin()
-    bus.close()
-    return seen
-
-
-def test_concurrent_stages_run_in_lanes_and_publish_in_the_one_thread_order() -> None:
-    alone, laned = _lanes_seen(False), _lanes_seen(True)
-    assert len(alone) == 3 * (4 + 2 + 8)
-    assert [s.replace("@True", "@False") for s in laned] == alone
-    assert any("a@True" in s for s in laned) and any("b@True" in s for s in laned)  # vision's lanes ran apart
-    assert not any("c@True" in s for s in laned)
 
 
 def test_two_stages_of_one_name_are_refused() -> None:

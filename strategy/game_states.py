@@ -20,7 +20,8 @@ from dataclasses import dataclass
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, Team
 from cmdragons.messages import BallState, GameState, RobotState
-from strategy.skills import Intent, SkillParams, goalie_block, kick_to
+from strategy.defense import DefenseParams, clear_target
+from strategy.skills import Intent, SkillParams, goalie_block, intercept, kick_to, pass_speed
 
 __all__ = [
     "GameStateParams",
@@ -32,6 +33,7 @@ __all__ = [
     "keeper_on_line",
     "our_kickoff",
     "own_goal_sign",
+    "penalty_rush",
     "penalty_shot",
     "place_ball",
     "restart_rules",
@@ -62,6 +64,18 @@ class GameStateParams(Validated):
     placement_line_m: float = setting(0.65, lo=0.5, hi=3.0)  # rule: 0.5 m off the placement's line, plus margin
     penalty_behind_m: float = setting(1.2, lo=1.0, hi=5.0)  # rule: 1 m behind the ball at a penalty, plus margin
     penalty_aim_share: float = setting(0.7, lo=0.0, hi=1.0)  # the taker aims this share of the half goal aside
+    penalty_kick_m_s: float = setting(6.2, lo=0.1, hi=6.5)  # the penalty's shot (rule: a ball over 6.5 m/s is a foul)
+    penalty_shoot_from_m: float = setting(1.8, lo=1.0, hi=10.0)  # ... from this far from the goal line, the
+    # ball tapped there first (rule: outside the 1 m deep defense area)
+    penalty_zone_m: float = setting(0.3, lo=0.0, hi=5.0)  # ... or up to this much farther
+    penalty_arrive_m_s: float = setting(0.1, lo=0.0, hi=3.0)  # ... the ball tapped there first, arriving this slow
+    penalty_tap_min_m_s: float = setting(0.5, lo=0.05, hi=6.5)  # ... tapped at least this fast
+    penalty_follow_m_s: float = setting(0.2, lo=0.0, hi=3.0)  # a tapped ball faster than this is followed, not played
+    penalty_lined_up_rad: float = setting(0.03, lo=0.001, hi=1.0)  # the shot's line-up: heading ...
+    penalty_lined_up_m: float = setting(0.01, lo=0.001, hi=0.5)  # ... and lateral error before driving through
+    penalty_rush_moved_m: float = setting(0.1, lo=0.0, hi=2.0)  # their penalty: the ball this far off the mark
+    # is in play (rule: 0.05 m, plus margin), our keeper goes out to it ...
+    penalty_rush_away_m_s: float = setting(0.3, lo=0.0, hi=5.0)  # ... unless it moves away from our goal this fast
     penalty_keeper_share: float = setting(0.6, lo=0.0, hi=1.0)  # our keeper's centre this share of its radius
     # inside the goal line while the penalty is prepared (the rules: touching the line)
 
@@ -248,15 +262,44 @@ def behind_ball(intents: Mapping[int, Intent], ball: BallState, attack_sign: flo
 
 def penalty_shot(robot: RobotState, ball: BallState, attack_sign: float, keeper: RobotState | None, pitch: Field,
                  skills: SkillParams, p: GameStateParams, ready: bool) -> Intent:  # fmt: skip
-    """The taker: behind the ball facing the goal while the penalty is prepared; at the normal
-    start a shot at the side of the goal the keeper leaves open."""
+    """The taker (the rules: after the normal start the kicker may play the ball as often as it
+    likes within 10 s, the ball only ever moving toward the goal). Prepared: behind the ball facing
+    the goal's centre. Started: a tap toward the goal's centre so the ball comes to rest
+    ``penalty_shoot_from_m`` from the goal line (outside the defense area: no touching the ball in
+    it), following it at a distance while it rolls; from there a shot at full legal speed at the
+    side of the goal the keeper leaves open, lined up tighter than in play."""
+    goal_x = attack_sign * pitch.half_length
+    to_line = (goal_x - ball.x) * attack_sign
+    centre = math.atan2(-ball.y, goal_x - ball.x)
+    behind = skills.contact_m + skills.approach_distance_m
+    if not ready:
+        return Intent(ball.x - behind * math.cos(centre), ball.y - behind * math.sin(centre), centre)
+    if to_line > p.penalty_shoot_from_m + p.penalty_zone_m:
+        if ball.vx * attack_sign > p.penalty_follow_m_s:  # rolling on: follow, hands off
+            return Intent(ball.x - behind * math.cos(centre), ball.y - behind * math.sin(centre), centre)
+        speed = pass_speed(to_line - p.penalty_shoot_from_m, skills, p.penalty_arrive_m_s, p.penalty_tap_min_m_s)
+        return kick_to(robot, ball, (goal_x, 0.0), speed, skills)
     side = -math.copysign(1.0, keeper.y) if keeper is not None and abs(keeper.y) > 1e-3 else 1.0
-    aim = (attack_sign * pitch.half_length, side * pitch.goal_half_width * p.penalty_aim_share)
-    if ready:
-        return kick_to(robot, ball, aim, skills.max_kick_m_s, skills)
-    heading = math.atan2(aim[1] - ball.y, aim[0] - ball.x)
-    wait = skills.contact_m + skills.approach_distance_m
-    return Intent(ball.x - wait * math.cos(heading), ball.y - wait * math.sin(heading), heading)
+    aim = (goal_x, side * pitch.goal_half_width * p.penalty_aim_share)
+    tight = dataclasses.replace(skills, lined_up_rad=p.penalty_lined_up_rad, lined_up_m=p.penalty_lined_up_m)
+    return kick_to(robot, ball, aim, p.penalty_kick_m_s, tight)
+
+
+def penalty_rush(robot: RobotState, ball: BallState, mark: tuple[float, float] | None, pitch: Field,
+                 own_sign: float, skills: SkillParams, defense: DefenseParams,
+                 p: GameStateParams) -> Intent | None:  # fmt: skip
+    """Our keeper at their penalty once the ball is in play (the rules: from then on it moves
+    freely): out to meet the ball where it can (:func:`intercept`) and clear it back up the field
+    before the taker shoots from close in (a shot at full speed from a few metres beats any keeper
+    on its line); None while the ball is still on the ``mark`` (``penalty_rush_moved_m``) or
+    already past the keeper's reach (moving away from our goal)."""
+    if mark is None or math.hypot(ball.x - mark[0], ball.y - mark[1]) < p.penalty_rush_moved_m:
+        return None
+    if ball.vx * own_sign < -p.penalty_rush_away_m_s:
+        return None
+    meet = intercept(robot, ball, skills, pitch)
+    intent = kick_to(robot, meet, clear_target(meet, pitch, own_sign, defense), defense.clear_kick_m_s, skills)
+    return dataclasses.replace(intent, allow_own_defense=True)
 
 
 def keeper_on_line(ball: BallState, pitch: Field, own_sign: float, skills: SkillParams,

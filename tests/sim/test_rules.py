@@ -369,3 +369,41 @@ def test_no_shootout_after_a_match_decided_or_unconfigured() -> None:
             ref.score["blue"] = 1  # decided: no shootout even when configured
         calls = play(w, ref, 2.5)
         assert "stage_penalty_shootout" not in kinds(calls) and ref.stage == "post_game"
+
+
+def test_a_penalty_waits_for_a_ball_at_rest_and_ends_when_the_ball_turns_back() -> None:
+    # the rules: the kicker may play the ball again and again for 10 s, the ball only ever moving
+    # toward the goal; a keeper turning it back ends the kick
+    w, ref = scene(prepare_timeout_s=0.5, penalty_time_s=5.0)
+    w.apply(ref.start_penalty("blue"))
+    mark = ref.penalty.mark if ref.penalty else (0.0, 0.0)
+    calls = play(w, ref, 1.0)
+    assert ref.ready
+    w.place_ball(mark[0] + 0.5, mark[1])  # played forward, now at rest: still the kicker's
+    calls += play(w, ref, 1.0)
+    assert ref.command == "penalty" and "penalty_over" not in kinds(calls)
+    w.place_ball(mark[0] + 0.5, mark[1], vx=-1.0)  # turned back toward the kicker's half
+    calls += play(w, ref, 0.2)
+    assert "penalty_over" in kinds(calls)
+
+
+def test_the_ball_is_not_put_into_a_robot_on_the_penalty_mark() -> None:
+    w, ref = scene()
+    mark = (w.field.half_length - ref.rules.penalty_mark_from_goal_m, 0.0)  # blue attacks +x
+    w.place_robot("yellow", 1, mark[0] + 0.02, mark[1] + 0.01, 0.0)  # standing on the mark
+    play(w, ref, 0.1)
+    teleport = ref.start_penalty("blue")
+    w.apply(teleport)
+    play(w, ref, 0.5)
+    truth = w.ground_truth()
+    assert math.hypot(truth.ball.x - mark[0], truth.ball.y - mark[1]) < 0.01  # the ball lies on the mark
+    assert all(math.hypot(r.x - mark[0], r.y - mark[1]) >= R + LEAGUE.ball.radius_m for r in truth.robots)
+
+
+def test_a_shootout_leaves_each_team_its_keeper_and_one_attacker() -> None:
+    w, ref = scene(blue=4, yellow=3, half_s=1.0, half_time_s=0.0, shootout_kicks=1, shootout_always=True)
+    play(w, ref, 2.5)
+    assert ref.stage == "penalty_shootout"
+    for team in ("blue", "yellow"):
+        on = [r.id for r in w.ground_truth().robots if r.team == team and w.field.in_field(r.x, r.y)]
+        assert sorted(on) == [0, 1]  # the keeper (0) and the field player of the lowest id

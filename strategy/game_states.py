@@ -61,6 +61,7 @@ class GameStateParams(Validated):
     placement_press_m: float = setting(0.03, lo=0.0, hi=0.1)  # ... aiming this far into it
     placement_grip_m: float = setting(0.015, lo=0.001, hi=0.1)  # the ball this near the face's middle: held
     placement_rest_m_s: float = setting(0.05, lo=0.0, hi=1.0)  # let go only of a ball this slow
+    placement_held_rest_m_s: float = setting(0.15, lo=0.0, hi=1.0)  # ... or held, the robot this slow
     placement_line_m: float = setting(0.65, lo=0.5, hi=3.0)  # rule: 0.5 m off the placement's line, plus margin
     penalty_behind_m: float = setting(1.2, lo=1.0, hi=5.0)  # rule: 1 m behind the ball at a penalty, plus margin
     penalty_aim_share: float = setting(0.7, lo=0.0, hi=1.0)  # the taker aims this share of the half goal aside
@@ -229,7 +230,8 @@ def place_ball(robot: RobotState, ball: BallState, target: tuple[float, float], 
     # that starts without the grip walks away from the ball)
     face_gap = math.hypot(ball.x - (robot.x + c * contact), ball.y - (robot.y + s * contact))
     on_face = face_gap < p.placement_grip_m or (held and face_gap < skills.dribble_hold_m)
-    resting = math.hypot(ball.vx, ball.vy) < p.placement_rest_m_s
+    # a ball on the face moves as the robot does, whose speed the cameras see only to a few cm/s
+    resting = math.hypot(ball.vx, ball.vy) < (p.placement_held_rest_m_s if on_face else p.placement_rest_m_s)
     if (off <= p.placement_done_m and resting) or (off <= p.placement_near_m and not on_face):
         away = math.atan2(robot.y - ball.y, robot.x - ball.x)
         reach = contact + p.placement_back_m

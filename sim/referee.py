@@ -339,7 +339,10 @@ class Referee:
             self._set("ball_placement", team)
             self.placement = _Placement(team, spot, t)
         elif kind == "penalty":
-            self._clear_spot(spot, self._attack_sign(team))
+            if self.stage == "penalty_shootout":
+                self._shootout_kick_setup(team, spot)
+            else:
+                self._clear_spot(spot, self._attack_sign(team))
             self._teleport(ball=spot)
             self._set("penalty", team, ready=False)
             self.penalty = _Penalty(team, t, spot)
@@ -378,6 +381,28 @@ class Referee:
             players = [rid for rid in on if rid != keeper]
             for rid in players[1:]:
                 self._send_off((team, rid), True)
+
+    def _shootout_kick_setup(self, team: Team, mark: tuple[float, float]) -> None:
+        """The rules: during a shootout attempt only the kicker and the other team's keeper may move
+        (the others must not interfere; robots may be substituted between attempts). The robot
+        handlers take the kicking team's keeper and the other team's field player off (where robots
+        sent off wait) and put the kicker ``penalty_behind_m`` behind the mark and the keeper on its
+        goal line."""
+        attack = self._attack_sign(team)
+        r = self.field.league.robot.radius_m
+        moves = []
+        for key in self.robot_keys:
+            if key in self.off:
+                continue
+            keeper = key[1] == self.rules.keepers.get(key[0], -1)
+            if key[0] == team and not keeper:
+                x, y, theta = mark[0] - attack * self.rules.penalty_behind_m, mark[1], 0.0 if attack > 0 else math.pi
+            elif key[0] != team and keeper:
+                x, y, theta = attack * (self.field.half_length - 0.5 * r), 0.0, math.pi if attack > 0 else 0.0
+            else:
+                (x, y), theta = self._park(key), 0.0
+            moves.append((key[0], key[1], x, y, theta))
+        self._teleport(moves)
 
     def _can_place(self, team: Team) -> bool:
         return self.placement_failures[team] < self.rules.placement_failures_max

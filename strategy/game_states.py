@@ -64,16 +64,19 @@ class GameStateParams(Validated):
     placement_held_rest_m_s: float = setting(0.15, lo=0.0, hi=1.0)  # ... or held, the robot this slow
     placement_line_m: float = setting(0.65, lo=0.5, hi=3.0)  # rule: 0.5 m off the placement's line, plus margin
     penalty_behind_m: float = setting(1.2, lo=1.0, hi=5.0)  # rule: 1 m behind the ball at a penalty, plus margin
-    penalty_aim_share: float = setting(0.7, lo=0.0, hi=1.0)  # the taker aims this share of the half goal aside
+    penalty_aim_share: float = setting(0.6, lo=0.0, hi=1.0)  # the taker aims this share of the half goal aside
     penalty_kick_m_s: float = setting(6.2, lo=0.1, hi=6.5)  # the penalty's shot (rule: a ball over 6.5 m/s is a foul)
-    penalty_shoot_from_m: float = setting(1.8, lo=1.0, hi=10.0)  # ... from this far from the goal line, the
+    penalty_shoot_from_m: float = setting(1.5, lo=1.0, hi=10.0)  # ... from this far from the goal line, the
     # ball tapped there first (rule: outside the 1 m deep defense area)
     penalty_zone_m: float = setting(0.3, lo=0.0, hi=5.0)  # ... or up to this much farther
     penalty_arrive_m_s: float = setting(0.1, lo=0.0, hi=3.0)  # ... the ball tapped there first, arriving this slow
     penalty_tap_min_m_s: float = setting(0.5, lo=0.05, hi=6.5)  # ... tapped at least this fast
     penalty_follow_m_s: float = setting(0.2, lo=0.0, hi=3.0)  # a tapped ball faster than this is followed, not played
-    penalty_lined_up_rad: float = setting(0.03, lo=0.001, hi=1.0)  # the shot's line-up: heading ...
+    penalty_follow_gap_m: float = setting(0.15, lo=0.0, hi=2.0)  # ... this much farther back than the waiting point
+    penalty_rest_m_s: float = setting(0.08, lo=0.0, hi=1.0)  # the shot waits for the ball slower than this
+    penalty_lined_up_rad: float = setting(0.05, lo=0.001, hi=1.0)  # the shot's line-up: heading ...
     penalty_lined_up_m: float = setting(0.01, lo=0.001, hi=0.5)  # ... and lateral error before driving through
+    penalty_push_m_s: float = setting(0.5, lo=0.05, hi=3.0)  # ... at this speed (slower than in play: a straighter shot)
     penalty_rush_moved_m: float = setting(0.1, lo=0.0, hi=2.0)  # their penalty: the ball this far off the mark
     # is in play (rule: 0.05 m, plus margin), our keeper goes out to it ...
     penalty_rush_away_m_s: float = setting(0.3, lo=0.0, hi=5.0)  # ... unless it moves away from our goal this fast
@@ -268,22 +271,31 @@ def penalty_shot(robot: RobotState, ball: BallState, attack_sign: float, keeper:
     likes within 10 s, the ball only ever moving toward the goal). Prepared: behind the ball facing
     the goal's centre. Started: a tap toward the goal's centre so the ball comes to rest
     ``penalty_shoot_from_m`` from the goal line (outside the defense area: no touching the ball in
-    it), following it at a distance while it rolls; from there a shot at full legal speed at the
-    side of the goal the keeper leaves open, lined up tighter than in play."""
+    it), following it at a distance while it rolls; from there, once it rests, a shot at full legal
+    speed at the side of the goal the keeper leaves open, lined up tighter than in play."""
     goal_x = attack_sign * pitch.half_length
     to_line = (goal_x - ball.x) * attack_sign
     centre = math.atan2(-ball.y, goal_x - ball.x)
     behind = skills.contact_m + skills.approach_distance_m
     if not ready:
         return Intent(ball.x - behind * math.cos(centre), ball.y - behind * math.sin(centre), centre)
+    # hands off while it rolls: behind it on its way, far enough back to line up afresh
+    speed = math.hypot(ball.vx, ball.vy)
+    way = math.atan2(ball.vy, ball.vx) if speed > p.penalty_rest_m_s else centre
+    follow = behind + p.penalty_follow_gap_m
+    follow_at = Intent(ball.x - follow * math.cos(way), ball.y - follow * math.sin(way), centre)
     if to_line > p.penalty_shoot_from_m + p.penalty_zone_m:
-        if ball.vx * attack_sign > p.penalty_follow_m_s:  # rolling on: follow, hands off
-            return Intent(ball.x - behind * math.cos(centre), ball.y - behind * math.sin(centre), centre)
-        speed = pass_speed(to_line - p.penalty_shoot_from_m, skills, p.penalty_arrive_m_s, p.penalty_tap_min_m_s)
-        return kick_to(robot, ball, (goal_x, 0.0), speed, skills)
+        if ball.vx * attack_sign > p.penalty_follow_m_s:
+            return follow_at
+        tap = pass_speed(to_line - p.penalty_shoot_from_m, skills, p.penalty_arrive_m_s, p.penalty_tap_min_m_s)
+        return kick_to(robot, ball, (goal_x, 0.0), tap, skills)
+    if speed > p.penalty_rest_m_s:
+        return follow_at  # the shot from a ball at rest: lined up, not caught up with a rolling ball
     side = -math.copysign(1.0, keeper.y) if keeper is not None and abs(keeper.y) > 1e-3 else 1.0
     aim = (goal_x, side * pitch.goal_half_width * p.penalty_aim_share)
-    tight = dataclasses.replace(skills, lined_up_rad=p.penalty_lined_up_rad, lined_up_m=p.penalty_lined_up_m)
+    # lined up before driving through, not on the way (no cone that narrows toward the ball)
+    tight = dataclasses.replace(skills, lined_up_rad=p.penalty_lined_up_rad, lined_up_m=p.penalty_lined_up_m,
+                                cone_slope=0.0, cone_heading_rad_m=0.0, push_speed_m_s=p.penalty_push_m_s)
     return kick_to(robot, ball, aim, p.penalty_kick_m_s, tight)
 
 

@@ -298,8 +298,8 @@ class Tracker:
 
     def _ball_rank(self, track: _BallTrack) -> tuple[bool, float, int]:
         confirmed = track.hits >= self.p.ball_confirm_detections
-        # a ball hidden in a robot's mouth is as current as the robot's detection
-        return (confirmed, self.t if self._held(track) else track.last_seen, track.hits)
+        # a ball seen since beats one hidden in a robot's mouth (the referee moved it, or the robot let it go unseen)
+        return (confirmed, track.last_seen, track.hits)
 
     def _held(self, ball: _BallTrack) -> bool:
         return ball.holder is not None and self.t - ball.held_since <= self.p.ball_held_timeout_s

@@ -400,10 +400,25 @@ def test_the_ball_is_not_put_into_a_robot_on_the_penalty_mark() -> None:
     assert all(math.hypot(r.x - mark[0], r.y - mark[1]) >= R + LEAGUE.ball.radius_m for r in truth.robots)
 
 
-def test_a_shootout_leaves_each_team_its_keeper_and_one_attacker() -> None:
-    w, ref = scene(blue=4, yellow=3, half_s=1.0, half_time_s=0.0, shootout_kicks=1, shootout_always=True)
-    play(w, ref, 2.5)
-    assert ref.stage == "penalty_shootout"
-    for team in ("blue", "yellow"):
-        on = [r.id for r in w.ground_truth().robots if r.team == team and w.field.in_field(r.x, r.y)]
-        assert sorted(on) == [0, 1]  # the keeper (0) and the field player of the lowest id
+def test_a_shootout_kick_has_only_the_kicker_and_the_other_keeper_on_the_field() -> None:
+    # the rules: one attacker and the keeper per team; during an attempt only the kicker and the
+    # other team's keeper move: the robot handlers take the others off and put these two in place
+    w, ref = scene(blue=4, yellow=3, half_s=1.0, half_time_s=0.0, shootout_kicks=1, shootout_always=True,
+                   prepare_timeout_s=0.5, penalty_time_s=1.0)  # fmt: skip
+    seen = []
+
+    def look(k: int) -> list[RobotCommand]:
+        pen = ref.penalty
+        if pen is not None and (not seen or seen[-1][0] != pen.team):
+            truth = w.ground_truth()
+            on = sorted((r.team, r.id) for r in truth.robots if w.field.in_field(r.x, r.y))
+            seen.append((pen.team, on, (truth.ball.x, truth.ball.y), pen.mark))
+        return []
+
+    play(w, ref, 2.0 + 2 * (1.0 + 0.5 + 1.0) + 1.0, look)
+    assert [s[0] for s in seen] == ["yellow", "blue"]
+    assert seen[0][1] == [("blue", 0), ("yellow", 1)]  # blue's keeper, yellow's kicker (the lowest field id)
+    assert seen[1][1] == [("blue", 1), ("yellow", 0)]
+    for _, _, ball, mark in seen:
+        assert math.hypot(ball[0] - mark[0], ball[1] - mark[1]) < 0.01
+    assert ref.stage == "post_game"

@@ -416,3 +416,23 @@ def test_a_ball_hidden_in_a_robots_mouth_is_carried_not_lost(on_face: bool) -> N
         assert worst < 0.03
     else:
         assert ws.ball is None  # lost for 2 s > ball_timeout_s
+
+
+def test_a_ball_seen_elsewhere_beats_one_hidden_in_a_robots_mouth() -> None:
+    # the referee puts the ball on a spot while the tracker has it hidden in a robot's mouth: the
+    # ball seen there is the ball from its confirming detections on
+    w = make_world()
+    w.place_robot("blue", 0, 0.0, 0.0, 0.0)
+    w.place_ball(FRONT + 0.003, 0.0)
+    p = params()
+    tracker = Tracker(p)
+    rng = np.random.default_rng(6)
+    for k in range(60):  # seen on the dribbler, then hidden there
+        tracker.step([detect(w.snapshot(), rng, ball=k < 30)])
+        w.step_frame([RobotCommand("blue", 0, dribbler=1.0)])
+    w.place_ball(2.0, 1.0)
+    for _ in range(p.ball_confirm_detections + 1):
+        w.step_frame()
+        ws = tracker.step([detect(w.snapshot(), rng)])
+    assert ws.ball is not None and ws.ball.visible
+    assert math.hypot(ws.ball.x - 2.0, ws.ball.y - 1.0) < 0.02

@@ -174,7 +174,10 @@ def restart_rules(intents: Mapping[int, Intent], game: GameState, ours: bool, ba
     restart is for our team."""
     out = dict(intents)
     if game.command == "stop" or (game.command in ("kickoff", "free_kick") and not ours):
-        out = keep_away(out, ball, pitch, own_sign, p, radius, game.command == "kickoff", game.command == "stop")
+        # slow in a stop (the rules) and at their kickoff (robots put in formation then cross round the
+        # ball to their places: fast, they swing in past the rules' distance)
+        out = keep_away(out, ball, pitch, own_sign, p, radius, game.command == "kickoff",
+                        game.command in ("stop", "kickoff"))  # fmt: skip
     if game.command == "kickoff" and ours:
         out = our_kickoff(out, pitch, own_sign, p, radius, kicker)
     return out

@@ -70,6 +70,12 @@ def _count(text: str) -> int:
     return int(text)
 
 
+def _count_or_none(text: str) -> int:
+    if not (text.isdigit() and 0 <= int(text) <= 1000):
+        raise argparse.ArgumentTypeError(f"must be a whole number 0 to 1000, got {text!r}")
+    return int(text)
+
+
 def _common(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--config", metavar="DIR", default=None, help="config folder (default: ./configs)")
     parser.add_argument(
@@ -159,6 +165,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="play: this many seeded matches (default 10, --quick 2)")
     p.add_argument("--half", metavar="S", type=_positive, default=None,
                    help="play: halves of S seconds (default the rules' 300, --quick 30)")
+    p.add_argument("--shootout", metavar="N", type=_count_or_none, default=None,
+                   help="play: the penalty shootout's kicks each way against simple (default 10, --quick 3; 0: none)")
     add_runtime_parsers(sub, _common)
     return parser
 

@@ -81,7 +81,7 @@ class BrainParams(Validated):
 
     ball_clearance_m: float = setting(0.05, lo=0.0, hi=1.0)  # kept from the ball when it is an obstacle
     # ... and in a stop, at their restarts and placements (rules: 0.5 m from the ball), this much
-    keep_away_clearance_m: float = setting(0.55, lo=0.0, hi=3.0)
+    keep_away_clearance_m: float = setting(0.65, lo=0.0, hi=3.0)
     arrive_tolerance_m: float = setting(0.01, lo=0.0, hi=1.0)  # closer than this to the goal: no planning
     # a navigator's deadline per robot and frame: only the safety net of a stalled machine
     navigate_deadline_ms: float = setting(50.0, lo=0.01, hi=10000.0)

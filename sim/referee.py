@@ -152,6 +152,7 @@ class Referee:
         self.shootout: dict[Team, dict[str, int]] = {t: {"taken": 0, "scored": 0} for t in TEAMS}
         self._last_t = 0.0
         self._teleports: list[Teleport] = []
+        self._truth: GroundTruth | None = None  # the last true state seen (where the robots stand)
 
     # --- commands ---------------------------------------------------------------------------
     def _set(self, command: str, for_team: Team | None, ready: bool = True) -> None:
@@ -278,6 +279,8 @@ class Referee:
                 self._clear_special()
                 self._set("stop", None)
                 self._restart = (t + self.params.restart_delay_s, "free_kick", taker, spot)
+        if truth is not None:
+            self._truth = truth
         if self.full and truth is not None:
             self._judge(truth)
             self._follow_placement(truth)
@@ -336,6 +339,10 @@ class Referee:
             self._set("ball_placement", team)
             self.placement = _Placement(team, spot, t)
         elif kind == "penalty":
+            if self.stage == "penalty_shootout":
+                self._shootout_kick_setup(team, spot)
+            else:
+                self._clear_spot(spot, self._attack_sign(team))
             self._teleport(ball=spot)
             self._set("penalty", team, ready=False)
             self.penalty = _Penalty(team, t, spot)
@@ -347,6 +354,55 @@ class Referee:
             self._set("kickoff" if kind == "kickoff" else "free_kick", team)
             self._restart_ball = ball_xy if placed else spot
             self._restart_t = t
+
+    def _clear_spot(self, spot: tuple[float, float], attack: float) -> None:
+        """Robots standing where the referee puts the ball moved aside first (straight away from it,
+        toward the kicking team's half when on it) so the ball is not put into a robot."""
+        if self._truth is None:
+            return
+        clear = self.field.league.robot.radius_m + self.field.league.ball.radius_m + self.rules.placement_clear_m
+        moved = []
+        for r in self._truth.robots:
+            dx, dy = r.x - spot[0], r.y - spot[1]
+            d = math.hypot(dx, dy)
+            if d >= clear or (r.team, r.id) in self.off:
+                continue
+            ux, uy = (dx / d, dy / d) if d > 1e-6 else (-attack, 0.0)
+            moved.append((r.team, r.id, spot[0] + ux * clear, spot[1] + uy * clear, r.theta))
+        if moved:
+            self._teleport(moved)
+
+    def _shootout_teams(self) -> None:
+        """The rules: in a shootout one attacker and the keeper per team; the others go off (the
+        keeper and the field player of the lowest id stay)."""
+        for team in TEAMS:
+            keeper = self.rules.keepers.get(team, -1)
+            on = sorted(rid for t, rid in self.robot_keys if t == team and (t, rid) not in self.off)
+            players = [rid for rid in on if rid != keeper]
+            for rid in players[1:]:
+                self._send_off((team, rid), True)
+
+    def _shootout_kick_setup(self, team: Team, mark: tuple[float, float]) -> None:
+        """The rules: during a shootout attempt only the kicker and the other team's keeper may move
+        (the others must not interfere; robots may be substituted between attempts). The robot
+        handlers take the kicking team's keeper and the other team's field player off (where robots
+        sent off wait) and put the kicker ``penalty_behind_m`` behind the mark and the keeper on its
+        goal line."""
+        attack = self._attack_sign(team)
+        r = self.field.league.robot.radius_m
+        moves = []
+        for key in self.robot_keys:
+            if key in self.off:
+                continue
+            keeper = key[1] == self.rules.keepers.get(key[0], -1)
+            if key[0] == team and not keeper:
+                x, y, theta = mark[0] - attack * self.rules.penalty_behind_m, mark[1], 0.0 if attack > 0 else math.pi
+            elif key[0] != team and keeper:
+                x, y, theta = attack * (self.field.half_length - 0.5 * r), 0.0, math.pi if attack > 0 else 0.0
+            else:
+                (x, y), theta = self._park(key), 0.0
+            moves.append((key[0], key[1], x, y, theta))
+        self._teleport(moves)
 
     def _can_place(self, team: Team) -> bool:
         return self.placement_failures[team] < self.rules.placement_failures_max
@@ -531,7 +587,10 @@ class Referee:
         attack = self._attack_sign(pen.team)
         moved = math.hypot(b.x - pen.mark[0], b.y - pen.mark[1]) > self.rules.ball_in_play_m
         took = self.t - pen.t_run
-        if took > self.rules.penalty_time_s or (moved and (math.hypot(b.vx, b.vy) < 0.05 or b.vx * attack < -0.05)):
+        # over (the rules) after the kicker's time, or once the ball in play moves away from the goal (the
+        # keeper turned it back, or the kicker broke the rule that it only ever moves toward the goal); a
+        # ball at rest waits for the kicker, who may play it again
+        if took > self.rules.penalty_time_s or (moved and b.vx * attack < -0.05):
             shootout = self.stage == "penalty_shootout"
             self._call(GameEvent(self.t, "penalty_over", pen.team, None, took, self.rules.penalty_time_s, "s",
                                  "" if shootout else "free_kick", None if shootout else _other(pen.team)))  # fmt: skip
@@ -562,6 +621,7 @@ class Referee:
         elif self.stage == "second_half" and r.shootout_kicks > 0 and (
                 r.shootout_always or self.score["blue"] == self.score["yellow"]):
             self.stage, self._stage_end = "penalty_shootout", math.inf
+            self._shootout_teams()
             self._call(GameEvent(self.t, f"stage_{self.stage}"))
             self._next_shootout_kick()
             return

@@ -20,7 +20,8 @@ from dataclasses import dataclass
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, Team
 from cmdragons.messages import BallState, GameState, RobotState
-from strategy.skills import Intent, SkillParams, goalie_block, kick_to
+from strategy.defense import DefenseParams, clear_target
+from strategy.skills import Intent, SkillParams, goalie_block, intercept, kick_to, pass_speed
 
 __all__ = [
     "GameStateParams",
@@ -32,6 +33,7 @@ __all__ = [
     "keeper_on_line",
     "our_kickoff",
     "own_goal_sign",
+    "penalty_rush",
     "penalty_shot",
     "place_ball",
     "restart_rules",
@@ -59,9 +61,25 @@ class GameStateParams(Validated):
     placement_press_m: float = setting(0.03, lo=0.0, hi=0.1)  # ... aiming this far into it
     placement_grip_m: float = setting(0.015, lo=0.001, hi=0.1)  # the ball this near the face's middle: held
     placement_rest_m_s: float = setting(0.05, lo=0.0, hi=1.0)  # let go only of a ball this slow
+    placement_held_rest_m_s: float = setting(0.15, lo=0.0, hi=1.0)  # ... or held, the robot this slow
     placement_line_m: float = setting(0.65, lo=0.5, hi=3.0)  # rule: 0.5 m off the placement's line, plus margin
     penalty_behind_m: float = setting(1.2, lo=1.0, hi=5.0)  # rule: 1 m behind the ball at a penalty, plus margin
-    penalty_aim_share: float = setting(0.7, lo=0.0, hi=1.0)  # the taker aims this share of the half goal aside
+    penalty_aim_share: float = setting(0.6, lo=0.0, hi=1.0)  # the taker aims this share of the half goal aside
+    penalty_kick_m_s: float = setting(6.2, lo=0.1, hi=6.5)  # the penalty's shot (rule: a ball over 6.5 m/s is a foul)
+    penalty_shoot_from_m: float = setting(1.5, lo=1.0, hi=10.0)  # ... from this far from the goal line, the
+    # ball tapped there first (rule: outside the 1 m deep defense area)
+    penalty_zone_m: float = setting(0.3, lo=0.0, hi=5.0)  # ... or up to this much farther
+    penalty_arrive_m_s: float = setting(0.1, lo=0.0, hi=3.0)  # ... the ball tapped there first, arriving this slow
+    penalty_tap_min_m_s: float = setting(0.5, lo=0.05, hi=6.5)  # ... tapped at least this fast
+    penalty_follow_m_s: float = setting(0.2, lo=0.0, hi=3.0)  # a tapped ball faster than this is followed, not played
+    penalty_follow_gap_m: float = setting(0.15, lo=0.0, hi=2.0)  # ... this much farther back than the waiting point
+    penalty_rest_m_s: float = setting(0.08, lo=0.0, hi=1.0)  # the shot waits for the ball slower than this
+    penalty_lined_up_rad: float = setting(0.05, lo=0.001, hi=1.0)  # the shot's line-up: heading ...
+    penalty_lined_up_m: float = setting(0.01, lo=0.001, hi=0.5)  # ... and lateral error before driving through
+    penalty_push_m_s: float = setting(0.5, lo=0.05, hi=3.0)  # ... at this speed (slower than in play: a straighter shot)
+    penalty_rush_moved_m: float = setting(0.1, lo=0.0, hi=2.0)  # their penalty: the ball this far off the mark
+    # is in play (rule: 0.05 m, plus margin), our keeper goes out to it ...
+    penalty_rush_away_m_s: float = setting(0.3, lo=0.0, hi=5.0)  # ... unless it moves away from our goal this fast
     penalty_keeper_share: float = setting(0.6, lo=0.0, hi=1.0)  # our keeper's centre this share of its radius
     # inside the goal line while the penalty is prepared (the rules: touching the line)
 
@@ -156,7 +174,10 @@ def restart_rules(intents: Mapping[int, Intent], game: GameState, ours: bool, ba
     restart is for our team."""
     out = dict(intents)
     if game.command == "stop" or (game.command in ("kickoff", "free_kick") and not ours):
-        out = keep_away(out, ball, pitch, own_sign, p, radius, game.command == "kickoff", game.command == "stop")
+        # slow in a stop (the rules) and at their kickoff (robots put in formation then cross round the
+        # ball to their places: fast, they swing in past the rules' distance)
+        out = keep_away(out, ball, pitch, own_sign, p, radius, game.command == "kickoff",
+                        game.command in ("stop", "kickoff"))  # fmt: skip
     if game.command == "kickoff" and ours:
         out = our_kickoff(out, pitch, own_sign, p, radius, kicker)
     return out
@@ -215,7 +236,8 @@ def place_ball(robot: RobotState, ball: BallState, target: tuple[float, float], 
     # that starts without the grip walks away from the ball)
     face_gap = math.hypot(ball.x - (robot.x + c * contact), ball.y - (robot.y + s * contact))
     on_face = face_gap < p.placement_grip_m or (held and face_gap < skills.dribble_hold_m)
-    resting = math.hypot(ball.vx, ball.vy) < p.placement_rest_m_s
+    # a ball on the face moves as the robot does, whose speed the cameras see only to a few cm/s
+    resting = math.hypot(ball.vx, ball.vy) < (p.placement_held_rest_m_s if on_face else p.placement_rest_m_s)
     if (off <= p.placement_done_m and resting) or (off <= p.placement_near_m and not on_face):
         away = math.atan2(robot.y - ball.y, robot.x - ball.x)
         reach = contact + p.placement_back_m
@@ -248,15 +270,53 @@ def behind_ball(intents: Mapping[int, Intent], ball: BallState, attack_sign: flo
 
 def penalty_shot(robot: RobotState, ball: BallState, attack_sign: float, keeper: RobotState | None, pitch: Field,
                  skills: SkillParams, p: GameStateParams, ready: bool) -> Intent:  # fmt: skip
-    """The taker: behind the ball facing the goal while the penalty is prepared; at the normal
-    start a shot at the side of the goal the keeper leaves open."""
+    """The taker (the rules: after the normal start the kicker may play the ball as often as it
+    likes within 10 s, the ball only ever moving toward the goal). Prepared: behind the ball facing
+    the goal's centre. Started: a tap toward the goal's centre so the ball comes to rest
+    ``penalty_shoot_from_m`` from the goal line (outside the defense area: no touching the ball in
+    it), following it at a distance while it rolls; from there, once it rests, a shot at full legal
+    speed at the side of the goal the keeper leaves open, lined up tighter than in play."""
+    goal_x = attack_sign * pitch.half_length
+    to_line = (goal_x - ball.x) * attack_sign
+    centre = math.atan2(-ball.y, goal_x - ball.x)
+    behind = skills.contact_m + skills.approach_distance_m
+    if not ready:
+        return Intent(ball.x - behind * math.cos(centre), ball.y - behind * math.sin(centre), centre)
+    # hands off while it rolls: behind it on its way, far enough back to line up afresh
+    speed = math.hypot(ball.vx, ball.vy)
+    way = math.atan2(ball.vy, ball.vx) if speed > p.penalty_rest_m_s else centre
+    follow = behind + p.penalty_follow_gap_m
+    follow_at = Intent(ball.x - follow * math.cos(way), ball.y - follow * math.sin(way), centre)
+    if to_line > p.penalty_shoot_from_m + p.penalty_zone_m:
+        if ball.vx * attack_sign > p.penalty_follow_m_s:
+            return follow_at
+        tap = pass_speed(to_line - p.penalty_shoot_from_m, skills, p.penalty_arrive_m_s, p.penalty_tap_min_m_s)
+        return kick_to(robot, ball, (goal_x, 0.0), tap, skills)
+    if speed > p.penalty_rest_m_s:
+        return follow_at  # the shot from a ball at rest: lined up, not caught up with a rolling ball
     side = -math.copysign(1.0, keeper.y) if keeper is not None and abs(keeper.y) > 1e-3 else 1.0
-    aim = (attack_sign * pitch.half_length, side * pitch.goal_half_width * p.penalty_aim_share)
-    if ready:
-        return kick_to(robot, ball, aim, skills.max_kick_m_s, skills)
-    heading = math.atan2(aim[1] - ball.y, aim[0] - ball.x)
-    wait = skills.contact_m + skills.approach_distance_m
-    return Intent(ball.x - wait * math.cos(heading), ball.y - wait * math.sin(heading), heading)
+    aim = (goal_x, side * pitch.goal_half_width * p.penalty_aim_share)
+    # lined up before driving through, not on the way (no cone that narrows toward the ball)
+    tight = dataclasses.replace(skills, lined_up_rad=p.penalty_lined_up_rad, lined_up_m=p.penalty_lined_up_m,
+                                cone_slope=0.0, cone_heading_rad_m=0.0, push_speed_m_s=p.penalty_push_m_s)
+    return kick_to(robot, ball, aim, p.penalty_kick_m_s, tight)
+
+
+def penalty_rush(robot: RobotState, ball: BallState, mark: tuple[float, float] | None, pitch: Field,
+                 own_sign: float, skills: SkillParams, defense: DefenseParams,
+                 p: GameStateParams) -> Intent | None:  # fmt: skip
+    """Our keeper at their penalty once the ball is in play (the rules: from then on it moves
+    freely): out to meet the ball where it can (:func:`intercept`) and clear it back up the field
+    before the taker shoots from close in (a shot at full speed from a few metres beats any keeper
+    on its line); None while the ball is still on the ``mark`` (``penalty_rush_moved_m``) or
+    already past the keeper's reach (moving away from our goal)."""
+    if mark is None or math.hypot(ball.x - mark[0], ball.y - mark[1]) < p.penalty_rush_moved_m:
+        return None
+    if ball.vx * own_sign < -p.penalty_rush_away_m_s:
+        return None
+    meet = intercept(robot, ball, skills, pitch)
+    intent = kick_to(robot, meet, clear_target(meet, pitch, own_sign, defense), defense.clear_kick_m_s, skills)
+    return dataclasses.replace(intent, allow_own_defense=True)
 
 
 def keeper_on_line(ball: BallState, pitch: Field, own_sign: float, skills: SkillParams,

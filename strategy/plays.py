@@ -32,6 +32,7 @@ from strategy.game_states import (
     keep_off_line,
     keeper_on_line,
     own_goal_sign,
+    penalty_rush,
     penalty_shot,
     place_ball,
     restart_rules,
@@ -133,7 +134,7 @@ class Strategy:
         if game.command == "ball_placement" and game.placement is not None:
             return self._placement(intents, own, ball, game.placement, ours, own_sign)
         if game.command == "penalty":
-            return self._penalty(intents, own, opp, ball, game.ready, ours, own_sign)
+            return self._penalty(intents, own, opp, ball, game, ours, own_sign)
         kicker = next((rid for rid, role in self.roles.roles.items() if role == ATTACKER), None)
         if game.command == "kickoff" and not game.ready:
             kicker = None  # prepared, not started: nobody plays the ball yet
@@ -161,10 +162,12 @@ class Strategy:
         return out
 
     def _penalty(self, intents: dict[int, Intent], own: Mapping[int, RobotState], opp: list[RobotState],
-                 ball: BallState, ready: bool, ours: bool, own_sign: float) -> dict[int, Intent]:  # fmt: skip
-        """A penalty kick: ours, the taker shoots at the normal start, everyone else behind the
-        ball; theirs, our keeper on its line until the normal start, everyone else behind the ball."""
+                 ball: BallState, game: GameState, ours: bool, own_sign: float) -> dict[int, Intent]:  # fmt: skip
+        """A penalty kick: ours, the taker plays it from the normal start (:func:`penalty_shot`),
+        everyone else behind the ball; theirs, our keeper on its line until the normal start, then
+        out at the ball once it is in play (:func:`penalty_rush`), everyone else behind the ball."""
         p, f, gs = self.p, self.field, self.p.game_states
+        ready = game.ready
         goalie_id = self._role_robot(GOALIE)
         if ours:
             attack = -own_sign
@@ -177,8 +180,11 @@ class Strategy:
             return out
         out = behind_ball({rid: it for rid, it in intents.items() if rid != goalie_id}, ball, own_sign, f, gs,
                           p.robot_radius_m)  # fmt: skip
-        if goalie_id is not None:
-            out[goalie_id] = intents[goalie_id] if ready else keeper_on_line(ball, f, own_sign, p.skills, gs)
+        if goalie_id is not None and not ready:
+            out[goalie_id] = keeper_on_line(ball, f, own_sign, p.skills, gs)
+        elif goalie_id is not None:
+            rush = penalty_rush(own[goalie_id], ball, game.placement, f, own_sign, p.skills, p.defense, gs)
+            out[goalie_id] = intents[goalie_id] if rush is None else rush
         return out
 
     def _objectives(self, own: Mapping[int, RobotState], ball: BallState, own_sign: float,

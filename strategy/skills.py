@@ -182,13 +182,16 @@ def speed_after(speed: float, distance: float, p: SkillParams) -> float:
     return math.sqrt(max(v_roll**2 - 2 * p.acc_roll_m_s2 * (distance - slide), 0.0))
 
 
-def pass_speed(distance: float, p: SkillParams) -> float:
-    """Kick speed so the ball arrives at ``distance`` with about ``pass_arrival_m_s`` (bisection)."""
+def pass_speed(distance: float, p: SkillParams, arrival_m_s: float | None = None,
+               min_m_s: float | None = None) -> float:  # fmt: skip
+    """Kick speed so the ball arrives at ``distance`` with about ``arrival_m_s`` (default
+    ``pass_arrival_m_s``; bisection), between ``min_m_s`` (default ``pass_min_m_s``) and ``pass_max_m_s``."""
+    arrival = p.pass_arrival_m_s if arrival_m_s is None else arrival_m_s
     lo, hi = 0.0, p.pass_max_m_s
     for _ in range(_BISECTIONS):
         mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if speed_after(mid, distance, p) < p.pass_arrival_m_s else (lo, mid)
-    return min(max(hi, p.pass_min_m_s), p.pass_max_m_s)
+        lo, hi = (mid, hi) if speed_after(mid, distance, p) < arrival else (lo, mid)
+    return min(max(hi, p.pass_min_m_s if min_m_s is None else min_m_s), p.pass_max_m_s)
 
 
 def intercept(robot: RobotState, ball: BallState, p: SkillParams, field: Field | None = None) -> BallState:

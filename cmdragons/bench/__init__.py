@@ -49,7 +49,7 @@ SUITES: dict[str, Suite] = {
 }
 # the options each suite takes
 OPTIONS: dict[str, tuple[str, ...]] = {"grid": ("maps",), "navigation": ("figures",),
-                                       "play": ("opponent", "matches", "half")}
+                                       "play": ("opponent", "matches", "half", "shootout")}
 
 
 TABLE_WIDTH = 100  # columns: a bench table fits a standard terminal

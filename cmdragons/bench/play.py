@@ -142,9 +142,10 @@ def _brain_cycle(settings: Settings, division: str, seconds: float) -> dict[str,
 
 
 def run(settings: Settings, quick: bool, opponent: str | None = None, matches: int | None = None,
-        half: float | None = None) -> list[dict[str, Any]]:
+        half: float | None = None, shootout: int | None = None) -> list[dict[str, Any]]:
     """The suite's rows. ``opponent``: "simple" (default) or "self" (our team in the other colour:
-    the matches and their fouls only); ``matches``, ``half``: how many and how long (seconds)."""
+    the matches and their fouls only); ``matches``, ``half``: how many and how long (seconds);
+    ``shootout``: the shootout's kicks each way (default ``SHOOTOUT_KICKS``, quick 3; 0: none)."""
     opponent = opponent or "simple"
     seeds = list(range(1, (matches or (2 if quick else 10)) + 1))
     half = half or (30.0 if quick else settings.sim.referee.figures.half_s)
@@ -179,8 +180,10 @@ def run(settings: Settings, quick: bool, opponent: str | None = None, matches: i
     })  # fmt: skip
     if opponent == "self":
         return rows
-    print("bench play: penalty shootout ...", file=sys.stderr, flush=True)
-    rows.append(_shootout_row(settings, 3 if quick else SHOOTOUT_KICKS, seeds[0]))
+    kicks = (3 if quick else SHOOTOUT_KICKS) if shootout is None else shootout
+    if kicks:
+        print("bench play: penalty shootout ...", file=sys.stderr, flush=True)
+        rows.append(_shootout_row(settings, kicks, seeds[0]))
     rows.append(_brain_cycle(settings, "B", 10.0 if quick else 30.0))
     rows.append(_brain_cycle(settings, "A", 10.0 if quick else 30.0))
     return rows

@@ -290,6 +290,17 @@ class BallFilter:
     def velocity(self) -> Vec:
         return cast(Vec, self.kf.x[2:])
 
+    def hold(self, x: float, y: float, vx: float, vy: float, sigma_m: float) -> None:
+        """The ball in a robot's mouth, out of the cameras' sight: where the robot carries it (field
+        frame, m and m/s), its position known to ``sigma_m``, its velocity the robot's; a new slide
+        starts when it leaves."""
+        self.kf.x[:] = (x, y, vx, vy)
+        self.kf.P[:] = 0.0
+        self.kf.P[0, 0] = self.kf.P[1, 1] = sigma_m * sigma_m
+        self.kf.P[2, 2] = self.kf.P[3, 3] = self.p.kick_speed_sigma_m_s**2
+        self.slide_start_speed = math.inf
+        self.held = None
+
 
 def _wrap(a: float) -> float:
     return (a + math.pi) % (2.0 * math.pi) - math.pi

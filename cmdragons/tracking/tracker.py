@@ -46,6 +46,13 @@ class TrackerParams(Validated):
     ball_hypotheses: int = setting(4, lo=1, hi=32)  # kept at once, at most
     ball_confirm_detections: int = setting(2, lo=1, hi=100)
     ball_timeout_s: float = setting(1.0, lo=0.0, hi=60.0)  # unseen this long: hypothesis dropped
+    # a ball lost from sight this near the middle of a robot's front (ball centre to where it would
+    # lie on the dribbler) is in the robot's mouth, hidden by it: carried with the robot, unseen ...
+    ball_held_m: float = setting(0.04, lo=0.0, hi=0.5)
+    ball_held_timeout_s: float = setting(30.0, lo=0.0, hi=600.0)  # ... for at most this long
+    # where a held ball lies: the robot's front and the ball's radius, configured once in field.yaml
+    robot_front_m: float = derived("field.robot.front_distance_m", 0.07, lo=0.0, hi=1.0)
+    ball_radius_m: float = derived("field.ball.radius_m", 0.0215, lo=0.0, hi=0.5)
     robot_gate_chi2: float = setting(60.0, lo=1.0, hi=1e6)  # Mahalanobis^2 (3 dof) for a detection
     robot_reinit_detections: int = setting(3, lo=1, hi=1000)  # consistent rejected detections -> restart
     robot_reinit_spread_m: float = setting(0.05, lo=0.0, hi=5.0)  # ... within this of each other
@@ -84,6 +91,8 @@ class _BallTrack:
     born: float
     hits: int = 1
     last_seen: float = 0.0
+    holder: tuple[Team, int] | None = None  # the robot whose mouth hides the ball from the cameras
+    held_since: float = math.nan
 
 
 class Tracker:
@@ -142,6 +151,7 @@ class Tracker:
         for track in self.robots.values():
             if track.last_seen != self.t:
                 track.filter.miss()
+        self._carry_held_balls()
         self._drop_stale()
         return self.world_state(self.t + (self.p.latency_s if ahead_s is None else ahead_s))
 
@@ -257,14 +267,47 @@ class Tracker:
             self.balls.sort(key=self._ball_rank, reverse=True)
             del self.balls[self.p.ball_hypotheses :]
 
+    def _carry_held_balls(self) -> None:
+        """A ball in a robot's mouth (within ``ball_held_m`` of where the dribbler holds it) and lost
+        from sight there is hidden by that robot, not lost: it goes where the robot carries it, with
+        the robot's velocity, until it is seen again off the robot's face (or ``ball_held_timeout_s``)."""
+        t = self.t
+        front = self.p.robot_front_m + self.p.ball_radius_m
+        for ball in self.balls:
+            bx, by = ball.filter.position.tolist()
+            seen = ball.last_seen == t
+            robot = self.robots.get(ball.holder) if ball.holder is not None else None
+            if robot is not None:
+                x, y, theta = robot.filter.kf.x[:3].tolist()
+                if math.hypot(bx - x - front * math.cos(theta), by - y - front * math.sin(theta)) > self.p.ball_held_m:
+                    robot = None  # off the face: no longer held (let go, kicked, or taken off it)
+            if robot is None:
+                ball.holder = None
+                best = self.p.ball_held_m
+                for key, track in self.robots.items():
+                    x, y, theta = track.filter.kf.x[:3].tolist()
+                    gap = math.hypot(bx - x - front * math.cos(theta), by - y - front * math.sin(theta))
+                    if gap < best:
+                        best, ball.holder, robot = gap, key, track
+                if robot is None:
+                    continue
+                ball.held_since = t
+            if not seen:
+                x, y, theta, vx, vy = robot.filter.kf.x[:5].tolist()
+                ball.filter.hold(x + front * math.cos(theta), y + front * math.sin(theta), vx, vy, self.p.ball_held_m)
+
     def _ball_rank(self, track: _BallTrack) -> tuple[bool, float, int]:
         confirmed = track.hits >= self.p.ball_confirm_detections
+        # a ball seen since beats one hidden in a robot's mouth (the referee moved it, or the robot let it go unseen)
         return (confirmed, track.last_seen, track.hits)
+
+    def _held(self, ball: _BallTrack) -> bool:
+        return ball.holder is not None and self.t - ball.held_since <= self.p.ball_held_timeout_s
 
     def _drop_stale(self) -> None:
         t = self.t
         self.robots = {k: r for k, r in self.robots.items() if t - r.last_seen <= self.p.robot_timeout_s}
-        self.balls = [b for b in self.balls if t - b.last_seen <= self.p.ball_timeout_s]
+        self.balls = [b for b in self.balls if t - b.last_seen <= self.p.ball_timeout_s or self._held(b)]
 
     # --- output -------------------------------------------------------------------------------
     def best_ball(self) -> _BallTrack | None:

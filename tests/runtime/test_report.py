@@ -28,8 +28,9 @@ from cmdragons.runtime.settings import load_settings
 from cmdragons.runtime.stages import LoggerStage
 
 
-def write_log(path: Path, frames: int, ball_visible_every: int, robot_1_visible: bool) -> None:
-    """A play log as the match's bus writes it."""
+def write_log(path: Path, frames: int, ball_visible_every: int, robot_1_visible: bool, hidden: bool = False) -> None:
+    """A play log as the match's bus writes it; the ball unseen in all but every ``ball_visible_every``-th
+    frame: lost (no ball in the world state) or, ``hidden``, tracked unseen (in a robot's mouth)."""
     with RunLog(path) as log:
         for i in range(frames):
             t = i / 60
@@ -40,7 +41,8 @@ def write_log(path: Path, frames: int, ball_visible_every: int, robot_1_visible:
             log.write("/referee", t, GameState(t, score_blue=int(i > frames // 2)))
             seen = (RobotState("blue", 0, -1.0, 0.0, 0.0),) + ((RobotState("blue", 1, 0.0, 0.0, 0.0),)
                                                                if robot_1_visible else ())  # fmt: skip
-            ball = BallState(0.0, 0.0, 0.0, 0.0, visible=i % ball_visible_every == 0)
+            visible = i % ball_visible_every == 0
+            ball = BallState(0.0, 0.0, 0.0, 0.0, visible=visible) if visible or hidden else None
             log.write("/world/blue", t, WorldState(t, ball, seen, i))
             log.write("/report/blue", t, TeamReport("blue", i, t, actions={0: "shot"}))
             kicks = (Kick(t, "blue", 0, 3.0, False),) if i == 30 else ()
@@ -56,11 +58,19 @@ def test_ball_seldom_and_a_robot_never_seen_are_warned(tmp_path: Path) -> None:
     assert run.possession[0] == "blue" and run.kicks[0]["action"] == "shot"
     summary = {"perception": "vision", "command_faults": {"clamped": 1}, "realtime_factor": 0.8}
     warnings = run_warnings(run, summary)
-    assert any("ball seldom (25 % of the frames)" in w for w in warnings)
+    assert any("ball seldom (25 % of the frames) (seen in 25 %)" in w for w in warnings)
     assert any("robot 1 never" in w for w in warnings)
     assert not any("robot 0" in w for w in warnings)
     assert any(w.startswith("1 command was clamped") for w in warnings)
     assert any("slower than real time (0.8x" in w for w in warnings)
+
+
+def test_a_ball_hidden_in_a_robots_mouth_is_no_warning(tmp_path: Path) -> None:
+    write_log(tmp_path / "run.mcap", 120, ball_visible_every=4, robot_1_visible=True, hidden=True)
+    run = load_run(tmp_path / "run.mcap")
+    assert run.ball_seen == pytest.approx(0.25) and run.ball_tracked == 1.0
+    summary = {"perception": "vision", "command_faults": {"clamped": 0}, "realtime_factor": 1.5}
+    assert run_warnings(run, summary) == []
 
 
 def test_a_clean_run_has_no_warning(tmp_path: Path) -> None:
@@ -97,5 +107,5 @@ def test_the_report_stage_gathers_what_the_log_reads_back(tmp_path: Path) -> Non
         np.testing.assert_array_equal(trace, back.traces[key])
     assert (live.possession, live.kicks, live.goals, live.score_t) == (back.possession, back.kicks, back.goals,
                                                                        back.score_t)  # fmt: skip
-    assert (live.ball_seen, live.robot_seen) == (back.ball_seen, back.robot_seen)
+    assert (live.ball_seen, live.ball_tracked, live.robot_seen) == (back.ball_seen, back.ball_tracked, back.robot_seen)
     assert live.kicks  # the match kicked: the comparison covers the kick events

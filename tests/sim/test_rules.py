@@ -369,3 +369,56 @@ def test_no_shootout_after_a_match_decided_or_unconfigured() -> None:
             ref.score["blue"] = 1  # decided: no shootout even when configured
         calls = play(w, ref, 2.5)
         assert "stage_penalty_shootout" not in kinds(calls) and ref.stage == "post_game"
+
+
+def test_a_penalty_waits_for_a_ball_at_rest_and_ends_when_the_ball_turns_back() -> None:
+    # the rules: the kicker may play the ball again and again for 10 s, the ball only ever moving
+    # toward the goal; a keeper turning it back ends the kick
+    w, ref = scene(prepare_timeout_s=0.5, penalty_time_s=5.0)
+    w.apply(ref.start_penalty("blue"))
+    mark = ref.penalty.mark if ref.penalty else (0.0, 0.0)
+    calls = play(w, ref, 1.0)
+    assert ref.ready
+    w.place_ball(mark[0] + 0.5, mark[1])  # played forward, now at rest: still the kicker's
+    calls += play(w, ref, 1.0)
+    assert ref.command == "penalty" and "penalty_over" not in kinds(calls)
+    w.place_ball(mark[0] + 0.5, mark[1], vx=-1.0)  # turned back toward the kicker's half
+    calls += play(w, ref, 0.2)
+    assert "penalty_over" in kinds(calls)
+
+
+def test_the_ball_is_not_put_into_a_robot_on_the_penalty_mark() -> None:
+    w, ref = scene()
+    mark = (w.field.half_length - ref.rules.penalty_mark_from_goal_m, 0.0)  # blue attacks +x
+    w.place_robot("yellow", 1, mark[0] + 0.02, mark[1] + 0.01, 0.0)  # standing on the mark
+    play(w, ref, 0.1)
+    teleport = ref.start_penalty("blue")
+    w.apply(teleport)
+    play(w, ref, 0.5)
+    truth = w.ground_truth()
+    assert math.hypot(truth.ball.x - mark[0], truth.ball.y - mark[1]) < 0.01  # the ball lies on the mark
+    assert all(math.hypot(r.x - mark[0], r.y - mark[1]) >= R + LEAGUE.ball.radius_m for r in truth.robots)
+
+
+def test_a_shootout_kick_has_only_the_kicker_and_the_other_keeper_on_the_field() -> None:
+    # the rules: one attacker and the keeper per team; during an attempt only the kicker and the
+    # other team's keeper move: the robot handlers take the others off and put these two in place
+    w, ref = scene(blue=4, yellow=3, half_s=1.0, half_time_s=0.0, shootout_kicks=1, shootout_always=True,
+                   prepare_timeout_s=0.5, penalty_time_s=1.0)  # fmt: skip
+    seen = []
+
+    def look(k: int) -> list[RobotCommand]:
+        pen = ref.penalty
+        if pen is not None and (not seen or seen[-1][0] != pen.team):
+            truth = w.ground_truth()
+            on = sorted((r.team, r.id) for r in truth.robots if w.field.in_field(r.x, r.y))
+            seen.append((pen.team, on, (truth.ball.x, truth.ball.y), pen.mark))
+        return []
+
+    play(w, ref, 2.0 + 2 * (1.0 + 0.5 + 1.0) + 1.0, look)
+    assert [s[0] for s in seen] == ["yellow", "blue"]
+    assert seen[0][1] == [("blue", 0), ("yellow", 1)]  # blue's keeper, yellow's kicker (the lowest field id)
+    assert seen[1][1] == [("blue", 1), ("yellow", 0)]
+    for _, _, ball, mark in seen:
+        assert math.hypot(ball[0] - mark[0], ball[1] - mark[1]) < 0.01
+    assert ref.stage == "post_game"

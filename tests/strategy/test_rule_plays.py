@@ -1,7 +1,8 @@
 """Our team under the full rules, in the simulator with the referee judging every frame: ball
 placement in the rules' time and tolerance from thirteen scenes (by the lines, in a corner, out of
 a defense area, the target behind the robot, an opponent by the ball or the target), a penalty scored against a still
-keeper, our keeper stopping a penalty kicked at its body, and a 30 s stop kept at the rules' speed
+keeper and against the simple opponent's keeper, our keeper stopping a penalty kicked at its body and
+saving the simple opponent's, and a 30 s stop kept at the rules' speed
 and distance every frame. The brain plays on the true state (no cameras) through its own planning,
 control and safety."""
 
@@ -19,6 +20,7 @@ from cmdragons.runtime.settings import load_settings
 from cmdragons.team import Brain
 from sim.referee import Referee
 from sim.world import World
+from strategy.simple import SimpleTeam
 
 SETTINGS = load_settings(Path(__file__).resolve().parents[2] / "configs")
 RULES = SETTINGS.sim.referee.figures
@@ -39,7 +41,8 @@ def scene(blue: int, yellow: int) -> tuple[World, Referee, Brain]:
 def play(w: World, ref: Referee, brain: Brain, seconds: float,
          theirs: Callable[[int], list[RobotCommand]] | None = None,
          until: Callable[[list[GameEvent]], bool] | None = None,
-         each: Callable[[World, Referee], None] | None = None) -> list[GameEvent]:  # fmt: skip
+         each: Callable[[World, Referee], None] | None = None,
+         opponent: Callable[[World, Referee, WorldState], list[RobotCommand]] | None = None) -> list[GameEvent]:  # fmt: skip
     calls: list[GameEvent] = []
     for k in range(round(seconds * 60)):
         truth = w.ground_truth()
@@ -48,6 +51,7 @@ def play(w: World, ref: Referee, brain: Brain, seconds: float,
             RobotState(r.team, r.id, r.x, r.y, r.theta, r.vx, r.vy, r.omega) for r in truth.robots
             if w.field.in_field(r.x, r.y, -w.field.dims.boundary_width_m)), truth.frame_number)  # fmt: skip
         commands = brain.step(world, ref.state()) + (theirs(k) if theirs else [])
+        commands += opponent(w, ref, world) if opponent else []
         events = w.step_frame(commands)
         teleport = ref.observe(w.t, events, tuple(w.ball_body.position), w.ground_truth())
         calls += ref.new_events
@@ -123,6 +127,34 @@ def test_our_keeper_stops_a_penalty_kicked_at_its_body() -> None:
     assert ref.score["yellow"] == 0, [e.kind for e in calls]
     assert any(e.kind == "penalty_over" for e in calls)
     assert any(e.kind for e in calls) and ref.kicks >= 1
+
+
+def simple_opponent() -> Callable[[World, Referee, WorldState], list[RobotCommand]]:
+    team = SimpleTeam("yellow", SETTINGS.field_geometry(), SETTINGS.team.simple_opponent, SETTINGS.strategy)
+    return lambda w, ref, world: team.commands(world, ref.state())
+
+
+@pytest.mark.parametrize("keeper_y", [0.0, 0.2, -0.2])
+def test_our_penalty_beats_the_simple_opponents_keeper(keeper_y: float) -> None:
+    # the keeper blocks on the ball's line (it saves any shot from the mark); the taker plays the
+    # ball up first, then shoots at the side the keeper leaves open
+    w, ref, brain = scene(blue=2, yellow=1)
+    w.place_robot("yellow", 0, w.field.half_length - 0.5 * R, keeper_y, math.pi)
+    w.apply(ref.start_penalty("blue"))
+    calls = play(w, ref, brain, RULES.prepare_timeout_s + RULES.penalty_time_s, opponent=simple_opponent(),
+                 until=lambda c: ref.score["blue"] > 0 or any(e.kind == "penalty_over" for e in c))  # fmt: skip
+    assert ref.penalties["blue"] == {"taken": 1, "scored": 1}, [e.kind for e in calls]
+    assert not [e for e in calls if e.team == "blue" and e.kind != "penalty_over"]  # no foul of ours
+
+
+def test_our_keeper_saves_the_simple_opponents_penalty() -> None:
+    w, ref, brain = scene(blue=2, yellow=2)
+    w.apply(ref.start_penalty("yellow"))
+    calls = play(w, ref, brain, RULES.prepare_timeout_s + RULES.penalty_time_s, opponent=simple_opponent(),
+                 until=lambda c: ref.score["yellow"] > 0 or any(e.kind == "penalty_over" for e in c))  # fmt: skip
+    assert ref.penalties["yellow"] == {"taken": 1, "scored": 0}, [e.kind for e in calls]
+    assert any(e.kind == "penalty_over" for e in calls)
+    assert not [e for e in calls if e.team == "blue" and e.kind != "penalty_over"]  # no foul of ours
 
 
 def test_stop_keeps_every_robot_away_from_the_ball_and_slow_every_frame() -> None:

@@ -386,3 +386,53 @@ def test_two_cameras_that_disagree_a_little_show_no_kick() -> None:
         if k >= 30:
             assert ws.ball is not None and abs(ws.ball.x - x - 0.0006) < 0.001
     assert tracker.stats.ball_kicks == kicks
+
+
+@pytest.mark.parametrize("on_face", [True, False])
+def test_a_ball_hidden_in_a_robots_mouth_is_carried_not_lost(on_face: bool) -> None:
+    # the ball on the dribbler goes out of the cameras' sight (the robot's body hides it) while the
+    # robot carries it 1 m: tracked at the robot's front, unseen; a ball lost away from any robot's
+    # face is dropped after the timeout as before
+    w = make_world()
+    w.place_robot("blue", 0, 0.0, 0.0, 0.0)
+    w.place_ball(FRONT + 0.003 if on_face else 0.5, 0.0 if on_face else 0.4)
+    p = params()
+    tracker = Tracker(p)
+    rng = np.random.default_rng(5)
+    carry = [RobotCommand("blue", 0, vx=0.5, dribbler=1.0)]
+    for _ in range(30):  # the ball on the dribbler, seen
+        tracker.step([detect(w.snapshot(), rng)])
+        w.step_frame([RobotCommand("blue", 0, dribbler=1.0)])
+    worst = 0.0
+    for _ in range(round(2.0 / DT)):  # carried 1 m, never seen
+        w.step_frame(carry if on_face else [])
+        snap = w.snapshot()
+        ws = tracker.step([detect(snap, rng, ball=False)])
+        if on_face:
+            assert ws.ball is not None and not ws.ball.visible
+            worst = max(worst, ball_error(ws, snap)[0])
+    if on_face:
+        assert snap.ball[0] > 0.8  # it did travel
+        assert worst < 0.03
+    else:
+        assert ws.ball is None  # lost for 2 s > ball_timeout_s
+
+
+def test_a_ball_seen_elsewhere_beats_one_hidden_in_a_robots_mouth() -> None:
+    # the referee puts the ball on a spot while the tracker has it hidden in a robot's mouth: the
+    # ball seen there is the ball from its confirming detections on
+    w = make_world()
+    w.place_robot("blue", 0, 0.0, 0.0, 0.0)
+    w.place_ball(FRONT + 0.003, 0.0)
+    p = params()
+    tracker = Tracker(p)
+    rng = np.random.default_rng(6)
+    for k in range(60):  # seen on the dribbler, then hidden there
+        tracker.step([detect(w.snapshot(), rng, ball=k < 30)])
+        w.step_frame([RobotCommand("blue", 0, dribbler=1.0)])
+    w.place_ball(2.0, 1.0)
+    for _ in range(p.ball_confirm_detections + 1):
+        w.step_frame()
+        ws = tracker.step([detect(w.snapshot(), rng)])
+    assert ws.ball is not None and ws.ball.visible
+    assert math.hypot(ws.ball.x - 2.0, ws.ball.y - 1.0) < 0.02

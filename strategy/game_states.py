@@ -76,7 +76,8 @@ class GameStateParams(Validated):
     penalty_rest_m_s: float = setting(0.08, lo=0.0, hi=1.0)  # the shot waits for the ball slower than this
     penalty_lined_up_rad: float = setting(0.05, lo=0.001, hi=1.0)  # the shot's line-up: heading ...
     penalty_lined_up_m: float = setting(0.01, lo=0.001, hi=0.5)  # ... and lateral error before driving through
-    penalty_push_m_s: float = setting(0.5, lo=0.05, hi=3.0)  # ... at this speed (slower than in play: a straighter shot)
+    # ... at this speed (slower than in play: a straighter shot)
+    penalty_push_m_s: float = setting(0.5, lo=0.05, hi=3.0)
     penalty_rush_moved_m: float = setting(0.1, lo=0.0, hi=2.0)  # their penalty: the ball this far off the mark
     # is in play (rule: 0.05 m, plus margin), our keeper goes out to it ...
     penalty_rush_away_m_s: float = setting(0.3, lo=0.0, hi=5.0)  # ... unless it moves away from our goal this fast

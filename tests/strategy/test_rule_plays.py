@@ -42,7 +42,8 @@ def play(w: World, ref: Referee, brain: Brain, seconds: float,
          theirs: Callable[[int], list[RobotCommand]] | None = None,
          until: Callable[[list[GameEvent]], bool] | None = None,
          each: Callable[[World, Referee], None] | None = None,
-         opponent: Callable[[World, Referee, WorldState], list[RobotCommand]] | None = None) -> list[GameEvent]:  # fmt: skip
+         opponent: Callable[[World, Referee, WorldState], list[RobotCommand]] | None = None,
+         ) -> list[GameEvent]:  # fmt: skip
     calls: list[GameEvent] = []
     for k in range(round(seconds * 60)):
         truth = w.ground_truth()

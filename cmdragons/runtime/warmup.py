@@ -3,7 +3,8 @@
 numba compiles a kernel on its first call and caches the machine code in the package's
 ``__pycache__`` (``cache=True``); a fresh clone has no cache, and a match would stall on its first
 frames for the better part of a minute without a word. :func:`warm_up` compiles the kernels a
-``play`` calls before the match starts, in four processes at once (the compile is single-threaded):
+``play`` calls before the match starts, in four processes at once (the compile is single-threaded;
+the three children are forked from the play's process, with its modules and settings):
 the planner's and the collision world's in a child that solves a few throwaway queries; motion
 control's, the safety stage's and strategy's in a child that drives a throwaway crowd of robots;
 the renderer's in a child that renders one throwaway frame; and vision's in this process on the

@@ -118,6 +118,9 @@ def ours(method: str, run: Run) -> Trace:
         f = ParticleLocalisation(run.landmarks, x0, START_COV, run.sensor_cov, n=PARTICLES, seed=SEED)
 
     def step(k: int) -> None:
+        if isinstance(f, ParticleLocalisation):  # its estimate is part of its step, as the toolbox's
+            f.step(run.odometry[k], run.odometry_cov, run.sightings[k])
+            return
         f.predict(run.odometry[k], run.odometry_cov)
         f.update(run.sightings[k])
 

@@ -2,7 +2,8 @@
 the Mars lander, EKF localisation against known landmarks, EKF-SLAM, and a particle filter.
 
 filterpy carries the Kalman algebra (``KalmanFilter``, ``ExtendedKalmanFilter``); the models, their
-Jacobians and the particle filter are ours (:mod:`cmdragons.estimation.models`). Every filter also
+Jacobians and the particle filter are ours (:mod:`cmdragons.estimation.models`; the particle
+filter's step runs in the numba kernels of :mod:`cmdragons.estimation._kernels`). Every filter also
 reports its consistency: the NEES (normalised estimation error squared) of its estimate against a
 truth, which for a consistent filter follows a chi-square distribution with the state's degrees of
 freedom.
@@ -17,6 +18,7 @@ import numpy as np
 from filterpy.kalman import ExtendedKalmanFilter, KalmanFilter
 from numpy.typing import ArrayLike, NDArray
 
+from cmdragons.estimation import _kernels as K
 from cmdragons.estimation.models import (
     compose,
     compose_jacobians,
@@ -44,6 +46,8 @@ __all__ = [
 ]
 
 FloatArray = NDArray[np.float64]
+
+_ZIGGURAT = K.ziggurat_tables()  # the particle filter's normal deviates' layer tables
 
 
 def nees(error: ArrayLike, cov: ArrayLike) -> float:
@@ -296,7 +300,11 @@ class ParticleLocalisation:
     of the cloud's covariance before resampling, scaled by ``bandwidth_share`` of the bandwidth that
     is optimal for a Gaussian density, (4 / (n (d + 2)))^(1 / (d + 4)). Without it a sharp sighting
     leaves a few distinct poses copied many times, whose spread understates the error (the filter
-    reads overconfident: mean NEES about 3.6 for 3 at 500 particles on the bench's run)."""
+    reads overconfident: mean NEES about 3.6 for 3 at 500 particles on the bench's run).
+
+    The work is done by the numba kernels of :mod:`cmdragons.estimation._kernels`: :meth:`step`
+    (predict, update and estimate in one call) or :meth:`predict` and :meth:`update` apart. Their
+    noise comes from a random stream of the filter's own, seeded from ``seed``'s generator."""
 
     def __init__(self, landmarks: ArrayLike, start: ArrayLike, start_cov: ArrayLike, sensor_cov: ArrayLike,
                  n: int = 500, seed: int = 0, bandwidth_share: float = 0.6) -> None:  # fmt: skip
@@ -309,53 +317,54 @@ class ParticleLocalisation:
                                                       np.asarray(start_cov, dtype=np.float64), size=n)  # fmt: skip
         self.weights = np.full(n, 1.0 / n)
         self.R_inv = np.linalg.inv(np.asarray(sensor_cov, dtype=np.float64))
+        self.stream = K.seed_stream(self.rng)
+        d = self.particles.shape[1]
+        self.bandwidth = bandwidth_share * (4.0 / (n * (d + 2))) ** (1.0 / (d + 4))
+        self._scratch = np.empty_like(self.particles)
+        self._mean, self._cov = np.empty(3), np.empty((3, 3))
+        self._estimated = False
+
+    def _seen(self, sightings: list[Sighting]) -> FloatArray:
+        """The sightings as the kernels take them: rows (landmark x, y, range, bearing)."""
+        seen = np.empty((len(sightings), 4))
+        for i, sgt in enumerate(sightings):
+            seen[i, :2] = self.landmarks[sgt.landmark]
+            seen[i, 2:] = sgt.z
+        return seen
 
     def predict(self, odometry: ArrayLike, odometry_cov: ArrayLike) -> None:
-        u = np.asarray(odometry, dtype=np.float64)
-        noisy = self.rng.multivariate_normal(u, np.asarray(odometry_cov, dtype=np.float64), size=len(self.particles))
-        p = self.particles
-        c, s = np.cos(p[:, 2]), np.sin(p[:, 2])
-        p[:, 0] += c * noisy[:, 0] - s * noisy[:, 1]
-        p[:, 1] += s * noisy[:, 0] + c * noisy[:, 1]
-        p[:, 2] = wrap_angle(p[:, 2] + noisy[:, 2])
+        low = K.psd_factor(np.asarray(odometry_cov, dtype=np.float64))
+        K.move(self.particles, np.asarray(odometry, dtype=np.float64), low, self.stream, *_ZIGGURAT)
+        self._estimated = False
 
     def update(self, sightings: list[Sighting]) -> None:
-        if not sightings:
-            return
-        p = self.particles
-        log_w = np.log(np.maximum(self.weights, 1e-300))
-        for sgt in sightings:
-            lx, ly = self.landmarks[sgt.landmark]
-            dx, dy = lx - p[:, 0], ly - p[:, 1]
-            r = np.hypot(dx, dy)
-            b = np.arctan2(dy, dx) - p[:, 2]
-            e = np.stack([sgt.z[0] - r, wrap_angle(sgt.z[1] - b)], axis=1)
-            log_w -= 0.5 * np.einsum("ni,ij,nj->n", e, self.R_inv, e)
-        log_w -= log_w.max()
-        w = np.exp(log_w)
-        self.weights = w / w.sum()
-        if 1.0 / np.sum(self.weights**2) < 0.5 * len(p):
-            self._resample()
+        K.correct(self.particles, self.weights, self._seen(sightings), self.R_inv, self.bandwidth, self.stream,
+                  *_ZIGGURAT, self._scratch)  # fmt: skip
+        self._estimated = False
 
-    def _resample(self) -> None:
-        n, d = self.particles.shape
-        _, cov = particle_estimate(self.particles, self.weights)
-        positions = (self.rng.random() + np.arange(n)) / n
-        idx = np.searchsorted(np.cumsum(self.weights), positions)
-        self.particles = self.particles[np.minimum(idx, n - 1)]
-        self.weights = np.full(n, 1.0 / n)
-        if self.bandwidth_share > 0.0:
-            h = self.bandwidth_share * (4.0 / (n * (d + 2))) ** (1.0 / (d + 4))
-            self.particles += self.rng.multivariate_normal(np.zeros(d), h * h * cov, size=n)
-            self.particles[:, 2] = wrap_angle(self.particles[:, 2])
+    def step(self, odometry: ArrayLike, odometry_cov: ArrayLike, sightings: list[Sighting]) -> None:
+        """:meth:`predict` then :meth:`update`, and the estimate, in one kernel call."""
+        K.particle_step(self.particles, self.weights, np.asarray(odometry, dtype=np.float64),
+                        np.asarray(odometry_cov, dtype=np.float64), self._seen(sightings), self.R_inv,
+                        self.bandwidth, self.stream, *_ZIGGURAT, self._scratch, self._mean, self._cov)  # fmt: skip
+        self._estimated = True
+
+    def _estimate(self) -> None:
+        if not self._estimated:
+            K.cloud_estimate(self.particles, self.weights, self._mean, self._cov)
+            self._estimated = True
 
     @property
     def pose(self) -> FloatArray:
-        return particle_estimate(self.particles, self.weights)[0]
+        """The cloud's weighted mean pose (the heading's circular mean)."""
+        self._estimate()
+        return self._mean.copy()
 
     @property
     def cov(self) -> FloatArray:
-        return particle_estimate(self.particles, self.weights)[1]
+        """The cloud's weighted covariance about :attr:`pose` (heading differences wrapped)."""
+        self._estimate()
+        return self._cov.copy()
 
     def nees(self, truth: ArrayLike) -> float:
         return nees(pose_error(self.pose, truth), self.cov)

@@ -14,7 +14,8 @@ particles from the same start distribution.
 
 Per method and implementation: the RMS position error over the run (m), the mean pose NEES (3 for a
 consistent filter), the fraction of steps whose NEES lies inside its chi-square (3 degrees of
-freedom) 95% interval, the median time of one step (predict and update, µs), and on our rows the
+freedom) 95% interval, the median time of one step (predict and update, µs; the particle filters'
+with their estimate, which the toolbox's step computes), and on our rows the
 ratio of our RMS error to the toolbox's (target <= ``TARGET_ERROR_RATIO``) and how many times
 faster our step is. The toolbox's step includes the replay of the run (a list look-up). The
 particle filters' NEES uses the covariance of the particle cloud; the toolbox's state noise is

@@ -2,9 +2,12 @@
 one step (move, weigh, resample and regularise, estimate) in one call, with its own random stream.
 
 Poses (x, y, theta) in metres and radians, the world frame; odometry in the vehicle's frame, as in
-:mod:`cmdragons.estimation.models`. A ``numpy.random.Generator`` costs microseconds to hand to a
-kernel on every call, more than the step itself, so the filter seeds a stream of its own from its
-generator once: xoshiro256** (Blackman and Vigna 2018, "Scrambled linear pseudorandom number
+:mod:`cmdragons.estimation.models`. The particles are a cloud (n, 5): rows (x, y, theta, cos theta,
+sin theta), each heading's cosine and sine computed once where it changes (a move, a regularising
+draw) and read by the next move, the sightings' weights and the estimate's circular mean: the
+trigonometry of the cloud is most of a step's time. A ``numpy.random.Generator`` costs about 10 µs
+to hand to a kernel on every call, more than the step itself, so the filter seeds a stream of its
+own from its generator once: xoshiro256** (Blackman and Vigna 2018, "Scrambled linear pseudorandom number
 generators", §4), a uint64 state of four words, normal deviates from it by the ziggurat
 (Marsaglia and Tsang 2000, "The ziggurat method for generating random variables", 256 layers; the
 layer tables built once by :func:`ziggurat_tables`).
@@ -21,12 +24,11 @@ import numpy as np
 from numba import njit, uint64
 from numpy.typing import NDArray
 
-from cmdragons.geometry import wrap_angle
-
 __all__ = [
     "ZIGGURAT_TAIL",
     "cloud_estimate",
     "correct",
+    "gaussian_draws",
     "move",
     "normal",
     "normals",
@@ -39,6 +41,7 @@ __all__ = [
     "uniform",
     "uniforms",
     "weigh",
+    "wrap",
     "ziggurat_tables",
 ]
 
@@ -49,7 +52,15 @@ FloatArray = NDArray[np.float64]
 ZIGGURAT_TAIL = 3.6541528853610088
 _LAYERS = 256
 
-_wrap = njit(cache=True, inline="always")(wrap_angle)
+_TWO_PI = 2.0 * math.pi
+
+
+@njit(cache=True, inline="always")
+def wrap(a: float) -> float:
+    """:func:`cmdragons.geometry.wrap_angle` (to rounding; the ends: [-pi, pi]) through a
+    floor: numba's float modulo, which that takes, runs through fmod at several times the cost, and
+    the cloud wraps every heading on every step (a test keeps the two in agreement)."""
+    return a - _TWO_PI * math.floor((a + math.pi) / _TWO_PI)
 
 
 def ziggurat_tables() -> tuple[FloatArray, FloatArray]:
@@ -171,42 +182,73 @@ def psd_factor(cov: np.ndarray) -> np.ndarray:
     return low
 
 
+@njit(cache=True)
+def gaussian_draws(low: np.ndarray, n: int, s: np.ndarray, zx: np.ndarray, zf: np.ndarray) -> np.ndarray:
+    """n draws L z (n, 3) of a 3-d Gaussian of lower-triangular factor L, z standard normal: one
+    deviate per non-zero column of L (a zero pivot's column is all zero), draw after draw, in column
+    order. The deviates are drawn in one loop first: drawn inside the loop over the draws, each
+    would pay numba's reference counting of the stream's arrays, several times the deviate."""
+    cols = np.zeros(3, dtype=np.int64)
+    m = 0
+    for j in range(3):
+        if low[j, j] != 0.0:
+            cols[m] = j
+            m += 1
+    z = normals(s, zx, zf, n * m)
+    out = np.empty((n, 3))
+    l00, l10, l11, l20, l21, l22 = low[0, 0], low[1, 0], low[1, 1], low[2, 0], low[2, 1], low[2, 2]
+    for k in range(n):
+        z0 = z1 = z2 = 0.0
+        for i in range(m):
+            v = z[k * m + i]
+            if cols[i] == 0:
+                z0 = v
+            elif cols[i] == 1:
+                z1 = v
+            else:
+                z2 = v
+        out[k, 0] = l00 * z0
+        out[k, 1] = l10 * z0 + l11 * z1
+        out[k, 2] = l20 * z0 + l21 * z1 + l22 * z2
+    return out
+
+
 @njit(cache=True, inline="always")
-def _add_noise(low: np.ndarray, j: int, z: float, e: np.ndarray) -> None:
-    for i in range(j, 3):
-        e[i] += low[i, j] * z
+def _turn(cloud: np.ndarray, k: int, heading: float) -> None:
+    """Particle ``k``'s heading set, wrapped, with its cosine and sine."""
+    heading = wrap(heading)
+    cloud[k, 2], cloud[k, 3], cloud[k, 4] = heading, math.cos(heading), math.sin(heading)
 
 
 @njit(cache=True)
-def move(particles: np.ndarray, u: np.ndarray, low: np.ndarray, s: np.ndarray, zx: np.ndarray,
-         zf: np.ndarray) -> None:  # fmt: skip
+def move(cloud: np.ndarray, u: np.ndarray, low: np.ndarray, s: np.ndarray, zx: np.ndarray, zf: np.ndarray) -> None:
     """Each particle composed with the odometry ``u`` (3,) plus its own noise L z, z standard
     normal, one deviate per non-zero column of L in column order (none for a zero column)."""
-    e = np.empty(3)
-    for k in range(particles.shape[0]):
-        e[0], e[1], e[2] = u[0], u[1], u[2]
-        for j in range(3):
-            if low[j, j] != 0.0:
-                _add_noise(low, j, normal(s, zx, zf), e)
-        t = particles[k, 2]
-        c, sn = math.cos(t), math.sin(t)
-        particles[k, 0] += c * e[0] - sn * e[1]
-        particles[k, 1] += sn * e[0] + c * e[1]
-        particles[k, 2] = _wrap(t + e[2])
+    e = gaussian_draws(low, cloud.shape[0], s, zx, zf)
+    for k in range(cloud.shape[0]):
+        dx, dy = u[0] + e[k, 0], u[1] + e[k, 1]
+        c, sn = cloud[k, 3], cloud[k, 4]
+        cloud[k, 0] += c * dx - sn * dy
+        cloud[k, 1] += sn * dx + c * dy
+        _turn(cloud, k, cloud[k, 2] + u[2] + e[k, 2])
 
 
 @njit(cache=True)
-def weigh(particles: np.ndarray, log_w: np.ndarray, lx: float, ly: float, z_range: float, z_bearing: float,
+def weigh(cloud: np.ndarray, log_l: np.ndarray, lx: float, ly: float, z_range: float, z_bearing: float,
           r_inv: np.ndarray) -> None:  # fmt: skip
-    """Adds to ``log_w`` each particle's log-likelihood (less its constant) of a sighting of the
+    """Adds to ``log_l`` each particle's log-likelihood (less its constant) of a sighting of the
     landmark at (lx, ly) at range ``z_range`` (m) and bearing ``z_bearing`` (rad), the sensor's
-    inverse covariance ``r_inv`` (2, 2): -e^T R^-1 e / 2, e the residual (the bearing's wrapped)."""
+    inverse covariance ``r_inv`` (2, 2): -e^T R^-1 e / 2, e the residual. The bearing's residual,
+    z_bearing - (atan2(dy, dx) - theta), is the angle from the landmark's direction (dx, dy) to the
+    sighting's, theta + z_bearing: one arctangent of their cross and dot products, already wrapped."""
     a, b, c = r_inv[0, 0], r_inv[0, 1] + r_inv[1, 0], r_inv[1, 1]
-    for k in range(particles.shape[0]):
-        dx, dy = lx - particles[k, 0], ly - particles[k, 1]
+    cz, sz = math.cos(z_bearing), math.sin(z_bearing)
+    for k in range(cloud.shape[0]):
+        dx, dy = lx - cloud[k, 0], ly - cloud[k, 1]
         er = z_range - math.sqrt(dx * dx + dy * dy)
-        eb = _wrap(z_bearing - (math.atan2(dy, dx) - particles[k, 2]))
-        log_w[k] -= 0.5 * (a * er * er + b * er * eb + c * eb * eb)
+        cs, ss = cloud[k, 3] * cz - cloud[k, 4] * sz, cloud[k, 4] * cz + cloud[k, 3] * sz  # theta + z_bearing
+        eb = math.atan2(ss * dx - cs * dy, cs * dx + ss * dy)
+        log_l[k] -= 0.5 * (a * er * er + b * er * eb + c * eb * eb)
 
 
 @njit(cache=True)
@@ -237,35 +279,36 @@ def reweigh(weights: np.ndarray, log_l: np.ndarray) -> float:
 
 
 @njit(cache=True)
-def resample(particles: np.ndarray, weights: np.ndarray, start: float, out: np.ndarray) -> None:
+def resample(cloud: np.ndarray, weights: np.ndarray, start: float, out: np.ndarray) -> None:
     """Systematic (low-variance) resampling into ``out``: the n positions (start + i) / n, ``start``
     uniform in [0, 1), each picks the particle whose cumulative weight first reaches it."""
-    n = particles.shape[0]
+    n, m = cloud.shape
     k, cum = 0, weights[0]
     for i in range(n):
         pos = (start + i) / n
         while cum < pos and k < n - 1:
             k += 1
             cum += weights[k]
-        out[i, 0], out[i, 1], out[i, 2] = particles[k, 0], particles[k, 1], particles[k, 2]
+        for j in range(m):
+            out[i, j] = cloud[k, j]
 
 
 @njit(cache=True)
-def cloud_estimate(particles: np.ndarray, weights: np.ndarray, mean: np.ndarray, cov: np.ndarray) -> None:
+def cloud_estimate(cloud: np.ndarray, weights: np.ndarray, mean: np.ndarray, cov: np.ndarray) -> None:
     """The cloud's weighted mean pose into ``mean`` (3,) (the heading's circular mean) and its
     weighted covariance about it into ``cov`` (3, 3) (heading differences wrapped)."""
     sx = sy = ss = sc = 0.0
-    for k in range(particles.shape[0]):
+    for k in range(cloud.shape[0]):
         w = weights[k]
-        sx += w * particles[k, 0]
-        sy += w * particles[k, 1]
-        ss += w * math.sin(particles[k, 2])
-        sc += w * math.cos(particles[k, 2])
+        sx += w * cloud[k, 0]
+        sy += w * cloud[k, 1]
+        sc += w * cloud[k, 3]
+        ss += w * cloud[k, 4]
     mean[0], mean[1], mean[2] = sx, sy, math.atan2(ss, sc)
     cov[:, :] = 0.0
-    for k in range(particles.shape[0]):
+    for k in range(cloud.shape[0]):
         w = weights[k]
-        ex, ey, et = particles[k, 0] - sx, particles[k, 1] - sy, _wrap(particles[k, 2] - mean[2])
+        ex, ey, et = cloud[k, 0] - sx, cloud[k, 1] - sy, wrap(cloud[k, 2] - mean[2])
         cov[0, 0] += w * ex * ex
         cov[0, 1] += w * ex * ey
         cov[0, 2] += w * ex * et
@@ -276,53 +319,50 @@ def cloud_estimate(particles: np.ndarray, weights: np.ndarray, mean: np.ndarray,
 
 
 @njit(cache=True)
-def regularise(particles: np.ndarray, low: np.ndarray, s: np.ndarray, zx: np.ndarray, zf: np.ndarray) -> None:
+def regularise(cloud: np.ndarray, low: np.ndarray, s: np.ndarray, zx: np.ndarray, zf: np.ndarray) -> None:
     """Each particle moved by its own draw L z of the regularisation kernel (L L^T its covariance;
-    one deviate per non-zero column of L), headings wrapped."""
-    e = np.empty(3)
-    for k in range(particles.shape[0]):
-        e[0] = e[1] = e[2] = 0.0
-        for j in range(3):
-            if low[j, j] != 0.0:
-                _add_noise(low, j, normal(s, zx, zf), e)
-        particles[k, 0] += e[0]
-        particles[k, 1] += e[1]
-        particles[k, 2] = _wrap(particles[k, 2] + e[2])
+    one deviate per non-zero column of L)."""
+    e = gaussian_draws(low, cloud.shape[0], s, zx, zf)
+    for k in range(cloud.shape[0]):
+        cloud[k, 0] += e[k, 0]
+        cloud[k, 1] += e[k, 1]
+        _turn(cloud, k, cloud[k, 2] + e[k, 2])
 
 
 @njit(cache=True)
-def correct(particles: np.ndarray, weights: np.ndarray, seen: np.ndarray, r_inv: np.ndarray, bandwidth: float,
+def correct(cloud: np.ndarray, weights: np.ndarray, seen: np.ndarray, r_inv: np.ndarray, bandwidth: float,
             s: np.ndarray, zx: np.ndarray, zf: np.ndarray, scratch: np.ndarray) -> bool:  # fmt: skip
     """The measurement half of a step: :func:`weigh` by each row of ``seen`` (m, 4: landmark x, y,
     range, bearing), :func:`reweigh`, and when the effective sample size falls below n / 2
-    :func:`resample` (``scratch`` (n, 3) its work space) and :func:`regularise` by ``bandwidth`` (h)
-    times the factor of the cloud's covariance before resampling. Returns whether it resampled."""
-    n = particles.shape[0]
+    :func:`resample` (``scratch`` the cloud's shape, its work space) and :func:`regularise` by
+    ``bandwidth`` (h) times the factor of the cloud's covariance before resampling. Returns whether
+    it resampled."""
+    n = cloud.shape[0]
     if seen.shape[0] == 0:
         return False
     log_l = np.zeros(n)
     for i in range(seen.shape[0]):
-        weigh(particles, log_l, seen[i, 0], seen[i, 1], seen[i, 2], seen[i, 3], r_inv)
+        weigh(cloud, log_l, seen[i, 0], seen[i, 1], seen[i, 2], seen[i, 3], r_inv)
     if reweigh(weights, log_l) >= 0.5 * n:
         return False
     mean, cov = np.empty(3), np.empty((3, 3))
-    cloud_estimate(particles, weights, mean, cov)
-    resample(particles, weights, uniform(s), scratch)
-    particles[:] = scratch
+    cloud_estimate(cloud, weights, mean, cov)
+    resample(cloud, weights, uniform(s), scratch)
+    cloud[:] = scratch
     weights[:] = 1.0 / n
     if bandwidth > 0.0:
-        regularise(particles, psd_factor(bandwidth * bandwidth * cov), s, zx, zf)
+        regularise(cloud, psd_factor(bandwidth * bandwidth * cov), s, zx, zf)
     return True
 
 
 @njit(cache=True)
-def particle_step(particles: np.ndarray, weights: np.ndarray, u: np.ndarray, u_cov: np.ndarray,
-                  seen: np.ndarray, r_inv: np.ndarray, bandwidth: float, s: np.ndarray, zx: np.ndarray,
-                  zf: np.ndarray, scratch: np.ndarray, mean: np.ndarray, cov: np.ndarray) -> bool:  # fmt: skip
+def particle_step(cloud: np.ndarray, weights: np.ndarray, u: np.ndarray, u_cov: np.ndarray, seen: np.ndarray,
+                  r_inv: np.ndarray, bandwidth: float, s: np.ndarray, zx: np.ndarray, zf: np.ndarray,
+                  scratch: np.ndarray, mean: np.ndarray, cov: np.ndarray) -> bool:  # fmt: skip
     """One step of the regularised particle filter: :func:`move` by the odometry ``u`` (3,) of
     covariance ``u_cov`` (3, 3), :func:`correct` by the sightings ``seen``, and the cloud's
     estimate into ``mean`` (3,) and ``cov`` (3, 3). Returns whether it resampled."""
-    move(particles, u, psd_factor(u_cov), s, zx, zf)
-    resampled = correct(particles, weights, seen, r_inv, bandwidth, s, zx, zf, scratch)
-    cloud_estimate(particles, weights, mean, cov)
+    move(cloud, u, psd_factor(u_cov), s, zx, zf)
+    resampled = correct(cloud, weights, seen, r_inv, bandwidth, s, zx, zf, scratch)
+    cloud_estimate(cloud, weights, mean, cov)
     return resampled

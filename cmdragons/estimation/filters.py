@@ -313,16 +313,23 @@ class ParticleLocalisation:
         self.bandwidth_share = bandwidth_share
         self.rng = np.random.default_rng(seed)
         self.landmarks = np.asarray(landmarks, dtype=np.float64)
-        self.particles = self.rng.multivariate_normal(np.asarray(start, dtype=np.float64),
-                                                      np.asarray(start_cov, dtype=np.float64), size=n)  # fmt: skip
+        poses = self.rng.multivariate_normal(np.asarray(start, dtype=np.float64),
+                                             np.asarray(start_cov, dtype=np.float64), size=n)  # fmt: skip
+        poses[:, 2] = wrap_angle(poses[:, 2])
+        self.cloud = np.column_stack([poses, np.cos(poses[:, 2]), np.sin(poses[:, 2])])  # the kernels' rows
         self.weights = np.full(n, 1.0 / n)
         self.R_inv = np.linalg.inv(np.asarray(sensor_cov, dtype=np.float64))
         self.stream = K.seed_stream(self.rng)
-        d = self.particles.shape[1]
+        d = 3
         self.bandwidth = bandwidth_share * (4.0 / (n * (d + 2))) ** (1.0 / (d + 4))
-        self._scratch = np.empty_like(self.particles)
+        self._scratch = np.empty_like(self.cloud)
         self._mean, self._cov = np.empty(3), np.empty((3, 3))
         self._estimated = False
+
+    @property
+    def particles(self) -> FloatArray:
+        """The particles' poses (n, 3), a view of the cloud."""
+        return self.cloud[:, :3]
 
     def _seen(self, sightings: list[Sighting]) -> FloatArray:
         """The sightings as the kernels take them: rows (landmark x, y, range, bearing)."""
@@ -334,24 +341,24 @@ class ParticleLocalisation:
 
     def predict(self, odometry: ArrayLike, odometry_cov: ArrayLike) -> None:
         low = K.psd_factor(np.asarray(odometry_cov, dtype=np.float64))
-        K.move(self.particles, np.asarray(odometry, dtype=np.float64), low, self.stream, *_ZIGGURAT)
+        K.move(self.cloud, np.asarray(odometry, dtype=np.float64), low, self.stream, *_ZIGGURAT)
         self._estimated = False
 
     def update(self, sightings: list[Sighting]) -> None:
-        K.correct(self.particles, self.weights, self._seen(sightings), self.R_inv, self.bandwidth, self.stream,
+        K.correct(self.cloud, self.weights, self._seen(sightings), self.R_inv, self.bandwidth, self.stream,
                   *_ZIGGURAT, self._scratch)  # fmt: skip
         self._estimated = False
 
     def step(self, odometry: ArrayLike, odometry_cov: ArrayLike, sightings: list[Sighting]) -> None:
         """:meth:`predict` then :meth:`update`, and the estimate, in one kernel call."""
-        K.particle_step(self.particles, self.weights, np.asarray(odometry, dtype=np.float64),
+        K.particle_step(self.cloud, self.weights, np.asarray(odometry, dtype=np.float64),
                         np.asarray(odometry_cov, dtype=np.float64), self._seen(sightings), self.R_inv,
                         self.bandwidth, self.stream, *_ZIGGURAT, self._scratch, self._mean, self._cov)  # fmt: skip
         self._estimated = True
 
     def _estimate(self) -> None:
         if not self._estimated:
-            K.cloud_estimate(self.particles, self.weights, self._mean, self._cov)
+            K.cloud_estimate(self.cloud, self.weights, self._mean, self._cov)
             self._estimated = True
 
     @property

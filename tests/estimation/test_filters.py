@@ -273,3 +273,14 @@ def test_predict_and_update_apart_give_the_step() -> None:
         b.update(run.sightings[k])
         np.testing.assert_array_equal(a.particles, b.particles)
         np.testing.assert_allclose(a.pose, b.pose, atol=1e-12)
+
+
+def test_the_kernels_angle_wrap_agrees_with_the_geometry_s() -> None:
+    from cmdragons.estimation import _kernels as K
+    from cmdragons.geometry import wrap_angle
+
+    a = np.concatenate([np.linspace(-40.0, 40.0, 100_001), [-math.pi, math.pi, 0.0, 3 * math.pi, -3 * math.pi]])
+    w = np.array([K.wrap(float(x)) for x in a[::97]])
+    assert np.all((w >= -math.pi) & (w <= math.pi))
+    np.testing.assert_allclose(np.cos(w), np.cos(a[::97]), atol=1e-12)
+    np.testing.assert_allclose(w, wrap_angle(a[::97]), atol=1e-12)

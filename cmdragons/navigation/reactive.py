@@ -28,7 +28,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from cmdragons.config import Validated, setting
 from cmdragons.control._kernels import limit_velocity
-from cmdragons.control.motion import ControlParams
+from cmdragons.control.motion import ControlParams, motion_command
 from cmdragons.messages import RobotState
 from cmdragons.navigation import _kernels as K
 from cmdragons.navigation.base import STOP, Arrival, NavStatus, VelocityCommand
@@ -117,9 +117,12 @@ class ReactiveNavigator(ABC):
         wx, wy = self.want(robot, cw, goal)
         if self.status in (NavStatus.BLOCKED, NavStatus.LOCAL_MINIMUM):
             wx, wy = 0.0, 0.0  # a method that is stuck stops (its status says why)
-        _, _, omega = self.follow.command(robot, world, termination)  # the heading's profile
+        # the heading's profile: the trajectory's command toward its target, which with its limits and
+        # its start state serves the guard below too (each taken once a frame: they are most of a step)
+        target, control = self.follow.target(robot)
         start = self.follow.start_state(robot)
-        motion = self.follow.target(robot)[1].motion
+        omega = STOP[2] if termination.reached(0) else motion_command(start, target, control).omega
+        motion = control.motion
         # a turned velocity changes at the smaller of the two: the guard must hold while turning too
         wx, wy = K.brake_guard(cw.obs, cw.inner, here[0], here[1], wx, wy, self.reactive.brake_margin_m,
                                min(motion.max_accel_m_s2, motion.max_brake_m_s2), motion.period_s)  # fmt: skip

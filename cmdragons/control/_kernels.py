@@ -251,6 +251,15 @@ def limit_velocity(
 
 
 @njit(cache=True)
+def heading_command(theta: float, omega: float, target_theta: float, wmax: float, alpha: float,
+                    period: float) -> float:  # fmt: skip
+    """The turn rate (rad/s) one ``period`` ahead on the heading's trapezoid from ``theta`` (rad),
+    turning at ``omega``, to rest at ``target_theta``, under ``wmax`` and the angular ``alpha``."""
+    ph, _ = profile_1d(wrap_angle(target_theta - theta), omega, 0.0, wmax, alpha, alpha)
+    return phases_state(ph, omega, period)[1]
+
+
+@njit(cache=True)
 def motion_commands(
     states: np.ndarray, targets: np.ndarray, vmax: float, accel: float, brake: float, wmax: float, alpha: float,
     period: float, iterations: int,
@@ -267,9 +276,7 @@ def motion_commands(
         cx, cy, _ = command_2d(targets[i, 0] - x, targets[i, 1] - y, vx, vy, targets[i, 2], targets[i, 3],
                                vmax, accel, brake, period, iterations)  # fmt: skip
         out[i, 0], out[i, 1] = limit_velocity(vx, vy, cx, cy, vmax, accel, brake, period)
-        dth: float = wrap_angle(targets[i, 4] - th)
-        ph, _ = profile_1d(dth, w, 0.0, wmax, alpha, alpha)
-        out[i, 2] = phases_state(ph, w, period)[1]
+        out[i, 2] = heading_command(th, w, targets[i, 4], wmax, alpha, period)
     return out
 
 

@@ -27,8 +27,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from cmdragons.config import Validated, setting
-from cmdragons.control._kernels import limit_velocity
-from cmdragons.control.motion import ControlParams, motion_command
+from cmdragons.control._kernels import heading_command, limit_velocity
+from cmdragons.control.motion import ControlParams
 from cmdragons.messages import RobotState
 from cmdragons.navigation import _kernels as K
 from cmdragons.navigation.base import STOP, Arrival, NavStatus, VelocityCommand
@@ -117,12 +117,16 @@ class ReactiveNavigator(ABC):
         wx, wy = self.want(robot, cw, goal)
         if self.status in (NavStatus.BLOCKED, NavStatus.LOCAL_MINIMUM):
             wx, wy = 0.0, 0.0  # a method that is stuck stops (its status says why)
-        # the heading's profile: the trajectory's command toward its target, which with its limits and
-        # its start state serves the guard below too (each taken once a frame: they are most of a step)
+        # the heading's profile toward the trajectory's target (the rotation of its command: the rest
+        # of that command, a 2D trapezoid, would be thrown away); the target's limits and the start
+        # state serve the guard below too, each taken once a frame
         target, control = self.follow.target(robot)
         start = self.follow.start_state(robot)
-        omega = STOP[2] if termination.reached(0) else motion_command(start, target, control).omega
         motion = control.motion
+        omega = STOP[2]
+        if not termination.reached(0):
+            omega = heading_command(start.theta, start.omega, target.theta, motion.max_omega_rad_s,
+                                    motion.max_alpha_rad_s2, motion.period_s)  # fmt: skip
         # a turned velocity changes at the smaller of the two: the guard must hold while turning too
         wx, wy = K.brake_guard(cw.obs, cw.inner, here[0], here[1], wx, wy, self.reactive.brake_margin_m,
                                min(motion.max_accel_m_s2, motion.max_brake_m_s2), motion.period_s)  # fmt: skip

@@ -121,3 +121,16 @@ def test_closed_loop_in_the_simulator_reaches_the_goal_in_the_profile_time(
     assert math.hypot(row[2] - goal[0], row[3] - goal[1]) < 0.01
     assert abs(wrap_angle(row[4] - goal[2])) < 0.02
     assert w.faults.clamped == 0
+
+
+@pytest.mark.parametrize("theta, omega, target", [(0.0, 0.0, 1.0), (3.0, 2.0, -3.0), (-1.0, -4.0, 0.5),
+                                                  (0.2, 0.0, 0.2)])  # fmt: skip
+def test_the_heading_command_is_the_motion_command_s_rotation(theta: float, omega: float, target: float) -> None:
+    # the reactive navigators take the rotation alone; it must be the full command's
+    from cmdragons.control._kernels import heading_command
+
+    m = PARAMS.motion
+    full = motion_commands(np.array([[0.1, -0.2, theta, 0.5, 0.0, omega]]), np.array([[1.0, 1.0, 0.0, 0.0, target]]),
+                           PARAMS)[0]  # fmt: skip
+    turn = heading_command(theta, omega, target, m.max_omega_rad_s, m.max_alpha_rad_s2, m.period_s)
+    assert turn == full[2]  # rad/s, the same arithmetic

@@ -129,7 +129,7 @@ def normal(s: np.ndarray, zx: np.ndarray, zf: np.ndarray) -> float:
                 return -(ZIGGURAT_TAIL + a) if negative else ZIGGURAT_TAIL + a
             continue
         i = int(bits & uint64(0xFF))
-        x = u * zx[i]
+        x: float = u * zx[i]
         if x < zx[i + 1]:
             return -x if negative else x
         if i == 0:

@@ -49,7 +49,7 @@ def particle_step(particles: FloatArray, weights: FloatArray, u: FloatArray, u_c
             p = p[np.minimum(np.searchsorted(np.cumsum(w), positions), n - 1)]
             w = np.full(n, 1.0 / n)
             if bandwidth > 0.0:
-                p += _noise(np.linalg.cholesky(bandwidth * bandwidth * cov), n, s, zx, zf)
+                p += _noise(np.asarray(np.linalg.cholesky(bandwidth * bandwidth * cov), dtype=np.float64), n, s, zx, zf)
                 p[:, 2] = wrap_angle(p[:, 2])
             resampled = True
     mean, cov = particle_estimate(p, w)

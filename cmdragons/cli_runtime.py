@@ -112,8 +112,12 @@ def _log_stages(spec: Any, folder: Path) -> tuple[Any, list[Any]]:
 def _connect(params: Any, name: str, router: bool, command: str) -> tuple[Any, Any] | None:
     """The router session (when ``router``) and ``name``'s transport; None once the error (no
     router there, or the endpoint taken) is said on one line."""
+    from cmdragons.runtime.distributed import frame_path_priority
     from cmdragons.runtime.zenoh_transport import RouterError, ZenohTransport, open_router
 
+    note = frame_path_priority(params, name)
+    if note is not None:
+        print(f"cmdragons {command}: {note}", file=sys.stderr)
     session = None
     try:
         session = open_router(params) if router else None

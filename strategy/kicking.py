@@ -26,7 +26,7 @@ from cmdragons.geometry import Field, wrap_angle
 from cmdragons.messages import BallState, RobotState
 from strategy.evaluation import PassParams, best_shot, clearest_direction, one_touch_turn, pass_values
 from strategy.passing import PassPlay
-from strategy.skills import Intent, SkillParams, drive_through, intercept, kick_to, pass_speed, receive
+from strategy.skills import Intent, SkillParams, drive_through, intercept, kick_to, pass_speed, receive, set_kick
 
 __all__ = ["Attacker", "Kick", "KickKind", "KickParams", "StillBall", "contest_angle", "decide_kick"]
 
@@ -165,9 +165,10 @@ class Attacker:
 
     def play(self, t: float, robot: RobotState, own: Mapping[int, RobotState], supporters: Sequence[int],
              opponents: Array, ball: BallState, attack_sign: float,
-             passes: PassPlay) -> tuple[Intent, KickKind]:  # fmt: skip
+             passes: PassPlay, restart: bool = False) -> tuple[Intent, KickKind]:  # fmt: skip
         """Play the ball where ``robot`` can meet it: shoot, pass (planned in ``passes``) or play it
-        forward. Returns the intent and what the kick is for."""
+        forward; ``restart``: our restart's kick, its only touch (:func:`~strategy.skills.set_kick`).
+        Returns the intent and what the kick is for."""
         p, skills = self.p, self.skills
         met = intercept(robot, ball, skills, self.field)
         kick = decide_kick(met, robot.id, own, supporters, passes, opponents, self.field, attack_sign, self.radius, p,
@@ -176,6 +177,8 @@ class Attacker:
             passes.plan(t, robot.id, kick.receiver, kick.target, kick.shoot_at)
         else:
             passes.cancel()
+        if restart:
+            return set_kick(robot, met, kick.target, kick.speed, skills), kick.kind
         speed = math.hypot(ball.vx, ball.vy)
         to_robot = math.hypot(robot.x - ball.x, robot.y - ball.y)
         toward = ((robot.x - ball.x) * ball.vx + (robot.y - ball.y) * ball.vy) / max(speed * to_robot, 1e-9)

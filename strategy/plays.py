@@ -64,6 +64,7 @@ class StrategyParams(Validated):
     support: SupportParams = SupportParams()
     game_states: GameStateParams = GameStateParams()
     ball_room_m: float = setting(0.35, lo=0.0, hi=3.0)  # team-mates leave the ball handler this much room
+    touched_m: float = setting(0.03, lo=0.0, hi=0.5)  # a robot's body this near the ball's has touched it
 
     @property
     def robot_radius_m(self) -> float:
@@ -100,6 +101,8 @@ class Strategy:
         self.frame = 0
         self.last_action: dict[int, str] = {}  # robot id -> "shot", "pass" or "clear": what its kick is for
         self._placing: int | None = None  # the robot holding the ball it places
+        self._taker: int | None = None  # the kicker of our kickoff or free kick under way
+        self._barred: int | None = None  # our restart's taker, until another robot touched the ball
 
     def own_sign(self, game: GameState) -> float:
         """-1 when we defend the goal at negative x, else +1."""
@@ -129,8 +132,11 @@ class Strategy:
             return halt(own)
         if ball is None:
             return hold_shape(own, self.field, own_sign, self.p.game_states)
-        intents = self._normal(world.t, own, opp, ball, own_sign)
         ours = game.for_team == self.team
+        restart = ours and game.command in ("kickoff", "free_kick")
+        self._barred = self._double_touch_bar(game, own, opp, ball)
+        intents = self._normal(world.t, own, opp, ball, own_sign, restart)
+        self._taker = self._role_robot(ATTACKER) if restart else None
         if game.command == "ball_placement" and game.placement is not None:
             return self._placement(intents, own, ball, game.placement, ours, own_sign)
         if game.command == "penalty":
@@ -140,6 +146,23 @@ class Strategy:
             kicker = None  # prepared, not started: nobody plays the ball yet
         return restart_rules(intents, game, ours, ball, self.field, own_sign, self.p.game_states,
                              self.p.robot_radius_m, kicker)  # fmt: skip
+
+    def _double_touch_bar(self, game: GameState, own: Mapping[int, RobotState], opp: list[RobotState],
+                          ball: BallState) -> int | None:  # fmt: skip
+        """The robot that may not touch the ball now (the rules: a restart's kicker touches it again
+        only after another robot has; else a free kick for them): the taker of our kickoff or free
+        kick from the normal start that followed it (the ball moved: the restart was taken) until
+        another robot, ours or theirs, comes within ``touched_m`` of the ball or the command changes."""
+        barred = self._barred
+        if game.command == "normal" and self._taker is not None:
+            barred = self._taker  # the command was our restart the frame before
+        if barred is None or game.command != "normal":
+            return None
+        reach = self.p.robot_radius_m + self.p.ball_radius_m + self.p.touched_m
+        others = [r for r in (*own.values(), *opp) if not (r.team == self.team and r.id == barred)]
+        if any(math.hypot(r.x - ball.x, r.y - ball.y) < reach for r in others):
+            return None
+        return barred
 
     def _role_robot(self, role: Role) -> int | None:
         return next((rid for rid, r in self.roles.roles.items() if r == role), None)
@@ -201,13 +224,16 @@ class Strategy:
             # the attacker's cost: the way to where each robot can meet the (moving) ball
             meet = {rid: intercept(r, ball, p.skills, f) for rid, r in own.items()}
             costs = {rid: math.hypot(m.x - own[rid].x, m.y - own[rid].y) for rid, m in meet.items()}
+            if self._barred in costs:  # our restart's taker plays the ball again only when nobody else can
+                costs[self._barred] = math.inf
             objectives.append(Objective(ATTACKER, ball.x, ball.y, costs=costs))
         objectives += [Objective(role, it.x, it.y) for role, it in defenders.items()]
         objectives += [Objective(Role(RoleKind.SUPPORTER, k), x, y) for k, (x, y) in enumerate(self.supporters.points)]
         return objectives
 
     def _normal(self, t: float, own: dict[int, RobotState], opp: list[RobotState], ball: BallState,
-                own_sign: float) -> dict[int, Intent]:  # fmt: skip
+                own_sign: float, restart: bool = False) -> dict[int, Intent]:  # fmt: skip
+        """Normal play; ``restart``: our kickoff or free kick (the attacker's kick its only touch)."""
         p, f = self.p, self.field
         attack_sign = -own_sign
         opp_xy = np.array([[r.x, r.y] for r in opp]) if opp else np.zeros((0, 2))
@@ -229,8 +255,11 @@ class Strategy:
                 out[rid], clears = goalie(r, ball, f, own_sign, p.defense, p.skills)
                 if clears:
                     self.last_action[rid] = KickKind.CLEAR.value
+            elif role == ATTACKER and rid == self._barred:
+                out[rid] = _facing_ball(r.x, r.y, ball)  # nobody else to play it: wait for theirs to touch it
             elif role == ATTACKER:
-                out[rid], kind = self.attacker.play(t, r, own, supporters, opp_xy, ball, attack_sign, self.passes)
+                out[rid], kind = self.attacker.play(t, r, own, supporters, opp_xy, ball, attack_sign, self.passes,
+                                                    restart)  # fmt: skip
                 self.last_action[rid] = kind.value
             elif role == RECEIVER and passing is not None and not passing.kicked:
                 out[rid] = _facing_ball(*passing.point, ball)
@@ -246,7 +275,7 @@ class Strategy:
             if rid not in out:
                 out[rid] = mark(opp[rid % len(opp)], f, own_sign, p.skills) if opp else Intent(r.x, r.y, r.theta)
         # everyone but the goalie and the robot playing the ball leaves it room
-        others = {rid: it for rid, it in out.items() if roles.get(rid) not in _BALL_PLAYERS}
+        others = {rid: it for rid, it in out.items() if roles.get(rid) not in _BALL_PLAYERS or rid == self._barred}
         out.update(keep_away(others, ball, f, own_sign, p.game_states, p.robot_radius_m, kickoff=False, slow=False,
                              distance_m=p.ball_room_m))  # fmt: skip
         return out

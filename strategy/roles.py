@@ -60,7 +60,8 @@ class RoleAssigner:
         self.roles: dict[int, Role] = {}  # robot id -> role
 
     def assign(self, robots: Mapping[int, tuple[float, float]], objectives: Sequence[Objective]) -> dict[int, Role]:
-        """``objectives`` in priority order; robots left over get no role."""
+        """``objectives`` in priority order; robots left over get no role. An infinite cost: the robot
+        takes that role only when no other is free."""
         free = dict(robots)
         previous = {role: rid for rid, role in self.roles.items()}
         out: dict[int, Role] = {}
@@ -78,7 +79,7 @@ class RoleAssigner:
                 cost = costs[rid] if rid in costs else math.hypot(x - obj.x, y - obj.y)
                 if previous.get(obj.role) == rid:
                     cost -= self.params.hysteresis_m
-                if cost < best_cost or (cost == best_cost and best is not None and rid < best):
+                if best is None or cost < best_cost or (cost == best_cost and rid < best):
                     best, best_cost = rid, cost
             assert best is not None
             out[best] = obj.role

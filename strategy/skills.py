@@ -7,6 +7,7 @@ happen. Skills keep no state; plays and roles (``strategy.plays``) choose them.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -29,6 +30,7 @@ __all__ = [
     "mark",
     "pass_speed",
     "receive",
+    "set_kick",
 ]
 
 
@@ -74,6 +76,12 @@ class SkillParams(Validated):
     rest_speed_m_s: float = setting(0.1, lo=0.0, hi=2.0)  # a ball slower than this is met where it lies
     intercept_step_s: float = setting(0.05, lo=0.001, hi=1.0)  # the moving ball's path is predicted in these steps
     receive_moving_m_s: float = setting(0.3, lo=0.0, hi=5.0)  # a ball faster than this is met on its path
+    set_lined_up_m: float = setting(0.015, lo=0.001, hi=0.5)  # a restart's kick: lateral error at the waiting point
+    set_lined_up_rad: float = setting(0.05, lo=0.001, hi=1.0)  # ... heading error
+    set_settle_m_s: float = setting(0.1, lo=0.0, hi=5.0)  # ... speed across the kick line before driving through
+    set_push_m_s: float = setting(0.5, lo=0.05, hi=5.0)  # ... driving through the ball this fast
+    set_near_m: float = setting(0.6, lo=0.0, hi=5.0)  # ... within this of the ball (centre to centre) ...
+    set_approach_m_s: float = setting(1.0, lo=0.05, hi=10.0)  # ... the way to the waiting point at most this fast
     goalie_post_share: float = setting(0.5, lo=0.0, hi=2.0)  # goalie's centre this share of its radius inside a post
     goalie_shot_speed_m_s: float = setting(0.5, lo=0.0, hi=10.0)  # a ball this fast ...
     goalie_shot_vx_m_s: float = setting(0.2, lo=0.0, hi=10.0)  # ... coming at our goal line this fast: met on its line
@@ -141,6 +149,28 @@ def kick_to(robot: RobotState, ball: BallState, target: tuple[float, float], spe
         px = ball.x - c * p.swing_back_share * behind - s * side * behind * p.swing_side_share
         py = ball.y - s * p.swing_back_share * behind + c * side * behind * p.swing_side_share
     return Intent(px, py, aim, avoid_ball=True)
+
+
+def set_kick(robot: RobotState, ball: BallState, target: tuple[float, float], speed: float,
+             p: SkillParams) -> Intent:  # fmt: skip
+    """A restart's kick at a ball lying still (a free kick, a kickoff), where any touch before the
+    kick is the restart's first and the kick a second one: the approach of :func:`kick_to` without
+    its cone (lined up within ``set_lined_up_m`` and ``set_lined_up_rad`` at the waiting point, not on
+    the way), driving through only once the robot no longer slides across the kick line
+    (``set_settle_m_s``) and then at ``set_push_m_s``; within ``set_near_m`` of the ball no faster than
+    ``set_approach_m_s`` (a robot that overshoots its waiting point meets the ball off its kicker), and
+    the kicker armed all along (a touch on the way is the kick)."""
+    lined = dataclasses.replace(p, lined_up_m=p.set_lined_up_m, lined_up_rad=p.set_lined_up_rad, cone_slope=0.0,
+                                cone_heading_rad_m=0.0, push_speed_m_s=p.set_push_m_s)  # fmt: skip
+    intent = kick_to(robot, ball, target, speed, lined)
+    aim = intent.theta
+    sliding = abs(-robot.vx * math.sin(aim) + robot.vy * math.cos(aim)) > p.set_settle_m_s
+    if not intent.avoid_ball and sliding:  # lined up but still sliding across: settle at the waiting point first
+        behind = p.contact_m + p.approach_distance_m
+        intent = Intent(ball.x - math.cos(aim) * behind, ball.y - math.sin(aim) * behind, aim)
+    if intent.avoid_ball and math.hypot(robot.x - ball.x, robot.y - ball.y) < p.set_near_m:
+        intent = dataclasses.replace(intent, max_speed_m_s=p.set_approach_m_s)
+    return dataclasses.replace(intent, kick_speed=speed, chip=False)
 
 
 def drive_through(ball: BallState, aim: float, speed: float, p: SkillParams, chip: bool = False) -> Intent:

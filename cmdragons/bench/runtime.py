@@ -25,8 +25,10 @@ twice (``--quick``: once, 2 s matches).
 
 from __future__ import annotations
 
+import concurrent.futures
 import dataclasses
 import io
+import multiprocessing
 import socket
 import subprocess
 import sys
@@ -39,7 +41,7 @@ import numpy as np
 
 from cmdragons.messages import CameraFrame
 from cmdragons.runtime.bus import InProcessTransport
-from cmdragons.runtime.distributed import MatchSpec, run_clock, wait_for_processes
+from cmdragons.runtime.distributed import MatchSpec, frame_path_priority, run_clock, wait_for_processes
 from cmdragons.runtime.match import Match
 from cmdragons.runtime.params import RuntimeParams
 from cmdragons.runtime.settings import Settings
@@ -66,7 +68,18 @@ def _node(role: str, params: RuntimeParams, opponent: str, perception: str) -> s
                              "--perception", perception, "--seed", str(SEED),
                              "--set", f"runtime.zenoh.router={params.zenoh.router}",
                              "--set", f"runtime.field_name={params.field_name}",
-                             "--set", f"runtime.vision_with_sim={str(params.vision_with_sim).lower()}"])  # fmt: skip
+                             "--set", f"runtime.vision_with_sim={str(params.vision_with_sim).lower()}",
+                             "--set", f"runtime.realtime_priority={params.realtime_priority}"])  # fmt: skip
+
+
+def _realtime_latency_rows(settings: Settings, seconds: float, rounds: int) -> list[dict[str, Any]]:
+    """:func:`_latency_rows` with this process (the embedded match, and the sim node with the
+    router) and the frame path's nodes on the real-time scheduler; in a process of its own, spawned
+    for it, so that every thread (zenoh's are made once a process and kept) inherits it."""
+    note = frame_path_priority(settings.runtime, "sim")
+    if note is not None:
+        return [{"name": "frame_to_command_rt", "note": note}]
+    return _latency_rows(settings, seconds, rounds, "_rt")
 
 
 class _TimesTicks:
@@ -128,9 +141,10 @@ def _embedded_latencies(settings: Settings, seconds: float) -> tuple[list[float]
     return ms, m.sim.t / (time.perf_counter() - wall)
 
 
-def _latency_rows(settings: Settings, seconds: float, rounds: int) -> list[dict[str, Any]]:
+def _latency_rows(settings: Settings, seconds: float, rounds: int, suffix: str = "") -> list[dict[str, Any]]:
     """The three set-ups in turn, ``rounds`` times (the machine's load drifts: each set-up meets
-    it alike), their frames pooled."""
+    it alike), their frames pooled; each on the scheduler of ``settings.runtime.realtime_priority``
+    (the nodes' processes: the process of this one has it already)."""
     setups: dict[str, Callable[[], tuple[list[float], float]]] = {
         "in_process": lambda: _embedded_latencies(settings, seconds),
         "zenoh": lambda: _zenoh_latencies(settings, seconds, vision_with_sim=False),
@@ -146,7 +160,7 @@ def _latency_rows(settings: Settings, seconds: float, rounds: int) -> list[dict[
     for name, (ms, rtfs) in pooled.items():
         medians.append(float(np.median(ms)))
         p99s.append(float(np.percentile(ms, 99)))
-        rows.append({"name": f"frame_to_command_{name}", "frames": len(ms), "median_ms": medians[-1],
+        rows.append({"name": f"frame_to_command_{name}{suffix}", "frames": len(ms), "median_ms": medians[-1],
                      "p99_ms": p99s[-1], "added_median_ms": medians[-1] - medians[0],
                      "added_p99_ms": p99s[-1] - p99s[0], "realtime_factor": float(np.mean(rtfs))})  # fmt: skip
     return rows
@@ -261,7 +275,14 @@ def _recovery_row(settings: Settings) -> dict[str, Any]:
 
 def run(settings: Settings, quick: bool) -> list[dict[str, Any]]:
     seconds = 2.0 if quick else 6.0
-    rows = _latency_rows(settings, seconds, 1 if quick else 2)
+    rounds = 1 if quick else 2
+    normal = dataclasses.replace(settings.runtime, realtime_priority=0)
+    rows = _latency_rows(dataclasses.replace(settings, runtime=normal), seconds, rounds)
+    realtime = dataclasses.replace(settings.runtime, realtime_priority=settings.runtime.realtime_priority or 10)
+    spawn = multiprocessing.get_context("spawn")  # (never fork a process that has zenoh open)
+    with concurrent.futures.ProcessPoolExecutor(1, mp_context=spawn) as pool:
+        rows += pool.submit(_realtime_latency_rows, dataclasses.replace(settings, runtime=realtime), seconds,
+                            rounds).result()  # fmt: skip
     rows.append(_floor_row(settings, 200 if quick else 1000))
     n = 120 if quick else 600
     rows += [_throughput_row(settings, shm, n, 10.0 if quick else 20.0) for shm in (True, False)]

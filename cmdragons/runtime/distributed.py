@@ -32,6 +32,7 @@ nodes agree on what the others are without asking.
 from __future__ import annotations
 
 import json
+import os
 import sys
 import threading
 import time
@@ -42,13 +43,13 @@ from typing import Any, TextIO
 from cmdragons.messages import NodeControl, Tick
 from cmdragons.runtime.bus import Bus, Stage
 from cmdragons.runtime.match import OURS, THEIRS, Match, Opponent, Perception, match_summary, summary_stages, wiring
-from cmdragons.runtime.params import ROLES
+from cmdragons.runtime.params import ROLES, RuntimeParams
 from cmdragons.runtime.settings import Settings
 from cmdragons.runtime.stages import SimStage, SummaryCollector, Tap
 from cmdragons.runtime.zenoh_transport import LATEST_ONLY, ZenohTransport
 
-__all__ = ["ROLES", "MatchSpec", "node_roles", "rehearse", "role_of", "run_clock", "run_node",
-           "wait_for_processes", "write_summary"]
+__all__ = ["FRAME_PATH", "ROLES", "MatchSpec", "frame_path_priority", "node_roles", "rehearse", "role_of",
+           "run_clock", "run_node", "wait_for_processes", "write_summary"]
 
 
 
@@ -69,6 +70,25 @@ def role_of(stage: str, vision_with_sim: bool = False) -> str:
     if stage == "referee":
         return "referee"
     raise ValueError(f"no node runs stage {stage!r}")
+
+
+FRAME_PATH = ("sim", "vision", "team")  # the nodes a camera frame goes through to our commands
+
+
+def frame_path_priority(params: RuntimeParams, role: str) -> str | None:
+    """Put this process on the real-time scheduler (SCHED_FIFO at ``runtime.realtime_priority``) when
+    ``role`` is on the frame path and the setting is on; call it before zenoh opens, whose threads
+    inherit it. On a host shared with other work (another team, a logger, a build) a frame's stages
+    then run the moment it comes instead of waiting for a time slice. None, or the one line why it
+    could not be done (not Linux, not permitted: root or CAP_SYS_NICE)."""
+    if params.realtime_priority == 0 or role not in FRAME_PATH:
+        return None
+    try:
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(params.realtime_priority))
+    except (AttributeError, OSError) as exc:
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else "not on this system"
+        return f"runtime.realtime_priority: the real-time scheduler is not available ({reason}); normal priority"
+    return None
 
 
 def node_roles(opponent: Opponent, log: bool, vision_with_sim: bool = False) -> list[str]:

@@ -62,6 +62,8 @@ class RuntimeParams(Validated):
     settle_s: float = setting(0.5, lo=0.0, hi=60.0)  # every node up: subscriptions reach every publisher in this
     rehearsal_frames: int = setting(12, lo=0, hi=600)  # frames of a throwaway match a node plays before it is ready
     vision_with_sim: bool = False  # vision (or the truth perception) runs in the sim node; camera frames stay there
+    realtime_priority: int = setting(0, lo=0, hi=99)  # the frame path's nodes (sim, vision, team) on the real-time
+    # scheduler (SCHED_FIFO at this priority) so that other work on the host waits for them; 0: the normal scheduler
 
     def __post_init__(self) -> None:
         super().__post_init__()

@@ -272,3 +272,30 @@ def test_a_node_without_a_clock_says_so_and_not_while_the_clock_waits_for_others
         said[clock_there] = err.getvalue()
     assert "no match clock" in said[False] and "is the sim node running" in said[False]
     assert said[True] == ""
+
+
+_SCHEDULER_PROBE = """
+import dataclasses, os
+from cmdragons.runtime.distributed import frame_path_priority
+from cmdragons.runtime.params import RuntimeParams
+params = dataclasses.replace(RuntimeParams(), realtime_priority={priority})
+note = frame_path_priority(params, {role!r})
+print(os.sched_getscheduler(0) == os.SCHED_FIFO, os.sched_getparam(0).sched_priority, note)
+"""
+
+
+@pytest.mark.skipif(not hasattr(__import__("os"), "sched_setscheduler"), reason="no POSIX scheduler calls here")
+@pytest.mark.parametrize(("priority", "role"), [(0, "team"), (7, "opponent"), (7, "log"), (7, "team"), (7, "sim")])
+def test_the_frame_paths_nodes_go_on_the_real_time_scheduler_only_when_set(priority: int, role: str) -> None:
+    """In a process of its own (the setting changes the whole process): off by default, and never
+    for the nodes off the frame path; on, the process runs SCHED_FIFO at the priority, or, where the
+    system does not allow it, keeps the normal scheduler and says why in one line."""
+    out = subprocess.run([sys.executable, "-c", _SCHEDULER_PROBE.format(priority=priority, role=role)], cwd=ROOT,
+                         capture_output=True, text=True, check=True).stdout.split(maxsplit=2)  # fmt: skip
+    fifo, level, note = out[0] == "True", int(out[1]), out[2].strip()
+    if priority == 0 or role not in ("sim", "vision", "team"):
+        assert (fifo, note) == (False, "None")
+    elif fifo:
+        assert level == priority and note == "None"
+    else:
+        assert note.startswith("runtime.realtime_priority: the real-time scheduler is not available (")

@@ -181,3 +181,25 @@ def test_stop_keeps_every_robot_away_from_the_ball_and_slow_every_frame() -> Non
     assert worst["gap"] >= RULES.stop_distance_m
     assert not [e for e in calls if e.kind.startswith("stop_")]
     assert ref.command == "stop"
+
+
+@pytest.mark.parametrize(("blue", "spot", "taker"), [
+    (3, (-2.0, 2.8), (0.6, 0.0, math.pi)),  # by the touch line, the taker on the ball's far side: it swings round
+    (3, (1.0, 0.0), (-0.6, 0.0, 0.0)),  # straight behind the ball
+    (3, (3.0, -1.0), (0.3, 0.4, 0.0)),  # beside the ball, the goal ahead
+    (2, (-3.0, 0.5), (-0.4, -0.3, 0.0)),  # the taker our only field player: nobody else plays the ball after its kick
+])  # fmt: skip
+def test_our_free_kick_taker_touches_the_ball_once(blue: int, spot: tuple[float, float],
+                                                   taker: tuple[float, float, float]) -> None:
+    # the rules: the kicker of a restart may touch the ball again only after another robot has; the
+    # taker's first touch must be its kick (a push on the way takes the restart, the kick after it is a
+    # second touch), and after it the taker leaves the ball to others
+    w, ref, brain = scene(blue=blue, yellow=1)
+    w.place_robot("yellow", 0, w.field.half_length - 0.5 * R, 0.0, math.pi)  # their keeper, far from the ball
+    if blue > 2:
+        w.place_robot("blue", 2, -3.0, -2.0, 0.0)
+    w.place_robot("blue", 1, spot[0] + taker[0], spot[1] + taker[1], taker[2])
+    w.apply(ref.free_kick("blue", spot))
+    calls = play(w, ref, brain, 8.0)
+    assert ref.kicks >= 1, [e.kind for e in calls]  # the restart was taken by a kick
+    assert not [e for e in calls if e.kind == "double_touch"], [(e.t, e.kind, e.team, e.robot) for e in calls]

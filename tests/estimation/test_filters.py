@@ -284,3 +284,29 @@ def test_the_kernels_angle_wrap_agrees_with_the_geometry_s() -> None:
     assert np.all((w >= -math.pi) & (w <= math.pi))
     np.testing.assert_allclose(np.cos(w), np.cos(a[::97]), atol=1e-12)
     np.testing.assert_allclose(w, wrap_angle(a[::97]), atol=1e-12)
+
+
+@pytest.mark.parametrize("radius", [1.0, 1e-300, 3.7, 1e300])
+def test_the_kernels_fast_arctangent_is_within_its_bound_of_atan2(radius: float) -> None:
+    from numba import njit
+
+    from cmdragons.estimation import _kernels as K
+    from cmdragons.geometry import wrap_angle
+
+    @njit(cache=False)
+    def many(y: np.ndarray, x: np.ndarray) -> np.ndarray:
+        out = np.empty(y.shape[0])
+        for i in range(y.shape[0]):
+            out[i] = K.fast_atan2(y[i], x[i])
+        return out
+
+    # a dense grid of directions, the axes and the octants' edges among them exactly
+    a = np.concatenate([np.linspace(-math.pi, math.pi, 1_000_001), np.arange(-8, 9) * math.pi / 8])
+    y, x = radius * np.sin(a), radius * np.cos(a)
+    axes = np.array([[0.0, 1.0], [1.0, 0.0], [0.0, -1.0], [-1.0, 0.0], [1.0, 1.0], [-1.0, 1.0], [2.0, -1.0]]) * radius
+    y, x = np.concatenate([y, axes[:, 0]]), np.concatenate([x, axes[:, 1]])
+    got = many(y, x)
+    assert np.all(np.abs(got) <= math.pi)
+    assert float(np.max(np.abs(wrap_angle(got - np.arctan2(y, x))))) <= 2e-15  # rad, the docstring's bound
+    for yy, xx in [*axes, (0.0, 0.0), (-0.0, -1.0), (-0.0, 1.0)]:  # the zero vector, signed zeros
+        assert abs(K.fast_atan2(yy, xx) - math.atan2(yy, xx)) <= 4.5e-16

@@ -2,15 +2,18 @@
 one step (move, weigh, resample and regularise, estimate) in one call, with its own random stream.
 
 Poses (x, y, theta) in metres and radians, the world frame; odometry in the vehicle's frame, as in
-:mod:`cmdragons.estimation.models`. The particles are a cloud (n, 5): rows (x, y, theta, cos theta,
-sin theta), each heading's cosine and sine computed once where it changes (a move, a regularising
-draw) and read by the next move, the sightings' weights and the estimate's circular mean: the
-trigonometry of the cloud is most of a step's time. A ``numpy.random.Generator`` costs about 10 µs
-to hand to a kernel on every call, more than the step itself, so the filter seeds a stream of its
-own from its generator once: xoshiro256** (Blackman and Vigna 2018, "Scrambled linear pseudorandom number
-generators", §4), a uint64 state of four words, normal deviates from it by the ziggurat
-(Marsaglia and Tsang 2000, "The ziggurat method for generating random variables", 256 layers; the
-layer tables built once by :func:`ziggurat_tables`).
+:mod:`cmdragons.estimation.models`. The particles are a cloud (5, n): rows x, y, theta, cos theta,
+sin theta, one particle per column, so that each loop over the particles reads and writes
+contiguous rows and numba (LLVM) runs it in vector lanes. Each heading's cosine and sine are kept
+beside it and turned with it (:func:`_turn`: a rotation by the turn's Taylor series, no library
+call), the bearing's residual takes a polynomial arctangent (:func:`fast_atan2`), and the loops
+divide with ``error_model="numpy"`` (IEEE division: numba's default tests every divisor for zero
+to raise ZeroDivisionError, a branch that keeps a loop from vectorising; no divisor here is zero).
+A ``numpy.random.Generator`` costs about 10 µs to hand to a kernel on every call, more than the step
+itself, so the filter seeds a stream of its own from its generator once: xoshiro256** (Blackman and
+Vigna 2018, "Scrambled linear pseudorandom number generators", §4), a uint64 state of four words,
+normal deviates from it by the ziggurat (Marsaglia and Tsang 2000, "The ziggurat method for
+generating random variables", 256 layers; the layer tables built once by :func:`ziggurat_tables`).
 
 Plain-numpy references: :mod:`cmdragons.estimation._reference`, which draw the same deviates in
 the same order from :func:`normals` and :func:`uniforms`; a test keeps them in agreement.
@@ -186,7 +189,7 @@ def psd_factor(cov: np.ndarray) -> np.ndarray:
 
 @njit(cache=True)
 def gaussian_draws(low: np.ndarray, n: int, s: np.ndarray, zx: np.ndarray, zf: np.ndarray) -> np.ndarray:
-    """n draws L z (n, 3) of a 3-d Gaussian of lower-triangular factor L, z standard normal: one
+    """n draws L z (3, n) of a 3-d Gaussian of lower-triangular factor L, z standard normal: one
     deviate per non-zero column of L (a zero pivot's column is all zero), draw after draw, in column
     order. The deviates are drawn in one loop first: drawn inside the loop over the draws, each
     would pay numba's reference counting of the stream's arrays, several times the deviate."""
@@ -197,7 +200,7 @@ def gaussian_draws(low: np.ndarray, n: int, s: np.ndarray, zx: np.ndarray, zf: n
             cols[m] = j
             m += 1
     z = normals(s, zx, zf, n * m)
-    out = np.empty((n, 3))
+    out = np.empty((3, n))
     l00, l10, l11, l20, l21, l22 = low[0, 0], low[1, 0], low[1, 1], low[2, 0], low[2, 1], low[2, 2]
     for k in range(n):
         z0 = z1 = z2 = 0.0
@@ -209,9 +212,9 @@ def gaussian_draws(low: np.ndarray, n: int, s: np.ndarray, zx: np.ndarray, zf: n
                 z1 = v
             else:
                 z2 = v
-        out[k, 0] = l00 * z0
-        out[k, 1] = l10 * z0 + l11 * z1
-        out[k, 2] = l20 * z0 + l21 * z1 + l22 * z2
+        out[0, k] = l00 * z0
+        out[1, k] = l10 * z0 + l11 * z1
+        out[2, k] = l20 * z0 + l21 * z1 + l22 * z2
     return out
 
 
@@ -268,14 +271,14 @@ def _turn(cloud: np.ndarray, k: int, d: float) -> bool:
     drift). Returns False, the cosine and sine left stale, when |d| > ``TAYLOR_TURN``: the caller
     sets those by :func:`_recompute_turns` (a library call in this loop would keep numba from
     vectorising it)."""
-    cloud[k, 2] = wrap(cloud[k, 2] + d)
+    cloud[2, k] = wrap(cloud[2, k] + d)
     d2 = d * d
     cd = 1.0 + d2 * (-1.0 / 2.0 + d2 * (1.0 / 24.0 + d2 * (-1.0 / 720.0 + d2 * (1.0 / 40320.0))))
     sd = d * (1.0 + d2 * (-1.0 / 6.0 + d2 * (1.0 / 120.0 + d2 * (-1.0 / 5040.0 + d2 * (1.0 / 362880.0)))))
-    c, s = cloud[k, 3], cloud[k, 4]
+    c, s = cloud[3, k], cloud[4, k]
     c, s = c * cd - s * sd, s * cd + c * sd
     g = 0.5 * (3.0 - c * c - s * s)
-    cloud[k, 3], cloud[k, 4] = c * g, s * g
+    cloud[3, k], cloud[4, k] = c * g, s * g
     return abs(d) <= TAYLOR_TURN
 
 
@@ -283,29 +286,29 @@ def _turn(cloud: np.ndarray, k: int, d: float) -> bool:
 def _recompute_turns(cloud: np.ndarray, turns: np.ndarray) -> None:
     """The cosine and sine of the headings of the particles whose turn ``turns`` (n,) exceeded
     ``TAYLOR_TURN``, from the library (rare: a turn that large is not a step's odometry)."""
-    for k in range(cloud.shape[0]):
+    for k in range(cloud.shape[1]):
         if abs(turns[k]) > TAYLOR_TURN:
-            cloud[k, 3], cloud[k, 4] = math.cos(cloud[k, 2]), math.sin(cloud[k, 2])
+            cloud[3, k], cloud[4, k] = math.cos(cloud[2, k]), math.sin(cloud[2, k])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def move(cloud: np.ndarray, u: np.ndarray, low: np.ndarray, s: np.ndarray, zx: np.ndarray, zf: np.ndarray) -> None:
     """Each particle composed with the odometry ``u`` (3,) plus its own noise L z, z standard
     normal, one deviate per non-zero column of L in column order (none for a zero column)."""
-    e = gaussian_draws(low, cloud.shape[0], s, zx, zf)
+    e = gaussian_draws(low, cloud.shape[1], s, zx, zf)
     small = True
-    for k in range(cloud.shape[0]):
-        dx, dy = u[0] + e[k, 0], u[1] + e[k, 1]
-        c, sn = cloud[k, 3], cloud[k, 4]
-        cloud[k, 0] += c * dx - sn * dy
-        cloud[k, 1] += sn * dx + c * dy
-        e[k, 2] += u[2]
-        small &= _turn(cloud, k, e[k, 2])
+    for k in range(cloud.shape[1]):
+        dx, dy = u[0] + e[0, k], u[1] + e[1, k]
+        c, sn = cloud[3, k], cloud[4, k]
+        cloud[0, k] += c * dx - sn * dy
+        cloud[1, k] += sn * dx + c * dy
+        e[2, k] += u[2]
+        small &= _turn(cloud, k, e[2, k])
     if not small:
-        _recompute_turns(cloud, e[:, 2])
+        _recompute_turns(cloud, e[2])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def weigh(cloud: np.ndarray, log_l: np.ndarray, lx: float, ly: float, z_range: float, z_bearing: float,
           r_inv: np.ndarray) -> None:  # fmt: skip
     """Adds to ``log_l`` each particle's log-likelihood (less its constant) of a sighting of the
@@ -315,10 +318,10 @@ def weigh(cloud: np.ndarray, log_l: np.ndarray, lx: float, ly: float, z_range: f
     sighting's, theta + z_bearing: one arctangent of their cross and dot products, already wrapped."""
     a, b, c = r_inv[0, 0], r_inv[0, 1] + r_inv[1, 0], r_inv[1, 1]
     cz, sz = math.cos(z_bearing), math.sin(z_bearing)
-    for k in range(cloud.shape[0]):
-        dx, dy = lx - cloud[k, 0], ly - cloud[k, 1]
+    for k in range(cloud.shape[1]):
+        dx, dy = lx - cloud[0, k], ly - cloud[1, k]
         er = z_range - math.sqrt(dx * dx + dy * dy)
-        cs, ss = cloud[k, 3] * cz - cloud[k, 4] * sz, cloud[k, 4] * cz + cloud[k, 3] * sz  # theta + z_bearing
+        cs, ss = cloud[3, k] * cz - cloud[4, k] * sz, cloud[4, k] * cz + cloud[3, k] * sz  # theta + z_bearing
         eb = fast_atan2(ss * dx - cs * dy, cs * dx + ss * dy)
         log_l[k] -= 0.5 * (a * er * er + b * er * eb + c * eb * eb)
 
@@ -354,7 +357,7 @@ def reweigh(weights: np.ndarray, log_l: np.ndarray) -> float:
 def resample(cloud: np.ndarray, weights: np.ndarray, start: float, out: np.ndarray) -> None:
     """Systematic (low-variance) resampling into ``out``: the n positions (start + i) / n, ``start``
     uniform in [0, 1), each picks the particle whose cumulative weight first reaches it."""
-    n, m = cloud.shape
+    m, n = cloud.shape
     k, cum = 0, weights[0]
     for i in range(n):
         pos = (start + i) / n
@@ -362,25 +365,25 @@ def resample(cloud: np.ndarray, weights: np.ndarray, start: float, out: np.ndarr
             k += 1
             cum += weights[k]
         for j in range(m):
-            out[i, j] = cloud[k, j]
+            out[j, i] = cloud[j, k]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def cloud_estimate(cloud: np.ndarray, weights: np.ndarray, mean: np.ndarray, cov: np.ndarray) -> None:
     """The cloud's weighted mean pose into ``mean`` (3,) (the heading's circular mean) and its
     weighted covariance about it into ``cov`` (3, 3) (heading differences wrapped)."""
     sx = sy = ss = sc = 0.0
-    for k in range(cloud.shape[0]):
+    for k in range(cloud.shape[1]):
         w = weights[k]
-        sx += w * cloud[k, 0]
-        sy += w * cloud[k, 1]
-        sc += w * cloud[k, 3]
-        ss += w * cloud[k, 4]
+        sx += w * cloud[0, k]
+        sy += w * cloud[1, k]
+        sc += w * cloud[3, k]
+        ss += w * cloud[4, k]
     mean[0], mean[1], mean[2] = sx, sy, math.atan2(ss, sc)
     cov[:, :] = 0.0
-    for k in range(cloud.shape[0]):
+    for k in range(cloud.shape[1]):
         w = weights[k]
-        ex, ey, et = cloud[k, 0] - sx, cloud[k, 1] - sy, wrap(cloud[k, 2] - mean[2])
+        ex, ey, et = cloud[0, k] - sx, cloud[1, k] - sy, wrap(cloud[2, k] - mean[2])
         cov[0, 0] += w * ex * ex
         cov[0, 1] += w * ex * ey
         cov[0, 2] += w * ex * et
@@ -390,18 +393,18 @@ def cloud_estimate(cloud: np.ndarray, weights: np.ndarray, mean: np.ndarray, cov
     cov[1, 0], cov[2, 0], cov[2, 1] = cov[0, 1], cov[0, 2], cov[1, 2]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def regularise(cloud: np.ndarray, low: np.ndarray, s: np.ndarray, zx: np.ndarray, zf: np.ndarray) -> None:
     """Each particle moved by its own draw L z of the regularisation kernel (L L^T its covariance;
     one deviate per non-zero column of L)."""
-    e = gaussian_draws(low, cloud.shape[0], s, zx, zf)
+    e = gaussian_draws(low, cloud.shape[1], s, zx, zf)
     small = True
-    for k in range(cloud.shape[0]):
-        cloud[k, 0] += e[k, 0]
-        cloud[k, 1] += e[k, 1]
-        small &= _turn(cloud, k, e[k, 2])
+    for k in range(cloud.shape[1]):
+        cloud[0, k] += e[0, k]
+        cloud[1, k] += e[1, k]
+        small &= _turn(cloud, k, e[2, k])
     if not small:
-        _recompute_turns(cloud, e[:, 2])
+        _recompute_turns(cloud, e[2])
 
 
 @njit(cache=True)
@@ -412,7 +415,7 @@ def correct(cloud: np.ndarray, weights: np.ndarray, seen: np.ndarray, r_inv: np.
     :func:`resample` (``scratch`` the cloud's shape, its work space) and :func:`regularise` by
     ``bandwidth`` (h) times the factor of the cloud's covariance before resampling. Returns whether
     it resampled."""
-    n = cloud.shape[0]
+    n = cloud.shape[1]
     if seen.shape[0] == 0:
         return False
     log_l = np.zeros(n)

@@ -316,7 +316,8 @@ class ParticleLocalisation:
         poses = self.rng.multivariate_normal(np.asarray(start, dtype=np.float64),
                                              np.asarray(start_cov, dtype=np.float64), size=n)  # fmt: skip
         poses[:, 2] = wrap_angle(poses[:, 2])
-        self.cloud = np.column_stack([poses, np.cos(poses[:, 2]), np.sin(poses[:, 2])])  # the kernels' rows
+        # the kernels' layout: one row per quantity (x, y, theta, cos theta, sin theta), the particles along it
+        self.cloud = np.vstack([poses.T, np.cos(poses[:, 2]), np.sin(poses[:, 2])])
         self.weights = np.full(n, 1.0 / n)
         self.R_inv = np.linalg.inv(np.asarray(sensor_cov, dtype=np.float64))
         self.stream = K.seed_stream(self.rng)
@@ -329,7 +330,7 @@ class ParticleLocalisation:
     @property
     def particles(self) -> FloatArray:
         """The particles' poses (n, 3), a view of the cloud."""
-        return self.cloud[:, :3]
+        return self.cloud[:3].T
 
     def _seen(self, sightings: list[Sighting]) -> FloatArray:
         """The sightings as the kernels take them: rows (landmark x, y, range, bearing)."""

@@ -58,6 +58,10 @@ ZIGGURAT_TAIL = 3.6541528853610088
 _LAYERS = 256
 
 _TWO_PI = 2.0 * math.pi
+# LLVM flags for the kernels that sum over the particles: sums reassociated into vector lanes (the
+# result moves in the last bits with the lanes' count, the same on every run of one machine) and
+# multiply-adds fused; no assumption that values are finite
+_SUMS = {"reassoc", "contract"}
 
 
 @njit(cache=True, inline="always")
@@ -326,7 +330,7 @@ def weigh(cloud: np.ndarray, log_l: np.ndarray, lx: float, ly: float, z_range: f
         log_l[k] -= 0.5 * (a * er * er + b * er * eb + c * eb * eb)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", fastmath=_SUMS)
 def reweigh(weights: np.ndarray, log_l: np.ndarray) -> float:
     """``weights`` times the likelihoods exp(``log_l``), scaled to sum 1; returns their effective
     sample size 1 / sum w^2. Through the largest log-likelihood, and when the products underflow
@@ -368,7 +372,7 @@ def resample(cloud: np.ndarray, weights: np.ndarray, start: float, out: np.ndarr
             out[j, i] = cloud[j, k]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", fastmath=_SUMS)
 def cloud_estimate(cloud: np.ndarray, weights: np.ndarray, mean: np.ndarray, cov: np.ndarray) -> None:
     """The cloud's weighted mean pose into ``mean`` (3,) (the heading's circular mean) and its
     weighted covariance about it into ``cov`` (3, 3) (heading differences wrapped)."""
@@ -379,17 +383,21 @@ def cloud_estimate(cloud: np.ndarray, weights: np.ndarray, mean: np.ndarray, cov
         sy += w * cloud[1, k]
         sc += w * cloud[3, k]
         ss += w * cloud[4, k]
-    mean[0], mean[1], mean[2] = sx, sy, math.atan2(ss, sc)
-    cov[:, :] = 0.0
+    theta = math.atan2(ss, sc)
+    mean[0], mean[1], mean[2] = sx, sy, theta
+    # sums in locals: written into cov in the loop, they would be stored and reloaded every pass
+    # (cov might alias the cloud as far as the compiler knows), which keeps it from vectorising
+    xx = xy = xt = yy = yt = tt = 0.0
     for k in range(cloud.shape[1]):
         w = weights[k]
-        ex, ey, et = cloud[0, k] - sx, cloud[1, k] - sy, wrap(cloud[2, k] - mean[2])
-        cov[0, 0] += w * ex * ex
-        cov[0, 1] += w * ex * ey
-        cov[0, 2] += w * ex * et
-        cov[1, 1] += w * ey * ey
-        cov[1, 2] += w * ey * et
-        cov[2, 2] += w * et * et
+        ex, ey, et = cloud[0, k] - sx, cloud[1, k] - sy, wrap(cloud[2, k] - theta)
+        xx += w * ex * ex
+        xy += w * ex * ey
+        xt += w * ex * et
+        yy += w * ey * ey
+        yt += w * ey * et
+        tt += w * et * et
+    cov[0, 0], cov[0, 1], cov[0, 2], cov[1, 1], cov[1, 2], cov[2, 2] = xx, xy, xt, yy, yt, tt
     cov[1, 0], cov[2, 0], cov[2, 1] = cov[0, 1], cov[0, 2], cov[1, 2]
 
 

@@ -35,7 +35,6 @@ __all__ = [
     "fast_atan2",
     "gaussian_draws",
     "move",
-    "normal",
     "normals",
     "particle_step",
     "psd_factor",
@@ -100,59 +99,71 @@ def _rotl(x: np.uint64, k: int) -> np.uint64:
 
 
 @njit(cache=True, inline="always")
-def _next(s: np.ndarray) -> np.uint64:
-    """The stream's next 64 bits (xoshiro256**); advances ``s``."""
-    out = _rotl(s[1] * uint64(5), 7) * uint64(9)
-    t = s[1] << uint64(17)
-    s[2] ^= s[0]
-    s[3] ^= s[1]
-    s[1] ^= s[2]
-    s[0] ^= s[3]
-    s[2] ^= t
-    s[3] = _rotl(s[3], 45)
-    return out
+def _xoshiro(s0: np.uint64, s1: np.uint64, s2: np.uint64, s3: np.uint64) -> tuple[np.uint64, ...]:
+    """xoshiro256**: the next 64 bits of the state (s0, s1, s2, s3), and the advanced state."""
+    out = _rotl(s1 * uint64(5), 7) * uint64(9)
+    t = s1 << uint64(17)
+    s2 ^= s0
+    s3 ^= s1
+    s1 ^= s2
+    s0 ^= s3
+    s2 ^= t
+    s3 = _rotl(s3, 45)
+    return out, s0, s1, s2, s3
+
+
+@njit(cache=True, inline="always")
+def _unit(bits: np.uint64) -> float:
+    """A uniform deviate in [0, 1) from the top 53 of 64 bits."""
+    return float(bits >> uint64(11)) * (1.0 / 9007199254740992.0)
 
 
 @njit(cache=True, inline="always")
 def uniform(s: np.ndarray) -> float:
-    """A uniform deviate in [0, 1) from the stream's top 53 bits."""
-    return float(_next(s) >> uint64(11)) * (1.0 / 9007199254740992.0)
-
-
-@njit(cache=True, inline="always")
-def normal(s: np.ndarray, zx: np.ndarray, zf: np.ndarray) -> float:
-    """A standard normal deviate by the ziggurat over the tables ``zx``, ``zf`` of
-    :func:`ziggurat_tables`: one 64-bit draw gives the layer (low 8 bits), the sign (bit 8) and the
-    position along the layer (top 53 bits); about 99% land inside the curve at once. A draw beyond
-    the bottom layer's edge r goes to the tail, sampled by Marsaglia's (1964) method: a = -ln(U1) / r
-    accepted when -2 ln(U2) > a^2 gives r + a. (One loop for both: numba keeps reference-count
-    calls on the arrays in every pass of a loop nested in an inlined kernel, ten times the draw.)"""
-    tail = False
-    while True:
-        bits = _next(s)
-        u = float(bits >> uint64(11)) * (1.0 / 9007199254740992.0)
-        negative = (bits >> uint64(8)) & uint64(1) == uint64(1)
-        if tail:
-            a = -math.log(1.0 - u) / ZIGGURAT_TAIL
-            if -2.0 * math.log(1.0 - uniform(s)) > a * a:
-                return -(ZIGGURAT_TAIL + a) if negative else ZIGGURAT_TAIL + a
-            continue
-        i = int(bits & uint64(0xFF))
-        x: float = u * zx[i]
-        if x < zx[i + 1]:
-            return -x if negative else x
-        if i == 0:
-            tail = True
-        elif zf[i] + uniform(s) * (zf[i + 1] - zf[i]) < math.exp(-0.5 * x * x):
-            return -x if negative else x
+    """A uniform deviate in [0, 1) from the stream ``s`` (4,); advances it."""
+    bits, s[0], s[1], s[2], s[3] = _xoshiro(s[0], s[1], s[2], s[3])
+    return _unit(bits)
 
 
 @njit(cache=True)
 def normals(s: np.ndarray, zx: np.ndarray, zf: np.ndarray, n: int) -> np.ndarray:
-    """``n`` standard normal deviates from the stream, in order (for the references and tests)."""
+    """``n`` standard normal deviates from the stream ``s``, in order, by the ziggurat over the
+    tables ``zx``, ``zf`` of :func:`ziggurat_tables`: one 64-bit draw gives the layer (low 8 bits),
+    the sign (bit 8) and the position along the layer (top 53 bits); about 99% land inside the curve
+    at once, the others test the layer's wedge against the density with a second draw. A draw beyond
+    the bottom layer's edge r goes to the tail, sampled by Marsaglia's (1964) method: a = -ln(U1) / r
+    accepted when -2 ln(U2) > a^2 gives r + a. The stream's state is held in locals for the whole
+    batch and written back at the end (read and written through the array on every draw, it costs
+    about as much as the draw)."""
     out = np.empty(n)
-    for k in range(n):
-        out[k] = normal(s, zx, zf)
+    s0, s1, s2, s3 = s[0], s[1], s[2], s[3]
+    k = 0
+    tail = False
+    while k < n:
+        bits, s0, s1, s2, s3 = _xoshiro(s0, s1, s2, s3)
+        u = _unit(bits)
+        sign = -1.0 if (bits >> uint64(8)) & uint64(1) == uint64(1) else 1.0
+        if tail:
+            a = -math.log(1.0 - u) / ZIGGURAT_TAIL
+            bits, s0, s1, s2, s3 = _xoshiro(s0, s1, s2, s3)
+            if -2.0 * math.log(1.0 - _unit(bits)) > a * a:
+                out[k] = sign * (ZIGGURAT_TAIL + a)
+                k += 1
+                tail = False
+            continue
+        i = int(bits & uint64(0xFF))
+        x = u * zx[i]
+        if x < zx[i + 1]:
+            out[k] = sign * x
+            k += 1
+        elif i == 0:
+            tail = True
+        else:
+            bits, s0, s1, s2, s3 = _xoshiro(s0, s1, s2, s3)
+            if zf[i] + _unit(bits) * (zf[i + 1] - zf[i]) < math.exp(-0.5 * x * x):
+                out[k] = sign * x
+                k += 1
+    s[0], s[1], s[2], s[3] = s0, s1, s2, s3
     return out
 
 

@@ -247,6 +247,7 @@ def test_the_particle_step_kernel_agrees_with_its_numpy_reference(seed: int) -> 
 
     run = simulate_run(seed=seed, steps=60, odometry_sigma=ODOMETRY_SIGMA, max_sightings=2)
     pf = ParticleLocalisation(run.landmarks, run.truth[0], START_COV, run.sensor_cov, n=300, seed=seed)
+    assert pf.cloud.flags.c_contiguous  # one row per quantity, contiguous: the kernels' loops vectorise over it
     zx, zf = K.ziggurat_tables()
     resampled = 0
     for k in range(len(run.odometry)):
@@ -310,3 +311,35 @@ def test_the_kernels_fast_arctangent_is_within_its_bound_of_atan2(radius: float)
     assert float(np.max(np.abs(wrap_angle(got - np.arctan2(y, x))))) <= 2e-15  # rad, the docstring's bound
     for yy, xx in [*axes, (0.0, 0.0), (-0.0, -1.0), (-0.0, 1.0)]:  # the zero vector, signed zeros
         assert abs(K.fast_atan2(yy, xx) - math.atan2(yy, xx)) <= 4.5e-16
+
+
+@pytest.mark.parametrize("kind", ["random", "one", "first_and_last", "sparse"])
+def test_the_branch_free_systematic_resampling_picks_as_a_search_of_the_cumulative_weights(kind: str) -> None:
+    from cmdragons.estimation import _kernels as K
+
+    rng = np.random.default_rng(7)
+    n = 400
+    w = {"random": rng.random(n), "one": np.eye(n)[123], "first_and_last": np.eye(n)[0] + np.eye(n)[-1],
+         "sparse": rng.random(n) * (rng.random(n) < 0.05)}[kind]  # fmt: skip
+    w = w / w.sum()
+    cloud = np.ascontiguousarray(np.vstack([np.arange(n, dtype=np.float64)] * 5))  # each particle's row: its index
+    out = np.empty_like(cloud)
+    for start in (0.0, 0.37, 0.999999):
+        K.resample(cloud, w, start, out)
+        expected = np.minimum(np.searchsorted(np.cumsum(w), (start + np.arange(n)) / n), n - 1)
+        np.testing.assert_array_equal(out, np.vstack([expected] * 5))
+
+
+def test_the_kernels_exponential_is_within_an_ulp_of_the_library_s() -> None:
+    from cmdragons.estimation import _kernels as K
+
+    x = np.concatenate([np.linspace(-760.0, 760.0, 400_001), [0.0, -708.0, 708.0, -745.2, -1e300, math.log(2) / 2]])
+    out = np.empty_like(x)
+    K.exps(x, 0.0, out)
+    ref = np.array([math.exp(v) if v < math.log(np.finfo(float).max) else math.inf for v in x])
+    normal = np.abs(x) <= 708.0
+    assert float(np.max(np.abs(out[normal] - ref[normal]) / np.spacing(ref[normal]))) <= 1.0
+    np.testing.assert_array_equal(out[~normal], ref[~normal])  # the library's beyond +-708
+    shifted = np.empty(5)
+    K.exps(np.array([1.0, 2.0, 3.0, 4.0, 5.0]), 5.0, shifted)  # as the reweighing calls it: x - max
+    np.testing.assert_allclose(shifted, np.exp(np.arange(-4.0, 1.0)), rtol=2.3e-16)

@@ -317,7 +317,8 @@ class ParticleLocalisation:
                                              np.asarray(start_cov, dtype=np.float64), size=n)  # fmt: skip
         poses[:, 2] = wrap_angle(poses[:, 2])
         # the kernels' layout: one row per quantity (x, y, theta, cos theta, sin theta), the particles along it
-        self.cloud = np.vstack([poses.T, np.cos(poses[:, 2]), np.sin(poses[:, 2])])
+        # (C order: a stack of the poses' transpose would be Fortran-ordered, each row strided)
+        self.cloud = np.ascontiguousarray(np.vstack([poses.T, np.cos(poses[:, 2]), np.sin(poses[:, 2])]))
         self.weights = np.full(n, 1.0 / n)
         self.R_inv = np.linalg.inv(np.asarray(sensor_cov, dtype=np.float64))
         self.stream = K.seed_stream(self.rng)

@@ -21,7 +21,7 @@ from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, Team
 from cmdragons.messages import BallState, GameState, RobotState
 from strategy.defense import DefenseParams, clear_target
-from strategy.skills import Intent, SkillParams, goalie_block, intercept, kick_to, pass_speed
+from strategy.skills import Intent, SkillParams, goalie_block, intercept, kick_to, pass_speed, waiting_point
 
 __all__ = [
     "GameStateParams",
@@ -282,7 +282,7 @@ def penalty_shot(robot: RobotState, ball: BallState, attack_sign: float, keeper:
     centre = math.atan2(-ball.y, goal_x - ball.x)
     behind = skills.contact_m + skills.approach_distance_m
     if not ready:
-        return Intent(ball.x - behind * math.cos(centre), ball.y - behind * math.sin(centre), centre)
+        return Intent(*waiting_point(ball, centre, skills), centre)
     # hands off while it rolls: behind it on its way, far enough back to line up afresh
     speed = math.hypot(ball.vx, ball.vy)
     way = math.atan2(ball.vy, ball.vx) if speed > p.penalty_rest_m_s else centre

@@ -31,6 +31,7 @@ __all__ = [
     "pass_speed",
     "receive",
     "set_kick",
+    "waiting_point",
 ]
 
 
@@ -122,6 +123,13 @@ def go_to_pose(x: float, y: float, theta: float, max_speed: float | None = None)
     return Intent(x, y, theta, max_speed_m_s=max_speed)
 
 
+def waiting_point(ball: BallState, aim: float, p: SkillParams) -> tuple[float, float]:
+    """Where a kicker waits, lined up, before driving through the ball along ``aim`` (rad): its
+    centre ``contact_m + approach_distance_m`` behind the ball's on the kick line."""
+    behind = p.contact_m + p.approach_distance_m
+    return ball.x - math.cos(aim) * behind, ball.y - math.sin(aim) * behind
+
+
 def kick_to(robot: RobotState, ball: BallState, target: tuple[float, float], speed: float, p: SkillParams,
             chip: bool = False) -> Intent:  # fmt: skip
     """Get behind the ball on the line to ``target``, then drive through it with the kicker armed."""
@@ -142,7 +150,7 @@ def kick_to(robot: RobotState, ball: BallState, target: tuple[float, float], spe
     if lined_up or at_ball:
         return drive_through(ball, aim, speed, p, chip)
     behind = contact + p.approach_distance_m
-    px, py = ball.x - c * behind, ball.y - s * behind
+    px, py = waiting_point(ball, aim, p)
     if along > -contact and abs(across) < behind:
         # on the wrong side of the ball: swing around it at a safe distance first
         side = 1.0 if across >= 0 else -1.0
@@ -166,8 +174,7 @@ def set_kick(robot: RobotState, ball: BallState, target: tuple[float, float], sp
     aim = intent.theta
     sliding = abs(-robot.vx * math.sin(aim) + robot.vy * math.cos(aim)) > p.set_settle_m_s
     if not intent.avoid_ball and sliding:  # lined up but still sliding across: settle at the waiting point first
-        behind = p.contact_m + p.approach_distance_m
-        intent = Intent(ball.x - math.cos(aim) * behind, ball.y - math.sin(aim) * behind, aim)
+        intent = Intent(*waiting_point(ball, aim, p), aim)
     if intent.avoid_ball and math.hypot(robot.x - ball.x, robot.y - ball.y) < p.set_near_m:
         intent = dataclasses.replace(intent, max_speed_m_s=p.set_approach_m_s)
     return dataclasses.replace(intent, kick_speed=speed, chip=False)

@@ -143,8 +143,8 @@ def _embedded_latencies(settings: Settings, seconds: float) -> tuple[list[float]
 
 def _latency_rows(settings: Settings, seconds: float, rounds: int, suffix: str = "") -> list[dict[str, Any]]:
     """The three set-ups in turn, ``rounds`` times (the machine's load drifts: each set-up meets
-    it alike), their frames pooled; each on the scheduler of ``settings.runtime.realtime_priority``
-    (the nodes' processes: the process of this one has it already)."""
+    it alike), their frames pooled. The nodes start on the scheduler of
+    ``settings.runtime.realtime_priority``; this process stays on the one it runs on."""
     setups: dict[str, Callable[[], tuple[list[float], float]]] = {
         "in_process": lambda: _embedded_latencies(settings, seconds),
         "zenoh": lambda: _zenoh_latencies(settings, seconds, vision_with_sim=False),

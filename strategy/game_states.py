@@ -59,7 +59,8 @@ class GameStateParams(Validated):
     placement_take_speed_m_s: float = setting(0.3, lo=0.05, hi=5.0)  # ... driving onto it this slowly ...
     placement_take_m: float = setting(0.3, lo=0.0, hi=2.0)  # ... from this far (face to ball centre) ...
     placement_press_m: float = setting(0.03, lo=0.0, hi=0.1)  # ... aiming this far into it
-    placement_grip_m: float = setting(0.015, lo=0.001, hi=0.1)  # the ball this near the face's middle: held
+    placement_grip_m: float = setting(0.015, lo=0.001, hi=0.1)  # the ball this near the face's middle ...
+    placement_grip_s: float = setting(0.25, lo=0.0, hi=2.0)  # ... this long, pressed on meanwhile: held
     placement_rest_m_s: float = setting(0.05, lo=0.0, hi=1.0)  # let go only of a ball this slow
     placement_held_rest_m_s: float = setting(0.15, lo=0.0, hi=1.0)  # ... or held, the robot this slow
     placement_line_m: float = setting(0.65, lo=0.5, hi=3.0)  # rule: 0.5 m off the placement's line, plus margin
@@ -223,37 +224,43 @@ def keep_off_line(intents: Mapping[int, Intent], start: tuple[float, float], end
 
 
 def place_ball(robot: RobotState, ball: BallState, target: tuple[float, float], skills: SkillParams,
-               p: GameStateParams, held: bool = False) -> tuple[Intent, bool]:  # fmt: skip
+               p: GameStateParams, t: float,
+               grip_since: float | None = None) -> tuple[Intent, float | None]:  # fmt: skip
     """Ball placement by one robot: take the ball on the dribbler from where the robot stands (no
     going round it: a ball by the line or past it is pulled back), carry it without turning until
     it lies within ``placement_done_m`` of ``target``, let go, and back off slowly to
-    ``placement_back_m`` from it. ``held``: the ball was held the frame before (it stays held until
-    it is ``dribble_hold_m`` off the face: a ball in the robot's mouth is seen late); returns the
-    intent and whether the ball is held now."""
+    ``placement_back_m`` from it. ``grip_since``: when (``t``, s) the ball was first seen on the
+    face, None when it was not the frame before. The robot presses on until it has been there
+    ``placement_grip_s`` (a ball by the robot is seen a centimetre or so off: seen on the face, it
+    may not be on the dribbler yet, and a carry backwards would leave it behind); from then on it
+    counts as held until it is ``dribble_hold_m`` off the face (a ball in the robot's mouth is seen
+    late). Returns the intent and the new ``grip_since``."""
     off = math.hypot(ball.x - target[0], ball.y - target[1])
     contact = skills.contact_m
     c, s = math.cos(robot.theta), math.sin(robot.theta)
-    # held: the ball against the middle of the face (tighter than the dribble skill's test: a carry
-    # that starts without the grip walks away from the ball)
+    # on the face: the ball against its middle (tighter than the dribble skill's test: a carry that
+    # starts without the grip walks away from the ball), looser once it is held
     face_gap = math.hypot(ball.x - (robot.x + c * contact), ball.y - (robot.y + s * contact))
-    on_face = face_gap < p.placement_grip_m or (held and face_gap < skills.dribble_hold_m)
+    held = grip_since is not None and t - grip_since >= p.placement_grip_s
+    on_face = face_gap < (skills.dribble_hold_m if held else p.placement_grip_m)
+    grip_since = (t if grip_since is None else grip_since) if on_face else None
     # a ball on the face moves as the robot does, whose speed the cameras see only to a few cm/s
     resting = math.hypot(ball.vx, ball.vy) < (p.placement_held_rest_m_s if on_face else p.placement_rest_m_s)
     if (off <= p.placement_done_m and resting) or (off <= p.placement_near_m and not on_face):
         away = math.atan2(robot.y - ball.y, robot.x - ball.x)
         reach = contact + p.placement_back_m
         return Intent(ball.x + reach * math.cos(away), ball.y + reach * math.sin(away), robot.theta,
-                      allow_any_defense=True, max_speed_m_s=p.placement_back_speed_m_s), False  # fmt: skip
-    if on_face:  # carry: the robot where the ball lies on the target, facing as it does
+                      allow_any_defense=True, max_speed_m_s=p.placement_back_speed_m_s), None  # fmt: skip
+    if held and on_face:  # carry: the robot where the ball lies on the target, facing as it does
         return Intent(target[0] - c * contact, target[1] - s * contact, robot.theta, dribbler=skills.hold_dribbler,
                       avoid_ball=False, allow_any_defense=True,
-                      max_speed_m_s=p.placement_carry_speed_m_s), True  # fmt: skip
+                      max_speed_m_s=p.placement_carry_speed_m_s), grip_since  # fmt: skip
     heading = math.atan2(ball.y - robot.y, ball.x - robot.x)
     near = math.hypot(ball.x - robot.x, ball.y - robot.y) < contact + p.placement_take_m
     reach = contact - p.placement_press_m  # a little into the ball: the face meets it before the robot stops
     return Intent(ball.x - math.cos(heading) * reach, ball.y - math.sin(heading) * reach, heading,
                   dribbler=skills.hold_dribbler, avoid_ball=False, allow_any_defense=True,
-                  max_speed_m_s=p.placement_take_speed_m_s if near else None), False  # fmt: skip
+                  max_speed_m_s=p.placement_take_speed_m_s if near else None), grip_since  # fmt: skip
 
 
 def behind_ball(intents: Mapping[int, Intent], ball: BallState, attack_sign: float, pitch: Field,

@@ -100,7 +100,7 @@ class Strategy:
         self.attacker = Attacker(pitch, params.kicking, params.passing, params.skills, params.obstacle_radius_m)
         self.frame = 0
         self.last_action: dict[int, str] = {}  # robot id -> "shot", "pass" or "clear": what its kick is for
-        self._placing: int | None = None  # the robot holding the ball it places
+        self._placing: tuple[int, float] | None = None  # the robot placing the ball, since when it has it on its face
         self._taker: int | None = None  # the kicker of our kickoff or free kick under way
         self._barred: int | None = None  # our restart's taker, until another robot touched the ball
 
@@ -138,7 +138,7 @@ class Strategy:
         intents = self._normal(world.t, own, opp, ball, own_sign, restart)
         self._taker = self._role_robot(ATTACKER) if restart else None
         if game.command == "ball_placement" and game.placement is not None:
-            return self._placement(intents, own, ball, game.placement, ours, own_sign)
+            return self._placement(world.t, intents, own, ball, game.placement, ours, own_sign)
         if game.command == "penalty":
             return self._penalty(intents, own, opp, ball, game, ours, own_sign)
         kicker = next((rid for rid, role in self.roles.roles.items() if role == ATTACKER), None)
@@ -167,7 +167,7 @@ class Strategy:
     def _role_robot(self, role: Role) -> int | None:
         return next((rid for rid, r in self.roles.roles.items() if r == role), None)
 
-    def _placement(self, intents: dict[int, Intent], own: Mapping[int, RobotState], ball: BallState,
+    def _placement(self, t: float, intents: dict[int, Intent], own: Mapping[int, RobotState], ball: BallState,
                    target: tuple[float, float], ours: bool, own_sign: float) -> dict[int, Intent]:  # fmt: skip
         """Ball placement: ours, the robot nearest the ball (the goalie only when alone) places it
         and the others keep off its way; theirs, everyone keeps off the line to the target."""
@@ -180,8 +180,9 @@ class Strategy:
         others = {rid: it for rid, it in intents.items() if rid != carrier}
         others = keep_off_line(others, (ball.x, ball.y), target, f, gs, p.robot_radius_m)
         out = dict(keep_away(others, ball, f, own_sign, gs, p.robot_radius_m, kickoff=False, slow=False))
-        out[carrier], held = place_ball(own[carrier], ball, target, p.skills, gs, self._placing == carrier)
-        self._placing = carrier if held else None
+        since = self._placing[1] if self._placing is not None and self._placing[0] == carrier else None
+        out[carrier], since = place_ball(own[carrier], ball, target, p.skills, gs, t, since)
+        self._placing = None if since is None else (carrier, since)
         return out
 
     def _penalty(self, intents: dict[int, Intent], own: Mapping[int, RobotState], opp: list[RobotState],

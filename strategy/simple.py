@@ -63,7 +63,7 @@ def steer(team: Team, rid: int, x: float, y: float, theta: float, it: Intent, p:
 class SimpleTeam:
     def __init__(self, team: Team, pitch: Field, params: SimpleTeamParams, strategy: StrategyParams) -> None:
         self.team, self.field, self.p, self.sp = team, pitch, params, strategy
-        self._placing: int | None = None  # the robot holding the ball it places
+        self._placing: tuple[int, float] | None = None  # the robot placing the ball, since when it has it on its face
 
     def commands(self, world: WorldState, game: GameState) -> list[RobotCommand]:
         f = self.field
@@ -105,9 +105,10 @@ class SimpleTeam:
         elif game.command == "ball_placement" and game.placement is not None:
             intents = keep_off_line(intents, (ball.x, ball.y), game.placement, f, gs, radius)
             if ours and field_players:
-                intents[chaser.id], held = place_ball(chaser, ball, game.placement, self.sp.skills, gs,
-                                                      self._placing == chaser.id)  # fmt: skip
-                self._placing = chaser.id if held else None
+                pl = self._placing
+                since = pl[1] if pl is not None and pl[0] == chaser.id else None
+                intents[chaser.id], since = place_ball(chaser, ball, game.placement, self.sp.skills, gs, world.t, since)
+                self._placing = None if since is None else (chaser.id, since)
         elif game.command == "penalty":
             intents = self._penalty(intents, own, world, ball, game.ready, ours, own_sign)
         return [steer(self.team, r.id, r.x, r.y, r.theta, intents[r.id], self.p) for r in own]

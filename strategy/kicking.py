@@ -54,6 +54,8 @@ class KickParams(Validated):
     contest_turn_rad: float = setting(0.6, lo=0.0, hi=3.2)  # a contested ball is kicked at most this far off
     stall_s: float = setting(2.0, lo=0.0, hi=60.0)  # a contested ball that lay still this long is driven through
     stall_moved_m: float = setting(0.05, lo=0.0, hi=1.0)  # ... lying still: within this of where it was
+    area_margin_m: float = setting(0.05, lo=0.0, hi=1.0)  # a ball met this near their defense area is left alone ...
+    area_wait_m: float = setting(0.15, lo=0.0, hi=2.0)  # ... the attacker waiting by it, its edge this far off the area
 
 
 class KickKind(enum.Enum):
@@ -62,6 +64,7 @@ class KickKind(enum.Enum):
     SHOT = "shot"
     PASS = "pass"
     CLEAR = "clear"
+    WAIT = "wait"  # no kick: the ball is theirs to play (in their defense area)
 
 
 @dataclass(frozen=True)
@@ -171,6 +174,11 @@ class Attacker:
         Returns the intent and what the kick is for."""
         p, skills = self.p, self.skills
         met = intercept(robot, ball, skills, self.field)
+        if self.field.in_defense_area(met.x, met.y, p.area_margin_m) == int(attack_sign):
+            # the rules: an attacker touching the ball in their defense area is a foul; their keeper plays it
+            passes.cancel()
+            x, y = self.field.free_kick_spot(met.x, met.y, skills.robot_radius_m + p.area_wait_m)
+            return Intent(x, y, math.atan2(ball.y - y, ball.x - x)), KickKind.WAIT
         kick = decide_kick(met, robot.id, own, supporters, passes, opponents, self.field, attack_sign, self.radius, p,
                            self.passing, skills)  # fmt: skip
         if kick.kind is KickKind.PASS and kick.receiver is not None:

@@ -32,7 +32,7 @@ def _decide(ball: BallState, own: dict[int, RobotState], supporters: list[int], 
 
 
 def test_the_kinds_keep_the_match_statistics_names() -> None:
-    assert [k.value for k in KickKind] == ["shot", "pass", "clear"]
+    assert [k.value for k in KickKind] == ["shot", "pass", "clear", "wait"]
 
 
 def test_an_open_goal_near_by_is_shot_at_full_speed() -> None:
@@ -133,3 +133,33 @@ def test_a_contested_ball_lying_still_is_driven_through_after_the_stall_time() -
     assert after.kick_speed == K.clear_speed_m_s and not after.avoid_ball  # through the ball from its side
     assert abs(math.remainder(after.theta - math.pi, 2 * math.pi)) == pytest.approx(K.contest_turn_rad)
     assert passes.current is None
+
+
+@pytest.mark.parametrize(("ball", "robot"), [
+    (BallState(FIELD.half_length - 0.5, 0.3, 0.0, 0.0), (FIELD.half_length - 1.5, 0.3)),  # deep in their area
+    (BallState(FIELD.half_length - FIELD.dims.defense_depth_m - 0.03, 0.5, 0.0, 0.0),  # just outside: the margin
+     (FIELD.half_length - 1.6, 0.5)),
+    (BallState(FIELD.half_length - 1.6, 0.2, 1.5, 0.0), (FIELD.half_length - 1.4, -0.8)),  # rolling into it
+])  # fmt: skip
+def test_a_ball_in_or_at_their_defense_area_is_left_to_them(ball: BallState, robot: tuple[float, float]) -> None:
+    """The rules: an attacker touching the ball in the opponent's defense area is a foul. The attacker
+    waits by the area, facing the ball, its edge ``area_wait_m`` off it."""
+    attacker, passes = _attacker(), PassPlay(PassPlayParams())
+    r = _robot(1, *robot)
+    attacker.watch(0.0, ball)
+    intent, kind = attacker.play(0.0, r, {1: r}, [], NONE, ball, 1.0, passes)
+    assert kind is KickKind.WAIT and intent.avoid_ball and intent.kick_speed == 0.0
+    assert FIELD.in_defense_area(intent.x, intent.y, SKILLS.robot_radius_m + K.area_wait_m - 1e-9) == 0
+    assert FIELD.in_defense_area(intent.x, intent.y, SKILLS.robot_radius_m + K.area_wait_m + 0.01) == 1  # by it
+    assert intent.theta == pytest.approx(math.atan2(ball.y - intent.y, ball.x - intent.x))
+    assert passes.current is None
+
+
+def test_a_ball_clear_of_their_defense_area_is_played() -> None:
+    attacker, passes = _attacker(), PassPlay(PassPlayParams())
+    ball = BallState(FIELD.half_length - FIELD.dims.defense_depth_m - K.area_margin_m - 0.02, 0.5, 0.0, 0.0)
+    r = _robot(1, ball.x - 0.5, 0.5)
+    attacker.watch(0.0, ball)
+    intent, kind = attacker.play(0.0, r, {1: r}, [], NONE, ball, 1.0, passes)
+    assert kind is KickKind.SHOT  # lining up behind the ball for it
+    assert math.hypot(intent.x - ball.x, intent.y - ball.y) < 0.5 and intent.x < ball.x

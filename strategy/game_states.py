@@ -42,9 +42,9 @@ __all__ = [
 
 @dataclass(frozen=True)
 class GameStateParams(Validated):
-    stop_distance_m: float = setting(0.65, lo=0.5, hi=3.0)  # rule: 0.5 m from the ball in a stop, plus margin
+    stop_distance_m: float = setting(0.7, lo=0.5, hi=3.0)  # rule: 0.5 m from the ball in a stop, plus margin
     stop_speed_m_s: float = setting(1.2, lo=0.1, hi=5.0)  # rule: 1.5 m/s in a stop, minus margin
-    center_circle_margin_m: float = setting(0.15, lo=0.0, hi=2.0)  # kept outside the centre circle at kickoffs
+    center_circle_margin_m: float = setting(0.2, lo=0.0, hi=2.0)  # kept outside the centre circle at kickoffs
     halfway_margin_m: float = setting(0.05, lo=0.0, hi=1.0)  # robots' edge this far on our side of the halfway line
     free_spot_steps: int = setting(12, lo=1, hi=180)  # the circle round the ball searched in steps of pi / this
     hold_depth_share: float = setting(0.3, lo=0.0, hi=1.0)  # no ball: the shape starts this share of our half deep

@@ -130,6 +130,17 @@ def test_ball_placement_backwards_with_the_ball_seen_nearer_than_it_is() -> None
     assert math.hypot(x - target[0], y - target[1]) <= RULES.placement_tolerance_m
 
 
+def test_the_keep_away_places_lie_outside_the_paths_keep_away_circle() -> None:
+    """In a stop and at their restarts the paths keep ``keep_away_clearance_m`` (plus the ball's
+    radius) off the ball. The places the strategy sends robots to (the stop's distance, the centre
+    circle at their kickoff) lie outside that circle: a place inside it has no path, and the robot
+    follows an approximate one that cut across the circle to 0.49 m from the ball at their kickoff."""
+    keep = SETTINGS.team.brain.keep_away_clearance_m + SETTINGS.field.ball.radius_m
+    gs = SETTINGS.strategy.game_states
+    assert gs.stop_distance_m > keep
+    assert SETTINGS.field.dims.center_circle_radius_m + gs.center_circle_margin_m > keep
+
+
 def test_penalty_scores_against_a_still_keeper() -> None:
     w, ref, brain = scene(blue=3, yellow=1)
     w.place_robot("yellow", 0, w.field.half_length - 0.5 * R, 0.0, math.pi)  # on its goal line, still

@@ -65,6 +65,9 @@ class StrategyParams(Validated):
     game_states: GameStateParams = GameStateParams()
     ball_room_m: float = setting(0.35, lo=0.0, hi=3.0)  # team-mates leave the ball handler this much room
     touched_m: float = setting(0.03, lo=0.0, hi=0.5)  # a robot's body this near the ball's has touched it
+    barred_near_m: float = setting(1.0, lo=0.0, hi=10.0)  # our restart's kicker this near the rolling ball ...
+    barred_clear_m: float = setting(0.4, lo=0.0, hi=3.0)  # ... steps this far off its line
+    barred_rolling_m_s: float = setting(0.3, lo=0.0, hi=10.0)  # ... while it rolls this fast
 
     @property
     def robot_radius_m(self) -> float:
@@ -87,6 +90,25 @@ class StrategyParams(Validated):
 
 def _facing_ball(x: float, y: float, ball: BallState) -> Intent:
     return Intent(x, y, math.atan2(ball.y - y, ball.x - x))
+
+
+def off_ball_line(robot: RobotState, intent: Intent, ball: BallState, pitch: Field, radius: float, near_m: float,
+                  clear_m: float, rolling_m_s: float) -> Intent:  # fmt: skip
+    """A robot that may not touch the ball (our restart's kicker, the rules' double touch) within
+    ``near_m`` of it while it rolls faster than ``rolling_m_s``: sideways out of its way, ``clear_m``
+    off its line on the robot's side, facing it (going its own way it ran alongside the ball and
+    into it); its ``intent`` otherwise."""
+    speed = math.hypot(ball.vx, ball.vy)
+    if speed < rolling_m_s or math.hypot(robot.x - ball.x, robot.y - ball.y) > near_m:
+        return intent
+    ux, uy = ball.vx / speed, ball.vy / speed
+    rx, ry = robot.x - ball.x, robot.y - ball.y
+    along, side = rx * ux + ry * uy, ux * ry - uy * rx  # side > 0: left of the ball's way
+    lateral = math.copysign(max(abs(side), clear_m), side if side != 0.0 else 1.0)
+    lim_x, lim_y = pitch.half_length - radius, pitch.half_width - radius
+    x = max(-lim_x, min(lim_x, ball.x + along * ux - lateral * uy))
+    y = max(-lim_y, min(lim_y, ball.y + along * uy + lateral * ux))
+    return _facing_ball(x, y, ball)
 
 
 class Strategy:
@@ -279,4 +301,7 @@ class Strategy:
         others = {rid: it for rid, it in out.items() if roles.get(rid) not in _BALL_PLAYERS or rid == self._barred}
         out.update(keep_away(others, ball, f, own_sign, p.game_states, p.robot_radius_m, kickoff=False, slow=False,
                              distance_m=p.ball_room_m))  # fmt: skip
+        if self._barred in out:  # whatever its role, it must not meet the ball it kicked on its way
+            out[self._barred] = off_ball_line(own[self._barred], out[self._barred], ball, f, p.robot_radius_m,
+                                              p.barred_near_m, p.barred_clear_m, p.barred_rolling_m_s)  # fmt: skip
         return out

@@ -11,8 +11,9 @@ from cmdragons.config import ConfigError, parse
 from cmdragons.geometry import Field, LeagueParams
 from cmdragons.messages import BallState, GameState, RobotState, WorldState
 from strategy.defense import DefenseParams
-from strategy.plays import Strategy, StrategyParams
+from strategy.plays import Strategy, StrategyParams, off_ball_line
 from strategy.roles import Role, RoleKind
+from strategy.skills import Intent
 
 GOALIE = Role(RoleKind.GOALIE)
 
@@ -152,3 +153,32 @@ def test_out_of_range_settings_are_refused_by_name(section: str, key: str, value
     raw = {section: {key: value}}
     with pytest.raises(ConfigError, match=f"{section}.{key}"):
         parse(StrategyParams, raw, file="strategy.yaml")
+
+
+@pytest.mark.parametrize(("robot", "expected"), [
+    ((0.3, 0.1), (0.3, 0.4)),  # beside the rolling ball's way: sideways to clear_m off it
+    ((-0.3, -0.2), (-0.3, -0.4)),  # behind it, on its right: likewise, on that side
+    ((0.5, -0.6), (0.5, -0.6)),  # already clear of its way: stays
+])  # fmt: skip
+def test_the_restart_kicker_steps_out_of_the_rolling_balls_way(robot: tuple[float, float],
+                                                               expected: tuple[float, float]) -> None:  # fmt: skip
+    p = StrategyParams()
+    ball = BallState(0.0, 0.0, 1.5, 0.0)
+    r = RobotState("blue", 1, *robot, 0.0)
+    away = Intent(3.0, 0.0, 0.0)  # its own way: along the ball's, into it
+    it = off_ball_line(r, away, ball, FIELD, p.robot_radius_m, p.barred_near_m, p.barred_clear_m, p.barred_rolling_m_s)
+    assert (it.x, it.y) == pytest.approx(expected, abs=1e-9)
+    assert it.avoid_ball and it.theta == pytest.approx(math.atan2(-it.y, -it.x))
+
+
+@pytest.mark.parametrize(("robot", "ball"), [
+    ((0.3, 0.1), BallState(0.0, 0.0, 0.2, 0.0)),  # the ball (nearly) at rest
+    ((1.5, 0.1), BallState(0.0, 0.0, 1.5, 0.0)),  # the robot far from it
+])  # fmt: skip
+def test_the_restart_kicker_goes_its_way_by_a_ball_at_rest_or_far(robot: tuple[float, float],
+                                                                  ball: BallState) -> None:  # fmt: skip
+    p = StrategyParams()
+    away = Intent(3.0, 0.0, 0.0)
+    r = RobotState("blue", 1, *robot, 0.0)
+    it = off_ball_line(r, away, ball, FIELD, p.robot_radius_m, p.barred_near_m, p.barred_clear_m, p.barred_rolling_m_s)
+    assert it is away

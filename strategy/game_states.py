@@ -35,6 +35,7 @@ __all__ = [
     "own_goal_sign",
     "penalty_rush",
     "penalty_shot",
+    "Placing",
     "place_ball",
     "restart_rules",
 ]
@@ -223,44 +224,62 @@ def keep_off_line(intents: Mapping[int, Intent], start: tuple[float, float], end
     return out
 
 
+@dataclass(frozen=True)
+class Placing:
+    """One robot's ball placement from frame to frame: which robot, since when (s) it has seen the
+    ball on its face (None: not), and whether it has let the ball go at the target."""
+
+    robot: int
+    grip_since: float | None = None
+    released: bool = False
+
+
 def place_ball(robot: RobotState, ball: BallState, target: tuple[float, float], skills: SkillParams,
-               p: GameStateParams, t: float,
-               grip_since: float | None = None) -> tuple[Intent, float | None]:  # fmt: skip
+               p: GameStateParams, t: float, state: Placing | None = None) -> tuple[Intent, Placing]:  # fmt: skip
     """Ball placement by one robot: take the ball on the dribbler from where the robot stands (no
     going round it: a ball by the line or past it is pulled back), carry it without turning until
     it lies within ``placement_done_m`` of ``target``, let go, and back off slowly to
-    ``placement_back_m`` from it. ``grip_since``: when (``t``, s) the ball was first seen on the
-    face, None when it was not the frame before. The robot presses on until it has been there
-    ``placement_grip_s`` (a ball by the robot is seen a centimetre or so off: seen on the face, it
-    may not be on the dribbler yet, and a carry backwards would leave it behind); from then on it
-    counts as held until it is ``dribble_hold_m`` off the face (a ball in the robot's mouth is seen
-    late). Returns the intent and the new ``grip_since``."""
+    ``placement_back_m`` from it. ``state``: the frame before's (None or another robot's: a new
+    placement); returns the intent and the state now.
+
+    The robot presses on until it has seen the ball on its face ``placement_grip_s`` (a ball by a
+    robot is seen a centimetre or so off: seen on the face, it may not be on the dribbler yet, and a
+    carry backwards would leave it behind); from then on it counts as held until it is
+    ``dribble_hold_m`` off the face (a ball in the robot's mouth is seen late). Once it let go, it
+    backs off whatever it sees while the ball lies within ``placement_near_m`` of the target (the
+    tracker keeps a ball in a robot's mouth with it: backing off, the ball is seen to follow it)."""
+    if state is None or state.robot != robot.id:
+        state = Placing(robot.id)
     off = math.hypot(ball.x - target[0], ball.y - target[1])
     contact = skills.contact_m
     c, s = math.cos(robot.theta), math.sin(robot.theta)
     # on the face: the ball against its middle (tighter than the dribble skill's test: a carry that
     # starts without the grip walks away from the ball), looser once it is held
     face_gap = math.hypot(ball.x - (robot.x + c * contact), ball.y - (robot.y + s * contact))
-    held = grip_since is not None and t - grip_since >= p.placement_grip_s
+    held = state.grip_since is not None and t - state.grip_since >= p.placement_grip_s
     on_face = face_gap < (skills.dribble_hold_m if held else p.placement_grip_m)
-    grip_since = (t if grip_since is None else grip_since) if on_face else None
+    grip_since = (t if state.grip_since is None else state.grip_since) if on_face else None
     # a ball on the face moves as the robot does, whose speed the cameras see only to a few cm/s
     resting = math.hypot(ball.vx, ball.vy) < (p.placement_held_rest_m_s if on_face else p.placement_rest_m_s)
-    if (off <= p.placement_done_m and resting) or (off <= p.placement_near_m and not on_face):
+    let_go = (state.released and off <= p.placement_near_m) or (off <= p.placement_done_m and resting) \
+        or (off <= p.placement_near_m and not on_face)  # fmt: skip
+    if let_go:
         away = math.atan2(robot.y - ball.y, robot.x - ball.x)
         reach = contact + p.placement_back_m
         return Intent(ball.x + reach * math.cos(away), ball.y + reach * math.sin(away), robot.theta,
-                      allow_any_defense=True, max_speed_m_s=p.placement_back_speed_m_s), None  # fmt: skip
+                      allow_any_defense=True, max_speed_m_s=p.placement_back_speed_m_s), \
+            Placing(robot.id, None, released=True)  # fmt: skip
+    state = Placing(robot.id, grip_since)
     if held and on_face:  # carry: the robot where the ball lies on the target, facing as it does
         return Intent(target[0] - c * contact, target[1] - s * contact, robot.theta, dribbler=skills.hold_dribbler,
                       avoid_ball=False, allow_any_defense=True,
-                      max_speed_m_s=p.placement_carry_speed_m_s), grip_since  # fmt: skip
+                      max_speed_m_s=p.placement_carry_speed_m_s), state  # fmt: skip
     heading = math.atan2(ball.y - robot.y, ball.x - robot.x)
     near = math.hypot(ball.x - robot.x, ball.y - robot.y) < contact + p.placement_take_m
     reach = contact - p.placement_press_m  # a little into the ball: the face meets it before the robot stops
     return Intent(ball.x - math.cos(heading) * reach, ball.y - math.sin(heading) * reach, heading,
                   dribbler=skills.hold_dribbler, avoid_ball=False, allow_any_defense=True,
-                  max_speed_m_s=p.placement_take_speed_m_s if near else None), grip_since  # fmt: skip
+                  max_speed_m_s=p.placement_take_speed_m_s if near else None), state  # fmt: skip
 
 
 def behind_ball(intents: Mapping[int, Intent], ball: BallState, attack_sign: float, pitch: Field,

@@ -25,6 +25,7 @@ from strategy.defense import DefenseParams, defender_slots, goalie
 from strategy.evaluation import PassParams
 from strategy.game_states import (
     GameStateParams,
+    Placing,
     behind_ball,
     halt,
     hold_shape,
@@ -122,7 +123,7 @@ class Strategy:
         self.attacker = Attacker(pitch, params.kicking, params.passing, params.skills, params.obstacle_radius_m)
         self.frame = 0
         self.last_action: dict[int, str] = {}  # robot id -> "shot", "pass" or "clear": what its kick is for
-        self._placing: tuple[int, float] | None = None  # the robot placing the ball, since when it has it on its face
+        self._placing: Placing | None = None  # our ball placement, frame to frame
         self._taker: int | None = None  # the kicker of our kickoff or free kick under way
         self._barred: int | None = None  # our restart's taker, until another robot touched the ball
 
@@ -202,9 +203,7 @@ class Strategy:
         others = {rid: it for rid, it in intents.items() if rid != carrier}
         others = keep_off_line(others, (ball.x, ball.y), target, f, gs, p.robot_radius_m)
         out = dict(keep_away(others, ball, f, own_sign, gs, p.robot_radius_m, kickoff=False, slow=False))
-        since = self._placing[1] if self._placing is not None and self._placing[0] == carrier else None
-        out[carrier], since = place_ball(own[carrier], ball, target, p.skills, gs, t, since)
-        self._placing = None if since is None else (carrier, since)
+        out[carrier], self._placing = place_ball(own[carrier], ball, target, p.skills, gs, t, self._placing)
         return out
 
     def _penalty(self, intents: dict[int, Intent], own: Mapping[int, RobotState], opp: list[RobotState],

@@ -21,6 +21,7 @@ from cmdragons.messages import BallState, GameState, RobotCommand, RobotState, W
 from strategy.defense import ball_to_clear, clear_target
 from strategy.evaluation import clearest_direction
 from strategy.game_states import (
+    Placing,
     behind_ball,
     keep_away,
     keep_off_line,
@@ -63,7 +64,7 @@ def steer(team: Team, rid: int, x: float, y: float, theta: float, it: Intent, p:
 class SimpleTeam:
     def __init__(self, team: Team, pitch: Field, params: SimpleTeamParams, strategy: StrategyParams) -> None:
         self.team, self.field, self.p, self.sp = team, pitch, params, strategy
-        self._placing: tuple[int, float] | None = None  # the robot placing the ball, since when it has it on its face
+        self._placing: Placing | None = None  # its ball placement, frame to frame
 
     def commands(self, world: WorldState, game: GameState) -> list[RobotCommand]:
         f = self.field
@@ -105,10 +106,8 @@ class SimpleTeam:
         elif game.command == "ball_placement" and game.placement is not None:
             intents = keep_off_line(intents, (ball.x, ball.y), game.placement, f, gs, radius)
             if ours and field_players:
-                pl = self._placing
-                since = pl[1] if pl is not None and pl[0] == chaser.id else None
-                intents[chaser.id], since = place_ball(chaser, ball, game.placement, self.sp.skills, gs, world.t, since)
-                self._placing = None if since is None else (chaser.id, since)
+                placed = place_ball(chaser, ball, game.placement, self.sp.skills, gs, world.t, self._placing)
+                intents[chaser.id], self._placing = placed
         elif game.command == "penalty":
             intents = self._penalty(intents, own, world, ball, game.ready, ours, own_sign)
         return [steer(self.team, r.id, r.x, r.y, r.theta, intents[r.id], self.p) for r in own]

@@ -130,6 +130,38 @@ def test_ball_placement_backwards_with_the_ball_seen_nearer_than_it_is() -> None
     assert math.hypot(x - target[0], y - target[1]) <= RULES.placement_tolerance_m
 
 
+def test_ball_placement_lets_go_with_the_ball_seen_to_follow_the_robot() -> None:
+    """The tracker keeps a ball in a robot's mouth with the robot: backing off from the ball it
+    placed, the placer sees it on its face, moving as it does, for a while. Once it has let go it
+    backs off all the same, its dribbler off (it had taken the ball again each time it saw it
+    there, and placed it over and over until the time ran out)."""
+    hold = 0.17  # the ball seen on the face of a robot whose centre is this near it (beyond the rules' clearance)
+
+    def follows(world: WorldState) -> WorldState:
+        b = world.ball
+        r = min((r for r in world.robots if r.team == "blue"), key=lambda r: math.hypot(r.x - b.x, r.y - b.y))
+        if math.hypot(r.x - b.x, r.y - b.y) >= hold:
+            return world
+        contact = SETTINGS.strategy.skills.contact_m
+        face = (r.x + contact * math.cos(r.theta), r.y + contact * math.sin(r.theta))
+        return dataclasses.replace(world, ball=BallState(*face, r.vx, r.vy))
+
+    dribbler: list[float] = []
+    w, ref, brain = scene(blue=3, yellow=1)
+    w.place_robot("blue", 1, 0.56, 1.8, math.pi / 2)
+    w.place_ball(0.56, 2.2)
+    target = (0.56, 2.8)
+    ref.start_placement("blue", target)
+    calls = play(w, ref, brain, RULES.placement_time_s + 1.0, see=follows,
+                 each=lambda w, ref: dribbler.append(brain.plans[1].intent.dribbler),
+                 until=lambda c: any(e.kind.startswith("placement_") for e in c))  # fmt: skip
+    assert [e.kind for e in calls if e.kind.startswith("placement_")] == ["placement_succeeded"]
+    x, y = w.ball_body.position
+    assert math.hypot(x - target[0], y - target[1]) <= RULES.placement_tolerance_m
+    let_go = next(k for k, d in enumerate(dribbler) if k > 0 and d == 0.0 and dribbler[k - 1] > 0.0)
+    assert max(dribbler[let_go:]) == 0.0  # not taken again
+
+
 def test_the_keep_away_places_lie_outside_the_paths_keep_away_circle() -> None:
     """In a stop and at their restarts the paths keep ``keep_away_clearance_m`` (plus the ball's
     radius) off the ball. The places the strategy sends robots to (the stop's distance, the centre

@@ -48,6 +48,7 @@ class GameStateParams(Validated):
     center_circle_margin_m: float = setting(0.2, lo=0.0, hi=2.0)  # kept outside the centre circle at kickoffs
     halfway_margin_m: float = setting(0.05, lo=0.0, hi=1.0)  # robots' edge this far on our side of the halfway line
     free_spot_steps: int = setting(12, lo=1, hi=180)  # the circle round the ball searched in steps of pi / this
+    area_clear_m: float = setting(0.05, lo=0.0, hi=1.0)  # ... for a place this far outside the defense areas
     hold_depth_share: float = setting(0.3, lo=0.0, hi=1.0)  # no ball: the shape starts this share of our half deep
     hold_row_m: float = setting(0.4, lo=0.0, hi=3.0)  # ... its rows this far apart
     hold_rows: int = setting(3, lo=1, hi=11)
@@ -157,12 +158,16 @@ def keep_away(intents: Mapping[int, Intent], ball: BallState, pitch: Field, own_
             if d < 1e-6:
                 dx, dy, d = own_sign, 0.0, 1.0
             # the nearest point of the circle around the ball that lies on the field (where the cameras see us)
+            # and outside the defense areas the robot may not enter (a place in one has no path: the robot
+            # stops at the area's edge, by the ball)
             lim_x, lim_y = pitch.half_length - radius, pitch.half_width - radius
+            allowed = int(own_sign) if it.allow_own_defense else 0
             base = math.atan2(dy, dx)
             steps = p.free_spot_steps
             for turn in (0.0, *(sign * k * math.pi / steps for k in range(1, steps + 1) for sign in (1.0, -1.0))):
                 x, y = ball.x + d_min * math.cos(base + turn), ball.y + d_min * math.sin(base + turn)
-                if abs(x) <= lim_x and abs(y) <= lim_y:
+                if abs(x) <= lim_x and abs(y) <= lim_y \
+                        and pitch.in_defense_area(x, y, radius + p.area_clear_m) in (0, allowed):  # fmt: skip
                     break
         out[rid] = Intent(x, y, it.theta, dribbler=0.0, avoid_ball=True, allow_own_defense=it.allow_own_defense,
                           max_speed_m_s=p.stop_speed_m_s if slow else it.max_speed_m_s)  # fmt: skip

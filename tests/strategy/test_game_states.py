@@ -66,6 +66,24 @@ def test_keep_away_holds_the_distance_on_the_field(seed: int, kickoff: bool) -> 
             assert it.x < 0.0 and math.hypot(it.x, it.y) >= CIRCLE + RADIUS
 
 
+@pytest.mark.parametrize("ball", [(-4.31, 1.31), (-4.31, -1.31), (-3.3, 0.0), (4.31, 1.1), (3.3, -0.5)])
+def test_keep_away_places_no_one_in_a_defense_area_it_may_not_enter(ball: tuple[float, float]) -> None:
+    """A free kick by a defense area: the places round the ball that lie in an area (with the
+    robot's radius and ``area_clear_m``) are skipped; the goalie may stay in ours."""
+    b = BallState(*ball, 0.0, 0.0)
+    # defenders' places round the area's edge (outside it), on the ball's side of the field
+    edge = FIELD.half_length - FIELD.dims.defense_depth_m - RADIUS - 0.15
+    wide = FIELD.dims.defense_width_m / 2 + RADIUS + 0.15
+    places = [(edge, -0.6), (edge, 0.0), (edge, 0.6), (3.8, wide), (4.2, wide), (3.8, -wide), (4.2, -wide)]
+    toward_area = {k: Intent(math.copysign(x, ball[0]), y, 0.0) for k, (x, y) in enumerate(places)}
+    goalie = Intent(-FIELD.half_length + 0.2, ball[1] * 0.3, 0.0, allow_own_defense=True)
+    out = keep_away({**toward_area, 9: goalie}, b, FIELD, -1.0, P, RADIUS, kickoff=False, slow=True)
+    for rid, it in out.items():
+        assert math.hypot(it.x - b.x, it.y - b.y) >= P.stop_distance_m + RADIUS - 1e-9
+        side = FIELD.in_defense_area(it.x, it.y, RADIUS + P.area_clear_m - 1e-9)
+        assert side == 0 or (rid == 9 and side == -1)
+
+
 def test_at_our_kickoff_all_but_the_kicker_stay_in_our_half_outside_the_circle() -> None:
     intents = _intents(np.random.default_rng(7), 8)
     intents[0] = Intent(0.1, 0.05, 0.0, kick_speed=3.0)  # the kicker at the ball

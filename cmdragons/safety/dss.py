@@ -55,6 +55,12 @@ class DSSParams(Validated):
     random_samples: int = setting(40, lo=0, hi=1000)  # random points of A(v) per searching robot
     scales: tuple[float, ...] = setting((0.75, 0.5, 0.25), lo=0.0, hi=1.0)  # shorter versions of the command
     rotations_deg: tuple[float, ...] = setting((20.0, 45.0, 90.0, 135.0), lo=0.0, hi=180.0)  # turned both ways
+    # the rules' crash: toward an opponent, a robot's speed along the line between them is held to what
+    # braking at crash_brake_share of max_brake_m_s2 over the gap (less crash_latency_s of closing) brings
+    # down to this closing speed, less the opponent's own speed toward it, at contact (0: no hold)
+    crash_closing_m_s: float = setting(1.0, lo=0.0, hi=10.0)
+    crash_brake_share: float = setting(0.75, lo=0.01, hi=1.0)
+    crash_latency_s: float = setting(0.1, lo=0.0, hi=1.0)
 
 
 def heuristic_table(params: DSSParams) -> FloatArray:
@@ -64,6 +70,31 @@ def heuristic_table(params: DSSParams) -> FloatArray:
     for deg in params.rotations_deg:
         rows += [(1.0, math.radians(deg), 1.0), (1.0, -math.radians(deg), 1.0)]
     return np.array(rows, dtype=np.float64).reshape(-1, 3)
+
+
+def crash_hold(states: FloatArray, velocities: FloatArray, opponents: FloatArray, body_m: float, closing_m_s: float,
+               brake_m_s2: float, latency_s: float) -> FloatArray:  # fmt: skip
+    """The commands (n, 2) with each robot's speed toward each opponent held to ``sqrt(c**2 + 2 b g)``:
+    ``c`` the closing speed allowed at contact less the opponent's speed toward the robot, ``g`` the
+    gap between their bodies less ``latency_s`` of their closing speed now, ``b`` the braking. A
+    robot braking no harder than ``b`` then meets the opponent no faster than ``closing_m_s``, the
+    opponent's share included (the rules call a crash beyond 1.5 m/s, the faster robot at fault).
+    ``states`` (n, 4) and ``opponents`` (m, 4): x, y, vx, vy."""
+    out = np.array(velocities, dtype=np.float64, copy=True)
+    rel = opponents[None, :, :2] - states[:, None, :2]  # (n, m, 2)
+    dist = np.maximum(np.hypot(rel[..., 0], rel[..., 1]), 1e-9)
+    unit = rel / dist[..., None]
+    theirs = -np.einsum("mj,nmj->nm", opponents[:, 2:4], unit)  # each opponent's speed toward each robot
+    now = np.einsum("nj,nmj->nm", states[:, 2:4], unit) + theirs  # closing speeds now
+    gap = np.maximum(dist - body_m - latency_s * np.maximum(now, 0.0), 0.0)
+    allowed = np.sqrt(np.maximum(closing_m_s - np.maximum(theirs, 0.0), 0.0) ** 2 + 2.0 * brake_m_s2 * gap)
+    over = np.einsum("nj,nmj->nm", out, unit) > allowed
+    for i in np.flatnonzero(over.any(axis=1)):
+        for k in np.argsort(dist[i]):  # the nearest first: each hold only takes speed away
+            toward = float(out[i] @ unit[i, k])
+            if toward > allowed[i, k]:
+                out[i] -= (toward - allowed[i, k]) * unit[i, k]
+    return out
 
 
 class DynamicsSafetySearch(ArraySafety):
@@ -93,6 +124,7 @@ class DynamicsSafetySearch(ArraySafety):
             static_step=params.static_step_m,
         )  # fmt: skip
         self.heuristics = heuristic_table(params)
+        self.body_m = d  # centre to centre at contact
 
     def unit_samples(self, n: int) -> FloatArray:
         """(n, random_samples, 2) points uniform in the unit disc, one set per robot."""
@@ -122,7 +154,12 @@ class DynamicsSafetySearch(ArraySafety):
         else the velocity one period of the chosen acceleration reaches."""
         s = np.asarray(states, dtype=np.float64).reshape(-1, 4)
         v = np.asarray(velocities, dtype=np.float64).reshape(-1, 2)
-        acc, status, trs = self.search(s, v, opponents)
+        opp = np.asarray(opponents, dtype=np.float64).reshape(-1, 4)
+        p = self.params
+        if p.crash_closing_m_s > 0.0 and len(opp):
+            v = crash_hold(s, v, opp, self.body_m, p.crash_closing_m_s,
+                           p.crash_brake_share * self.motion.max_brake_m_s2, p.crash_latency_s)  # fmt: skip
+        acc, status, trs = self.search(s, v, opp)
         out = s[:, 2:4] + acc * self.motion.period_s
         out[status == K.KEPT] = v[status == K.KEPT]
         out[(status == K.STOPPED) | (status == K.STOP_ASKED)] = 0.0

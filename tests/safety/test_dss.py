@@ -212,3 +212,59 @@ def test_closed_loop_with_the_exact_model_never_brings_robots_too_close() -> Non
     assert closest >= limit - 1e-6
     assert statuses.count(CHANGED) > 20  # the search did real work
     assert np.linalg.norm(pos - goals, axis=1).max() < 0.05  # and everyone got through
+
+
+def test_crash_hold_caps_the_speed_toward_an_opponent_to_what_braking_brings_down() -> None:
+    from cmdragons.safety.dss import crash_hold
+
+    p = DSSParams()
+    brake = p.crash_brake_share * MOTION.max_brake_m_s2
+    body = 2 * RADIUS
+
+    def hold(state: list[float], command: list[float], opponent: list[float]) -> np.ndarray:
+        return crash_hold(np.array([state]), np.array([command]), np.array([opponent]), body, p.crash_closing_m_s,
+                          brake, p.crash_latency_s)[0]  # fmt: skip
+
+    # at the opponent's body, driving at it: the allowed closing speed
+    assert hold([0, 0, 3, 0], [3, 0], [body, 0, 0, 0]) == pytest.approx([p.crash_closing_m_s, 0.0])
+    # ... less what the opponent brings toward us
+    assert hold([0, 0, 3, 0], [3, 0], [body, 0, -0.4, 0]) == pytest.approx([p.crash_closing_m_s - 0.4, 0.0])
+    # sideways past it, or away from it: untouched
+    assert hold([0, 0, 0, 2], [0.3, 2.0], [body, 0, 0, 0]) == pytest.approx([0.3, 2.0])
+    assert hold([0, 0, -3, 0], [-3, 0], [body, 0, 0, 0]) == pytest.approx([-3.0, 0.0])
+    # 0.5 m of gap, the robot at rest: sqrt(c**2 + 2 b g)
+    gap = 0.5
+    expected = np.sqrt(p.crash_closing_m_s**2 + 2 * brake * gap)
+    assert hold([0, 0, 0, 0], [3, 0], [body + gap, 0, 0, 0])[0] == pytest.approx(expected)
+    # far away: untouched
+    assert hold([0, 0, 3, 0], [3, 0], [5.0, 0, 0, 0]) == pytest.approx([3.0, 0.0])
+
+
+@pytest.mark.parametrize("hold_on", [True, False])
+def test_a_robot_meets_an_opponent_that_turns_into_its_way_below_the_crash_speed(hold_on: bool) -> None:
+    """The rules' crash: closing beyond 1.5 m/s, the faster robot at fault. Our robot drives at full
+    speed; an opponent crosses its way 2.2 m ahead and, there, turns toward it at 0.7 m/s (DSS takes
+    opponents to keep their velocity: it cannot see the turn coming). With the crash hold the two
+    meet below the rules' speed, ours the slower; without, ours crashes into it."""
+    dss = make_dss(0) if hold_on else make_dss(0, crash_closing_m_s=0.0)
+    pos, vel = np.array([[0.0, 0.0]]), np.array([[3.0, 0.0]])
+    opp, opp_v = np.array([2.2, 0.6]), np.array([0.0, -1.0])
+    met = None
+    for _ in range(300):
+        r = dss.filter(np.column_stack([pos, vel]), np.array([[3.0, 0.0]]), np.array([[*opp, *opp_v]]))
+        tr = trajectories(np.column_stack([pos, vel]), (r.velocities - vel) / DT)[0]
+        new_pos, new_vel = R.positions(tr, np.array([DT]))[0], tr[2, 4:6]
+        opp = opp + opp_v * DT
+        if opp[1] <= 0.0 and opp_v[1] != 0.0:  # in our robot's way: it turns at it
+            opp, opp_v = np.array([opp[0], 0.0]), np.array([-0.7, 0.0])
+        if np.hypot(*(opp - new_pos)) <= 2 * RADIUS:
+            n = (opp - pos[0]) / np.hypot(*(opp - pos[0]))
+            met = (float((vel[0] - opp_v) @ n), float(np.hypot(*vel[0])))  # the frame before contact
+            break
+        pos, vel = np.array([new_pos]), np.array([new_vel])
+    assert met is not None
+    closing, ours = met
+    if hold_on:
+        assert closing < 1.5 and ours < 0.7  # no crash; were it one, theirs
+    else:
+        assert closing > 1.5 and ours > 0.7

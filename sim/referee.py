@@ -64,6 +64,8 @@ class RefereeParams(Validated):
     free_kick_distance_m: float = setting(0.2, lo=0.0, hi=2.0)  # from the lines and defense areas
     restart_timeout_s: float = setting(10.0, lo=0.1, hi=600.0)  # a restart not taken by then: play on
     keeper_held_ball_s: float = setting(10.0, lo=0.1, hi=600.0)  # ball this long in a defense area: free kick
+    no_progress_s: float = setting(10.0, lo=0.1, hi=600.0)  # the ball this long in one place in play: stop, force start
+    no_progress_m: float = setting(0.05, lo=0.0, hi=5.0)  # ... within this of it
     # start poses (x m, y m, theta rad) of the team defending -x, per division; mirrored for the other
     formations: Mapping[Literal["A", "B"], tuple[tuple[float, float, float], ...]] = field(
         default_factory=lambda: dict(_DEFAULT_FORMATIONS)
@@ -119,10 +121,11 @@ class Referee:
         self.for_team: Team | None = "blue"
         self.ready = True
         self.t = 0.0
-        self._restart: tuple[float, str, Team, tuple[float, float]] | None = None
+        self._restart: tuple[float, str, Team | None, tuple[float, float]] | None = None
         self._restart_ball: tuple[float, float] | None = (0.0, 0.0)
         self._restart_t = 0.0  # when the restart in force was given
         self._in_area_since: float | None = None  # normal play with the ball in a defense area since
+        self._still: tuple[float, tuple[float, float]] | None = None  # in play, the ball in one place since, where
         self.keeper_held_ball = 0
         # the full rules
         self.full = params.enabled and params.rules == "full"
@@ -288,6 +291,7 @@ class Referee:
             self._follow_cards(dt, truth)
             self._follow_stage()
         self._check_keeper_held_ball(t, ball_xy)
+        self._check_progress(t, ball_xy)
         if self._restart is not None and t >= self._restart[0]:
             _, kind, team, spot = self._restart
             self._restart = None
@@ -331,9 +335,12 @@ class Referee:
         ball = next((p.ball for p in reversed(parts) if p.ball is not None), None)
         return Teleport(self.t, tuple(r for p in parts for r in p.robots), ball)
 
-    def _start_restart(self, kind: str, team: Team, spot: tuple[float, float], ball_xy: tuple[float, float]) -> None:
+    def _start_restart(self, kind: str, team: Team | None, spot: tuple[float, float],
+                       ball_xy: tuple[float, float]) -> None:  # fmt: skip
         t = self.t
-        if kind == "kickoff" and self.params.place_robots_on_goal:
+        if kind == "force_start" or team is None:  # after no progress: where the ball lies, for both
+            self._set("force_start", None)
+        elif kind == "kickoff" and self.params.place_robots_on_goal:
             self._teleports.append(self.kickoff_setup(team))
         elif kind == "free_kick" and self.full and self._can_place(team):
             self._set("ball_placement", team)
@@ -674,6 +681,22 @@ class Referee:
                                      "free_kick", taker))  # fmt: skip
                 self._foul(holder, self.rules.keepers.get(holder))
             self._award("free_kick", taker, spot)
+
+    def _check_progress(self, t: float, ball_xy: tuple[float, float]) -> None:
+        """Rules (no progress in game): the ball within ``no_progress_m`` of one place for
+        ``no_progress_s`` while both teams may play it (two robots stuck at it, neither getting it
+        away): a stop, then a force start where it lies."""
+        if not self.full or self.command not in ("normal", "force_start") or self._restart is not None:
+            self._still = None
+            return
+        if self._still is None or math.dist(ball_xy, self._still[1]) > self.params.no_progress_m:
+            self._still = (t, ball_xy)
+        elif t - self._still[0] >= self.params.no_progress_s:
+            self._still = None
+            self._call(GameEvent(t, "no_progress", None, None, self.params.no_progress_s, self.params.no_progress_s,
+                                 "s", "force_start"))  # fmt: skip
+            self._set("stop", None)
+            self._restart = (t + self.params.restart_delay_s, "force_start", None, ball_xy)
 
     # --- out --------------------------------------------------------------------------------
     def _action_left(self) -> float:

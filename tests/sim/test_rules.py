@@ -422,3 +422,22 @@ def test_a_shootout_kick_has_only_the_kicker_and_the_other_keeper_on_the_field()
     for _, _, ball, mark in seen:
         assert math.hypot(ball[0] - mark[0], ball[1] - mark[1]) < 0.01
     assert ref.stage == "post_game"
+
+
+@pytest.mark.parametrize(("roll", "called"), [(0.0, True), (0.4, False)])
+def test_no_progress_in_game_stops_play_and_force_starts_it(roll: float, called: bool) -> None:
+    """The rules' no progress in game: the ball in one place for no_progress_s while both teams may
+    play it is a stop, then a force start where it lies; a ball that rolls on is progress."""
+    w, ref = scene()
+    w.place_ball(0.0, 1.5, vx=roll)
+    calls = play(w, ref, RefereeParams().no_progress_s + 0.5)
+    stuck = [c for c in calls if c.kind == "no_progress"]
+    assert bool(stuck) == called
+    if called:
+        assert stuck[0].t == pytest.approx(RefereeParams().no_progress_s, abs=0.05) and stuck[0].team is None
+        assert ref.command == "stop"
+        play(w, ref, RefereeParams().restart_delay_s + 0.1)
+        assert ref.command == "force_start"
+        assert math.dist(tuple(w.ball_body.position), (0.0, 1.5)) < RefereeParams().no_progress_m  # not moved
+    else:
+        assert ref.command == "normal"

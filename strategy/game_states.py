@@ -209,20 +209,49 @@ def _capsule_push(x: float, y: float, a: tuple[float, float], b: tuple[float, fl
     return qx + ox / d * d_min, qy + oy / d * d_min
 
 
+def _capsule_outline(a: tuple[float, float], b: tuple[float, float], d_min: float,
+                     steps: int) -> list[tuple[float, float]]:  # fmt: skip
+    """Points on the outline of the capsule of radius ``d_min`` round the segment a-b: both sides in
+    ``steps`` pieces and each end's half circle in steps of pi / ``steps``."""
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    n = math.hypot(dx, dy)
+    ux, uy = (dx / n, dy / n) if n > 1e-9 else (1.0, 0.0)
+    pts = []
+    for k in range(steps + 1):
+        t = k / steps
+        cx, cy = a[0] + t * dx, a[1] + t * dy
+        pts += [(cx - uy * d_min, cy + ux * d_min), (cx + uy * d_min, cy - ux * d_min)]
+    base = math.atan2(uy, ux)
+    for k in range(1, steps):
+        turn = math.pi / 2 - k * math.pi / steps  # from the left side round the end
+        pts.append((b[0] + d_min * math.cos(base + turn), b[1] + d_min * math.sin(base + turn)))
+        pts.append((a[0] - d_min * math.cos(base + turn), a[1] - d_min * math.sin(base + turn)))
+    return pts
+
+
 def keep_off_line(intents: Mapping[int, Intent], start: tuple[float, float], end: tuple[float, float], pitch: Field,
                   p: GameStateParams, radius: float) -> dict[int, Intent]:  # fmt: skip
     """Every target ``placement_line_m`` (plus the robot's radius) off the segment from the ball
     ``start`` to the placement's target ``end``, on the field (across the line when the field's
-    edge leaves no room on the near side)."""
+    edge leaves no room on the near side; in a corner, where neither side has room, the nearest point
+    of the way round the line's ends that is on the field: clamped into the field, a robot moved off
+    the line stood by the ball again, in the placer's way)."""
     d_min = p.placement_line_m + radius
     lim_x, lim_y = pitch.half_length - radius, pitch.half_width - radius
+
+    def on_field(q: tuple[float, float]) -> bool:
+        return abs(q[0]) <= lim_x and abs(q[1]) <= lim_y
+
     out = {}
     for rid, it in intents.items():
         x, y = _capsule_push(it.x, it.y, start, end, d_min)
-        if abs(x) > lim_x or abs(y) > lim_y:
+        if not on_field((x, y)):
             # mirror through the line: the far side
-            cx, cy = _capsule_push(2.0 * x - it.x, 2.0 * y - it.y, start, end, d_min)
-            x, y = (cx, cy) if abs(cx) <= lim_x and abs(cy) <= lim_y else (x, y)
+            far = _capsule_push(2.0 * x - it.x, 2.0 * y - it.y, start, end, d_min)
+            room = [far] if on_field(far) else [q for q in _capsule_outline(start, end, d_min, p.free_spot_steps)
+                                                if on_field(q)]  # fmt: skip
+            if room:
+                x, y = min(room, key=lambda q: math.hypot(q[0] - it.x, q[1] - it.y))
         x, y = max(-lim_x, min(lim_x, x)), max(-lim_y, min(lim_y, y))
         out[rid] = Intent(x, y, it.theta, avoid_ball=True, allow_own_defense=it.allow_own_defense,
                           max_speed_m_s=it.max_speed_m_s)  # fmt: skip

@@ -14,6 +14,7 @@ from strategy.game_states import (
     halt,
     hold_shape,
     keep_away,
+    keep_off_line,
     our_kickoff,
     own_goal_sign,
     restart_rules,
@@ -82,6 +83,32 @@ def test_keep_away_places_no_one_in_a_defense_area_it_may_not_enter(ball: tuple[
         assert math.hypot(it.x - b.x, it.y - b.y) >= P.stop_distance_m + RADIUS - 1e-9
         side = FIELD.in_defense_area(it.x, it.y, RADIUS + P.area_clear_m - 1e-9)
         assert side == 0 or (rid == 9 and side == -1)
+
+
+def _segment_distance(q: tuple[float, float], a: tuple[float, float], b: tuple[float, float]) -> float:
+    d = np.subtract(b, a)
+    u = float(np.clip(np.dot(np.subtract(q, a), d) / np.dot(d, d), 0.0, 1.0))
+    return float(np.hypot(*(np.subtract(q, a) - u * d)))
+
+
+@pytest.mark.parametrize(("ball", "target"), [
+    ((4.4, 2.9), (3.5, 2.0)),  # out of a corner, diagonally
+    ((-4.4, -2.9), (-4.3, -1.5)),  # out of a corner, along the goal line
+    ((0.0, 2.9), (1.0, 2.8)),  # along the touch line
+    ((1.0, 0.0), (-1.0, 0.5)),  # mid-field
+])  # fmt: skip
+def test_keep_off_line_leaves_the_placement_room_even_in_a_corner(ball: tuple[float, float],
+                                                                  target: tuple[float, float]) -> None:  # fmt: skip
+    """Every place at least placement_line_m (plus the radius) off the ball's way to its target and
+    on the field, wherever the robots were: in a corner neither side of the line has room, and a
+    robot clamped back into the field stood by the ball in the placer's way."""
+    rng = np.random.default_rng(3)
+    near = {k: Intent(float(ball[0] + dx), float(ball[1] + dy), 0.0)
+            for k, (dx, dy) in enumerate(rng.uniform(-0.6, 0.6, (12, 2)))}  # fmt: skip
+    out = keep_off_line(near, ball, target, FIELD, P, RADIUS)
+    for it in out.values():
+        assert abs(it.x) <= FIELD.half_length - RADIUS + 1e-9 and abs(it.y) <= FIELD.half_width - RADIUS + 1e-9
+        assert _segment_distance((it.x, it.y), ball, target) >= P.placement_line_m + RADIUS - 1e-9
 
 
 def test_at_our_kickoff_all_but_the_kicker_stay_in_our_half_outside_the_circle() -> None:

@@ -82,6 +82,7 @@ class BrainParams(Validated):
     ball_clearance_m: float = setting(0.05, lo=0.0, hi=1.0)  # kept from the ball when it is an obstacle
     # ... and in a stop, at their restarts and placements (rules: 0.5 m from the ball), this much
     keep_away_clearance_m: float = setting(0.65, lo=0.0, hi=3.0)
+    escape_margin_m: float = setting(0.03, lo=0.0, hi=1.0)  # a robot with no path inside that circle leaves it by this
     arrive_tolerance_m: float = setting(0.01, lo=0.0, hi=1.0)  # closer than this to the goal: no planning
     # a navigator's deadline per robot and frame: only the safety net of a stalled machine
     navigate_deadline_ms: float = setting(50.0, lo=0.01, hi=10000.0)
@@ -286,6 +287,20 @@ class Brain:
                                                         c.chip, c.dribbler))  # fmt: skip
         return out
 
+    def _ball_escape(self, frame: Frame, start: tuple[float, float], it: Intent) -> tuple[float, float] | None:
+        """Where a robot that found no path, standing inside the circle its paths keep round the ball,
+        gets out of it the short way (straight off the ball); None when it is not inside. (Without a
+        path it drove straight at its goal: from beside the ball, across it.)"""
+        if not (frame.has_ball and it.avoid_ball):
+            return None
+        bx, by, br = frame.world.circles[-1]
+        need = br + self.radius + self.params.brain.escape_margin_m
+        d = math.hypot(start[0] - bx, start[1] - by)
+        if d >= need:
+            return None
+        ux, uy = ((start[0] - bx) / d, (start[1] - by) / d) if d > 1e-6 else (1.0, 0.0)
+        return float(bx + ux * need), float(by + uy * need)
+
     def _navigate(self, frame: Frame, i: int, it: Intent, game: GameState) -> RobotCommand:
         robot = frame.robots[i]
         if it.max_speed_m_s == 0.0:
@@ -305,6 +320,8 @@ class Brain:
             status = result.status.name.lower()
             if result.status in (PlanStatus.SOLVED, PlanStatus.APPROXIMATE) and len(result.path) >= 2:
                 path = np.asarray(result.path)
+            elif (escape := self._ball_escape(frame, start, it)) is not None:
+                path, status = np.array([start, escape]), "escape"
         # drive through the goal only where the path ends at it (not at a stand-in for a blocked goal)
         through = max(it.final_speed_m_s, 0.0) if math.dist(tuple(path[-1]), goal) < 1e-9 else 0.0
         nav = self._navigator(robot.id)

@@ -162,6 +162,31 @@ def test_ball_placement_lets_go_with_the_ball_seen_to_follow_the_robot() -> None
     assert max(dribbler[let_go:]) == 0.0  # not taken again
 
 
+@pytest.mark.parametrize("robot", [(-4.42, 1.48, -0.21), (-4.5, 2.1, -1.0)])
+def test_a_robot_beside_the_ball_in_a_corner_at_a_stop_leaves_it_without_touching_it(
+        robot: tuple[float, float, float]) -> None:  # fmt: skip
+    """After their placement in our corner a robot stands 0.35 m from the ball with no path round it
+    to its place (the field's edge, our defense area): it leaves the ball's circle straight off the
+    ball (it had driven straight at its place, across the ball, and moved it)."""
+    w, ref, brain = scene(blue=3, yellow=1)
+    ball = (-4.3, 1.82)
+    w.place_ball(*ball)
+    w.place_robot("blue", 1, *robot)
+    w.place_robot("blue", 2, -3.0, -2.0, 0.0)
+    w.place_robot("yellow", 0, 4.0, 0.0, math.pi)
+    ref.give("stop")
+    gaps: list[float] = []
+
+    def each(w: World, ref: Referee) -> None:
+        r = next(q for q in w.ground_truth().robots if q.team == "blue" and q.id == 1)
+        gaps.append(math.hypot(r.x - ball[0], r.y - ball[1]))
+
+    play(w, ref, brain, 3.0, each=each)
+    assert math.dist(tuple(w.ball_body.position), ball) < 1e-3  # never touched
+    assert min(gaps) >= gaps[0] - 0.005
+    assert gaps[-1] >= SETTINGS.strategy.game_states.stop_distance_m + R - 0.01  # out at the stop's distance
+
+
 def test_the_keep_away_places_lie_outside_the_paths_keep_away_circle() -> None:
     """In a stop and at their restarts the paths keep ``keep_away_clearance_m`` (plus the ball's
     radius) off the ball. The places the strategy sends robots to (the stop's distance, the centre

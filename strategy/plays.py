@@ -44,7 +44,7 @@ from strategy.roles import Objective, Role, RoleAssigner, RoleKind, RoleParams
 from strategy.skills import Intent, SkillParams, defend, intercept, mark, receive
 from strategy.support import Supporters, SupportParams
 
-__all__ = ["Strategy", "StrategyParams"]
+__all__ = ["Strategy", "StrategyParams", "off_ball_line"]
 
 Array = NDArray[np.float64]
 

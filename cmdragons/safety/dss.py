@@ -29,7 +29,7 @@ from cmdragons.planning.world import CollisionWorld, CompiledWorld
 from cmdragons.safety import _kernels as K
 from cmdragons.safety.base import ArraySafety, SafetyResult
 
-__all__ = ["DSSParams", "DynamicsSafetySearch", "heuristic_table"]
+__all__ = ["DSSParams", "DynamicsSafetySearch", "crash_hold", "heuristic_table"]
 
 FloatArray = NDArray[np.float64]
 

@@ -365,7 +365,7 @@ def test_the_example_client_plays_yellow_in_our_simulator_over_the_leagues_proto
         if match is not None:
             match.close()
         client.send_signal(signal.SIGINT)
-        _, err = client.communicate(timeout=60)  # a hang guard: a cold, busy 2-core machine shuts down slowly
+        _, err = client.communicate(timeout=20)
     assert client.returncode == 0 and "Traceback" not in err, err
     figures = summary["protocols"]["ssl/simulation_in/yellow"]
     assert figures["packets"] >= 55 and figures["frames_waited_out"] <= 2 and figures["dropped"] == {}

@@ -8,6 +8,7 @@ RobotControl on cmdragons/<field>/commands/yellow: each robot drives at the ball
 
 import argparse
 import json
+import signal
 import time
 
 import zenoh
@@ -20,6 +21,7 @@ ap.add_argument("--router", default="tcp/127.0.0.1:7447", help="the match's zeno
 ap.add_argument("--field", default="main", help="the key space's <field> (runtime.field_name)")
 ap.add_argument("--speed", type=float, default=1.0, help="driving speed (m/s)")
 args = ap.parse_args()
+signal.signal(signal.SIGINT, signal.default_int_handler)  # Ctrl-C stops it, even started as a background job
 # a client of the router only: no listening socket, no multicast scouting (zenoh's defaults would
 # listen on every interface and scout by multicast)
 config = {"mode": "client", "connect": {"endpoints": [args.router]}, "listen": {"endpoints": []},

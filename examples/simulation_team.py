@@ -9,6 +9,7 @@ generated protobuf modules; a team in another language compiles the same .proto 
 """
 
 import argparse
+import signal
 import socket
 
 from chase import chase, see
@@ -21,6 +22,7 @@ ap.add_argument("--vision-port", type=int, default=10006, help="SSL-Vision's por
 ap.add_argument("--port", type=int, default=10302, help="the simulator's RobotControl port for yellow")
 ap.add_argument("--speed", type=float, default=1.0, help="driving speed (m/s)")
 args = ap.parse_args()
+signal.signal(signal.SIGINT, signal.default_int_handler)  # Ctrl-C stops it, even started as a background job
 
 vision = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
 vision.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)

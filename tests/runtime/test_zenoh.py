@@ -112,8 +112,10 @@ def test_a_receiver_behind_skips_to_the_newest_sensor_message_when_asked(router:
             t.close()
     frames = [f for f in got if f >= 0]
     assert frames == sorted(set(frames)) and frames[-1] == 4 and got.count(-1) == 1
-    if latest_only:  # of what waited (at least what came while the first was handled) only the newest
-        assert len(frames) + b.superseded == 5 and b.superseded >= 1 and len(frames) <= 2
+    if latest_only:  # of what waited while a frame was handled only the newest: each one delivered or skipped,
+        # some skipped (how many arrive within the 0.5 s varies with the machine's load: a clean-clone CI run
+        # saw 0-2 come together, then 3 and 4 one by one)
+        assert len(frames) + b.superseded == 5 and b.superseded >= 1
     else:
         assert frames == [0, 1, 2, 3, 4] and b.superseded == 0
 

@@ -3,7 +3,10 @@ free robot that reaches its objective at the lowest cost, with hysteresis agains
 
 A role's cost for a robot is the distance from the robot to the role's objective point; the robot
 holding the role since the last frame gets ``hysteresis_m`` off its cost, so two robots at nearly
-the same distance do not swap roles frame after frame.
+the same distance do not swap roles frame after frame. Among the robots holding roles of one kind
+(the defenders, the supporters), the points are then swapped pairwise wherever that shortens their
+ways together by more than ``swap_margin_m``: two robots never cross each other's way to their
+points (the greedy order with hysteresis could send two defenders through each other).
 
 A role is a value: its kind and, for the kinds a team fills several times (defenders,
 supporters), which one (``Role(RoleKind.DEFENDER, 1)``).
@@ -25,6 +28,8 @@ __all__ = ["Objective", "Role", "RoleAssigner", "RoleKind", "RoleParams"]
 class RoleParams(Validated):
     hysteresis_m: float = setting(0.5, lo=0.0, hi=10.0)  # cost bonus of the robot already in the role
     goalie_id: int = setting(0, lo=-1, hi=15)  # -1: whoever is nearest the goal when play starts
+    # two robots of one kind swap points when that shortens their two ways together by more than this
+    swap_margin_m: float = setting(0.05, lo=0.0, hi=10.0)
 
 
 class RoleKind(enum.Enum):
@@ -84,5 +89,27 @@ class RoleAssigner:
             assert best is not None
             out[best] = obj.role
             del free[best]
+        self._uncross(out, robots, objectives)
         self.roles = out
         return out
+
+    def _uncross(self, out: dict[int, Role], robots: Mapping[int, tuple[float, float]],
+                 objectives: Sequence[Objective]) -> None:  # fmt: skip
+        """Swap the points of two robots of one kind while that shortens their two ways together by
+        more than ``swap_margin_m`` (in place). Roles with a fixed robot or their own costs stay."""
+        point = {o.role: (o.x, o.y) for o in objectives if o.fixed_robot is None and o.costs is None}
+        ids = sorted(rid for rid, role in out.items() if role in point)
+        margin = self.params.swap_margin_m
+
+        def way(rid: int, role: Role) -> float:
+            return math.dist(robots[rid], point[role])
+
+        swapped = True
+        while swapped:  # each swap shortens the total by more than the margin: this ends
+            swapped = False
+            for k, a in enumerate(ids):
+                for b in ids[k + 1:]:
+                    ra, rb = out[a], out[b]
+                    if ra.kind is rb.kind and way(a, rb) + way(b, ra) < way(a, ra) + way(b, rb) - margin:
+                        out[a], out[b] = rb, ra
+                        swapped = True

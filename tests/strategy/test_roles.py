@@ -57,3 +57,26 @@ def test_per_robot_costs_replace_the_distance() -> None:
 def test_hysteresis_out_of_range_is_refused(value: float) -> None:
     with pytest.raises(ValueError, match="hysteresis_m"):
         RoleParams(hysteresis_m=value)
+
+
+def test_two_robots_of_one_kind_never_cross_each_others_way() -> None:
+    # defender 0 was robot 3's and defender 1 robot 1's; the points moved past each other: hysteresis
+    # alone keeps the roles, and the two would drive through each other
+    d0, d1 = Role(RoleKind.DEFENDER, 0), Role(RoleKind.DEFENDER, 1)
+    roles = RoleAssigner(RoleParams(hysteresis_m=0.5, swap_margin_m=0.05))
+    roles.roles = {3: d0, 1: d1}
+    robots = {1: (-3.41, 1.21), 3: (-3.23, 1.19)}
+    objectives = [Objective(d0, -3.36, 1.11), Objective(d1, -3.27, 1.26)]
+    assert roles.assign(robots, objectives) == {1: d0, 3: d1}
+    assert roles.roles == {1: d0, 3: d1}  # kept for the next frame's hysteresis
+    # a swap that gains less than the margin (here 0.018 m) does not happen (no flicker)
+    near = [Objective(d0, 0.5, 1.0), Objective(d1, 0.52, 1.0)]
+    roles.roles = {3: d0, 1: d1}
+    assert roles.assign({1: (0.0, 0.0), 3: (1.0, 0.0)}, near) == {3: d0, 1: d1}
+    eager = RoleAssigner(RoleParams(hysteresis_m=0.5, swap_margin_m=0.0))
+    eager.roles = {3: d0, 1: d1}
+    assert eager.assign({1: (0.0, 0.0), 3: (1.0, 0.0)}, near) == {1: d0, 3: d1}
+    # roles of different kinds are never swapped
+    mixed = [Objective(d0, -3.36, 1.11), Objective(Role(RoleKind.SUPPORTER, 0), -3.27, 1.26)]
+    roles.roles = {3: d0, 1: Role(RoleKind.SUPPORTER, 0)}
+    assert roles.assign(robots, mixed) == {3: d0, 1: Role(RoleKind.SUPPORTER, 0)}

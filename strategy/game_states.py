@@ -49,6 +49,7 @@ class GameStateParams(Validated):
     halfway_margin_m: float = setting(0.05, lo=0.0, hi=1.0)  # robots' edge this far on our side of the halfway line
     free_spot_steps: int = setting(12, lo=1, hi=180)  # the circle round the ball searched in steps of pi / this
     area_clear_m: float = setting(0.05, lo=0.0, hi=1.0)  # ... for a place this far outside the defense areas
+    spread_m: float = setting(0.3, lo=0.0, hi=3.0)  # ... and this far (centres) from every other robot's place
     hold_depth_share: float = setting(0.3, lo=0.0, hi=1.0)  # no ball: the shape starts this share of our half deep
     hold_row_m: float = setting(0.4, lo=0.0, hi=3.0)  # ... its rows this far apart
     hold_rows: int = setting(3, lo=1, hi=11)
@@ -142,9 +143,11 @@ def keep_away(intents: Mapping[int, Intent], ball: BallState, pitch: Field, own_
     """Every target at least ``distance_m`` (default ``stop_distance_m``: the rules' 0.5 m plus a
     margin) from the ball, on the field; at their kickoff also in our half and outside the centre
     circle; slow (``stop_speed_m_s``) in a stop. ``radius``: the robots'."""
-    out = {}
     d_min = (p.stop_distance_m if distance_m is None else distance_m) + radius
     r_c = _circle_clearance(pitch, radius, p)
+    lim_x, lim_y = pitch.half_length - radius, pitch.half_width - radius
+    places: dict[int, tuple[float, float]] = {}  # the places that stay, then each moved one as it is found
+    moved = []
     for rid, it in intents.items():
         x, y = it.x, it.y
         if kickoff:
@@ -152,23 +155,36 @@ def keep_away(intents: Mapping[int, Intent], ball: BallState, pitch: Field, own_
             if math.hypot(x, y) < r_c:
                 ang = math.atan2(y, x) if math.hypot(x, y) > 1e-6 else (0.0 if own_sign > 0 else math.pi)
                 x, y = r_c * math.cos(ang), r_c * math.sin(ang)
+        if math.hypot(x - ball.x, y - ball.y) < d_min:
+            moved.append((rid, x, y))
+        else:
+            places[rid] = (x, y)
+    for rid, x, y in moved:
         dx, dy = x - ball.x, y - ball.y
-        d = math.hypot(dx, dy)
-        if d < d_min:
-            if d < 1e-6:
-                dx, dy, d = own_sign, 0.0, 1.0
-            # the nearest point of the circle around the ball that lies on the field (where the cameras see us)
-            # and outside the defense areas the robot may not enter (a place in one has no path: the robot
-            # stops at the area's edge, by the ball)
-            lim_x, lim_y = pitch.half_length - radius, pitch.half_width - radius
-            allowed = int(own_sign) if it.allow_own_defense else 0
-            base = math.atan2(dy, dx)
-            steps = p.free_spot_steps
-            for turn in (0.0, *(sign * k * math.pi / steps for k in range(1, steps + 1) for sign in (1.0, -1.0))):
-                x, y = ball.x + d_min * math.cos(base + turn), ball.y + d_min * math.sin(base + turn)
-                if abs(x) <= lim_x and abs(y) <= lim_y \
-                        and pitch.in_defense_area(x, y, radius + p.area_clear_m) in (0, allowed):  # fmt: skip
+        if math.hypot(dx, dy) < 1e-6:
+            dx, dy = own_sign, 0.0
+        # the nearest point of the circle around the ball that lies on the field (where the cameras see
+        # us), outside the defense areas the robot may not enter (a place in one has no path: the robot
+        # stops at the area's edge, by the ball) and spread_m from the other places (two robots sent to
+        # one spot stand body to body: a push moves one into the other); without a spread one, the
+        # nearest of the rest
+        allowed = int(own_sign) if intents[rid].allow_own_defense else 0
+        base = math.atan2(dy, dx)
+        steps = p.free_spot_steps
+        first = None
+        for turn in (0.0, *(sign * k * math.pi / steps for k in range(1, steps + 1) for sign in (1.0, -1.0))):
+            x, y = ball.x + d_min * math.cos(base + turn), ball.y + d_min * math.sin(base + turn)
+            if abs(x) <= lim_x and abs(y) <= lim_y \
+                    and pitch.in_defense_area(x, y, radius + p.area_clear_m) in (0, allowed):  # fmt: skip
+                first = first or (x, y)
+                if all(math.hypot(x - q[0], y - q[1]) >= p.spread_m for q in places.values()):
                     break
+        else:
+            x, y = first or (x, y)
+        places[rid] = (x, y)
+    out = {}
+    for rid, it in intents.items():
+        x, y = places[rid]
         out[rid] = Intent(x, y, it.theta, dribbler=0.0, avoid_ball=True, allow_own_defense=it.allow_own_defense,
                           max_speed_m_s=p.stop_speed_m_s if slow else it.max_speed_m_s)  # fmt: skip
     return out

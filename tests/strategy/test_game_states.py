@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -83,6 +84,29 @@ def test_keep_away_places_no_one_in_a_defense_area_it_may_not_enter(ball: tuple[
         assert math.hypot(it.x - b.x, it.y - b.y) >= P.stop_distance_m + RADIUS - 1e-9
         side = FIELD.in_defense_area(it.x, it.y, RADIUS + P.area_clear_m - 1e-9)
         assert side == 0 or (rid == 9 and side == -1)
+
+
+@pytest.mark.parametrize("ball", [(-4.45, 1.45), (0.3, -0.2), (2.0, 2.85)])
+def test_keep_away_spreads_robots_sent_to_one_spot(ball: tuple[float, float]) -> None:
+    """Two defenders (or more) whose places fall inside the ball's circle together are moved to
+    places ``spread_m`` apart round it, not to one spot where they stand body to body (a push moves
+    one into the other); a place outside the circle stays where it is."""
+    b = BallState(*ball, 0.0, 0.0)
+    side = math.copysign(0.2, -ball[1])
+    crowd = {k: Intent(ball[0] + 0.3 + 0.01 * k, ball[1] + side + 0.01 * k, 0.0) for k in range(4)}
+    far = Intent(ball[0] + math.copysign(1.5, -ball[0]), ball[1] + side, 0.0)
+    out = keep_away({**crowd, 7: far}, b, FIELD, -1.0, P, RADIUS, kickoff=False, slow=True)
+    assert (out[7].x, out[7].y) == (far.x, far.y)
+    places = [(it.x, it.y) for it in out.values()]
+    gaps = [math.dist(p, q) for i, p in enumerate(places) for q in places[i + 1:]]
+    assert min(gaps) >= P.spread_m - 1e-9
+    for it in out.values():
+        assert math.hypot(it.x - b.x, it.y - b.y) >= P.stop_distance_m + RADIUS - 1e-9
+        assert abs(it.x) <= FIELD.half_length - RADIUS + 1e-9 and abs(it.y) <= FIELD.half_width - RADIUS + 1e-9
+    # without the spread, the four crowd the circle's nearest spot, closer than two bodies
+    tight = keep_away(crowd, b, FIELD, -1.0, dataclasses.replace(P, spread_m=0.0), RADIUS, kickoff=False, slow=True)
+    spots = [(it.x, it.y) for it in tight.values()]
+    assert max(math.dist(p, q) for p in spots for q in spots) < 2 * RADIUS
 
 
 def _segment_distance(q: tuple[float, float], a: tuple[float, float], b: tuple[float, float]) -> float:

@@ -463,7 +463,7 @@ def _finish_play(folder: Path, run: RunData, summary: dict[str, Any], args: argp
         f"play: {played} against {args.opponent} ({args.perception}) in {summary['wall_seconds']:.1f} s "
         f"({rtf}x real time{compile_note}): blue (us) {score['blue']}:{score['yellow']} yellow (them); ours: "
         f"{_plural(summary['shots'], 'shot')}, passes {passes['completed']}/{passes['tried']} completed, "
-        f"{_plural(coll['own'], 'own collision')}; brain {brain:.2f} ms median"
+        f"{_plural(coll['own'], 'own collision')}{_pushed(coll)}; brain {brain:.2f} ms median"
         + _their_line(summary)
     )
     rules = summary.get("rules")
@@ -496,13 +496,20 @@ def _rules_line(rules: dict[str, Any]) -> str:
     return "rules: " + "; ".join(parts)
 
 
+def _pushed(collisions: dict[str, int]) -> str:
+    """The own collisions an opponent pushed into, when there were any."""
+    n = collisions.get("own_pushed", 0)
+    return f" (and {n} pushed by an opponent)" if n else ""
+
+
 def _their_line(summary: dict[str, Any]) -> str:
     """The copy of our team's figures for the summary line (a self match only)."""
     them = summary.get("opponent_team")
     if them is None:
         return ""
     brain = summary["cycle_ms"].get("opponent_brain", {}).get("median", float("nan"))
-    return (f"; theirs: {_plural(them['shots'], 'shot')}, {_plural(them['collisions']['own'], 'own collision')}, "
+    return (f"; theirs: {_plural(them['shots'], 'shot')}, {_plural(them['collisions']['own'], 'own collision')}"
+            f"{_pushed(them['collisions'])}, "
             f"brain {brain:.2f} ms median")  # fmt: skip
 
 

@@ -549,6 +549,9 @@ class Contact:
     b: tuple[Team, int]
     max_depth_m: float  # deepest interpenetration seen
     relative_speed_m_s: float  # closing speed along the contact normal at first touch
+    # two robots of one team: the first robot of the other team seen touching either of them during
+    # the contact (it pushed one into the other), else None
+    pushed_by: tuple[Team, int] | None = None
 
 
 Event = Goal | BallOut | Kick | Contact
@@ -569,8 +572,10 @@ def _event_from_dict(d: Mapping[str, Any]) -> Event:
         raise MessageError(f"unknown event type {d.get('type')!r}")
     kwargs = {}
     for f in dataclasses.fields(cls):
+        if f.name not in d and f.default is not dataclasses.MISSING:
+            continue  # an optional field a log from before it was added does not have
         v = d[f.name]
-        kwargs[f.name] = (_team(v[0]), int(v[1])) if f.name in ("a", "b") else v
+        kwargs[f.name] = (_team(v[0]), int(v[1])) if f.name in ("a", "b", "pushed_by") and v is not None else v
     return cls(**kwargs)  # type: ignore[no-any-return]
 
 

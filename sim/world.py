@@ -144,6 +144,7 @@ class _ContactTrack:
     t_start: float
     relative_speed: float
     max_depth: float = 0.0
+    pushed_by: int | None = None  # two robots of one team: the first of the other team touching either
 
 
 @dataclass
@@ -550,10 +551,23 @@ class World:
         self._contacts[self._pair(arbiter)] = _ContactTrack(self.t, abs(rel))
 
     def _robot_contact_post(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: object) -> None:
-        track = self._contacts.get(self._pair(arbiter))
+        key = self._pair(arbiter)
+        track = self._contacts.get(key)
         if track is not None:
             for pt in arbiter.contact_point_set.points:
                 track.max_depth = max(track.max_depth, -pt.distance)
+            if track.pushed_by is None and self.robots[key[0]].team == self.robots[key[1]].team:
+                track.pushed_by = self._pusher(key)
+
+    def _pusher(self, key: tuple[int, int]) -> int | None:
+        """A robot of the other team in contact with either robot of the pair ``key`` (one team's), or None."""
+        team = self.robots[key[0]].team
+        for pair in self._contacts:
+            if pair != key and (key[0] in pair or key[1] in pair):
+                other = pair[0] if pair[1] in key else pair[1]
+                if self.robots[other].team != team:
+                    return other
+        return None
 
     def _robot_contact_end(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: object) -> None:
         key = self._pair(arbiter)
@@ -563,8 +577,9 @@ class World:
 
     def _contact_event(self, key: tuple[int, int], track: _ContactTrack) -> Contact:
         ra, rb = self.robots[key[0]], self.robots[key[1]]
-        return Contact(track.t_start, self.t - track.t_start, (ra.team, ra.id), (rb.team, rb.id),
-                       track.max_depth, track.relative_speed)  # fmt: skip
+        pusher = None if track.pushed_by is None else self.robots[track.pushed_by]
+        return Contact(track.t_start, self.t - track.t_start, (ra.team, ra.id), (rb.team, rb.id), track.max_depth,
+                       track.relative_speed, None if pusher is None else (pusher.team, pusher.id))  # fmt: skip
 
     def open_contacts(self) -> list[Contact]:
         """Contacts still going on now, as if they ended now (for a run's summary)."""

@@ -3,7 +3,8 @@ our team seeing through the cameras; and the brain's cycle for 11 v 11 in divisi
 
 A match is two halves of the rules' duration (5 minutes each; the half-time break, in which nothing
 moves, is not simulated), the sides changed between them. Rows per match (goals for and against,
-shots, passes, own collisions, fouls and cards per team, our placements tried and succeeded, stage
+shots, passes, own collisions (apart: those where an opponent touched one of the two, pushing it into
+the other), fouls and cards per team, our placements tried and succeeded, stage
 times), a totals row (matches won, drawn, lost; pass completion; own collisions; our fouls by kind,
 per match; placements succeeded and their median time), and the brain's cycle time (tracker to
 commands) for 6 and 11 robots; a penalty shootout of ``SHOOTOUT_KICKS`` kicks each way (ours against their
@@ -94,6 +95,7 @@ def _match_row(settings: Settings, seed: int, seconds: float, opponent: str) -> 
         "passes_tried": s["passes"]["tried"],
         "passes_completed": s["passes"]["completed"],
         "own_collisions": s["collisions"]["own"],
+        "own_collisions_pushed": s["collisions"]["own_pushed"],
         "fouls_ours": ours["total"],
         "fouls_theirs": theirs["total"],
         "fouls_ours_by_kind": _kinds_text({k: v for k, v in ours.items() if k != "total"}),
@@ -167,6 +169,7 @@ def run(settings: Settings, quick: bool, opponent: str | None = None, matches: i
         "goals_for": sum(r["goals_for"] for r in rows), "goals_against": sum(r["goals_against"] for r in rows),
         "pass_completion": sum(r["passes_completed"] for r in rows) / tried if tried else float("nan"),
         "own_collisions": sum(r["own_collisions"] for r in rows),
+        "own_collisions_pushed": sum(r["own_collisions_pushed"] for r in rows),
         "fouls_ours_per_match": sum(r["fouls_ours"] for r in rows) / len(rows),
         "fouls_theirs_per_match": sum(r["fouls_theirs"] for r in rows) / len(rows),
         "fouls_ours_by_kind": _kinds_text(_sum_kinds([r.pop("_kinds") for r in rows])),

@@ -271,6 +271,7 @@ def match_summary(f: dict[str, Any], stage_ms: dict[str, list[float]], seed: int
         "shots": stats["shots"],
         "passes": stats["passes"],
         "collisions": {"own": stats["collisions"]["own"] + sum(p == {OURS} for p in open_pairs),
+                       "own_pushed": stats["collisions"]["own_pushed"],
                        "opponent": stats["collisions"]["opponent"] + sum(p == {OURS, THEIRS} for p in open_pairs)},
         "cycle_ms": cycle,
         "seconds": sim["seconds"],
@@ -292,4 +293,5 @@ def _their_figures(f: dict[str, Any], open_pairs: list[set[str]]) -> dict[str, A
     """The copy of our team's own figures: shots, passes, collisions among its robots."""
     stats = f[f"stats/{THEIRS}"]
     return {"shots": stats["shots"], "passes": stats["passes"],
-            "collisions": {"own": stats["collisions"]["own"] + sum(p == {THEIRS} for p in open_pairs)}}  # fmt: skip
+            "collisions": {"own": stats["collisions"]["own"] + sum(p == {THEIRS} for p in open_pairs),
+                           "own_pushed": stats["collisions"]["own_pushed"]}}  # fmt: skip

@@ -355,7 +355,8 @@ class RefereeStage(BaseStage):
 class StatsStage(BaseStage):
     """One team's match statistics from the bus: shots and passes (kicks with the action the
     strategy had decided), passes completed (a team-mate holds the ball next), collisions among
-    own robots and with opponents."""
+    own robots (apart: those where an opponent touched one of the two, pushing it into the other)
+    and with opponents."""
 
     def __init__(self, team: Team, pass_timeout_s: float, hold_m: float = 0.15) -> None:
         self.name = f"stats/{team}"
@@ -364,7 +365,7 @@ class StatsStage(BaseStage):
         self.pass_timeout_s = pass_timeout_s
         self.hold_m = hold_m  # a robot whose centre is this near the ball holds it
         self.shots = self.passes_tried = self.passes_completed = 0
-        self.own_collisions = self.opponent_collisions = 0
+        self.own_collisions = self.own_pushed = self.opponent_collisions = 0
         self.pending_pass: tuple[float, int] | None = None  # (time kicked, passer id)
         self._truth: GroundTruth | None = None
         self._game = GameState(0.0)
@@ -391,7 +392,9 @@ class StatsStage(BaseStage):
                     self.pending_pass = (e.t, e.id)
             elif isinstance(e, Contact):
                 teams = {e.a[0], e.b[0]}
-                if teams == {self.team}:
+                if teams == {self.team} and e.pushed_by is not None:
+                    self.own_pushed += 1
+                elif teams == {self.team}:
                     self.own_collisions += 1
                 elif self.team in teams:
                     self.opponent_collisions += 1
@@ -409,7 +412,8 @@ class StatsStage(BaseStage):
     def summarize(self, publish: Publish) -> None:
         publish(f"summary/{self.name}", StageSummary(self.name, {
             "shots": self.shots, "passes": {"tried": self.passes_tried, "completed": self.passes_completed},
-            "collisions": {"own": self.own_collisions, "opponent": self.opponent_collisions},
+            "collisions": {"own": self.own_collisions, "own_pushed": self.own_pushed,
+                           "opponent": self.opponent_collisions},
         }))  # fmt: skip
 
 

@@ -310,6 +310,8 @@ def _event_to(e: Event, into: Any) -> None:
             t_start=e.t_start, duration_s=e.duration_s, a=trk_pb.RobotId(id=e.a[1], team=_TEAM_PB[e.a[0]]),
             b=trk_pb.RobotId(id=e.b[1], team=_TEAM_PB[e.b[0]]), max_depth_m=e.max_depth_m,
             relative_speed_m_s=e.relative_speed_m_s))  # fmt: skip
+        if e.pushed_by is not None:
+            into.contact.pushed_by.CopyFrom(trk_pb.RobotId(id=e.pushed_by[1], team=_TEAM_PB[e.pushed_by[0]]))
 
 
 def _event_from(m: Any) -> Event:
@@ -325,8 +327,9 @@ def _event_from(m: Any) -> Event:
         return Kick(k.t, _team(k.team), k.id, k.speed_m_s, k.chip)
     if kind == "contact":
         c = m.contact
+        pushed = (_team(c.pushed_by.team), c.pushed_by.id) if c.HasField("pushed_by") else None
         return Contact(c.t_start, c.duration_s, (_team(c.a.team), c.a.id), (_team(c.b.team), c.b.id), c.max_depth_m,
-                       c.relative_speed_m_s)  # fmt: skip
+                       c.relative_speed_m_s, pushed)  # fmt: skip
     raise MessageError("event without a kind")
 
 

@@ -255,6 +255,25 @@ def test_robot_contacts_are_reported() -> None:
     assert c.duration_s > 0.0 and c.max_depth_m >= 0.0
 
 
+def test_a_contact_between_team_mates_names_the_opponent_pushing_one_into_the_other() -> None:
+    # blue 0 and 1 stand side by side, 2 cm apart; yellow drives into blue 0 from behind at 1 m/s
+    w = make_world(blue=2, yellow=1)
+    w.place_robot("blue", 0, 0.0, 0.0, 0.0)
+    w.place_robot("blue", 1, 2 * LEAGUE.robot.radius_m + 0.02, 0.0, 0.0)
+    w.place_robot("yellow", 0, -1.0, 0.0, 0.0)
+    events = run(w, 1.5, [RobotCommand("yellow", 0, vx=1.0)]) + w.open_contacts()
+    own = [e for e in events if isinstance(e, Contact) and e.a[0] == e.b[0] == "blue"]
+    assert own and all(c.pushed_by == ("yellow", 0) for c in own)
+    # the same two driven into each other by themselves: nobody pushed
+    w = make_world(blue=2, yellow=1)
+    w.place_robot("blue", 0, 0.0, 0.0, 0.0)
+    w.place_robot("blue", 1, 0.5, 0.0, math.pi)
+    w.place_robot("yellow", 0, -2.0, 2.0, 0.0)
+    events = run(w, 1.0, [RobotCommand("blue", 0, vx=1.0), RobotCommand("blue", 1, vx=-1.0)]) + w.open_contacts()
+    own = [e for e in events if isinstance(e, Contact) and e.a[0] == e.b[0] == "blue"]
+    assert own and all(c.pushed_by is None for c in own)
+
+
 def test_dribbler_holds_the_ball_while_turning() -> None:
     w = make_world()
     w.place_robot("blue", 0, 0.0, 0.0, 0.0)

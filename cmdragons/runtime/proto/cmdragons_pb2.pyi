@@ -270,20 +270,22 @@ class Kick(_message.Message):
     def __init__(self, t: _Optional[float] = ..., team: _Optional[_Union[_ssl_tracked_pb2.Team, str]] = ..., id: _Optional[int] = ..., speed_m_s: _Optional[float] = ..., chip: _Optional[bool] = ...) -> None: ...
 
 class Contact(_message.Message):
-    __slots__ = ("t_start", "duration_s", "a", "b", "max_depth_m", "relative_speed_m_s")
+    __slots__ = ("t_start", "duration_s", "a", "b", "max_depth_m", "relative_speed_m_s", "pushed_by")
     T_START_FIELD_NUMBER: _ClassVar[int]
     DURATION_S_FIELD_NUMBER: _ClassVar[int]
     A_FIELD_NUMBER: _ClassVar[int]
     B_FIELD_NUMBER: _ClassVar[int]
     MAX_DEPTH_M_FIELD_NUMBER: _ClassVar[int]
     RELATIVE_SPEED_M_S_FIELD_NUMBER: _ClassVar[int]
+    PUSHED_BY_FIELD_NUMBER: _ClassVar[int]
     t_start: float
     duration_s: float
     a: _ssl_tracked_pb2.RobotId
     b: _ssl_tracked_pb2.RobotId
     max_depth_m: float
     relative_speed_m_s: float
-    def __init__(self, t_start: _Optional[float] = ..., duration_s: _Optional[float] = ..., a: _Optional[_Union[_ssl_tracked_pb2.RobotId, _Mapping]] = ..., b: _Optional[_Union[_ssl_tracked_pb2.RobotId, _Mapping]] = ..., max_depth_m: _Optional[float] = ..., relative_speed_m_s: _Optional[float] = ...) -> None: ...
+    pushed_by: _ssl_tracked_pb2.RobotId
+    def __init__(self, t_start: _Optional[float] = ..., duration_s: _Optional[float] = ..., a: _Optional[_Union[_ssl_tracked_pb2.RobotId, _Mapping]] = ..., b: _Optional[_Union[_ssl_tracked_pb2.RobotId, _Mapping]] = ..., max_depth_m: _Optional[float] = ..., relative_speed_m_s: _Optional[float] = ..., pushed_by: _Optional[_Union[_ssl_tracked_pb2.RobotId, _Mapping]] = ...) -> None: ...
 
 class Event(_message.Message):
     __slots__ = ("goal", "ball_out", "kick", "contact")

@@ -77,11 +77,15 @@ def wiring(settings: Settings, sim: Simulator, opponent: Opponent, perception: P
         stages += [VisionStage(m.id, VisionPipeline(settings.vision, settings.field, m)) for m in sim.cameras]
         topics = {team: [f"detections/{m.id}" for m in sim.cameras] for team in brains}
         stages += _ssl_vision_stages(settings, sim, topics, outside=opponent == "simulation")
+        # the simulator's cameras capture together: one capture time a frame (not so SSL-Vision's packets,
+        # which may come from cameras of their own)
+        synchronized = settings.protocols.perception != "ssl_vision"
     else:
         t = settings.tracker  # the noise vision measures: the tracker's measurement model
         sigmas = (t.ball.measurement_sigma_m, t.robot.measurement_sigma_m, t.robot.measurement_sigma_rad)
         stages += [TruthPerceptionStage(team, sigmas, seed + k) for k, team in enumerate(seeing)]
         topics = {team: [f"perception/{team}"] for team in brains}
+        synchronized = True  # (one topic)
         if opponent == "simulation":  # the outside team's noisy truth, as SSL-Vision packets
             stages += _ssl_vision_stages(settings, sim, {}, outside=True, topics_out=[f"perception/{THEIRS}"])
     referee_topic = "referee"
@@ -95,7 +99,7 @@ def wiring(settings: Settings, sim: Simulator, opponent: Opponent, perception: P
         stages.append(SimulationInStage(p, THEIRS))
     for team in brains:
         own = opponent_settings if team == THEIRS and opponent_settings is not None else settings
-        stages += [TrackerStage(team, Tracker(own.tracker), topics[team]),
+        stages += [TrackerStage(team, Tracker(own.tracker), topics[team], synchronized=synchronized),
                    TeamStage(team, Brain(team, own), referee_topic)]  # fmt: skip
     stages += _ssl_out_stages(settings)
     if opponent == "simple":

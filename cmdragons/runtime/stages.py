@@ -197,17 +197,27 @@ class TrackerStage(BaseStage):
     """One team's tracker: steps once every detection topic it reads has delivered the frame (a
     newer frame first closes the one in progress with what came), and takes its team's commands as
     the robots' control input (``take_commands``; not when the robots seen are driven by someone
-    else, as in a real match's log)."""
+    else, as in a real match's log).
+
+    ``synchronized``: the cameras of a frame share its capture time (the simulator's cameras), so
+    each camera's detections are taken as they come, in the order of ``detection_topics``, and the
+    frame is closed when the last comes: the same work in the same order as taking them together,
+    but done while the other cameras are still being seen (in another process, the tracker works on
+    the first camera while vision works on the second). Otherwise a frame's detections wait for
+    one another and are taken in capture-time order."""
 
     def __init__(self, team: Team, tracker: Tracker, detection_topics: Sequence[str],
-                 take_commands: bool = True) -> None:  # fmt: skip
+                 take_commands: bool = True, synchronized: bool = False) -> None:  # fmt: skip
         self.name = f"tracker/{team}"
         self.team = team
         self.detection_topics = tuple(detection_topics)
         self.inputs = (*self.detection_topics, *((f"commands/{team}",) if take_commands else ()))
         self.tracker = tracker
+        self.synchronized = synchronized
         self._frame = -1
         self._pending: dict[str, DetectionFrame] = {}
+        self._taken = 0  # synchronized: how many of the frame's topics, in order, the tracker took
+        self._t_frame = -math.inf  # the newest capture time of the frame in progress
         self._t_capture: dict[int, float] = {}
 
     def on_message(self, topic: str, message: Any, publish: Publish) -> None:
@@ -217,18 +227,29 @@ class TrackerStage(BaseStage):
                 self.tracker.command_sent(message.commands, t)
             return
         det: DetectionFrame = message
-        if det.frame_number != self._frame and self._pending:
+        if det.frame_number != self._frame and (self._pending or self._taken):
             self._step(publish)
         self._frame = det.frame_number
         self._pending[topic] = det
-        if len(self._pending) == len(self.detection_topics):
+        self._t_frame = max(self._t_frame, det.t_capture)
+        if self.synchronized:
+            while self._taken < len(self.detection_topics) and self.detection_topics[self._taken] in self._pending:
+                self.tracker.take(self._pending.pop(self.detection_topics[self._taken]))
+                self._taken += 1
+        if self._taken + len(self._pending) == len(self.detection_topics):
             self._step(publish)
 
     def _step(self, publish: Publish) -> None:
         frames = [self._pending[t] for t in sorted(self._pending, key=self.detection_topics.index)]
-        self._pending = {}
-        world = self.tracker.step(frames)
-        self._t_capture = {self._frame: max(f.t_capture for f in frames)}
+        if self.synchronized:
+            for frame in frames:  # (a frame closed early: what came after the first missing camera)
+                self.tracker.take(frame)
+            world = self.tracker.finish()
+        else:
+            world = self.tracker.step(frames)
+        self._pending, self._taken = {}, 0
+        self._t_capture = {self._frame: self._t_frame}
+        self._t_frame = -math.inf
         publish(f"world/{self.team}", WorldState(world.t, world.ball, world.robots, self._frame))
 
     def summarize(self, publish: Publish) -> None:

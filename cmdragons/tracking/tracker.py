@@ -141,12 +141,24 @@ class Tracker:
         """Take one set of camera frames (any order, any cameras) and return the world state
         predicted to the newest capture time plus ``ahead_s``: by default ``latency_s``, what the
         live loop hands the team; 0 gives the filtered estimate at the capture time (offline
-        tracks, scoring against truth)."""
+        tracks, scoring against truth). The same as :meth:`take` for each frame in capture-time
+        order, then :meth:`finish`."""
         for frame in sorted(frames, key=lambda f: f.t_capture):
-            if frame.t_capture < self.t - 1e-9 or not math.isfinite(frame.t_capture):
-                self.stats.stale_frames += 1
-                continue
-            self._take(frame)
+            self.take(frame)
+        return self.finish(ahead_s)
+
+    def take(self, frame: DetectionFrame) -> None:
+        """Take one camera frame of the set in progress: every track predicted to its capture time,
+        its detections fused. A frame older than one already taken is counted stale and left out,
+        so a caller that takes frames as they come gives them in capture-time order."""
+        if frame.t_capture < self.t - 1e-9 or not math.isfinite(frame.t_capture):
+            self.stats.stale_frames += 1
+            return
+        self._take(frame)
+
+    def finish(self, ahead_s: float | None = None) -> WorldState:
+        """Close the set of frames taken since the last call (tracks no camera saw miss, held balls
+        move with their holder, old tracks go) and return the world state, as :meth:`step` does."""
         self.stats.frames += 1
         for track in self.robots.values():
             if track.last_seen != self.t:

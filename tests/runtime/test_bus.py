@@ -127,7 +127,8 @@ def test_the_log_holds_every_topic_each_readable_as_its_message(tmp_path: Path) 
     assert {"/summary/sim", "/summary/referee", "/summary/tracker/blue", "/summary/stats/blue"} <= set(counts)
 
 
-def test_the_tracker_stage_on_a_recorded_detection_topic_equals_the_direct_call() -> None:
+@pytest.mark.parametrize("synchronized", [False, True])
+def test_the_tracker_stage_on_a_recorded_detection_topic_equals_the_direct_call(synchronized: bool) -> None:
     m = Match(SETTINGS, "simple", "vision", seed=4)
     recorded: list[tuple[str, Any]] = []
     m.bus.add(Tap("recorder", ("detections/*", "commands/blue", "world/blue"), lambda t, x: recorded.append((t, x))))
@@ -137,12 +138,16 @@ def test_the_tracker_stage_on_a_recorded_detection_topic_equals_the_direct_call(
     # the stage, fed the recorded topics on a bus of its own
     bus = Bus()
     worlds: list[msg.WorldState] = []
-    bus.add(TrackerStage("blue", Tracker(SETTINGS.tracker), cams))
+    stage = TrackerStage("blue", Tracker(SETTINGS.tracker), cams, synchronized=synchronized)
+    bus.add(stage)
     bus.add(Tap("out", ("world/blue",), lambda _t, w: worlds.append(w)))
     for topic, x in recorded:
         if topic != "world/blue":
+            before = stage.tracker.stats.detections
             bus.publish(topic, x)
             bus.spin()
+            if topic == cams[0] and x.robots:  # synchronized: the first camera is taken before the second comes
+                assert (stage.tracker.stats.detections > before) == synchronized
     # the direct calls on the same detections and commands
     direct = Tracker(SETTINGS.tracker)
     expected: list[msg.WorldState] = []

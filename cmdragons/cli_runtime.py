@@ -110,8 +110,9 @@ def _log_stages(spec: Any, folder: Path) -> tuple[Any, list[Any]]:
 
 
 def _connect(params: Any, name: str, router: bool, command: str) -> tuple[Any, Any] | None:
-    """The router session (when ``router``) and ``name``'s transport; None once the error (no
-    router there, or the endpoint taken) is said on one line."""
+    """The router session (when ``router``) and ``name``'s transport, on that session when there is
+    one (a message to or from the router's node then crosses one link, not two); None once the
+    error (no router there, or the endpoint taken) is said on one line."""
     from cmdragons.runtime.distributed import frame_path_priority
     from cmdragons.runtime.zenoh_transport import RouterError, ZenohTransport, open_router
 
@@ -121,7 +122,7 @@ def _connect(params: Any, name: str, router: bool, command: str) -> tuple[Any, A
     session = None
     try:
         session = open_router(params) if router else None
-        return session, ZenohTransport(params, name)
+        return session, ZenohTransport(params, name, session=session)
     except RouterError as exc:
         if session is not None:
             session.close()

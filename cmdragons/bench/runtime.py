@@ -40,7 +40,7 @@ from typing import Any
 import numpy as np
 
 from cmdragons.messages import CameraFrame
-from cmdragons.runtime.bus import InProcessTransport
+from cmdragons.runtime.bus import InProcessTransport, Transport
 from cmdragons.runtime.distributed import MatchSpec, frame_path_priority, run_clock, wait_for_processes
 from cmdragons.runtime.match import Match
 from cmdragons.runtime.params import RuntimeParams
@@ -100,10 +100,10 @@ class _InProcessTicks(_TimesTicks, InProcessTransport):
         self.tick = tick
 
 
-def _latency_tap(tick: list[float], latencies: list[float]) -> Tap:
-    """A tap that times each frame from its tick to our team's commands for it arriving."""
-    return Tap("bench:commands", ("commands/blue",),
-               lambda _t, _m: latencies.append((time.perf_counter() - tick[0]) * 1e3))
+def _time_commands(transport: Transport, tick: list[float], latencies: list[float]) -> None:
+    """Time each frame from its tick to our team's commands for it arriving (ms): subscribed on the
+    transport before any stage, so the time is taken as they come, before the simulator steps on them."""
+    transport.subscribe("commands/blue", lambda _t, _m: latencies.append((time.perf_counter() - tick[0]) * 1e3))
 
 
 def _zenoh_latencies(settings: Settings, seconds: float, vision_with_sim: bool) -> tuple[list[float], float]:
@@ -119,11 +119,12 @@ def _zenoh_latencies(settings: Settings, seconds: float, vision_with_sim: bool) 
     roles = spec.roles(log=False)
     router = open_router(params)
     children = [_node(r, params, "simple", "vision") for r in roles if r != "sim"]
-    clock = ZenohTicks(params, "sim")
+    clock = ZenohTicks(params, "sim", session=router)  # the sim node is the router, as in play --distributed
     clock.tick = [0.0]
     ms: list[float] = []
+    _time_commands(clock, clock.tick, ms)
     try:
-        summary = run_clock(spec, clock, seconds, roles, extra=[_latency_tap(clock.tick, ms)], err=io.StringIO())
+        summary = run_clock(spec, clock, seconds, roles, err=io.StringIO())
     finally:
         wait_for_processes(children, 20.0)
         clock.close()
@@ -134,8 +135,9 @@ def _zenoh_latencies(settings: Settings, seconds: float, vision_with_sim: bool) 
 def _embedded_latencies(settings: Settings, seconds: float) -> tuple[list[float], float]:
     """The bench's match embedded: per frame tick -> commands (ms), and the real-time factor."""
     ms: list[float] = []
-    tick = [0.0]
-    m = Match(settings, "simple", "vision", seed=SEED, extra=[_latency_tap(tick, ms)], transport=_InProcessTicks(tick))
+    transport = _InProcessTicks([0.0])
+    _time_commands(transport, transport.tick, ms)
+    m = Match(settings, "simple", "vision", seed=SEED, transport=transport)
     wall = time.perf_counter()
     m.run(seconds)
     return ms, m.sim.t / (time.perf_counter() - wall)
@@ -240,7 +242,7 @@ def _recovery_row(settings: Settings) -> dict[str, Any]:
     router = open_router(params)
     others = [_node(r, params, "simple", "truth") for r in roles if r not in ("sim", "team")]
     team = _node("team", params, "simple", "truth")
-    clock = ZenohTransport(params, "sim")
+    clock = ZenohTransport(params, "sim", session=router)
     commands: list[tuple[float, int]] = []
     frames: list[int] = []
     enough = threading.Event()

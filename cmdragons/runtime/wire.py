@@ -64,8 +64,8 @@ from cmdragons.runtime.proto import ssl_detection_pb2 as det_pb
 from cmdragons.runtime.proto import ssl_simulation_control_pb2 as ctl_pb
 from cmdragons.runtime.proto import ssl_tracked_pb2 as trk_pb
 
-__all__ = ["CODECS", "LOSSY", "TOPICS", "Codec", "canonical", "decode", "encode", "encode_chunks", "from_proto",
-           "message_type", "parse", "to_proto"]  # fmt: skip
+__all__ = ["CODECS", "LOSSY", "TOPICS", "Codec", "canonical", "canonical_and_chunks", "decode", "encode",
+           "encode_chunks", "from_proto", "message_type", "parse", "to_proto"]  # fmt: skip
 
 MM = 1000.0  # millimetres a metre: the league's vision speaks millimetres
 
@@ -540,6 +540,17 @@ def encode_chunks(message: Any) -> tuple[bytes, ...]:
     if type(message) is CameraFrame:
         return _camera_chunks(message)
     return (encode(message),)
+
+
+def canonical_and_chunks(message: Any) -> tuple[Any, tuple[bytes, ...]]:
+    """:func:`canonical` and :func:`encode_chunks` of ``message`` at once, for a message that goes
+    both to stages of this process and over the wire: one whose wire form rounds is turned into
+    its protobuf object once for both."""
+    codec = CODECS.get(type(message))
+    if codec is not None and type(message) in LOSSY:
+        proto = codec.to_proto(message)
+        return codec.from_proto(proto), (proto.SerializeToString(deterministic=True),)
+    return message, encode_chunks(message)
 
 
 def decode(topic: str, data: bytes | bytearray | memoryview) -> Any:

@@ -188,3 +188,11 @@ def test_a_camera_frame_in_pieces_joins_to_its_protobuf_bytes(shape: tuple[int, 
 def test_other_messages_are_one_piece() -> None:
     tick = msg.Tick(5)
     assert wire.encode_chunks(tick) == (wire.encode(tick),)
+
+
+@pytest.mark.parametrize("m", [*EXACT, DET, WORLD, COMMANDS, REPORT], ids=lambda m: type(m).__name__)
+def test_canonical_and_chunks_at_once_are_each_alone(m: Any) -> None:
+    local, chunks = wire.canonical_and_chunks(m)
+    assert chunks == wire.encode_chunks(m)
+    assert type(local) is type(m) and wire.encode(local) == wire.encode(wire.canonical(m))
+    assert (local is m) == (type(m) not in wire.LOSSY)

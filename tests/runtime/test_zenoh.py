@@ -139,6 +139,31 @@ def test_local_only_topics_reach_this_process_only(router: RuntimeParams) -> Non
     assert got == {"a": ["camera/0/frame", "clock"], "b": ["clock"]}
 
 
+def test_a_topic_no_other_node_hears_is_not_sent_until_one_subscribes(router: RuntimeParams) -> None:
+    import time
+
+    params = dataclasses.replace(router, settle_s=0.2)
+    a, b = _transports(params, 2)
+    got: list[int] = []
+    try:
+        world = msg.WorldState(0.0, msg.BallState(0.0, 0.0, 0.0, 0.0), ())
+        a.publish("world/blue", world)  # a new publisher: sent while it learns who subscribes
+        assert a.sent == 1
+        time.sleep(0.3)
+        for _ in range(3):
+            a.publish("world/blue", world)
+        assert a.sent == 1  # nobody subscribes: neither encoded nor sent
+        b.subscribe("world/blue", lambda _t, w: got.append(w.frame_number))
+        assert a.wait_for(lambda: a.has_subscribers("world/blue"), 10.0)
+        for k in range(3):
+            a.publish("world/blue", dataclasses.replace(world, frame_number=k))
+        assert b.wait_for(lambda: len(got) == 3, 10.0)
+    finally:
+        for t in (a, b):
+            t.close()
+    assert got == [0, 1, 2] and a.sent == 4
+
+
 def test_garbage_is_counted_dropped_and_reported_once(router: RuntimeParams) -> None:
     import zenoh
 

@@ -158,10 +158,18 @@ def test_a_topic_no_other_node_hears_is_not_sent_until_one_subscribes(router: Ru
         for k in range(3):
             a.publish("world/blue", dataclasses.replace(world, frame_number=k))
         assert b.wait_for(lambda: len(got) == 3, 10.0)
+        assert got == [0, 1, 2] and a.sent == 4
+        b.close()  # the subscriber goes: its publisher hears so and sends no more
+
+        def sends() -> bool:
+            before = a.sent
+            a.publish("world/blue", world)
+            return a.sent > before
+
+        assert a.wait_for(lambda: not sends(), 10.0, poll_s=0.01)
     finally:
         for t in (a, b):
             t.close()
-    assert got == [0, 1, 2] and a.sent == 4
 
 
 def test_garbage_is_counted_dropped_and_reported_once(router: RuntimeParams) -> None:

@@ -715,7 +715,7 @@ class Referee:
         if self._restart is None:
             return None, None
         _, kind, team, _ = self._restart
-        if kind == "free_kick" and self.full and self._can_place(team):
+        if kind == "free_kick" and team is not None and self.full and self._can_place(team):
             return "ball_placement", team
         return ("free_kick" if kind == "placed_free_kick" else kind), team
 

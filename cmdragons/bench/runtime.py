@@ -177,7 +177,7 @@ def _floor_row(settings: Settings, messages: int, size_bytes: int = 300) -> dict
     params = _loopback(settings.runtime)
     router = open_router(params)
     try:
-        rtt = round_trips(params, messages, size_bytes)
+        rtt = round_trips(params, messages, size_bytes, session=router)
     finally:
         router.close()
     one_way = np.asarray(rtt[10:]) / 2

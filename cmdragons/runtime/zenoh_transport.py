@@ -330,10 +330,11 @@ def _echo(config: str, prefix: str, ready: Any, done: Any) -> None:
         done.wait(120.0)
 
 
-def round_trips(params: RuntimeParams, messages: int, size_bytes: int) -> list[float]:
+def round_trips(params: RuntimeParams, messages: int, size_bytes: int, session: Any = None) -> list[float]:
     """zenoh alone (no protobuf, no stage): ``messages`` payloads of ``size_bytes`` to a client in
-    another process (spawned), which puts each back from its callback; the round trips (ms). Both
-    are clients of the router of ``params`` (which must be open)."""
+    another process (spawned), which puts each back from its callback; the round trips (ms). The
+    pings go from ``session`` (the router's: one link each way, as between the sim node and a node),
+    else from a client of the router of ``params`` (which must be open; two links each way)."""
     import json
     import multiprocessing
     import threading
@@ -346,29 +347,34 @@ def round_trips(params: RuntimeParams, messages: int, size_bytes: int) -> list[f
     echo = ctx.Process(target=_echo, args=(json.dumps(params.zenoh.session("client")), prefix, ready, done))
     echo.start()
     rtt: list[float] = []
+    own = session is None
+    pinger = zenoh.open(params.zenoh.config("client")) if own else session
+    back = threading.Event()
+    pong = pinger.declare_subscriber(f"{prefix}/pong", lambda _s: back.set())
+    ping: Any = pinger.declare_publisher(f"{prefix}/ping")  # (the stubs type matching_status wrongly)
     try:
-        with zenoh.open(params.zenoh.config("client")) as session:
-            back = threading.Event()
-            session.declare_subscriber(f"{prefix}/pong", lambda _s: back.set())
-            ping: Any = session.declare_publisher(f"{prefix}/ping")  # (the stubs type matching_status wrongly)
-            if not ready.wait(60.0):
-                raise TimeoutError("the echo process never came up")
-            for _ in range(500):  # its subscriber reaches this session
-                if ping.matching_status.matching:
-                    break
-                time.sleep(0.02)
-            else:
-                raise TimeoutError("the echo's subscriber never reached this session")
-            time.sleep(0.2)  # its pong publisher's route reaches this session too
-            payload = bytes(size_bytes)
-            for _ in range(messages):
-                back.clear()
-                t0 = time.perf_counter()
-                ping.put(payload)
-                if back.wait(1.0):
-                    rtt.append((time.perf_counter() - t0) * 1e3)
-                time.sleep(0.002)
+        if not ready.wait(60.0):
+            raise TimeoutError("the echo process never came up")
+        for _ in range(500):  # its subscriber reaches this session
+            if ping.matching_status.matching:
+                break
+            time.sleep(0.02)
+        else:
+            raise TimeoutError("the echo's subscriber never reached this session")
+        time.sleep(0.2)  # its pong publisher's route reaches this session too
+        payload = bytes(size_bytes)
+        for _ in range(messages):
+            back.clear()
+            t0 = time.perf_counter()
+            ping.put(payload)
+            if back.wait(1.0):
+                rtt.append((time.perf_counter() - t0) * 1e3)
+            time.sleep(0.002)
     finally:
         done.set()
         echo.join(10)
+        pong.undeclare()
+        ping.undeclare()
+        if own:
+            pinger.close()
     return rtt

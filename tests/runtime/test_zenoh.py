@@ -198,3 +198,13 @@ def test_every_ping_of_the_floor_measure_comes_back(router: RuntimeParams) -> No
     from cmdragons.runtime.zenoh_transport import round_trips
 
     assert len(round_trips(router, 20, 300)) == 20  # (what they take is bench runtime's, not a test's)
+
+
+def test_every_ping_of_the_floor_measure_from_the_routers_session_comes_back() -> None:
+    import zenoh
+
+    from cmdragons.runtime.zenoh_transport import round_trips
+
+    params = loopback_params()
+    with zenoh.open(params.zenoh.config("router")) as session:
+        assert len(round_trips(params, 20, 300, session=session)) == 20

@@ -20,7 +20,7 @@
 
 Every session is on a free loopback port; the node processes load the default configs/ (a
 ``--set`` given to the bench reaches the in-process parts only). The three set-ups play in turn,
-twice (``--quick``: once, 2 s matches).
+four times (``--quick``: once, 2 s matches), their frames pooled.
 """
 
 from __future__ import annotations
@@ -69,13 +69,16 @@ def _node(role: str, params: RuntimeParams, opponent: str, perception: str) -> s
                              "--set", f"runtime.zenoh.router={params.zenoh.router}",
                              "--set", f"runtime.field_name={params.field_name}",
                              "--set", f"runtime.vision_with_sim={str(params.vision_with_sim).lower()}",
-                             "--set", f"runtime.realtime_priority={params.realtime_priority}"])  # fmt: skip
+                             "--set", f"runtime.realtime_priority={params.realtime_priority}",
+                             "--set", f"runtime.cpu_latency_us={params.cpu_latency_us}"])  # fmt: skip
 
 
 def _realtime_latency_rows(settings: Settings, seconds: float, rounds: int) -> list[dict[str, Any]]:
     """:func:`_latency_rows` with this process (the embedded match, and the sim node with the
-    router) and the frame path's nodes on the real-time scheduler; in a process of its own, spawned
-    for it, so that every thread (zenoh's are made once a process and kept) inherits it."""
+    router) and the frame path's nodes on the real-time scheduler, and the CPUs kept from idle
+    states slow to wake while they run (``runtime.cpu_latency_us``); in a process of its own,
+    spawned for it, so that every thread (zenoh's are made once a process and kept) inherits the
+    scheduler and the CPU request ends with it."""
     note = frame_path_priority(settings.runtime, "sim")
     if note is not None:
         return [{"name": "frame_to_command_rt", "note": note}]
@@ -277,10 +280,12 @@ def _recovery_row(settings: Settings) -> dict[str, Any]:
 
 def run(settings: Settings, quick: bool) -> list[dict[str, Any]]:
     seconds = 2.0 if quick else 6.0
-    rounds = 1 if quick else 2
-    normal = dataclasses.replace(settings.runtime, realtime_priority=0)
+    rounds = 1 if quick else 4  # a 6 s match's median moves by a few tenths of a ms from one round to the next
+    normal = dataclasses.replace(settings.runtime, realtime_priority=0, cpu_latency_us=-1)
     rows = _latency_rows(dataclasses.replace(settings, runtime=normal), seconds, rounds)
-    realtime = dataclasses.replace(settings.runtime, realtime_priority=settings.runtime.realtime_priority or 10)
+    r = settings.runtime  # the real-time rows: the real-time scheduler and CPUs that wake at once
+    realtime = dataclasses.replace(r, realtime_priority=r.realtime_priority or 10,
+                                   cpu_latency_us=r.cpu_latency_us if r.cpu_latency_us >= 0 else 0)  # fmt: skip
     spawn = multiprocessing.get_context("spawn")  # (never fork a process that has zenoh open)
     with concurrent.futures.ProcessPoolExecutor(1, mp_context=spawn) as pool:
         rows += pool.submit(_realtime_latency_rows, dataclasses.replace(settings, runtime=realtime), seconds,

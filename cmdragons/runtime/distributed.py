@@ -76,18 +76,49 @@ FRAME_PATH = ("sim", "vision", "team")  # the nodes a camera frame goes through 
 
 
 def frame_path_priority(params: RuntimeParams, role: str) -> str | None:
-    """Put this process on the real-time scheduler (SCHED_FIFO at ``runtime.realtime_priority``) when
-    ``role`` is on the frame path and the setting is on; call it before zenoh opens, whose threads
-    inherit it. On a host shared with other work (another team, a logger, a build) a frame's stages
-    then run the moment it comes instead of waiting for a time slice. None, or the one line why it
-    could not be done (not Linux, not permitted: root or CAP_SYS_NICE)."""
-    if params.realtime_priority == 0 or role not in FRAME_PATH:
+    """Tune this process for real time when ``role`` is on the frame path: the real-time scheduler
+    (SCHED_FIFO at ``runtime.realtime_priority``, when set; call it before zenoh opens, whose threads
+    inherit it), so that on a host shared with other work (another team, a logger, a build) a
+    frame's stages run the moment it comes instead of waiting for a time slice; and a CPU wake-up
+    latency request (``runtime.cpu_latency_us``, when set; Linux PM QoS), held while the process
+    runs, so that a CPU idle between two stages of a frame wakes at once instead of from a deep
+    idle state. None, or the one line why something could not be done (not Linux, not permitted:
+    root or CAP_SYS_NICE)."""
+    if role not in FRAME_PATH:
+        return None
+    notes = []
+    if params.realtime_priority > 0:
+        try:
+            os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(params.realtime_priority))
+        except (AttributeError, OSError) as exc:
+            reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else "not on this system"
+            notes.append(f"runtime.realtime_priority: the real-time scheduler is not available ({reason}); "
+                         "normal priority")  # fmt: skip
+    if params.cpu_latency_us >= 0:
+        note = _hold_cpu_latency(params.cpu_latency_us)
+        if note is not None:
+            notes.append(note)
+    return "; ".join(notes) or None
+
+
+CPU_LATENCY_DEVICE = "/dev/cpu_dma_latency"  # Linux PM QoS: a request held while the file is open
+_cpu_latency: list[int] = []  # this process's open request (its file descriptor), at most one
+
+
+def _hold_cpu_latency(us: int) -> str | None:
+    """Ask the kernel to keep every CPU out of idle states slower to wake than ``us`` µs while this
+    process runs (the request lasts while the device stays open, and ends with the process)."""
+    import struct
+
+    if _cpu_latency:
         return None
     try:
-        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(params.realtime_priority))
-    except (AttributeError, OSError) as exc:
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else "not on this system"
-        return f"runtime.realtime_priority: the real-time scheduler is not available ({reason}); normal priority"
+        fd = os.open(CPU_LATENCY_DEVICE, os.O_WRONLY)
+    except OSError as exc:
+        return (f"runtime.cpu_latency_us: {CPU_LATENCY_DEVICE} cannot be opened ({exc.strerror}); the kernel's "
+                "idle states")  # fmt: skip
+    os.write(fd, struct.pack("i", us))
+    _cpu_latency.append(fd)
     return None
 
 

@@ -64,6 +64,9 @@ class RuntimeParams(Validated):
     vision_with_sim: bool = False  # vision (or the truth perception) runs in the sim node; camera frames stay there
     realtime_priority: int = setting(0, lo=0, hi=99)  # the frame path's nodes (sim, vision, team) on the real-time
     # scheduler (SCHED_FIFO at this priority) so that other work on the host waits for them; 0: the normal scheduler
+    cpu_latency_us: int = setting(-1, lo=-1, hi=1_000_000)  # >= 0: while a frame path node runs, the host's CPUs
+    # stay out of idle states slower to wake than this (µs; Linux PM QoS, /dev/cpu_dma_latency; 0: an idle CPU
+    # polls, at the cost of its power); -1: the kernel's choice
 
     def __post_init__(self) -> None:
         super().__post_init__()

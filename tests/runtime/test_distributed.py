@@ -299,3 +299,38 @@ def test_the_frame_paths_nodes_go_on_the_real_time_scheduler_only_when_set(prior
         assert level == priority and note == "None"
     else:
         assert note.startswith("runtime.realtime_priority: the real-time scheduler is not available (")
+
+
+_CPU_LATENCY_PROBE = """
+import dataclasses, os, struct
+from cmdragons.runtime.distributed import CPU_LATENCY_DEVICE, frame_path_priority
+from cmdragons.runtime.params import RuntimeParams
+
+def target():  # the kernel's CPU latency target now: the least of every request held
+    try:
+        with open(CPU_LATENCY_DEVICE, "rb") as f:
+            return struct.unpack("i", f.read(4))[0]
+    except OSError:
+        return None
+
+before = target()
+note = frame_path_priority(dataclasses.replace(RuntimeParams(), cpu_latency_us={us}), {role!r})
+print(before, target(), note)
+"""
+
+
+@pytest.mark.skipif(not __import__("os").path.exists("/dev/cpu_dma_latency"), reason="no Linux PM QoS device here")
+@pytest.mark.parametrize(("us", "role"), [(-1, "team"), (37, "opponent"), (37, "team"), (0, "sim")])
+def test_the_frame_paths_nodes_hold_a_cpu_latency_request_only_when_set(us: int, role: str) -> None:
+    """In a process of its own (the request lasts as long as the process): none by default or off
+    the frame path; on, the kernel's target is at most the request while the process runs, or,
+    where the device may not be opened, the node says why in one line."""
+    out = subprocess.run([sys.executable, "-c", _CPU_LATENCY_PROBE.format(us=us, role=role)], cwd=ROOT,
+                         capture_output=True, text=True, check=True).stdout.split(maxsplit=2)  # fmt: skip
+    before, during, note = out[0], out[1], out[2].strip()
+    if us < 0 or role not in ("sim", "vision", "team"):
+        assert (during, note) == (before, "None")
+    elif note == "None":
+        assert int(during) <= us
+    else:
+        assert note.startswith("runtime.cpu_latency_us: /dev/cpu_dma_latency cannot be opened (")

@@ -6,7 +6,9 @@ Messages go as protobuf (:mod:`cmdragons.runtime.wire`); payloads from ``shm_min
 frames) are written into zenoh's shared memory, so a same-host subscriber maps them instead of
 copying them through a socket; a camera frame's image is copied once from its array into the
 buffer, beside the message's header (:func:`~cmdragons.runtime.wire.encode_chunks`). Publishers
-block rather than drop when a link is congested: a lock-step match must lose nothing.
+block rather than drop when a link is congested: a lock-step match must lose nothing. A topic that
+no other node subscribes to is neither encoded nor sent (each topic's publisher is told by a
+matching listener when a subscriber comes or goes).
 
 Zenoh delivers on its own threads; this transport only queues there. :meth:`ZenohTransport.spin`
 decodes and delivers in the calling thread, first received first delivered, each message to its

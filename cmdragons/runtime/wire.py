@@ -546,8 +546,8 @@ def canonical_and_chunks(message: Any) -> tuple[Any, tuple[bytes, ...]]:
     """:func:`canonical` and :func:`encode_chunks` of ``message`` at once, for a message that goes
     both to stages of this process and over the wire: one whose wire form rounds is turned into
     its protobuf object once for both."""
-    codec = CODECS.get(type(message))
-    if codec is not None and type(message) in LOSSY:
+    if type(message) in LOSSY:
+        codec = CODECS[type(message)]
         proto = codec.to_proto(message)
         return codec.from_proto(proto), (proto.SerializeToString(deterministic=True),)
     return message, encode_chunks(message)

@@ -34,6 +34,7 @@ __all__ = [
     "cameras_from_config",
     "opencv_extrinsics",
     "params_from_opencv",
+    "scaled_to",
     "smallest_ball_px",
 ]
 
@@ -216,6 +217,26 @@ class CameraModel:
         sx = np.linalg.norm(px[1] - px[0]) / (2 * h)
         sy = np.linalg.norm(px[3] - px[2]) / (2 * h)
         return float(min(sx, sy))
+
+
+ASPECT_TOLERANCE = 0.005  # relative difference of width/height ratios still taken as the same aspect
+
+
+def scaled_to(params: CameraParams, width: int, height: int) -> CameraParams | None:
+    """``params`` for frames of ``width`` x ``height`` px of the same camera (a calibration made at
+    one size, frames delivered at another): focal length and principal point scaled with the image
+    (pixels measured from the top-left corner, so the corner stays the origin); the distortion acts
+    on normalised coordinates and is unchanged. None when the aspect ratio differs by more than
+    ``ASPECT_TOLERANCE`` (a cropped or stretched image: the model cannot follow it)."""
+    w0, h0 = params.resolution_px
+    if (width, height) == (w0, h0):
+        return params
+    sx, sy = width / w0, height / h0
+    if abs(sx - sy) > ASPECT_TOLERANCE * max(sx, sy):
+        return None
+    cx, cy = params.principal_point_px
+    return dataclasses.replace(params, resolution_px=(width, height), focal_px=params.focal_px * math.sqrt(sx * sy),
+                               principal_point_px=(cx * sx, cy * sy))  # fmt: skip
 
 
 def opencv_extrinsics(model: CameraModel) -> tuple[NDArray[np.float64], NDArray[np.float64]]:

@@ -1,16 +1,21 @@
 """``cmdragons vision SOURCE...``: every camera frame of the sources through the pipeline, into
 detections.jsonl (DESIGN.md), an optional annotated video per camera, and a summary.
 
-A frame that cannot be read, is empty or has the wrong size is counted and reported by number; it
-never stops the run. A video that breaks off (truncated, corrupt) is processed up to its last good
+Frames of another size than the camera model's, at the same aspect ratio, are processed through
+the model scaled to them (:func:`cmdragons.camera.scaled_to`); a source whose first frame has
+another aspect ratio stops the run before any frame is processed (:class:`FrameSizeError`, one
+line: the size found, the size expected, the command that fixes it). A later frame that cannot be
+read, is empty or has another size than the first is counted and reported by number; it never
+stops the run. A video that breaks off (truncated, corrupt) is processed up to its last good
 frame and the break is reported by file and frame.
 """
 
 from __future__ import annotations
 
+import itertools
 import json
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -19,14 +24,14 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from cmdragons.camera import CameraModel
+from cmdragons.camera import CameraModel, scaled_to
 from cmdragons.geometry import LeagueParams
 from cmdragons.messages import DetectionFrame, GroundTruth
 from cmdragons.recording import RecordingReader
 from cmdragons.videoio import VideoError, VideoWriter
 from vision.pipeline import VisionParams, VisionPipeline
 from vision.score import Score
-from vision.sources import FrameSource, SourceError
+from vision.sources import Frame, FrameSizeError, FrameSource, SourceError
 
 __all__ = ["RunSummary", "annotate", "run_vision"]
 
@@ -87,6 +92,33 @@ def annotate(image: NDArray[np.uint8], pipe: VisionPipeline, det: DetectionFrame
     return out
 
 
+def _first_frame(src: FrameSource) -> tuple[Iterator[Frame], NDArray[np.uint8] | None]:
+    """The source's frames (the first read ahead and put back) and its first image (None when the
+    first frame cannot be read or the source has none)."""
+    frames = src.frames()
+    try:
+        first = next(frames)
+    except (StopIteration, VideoError):
+        return src.frames(), None  # read again in the run, which reports the break
+    image = first[1]
+    return itertools.chain([first], frames), image if image is not None and image.size else None
+
+
+def model_for_frames(src: FrameSource, model: CameraModel, image: NDArray[np.uint8] | None) -> CameraModel:
+    """``model`` for the size of the source's first frame ``image``: itself, scaled to it (same
+    aspect ratio), or :class:`FrameSizeError` naming the sizes and the command that fixes it."""
+    if image is None or image.ndim != 3 or image.shape[2] != 3:
+        return model
+    h, w = image.shape[:2]
+    scaled = scaled_to(model.params, w, h)
+    if scaled is not None:
+        return model if scaled is model.params else CameraModel(scaled)
+    frame = str(src.paths[0]) if src.kind == "images" else "FRAME.png (one frame of it saved as an image)"
+    raise FrameSizeError(f"{src.name}: frames are {w}x{h}, camera {model.id}'s model is {model.width}x"
+                         f"{model.height} (another aspect ratio, cannot be scaled); calibrate the camera at this "
+                         f"size: cmdragons vision calibrate --lines {frame} --camera {model.id}")  # fmt: skip
+
+
 def run_vision(sources: Sequence[FrameSource], cameras: dict[int, CameraModel], params: VisionParams,
                league: LeagueParams, out: Path, video: bool, fps: float, recording: Path | None = None,
                progress: Callable[[int], None] | None = None) -> RunSummary:  # fmt: skip
@@ -100,6 +132,11 @@ def run_vision(sources: Sequence[FrameSource], cameras: dict[int, CameraModel], 
         raise SourceError(f"{len(sources)} sources but only {len(cameras)} camera model(s) in the config: "
                           f"{missing[0].name} would be camera {missing[0].camera_id}; give one source per camera "
                           "(or a config whose cameras.yaml lists more)")  # fmt: skip
+    # every source's first frame read and its size checked before any frame is processed
+    opened = []
+    for src in sources:
+        frames, first = _first_frame(src)
+        opened.append((src, frames, model_for_frames(src, src.camera or cameras[src.camera_id], first)))
     truth: dict[int, GroundTruth] = {}
     if recording is not None:
         reader = RecordingReader(recording)
@@ -108,11 +145,9 @@ def run_vision(sources: Sequence[FrameSource], cameras: dict[int, CameraModel], 
             summary.broken_off.append(reader.truth_broken)
     score = Score() if truth else None
     with open(out / "detections.jsonl", "w", encoding="utf-8") as jsonl:
-        for src in sources:
-            model = src.camera or cameras[src.camera_id]
+        for src, frames, model in opened:
             pipe = VisionPipeline(params, league, model)
             writer: VideoWriter | None = None
-            frames = src.frames()
             while True:
                 try:
                     k, image = next(frames)

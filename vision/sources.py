@@ -21,7 +21,7 @@ from cmdragons.camera import CameraModel
 from cmdragons.recording import RecordingError, RecordingReader, camera_files
 from cmdragons.videoio import read_video
 
-__all__ = ["FrameSource", "SourceError", "open_sources"]
+__all__ = ["FrameSizeError", "FrameSource", "SourceError", "open_sources"]
 
 IMAGE_SUFFIXES = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff"}
 VIDEO_SUFFIXES = {".mp4", ".avi", ".mkv", ".mov", ".webm", ".m4v", ".ts"}
@@ -30,6 +30,11 @@ Frame = tuple[int, NDArray[np.uint8] | None]
 
 class SourceError(ValueError):
     """A SOURCE that is none of the kinds ``cmdragons vision`` reads."""
+
+
+class FrameSizeError(SourceError):
+    """A source whose first frame has a size the camera model cannot be scaled to (another aspect
+    ratio): one line naming the size found, the size expected and the command that fixes it."""
 
 
 @dataclass

@@ -13,6 +13,12 @@ An image (H, W, 3) BGR uint8 becomes colour regions in four steps:
 4. Region statistics (A.1.5): area, centroid, bounding box, second moments; density-based merging
    of nearby fragments (A.1.6); a minimum area per class; regions sorted by area.
 
+A region too large for what its class marks (:class:`SplitRule`: a dot that touches a light segment
+of its colour on a real robot cover, the two joined into one region) is opened by a disc, a
+morphological opening that keeps the parts a disc of that radius fits in and drops the thin ones
+and the necks between them; the round parts that remain become regions of their own, and the rest
+is dropped.
+
 Pixel coordinates: (u, v) = (column, row); a centroid is reported at pixel centres, so the
 centre of pixel (i, j) is (j + 0.5, i + 0.5), as in :mod:`cmdragons.camera`.
 """
@@ -37,6 +43,7 @@ __all__ = [
     "RegionParams",
     "Regions",
     "Segmenter",
+    "SplitRule",
     "build_lut",
     "classify_reference",
     "convert_colour",
@@ -82,6 +89,49 @@ class RegionParams(Validated):
     # once (the same runs either way); smaller ones on one
     threads: int = setting(2, lo=1, hi=64)
     threads_min_pixels: int = setting(1_500_000, lo=0, hi=10**9)
+
+
+@dataclass(frozen=True)
+class SplitRule:
+    """Which regions :class:`Segmenter` splits, pixels: those of a class larger than its
+    ``max_area_px`` (inf: never), opened by a disc of ``open_radius_px``; of the parts, those no
+    more elongated than ``max_elongation`` (ratio of the second moments' axes) are kept."""
+
+    max_area_px: NDArray[np.float64]  # per class
+    open_radius_px: float
+    max_elongation: float = 1.6
+
+
+def split_region(flat: NDArray[np.int32], rule: SplitRule) -> NDArray[np.float64]:
+    """The round parts of one region given by its runs ``flat`` (n, 4: row, u_start, u_end, class)
+    after an opening by a disc of ``rule.open_radius_px``: rows of the region table
+    (:mod:`vision._kernels` layout, u and v at pixel corners), possibly none."""
+    import cv2
+
+    r = max(1, int(round(rule.open_radius_px)))
+    u0, v0 = int(flat[:, 1].min()) - r, int(flat[:, 0].min()) - r
+    mask = np.zeros((int(flat[:, 0].max()) - v0 + r + 1, int(flat[:, 2].max()) - u0 + r + 1), np.uint8)
+    for row, a, b, _ in flat:
+        mask[row - v0, a - u0 : b - u0 + 1] = 1
+    disc = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * r + 1, 2 * r + 1))
+    n, labels = cv2.connectedComponents(cv2.morphologyEx(mask, cv2.MORPH_OPEN, disc), connectivity=8)
+    rows = regions_reference(labels.astype(np.int64) - 1, np.full(labels.shape, int(flat[0, 3]), np.int64))
+    if n <= 1:
+        return rows
+    # back to image coordinates: shift the sums and the boxes by the crop's corner
+    a, su, sv = rows[:, kern.R_AREA], rows[:, kern.R_SUM_U].copy(), rows[:, kern.R_SUM_V].copy()
+    rows[:, kern.R_SUM_U] += a * u0
+    rows[:, kern.R_SUM_V] += a * v0
+    rows[:, kern.R_SUM_UU] += 2 * u0 * su + a * u0 * u0
+    rows[:, kern.R_SUM_VV] += 2 * v0 * sv + a * v0 * v0
+    rows[:, kern.R_SUM_UV] += u0 * sv + v0 * su + a * u0 * v0
+    rows[:, [kern.R_U0, kern.R_U1]] += u0
+    rows[:, [kern.R_V0, kern.R_V1]] += v0
+    m = Regions.from_stats(rows).moments
+    tr, det = m[:, 0] + m[:, 1], m[:, 0] * m[:, 1] - m[:, 2] ** 2
+    disc_ = np.sqrt(np.maximum(tr * tr / 4.0 - det, 0.0))
+    elong = np.sqrt((tr / 2.0 + disc_) / np.maximum(tr / 2.0 - disc_, 1e-6))
+    return rows[elong <= rule.max_elongation]
 
 
 def convert_colour(image: NDArray[np.uint8], space: ColourSpace) -> NDArray[np.int32]:
@@ -174,7 +224,9 @@ def _finish(stats: NDArray[np.float64], min_area: NDArray[np.float64]) -> Region
 class Segmenter:
     """CMVision over images of one size: the compiled tables and reusable run buffers."""
 
-    def __init__(self, classes: Mapping[str, ColourClass], space: ColourSpace, params: RegionParams) -> None:
+    def __init__(self, classes: Mapping[str, ColourClass], space: ColourSpace, params: RegionParams,
+                 split: SplitRule | None = None) -> None:  # fmt: skip
+        self.split = split
         self.names = list(classes)
         self.classes = [classes[n] for n in self.names]
         self.space = space
@@ -226,10 +278,24 @@ class Segmenter:
         runs, counts = self.runs(image)
         flat, label, n = kern.connect_runs(runs, counts, self.params.connectivity == 8)
         stats = kern.region_stats(flat, label, int(n[0]))
+        if self.split is not None:
+            stats = self._split(stats, flat, label, self.split)
         if merge and self.params.merge_gap_px > 0.0 and stats.shape[0] > 1:
             alive = kern.merge_regions(stats, self.params.merge_gap_px, self.params.merge_min_density)
             stats = stats[alive]
         return _finish(stats, self.min_area)
+
+
+    @staticmethod
+    def _split(stats: NDArray[np.float64], flat: NDArray[np.int32], label: NDArray[np.int64],
+               rule: SplitRule) -> NDArray[np.float64]:  # fmt: skip
+        """``stats`` (one row per label) with each region too large for its class replaced by its
+        round parts (:func:`split_region`)."""
+        big = np.flatnonzero(stats[:, kern.R_AREA] > rule.max_area_px[stats[:, kern.R_CLASS].astype(np.int64)])
+        if big.size == 0:
+            return stats
+        parts = [split_region(flat[label == k], rule) for k in big]
+        return np.concatenate([np.delete(stats, big, axis=0), *parts], axis=0)
 
 
 def regions_reference(labels: NDArray[np.int64], cls_of_pixel: NDArray[np.int64]) -> NDArray[np.float64]:

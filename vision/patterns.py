@@ -55,7 +55,11 @@ class PatternParams(Validated):
     residual_scale_m: float = setting(0.006, lo=0.0005, hi=0.1)  # confidence exp(-(res/scale)^2 / 2)
     min_area_fraction: float = setting(0.3, lo=0.0, hi=1.0)  # of a dot's expected area, for centre and id dots
     max_area_fraction: float = setting(2.5, lo=1.0, hi=20.0)
-    min_dots: int = setting(4, lo=3, hi=4)  # id dots needed; with 3 the missing slot's colour is read from the image
+    # id dots needed; with 3 the missing slot's colour is read from the image, or, where nothing of
+    # either colour is there (a dot hidden), taken from the ids in play when only one of them fits
+    min_dots: int = setting(4, lo=3, hi=4)
+    ids_in_play: tuple[int, ...] = setting((), lo=0, hi=15)  # ids of the covers in use; empty: every id
+    table_confidence: float = setting(0.8, lo=0.0, hi=1.0)  # times the 3-dot confidence, for an id from the table
     duplicate_distance_m: float = setting(0.12, lo=0.0, hi=1.0)  # closer robots are one robot seen twice
     min_confidence: float = setting(0.1, lo=0.0, hi=1.0)
 
@@ -149,8 +153,10 @@ class PatternMatcher:
         self.assign = np.array(list(itertools.permutations(range(len(self.slots)))), dtype=np.int64)
         # the id of each code (pink slots as bits), -1 for a code no robot has
         self.id_of_code = np.full(1 << len(self.slots), -1, dtype=np.int64)
+        in_play = set(params.ids_in_play) or set(range(len(pattern.ids)))
         for i, code in enumerate(pattern.ids):
-            self.id_of_code[sum(1 << s for s, ch in enumerate(code) if ch == "P")] = i
+            if i in in_play:
+                self.id_of_code[sum(1 << s for s, ch in enumerate(code) if ch == "P")] = i
         self.centre_area = math.pi * (pattern.center_dot_diameter_m / 2.0) ** 2
         self.dot_area = math.pi * (pattern.id_dot_diameter_m / 2.0) ** 2
 
@@ -180,28 +186,34 @@ class PatternMatcher:
                                         params.min_confidence)  # fmt: skip
             for r in np.flatnonzero(table[:, kern.M_VERDICT] != kern.V_REJECT):
                 row, robot_id = table[r], int(table[r, kern.M_ID])
+                conf = float(row[kern.M_CONF])
                 if row[kern.M_VERDICT] == kern.V_READ_MISSING:
-                    robot_id = self._complete(row, z, geo.camera, is_pink)
+                    robot_id, seen = self._complete(row, z, geo.camera, is_pink)
                     if robot_id < 0:
                         continue
+                    conf *= 1.0 if seen else params.table_confidence
                 pixel = regions.centroid[c_idx[r]]
                 heading = math.remainder(float(row[kern.M_THETA]), 2.0 * math.pi)
                 found.append(RobotDetection(team, robot_id, float(row[kern.M_X]), float(row[kern.M_Y]), heading,
-                                            float(row[kern.M_CONF]), (float(pixel[0]), float(pixel[1]))))  # fmt: skip
+                                            conf, (float(pixel[0]), float(pixel[1]))))  # fmt: skip
         return merge_duplicates(found, params.duplicate_distance_m)
 
     def _complete(self, row: NDArray[np.float64], z: float, camera: CameraModel,
-                  is_pink: Callable[[NDArray[np.float64]], bool | None]) -> int:  # fmt: skip
+                  is_pink: Callable[[NDArray[np.float64]], bool | None]) -> tuple[int, bool]:  # fmt: skip
         """The id of a fit with a dot the regions missed (glare, a dark corner), its colour read
-        where the fit puts it; -1 where neither colour is there or the code is no robot's."""
+        where the fit puts it, and True; where neither colour is there (the dot hidden), the one id
+        in play that the three dots seen fit, and False; -1 where the colour read makes a code no
+        robot in play has, or where both colours make one (ambiguous)."""
         missing = int(row[kern.M_MISSING])
         c, s = math.cos(row[kern.M_THETA]), math.sin(row[kern.M_THETA])
         sx, sy = self.slots[missing]
         at = camera.project_xy(np.array([row[kern.M_X] + c * sx - s * sy, row[kern.M_Y] + s * sx + c * sy]), z)
         colour = is_pink(at)
-        if colour is None:
-            return -1
-        return int(self.id_of_code[int(row[kern.M_PINK]) | int(colour) << missing])
+        pink = int(row[kern.M_PINK])
+        if colour is not None:
+            return int(self.id_of_code[pink | int(colour) << missing]), True
+        fits = [int(i) for i in (self.id_of_code[pink], self.id_of_code[pink | 1 << missing]) if i >= 0]
+        return (fits[0] if len(fits) == 1 else -1), False
 
 
 def merge_duplicates(robots: list[RobotDetection], distance_m: float) -> list[RobotDetection]:
@@ -261,9 +273,10 @@ def detect_ball(
     robot_height_m: dict[Team, float],
     pattern_radius_m: float,
     params: BallParams,
+    in_field: Callable[[float, float], bool] = lambda x, y: True,
 ) -> list[BallDetection]:
     """Ball candidates: orange regions of the ball's size and shape, not inside a detected
-    robot's pattern, centred as ``params.centre`` says in ``image`` (H, W, 3) BGR uint8 and
+    robot's pattern, inside the field mask ``in_field(x, y)``, centred as ``params.centre`` says in ``image`` (H, W, 3) BGR uint8 and
     projected on the plane of the ball centre's height plus ``params.blob_height_above_centre_m``;
     most confident first."""
     regions = geo.regions
@@ -297,7 +310,7 @@ def detect_ball(
         size_conf = min(ratio[j], 1.0 / ratio[j])
         shape_conf = min(1.0, 1.5 / elong[j])
         conf = float(np.clip(size_conf * shape_conf / 0.6, 0.0, 1.0))
-        if conf >= params.min_confidence:
+        if conf >= params.min_confidence and in_field(float(xy[j, 0]), float(xy[j, 1])):
             out.append(BallDetection(float(xy[j, 0]), float(xy[j, 1]), conf, (float(px[j, 0]), float(px[j, 1])),
                                      float(sigma[j])))  # fmt: skip
     out.sort(key=lambda b: -b.confidence)

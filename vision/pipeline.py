@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 
 from cmdragons.camera import CameraModel
 from cmdragons.config import Validated
-from cmdragons.geometry import TEAMS, LeagueParams, Team
+from cmdragons.geometry import TEAMS, Field, LeagueParams, Team
 from cmdragons.messages import DetectionFrame
 from vision.cmvision import (
     MAX_CLASSES,
@@ -25,6 +25,7 @@ from vision.cmvision import (
     RegionParams,
     Regions,
     Segmenter,
+    SplitRule,
     convert_colour,
 )
 from vision.patterns import BallParams, PatternMatcher, PatternParams, RegionGeometry, detect_ball
@@ -71,6 +72,9 @@ class VisionParams(Validated):
     ball: BallParams = BallParams()
     # height of the pattern plane per team, m; a team left out: the robot height of configs/field.yaml
     robot_height_m: Mapping[Team, float] = field(default_factory=dict)
+    # the field mask: a detection further than this past the field lines is dropped (m; null: the
+    # boundary width of configs/field.yaml, the walls; a negative value: no mask)
+    field_margin_m: float | None = None
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -82,6 +86,8 @@ class VisionParams(Validated):
                 raise ValueError(
                     f"roles.{role}: unknown colour {name!r}; colours defined: {', '.join(self.colours) or 'none'}"
                 )
+        if self.field_margin_m is not None and self.field_margin_m > 20.0:
+            raise ValueError(f"field_margin_m must be at most 20 m (negative: no mask), got {self.field_margin_m}")
         for team, h in self.robot_height_m.items():
             if not 0.01 <= h <= 1.0:
                 raise ValueError(f"robot_height_m.{team} must be 0.01 to 1.0 m, got {h}")
@@ -92,19 +98,40 @@ class VisionPipeline:
 
     def __init__(self, params: VisionParams, league: LeagueParams, camera: CameraModel) -> None:
         self.params, self.league, self.camera = params, league, camera
-        self.segmenter = Segmenter(params.colours, params.colour_space, params.regions)
         roles = params.roles
-        self.classes = {role: self.segmenter.index(getattr(roles, role)) for role in ("ball", "blue", "yellow",
-                                                                                       "pink", "green")}  # fmt: skip
-        self.heights: dict[Team, float] = {t: params.robot_height_m.get(t, league.robot.height_m) for t in TEAMS}
-        self.matcher = PatternMatcher(league.pattern, params.patterns)
+        names = list(params.colours)
+        self.classes = {role: names.index(getattr(roles, role)) for role in ("ball", "blue", "yellow", "pink", "green")}
         self.grid = camera.pixel_rays_grid()
-        dots = np.array(league.pattern.dot_positions_m)
-        self.pattern_radius_m = float(np.max(np.hypot(dots[:, 0], dots[:, 1]))) + league.pattern.id_dot_diameter_m / 2
         # an id dot's radius in the image (at the nadir: the scale changes little over a frame)
         depth = camera.center[2] - league.robot.height_m
         self.dot_radius_px = league.pattern.id_dot_diameter_m / 2 * camera.f / depth
+        # id-dot regions larger than any dot can look anywhere in the image are split (a dot joined
+        # to a light segment of its colour on a real cover)
+        dot_px = math.pi * (league.pattern.id_dot_diameter_m / 2) ** 2 / (self._smallest_pixel_area() * depth**2)
+        max_area = np.full(len(names), np.inf)
+        max_area[[self.classes["pink"], self.classes["green"]]] = params.patterns.max_area_fraction * dot_px
+        split = SplitRule(max_area, open_radius_px=0.6 * self.dot_radius_px)
+        self.segmenter = Segmenter(params.colours, params.colour_space, params.regions, split)
+        self.heights: dict[Team, float] = {t: params.robot_height_m.get(t, league.robot.height_m) for t in TEAMS}
+        self.matcher = PatternMatcher(league.pattern, params.patterns)
+        dots = np.array(league.pattern.dot_positions_m)
+        self.pattern_radius_m = float(np.max(np.hypot(dots[:, 0], dots[:, 1]))) + league.pattern.id_dot_diameter_m / 2
+        f = Field(league)
+        margin = f.dims.boundary_width_m if params.field_margin_m is None else params.field_margin_m
+        # half extents of the field mask (inf: none)
+        self.mask_half_m = (f.half_length + margin, f.half_width + margin) if margin >= 0.0 else (math.inf, math.inf)
         self.last_regions: Regions | None = None
+
+    def _smallest_pixel_area(self) -> float:
+        """The smallest field area of one pixel per metre of descent squared over the image (where
+        objects look largest), from the ray grid sampled every 8 pixels."""
+        g = self.grid[::8, ::8].astype(np.float64)
+        du, dv = (g[:-1, 1:] - g[:-1, :-1]) / 8.0, (g[1:, :-1] - g[:-1, :-1]) / 8.0
+        return float(np.min(np.abs(du[..., 0] * dv[..., 1] - du[..., 1] * dv[..., 0])))
+
+    def in_field(self, x: float, y: float) -> bool:
+        """Whether field point (x, y) m lies inside the field mask (the field lines plus the margin)."""
+        return abs(x) <= self.mask_half_m[0] and abs(y) <= self.mask_half_m[1]
 
     @property
     def shape(self) -> tuple[int, int, int]:
@@ -125,7 +152,8 @@ class VisionPipeline:
         robots = self.matcher.detect(geo, self.classes, self.heights, lambda px: self._is_pink(image, px))
         # a ball seen beside a robot lies outside its top: only a misread marker is well inside
         balls = detect_ball(geo, image, self.classes["ball"], self.league.ball.radius_m, robots, self.heights,
-                            self.pattern_radius_m * 0.8, self.params.ball)  # fmt: skip
+                            self.pattern_radius_m * 0.8, self.params.ball, self.in_field)  # fmt: skip
+        robots = [r for r in robots if self.in_field(r.x, r.y)]
         # no wall clock here: the frame is "sent" at its capture time (latency is the runtime's)
         return DetectionFrame(self.camera.id, frame_number, t_capture, t_capture, tuple(balls),
                               tuple(sorted(robots, key=lambda r: (r.team, r.id))))  # fmt: skip
@@ -134,9 +162,10 @@ class VisionPipeline:
         """The id-dot colour at ``pixel`` (u, v): the mean colour of the pixels within 0.7 of the
         dot's radius, pink or green by which box's centre is nearer in the two colour channels
         (each box's half-width the unit); None off the image or more than two half-widths from
-        both. A mean over the dot rather than a vote of thresholded pixels: 4:2:0 video pulls a
-        small dot's pixels out of their box (toward the black cover), but keeps its mean colour on
-        its side of grey."""
+        both, or where the two are nearly as far (a colour between them: a dot hidden under
+        something grey or white, or washed out). A mean over the dot rather than a vote of
+        thresholded pixels: 4:2:0 video pulls a small dot's pixels out of their box (toward the
+        black cover), but keeps its mean colour on its side of grey."""
         if not np.all(np.isfinite(pixel)):
             return None
         r = max(1.0, 0.7 * self.dot_radius_px)
@@ -152,7 +181,7 @@ class VisionPipeline:
             box = self.params.colours[getattr(self.params.roles, role)]
             lo, hi = np.array(box.lo[1:], dtype=np.float64), np.array(box.hi[1:], dtype=np.float64)
             reach.append(float(np.max(np.abs(mean[1:] - (lo + hi) / 2.0) / np.maximum((hi - lo) / 2.0, 1.0))))
-        if min(reach) > 2.0:
+        if min(reach) > 2.0 or min(reach) > 0.75 * max(reach):
             return None
         return reach[0] < reach[1]
 

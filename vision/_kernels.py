@@ -584,19 +584,21 @@ M_COLS = 12
 # verdicts: rejected, a robot, a robot if the missing dot's colour (read from the image by the
 # caller) completes a known id
 V_REJECT, V_ROBOT, V_READ_MISSING = 0, 1, 2
+FULL_DOT_AREA = 0.9  # share of a dot's expected area at which its area confidence is whole
 
 
 @numba.njit(cache=True, inline="always")
 def _verdict(row: np.ndarray, id_of_code: np.ndarray, max_res: float, res_scale: float, min_conf: float) -> None:
     """A fitted row's verdict, robot id (``id_of_code`` at the pink bits; -1 unknown) and
     confidence: the fit residual against the pattern noise (``exp(-(res / res_scale)^2 / 2)``)
-    times how far the smallest dot falls short of its expected area (half the area or less: no
-    trust), halved where a dot is missing. A fit above ``max_res``, an unknown code or a
-    confidence below ``min_conf`` is rejected."""
+    times the share of its expected area the smallest dot shows, up to ``FULL_DOT_AREA`` (a dot's
+    blurred rim falls out of its class: 90% of it counts whole), so that a dot at the smallest area
+    the matcher accepts still gives a confidence in proportion; halved where a dot is missing. A
+    fit above ``max_res``, an unknown code or a confidence below ``min_conf`` is rejected."""
     row[M_VERDICT], row[M_ID], row[M_CONF] = V_REJECT, -1.0, 0.0
     if row[M_RES] > max_res:
         return
-    area_conf = min(1.0, max(0.0, (row[M_AREA] - 0.5) / 0.4))
+    area_conf = min(1.0, max(0.0, row[M_AREA] / FULL_DOT_AREA))
     q = row[M_RES] / res_scale
     c = math.exp(-0.5 * (q * q)) * area_conf
     if row[M_MISSING] >= 0:

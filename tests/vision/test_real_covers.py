@@ -175,3 +175,28 @@ def test_the_field_mask_drops_what_lies_outside(cameras: list[CameraModel]) -> N
     default = VisionPipeline(VisionParams(), LEAGUE, model).process(image, 0, 0.0)
     assert sorted((r_.team, r_.id) for r_ in default.robots) == [(TEAMS[0], 3), (TEAMS[1], 5)]
 
+
+@pytest.mark.parametrize("area", [0.3, 0.45, 0.7, 0.9, 1.5])
+def test_the_confidence_follows_the_dot_area_the_matcher_accepts(area: float) -> None:
+    """A perfect fit whose smallest dot shows ``area`` of its expected area: the confidence is that
+    share of 90% (the blurred rim lost counts whole), so a dot at the smallest accepted area (0.3)
+    still gives a robot, at a third of the confidence."""
+    import itertools
+
+    from vision.patterns import PatternMatcher
+
+    params = VisionParams().patterns
+    matcher = PatternMatcher(LEAGUE.pattern, params)
+    slots = np.array(LEAGUE.pattern.dot_positions_m)
+    theta = 0.7
+    c, s = math.cos(theta), math.sin(theta)
+    dots = slots @ np.array([[c, s], [-s, c]]) + [1.0, -0.5]
+    weights = np.array([1.0, area, 1.0, 1.0])
+    assign = np.array(list(itertools.permutations(range(4))), dtype=np.int64)
+    table = kern.match_patterns(np.array([[1.0, -0.5]]), np.ones(1), dots, weights, np.array([True, True, False, True]),
+                                weights >= params.min_area_fraction, slots, assign, params.search_radius_m,
+                                params.min_dots, matcher.id_of_code, params.max_residual_m, params.residual_scale_m,
+                                params.min_confidence)  # fmt: skip
+    row = table[0]
+    assert row[kern.M_VERDICT] == kern.V_ROBOT and row[kern.M_ID] == 0  # PPGP
+    assert row[kern.M_CONF] == pytest.approx(min(1.0, area / 0.9), rel=1e-6)

@@ -1,5 +1,7 @@
 """``cmdragons vision SOURCE...``: every camera frame of the sources through the pipeline, into
-detections.jsonl (DESIGN.md), an optional annotated video per camera, and a summary.
+detections.jsonl (DESIGN.md), optional overlays (each frame with its detections and the fitted field
+drawn on it: a PNG per still image, a video per video source or, with ``video``, per camera), and a
+summary.
 
 Frames of another size than the camera model's, at the same aspect ratio, are processed through
 the model scaled to them (:func:`cmdragons.camera.scaled_to`); a source whose first frame has
@@ -67,28 +69,47 @@ class RunSummary:
 COLOURS_BGR = {"blue": (255, 160, 0), "yellow": (0, 230, 255), "ball": (0, 140, 255)}
 
 
-def annotate(image: NDArray[np.uint8], pipe: VisionPipeline, det: DetectionFrame) -> NDArray[np.uint8]:
-    """A copy of ``image`` with the regions' boxes, each robot's pattern circle, heading and id,
-    and the ball."""
+def field_layer(pipe: VisionPipeline) -> tuple[NDArray[np.uint8], NDArray[np.bool_]]:
+    """The field lines of configs/field.yaml drawn through the pipeline's camera model on a black
+    image (the fitted field, as calibration draws it), and where they are drawn."""
+    from vision.field_lines import draw_field
+
+    layer = draw_field(np.zeros(pipe.shape, np.uint8), pipe.camera.params, pipe.league)
+    return layer, layer.any(axis=2)
+
+
+def annotate(image: NDArray[np.uint8], pipe: VisionPipeline, det: DetectionFrame,
+             field: tuple[NDArray[np.uint8], NDArray[np.bool_]] | None = None) -> NDArray[np.uint8]:  # fmt: skip
+    """A copy of ``image`` with the regions' boxes (grey), the fitted field (``field``, from
+    :func:`field_layer`), each robot's outline, heading, team, id and confidence (e.g. ``B3 0.97``,
+    blue or yellow), and each ball with its confidence (orange)."""
     out = image.copy()
+    if field is not None:
+        out[field[1]] = field[0][field[1]]
     regions = pipe.last_regions
     if regions is not None:
         for k in range(len(regions)):
             u0, v0, u1, v1 = (int(x) for x in regions.bbox[k])
             cv2.rectangle(out, (u0 - 1, v0 - 1), (u1 + 1, v1 + 1), (200, 200, 200), 1)
     cam, league = pipe.camera, pipe.league
+    scale = max(0.4, cam.width / 2000.0)  # text size: legible at any image size
     for r in det.robots:
         z = pipe.heights[r.team]
         c = cam.project_xy(np.array([r.x, r.y]), z)
         tip = cam.project_xy(np.array([r.x + 0.12 * np.cos(r.theta), r.y + 0.12 * np.sin(r.theta)]), z)
         radius = int(round(league.robot.radius_m * cam.pixels_per_metre((r.x, r.y), z)))
         colour = COLOURS_BGR[r.team]
-        cv2.circle(out, (int(c[0]), int(c[1])), radius, colour, 1, cv2.LINE_AA)
-        cv2.line(out, (int(c[0]), int(c[1])), (int(tip[0]), int(tip[1])), colour, 1, cv2.LINE_AA)
-        cv2.putText(out, str(r.id), (int(c[0]) + radius, int(c[1]) - radius), cv2.FONT_HERSHEY_SIMPLEX, 0.5, colour,
-                    1, cv2.LINE_AA)  # fmt: skip
+        cu, cv = int(round(c[0])), int(round(c[1]))
+        cv2.circle(out, (cu, cv), radius, colour, 1, cv2.LINE_AA)
+        cv2.line(out, (cu, cv), (int(round(tip[0])), int(round(tip[1]))), colour, 1, cv2.LINE_AA)
+        cv2.putText(out, f"{r.team[0].upper()}{r.id} {r.confidence:.2f}", (cu + radius, cv - radius),
+                    cv2.FONT_HERSHEY_SIMPLEX, scale, colour, 1, cv2.LINE_AA)  # fmt: skip
     for b in det.balls:
-        cv2.circle(out, (int(b.pixel[0]), int(b.pixel[1])), 8, COLOURS_BGR["ball"], 1, cv2.LINE_AA)
+        bu, bv = int(round(b.pixel[0])), int(round(b.pixel[1]))
+        radius = max(4, int(round(2.0 * league.ball.radius_m * cam.pixels_per_metre((b.x, b.y), 0.0))))
+        cv2.circle(out, (bu, bv), radius, COLOURS_BGR["ball"], 1, cv2.LINE_AA)
+        cv2.putText(out, f"{b.confidence:.2f}", (bu + radius, bv + radius), cv2.FONT_HERSHEY_SIMPLEX, scale,
+                    COLOURS_BGR["ball"], 1, cv2.LINE_AA)  # fmt: skip
     return out
 
 
@@ -121,10 +142,12 @@ def model_for_frames(src: FrameSource, model: CameraModel, image: NDArray[np.uin
 
 def run_vision(sources: Sequence[FrameSource], cameras: dict[int, CameraModel], params: VisionParams,
                league: LeagueParams, out: Path, video: bool, fps: float, recording: Path | None = None,
-               progress: Callable[[int], None] | None = None) -> RunSummary:  # fmt: skip
+               progress: Callable[[int], None] | None = None, overlay: bool = False) -> RunSummary:  # fmt: skip
     """Process every frame of every source; ``cameras`` gives the model of a source that brings
-    none (by its camera id). Writes ``out/detections.jsonl`` and, with ``video``,
-    ``out/annotated_camera_<id>.mp4``. With a recording's truth, the detections are scored."""
+    none (by its camera id). Writes ``out/detections.jsonl``; with ``video``, and with
+    ``overlay`` for a video source, ``out/annotated_camera_<id>.mp4``; with ``overlay`` for still
+    images, ``out/overlay/camera_<id>_<frame>.png`` each (:func:`annotate`). With a recording's
+    truth, the detections are scored."""
     out.mkdir(parents=True, exist_ok=True)
     summary = RunSummary()
     missing = [s for s in sources if s.camera is None and s.camera_id not in cameras]
@@ -148,6 +171,8 @@ def run_vision(sources: Sequence[FrameSource], cameras: dict[int, CameraModel], 
         for src, frames, model in opened:
             pipe = VisionPipeline(params, league, model)
             writer: VideoWriter | None = None
+            as_video, as_png = video or (overlay and src.kind == "video"), overlay and src.kind != "video"
+            field = field_layer(pipe) if as_video or as_png else None
             while True:
                 try:
                     k, image = next(frames)
@@ -178,12 +203,16 @@ def run_vision(sources: Sequence[FrameSource], cameras: dict[int, CameraModel], 
                 jsonl.write(json.dumps(det.to_dict(), separators=(",", ":")) + "\n")
                 if score is not None and k in truth:
                     score.add(det, truth[k])
-                if video:
+                if as_png:
+                    (out / "overlay").mkdir(exist_ok=True)
+                    cv2.imwrite(str(out / "overlay" / f"camera_{src.camera_id}_{k:06d}.png"),
+                                annotate(image, pipe, det, field))  # fmt: skip
+                if as_video:
                     # H.264 in 4:2:0 takes even sizes: an odd last column or row is left out
                     w2, h2 = model.width // 2 * 2, model.height // 2 * 2
                     if writer is None:
                         writer = VideoWriter(out / f"annotated_camera_{src.camera_id}.mp4", w2, h2, fps, "h264", 23)
-                    writer.write(np.ascontiguousarray(annotate(image, pipe, det)[:h2, :w2]))
+                    writer.write(np.ascontiguousarray(annotate(image, pipe, det, field)[:h2, :w2]))
             if writer is not None:
                 writer.close()
     if score is not None:

@@ -139,6 +139,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", metavar="DIR", default=None, help="output folder (default logs/<time>-vision)")
     p.add_argument("--overwrite", action="store_true", help="let --out replace the run already in that folder")
     p.add_argument("--video", action="store_true", help="also write an annotated video per camera")
+    p.add_argument("--overlay", action="store_true",
+                   help="also draw each frame's detections (team, id, heading, confidence), the balls and the fitted "
+                   "field on it: a PNG per still image (OUT/overlay/), a video per video source")
     p.add_argument("--fps", type=_positive, default=None, help="frames per second for t_capture (default: sim's)")
     p.add_argument("--track", action="store_true", help="also track the detections and write tracks.jsonl")
     p.add_argument("--track-ahead", action="store_true",
@@ -540,7 +543,8 @@ def _cmd_vision(args: argparse.Namespace) -> int:
         task = progress.add_task("vision", total=total, info="")
         try:
             summary = run_vision(sources, {m.id: m for m in settings.camera_models()}, settings.vision, settings.field,
-                                 folder, args.video, fps, recording, lambda n: progress.advance(task, n))  # fmt: skip
+                                 folder, args.video, fps, recording, lambda n: progress.advance(task, n),
+                                 args.overlay)  # fmt: skip
         except (SourceError, RecordingError) as exc:
             print(f"cmdragons vision: {exc}", file=sys.stderr)
             return 2
@@ -550,6 +554,11 @@ def _cmd_vision(args: argparse.Namespace) -> int:
     print(f"vision: {summary.frames} frames from {len(sources)} camera(s), {d['robots_per_frame']:.2f} robots and "
           f"{d['balls_per_frame']:.2f} balls per frame, " + (f"{ms:.2f} ms per frame (median)" if ms else "no frame")
           + f" -> {folder}")  # fmt: skip
+    if args.overlay:
+        pngs = len(list((folder / "overlay").glob("*.png"))) if (folder / "overlay").is_dir() else 0
+        videos = sorted(p.name for p in folder.glob("annotated_camera_*.mp4"))
+        print("vision: overlays -> " + ", ".join(([f"{pngs} PNG in {folder / 'overlay'}"] if pngs else [])
+                                                   + [str(folder / v) for v in videos]))  # fmt: skip
     for name, frames in d["bad_frames"].items():
         if frames:
             print(f"vision: {len(frames)} {name.replace('_', ' ')} frame(s): {', '.join(frames[:20])}"

@@ -614,6 +614,36 @@ def _verdict(row: np.ndarray, id_of_code: np.ndarray, max_res: float, res_scale:
         row[M_VERDICT] = V_ROBOT
 
 
+MAX_CANDIDATES = 6  # id-dot candidates per centre dot tried in every choice of four, nearest the ring first
+
+
+@numba.njit(cache=True, inline="always")
+def _popcount(x: int) -> int:
+    n = 0
+    while x:
+        x &= x - 1
+        n += 1
+    return n
+
+
+@numba.njit(cache=True)
+def _best_assignment(centre: np.ndarray, w_centre: float, obs: np.ndarray, w_obs: np.ndarray, slots: np.ndarray,
+                     assign: np.ndarray, t: np.ndarray) -> int:  # fmt: skip
+    """The row of ``assign`` (slot per observed dot) whose fit of the k = len(obs) dots ranks best
+    (:func:`fit_score`); ``t`` (k_max, 2) is scratch."""
+    k = obs.shape[0]
+    best_score, best = np.inf, -1
+    for a in range(assign.shape[0]):
+        # an assignment of k dots: its first k slots distinct (rows repeat for k < k_max)
+        for i in range(k):
+            t[i, 0] = slots[assign[a, i], 0]
+            t[i, 1] = slots[assign[a, i], 1]
+        score = fit_score(centre, w_centre, obs, w_obs, t[:k])
+        if score < best_score:
+            best_score, best = score, a
+    return best
+
+
 @numba.njit(cache=True)
 def match_patterns(cxy: np.ndarray, cw: np.ndarray, dxy: np.ndarray, dw: np.ndarray, dpink: np.ndarray,
                    dgood: np.ndarray, slots: np.ndarray, assign: np.ndarray, search_r: float, min_dots: int,
@@ -654,22 +684,39 @@ def match_patterns(cxy: np.ndarray, cw: np.ndarray, dxy: np.ndarray, dw: np.ndar
         # nearest the ring first; ties keep index order, as numba's argsort does for up to 15 values
         order = argsort_stable(off[:m])
         k = min(m, k_max)
-        min_w = cw[c]
-        for i in range(k):
-            obs[i, 0] = dxy[near[order[i]], 0]
-            obs[i, 1] = dxy[near[order[i]], 1]
-            w_obs[i] = dw[near[order[i]]]
-            min_w = min(min_w, w_obs[i])
-        best_score, best = np.inf, -1
-        for a in range(assign.shape[0]):
-            # an assignment of k dots: its first k slots distinct (rows repeat for k < k_max)
+        # more candidates than slots (a light part of a real cover passing for a dot): every choice
+        # of k among the MAX_CANDIDATES nearest the ring is fitted, the smallest residual kept
+        n_cand = min(m, MAX_CANDIDATES)
+        best_res, best, best_pick = np.inf, -1, 0
+        for pick in range(1 << n_cand):
+            if _popcount(pick) != k or (m <= k_max and pick != (1 << k) - 1):
+                continue
+            i = 0
+            for j in range(n_cand):
+                if (pick >> j) & 1:
+                    obs[i, 0] = dxy[near[order[j]], 0]
+                    obs[i, 1] = dxy[near[order[j]], 1]
+                    w_obs[i] = dw[near[order[j]]]
+                    i += 1
+            a = _best_assignment(cxy[c], cw[c], obs[:k], w_obs[:k], slots, assign, t)
             for i in range(k):
                 t[i, 0] = slots[assign[a, i], 0]
                 t[i, 1] = slots[assign[a, i], 1]
-            score = fit_score(cxy[c], cw[c], obs[:k], w_obs[:k], t[:k])
-            if score < best_score:
-                best_score, best = score, a
+            res = fit_pattern(cxy[c], cw[c], obs[:k], w_obs[:k], t[:k])[3]
+            if res < best_res:
+                best_res, best, best_pick = res, a, pick
+        chosen = np.empty(k, np.int64)
+        i = 0
+        for j in range(n_cand):
+            if (best_pick >> j) & 1:
+                chosen[i] = order[j]
+                i += 1
+        min_w = cw[c]
         for i in range(k):
+            obs[i, 0] = dxy[near[chosen[i]], 0]
+            obs[i, 1] = dxy[near[chosen[i]], 1]
+            w_obs[i] = dw[near[chosen[i]]]
+            min_w = min(min_w, w_obs[i])
             t[i, 0] = slots[assign[best, i], 0]
             t[i, 1] = slots[assign[best, i], 1]
         bt, bx, by, best_res = fit_pattern(cxy[c], cw[c], obs[:k], w_obs[:k], t[:k])
@@ -677,7 +724,7 @@ def match_patterns(cxy: np.ndarray, cw: np.ndarray, dxy: np.ndarray, dw: np.ndar
         used = 0
         for i in range(k):
             used |= 1 << assign[best, i]
-            if dpink[near[order[i]]]:
+            if dpink[near[chosen[i]]]:
                 pink |= 1 << assign[best, i]
         missing = -1
         for s in range(k_max):

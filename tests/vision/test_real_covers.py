@@ -69,13 +69,14 @@ def _runs(row: NDArray[np.uint8]) -> list[tuple[int, int]]:
 
 def test_a_light_segment_touching_a_dot_is_split_from_it(cameras: list[CameraModel]) -> None:
     """Robot 1 (GPGP) with the flat front's segment of its cover printed in a light green of the
-    green class, the segment reaching its green front-left dot: one region of a dot and a segment,
-    too large for a dot; split, the cover is found with the right id, pose within 3 mm."""
+    green class, reaching 2 mm into its green front-left dot (the flat front is cut at 0.055 m):
+    one region of a dot and a segment, too large for a dot; split, the cover is found with the
+    right id, pose within 3 mm."""
     model = cameras[0]
     robots = _robots(model, [1, 3, 6, 12])
     image, _ = render(model, snapshot(robots))
     robot = robots[0]
-    r, front = 0.085, 0.053  # the flat front cut at 0.055 m, the segment drawn 2 mm into the dots
+    r, front = 0.085, 0.053
     a = math.acos(front / r)
     arc = np.array([(r * math.cos(t), r * math.sin(t)) for t in np.linspace(-a, a, 24)])
     segment = _to_image(model, robot, arc)
@@ -200,3 +201,29 @@ def test_the_confidence_follows_the_dot_area_the_matcher_accepts(area: float) ->
     row = table[0]
     assert row[kern.M_VERDICT] == kern.V_ROBOT and row[kern.M_ID] == 0  # PPGP
     assert row[kern.M_CONF] == pytest.approx(min(1.0, area / 0.9), rel=1e-6)
+
+
+def test_a_fifth_candidate_on_the_ring_does_not_displace_a_dot() -> None:
+    """Four dots 1 mm off their places and a fifth dot-sized region exactly on the pattern's ring
+    between the front dots (what a light segment's remnant on a real cover is): every choice of
+    four among the candidates is fitted, and the true four give the id and pose (the four
+    nearest the ring would have taken the decoy)."""
+    import itertools
+
+    from vision.patterns import PatternMatcher
+
+    params = VisionParams().patterns
+    matcher = PatternMatcher(LEAGUE.pattern, params)
+    slots = np.array(LEAGUE.pattern.dot_positions_m)
+    ring = float(np.mean(np.hypot(slots[:, 0], slots[:, 1])))
+    radial = slots / np.hypot(slots[:, 0], slots[:, 1])[:, None]
+    dots = np.vstack([slots + 0.001 * radial, [[ring, 0.0]]])  # in the robot frame, heading 0
+    pink = np.array([False, True, False, True, False])  # GPGP: id 1; the decoy green
+    weights = np.ones(5)
+    assign = np.array(list(itertools.permutations(range(4))), dtype=np.int64)
+    table = kern.match_patterns(np.zeros((1, 2)), np.ones(1), dots, weights, pink, weights > 0, slots, assign,
+                                params.search_radius_m, params.min_dots, matcher.id_of_code, params.max_residual_m,
+                                params.residual_scale_m, params.min_confidence)  # fmt: skip
+    row = table[0]
+    assert row[kern.M_VERDICT] == kern.V_ROBOT and row[kern.M_ID] == 1
+    assert math.hypot(row[kern.M_X], row[kern.M_Y]) < 0.001 and abs(row[kern.M_THETA]) < 0.01

@@ -276,9 +276,9 @@ def detect_ball(
     in_field: Callable[[float, float], bool] = lambda x, y: True,
 ) -> list[BallDetection]:
     """Ball candidates: orange regions of the ball's size and shape, not inside a detected
-    robot's pattern, inside the field mask ``in_field(x, y)``, centred as ``params.centre`` says in ``image`` (H, W, 3) BGR uint8 and
-    projected on the plane of the ball centre's height plus ``params.blob_height_above_centre_m``;
-    most confident first."""
+    robot's pattern, inside the field mask ``in_field(x, y)``, centred as ``params.centre`` says
+    in ``image`` (H, W, 3) BGR uint8 and projected on the plane of the ball centre's height plus
+    ``params.blob_height_above_centre_m``; most confident first."""
     regions = geo.regions
     idx = regions.of_class(orange)
     if idx.size == 0 or params.max_balls == 0:

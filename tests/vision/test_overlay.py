@@ -17,8 +17,9 @@ from cmdragons.geometry import Field
 from .conftest import LEAGUE, grid_of_robots, render, snapshot
 
 
-def test_overlay_of_a_still_image_draws_detections_ball_and_field(cameras: list[CameraModel], tmp_path: Path,
-                                                                  capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
+def test_overlay_of_a_still_image_draws_detections_ball_and_field(
+    cameras: list[CameraModel], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     model = cameras[0]
     robots = grid_of_robots(model, [1.0], margin_px=80.0)[:6]
     r = LEAGUE.ball.radius_m

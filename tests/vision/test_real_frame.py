@@ -15,7 +15,6 @@ import math
 from pathlib import Path
 
 import cv2
-import numpy as np
 import pytest
 
 from cmdragons.camera import CameraModel, CameraParams

@@ -4,8 +4,13 @@ Robots carry the league's standard pattern (:class:`cmdragons.geometry.PatternGe
 team-colour centre dot and four pink/green id dots. Each centre region is projected to the field
 on the plane of the robot tops; the pink and green regions around it are gathered and the dot
 arrangement is fitted to the template by weighted least squares over position and heading, for
-every assignment of dots to template slots (A.2.2-A.2.3). The best fit gives the slots' colours,
-hence the id, the centre and the heading; its residual and the regions' areas give a confidence.
+every assignment of dots to template slots (A.2.2-A.2.3), and, where more candidates lie round
+a centre than the pattern has dots (a light part of a real cover passing for a dot), for every
+choice of four among them. The best fit gives the slots' colours, hence the id, the centre and the
+heading; its residual and the regions' areas give a confidence. A cover with one dot not found is
+read with three (``min_dots: 3``): the fourth dot's colour read where the fit puts it, or, where
+neither colour is there (the dot hidden), the one id in play (``ids_in_play``) the three fit; its
+confidence is halved, and lowered again for an id from the table.
 
 The ball is the orange region of the right size and shape that is not inside a detected robot's
 pattern; its centre in the image is the centroid of each pixel's ball coverage, read by unmixing

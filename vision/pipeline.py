@@ -1,5 +1,6 @@
 """One camera image -> one :class:`~cmdragons.messages.DetectionFrame`: CMVision regions, then
-robot patterns and the ball (Bruce's thesis, appendix A).
+robot patterns and the ball (Bruce's thesis, appendix A), then the field mask: nothing further
+past the field lines than ``field_margin_m`` (default the boundary width, the walls) is reported.
 
 :class:`VisionParams` is ``configs/vision.yaml``: the colour space, the colour classes (threshold
 boxes), which class plays which role, and the region, pattern and ball parameters.

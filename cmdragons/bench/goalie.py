@@ -123,7 +123,7 @@ def shoot(settings: Settings, shot: Shot, goalie: bool = True) -> bool:
             d = math.hypot(dx, dy)
             w.place_ball(x, y, shot.speed_m_s * dx / d, shot.speed_m_s * dy / d)
             shot_at = k
-        events = w.step_frame(brain.step(_world_state(w), ref.state()) if brain is not None else [])
+        events = w.step_frame(list(brain.step(_world_state(w), ref.state()).commands) if brain is not None else [])
         if shot_at is not None and any(isinstance(e, Goal) and e.x * own > 0 for e in events):
             return True
         if shot_at is not None and k > shot_at + round(SHOT_S * FPS):

@@ -44,7 +44,7 @@ from cmdragons.messages import (
 from cmdragons.runtime.bus import BaseStage, Publish
 from cmdragons.runtime.topics import ANY, Contract, Port, summary_port, topic_matches
 from cmdragons.runtime.log import RunLog
-from cmdragons.team import Brain
+from cmdragons.team import Brain, BrainOutput
 from cmdragons.tracking import Tracker
 from sim.referee import Referee
 from sim.simulator import Simulator
@@ -290,7 +290,7 @@ class _PlayingStage(BaseStage, ABC):
 
 class TeamStage(_PlayingStage):
     """One team's brain: world state and game state -> that frame's commands, its report and its
-    parts' times."""
+    parts' times, all from the brain's output of the frame."""
 
     @staticmethod
     def declare(team: Team, referee_topic: str = "referee") -> Contract:
@@ -301,36 +301,28 @@ class TeamStage(_PlayingStage):
     def __init__(self, team: Team, brain: Brain, referee_topic: str = "referee") -> None:
         super().__init__(self.declare(team, referee_topic), team, referee_topic)
         self.brain = brain
-        self._heat: tuple[Any, Any] | None = None  # the pass evaluation last sent
+        self._out: BrainOutput | None = None
 
     def play(self, message: Any) -> tuple[WorldState, list[RobotCommand]]:
-        return message, self.brain.step(message, self.game)
+        self._out = self.brain.step(message, self.game)
+        return message, list(self._out.commands)
 
     def after(self, world: WorldState, publish: Publish) -> None:
-        publish(f"report/{self.team}", self._report(world))
-        times = {k: v[-1] for k, v in self.brain.times.items() if v}
-        publish(f"timing/{self.team}", Timing(self.name, world.frame_number, times))
-
-    def _report(self, world: WorldState) -> TeamReport:
-        b = self.brain
-        robots = tuple(
-            RobotReport(rid, p.status, (p.intent.x, p.intent.y, p.intent.theta), _points(p.path), p.command,
-                        _points(b.braking.get(rid, ())))
-            for rid, p in sorted(b.plans.items())
-        )  # fmt: skip
-        heat = b.strategy.pass_heat
-        points, values = _points(()), np.zeros(0)
-        if heat is not None and not (self._heat is not None and _same(self._heat[0], heat[0])
-                                     and _same(self._heat[1], heat[1])):  # fmt: skip
-            points, values = heat  # the grid is evaluated every few frames only: sent when it was
-            self._heat = heat
-        return TeamReport(self.team, world.frame_number, world.t, robots, dict(b.strategy.last_action), points,
-                          values)  # fmt: skip
+        out = self._out
+        assert out is not None
+        publish(f"report/{self.team}", _report(self.team, world, out))
+        publish(f"timing/{self.team}", Timing(self.name, world.frame_number, dict(out.times_ms)))
 
 
-def _same(a: Any, b: Any) -> bool:
-    """Whether two arrays are (views of) the same memory: an evaluation not redone."""
-    return bool((a.base if a.base is not None else a) is (b.base if b.base is not None else b))
+def _report(team: Team, world: WorldState, out: BrainOutput) -> TeamReport:
+    """The brain's output of a frame as its report (the pass evaluation on the frames it was redone)."""
+    robots = tuple(
+        RobotReport(rid, p.status.value, (p.intent.x, p.intent.y, p.intent.theta), _points(p.path), p.command,
+                    _points(out.braking.get(rid, ())))
+        for rid, p in out.plans.items()
+    )  # fmt: skip
+    points, values = out.pass_heat if out.pass_heat is not None else (_points(()), np.zeros(0))
+    return TeamReport(team, world.frame_number, world.t, robots, dict(out.last_actions), points, values)
 
 
 def _points(a: Any) -> NDArray[np.float64]:

@@ -52,7 +52,7 @@ def play(w: World, ref: Referee, brain: Brain, seconds: float,
         world = WorldState(truth.t, BallState(b.x, b.y, b.vx, b.vy), tuple(
             RobotState(r.team, r.id, r.x, r.y, r.theta, r.vx, r.vy, r.omega) for r in truth.robots
             if w.field.in_field(r.x, r.y, -w.field.dims.boundary_width_m)), truth.frame_number)  # fmt: skip
-        commands = brain.step(see(world) if see else world, ref.state()) + (theirs(k) if theirs else [])
+        commands = [*brain.step(see(world) if see else world, ref.state()).commands, *(theirs(k) if theirs else [])]
         commands += opponent(w, ref, world) if opponent else []
         events = w.step_frame(commands)
         teleport = ref.observe(w.t, events, tuple(w.ball_body.position), w.ground_truth())

@@ -222,15 +222,18 @@ class Brain:
         self.times["strategy"] = (t1 - t0) * 1e3
         safe = self.drive(world, intents, game)
         self.times["brain"] = (time.perf_counter() - t0) * 1e3
+        ours = {r.id for r in world.robots if r.team == self.team}
+        actions = {rid: a for rid, a in self.strategy.last_action.items() if rid in ours}
         return BrainOutput(tuple(safe), dict(sorted(self.plans.items())), dict(self.braking),
-                           self.strategy.pass_heat if self.strategy.pass_heat_redone else None,
-                           dict(self.strategy.last_action), dict(self.times))  # fmt: skip
+                           self.strategy.pass_heat if self.strategy.pass_heat_redone else None, actions,
+                           dict(self.times))  # fmt: skip
 
     def drive(self, world: WorldState, intents: Mapping[int, Intent], game: GameState) -> list[RobotCommand]:
         """Everything after strategy: each robot's planner and navigator toward its intent, then team
         safety (the loop ``cmdragons bench safety`` measures). Robots of ``intents`` must be ours and
         in ``world``."""
         t1 = time.perf_counter()
+        self.plans = {}
         frame = self._frame(world, game)
         index = {r.id: i for i, r in enumerate(world.robots) if r.team == self.team}
         commands = [self._navigate(frame, index[rid], intent, game) for rid, intent in sorted(intents.items())]

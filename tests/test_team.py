@@ -143,3 +143,20 @@ def test_the_braking_paths_dss_checked_are_kept_for_the_video() -> None:
         # ... along its velocity to where it rests: moving at most the command's period plus braking
         reach = np.hypot(r.vx, r.vy) + 0.1
         assert np.hypot(*(path[-1] - (r.x, r.y))) <= reach**2 / (2 * SETTINGS.control.motion.max_brake_m_s2) + 0.1
+
+
+def test_the_brains_output_holds_only_the_robots_in_the_frame_and_the_pass_evaluation_when_redone() -> None:
+    brain = Brain("blue", SETTINGS)
+    game = GameState(0.0, command="normal")
+    both = (RobotState("blue", 0, -1.0, 0.0, 0.0), RobotState("blue", 1, 0.0, 1.0, 0.0),
+            RobotState("yellow", 0, 1.0, 0.0, 0.0))
+    first = brain.step(world(0.0, *both), game)
+    assert sorted(first.plans) == [0, 1] and {c.id for c in first.commands} == {0, 1}
+    assert first.pass_heat is not None  # the first frame evaluates the passes
+    gone = brain.step(world(1 / 60, both[0], both[2]), game)  # robot 1 left the field (or the cameras' view)
+    assert sorted(gone.plans) == [0]
+    assert set(gone.last_actions) <= {0}
+    assert {c.id for c in gone.commands} == {0, 1}  # (robot 1 is still told to stop)
+    every = SETTINGS.strategy.support.eval_every_frames
+    heats = [brain.step(world(k / 60, both[0], both[2]), game).pass_heat is not None for k in range(2, 2 + 2 * every)]
+    assert sum(heats) == 2  # redone every eval_every_frames frames, and only then in the output

@@ -21,7 +21,7 @@ import math
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, Literal, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -65,10 +65,14 @@ from strategy.plays import Strategy
 from strategy.simple import SimpleTeamParams
 from strategy.skills import Intent
 
-if TYPE_CHECKING:  # the settings compose this module's params: import them only for the types
-    from cmdragons.runtime.settings import Settings
+if TYPE_CHECKING:
+    from cmdragons.control.motion import ControlParams
+    from cmdragons.geometry import Field, LeagueParams
+    from cmdragons.planning.registry import PlannerParams
+    from cmdragons.safety.registry import SafetyParams
+    from strategy.plays import StrategyParams
 
-__all__ = ["Brain", "BrainOutput", "BrainParams", "RobotPlan", "RobotPlanStatus", "TeamParams"]
+__all__ = ["Brain", "BrainOutput", "BrainParams", "RobotPlan", "RobotPlanStatus", "TeamParams", "TeamSettings"]
 
 
 # which defense areas a robot must keep out of: both, or only the one at x of the sign given
@@ -171,10 +175,35 @@ class Frame:
     has_ball: bool
 
 
+class TeamSettings(Protocol):
+    """What a team's brain is built from: the league (field, robots, ball) and the team's own
+    concerns (the run's settings have them, as has a team's own config in a match)."""
+
+    @property
+    def field(self) -> LeagueParams: ...
+
+    @property
+    def planner(self) -> PlannerParams: ...
+
+    @property
+    def control(self) -> ControlParams: ...
+
+    @property
+    def safety(self) -> SafetyParams: ...
+
+    @property
+    def strategy(self) -> StrategyParams: ...
+
+    @property
+    def team(self) -> TeamParams: ...
+
+    def field_geometry(self) -> Field: ...
+
+
 class Brain:
     """The team's brain for one team colour."""
 
-    def __init__(self, team: Team, settings: Settings, params: TeamParams | None = None) -> None:
+    def __init__(self, team: Team, settings: TeamSettings, params: TeamParams | None = None) -> None:
         self.team = team
         self.settings = settings
         self.params = params or settings.team

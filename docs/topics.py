@@ -31,7 +31,8 @@ def contracts() -> list[Contract]:
     for overrides in ((), PROTOCOLS):
         settings = load_settings(overrides=overrides)
         for opponent, perception in SETUPS:
-            out += [e.contract for e in wiring(settings, opponent, perception, 0, lambda: None)]  # type: ignore[arg-type, return-value]
+            table = wiring(settings, opponent, perception, 0, lambda: None)  # type: ignore[arg-type, return-value]
+            out += [e.contract for e in table]
     return out
 
 

@@ -42,7 +42,6 @@ from cmdragons.runtime.stages import (
     TrackerStage,
     TruthPerceptionStage,
     VisionStage,
-    truth_world,
 )
 from cmdragons.runtime.topics import Contract, Port, WiringError, check_wiring
 from cmdragons.team import Brain
@@ -53,7 +52,7 @@ from sim.simulator import Simulator, robot_keys
 from strategy.simple import SimpleTeam
 
 __all__ = ["CLOCK", "OURS", "THEIRS", "Entry", "Match", "Opponent", "Perception", "build", "match_sim_params",
-           "match_summary", "summary_stages", "truth_world", "wiring"]
+           "match_summary", "summary_stages", "wiring"]
 
 Opponent = Literal["simple", "self", "none", "outside", "simulation"]
 Perception = Literal["vision", "truth"]

@@ -64,16 +64,7 @@ __all__ = [
     "TruthPerceptionStage",
     "VisionStage",
     "message_time",
-    "truth_world",
 ]
-
-
-def truth_world(gt: GroundTruth) -> WorldState:
-    """The simulator's truth as a world state (what the simple opponent plays on)."""
-    b = gt.ball
-    return WorldState(gt.t, BallState(b.x, b.y, b.vx, b.vy), tuple(
-        RobotState(r.team, r.id, r.x, r.y, r.theta, r.vx, r.vy, r.omega) for r in gt.robots),
-        gt.frame_number)  # fmt: skip
 
 
 class SimStage(BaseStage):
@@ -176,7 +167,8 @@ class TruthPerceptionStage(BaseStage):
 
     @staticmethod
     def declare(team: Team) -> Contract:
-        return Contract(f"perception/{team}", (Port("truth", GroundTruth),), (Port(f"perception/{team}", DetectionFrame),))
+        return Contract(f"perception/{team}", (Port("truth", GroundTruth),),
+                        (Port(f"perception/{team}", DetectionFrame),))
 
     def __init__(self, team: Team, sigmas: tuple[float, float, float], seed: int) -> None:
         self.contract = self.declare(team)
@@ -343,7 +335,7 @@ class SimpleOpponentStage(_PlayingStage):
         self.simple = simple
 
     def play(self, message: Any) -> tuple[WorldState, list[RobotCommand]]:
-        world = truth_world(message)
+        world = message.world()
         return world, self.simple.commands(world, self.game)
 
 
@@ -352,7 +344,8 @@ class RefereeStage(BaseStage):
     auto-referee judges) -> the game state, the frame's calls and a restart's teleport."""
 
     contract = Contract("referee", (Port("truth", GroundTruth), Port("events", SimEvents)),
-                        (Port("teleport", Teleport), Port("referee", GameState), Port("referee/events", GameEvents, sometimes=True),
+                        (Port("teleport", Teleport), Port("referee", GameState),
+                         Port("referee/events", GameEvents, sometimes=True),
                          summary_port("referee")))  # fmt: skip
 
     def __init__(self, referee: Referee) -> None:

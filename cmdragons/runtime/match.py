@@ -52,7 +52,7 @@ from sim.simulator import Simulator, robot_keys
 from strategy.simple import SimpleTeam
 
 __all__ = ["CLOCK", "OURS", "THEIRS", "Entry", "Match", "Opponent", "Perception", "build", "match_sim_params",
-           "match_summary", "summary_stages", "wiring"]
+           "match_summary", "summary_stages", "timing_keys", "wiring"]
 
 Opponent = Literal["simple", "self", "none", "outside", "simulation"]
 Perception = Literal["vision", "truth"]
@@ -238,25 +238,26 @@ def _ssl_out_stages(settings: Settings) -> list[Entry]:
     return entries
 
 
-# per-frame timings of the summary: name -> the bus timing keys summed into it
-_TIMINGS: dict[str, tuple[str, ...]] = {
-    "render": ("sim:clock",),
-    "vision": ("vision/*", "perception/blue", "ssl/*"),
-    "tracker": ("tracker/blue",),
-    "brain": ("team/blue",),
-    "physics_and_opponent": ("sim:commands/*", "sim:teleport", "referee", "opponent/*", "tracker/yellow",
-                             "team/yellow", "perception/yellow"),
-}  # fmt: skip
-
-
-def _sum_times(times: dict[str, float], keys: Sequence[str]) -> float:
-    total = 0.0
-    for k in keys:
-        if k.endswith("/*"):
-            total += sum(v for name, v in times.items() if name.startswith(k[:-1]) and ":" not in name)
-        else:
-            total += times.get(k, 0.0)
-    return total
+def timing_keys(table: Sequence[Entry]) -> dict[str, tuple[str, ...]]:
+    """The per-frame timings of the summary, from a match's table: name -> the bus timing keys (a
+    stage's name, or ``<stage>:<input>``) summed into it. The simulator's capture is ``render``, its
+    steps go with ``physics_and_opponent``; our perception (vision per camera, our truth perception,
+    the league's protocols) is ``vision``; our tracker and brain their own; what the match runs for
+    the other side (the referee, the opponent and its perception) goes with the physics; the
+    statistics are not timed."""
+    keys: dict[str, list[str]] = {"render": [], "vision": [], "tracker": [], "brain": [], "physics_and_opponent": []}
+    for e in table:
+        name = e.contract.name
+        if name == "sim":
+            keys["render"].append("sim:clock")
+            keys["physics_and_opponent"] += [f"sim:{t}" for t in e.contract.inputs if t != "clock"]
+        elif name.startswith("vision/") or name == f"perception/{OURS}" or not e.node:
+            keys["vision"].append(name)
+        elif name in (f"tracker/{OURS}", f"team/{OURS}"):
+            keys["tracker" if name.startswith("tracker/") else "brain"].append(name)
+        elif not (name.startswith("stats/") or name == "timing"):
+            keys["physics_and_opponent"].append(name)
+    return {k: tuple(v) for k, v in keys.items()}
 
 
 class Match:
@@ -284,6 +285,7 @@ class Match:
         table = wiring(settings, opponent, perception, self.seed, lambda: self.sim, render, opponent_settings)
         for stage in build(table, [*extra, self._summaries]):
             self.bus.add(stage)
+        self._timings = timing_keys(table)
         self.frames = 0
         self.stage_ms: dict[str, list[float]] = {}
         self.bus.start()
@@ -296,8 +298,8 @@ class Match:
         frame_ms = (time.perf_counter() - t0) * 1e3
         self.frames += 1
         times = self.bus.take_times()
-        for name, keys in _TIMINGS.items():
-            self.stage_ms.setdefault(name, []).append(_sum_times(times, keys))
+        for name, keys in self._timings.items():
+            self.stage_ms.setdefault(name, []).append(sum(times.get(k, 0.0) for k in keys))
         self.stage_ms.setdefault("frame", []).append(frame_ms)
         if self.opponent == "self":  # the copy's brain apart (it is also in physics_and_opponent)
             self.stage_ms.setdefault("opponent_brain", []).append(times.get(f"team/{THEIRS}", 0.0))

@@ -160,3 +160,12 @@ def test_the_brains_output_holds_only_the_robots_in_the_frame_and_the_pass_evalu
     every = SETTINGS.strategy.support.eval_every_frames
     heats = [brain.step(world(k / 60, both[0], both[2]), game).pass_heat is not None for k in range(2, 2 + 2 * every)]
     assert sum(heats) == 2  # redone every eval_every_frames frames, and only then in the output
+
+
+def test_every_planner_status_is_a_robot_plan_status_of_the_same_value() -> None:
+    from cmdragons.planning import PlanStatus
+    from cmdragons.team import RobotPlanStatus
+
+    for status in PlanStatus:
+        assert RobotPlanStatus.planned(status).value == status.value
+    assert {s.value for s in RobotPlanStatus} - {s.value for s in PlanStatus} == {"halt", "direct", "escape"}

@@ -314,6 +314,14 @@ class GroundTruth:
     ball: BallTruth
     robots: tuple[RobotTruth, ...] = ()
 
+    def world(self) -> WorldState:
+        """The truth as a world state: what a team with perfect perception would see (the simple
+        opponent's input, scripted tests, benchmarks)."""
+        b = self.ball
+        return WorldState(self.t, BallState(b.x, b.y, b.vx, b.vy), tuple(
+            RobotState(r.team, r.id, r.x, r.y, r.theta, r.vx, r.vy, r.omega) for r in self.robots),
+            self.frame_number)  # fmt: skip
+
     def to_dict(self) -> dict[str, Any]:
         b = self.ball
         ball: dict[str, Any] = {"x": b.x, "y": b.y, "z": b.z, "vx": b.vx, "vy": b.vy, "vz": b.vz}

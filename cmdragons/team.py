@@ -9,18 +9,19 @@ commands safe together (ch. 5). The brain knows neither which planner nor which 
 
 Each frame turns the world's robots into arrays once and builds one collision world; each robot's
 queries see it without the robot itself (and without the ball or its own defense area where its
-intent allows). Each stage's wall-clock time is kept for summaries.
+intent allows). A frame's result is one value (:class:`BrainOutput`): the commands and what viewers
+and statistics need, each part's wall-clock time included.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import enum
 import math
 import time
-from collections import defaultdict
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, Literal, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -64,10 +65,14 @@ from strategy.plays import Strategy
 from strategy.simple import SimpleTeamParams
 from strategy.skills import Intent
 
-if TYPE_CHECKING:  # the settings compose this module's params: import them only for the types
-    from cmdragons.runtime.settings import Settings
+if TYPE_CHECKING:
+    from cmdragons.control.motion import ControlParams
+    from cmdragons.geometry import Field, LeagueParams
+    from cmdragons.planning.registry import PlannerParams
+    from cmdragons.safety.registry import SafetyParams
+    from strategy.plays import StrategyParams
 
-__all__ = ["Brain", "BrainParams", "RobotPlan", "TeamParams"]
+__all__ = ["Brain", "BrainOutput", "BrainParams", "RobotPlan", "RobotPlanStatus", "TeamParams", "TeamSettings"]
 
 
 # which defense areas a robot must keep out of: both, or only the one at x of the sign given
@@ -112,14 +117,49 @@ class TeamParams(Validated):
     simple_opponent: SimpleTeamParams = SimpleTeamParams()
 
 
+class RobotPlanStatus(enum.Enum):
+    """How a robot's path of the frame came about: its planner's status (:class:`PlanStatus`, same
+    values), or no planning (halted, already at its goal) or the way out of the ball's circle."""
+
+    SOLVED = "solved"
+    APPROXIMATE = "approximate"
+    NO_PATH = "no_path"
+    TIMEOUT = "timeout"
+    INVALID_START = "invalid_start"
+    INVALID_GOAL = "invalid_goal"
+    HALT = "halt"  # told to stand: no path
+    DIRECT = "direct"  # at its goal already: straight there, no planning
+    ESCAPE = "escape"  # no path from inside the ball's circle: straight off the ball
+
+    @classmethod
+    def planned(cls, status: PlanStatus) -> RobotPlanStatus:
+        return cls(status.value)
+
+
 @dataclass(frozen=True)
 class RobotPlan:
     """What the brain did for one robot this frame (for overlays and logs)."""
 
     intent: Intent
     path: np.ndarray  # (k, 2) from the robot to its goal
-    status: str
+    status: RobotPlanStatus
     command: RobotCommand  # before safety
+
+
+@dataclass(frozen=True, eq=False)
+class BrainOutput:
+    """One frame of the brain: our robots' commands (after safety) and, for viewers, logs and
+    statistics, what led to them. Only robots in this frame's world (or, lost, still braking) are
+    in it."""
+
+    commands: tuple[RobotCommand, ...]
+    plans: Mapping[int, RobotPlan]  # robot id -> its plan of this frame
+    braking: Mapping[int, NDArray[np.float64]]  # robot id -> (k, 2) the braking path DSS checked, m
+    # the pass evaluation over the candidate grid, points (n, 2) m and values (n,): only on the
+    # frames it was redone
+    pass_heat: tuple[NDArray[np.float64], NDArray[np.float64]] | None
+    last_actions: Mapping[int, str]  # robot id -> what its last kick was for ("shot", "pass", "clear")
+    times_ms: Mapping[str, float]  # each part's wall-clock time this frame (strategy, planning_control, safety, brain)
 
 
 @dataclass(frozen=True, eq=False)
@@ -135,10 +175,35 @@ class Frame:
     has_ball: bool
 
 
+class TeamSettings(Protocol):
+    """What a team's brain is built from: the league (field, robots, ball) and the team's own
+    concerns (the run's settings have them, as has a team's own config in a match)."""
+
+    @property
+    def field(self) -> LeagueParams: ...
+
+    @property
+    def planner(self) -> PlannerParams: ...
+
+    @property
+    def control(self) -> ControlParams: ...
+
+    @property
+    def safety(self) -> SafetyParams: ...
+
+    @property
+    def strategy(self) -> StrategyParams: ...
+
+    @property
+    def team(self) -> TeamParams: ...
+
+    def field_geometry(self) -> Field: ...
+
+
 class Brain:
     """The team's brain for one team colour."""
 
-    def __init__(self, team: Team, settings: Settings, params: TeamParams | None = None) -> None:
+    def __init__(self, team: Team, settings: TeamSettings, params: TeamParams | None = None) -> None:
         self.team = team
         self.settings = settings
         self.params = params or settings.team
@@ -150,8 +215,8 @@ class Brain:
         static = field_world(self.field, defense_areas=False)
         stream = 0 if team == "blue" else 1
         self.safety: Safety = make_safety(settings.safety, settings.control, self.radius, static, stream=stream)
-        self.times: dict[str, list[float]] = defaultdict(list)
-        self.plans: dict[int, RobotPlan] = {}
+        self.times: dict[str, float] = {}  # each part's ms, the frame in progress
+        self.plans: dict[int, RobotPlan] = {}  # robot id -> its plan, the frame in progress
         self.braking: dict[int, np.ndarray] = {}  # robot id -> (k, 2) the braking path DSS checked last frame
         self._last_seen: dict[int, tuple[float, RobotState]] = {}  # own robots as the world last showed them
         # which boxes of the frame's world (both defense areas, then the goal walls) each intent keeps:
@@ -177,21 +242,27 @@ class Brain:
                                                         self.radius, self.settings.planner.collision)  # fmt: skip
         return nav
 
-    def step(self, world: WorldState, game: GameState) -> list[RobotCommand]:
-        """Commands for our robots seen in ``world`` (field frame)."""
+    def step(self, world: WorldState, game: GameState) -> BrainOutput:
+        """This frame's commands for our robots seen in ``world`` (field frame) and what led to them."""
         t0 = time.perf_counter()
+        self.times = {}
         intents = self.strategy.decide(world, game)
         t1 = time.perf_counter()
-        self.times["strategy"].append((t1 - t0) * 1e3)
+        self.times["strategy"] = (t1 - t0) * 1e3
         safe = self.drive(world, intents, game)
-        self.times["brain"].append((time.perf_counter() - t0) * 1e3)
-        return safe
+        self.times["brain"] = (time.perf_counter() - t0) * 1e3
+        ours = {r.id for r in world.robots if r.team == self.team}
+        actions = {rid: a for rid, a in self.strategy.last_action.items() if rid in ours}
+        return BrainOutput(tuple(safe), dict(sorted(self.plans.items())), dict(self.braking),
+                           self.strategy.pass_heat if self.strategy.pass_heat_redone else None, actions,
+                           dict(self.times))  # fmt: skip
 
     def drive(self, world: WorldState, intents: Mapping[int, Intent], game: GameState) -> list[RobotCommand]:
         """Everything after strategy: each robot's planner and navigator toward its intent, then team
         safety (the loop ``cmdragons bench safety`` measures). Robots of ``intents`` must be ours and
         in ``world``."""
         t1 = time.perf_counter()
+        self.plans = {}
         frame = self._frame(world, game)
         index = {r.id: i for i, r in enumerate(world.robots) if r.team == self.team}
         commands = [self._navigate(frame, index[rid], intent, game) for rid, intent in sorted(intents.items())]
@@ -206,8 +277,8 @@ class Brain:
             if rid not in sent:
                 nav.reset()  # nothing sent this frame: its next profile starts from what it measures
         t3 = time.perf_counter()
-        self.times["planning_control"].append((t2 - t1) * 1e3)
-        self.times["safety"].append((t3 - t2) * 1e3)
+        self.times["planning_control"] = (t2 - t1) * 1e3
+        self.times["safety"] = (t3 - t2) * 1e3
         return safe
 
     def _ball_clearance(self, game: GameState) -> float:
@@ -305,23 +376,23 @@ class Brain:
         robot = frame.robots[i]
         if it.max_speed_m_s == 0.0:
             cmd = RobotCommand(self.team, robot.id)
-            self.plans[robot.id] = RobotPlan(it, np.array([[robot.x, robot.y]]), "halt", cmd)
+            self.plans[robot.id] = RobotPlan(it, np.array([[robot.x, robot.y]]), RobotPlanStatus.HALT, cmd)
             self._navigator(robot.id)  # it hears what is sent, for when it moves again
             return cmd
         start = (robot.x, robot.y)
         goal = (it.x, it.y)
         path = np.array([start, goal])
-        status = "direct"
+        status = RobotPlanStatus.DIRECT
         cworld = self._robot_world(frame, i, it, game)
         if math.dist(start, goal) > self.params.brain.arrive_tolerance_m:
             p = self.settings.planner
             problem = PlanProblem(start, goal, self.radius, cworld, p.horizon_s, p.collision)
             result = self._planner(robot.id).solve(problem, make_termination(p))
-            status = result.status.name.lower()
+            status = RobotPlanStatus.planned(result.status)
             if result.status in (PlanStatus.SOLVED, PlanStatus.APPROXIMATE) and len(result.path) >= 2:
                 path = np.asarray(result.path)
             elif (escape := self._ball_escape(frame, start, it)) is not None:
-                path, status = np.array([start, escape]), "escape"
+                path, status = np.array([start, escape]), RobotPlanStatus.ESCAPE
         # drive through the goal only where the path ends at it (not at a stand-in for a blocked goal)
         through = max(it.final_speed_m_s, 0.0) if math.dist(tuple(path[-1]), goal) < 1e-9 else 0.0
         nav = self._navigator(robot.id)

@@ -22,7 +22,17 @@ from sim.referee import Referee
 from sim.render import CameraRenderer
 from sim.world import World
 
-__all__ = ["Frame", "Simulator", "referee_summary"]
+__all__ = ["Frame", "Simulator", "referee_summary", "robot_counts", "robot_keys"]
+
+
+def robot_counts(league: LeagueParams, params: SimParams) -> dict[Team, int]:
+    """How many robots each team has on the field (the sim's own count, else the league's)."""
+    return {t: params.robots_per_team.get(t, league.dims.robots_per_team) for t in TEAMS}
+
+
+def robot_keys(league: LeagueParams, params: SimParams) -> list[tuple[Team, int]]:
+    """Every robot on the field as (team, id), in the simulator's order."""
+    return [(t, rid) for t, n in robot_counts(league, params).items() for rid in range(n)]
 
 
 @dataclass(frozen=True)
@@ -59,7 +69,7 @@ class Simulator:
         that sends teleports (:meth:`teleport`)."""
         self.league, self.params = league, params
         self.seed = params.seed if seed is None else seed
-        counts = {t: params.robots_per_team.get(t, league.dims.robots_per_team) for t in TEAMS}
+        counts = robot_counts(league, params)
         self.world = World(league, params.physics, params.robot, params.ball, params.kicker, params.dribbler,
                            robots_per_team=counts)  # fmt: skip
         self.world.blue_defends = -1 if params.referee.blue_defends == "negative_x" else 1

@@ -142,6 +142,11 @@ class Strategy:
         points.flags.writeable = values.flags.writeable = False
         return points, values
 
+    @property
+    def pass_heat_redone(self) -> bool:
+        """Whether the last :meth:`decide` evaluated the passes anew (:attr:`pass_heat` is new)."""
+        return self.supporters.evaluation is not None and self.supporters.evaluated_frame == self.frame
+
     def decide(self, world: WorldState, game: GameState) -> dict[int, Intent]:
         """An intent for each of our robots in ``world``."""
         self.frame += 1

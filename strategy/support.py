@@ -54,6 +54,7 @@ class Supporters:
         self.obstacle_radius = obstacle_radius  # a robot's plus the ball's: whether the ball gets past
         self.grid = candidate_grid(pitch, passing)
         self.evaluation: PassEvaluation | None = None
+        self.evaluated_frame = -1  # the frame the evaluation was made on
         self.points: list[tuple[float, float]] = []
 
     def update(self, frame: int, ball: Array, attack_sign: float, opponents: Array, count: int) -> None:
@@ -63,4 +64,5 @@ class Supporters:
             return
         self.evaluation = pass_values(ball, self.grid, self.field, attack_sign, opponents, self.obstacle_radius,
                                       self.passing)  # fmt: skip
+        self.evaluated_frame = frame
         self.points = spread_points(self.evaluation, ball, count, self.p)

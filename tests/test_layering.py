@@ -116,3 +116,43 @@ def test_heavy_io_libraries_stay_with_their_owners(path: Path) -> None:
     if not under(module, CV2_VIDEO_OWNERS):
         text = path.read_text(encoding="utf-8")
         assert not any(f"cv2.{name}" in text for name in CV2_VIDEO), f"{path} opens video files with OpenCV"
+
+
+CYCLE_FREE = ("cmdragons.runtime", "cmdragons.cli", "cmdragons.team", "cmdragons.bench")
+
+
+def import_cycle(modules: dict[str, set[str]]) -> list[str] | None:
+    """One cycle of the import graph ``modules`` (module -> the modules it imports), or None."""
+    done: set[str] = set()
+    path: list[str] = []
+
+    def visit(m: str) -> list[str] | None:
+        if m in path:
+            return [*path[path.index(m):], m]
+        if m in done:
+            return None
+        path.append(m)
+        for n in sorted(modules.get(m, ())):
+            if (found := visit(n)) is not None:
+                return found
+        path.pop()
+        done.add(m)
+        return None
+
+    for m in sorted(modules):
+        if (found := visit(m)) is not None:
+            return found
+    return None
+
+
+def test_import_cycles_are_found() -> None:
+    assert import_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
+    assert import_cycle({"a": {"b"}, "b": {"c"}, "c": set()}) is None
+
+
+def test_the_composition_imports_without_cycles() -> None:
+    """Every import counts, at the top of a module, inside a function or for types only: a module
+    that needs another's helper and is needed by it wants the helper in a module of its own."""
+    paths = {module_name(p): p for p in ALL if under(module_name(p), CYCLE_FREE)}
+    graph = {m: {n for n in project_imports(p) if n in paths and n != m} for m, p in paths.items()}
+    assert import_cycle(graph) is None

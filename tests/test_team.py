@@ -42,7 +42,7 @@ def test_a_lost_robot_is_stopped_and_kept_where_it_brakes_to() -> None:
     brain.step(world(0.0, RobotState("blue", 0, -1.0, 0.0, 0.0), RobotState("blue", 1, 0.0, 0.0, 0.0, 1.2, 0.0)),
                game)  # fmt: skip
     later = world(0.1, RobotState("blue", 0, -1.0, 0.0, 0.0))
-    out = {c.id: c for c in brain.step(later, game)}
+    out = {c.id: c for c in brain.step(later, game).commands}
     assert (out[1].vx, out[1].vy, out[1].omega) == (0.0, 0.0, 0.0)
     brake = SETTINGS.control.motion.max_brake_m_s2
     (ghost,) = brain._lost_robots(later)
@@ -73,7 +73,7 @@ def test_a_robot_held_back_keeps_pressing_on() -> None:
     # frame, as if it moved
     def speed(brain: Brain, frames: int) -> float:
         held = RobotState("blue", 3, 0.0, 0.0, 0.0)
-        cmds = [brain.step(world(k / 60, held), GameState(0.0))[0] for k in range(frames)]
+        cmds = [brain.step(world(k / 60, held), GameState(0.0)).commands[0] for k in range(frames)]
         return float(np.hypot(cmds[-1].vx, cmds[-1].vy))
 
     accel = SETTINGS.control.motion.max_accel_m_s2
@@ -134,12 +134,38 @@ def test_the_braking_paths_dss_checked_are_kept_for_the_video() -> None:
     brain = Brain("blue", SETTINGS)
     robots = (RobotState("blue", 0, -1.0, 0.0, 0.0, 1.5, 0.0), RobotState("blue", 2, 1.0, 1.0, 0.0, 0.0, -1.0),
               RobotState("yellow", 0, 0.0, -2.0, 0.0))  # fmt: skip
-    brain.step(world(0.0, *robots), GameState(0.0))
-    assert sorted(brain.braking) == [0, 2]  # our robots only
+    out = brain.step(world(0.0, *robots), GameState(0.0))
+    assert sorted(out.braking) == [0, 2]  # our robots only
     for r in robots[:2]:
-        path = brain.braking[r.id]
+        path = out.braking[r.id]
         assert path.ndim == 2 and path.shape[1] == 2
         np.testing.assert_allclose(path[0], (r.x, r.y))  # from where the robot is ...
         # ... along its velocity to where it rests: moving at most the command's period plus braking
         reach = np.hypot(r.vx, r.vy) + 0.1
         assert np.hypot(*(path[-1] - (r.x, r.y))) <= reach**2 / (2 * SETTINGS.control.motion.max_brake_m_s2) + 0.1
+
+
+def test_the_brains_output_holds_only_the_robots_in_the_frame_and_the_pass_evaluation_when_redone() -> None:
+    brain = Brain("blue", SETTINGS)
+    game = GameState(0.0, command="normal")
+    both = (RobotState("blue", 0, -1.0, 0.0, 0.0), RobotState("blue", 1, 0.0, 1.0, 0.0),
+            RobotState("yellow", 0, 1.0, 0.0, 0.0))
+    first = brain.step(world(0.0, *both), game)
+    assert sorted(first.plans) == [0, 1] and {c.id for c in first.commands} == {0, 1}
+    assert first.pass_heat is not None  # the first frame evaluates the passes
+    gone = brain.step(world(1 / 60, both[0], both[2]), game)  # robot 1 left the field (or the cameras' view)
+    assert sorted(gone.plans) == [0]
+    assert set(gone.last_actions) <= {0}
+    assert {c.id for c in gone.commands} == {0, 1}  # (robot 1 is still told to stop)
+    every = SETTINGS.strategy.support.eval_every_frames
+    heats = [brain.step(world(k / 60, both[0], both[2]), game).pass_heat is not None for k in range(2, 2 + 2 * every)]
+    assert sum(heats) == 2  # redone every eval_every_frames frames, and only then in the output
+
+
+def test_every_planner_status_is_a_robot_plan_status_of_the_same_value() -> None:
+    from cmdragons.planning import PlanStatus
+    from cmdragons.team import RobotPlanStatus
+
+    for status in PlanStatus:
+        assert RobotPlanStatus.planned(status).value == status.value
+    assert {s.value for s in RobotPlanStatus} - {s.value for s in PlanStatus} == {"halt", "direct", "escape"}

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from cmdragons.messages import BallState, Goal, RobotState, WorldState
+from cmdragons.messages import Goal
 from cmdragons.runtime.settings import Settings
 from cmdragons.team import Brain
 from sim.referee import Referee
@@ -82,13 +82,6 @@ def shots(n: int, seed: int, settings: Settings) -> list[Shot]:
     return out
 
 
-def _world_state(w: World) -> WorldState:
-    truth = w.ground_truth()
-    b = truth.ball
-    robots = tuple(RobotState(r.team, r.id, r.x, r.y, r.theta, r.vx, r.vy, r.omega) for r in truth.robots)
-    return WorldState(truth.t, BallState(b.x, b.y, b.vx, b.vy), robots, truth.frame_number)
-
-
 def shoot(settings: Settings, shot: Shot, goalie: bool = True) -> bool:
     """One shot at our goal, our goalie there (or none): whether it is a goal."""
     s = settings.sim
@@ -123,7 +116,7 @@ def shoot(settings: Settings, shot: Shot, goalie: bool = True) -> bool:
             d = math.hypot(dx, dy)
             w.place_ball(x, y, shot.speed_m_s * dx / d, shot.speed_m_s * dy / d)
             shot_at = k
-        events = w.step_frame(brain.step(_world_state(w), ref.state()) if brain is not None else [])
+        events = w.step_frame(list(brain.step(w.ground_truth().world(), ref.state()).commands) if brain is not None else [])
         if shot_at is not None and any(isinstance(e, Goal) and e.x * own > 0 for e in events):
             return True
         if shot_at is not None and k > shot_at + round(SHOT_S * FPS):

@@ -23,6 +23,7 @@ import numpy as np
 
 from cmdragons.messages import GameState
 from cmdragons.runtime.bus import BaseStage, Publish
+from cmdragons.runtime.topics import Contract, Port
 from cmdragons.runtime.match import Match
 from cmdragons.runtime.settings import Settings
 
@@ -45,8 +46,7 @@ def _halves(settings: Settings, half_s: float, shootout_kicks: int = 0) -> Setti
 class _StageWatch(BaseStage):
     """The game's stage as the referee last published it."""
 
-    name = "bench/stage"
-    inputs = ("referee",)
+    contract = Contract("bench/stage", (Port("referee", GameState),))
 
     def __init__(self) -> None:
         self.stage = ""

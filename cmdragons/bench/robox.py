@@ -41,7 +41,6 @@ from cmdragons.navigation import _kernels as NK
 from cmdragons.planning import deadline, field_world
 from cmdragons.runtime.match import Match
 from cmdragons.runtime.settings import Settings
-from cmdragons.runtime.stages import truth_world
 from cmdragons.team import Brain
 from sim.world import Contact, World
 from strategy.skills import Intent
@@ -166,7 +165,7 @@ def crossing(settings: Settings, seed: int) -> Crossing:
     spent: list[float] = []
     arrived = math.nan
     for frame in range(round(TIMEOUT_S * sp.physics.frame_rate_hz)):
-        seen = truth_world(world.ground_truth())
+        seen = world.ground_truth().world()
         t0 = time.perf_counter()
         ours = brain.drive(seen, intents, game)
         if frame >= WARMUP_FRAMES:

@@ -10,8 +10,8 @@ stage changes. Either delivers a message as it comes off the wire
 (:func:`cmdragons.runtime.wire.canonical`: detections, world states and commands in the league's
 32-bit floats), so a stage sees the same inputs whichever process its peers run in.
 
-Topic patterns: an exact topic (``world/blue``), a prefix ending in ``/*`` (``detections/*`` matches
-``detections/0`` and ``detections/1``), or ``*`` for every topic.
+What a stage reads and writes is its :class:`~cmdragons.runtime.topics.Contract`; topic patterns
+are those of :func:`~cmdragons.runtime.topics.topic_matches`.
 """
 
 from __future__ import annotations
@@ -21,19 +21,12 @@ from collections import deque
 from collections.abc import Callable, Sequence
 from typing import Any, Protocol
 
-__all__ = ["Bus", "InProcessTransport", "Publish", "Stage", "Transport", "topic_matches"]
+from cmdragons.runtime.topics import Contract, topic_matches
+
+__all__ = ["BaseStage", "Bus", "InProcessTransport", "Publish", "Stage", "Transport"]
 
 Handler = Callable[[str, Any], None]
 Publish = Callable[[str, Any], None]
-
-
-def topic_matches(pattern: str, topic: str) -> bool:
-    """Whether ``topic`` falls under ``pattern`` (exact, ``prefix/*`` or ``*``)."""
-    if pattern == "*":
-        return True
-    if pattern.endswith("/*"):
-        return topic.startswith(pattern[:-1])
-    return pattern == topic
 
 
 class Transport(Protocol):
@@ -90,10 +83,14 @@ class InProcessTransport:
 class Stage(Protocol):
     """One part of the system on the bus.
 
-    ``inputs``: the topic patterns it reads. ``start``: publish what it has before any input (a
+    ``contract``: its name and the topics it reads and writes; ``inputs``: the topic patterns it
+    reads (the contract's). ``start``: publish what it has before any input (a
     referee's first game state). ``on_message``: handle one input and publish the outputs.
     ``summarize``: publish its figures of the run so far (a :class:`~cmdragons.messages.StageSummary`
     on ``summary/<name>``)."""
+
+    @property
+    def contract(self) -> Contract: ...
 
     @property
     def name(self) -> str: ...
@@ -166,10 +163,18 @@ class Bus:
 
 
 class BaseStage:
-    """Defaults for stages with nothing to start with or to summarize."""
+    """Defaults for stages with nothing to start with or to summarize; name and inputs from the
+    stage's contract."""
 
-    name: str = ""
-    inputs: Sequence[str] = ()
+    contract: Contract = Contract("")
+
+    @property
+    def name(self) -> str:
+        return self.contract.name
+
+    @property
+    def inputs(self) -> Sequence[str]:
+        return self.contract.inputs
 
     def start(self, publish: Publish) -> None:
         return None

@@ -25,8 +25,9 @@ Before it says it is ready, every node plays the first frames of a throwaway mat
 cached kernels, the first plans) which a free-running match would otherwise spend with its robots
 standing.
 
-Every node builds the whole wiring from the same config and seed and keeps its own stages, so all
-nodes agree on what the others are without asking.
+Every node reads the match's table (:func:`~cmdragons.runtime.match.wiring`: each stage's contract
+and its node) from the same config and seed, checks it whole, and builds only its own stages (a
+team node builds no simulator), so all nodes agree on what the others are without asking.
 """
 
 from __future__ import annotations
@@ -42,34 +43,30 @@ from typing import Any, TextIO
 
 from cmdragons.messages import NodeControl, Tick
 from cmdragons.runtime.bus import Bus, Stage
-from cmdragons.runtime.match import OURS, THEIRS, Match, Opponent, Perception, match_summary, summary_stages, wiring
+from cmdragons.runtime.match import (
+    THEIRS,
+    Entry,
+    Match,
+    Opponent,
+    Perception,
+    build,
+    match_sim_params,
+    match_summary,
+    summary_stages,
+    wiring,
+)
 from cmdragons.runtime.params import ROLES, RuntimeParams
 from cmdragons.runtime.settings import Settings
 from cmdragons.runtime.stages import SimStage, SummaryCollector, Tap
 from cmdragons.runtime.zenoh_transport import LATEST_ONLY, ZenohTransport
 
-__all__ = ["FRAME_PATH", "ROLES", "MatchSpec", "frame_path_priority", "node_roles", "rehearse", "role_of",
-           "run_clock", "run_node", "wait_for_processes", "write_summary"]
+__all__ = ["FRAME_PATH", "ROLES", "MatchSpec", "frame_path_priority", "node_roles", "rehearse", "run_clock",
+           "run_node", "wait_for_processes", "write_summary"]
 
 
 
 FREE_RUNNING = "start_free_running"  # the clock's start of a free-running match (lock-step: "start")
 STARTS = frozenset({"start", FREE_RUNNING})
-
-
-def role_of(stage: str, vision_with_sim: bool = False) -> str:
-    """The node a stage of the wiring runs in (``vision_with_sim``: vision in the sim node)."""
-    if stage == "sim":
-        return "sim"
-    if stage.startswith(("vision/", "perception/")):
-        return "sim" if vision_with_sim else "vision"
-    if stage in (f"tracker/{OURS}", f"team/{OURS}", f"stats/{OURS}", "timing"):
-        return "team"
-    if stage.startswith("opponent/") or stage in (f"tracker/{THEIRS}", f"team/{THEIRS}", f"stats/{THEIRS}"):
-        return "opponent"
-    if stage == "referee":
-        return "referee"
-    raise ValueError(f"no node runs stage {stage!r}")
 
 
 FRAME_PATH = ("sim", "vision", "team")  # the nodes a camera frame goes through to our commands
@@ -140,22 +137,31 @@ class MatchSpec:
         self.seed = seed
         self.opponent_settings = opponent_settings
 
-    def stages(self, role: str) -> tuple[Any, list[Stage], list[str]]:
-        """The simulator object and the stages of ``role``, built as the embedded match builds them,
-        and the names of every node's stages."""
-        import dataclasses
-
+    def table(self) -> list[Entry]:
+        """The match's table: every stage's contract and node (nothing built; the sim node's
+        simulator is built by its row)."""
         from sim.simulator import Simulator
 
-        params = self.settings.sim
-        if self.opponent == "none":
-            params = dataclasses.replace(params, robots_per_team={**params.robots_per_team, THEIRS: 0})
-        render = role == "sim" and self.perception == "vision"
-        sim = Simulator(self.settings.field, self.settings.camera_models(), params, seed=self.seed, render=render,
-                        referee=False)  # fmt: skip
-        every = wiring(self.settings, sim, self.opponent, self.perception, sim.seed, self.opponent_settings)
-        placed = self.settings.runtime.vision_with_sim
-        return sim, [s for s in every if role_of(s.name, placed) == role], [s.name for s in every]
+        def simulator() -> Simulator:
+            return Simulator(self.settings.field, self.settings.camera_models(),
+                             match_sim_params(self.settings, self.opponent), seed=self.seed,
+                             render=self.perception == "vision", referee=False)  # fmt: skip
+
+        return wiring(self.settings, self.opponent, self.perception, self.seed, simulator,
+                      opponent_settings=self.opponent_settings)  # fmt: skip
+
+    def stages(self, role: str) -> list[Stage]:
+        """The stages of ``role``, built as the embedded match builds them, after the whole table is
+        checked; a stage no node runs (a league protocol's) is an error."""
+        table = self.table()
+        unplaced = [e.contract.name for e in table if not e.node]
+        if unplaced:
+            raise ValueError(f"no node runs stage {unplaced[0]!r}")
+        return build(table, node=role)
+
+    def nodes(self) -> dict[str, str]:
+        """Stage name -> the node that runs it."""
+        return {e.contract.name: e.node for e in self.table()}
 
     def roles(self, log: bool) -> list[str]:
         """The nodes of this match (:func:`node_roles`)."""
@@ -221,7 +227,7 @@ def run_node(role: str, spec: MatchSpec, transport: ZenohTransport, extra: Seque
     err = err if err is not None else sys.stderr
     params = spec.settings.runtime
     rehearse(spec, role)
-    stages = spec.stages(role)[1] if role != "log" else []
+    stages = spec.stages(role) if role != "log" else []
     bus = Bus(transport)
     commands: list[str] = []
     bus.add(Tap(f"control:{role}", ("control/clock",), lambda _t, c: commands.append(c.command)))
@@ -279,7 +285,7 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
         transport.local_only = ("camera/*",)  # vision is here: the frames stay in this process
     elif spec.perception == "vision":  # camera frames go through shared memory
         transport.reserve_shared_memory()
-    sim, stages, _ = spec.stages("sim")
+    stages = spec.stages("sim")
     bus = Bus(transport)
     ready: set[str] = set()
     judged = [0]  # the referee's words so far
@@ -301,6 +307,7 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
     for stage in [*stages, *extra, summaries]:
         bus.add(stage)
     sim_stage = next(s for s in stages if isinstance(s, SimStage))
+    sim = sim_stage.sim
     others = [r for r in roles if r != "sim"]
     t0 = time.monotonic()
     warned = t0
@@ -359,7 +366,8 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
         if on_frame is not None:
             on_frame(i)
     wall = time.perf_counter() - wall0
-    wanted = {s for s in summary_stages(spec.opponent) if role_of(s, params.vision_with_sim) in roles}
+    nodes = spec.nodes()
+    wanted = {s for s in summary_stages(spec.opponent) if nodes[s] in roles}
     _control(transport, "clock", "summarize")
     bus.summarize()
     if not transport.wait_for(lambda: wanted <= set(summaries.figures), params.start_timeout_s):

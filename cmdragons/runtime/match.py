@@ -18,12 +18,15 @@ timing), never from a stage's attributes.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import time
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
 
+from cmdragons.camera import CameraModel
 from cmdragons.geometry import Team
 from cmdragons.messages import Tick
 from cmdragons.runtime.bus import Bus, Stage, Transport
@@ -39,16 +42,17 @@ from cmdragons.runtime.stages import (
     TrackerStage,
     TruthPerceptionStage,
     VisionStage,
-    truth_world,
 )
+from cmdragons.runtime.topics import Contract, Port, WiringError, check_wiring
 from cmdragons.team import Brain
 from cmdragons.tracking import Tracker
 from sim.referee import Referee
-from sim.simulator import Simulator
+from sim.params import SimParams
+from sim.simulator import Simulator, robot_keys
 from strategy.simple import SimpleTeam
 
-__all__ = ["OURS", "THEIRS", "Match", "Opponent", "Perception", "match_summary", "summary_stages", "truth_world",
-           "wiring"]
+__all__ = ["CLOCK", "OURS", "THEIRS", "Entry", "Match", "Opponent", "Perception", "build", "match_sim_params",
+           "match_summary", "summary_stages", "timing_keys", "wiring"]
 
 Opponent = Literal["simple", "self", "none", "outside", "simulation"]
 Perception = Literal["vision", "truth"]
@@ -56,63 +60,131 @@ OURS: Team = "blue"
 THEIRS: Team = "yellow"
 
 
-def wiring(settings: Settings, sim: Simulator, opponent: Opponent, perception: Perception,
-           seed: int, opponent_settings: Settings | None = None) -> list[Stage]:  # fmt: skip
-    """The stages of a match, in the order they subscribe (which fixes the order of delivery).
-    ``opponent_settings``: the brain and tracker settings of the copy of our team (``self``; default
-    ours)."""
+@dataclass(frozen=True)
+class Entry:
+    """One row of a set-up's table: a stage's contract, the node that runs it in a distributed
+    match ("": none does) and how to build it (only the node that runs it builds it)."""
+
+    contract: Contract
+    node: str
+    build: Callable[[], Stage]
+
+
+# where a topic nobody in a match writes comes from: the runtime's clock
+CLOCK = (Port("clock", Tick),)
+
+
+def match_sim_params(settings: Settings, opponent: Opponent) -> SimParams:
+    """The simulator's parameters of a match: no robots of theirs against nobody."""
+    params = settings.sim
+    if opponent == "none":
+        params = dataclasses.replace(params, robots_per_team={**params.robots_per_team, THEIRS: 0})
+    return params
+
+
+def wiring(settings: Settings, opponent: Opponent, perception: Perception, seed: int,
+           sim: Callable[[], Simulator], render: bool = False,
+           opponent_settings: Settings | None = None) -> list[Entry]:  # fmt: skip
+    """The table of a match's stages, in the order they subscribe (which fixes the order of
+    delivery). ``sim``: builds (or gives) the match's simulator, with ``seed``; ``render``: it draws
+    the camera images also when the team plays on truth. ``opponent_settings``: the brain and
+    tracker settings of the copy of our team (``self``; default ours)."""
     playing: list[Team] = [OURS] if opponent == "none" else [OURS, THEIRS]
-    stages: list[Stage] = [
-        SimStage(sim, playing),
-        RefereeStage(Referee(sim.world.field, sim.world.robot_keys(), settings.sim.referee)),
-    ]
+    models = settings.camera_models()
+    drawn = [m.id for m in models] if render or perception == "vision" else []
+    vision_node = "sim" if settings.runtime.vision_with_sim else "vision"
+    keys = robot_keys(settings.field, match_sim_params(settings, opponent))
+    entries = [
+        Entry(SimStage.declare(drawn), "sim", lambda: SimStage(sim(), playing)),
+        Entry(RefereeStage.contract, "referee",
+              lambda: RefereeStage(Referee(settings.field_geometry(), keys, settings.sim.referee))),
+    ]  # fmt: skip
     brains: list[Team] = [OURS, THEIRS] if opponent == "self" else [OURS]
     # who is given detections: our team, its copy, or a team outside (``outside``: its own client on
     # the bus, commands on commands/yellow; ``simulation``: over the league's simulation protocol,
     # seeing SSL-Vision packets; the runtime runs nothing of it)
     seeing: list[Team] = [OURS, THEIRS] if opponent in ("self", "outside", "simulation") else [OURS]
     if perception == "vision":
-        from vision.pipeline import VisionPipeline  # imported here: truth runs need no vision
 
-        stages += [VisionStage(m.id, VisionPipeline(settings.vision, settings.field, m)) for m in sim.cameras]
-        topics = {team: [f"detections/{m.id}" for m in sim.cameras] for team in brains}
-        stages += _ssl_vision_stages(settings, sim, topics, outside=opponent == "simulation")
+        def vision(m: CameraModel) -> Stage:
+            from vision.pipeline import VisionPipeline  # imported here: truth runs need no vision
+
+            return VisionStage(m.id, VisionPipeline(settings.vision, settings.field, m))
+
+        entries += [Entry(VisionStage.declare(m.id), vision_node, functools.partial(vision, m)) for m in models]
+        topics = {team: [f"detections/{m.id}" for m in models] for team in brains}
+        entries += _ssl_vision_stages(settings, models, topics, outside=opponent == "simulation")
         # the simulator's cameras capture together: one capture time a frame (not so SSL-Vision's packets,
         # which may come from cameras of their own)
         synchronized = settings.protocols.perception != "ssl_vision"
     else:
         t = settings.tracker  # the noise vision measures: the tracker's measurement model
         sigmas = (t.ball.measurement_sigma_m, t.robot.measurement_sigma_m, t.robot.measurement_sigma_rad)
-        stages += [TruthPerceptionStage(team, sigmas, seed + k) for k, team in enumerate(seeing)]
+        entries += [Entry(TruthPerceptionStage.declare(team), vision_node,
+                          functools.partial(TruthPerceptionStage, team, sigmas, seed + k))
+                    for k, team in enumerate(seeing)]  # fmt: skip
         topics = {team: [f"perception/{team}"] for team in brains}
         synchronized = True  # (one topic)
         if opponent == "simulation":  # the outside team's noisy truth, as SSL-Vision packets
-            stages += _ssl_vision_stages(settings, sim, {}, outside=True, topics_out=[f"perception/{THEIRS}"])
+            entries += _ssl_vision_stages(settings, models, {}, outside=True, topics_out=[f"perception/{THEIRS}"])
     referee_topic = "referee"
     p = settings.protocols
     if p.referee.send or p.referee.source == "game_controller" or opponent == "simulation":
         referee_stages, referee_topic = _ssl_referee_stages(settings, brains, send=opponent == "simulation")
-        stages += referee_stages
+        entries += referee_stages
     if opponent == "simulation":
         from cmdragons.runtime.ssl.stages import SimulationInStage
 
-        stages.append(SimulationInStage(p, THEIRS))
+        entries.append(_protocol(SimulationInStage, p, THEIRS))
     for team in brains:
         own = opponent_settings if team == THEIRS and opponent_settings is not None else settings
-        stages += [TrackerStage(team, Tracker(own.tracker), topics[team], synchronized=synchronized),
-                   TeamStage(team, Brain(team, own), referee_topic)]  # fmt: skip
-    stages += _ssl_out_stages(settings)
+        node = "team" if team == OURS else "opponent"
+        entries += [Entry(TrackerStage.declare(team, topics[team]), node,
+                          lambda team=team, own=own: TrackerStage(team, Tracker(own.tracker), topics[team],
+                                                                  synchronized=synchronized)),
+                    Entry(TeamStage.declare(team, referee_topic), node,
+                          lambda team=team, own=own: TeamStage(team, Brain(team, own), referee_topic))]  # fmt: skip
+    entries += _ssl_out_stages(settings)
     if opponent == "simple":
-        simple = SimpleTeam(THEIRS, settings.field_geometry(), settings.team.simple_opponent, settings.strategy)
-        stages.append(SimpleOpponentStage(THEIRS, simple))
-    stages += [StatsStage(OURS, settings.strategy.pass_timeout_s), TimingStage()]
+        simple = functools.partial(SimpleTeam, THEIRS, settings.field_geometry(), settings.team.simple_opponent,
+                                   settings.strategy)  # fmt: skip
+        entries.append(Entry(SimpleOpponentStage.declare(THEIRS), "opponent",
+                             lambda: SimpleOpponentStage(THEIRS, simple())))  # fmt: skip
+    pass_timeout_s = settings.strategy.pass_timeout_s
+    entries += [Entry(StatsStage.declare(OURS), "team", lambda: StatsStage(OURS, pass_timeout_s)),
+                Entry(TimingStage.contract, "team", TimingStage)]  # fmt: skip
     if opponent == "self":  # the copy of our team: its own figures too
-        stages.append(StatsStage(THEIRS, (opponent_settings or settings).strategy.pass_timeout_s))
-    return stages
+        theirs_s = (opponent_settings or settings).strategy.pass_timeout_s
+        entries.append(Entry(StatsStage.declare(THEIRS), "opponent", lambda: StatsStage(THEIRS, theirs_s)))
+    return entries
 
 
-def _ssl_vision_stages(settings: Settings, sim: Simulator, topics: dict[Team, list[str]], outside: bool = False,
-                       topics_out: list[str] | None = None) -> list[Stage]:  # fmt: skip
+def _protocol(cls: Any, *args: Any) -> Entry:
+    """A league protocol's stage, which no node of a distributed match runs: its contract is its
+    own (it opens its sockets when built)."""
+    return Entry(cls.declare(*args) if hasattr(cls, "declare") else cls.contract, "", lambda: cls(*args))
+
+
+def build(entries: Sequence[Entry], extra: Sequence[Stage] = (), node: str | None = None,
+          outside: Sequence[Port] = CLOCK) -> list[Stage]:
+    """The stages of a set-up's table (``node``: only those that node runs), checked: the table's
+    contracts with ``extra``'s fit (:func:`~cmdragons.runtime.topics.check_wiring`) and each stage
+    built is what its row declared."""
+    check_wiring([*(e.contract for e in entries), *(s.contract for s in extra)], outside)
+    stages = []
+    for e in entries:
+        if node is not None and e.node != node:
+            continue
+        stage = e.build()
+        if stage.contract != e.contract:
+            raise WiringError(f"stage {e.contract.name!r} was built with the contract {stage.contract} but its row "
+                              f"declares {e.contract}")  # fmt: skip
+        stages.append(stage)
+    return [*stages, *extra]
+
+
+def _ssl_vision_stages(settings: Settings, models: Sequence[CameraModel], topics: dict[Team, list[str]],
+                       outside: bool = False, topics_out: list[str] | None = None) -> list[Entry]:  # fmt: skip
     """Our vision as SSL-Vision packets (``protocols.vision.send``, or ``outside``: a team outside
     sees them; ``topics_out``: the detection topics sent, default our cameras') and our trackers on
     SSL-Vision packets (``protocols.perception: ssl_vision``; in lock-step with our own packets when
@@ -122,37 +194,37 @@ def _ssl_vision_stages(settings: Settings, sim: Simulator, topics: dict[Team, li
     from cmdragons.runtime.ssl.vision import geometry_packet
 
     p = settings.protocols
-    ids = [m.id for m in sim.cameras]
-    stages: list[Stage] = []
+    ids = [m.id for m in models]
+    entries: list[Entry] = []
     if p.vision.send or outside:
         sent_ids = ids if topics_out is None else [0]
-        stages.append(VisionOutStage(p, sent_ids, geometry_packet(settings.field_geometry(), list(sim.cameras)),
-                                     topics_out))  # fmt: skip
+        entries.append(_protocol(VisionOutStage, p, sent_ids, geometry_packet(settings.field_geometry(), list(models)),
+                                 topics_out))  # fmt: skip
     if topics_out is not None:
-        return stages
+        return entries
     if p.perception == "ssl_vision":
-        stages.append(VisionInStage(p, ids, lockstep=p.vision.send or outside))
+        entries.append(_protocol(VisionInStage, p, ids, p.vision.send or outside))
         for team in topics:
             topics[team] = [f"ssl/vision/{i}" for i in ids]
-    return stages
+    return entries
 
 
-def _ssl_referee_stages(settings: Settings, brains: list[Team], send: bool = False) -> tuple[list[Stage], str]:
+def _ssl_referee_stages(settings: Settings, brains: list[Team], send: bool = False) -> tuple[list[Entry], str]:
     """Our referee's word as the league's Referee packets (``protocols.referee.send`` or ``send``)
     and our brains on a game controller's packets (``protocols.referee.source: game_controller``);
     the referee topic the brains read."""
     from cmdragons.runtime.ssl.stages import RefereeInStage, RefereeOutStage
 
     p = settings.protocols
-    stages: list[Stage] = [RefereeOutStage(p)] if p.referee.send or send else []
+    entries: list[Entry] = [_protocol(RefereeOutStage, p)] if p.referee.send or send else []
     if p.referee.source == "simulator":
-        return stages, "referee"
+        return entries, "referee"
     moved_m = settings.sim.referee.figures.ball_in_play_m
-    stages.append(RefereeInStage(p, f"world/{brains[0]}", moved_m))
-    return stages, "referee/gc"
+    entries.append(_protocol(RefereeInStage, p, f"world/{brains[0]}", moved_m))
+    return entries, "referee/gc"
 
 
-def _ssl_out_stages(settings: Settings) -> list[Stage]:
+def _ssl_out_stages(settings: Settings) -> list[Entry]:
     """Our tracker's world state as tracker packets (``protocols.tracker.send``) and our team's
     commands to a league simulator (``protocols.commands_to``)."""
     p = settings.protocols
@@ -160,31 +232,32 @@ def _ssl_out_stages(settings: Settings) -> list[Stage]:
         return []
     from cmdragons.runtime.ssl.stages import CommandsOutStage, TrackerOutStage
 
-    stages: list[Stage] = [TrackerOutStage(p, OURS)] if p.tracker.send else []
+    entries: list[Entry] = [_protocol(TrackerOutStage, p, OURS)] if p.tracker.send else []
     if p.commands_to != "none":
-        stages.append(CommandsOutStage(p, OURS, settings.sim.kicker.chip_angle_rad))
-    return stages
+        entries.append(_protocol(CommandsOutStage, p, OURS, settings.sim.kicker.chip_angle_rad))
+    return entries
 
 
-# per-frame timings of the summary: name -> the bus timing keys summed into it
-_TIMINGS: dict[str, tuple[str, ...]] = {
-    "render": ("sim:clock",),
-    "vision": ("vision/*", "perception/blue", "ssl/*"),
-    "tracker": ("tracker/blue",),
-    "brain": ("team/blue",),
-    "physics_and_opponent": ("sim:commands/*", "sim:teleport", "referee", "opponent/*", "tracker/yellow",
-                             "team/yellow", "perception/yellow"),
-}  # fmt: skip
-
-
-def _sum_times(times: dict[str, float], keys: Sequence[str]) -> float:
-    total = 0.0
-    for k in keys:
-        if k.endswith("/*"):
-            total += sum(v for name, v in times.items() if name.startswith(k[:-1]) and ":" not in name)
-        else:
-            total += times.get(k, 0.0)
-    return total
+def timing_keys(table: Sequence[Entry]) -> dict[str, tuple[str, ...]]:
+    """The per-frame timings of the summary, from a match's table: name -> the bus timing keys (a
+    stage's name, or ``<stage>:<input>``) summed into it. The simulator's capture is ``render``, its
+    steps go with ``physics_and_opponent``; our perception (vision per camera, our truth perception,
+    the league's protocols) is ``vision``; our tracker and brain their own; what the match runs for
+    the other side (the referee, the opponent and its perception) goes with the physics; the
+    statistics are not timed."""
+    keys: dict[str, list[str]] = {"render": [], "vision": [], "tracker": [], "brain": [], "physics_and_opponent": []}
+    for e in table:
+        name = e.contract.name
+        if name == "sim":
+            keys["render"].append("sim:clock")
+            keys["physics_and_opponent"] += [f"sim:{t}" for t in e.contract.inputs if t != "clock"]
+        elif name.startswith("vision/") or name == f"perception/{OURS}" or not e.node:
+            keys["vision"].append(name)
+        elif name in (f"tracker/{OURS}", f"team/{OURS}"):
+            keys["tracker" if name.startswith("tracker/") else "brain"].append(name)
+        elif not (name.startswith("stats/") or name == "timing"):
+            keys["physics_and_opponent"].append(name)
+    return {k: tuple(v) for k, v in keys.items()}
 
 
 class Match:
@@ -200,22 +273,19 @@ class Match:
                  transport: Transport | None = None, opponent_settings: Settings | None = None) -> None:  # fmt: skip
         if opponent_settings is not None and opponent != "self":
             raise ValueError("opponent_settings are for a copy of our team (opponent 'self')")
-        params = settings.sim
-        if opponent == "none":
-            params = dataclasses.replace(params, robots_per_team={**params.robots_per_team, THEIRS: 0})
         self.settings = settings
         self.opponent: Opponent = opponent
         self.perception: Perception = perception
-        self.sim = Simulator(settings.field, settings.camera_models(), params, seed=seed,
+        self.sim = Simulator(settings.field, settings.camera_models(), match_sim_params(settings, opponent), seed=seed,
                              render=render or perception == "vision", referee=False)  # fmt: skip
         self.seed = self.sim.seed
         self.cameras = list(self.sim.cameras)
         self.bus = Bus(transport)
         self._summaries = SummaryCollector()
-        stages: list[Stage] = [*wiring(settings, self.sim, opponent, perception, self.seed, opponent_settings), *extra,
-                               self._summaries]  # fmt: skip
-        for stage in stages:
+        table = wiring(settings, opponent, perception, self.seed, lambda: self.sim, render, opponent_settings)
+        for stage in build(table, [*extra, self._summaries]):
             self.bus.add(stage)
+        self._timings = timing_keys(table)
         self.frames = 0
         self.stage_ms: dict[str, list[float]] = {}
         self.bus.start()
@@ -228,8 +298,8 @@ class Match:
         frame_ms = (time.perf_counter() - t0) * 1e3
         self.frames += 1
         times = self.bus.take_times()
-        for name, keys in _TIMINGS.items():
-            self.stage_ms.setdefault(name, []).append(_sum_times(times, keys))
+        for name, keys in self._timings.items():
+            self.stage_ms.setdefault(name, []).append(sum(times.get(k, 0.0) for k in keys))
         self.stage_ms.setdefault("frame", []).append(frame_ms)
         if self.opponent == "self":  # the copy's brain apart (it is also in physics_and_opponent)
             self.stage_ms.setdefault("opponent_brain", []).append(times.get(f"team/{THEIRS}", 0.0))

@@ -20,6 +20,7 @@ from cmdragons.camera import CameraModel
 from cmdragons.geometry import Field, Team
 from cmdragons.messages import CameraFrame, GameState, GroundTruth, RobotCommand, TeamCommands, TeamReport, WorldState
 from cmdragons.runtime.bus import BaseStage, Publish
+from cmdragons.runtime.topics import ANY, Contract, Port
 
 __all__ = ["MatchVideoStage", "draw_overlays", "tile_cameras"]
 
@@ -113,13 +114,12 @@ class MatchVideoStage(BaseStage):
     top-down field (``view`` "field", :mod:`cmdragons.runtime.topdown`) or as the camera images with
     the team's overlays, tiled as the cameras hang ("cameras"); H.264 through PyAV."""
 
-    name = "video"
-
     def __init__(self, path: Path, view: str, team: Team, models: Sequence[CameraModel], geometry: Field,
                  robot_radius_m: float, robot_height_m: float, fps: float) -> None:  # fmt: skip
         from cmdragons.runtime.topdown import TopDownView
 
-        self.inputs = ("camera/*", "truth", "referee", f"world/{team}", f"report/{team}", f"commands/{team}")
+        self.contract = Contract("video", tuple(Port(t, ANY) for t in ("camera/*", "truth", "referee", f"world/{team}",
+                                                                        f"report/{team}", f"commands/{team}")))
         self.path, self.view, self.team, self.fps = path, view, team, fps
         self.models = list(models)
         self.robot_height_m = robot_height_m

@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cmdragons.runtime.bus import BaseStage, Publish
+from cmdragons.runtime.topics import ANY, Contract, Port
 
 __all__ = ["ReportStage", "RunCollector", "RunData", "load_run", "run_warnings", "write_report"]
 
@@ -121,11 +122,9 @@ class ReportStage(BaseStage):
     """The match report's data gathered as the match runs (a subscriber: what :func:`load_run`
     would read back from the log, without reading it)."""
 
-    name = "report"
-
     def __init__(self, ours: str = "blue") -> None:
         self.collector = RunCollector(ours)
-        self.inputs = self.collector.topics
+        self.contract = Contract("report", tuple(Port(t, ANY) for t in self.collector.topics))
 
     def on_message(self, topic: str, message: Any, publish: Publish) -> None:
         self.collector.take(topic, message)

@@ -22,6 +22,7 @@ import numpy as np
 from cmdragons.geometry import Field
 from cmdragons.messages import GroundTruth, TeamReport
 from cmdragons.runtime.bus import BaseStage, Publish
+from cmdragons.runtime.topics import ANY, Contract, Port
 from cmdragons.runtime.log import RunLog
 
 __all__ = ["FRAME", "SceneStage"]
@@ -40,8 +41,7 @@ _CIRCLE_POINTS = 48  # the centre circle as a closed polygon of this many corner
 class SceneStage(BaseStage):
     """Writes the scene topics into ``log`` from the truth and the brains' reports."""
 
-    name = "scene"
-    inputs = ("truth", "report/*")
+    contract = Contract("scene", (Port("truth", ANY), Port("report/*", ANY)))
 
     def __init__(self, log: RunLog, field: Field, robot_radius_m: float, robot_height_m: float,
                  ball_radius_m: float) -> None:  # fmt: skip

@@ -1,22 +1,8 @@
 """The stages of a match, each a thin adapter between the bus and one algorithm object.
 
-Topics (what each stage reads -> writes):
-
-    clock              Tick                 -> sim
-    camera/<id>/frame  CameraFrame          sim -> vision/<id> (and a video, a logger)
-    truth              GroundTruth          sim -> simple opponent, truth perception, statistics
-    events             SimEvents            sim -> referee, statistics
-    teleport           Teleport             referee -> sim
-    referee            GameState            referee -> brains, opponent, statistics
-    referee/gc         GameState            a game controller's Referee packets -> brains (referee.source)
-    referee/events     GameEvents           referee -> logs (its calls: fouls, cards, placements)
-    detections/<id>    DetectionFrame       vision/<id> -> trackers
-    perception/<team>  DetectionFrame       truth perception/<team> -> tracker/<team>
-    world/<team>       WorldState           tracker/<team> -> team/<team>
-    commands/<team>    TeamCommands         team/<team> or the opponent -> sim, tracker/<team>
-    report/<team>      TeamReport           team/<team> -> statistics, overlays
-    timing/<team>      Timing               team/<team> -> timings (wall clock: not in same-seed logs)
-    summary/<stage>    StageSummary         every stage, on request -> the match summary
+Each declares its contract (:class:`~cmdragons.runtime.topics.Contract`: the topics it reads and
+writes, with their messages), as a class attribute or a ``declare`` of the arguments that shape its
+topics; the topic reference of docs/architecture.md is generated from them (docs/topics.py).
 
 Nothing here reaches into another stage: what a stage needs from another comes on a topic.
 """
@@ -49,13 +35,16 @@ from cmdragons.messages import (
     SimEvents,
     StageSummary,
     TeamCommands,
+    Teleport,
     TeamReport,
+    Tick,
     Timing,
     WorldState,
 )
-from cmdragons.runtime.bus import BaseStage, Publish, topic_matches
+from cmdragons.runtime.bus import BaseStage, Publish
+from cmdragons.runtime.topics import ANY, Contract, Port, summary_port, topic_matches
 from cmdragons.runtime.log import RunLog
-from cmdragons.team import Brain
+from cmdragons.team import Brain, BrainOutput
 from cmdragons.tracking import Tracker
 from sim.referee import Referee
 from sim.simulator import Simulator
@@ -75,16 +64,7 @@ __all__ = [
     "TruthPerceptionStage",
     "VisionStage",
     "message_time",
-    "truth_world",
 ]
-
-
-def truth_world(gt: GroundTruth) -> WorldState:
-    """The simulator's truth as a world state (what the simple opponent plays on)."""
-    b = gt.ball
-    return WorldState(gt.t, BallState(b.x, b.y, b.vx, b.vy), tuple(
-        RobotState(r.team, r.id, r.x, r.y, r.theta, r.vx, r.vy, r.omega) for r in gt.robots),
-        gt.frame_number)  # fmt: skip
 
 
 class SimStage(BaseStage):
@@ -97,10 +77,14 @@ class SimStage(BaseStage):
     robot's radio would get late: the newest of them is sent with the next step that has no
     commands of its own frame from that team, once."""
 
-    name = "sim"
-    inputs = ("clock", "commands/*", "teleport")
+    @staticmethod
+    def declare(camera_ids: Sequence[int]) -> Contract:
+        return Contract("sim", (Port("clock", Tick), Port("commands/*", TeamCommands), Port("teleport", Teleport)),
+                        (Port("truth", GroundTruth), *(Port(f"camera/{c}/frame", CameraFrame) for c in camera_ids),
+                         Port("events", SimEvents), summary_port("sim")))  # fmt: skip
 
     def __init__(self, sim: Simulator, teams: Sequence[Team]) -> None:
+        self.contract = self.declare([r.model.id for r in sim.renderers])  # the cameras it draws
         self.sim = sim
         self.teams = tuple(t for t in TEAMS if t in teams)
         self.frame_number = -1
@@ -162,9 +146,13 @@ class SimStage(BaseStage):
 class VisionStage(BaseStage):
     """One camera's vision: image -> detections."""
 
+    @staticmethod
+    def declare(camera_id: int) -> Contract:
+        return Contract(f"vision/{camera_id}", (Port(f"camera/{camera_id}/frame", CameraFrame),),
+                        (Port(f"detections/{camera_id}", DetectionFrame),))
+
     def __init__(self, camera_id: int, pipeline: Any) -> None:
-        self.name = f"vision/{camera_id}"
-        self.inputs = (f"camera/{camera_id}/frame",)
+        self.contract = self.declare(camera_id)
         self.camera_id = camera_id
         self.pipeline = pipeline
 
@@ -177,9 +165,13 @@ class TruthPerceptionStage(BaseStage):
     """Detections made from the simulator's truth plus vision-like noise, for one team (its own
     draws): for work on strategy, planning and control without vision in the way."""
 
+    @staticmethod
+    def declare(team: Team) -> Contract:
+        return Contract(f"perception/{team}", (Port("truth", GroundTruth),),
+                        (Port(f"perception/{team}", DetectionFrame),))
+
     def __init__(self, team: Team, sigmas: tuple[float, float, float], seed: int) -> None:
-        self.name = f"perception/{team}"
-        self.inputs = ("truth",)
+        self.contract = self.declare(team)
         self.topic = f"perception/{team}"
         self.sigma_ball, self.sigma_xy, self.sigma_theta = sigmas
         self.rng = np.random.default_rng(seed)
@@ -206,12 +198,18 @@ class TrackerStage(BaseStage):
     the first camera while vision works on the second). Otherwise a frame's detections wait for
     one another and are taken in capture-time order."""
 
+    @staticmethod
+    def declare(team: Team, detection_topics: Sequence[str], take_commands: bool = True) -> Contract:
+        name = f"tracker/{team}"
+        return Contract(name, (*(Port(t, DetectionFrame) for t in detection_topics),
+                               *((Port(f"commands/{team}", TeamCommands),) if take_commands else ())),
+                        (Port(f"world/{team}", WorldState), summary_port(name)))  # fmt: skip
+
     def __init__(self, team: Team, tracker: Tracker, detection_topics: Sequence[str],
                  take_commands: bool = True, synchronized: bool = False) -> None:  # fmt: skip
-        self.name = f"tracker/{team}"
+        self.contract = self.declare(team, detection_topics, take_commands)
         self.team = team
         self.detection_topics = tuple(detection_topics)
-        self.inputs = (*self.detection_topics, *((f"commands/{team}",) if take_commands else ()))
         self.tracker = tracker
         self.synchronized = synchronized
         self._frame = -1
@@ -260,9 +258,8 @@ class _PlayingStage(BaseStage, ABC):
     """A team that plays: keeps the referee's latest word and answers each of its world inputs
     with that frame's commands (:meth:`play`)."""
 
-    def __init__(self, name: str, team: Team, world_topic: str, referee_topic: str = "referee") -> None:
-        self.name = name
-        self.inputs = (world_topic, referee_topic)
+    def __init__(self, contract: Contract, team: Team, referee_topic: str = "referee") -> None:
+        self.contract = contract
         self.referee_topic = referee_topic
         self.team = team
         self.game = GameState(0.0)
@@ -285,41 +282,39 @@ class _PlayingStage(BaseStage, ABC):
 
 class TeamStage(_PlayingStage):
     """One team's brain: world state and game state -> that frame's commands, its report and its
-    parts' times."""
+    parts' times, all from the brain's output of the frame."""
+
+    @staticmethod
+    def declare(team: Team, referee_topic: str = "referee") -> Contract:
+        return Contract(f"team/{team}", (Port(f"world/{team}", WorldState), Port(referee_topic, GameState)),
+                        (Port(f"commands/{team}", TeamCommands), Port(f"report/{team}", TeamReport),
+                         Port(f"timing/{team}", Timing)))  # fmt: skip
 
     def __init__(self, team: Team, brain: Brain, referee_topic: str = "referee") -> None:
-        super().__init__(f"team/{team}", team, f"world/{team}", referee_topic)
+        super().__init__(self.declare(team, referee_topic), team, referee_topic)
         self.brain = brain
-        self._heat: tuple[Any, Any] | None = None  # the pass evaluation last sent
+        self._out: BrainOutput | None = None
 
     def play(self, message: Any) -> tuple[WorldState, list[RobotCommand]]:
-        return message, self.brain.step(message, self.game)
+        self._out = self.brain.step(message, self.game)
+        return message, list(self._out.commands)
 
     def after(self, world: WorldState, publish: Publish) -> None:
-        publish(f"report/{self.team}", self._report(world))
-        times = {k: v[-1] for k, v in self.brain.times.items() if v}
-        publish(f"timing/{self.team}", Timing(self.name, world.frame_number, times))
-
-    def _report(self, world: WorldState) -> TeamReport:
-        b = self.brain
-        robots = tuple(
-            RobotReport(rid, p.status, (p.intent.x, p.intent.y, p.intent.theta), _points(p.path), p.command,
-                        _points(b.braking.get(rid, ())))
-            for rid, p in sorted(b.plans.items())
-        )  # fmt: skip
-        heat = b.strategy.pass_heat
-        points, values = _points(()), np.zeros(0)
-        if heat is not None and not (self._heat is not None and _same(self._heat[0], heat[0])
-                                     and _same(self._heat[1], heat[1])):  # fmt: skip
-            points, values = heat  # the grid is evaluated every few frames only: sent when it was
-            self._heat = heat
-        return TeamReport(self.team, world.frame_number, world.t, robots, dict(b.strategy.last_action), points,
-                          values)  # fmt: skip
+        out = self._out
+        assert out is not None
+        publish(f"report/{self.team}", _report(self.team, world, out))
+        publish(f"timing/{self.team}", Timing(self.name, world.frame_number, dict(out.times_ms)))
 
 
-def _same(a: Any, b: Any) -> bool:
-    """Whether two arrays are (views of) the same memory: an evaluation not redone."""
-    return bool((a.base if a.base is not None else a) is (b.base if b.base is not None else b))
+def _report(team: Team, world: WorldState, out: BrainOutput) -> TeamReport:
+    """The brain's output of a frame as its report (the pass evaluation on the frames it was redone)."""
+    robots = tuple(
+        RobotReport(rid, p.status.value, (p.intent.x, p.intent.y, p.intent.theta), _points(p.path), p.command,
+                    _points(out.braking.get(rid, ())))
+        for rid, p in out.plans.items()
+    )  # fmt: skip
+    points, values = out.pass_heat if out.pass_heat is not None else (_points(()), np.zeros(0))
+    return TeamReport(team, world.frame_number, world.t, robots, dict(out.last_actions), points, values)
 
 
 def _points(a: Any) -> NDArray[np.float64]:
@@ -330,12 +325,17 @@ def _points(a: Any) -> NDArray[np.float64]:
 class SimpleOpponentStage(_PlayingStage):
     """The built-in simple team: plays on the true state, plain steering."""
 
+    @staticmethod
+    def declare(team: Team) -> Contract:
+        return Contract(f"opponent/{team}", (Port("truth", GroundTruth), Port("referee", GameState)),
+                        (Port(f"commands/{team}", TeamCommands),))
+
     def __init__(self, team: Team, simple: SimpleTeam) -> None:
-        super().__init__(f"opponent/{team}", team, "truth")
+        super().__init__(self.declare(team), team)
         self.simple = simple
 
     def play(self, message: Any) -> tuple[WorldState, list[RobotCommand]]:
-        world = truth_world(message)
+        world = message.world()
         return world, self.simple.commands(world, self.game)
 
 
@@ -343,8 +343,10 @@ class RefereeStage(BaseStage):
     """The simulator's referee: the frame's events (and, for the full rules, the true state the
     auto-referee judges) -> the game state, the frame's calls and a restart's teleport."""
 
-    name = "referee"
-    inputs = ("truth", "events")
+    contract = Contract("referee", (Port("truth", GroundTruth), Port("events", SimEvents)),
+                        (Port("teleport", Teleport), Port("referee", GameState),
+                         Port("referee/events", GameEvents, sometimes=True),
+                         summary_port("referee")))  # fmt: skip
 
     def __init__(self, referee: Referee) -> None:
         self.referee = referee
@@ -379,9 +381,14 @@ class StatsStage(BaseStage):
     own robots (apart: those where an opponent touched one of the two, pushing it into the other)
     and with opponents."""
 
+    @staticmethod
+    def declare(team: Team) -> Contract:
+        return Contract(f"stats/{team}", (Port("truth", GroundTruth), Port("referee", GameState),
+                                          Port(f"report/{team}", TeamReport), Port("events", SimEvents)),
+                        (summary_port(f"stats/{team}"),))  # fmt: skip
+
     def __init__(self, team: Team, pass_timeout_s: float, hold_m: float = 0.15) -> None:
-        self.name = f"stats/{team}"
-        self.inputs = ("truth", "referee", f"report/{team}", "events")
+        self.contract = self.declare(team)
         self.team = team
         self.pass_timeout_s = pass_timeout_s
         self.hold_m = hold_m  # a robot whose centre is this near the ball holds it
@@ -441,8 +448,7 @@ class StatsStage(BaseStage):
 class TimingStage(BaseStage):
     """Median and 95th percentile of every timed part on ``timing/*`` (ms), per stage."""
 
-    name = "timing"
-    inputs = ("timing/*",)
+    contract = Contract("timing", (Port("timing/*", Timing),), (summary_port("timing"),))
 
     def __init__(self) -> None:
         self.ms: dict[str, dict[str, list[float]]] = {}
@@ -473,8 +479,7 @@ class LoggerStage(BaseStage):
     asked (about 2.4 MB a frame and camera). Wall-clock timings are left out by default, so the same
     seed gives the same log byte for byte."""
 
-    name = "logger"
-    inputs = ("*",)
+    contract = Contract("logger", (Port("*", ANY),))
 
     def __init__(self, log: RunLog, images: bool = False,
                  skip: Sequence[str] = ("clock", "control/*", "timing/*", "summary/timing")) -> None:  # fmt: skip
@@ -492,8 +497,7 @@ class LoggerStage(BaseStage):
 class SummaryCollector(BaseStage):
     """Keeps the latest summary of every stage (topic ``summary/<stage>``)."""
 
-    name = "summaries"
-    inputs = ("summary/*",)
+    contract = Contract("summaries", (Port("summary/*", StageSummary),))
 
     def __init__(self) -> None:
         self.figures: dict[str, dict[str, Any]] = {}
@@ -507,8 +511,7 @@ class Tap(BaseStage):
     """Calls ``fn(topic, message)`` for every message on its topics (progress bars, viewers)."""
 
     def __init__(self, name: str, inputs: Sequence[str], fn: Callable[[str, Any], None]) -> None:
-        self.name = name
-        self.inputs = tuple(inputs)
+        self.contract = Contract(name, tuple(Port(t, ANY) for t in inputs))
         self.fn = fn
 
     def on_message(self, topic: str, message: Any, publish: Publish) -> None:

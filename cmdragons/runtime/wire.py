@@ -58,7 +58,7 @@ from cmdragons.messages import (
     Timing,
     WorldState,
 )
-from cmdragons.runtime.bus import topic_matches
+from cmdragons.runtime.topics import topic_matches
 from cmdragons.runtime.proto import cmdragons_pb2 as pb
 from cmdragons.runtime.proto import ssl_detection_pb2 as det_pb
 from cmdragons.runtime.proto import ssl_simulation_control_pb2 as ctl_pb

@@ -13,7 +13,8 @@ from mcap_protobuf.decoder import DecoderFactory
 
 from cmdragons import messages as msg
 from cmdragons.runtime import wire
-from cmdragons.runtime.bus import BaseStage, Bus, InProcessTransport, Publish, topic_matches
+from cmdragons.runtime.bus import BaseStage, Bus, InProcessTransport, Publish
+from cmdragons.runtime.topics import ANY, Contract, Port, topic_matches
 from cmdragons.runtime.log import RunLog, read_log
 from cmdragons.runtime.match import Match
 from cmdragons.runtime.settings import load_settings
@@ -37,7 +38,8 @@ class Relay(BaseStage):
     """Publishes ``out`` + the message for each input: the order of deliveries becomes visible."""
 
     def __init__(self, name: str, inputs: tuple[str, ...], out: str, seen: list[str]) -> None:
-        self.name, self.inputs, self.out, self.seen = name, inputs, out, seen
+        self.contract = Contract(name, tuple(Port(t, ANY) for t in inputs), (Port(out, ANY),) if out else ())
+        self.out, self.seen = out, seen
 
     def on_message(self, topic: str, message: Any, publish: Publish) -> None:
         self.seen.append(f"{self.name}<{topic}:{message}")

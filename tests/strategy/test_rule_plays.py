@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from cmdragons.messages import BallState, GameEvent, RobotCommand, RobotState, WorldState
+from cmdragons.messages import BallState, GameEvent, RobotCommand, WorldState
 from cmdragons.runtime.settings import load_settings
 from cmdragons.team import Brain
 from sim.referee import Referee
@@ -48,11 +48,10 @@ def play(w: World, ref: Referee, brain: Brain, seconds: float,
     calls: list[GameEvent] = []
     for k in range(round(seconds * 60)):
         truth = w.ground_truth()
-        b = truth.ball
-        world = WorldState(truth.t, BallState(b.x, b.y, b.vx, b.vy), tuple(
-            RobotState(r.team, r.id, r.x, r.y, r.theta, r.vx, r.vy, r.omega) for r in truth.robots
-            if w.field.in_field(r.x, r.y, -w.field.dims.boundary_width_m)), truth.frame_number)  # fmt: skip
-        commands = brain.step(see(world) if see else world, ref.state()) + (theirs(k) if theirs else [])
+        seen = truth.world()
+        world = dataclasses.replace(seen, robots=tuple(r for r in seen.robots
+                                                       if w.field.in_field(r.x, r.y, -w.field.dims.boundary_width_m)))
+        commands = [*brain.step(see(world) if see else world, ref.state()).commands, *(theirs(k) if theirs else [])]
         commands += opponent(w, ref, world) if opponent else []
         events = w.step_frame(commands)
         teleport = ref.observe(w.t, events, tuple(w.ball_body.position), w.ground_truth())

@@ -13,7 +13,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from cmdragons.messages import DetectionFrame, GameState, MessageError
-from cmdragons.runtime.bus import topic_matches
+from cmdragons.runtime.topics import topic_matches
 from cmdragons.runtime.log import RunLog, read_log
 from cmdragons.runtime.ssl.logfile import LogReader, LogRecord, MessageType, write_log
 from cmdragons.runtime.ssl.referee import RefereeReader, referee_packet

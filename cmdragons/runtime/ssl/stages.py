@@ -28,7 +28,18 @@ from typing import Any, Protocol, TextIO
 from google.protobuf.message import DecodeError
 
 from cmdragons.geometry import Team
-from cmdragons.messages import DetectionFrame, GroundTruth, MessageError, RobotCommand, StageSummary, TeamCommands, Tick
+from cmdragons.messages import (
+    DetectionFrame,
+    GameState,
+    GroundTruth,
+    MessageError,
+    RobotCommand,
+    StageSummary,
+    TeamCommands,
+    Teleport,
+    Tick,
+    WorldState,
+)
 from cmdragons.runtime.bus import BaseStage, Publish
 from cmdragons.runtime.proto import ssl_simulator_pb2 as sim_pb
 from cmdragons.runtime.ssl.commands import (
@@ -45,6 +56,7 @@ from cmdragons.runtime.ssl.referee import RefereeReader, referee_packet
 from cmdragons.runtime.ssl.tracker import tracker_packet
 from cmdragons.runtime.ssl.udp import DropLog, MulticastReceiver, MulticastSender, UdpEndpoint
 from cmdragons.runtime.ssl.vision import VisionGeometry, decode_wrapper, detection_packet
+from cmdragons.runtime.topics import Contract, Port, summary_port
 
 __all__ = ["CommandsOutStage", "RefereeInStage", "RefereeOutStage", "SimulationInStage", "SocketStage",
            "TrackerOutStage", "VisionInStage", "VisionOutStage", "close_sockets"]  # fmt: skip
@@ -78,12 +90,17 @@ class VisionOutStage(SocketStage):
     """Our vision as SSL-Vision: each camera frame's detections as an SSL_WrapperPacket, the
     geometry (field and calibrations) every ``vision.geometry_interval_s`` of camera time."""
 
-    name = "ssl/vision_out"
+    @staticmethod
+    def declare(params: ProtocolParams, camera_ids: Sequence[int], geometry: bytes = b"",
+                topics: Sequence[str] | None = None) -> Contract:  # fmt: skip
+        read = tuple(topics) if topics is not None else tuple(f"detections/{c}" for c in camera_ids)
+        return Contract("ssl/vision_out", tuple(Port(t, DetectionFrame) for t in read),
+                        (Port("ssl/vision/sent", Tick), summary_port("ssl/vision_out")))
 
     def __init__(self, params: ProtocolParams, camera_ids: Sequence[int], geometry: bytes,
                  topics: Sequence[str] | None = None) -> None:  # fmt: skip
         v = params.vision
-        self.inputs = tuple(topics) if topics is not None else tuple(f"detections/{c}" for c in camera_ids)
+        self.contract = self.declare(params, camera_ids, geometry, topics)
         self.camera_ids = tuple(camera_ids)
         self.sender = MulticastSender(v.group, v.port, params.interface, params.ttl)
         self.geometry = geometry
@@ -126,7 +143,11 @@ class VisionInStage(SocketStage):
     """SSL-Vision packets from multicast -> ``ssl/vision/<camera id>`` detections (metres), the
     latest geometry kept. ``lockstep``: fed by our own sender in this match (see the module)."""
 
-    name = "ssl/vision_in"
+    @staticmethod
+    def declare(params: ProtocolParams, camera_ids: Sequence[int], lockstep: bool) -> Contract:
+        return Contract("ssl/vision_in", (Port("ssl/vision/sent" if lockstep else "clock", Tick),),
+                        (*(Port(f"ssl/vision/{c}", DetectionFrame) for c in sorted(camera_ids)),
+                         summary_port("ssl/vision_in")))  # fmt: skip
 
     def __init__(self, params: ProtocolParams, camera_ids: Sequence[int], lockstep: bool,
                  err: TextIO | None = None, receiver: Receiver | None = None) -> None:  # fmt: skip
@@ -136,7 +157,7 @@ class VisionInStage(SocketStage):
         self.camera_ids = frozenset(camera_ids)
         self.lockstep = lockstep
         self.wait_s = v.wait_s
-        self.inputs = ("ssl/vision/sent",) if lockstep else ("clock",)
+        self.contract = self.declare(params, camera_ids, lockstep)
         self.drops = DropLog(f"ssl-vision {v.group}:{v.port}", params.drop_report_interval_s, err)
         self.geometry: VisionGeometry | None = None
         self.received = self.detections = self.geometry_packets = self.late = 0
@@ -194,8 +215,7 @@ class VisionInStage(SocketStage):
 class RefereeOutStage(SocketStage):
     """Our referee's game state as the league's Referee message, multicast."""
 
-    name = "ssl/referee_out"
-    inputs = ("referee",)
+    contract = Contract("ssl/referee_out", (Port("referee", GameState),), (summary_port("ssl/referee_out"),))
 
     def __init__(self, params: ProtocolParams) -> None:
         r = params.referee
@@ -218,14 +238,17 @@ class RefereeInStage(SocketStage):
     ``world_topic`` it watches the ball: once a kickoff's or penalty's restart is taken (the ball
     ``moved_m`` from the designated position), play is normal."""
 
-    name = "ssl/referee_in"
+    @staticmethod
+    def declare(params: ProtocolParams, world_topic: str, moved_m: float = 0.0) -> Contract:
+        return Contract("ssl/referee_in", (Port("clock", Tick), Port(world_topic, WorldState)),
+                        (Port("referee/gc", GameState), summary_port("ssl/referee_in")))
 
     def __init__(self, params: ProtocolParams, world_topic: str, moved_m: float,
                  err: TextIO | None = None, receiver: Receiver | None = None) -> None:  # fmt: skip
         r = params.referee
         self.receiver: Receiver = receiver if receiver is not None else MulticastReceiver(
             r.group, r.port, params.interface, params.receive_buffer_bytes, params.max_datagram_bytes)  # fmt: skip
-        self.inputs = ("clock", world_topic)
+        self.contract = self.declare(params, world_topic)
         self.moved_m = moved_m
         self.reader = RefereeReader()
         self.drops = DropLog(f"referee {r.group}:{r.port}", params.drop_report_interval_s, err)
@@ -266,10 +289,14 @@ class TrackerOutStage(SocketStage):
     """Our tracker's world state as the league's TrackerWrapperPacket (metres), multicast; one
     ``uuid`` for the run."""
 
+    @staticmethod
+    def declare(params: ProtocolParams, team: Team) -> Contract:
+        name = f"ssl/tracker_out/{team}"
+        return Contract(name, (Port(f"world/{team}", WorldState),), (summary_port(name),))
+
     def __init__(self, params: ProtocolParams, team: Team) -> None:
         t = params.tracker
-        self.name = f"ssl/tracker_out/{team}"
-        self.inputs = (f"world/{team}",)
+        self.contract = self.declare(params, team)
         self.sender = MulticastSender(t.group, t.port, params.interface, params.ttl)
         self.uuid = str(uuid.uuid4())
         self.source = t.source_name
@@ -291,12 +318,18 @@ class CommandsOutStage(SocketStage):
     ``SimulatorCommand`` to the control port). Velocities go in each robot's frame by its heading in
     our tracker's latest world state. The simulators' answers are read and counted."""
 
+    @staticmethod
+    def declare(params: ProtocolParams, team: Team, chip_angle_rad: float = 0.0) -> Contract:
+        name = f"ssl/commands_out/{team}"
+        return Contract(name, (Port(f"world/{team}", WorldState), Port(f"commands/{team}", TeamCommands),
+                               *((Port("teleport", Teleport),) if params.commands_to == "simulation" else ())),
+                        (summary_port(name),))  # fmt: skip
+
     def __init__(self, params: ProtocolParams, team: Team, chip_angle_rad: float, err: TextIO | None = None) -> None:
-        self.name = f"ssl/commands_out/{team}"
+        self.contract = self.declare(params, team)
         self.team = team
         self.to = params.commands_to
         sim = params.simulation
-        self.inputs = (f"world/{team}", f"commands/{team}", *(("teleport",) if self.to == "simulation" else ()))
         self.endpoint = UdpEndpoint(sim.address if self.to == "simulation" else params.grsim.address)
         self.peer = (params.grsim.address, params.grsim.port) if self.to == "grsim" else (sim.address,
                                                                                            sim.port(team))  # fmt: skip
@@ -353,10 +386,15 @@ class SimulationInStage(SocketStage):
     heading. Each packet is answered (RobotControlResponse, SimulatorResponse); garbage and a
     packet cut short are counted and dropped with a line on stderr."""
 
+    @staticmethod
+    def declare(params: ProtocolParams, team: Team) -> Contract:
+        name = f"ssl/simulation_in/{team}"
+        return Contract(name, (Port("truth", GroundTruth),), (Port(f"commands/{team}", TeamCommands),
+                        Port("teleport", Teleport), summary_port(name)))  # fmt: skip
+
     def __init__(self, params: ProtocolParams, team: Team, err: TextIO | None = None) -> None:
         sim = params.simulation
-        self.name = f"ssl/simulation_in/{team}"
-        self.inputs = ("truth",)
+        self.contract = self.declare(params, team)
         self.team = team
         self.robots = UdpEndpoint(sim.address, sim.port(team), params.max_datagram_bytes)
         self.control = UdpEndpoint(sim.address, sim.control_port, params.max_datagram_bytes)

@@ -1,0 +1,102 @@
+"""Stage contracts: what a match's stages publish is what they declare; a table that does not fit is
+refused naming both ends; a distributed node builds only its own stages."""
+
+from __future__ import annotations
+
+import gc
+import importlib.util
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from cmdragons.messages import DetectionFrame, Tick, WorldState
+from cmdragons.runtime.distributed import MatchSpec
+from cmdragons.runtime.match import CLOCK, Match
+from cmdragons.runtime.settings import load_settings
+from cmdragons.runtime.stages import Tap
+from cmdragons.runtime.topics import Contract, Port, WiringError, check_wiring, topic_matches
+from cmdragons.runtime.wire import message_type
+from sim.simulator import Simulator
+
+SETTINGS = load_settings()
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.mark.parametrize(("opponent", "perception"), [("simple", "truth"), ("self", "vision")])
+def test_every_topic_published_is_declared_and_every_declared_one_is_published(opponent: str,
+                                                                                perception: str) -> None:  # fmt: skip
+    seen: dict[str, set[type]] = {}
+    tap = Tap("every", ("*",), lambda topic, m: seen.setdefault(topic, set()).add(type(m)))
+    match = Match(SETTINGS, opponent, perception, seed=1, extra=[tap])  # type: ignore[arg-type]
+    match.run(5.0 if perception == "truth" else 1.0)  # (its summary: every stage's summary/<name> too)
+    declared = [p for s in match.bus.stages for p in s.contract.writes] + list(CLOCK)
+    for topic, types in seen.items():
+        ports = [p for p in declared if topic_matches(p.topic, topic)]
+        assert ports, f"{topic} published but declared by no stage"
+        assert types == {ports[0].type}, f"{topic}: published {types}, declared {ports[0].type}"
+    for p in declared:
+        assert p.sometimes or any(topic_matches(p.topic, t) for t in seen), f"{p.topic} declared but never published"
+
+
+def test_a_topic_read_that_nobody_writes_is_refused_naming_the_reader_and_the_topic() -> None:
+    writer = Contract("tracker/blue", (), (Port("world/blue", WorldState),))
+    reader = Contract("team/yellow", (Port("world/yellow", WorldState),))
+    with pytest.raises(WiringError, match=r"'team/yellow' reads topic 'world/yellow'.*no stage writes"):
+        check_wiring([writer, reader])
+    check_wiring([writer, Contract("team/blue", (Port("world/blue", WorldState),))])  # what fits passes
+
+
+def test_a_topic_written_with_another_type_is_refused_naming_both_stages() -> None:
+    writer = Contract("vision/0", (), (Port("detections/0", DetectionFrame),))
+    reader = Contract("tracker/blue", (Port("detections/0", WorldState),))
+    with pytest.raises(WiringError, match=r"'tracker/blue' reads topic 'detections/0' as WorldState, but stage "
+                                          r"'vision/0' writes 'detections/0' as DetectionFrame"):  # fmt: skip
+        check_wiring([writer, reader])
+    with pytest.raises(WiringError, match=r"'detections/0'.*'vision/1'.*'vision/0'"):
+        check_wiring([writer, Contract("vision/1", (), (Port("detections/0", Tick),))])
+
+
+def test_the_match_table_is_checked_when_a_match_is_built() -> None:
+    lost = Tap("viewer", ("world/blue",), lambda _t, _m: None)  # takes anything: fits
+    Match(SETTINGS, "none", "truth", seed=1, extra=[lost])
+    dangling = Tap("viewer", (), lambda _t, _m: None)
+    dangling.contract = Contract("viewer", (Port("world/green", WorldState),))
+    with pytest.raises(WiringError, match="'viewer' reads topic 'world/green'"):
+        Match(SETTINGS, "none", "truth", seed=1, extra=[dangling])
+
+
+def _simulators() -> int:
+    return sum(isinstance(o, Simulator) for o in gc.get_objects())
+
+
+@pytest.mark.parametrize("role", ["team", "opponent", "referee", "vision"])
+def test_a_node_builds_only_its_own_stages_and_no_simulator_off_the_sim_node(role: str) -> None:
+    spec = MatchSpec(SETTINGS, "simple", "truth", 1)
+    nodes = spec.nodes()
+    gc.collect()
+    before = _simulators()
+    stages = spec.stages(role)
+    assert sorted(s.name for s in stages) == sorted(name for name, node in nodes.items() if node == role)
+    assert _simulators() == before, f"the {role} node built a simulator"
+    sim_node = spec.stages("sim")
+    assert [s.name for s in sim_node] == ["sim"] and _simulators() == before + 1
+
+
+def _docs_topics() -> Any:
+    spec = importlib.util.spec_from_file_location("docs_topics", ROOT / "docs" / "topics.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_topic_reference_in_the_docs_is_the_one_the_contracts_give() -> None:
+    docs = _docs_topics()
+    assert docs.written() == docs.section(), "docs/architecture.md's topics are stale: python docs/topics.py --write"
+
+
+def test_every_declared_topic_crosses_the_wire_as_its_declared_type() -> None:
+    for c in _docs_topics().contracts():
+        for p in c.writes:
+            assert message_type(p.topic.replace("*", "0")) is p.type, f"{c.name} writes {p.topic}"

@@ -33,10 +33,12 @@ from cmdragons.messages import (
     Contact,
     Event,
     GameEvent,
+    GameStage,
     GameState,
     Goal,
     GroundTruth,
     Kick,
+    RefereeCommand,
     TeamInfo,
     Teleport,
 )
@@ -75,7 +77,7 @@ class RefereeParams(Validated):
 
 
 Key = tuple[Team, int]
-_LIVE = ("normal", "force_start", "kickoff", "free_kick")  # commands with the ball in play or about to be
+_LIVE = (RefereeCommand.NORMAL, RefereeCommand.FORCE_START, RefereeCommand.KICKOFF, RefereeCommand.FREE_KICK)  # commands with the ball in play or about to be
 
 
 def _other(team: Team) -> Team:
@@ -117,7 +119,7 @@ class Referee:
         self.balls_out = 0
         self.kicks = 0
         self.contacts: list[Contact] = []
-        self.command: str = "kickoff"
+        self.command = RefereeCommand.KICKOFF
         self.for_team: Team | None = "blue"
         self.ready = True
         self.t = 0.0
@@ -130,7 +132,7 @@ class Referee:
         # the full rules
         self.full = params.enabled and params.rules == "full"
         self.rules = params.figures
-        self.stage = "first_half"
+        self.stage = GameStage.FIRST_HALF
         self._stage_end = self.rules.half_s if self.full else math.inf
         self.command_counter = 0
         self.command_t = 0.0
@@ -158,14 +160,14 @@ class Referee:
         self._truth: GroundTruth | None = None  # the last true state seen (where the robots stand)
 
     # --- commands ---------------------------------------------------------------------------
-    def _set(self, command: str, for_team: Team | None, ready: bool = True) -> None:
+    def _set(self, command: RefereeCommand, for_team: Team | None, ready: bool = True) -> None:
         """Give a command (its counter and time move when it changes)."""
         if (command, for_team, ready) != (self.command, self.for_team, self.ready):
             self.command_counter += 1
             self.command_t = self.t
         self.command, self.for_team, self.ready = command, for_team, ready
 
-    def give(self, command: str, for_team: Team | None = None, ready: bool = True) -> None:
+    def give(self, command: RefereeCommand, for_team: Team | None = None, ready: bool = True) -> None:
         """A command by hand (what a human referee or a scripted scene gives); restarts that need a
         ball in place are :meth:`free_kick`, :meth:`start_placement` and :meth:`start_penalty`."""
         self._restart = None
@@ -174,7 +176,7 @@ class Referee:
 
     def free_kick(self, team: Team, spot: tuple[float, float]) -> Teleport:
         """A free kick for ``team`` with the ball put at ``spot`` (the teleport to carry out)."""
-        self.give("stop")
+        self.give(RefereeCommand.STOP)
         self._start_restart("free_kick_by_referee", team, spot, spot)
         teleport = self._take_teleports()
         assert teleport is not None
@@ -182,23 +184,23 @@ class Referee:
 
     def start_placement(self, team: Team, target: tuple[float, float]) -> None:
         """Ball placement by ``team`` to ``target`` now, a free kick for it to follow."""
-        self.give("stop")
+        self.give(RefereeCommand.STOP)
         self._start_restart("free_kick", team, target, target)
 
     def start_penalty(self, team: Team) -> Teleport:
         """A penalty kick for ``team``: the ball on the mark (the teleport to carry out), prepared."""
-        self.give("stop")
+        self.give(RefereeCommand.STOP)
         self._start_restart("penalty", team, self._spot("penalty", team, (0.0, 0.0)), (0.0, 0.0))
         teleport = self._take_teleports()
         assert teleport is not None
         return teleport
 
     def _in_play(self) -> bool:
-        return self.command in ("normal", "force_start") or (self.command == "penalty" and self.ready)
+        return self.command.running or (self.command == RefereeCommand.PENALTY and self.ready)
 
     def _live(self) -> bool:
         """Do goals and balls out count now? (Basic rules: whenever no restart is pending.)"""
-        return not self.full or self.command in _LIVE or (self.command == "penalty" and self.ready)
+        return not self.full or self.command in _LIVE or (self.command == RefereeCommand.PENALTY and self.ready)
 
     def _team_count(self, team: Team) -> int:
         return sum(1 for t, _ in self.robot_keys if t == team)
@@ -233,7 +235,7 @@ class Referee:
             ids = [rid for t, rid in self.robot_keys if t == team]
             robots += [(team, rid, x, y, th) for rid, (x, y, th) in zip(ids, self.formation(team), strict=False)
                        if (team, rid) not in self.off]  # fmt: skip
-        self._set("kickoff", kicking_team)
+        self._set(RefereeCommand.KICKOFF, kicking_team)
         self._restart_ball = (0.0, 0.0)
         self._restart_t = self.t
         return Teleport(self.t, tuple(robots), (0.0, 0.0))
@@ -259,20 +261,20 @@ class Referee:
                 self.watch.kicked((e.team, e.id))
             elif isinstance(e, Goal) and self._restart is None and self._live():
                 scorer = self._scorer(e.x)
-                if self.stage == "penalty_shootout":
+                if self.stage == GameStage.PENALTY_SHOOTOUT:
                     if self.for_team == scorer:
                         self.shootout[scorer]["scored"] += 1
                     self._next_shootout_kick()
                     continue
                 self.score[scorer] += 1
-                if self.command == "penalty" and self.for_team == scorer:
+                if self.command == RefereeCommand.PENALTY and self.for_team == scorer:
                     self.penalties[scorer]["scored"] += 1
                 self._clear_special()
-                self._set("stop", None)
+                self._set(RefereeCommand.STOP, None)
                 self._restart = (t + self.params.restart_delay_s, "kickoff", _other(scorer), (0.0, 0.0))
             elif isinstance(e, BallOut) and self._restart is None and self._live():
                 self.balls_out += 1
-                if self.stage == "penalty_shootout":  # the kick missed
+                if self.stage == GameStage.PENALTY_SHOOTOUT:  # the kick missed
                     self._next_shootout_kick()
                     continue
                 taker: Team = "yellow" if e.last_touch == "blue" else "blue"
@@ -280,7 +282,7 @@ class Referee:
                     taker = "blue" if (e.x < 0) == (self.blue_sign < 0) else "yellow"
                 spot = self.field.free_kick_spot(e.x, e.y, self.params.free_kick_distance_m)
                 self._clear_special()
-                self._set("stop", None)
+                self._set(RefereeCommand.STOP, None)
                 self._restart = (t + self.params.restart_delay_s, "free_kick", taker, spot)
         if truth is not None:
             self._truth = truth
@@ -300,15 +302,15 @@ class Referee:
         if teleport is not None and teleport.ball is not None:
             ball_xy = teleport.ball
         # a restart is taken once the ball moved: normal play; not taken in time, play goes on anyway
-        if self.command in ("kickoff", "free_kick") and self._restart_ball is not None:
+        if self.command.kick_restart and self._restart_ball is not None:
             bx, by = ball_xy
             moved = math.hypot(bx - self._restart_ball[0], by - self._restart_ball[1]) > 0.05
             if moved:
-                self._set("normal", None)
+                self._set(RefereeCommand.NORMAL, None)
                 self._restart_ball = None
                 self.watch.restart_taken(self.watch.last_touch)
             elif t - self._restart_t > self.params.restart_timeout_s:
-                self._set("force_start" if self.full else "normal", None)
+                self._set(RefereeCommand.FORCE_START if self.full else RefereeCommand.NORMAL, None)
                 self._restart_ball = None
         return teleport
 
@@ -339,26 +341,26 @@ class Referee:
                        ball_xy: tuple[float, float]) -> None:  # fmt: skip
         t = self.t
         if kind == "force_start" or team is None:  # after no progress: where the ball lies, for both
-            self._set("force_start", None)
+            self._set(RefereeCommand.FORCE_START, None)
         elif kind == "kickoff" and self.params.place_robots_on_goal:
             self._teleports.append(self.kickoff_setup(team))
         elif kind == "free_kick" and self.full and self._can_place(team):
-            self._set("ball_placement", team)
+            self._set(RefereeCommand.BALL_PLACEMENT, team)
             self.placement = _Placement(team, spot, t)
         elif kind == "penalty":
-            if self.stage == "penalty_shootout":
+            if self.stage == GameStage.PENALTY_SHOOTOUT:
                 self._shootout_kick_setup(team, spot)
             else:
                 self._clear_spot(spot, self._attack_sign(team))
             self._teleport(ball=spot)
-            self._set("penalty", team, ready=False)
+            self._set(RefereeCommand.PENALTY, team, ready=False)
             self.penalty = _Penalty(team, t, spot)
-            (self.shootout if self.stage == "penalty_shootout" else self.penalties)[team]["taken"] += 1
+            (self.shootout if self.stage == GameStage.PENALTY_SHOOTOUT else self.penalties)[team]["taken"] += 1
         else:
             placed = kind == "placed_free_kick"
             if not placed:
                 self._teleport(ball=spot)
-            self._set("kickoff" if kind == "kickoff" else "free_kick", team)
+            self._set(RefereeCommand.KICKOFF if kind == "kickoff" else RefereeCommand.FREE_KICK, team)
             self._restart_ball = ball_xy if placed else spot
             self._restart_t = t
 
@@ -421,11 +423,11 @@ class Referee:
     def _award(self, kind: str, team: Team, spot: tuple[float, float]) -> None:
         """Stop play; after the restart delay ``kind`` ("free_kick", "penalty") for ``team`` at ``spot``
         (in a penalty shootout: its next kick, this one over)."""
-        if self.stage == "penalty_shootout":
+        if self.stage == GameStage.PENALTY_SHOOTOUT:
             self._next_shootout_kick()
             return
         self._clear_special()
-        self._set("stop", None)
+        self._set(RefereeCommand.STOP, None)
         self._restart = (self.t + self.params.restart_delay_s, kind, team, spot)
 
     def _attack_sign(self, team: Team) -> float:
@@ -494,7 +496,7 @@ class Referee:
     def _follow_cards(self, dt: float, truth: GroundTruth) -> None:
         """Cards run while the game is not halted; a robot whose card ran out comes back at the
         halfway line, by the touch line, on a free spot."""
-        if self.command == "halt":
+        if self.command == RefereeCommand.HALT:
             return
         for c in list(self.cards):
             c.left_s -= dt
@@ -542,7 +544,7 @@ class Referee:
         """A placement succeeds when the ball rests within the tolerance of the designated position
         with the placing team's robots clear of it; it fails when the time is up."""
         pl = self.placement
-        if pl is None or self.command != "ball_placement":
+        if pl is None or self.command != RefereeCommand.BALL_PLACEMENT:
             return
         r, b = self.rules, truth.ball
         off = math.hypot(b.x - pl.target[0], b.y - pl.target[1])
@@ -582,12 +584,12 @@ class Referee:
 
     def _follow_penalty(self, truth: GroundTruth) -> None:
         pen = self.penalty
-        if pen is None or self.command != "penalty":
+        if pen is None or self.command != RefereeCommand.PENALTY:
             return
         if not self.ready:
             if self.t - pen.t_start >= self.rules.prepare_timeout_s or self._penalty_set(truth, pen):
                 pen.t_run = self.t
-                self._set("penalty", pen.team, ready=True)
+                self._set(RefereeCommand.PENALTY, pen.team, ready=True)
             return
         assert pen.t_run is not None
         b = truth.ball
@@ -598,7 +600,7 @@ class Referee:
         # keeper turned it back, or the kicker broke the rule that it only ever moves toward the goal); a
         # ball at rest waits for the kicker, who may play it again
         if took > self.rules.penalty_time_s or (moved and b.vx * attack < -0.05):
-            shootout = self.stage == "penalty_shootout"
+            shootout = self.stage == GameStage.PENALTY_SHOOTOUT
             self._call(GameEvent(self.t, "penalty_over", pen.team, None, took, self.rules.penalty_time_s, "s",
                                  "" if shootout else "free_kick", None if shootout else _other(pen.team)))  # fmt: skip
             if shootout:
@@ -612,42 +614,42 @@ class Referee:
         if self.t < self._stage_end:
             return
         r = self.rules
-        if self.placement is not None and self.command == "ball_placement":
+        if self.placement is not None and self.command == RefereeCommand.BALL_PLACEMENT:
             self.placements[self.placement.team]["cut_short"] += 1
-        if self.stage == "first_half" and r.half_time_s > 0.0:
-            self.stage, self._stage_end = "half_time", self.t + r.half_time_s
+        if self.stage == GameStage.FIRST_HALF and r.half_time_s > 0.0:
+            self.stage, self._stage_end = GameStage.HALF_TIME, self.t + r.half_time_s
             self._restart = None
             self._clear_special()
-            self._set("halt", None)
-        elif self.stage in ("first_half", "half_time"):
-            self.stage, self._stage_end = "second_half", self.t + r.half_s
+            self._set(RefereeCommand.HALT, None)
+        elif self.stage in (GameStage.FIRST_HALF, GameStage.HALF_TIME):
+            self.stage, self._stage_end = GameStage.SECOND_HALF, self.t + r.half_s
             self.blue_sign = -1 if self.blue_sign > 0 else 1
             self._restart = None
             self._clear_special()
             self._teleports.append(self.kickoff_setup("yellow"))
-        elif self.stage == "second_half" and r.shootout_kicks > 0 and (
+        elif self.stage == GameStage.SECOND_HALF and r.shootout_kicks > 0 and (
                 r.shootout_always or self.score["blue"] == self.score["yellow"]):
-            self.stage, self._stage_end = "penalty_shootout", math.inf
+            self.stage, self._stage_end = GameStage.PENALTY_SHOOTOUT, math.inf
             self._shootout_teams()
             self._call(GameEvent(self.t, f"stage_{self.stage}"))
             self._next_shootout_kick()
             return
-        elif self.stage in ("second_half", "penalty_shootout"):
+        elif self.stage in (GameStage.SECOND_HALF, GameStage.PENALTY_SHOOTOUT):
             self._end_match()
         self._call(GameEvent(self.t, f"stage_{self.stage}"))
 
     def _end_match(self) -> None:
-        self.stage, self._stage_end = "post_game", math.inf
+        self.stage, self._stage_end = GameStage.POST_GAME, math.inf
         self._restart = None
         self._clear_special()
-        self._set("halt", None)
+        self._set(RefereeCommand.HALT, None)
 
     def _next_shootout_kick(self) -> None:
         """The shootout's next kick after the restart delay: the teams in turn (yellow first: blue kicked
         off the match), ``shootout_kicks`` each, then (a drawn match's shootout) one each until one
         team scored more of an equal number; then the game is over."""
         self._clear_special()
-        self._set("stop", None)
+        self._set(RefereeCommand.STOP, None)
         r, done = self.rules, self.shootout
         taken = {t: done[t]["taken"] for t in TEAMS}
         even = taken["blue"] == taken["yellow"]
@@ -664,7 +666,7 @@ class Referee:
         play gives the other team a free kick at the nearest legal spot."""
         bx, by = ball_xy
         side = self.field.in_defense_area(bx, by)
-        if self.command not in ("normal", "force_start") or self._restart is not None or not side:
+        if not self.command.running or self._restart is not None or not side:
             self._in_area_since = None
             return
         if self._in_area_since is None:
@@ -686,7 +688,7 @@ class Referee:
         """Rules (no progress in game): the ball within ``no_progress_m`` of one place for
         ``no_progress_s`` while both teams may play it (two robots stuck at it, neither getting it
         away): a stop, then a force start where it lies."""
-        if not self.full or self.command not in ("normal", "force_start") or self._restart is not None:
+        if not self.full or not self.command.running or self._restart is not None:
             self._still = None
             return
         if self._still is None or math.dist(ball_xy, self._still[1]) > self.params.no_progress_m:
@@ -695,17 +697,17 @@ class Referee:
             self._still = None
             self._call(GameEvent(t, "no_progress", None, None, self.params.no_progress_s, self.params.no_progress_s,
                                  "s", "force_start"))  # fmt: skip
-            self._set("stop", None)
+            self._set(RefereeCommand.STOP, None)
             self._restart = (t + self.params.restart_delay_s, "force_start", None, ball_xy)
 
     # --- out --------------------------------------------------------------------------------
     def _action_left(self) -> float:
         t, r = self.t, self.rules
-        if self.command == "ball_placement" and self.placement is not None:
+        if self.command == RefereeCommand.BALL_PLACEMENT and self.placement is not None:
             return r.placement_time_s - (t - self.placement.t_start)
-        if self.command in ("kickoff", "free_kick"):
+        if self.command.kick_restart:
             return self.params.restart_timeout_s - (t - self._restart_t)
-        if self.command == "penalty" and self.penalty is not None:
+        if self.command == RefereeCommand.PENALTY and self.penalty is not None:
             if self.penalty.t_run is None:
                 return r.prepare_timeout_s - (t - self.penalty.t_start)
             return r.penalty_time_s - (t - self.penalty.t_run)
@@ -716,7 +718,7 @@ class Referee:
             return None, None
         _, kind, team, _ = self._restart
         if kind == "free_kick" and team is not None and self.full and self._can_place(team):
-            return "ball_placement", team
+            return RefereeCommand.BALL_PLACEMENT, team
         return ("free_kick" if kind == "placed_free_kick" else kind), team
 
     def team_info(self, team: Team) -> TeamInfo:
@@ -748,7 +750,7 @@ class Referee:
     def _under_way(self, team: Team) -> int:
         """1 while ``team``'s placement is under way (a match that ends now cuts it short), else 0."""
         pl = self.placement
-        return int(pl is not None and pl.team == team and self.command == "ball_placement")
+        return int(pl is not None and pl.team == team and self.command == RefereeCommand.BALL_PLACEMENT)
 
     def summary(self) -> dict[str, object]:
         """The rules' figures of the match: fouls per team by kind, cards, placements, penalties."""

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, Team
-from cmdragons.messages import GameEvent, GroundTruth, RobotTruth
+from cmdragons.messages import GameEvent, GroundTruth, RefereeCommand, RobotTruth
 
 __all__ = ["FOUL_RESTARTS", "FoulWatch", "RulesParams", "Situation"]
 
@@ -73,7 +73,7 @@ class RulesParams(Validated):
 class Situation:
     """What the checks need of the game controller this frame."""
 
-    command: str
+    command: RefereeCommand
     for_team: Team | None
     since: float  # when the command was given (s)
     blue_sign: int  # -1: blue defends the goal at -x
@@ -138,7 +138,7 @@ class FoulWatch:
         robots = [r for r in gt.robots if self.field.in_field(r.x, r.y, -self.field.dims.boundary_width_m)]
         out: list[GameEvent] = []
         new_touches = self._touches(gt, robots)
-        if s.command != "halt":
+        if s.command != RefereeCommand.HALT:
             out += self._crashes(gt, robots)
         if s.in_play:
             out += self._ball_too_fast(gt)
@@ -147,11 +147,11 @@ class FoulWatch:
             out += self._double_touch(gt, new_touches)
         else:
             self._restart_kicker = None
-        if s.command != "halt":  # the ball crosses the boundary after the line: play is already stopped
+        if s.command != RefereeCommand.HALT:  # the ball crosses the boundary after the line: play is already stopped
             out += self._boundary(gt)
-        if s.command == "stop" and gt.t - s.since >= self.p.stop_grace_s:
+        if s.command == RefereeCommand.STOP and gt.t - s.since >= self.p.stop_grace_s:
             out += self._stop(gt, robots)
-        if s.command in ("free_kick", "kickoff") and s.for_team is not None and not s.in_play \
+        if s.command.kick_restart and s.for_team is not None and not s.in_play \
                 and gt.t - s.since >= self.p.kick_point_grace_s:  # fmt: skip
             out += self._kick_point(gt, robots, _other(s.for_team))
         self._prev = {(r.team, r.id): r for r in robots}

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from cmdragons.messages import BallState, Goal, RobotState, WorldState
+from cmdragons.messages import BallState, Goal, RefereeCommand, RobotState, WorldState
 from cmdragons.runtime.settings import Settings
 from cmdragons.team import Brain
 from sim.referee import Referee
@@ -96,7 +96,7 @@ def shoot(settings: Settings, shot: Shot, goalie: bool = True) -> bool:
     w = World(settings.field, s.physics, robot, s.ball, s.kicker, s.dribbler,
               robots_per_team={"blue": int(goalie), "yellow": 0})  # fmt: skip
     ref = Referee(w.field, w.robot_keys(), s.referee)
-    ref.give("force_start")
+    ref.give(RefereeCommand.FORCE_START)
     own = own_goal_sign("blue", ref.state())
     brain = Brain("blue", settings) if goalie else None
     goal_x = own * w.field.half_length

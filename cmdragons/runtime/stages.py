@@ -42,6 +42,7 @@ from cmdragons.messages import (
     GameState,
     GroundTruth,
     Kick,
+    RefereeCommand,
     RobotCommand,
     RobotDetection,
     RobotReport,
@@ -423,7 +424,7 @@ class StatsStage(BaseStage):
             t_kick, passer = self.pending_pass
             gt = self._truth
             holders = [r for r in gt.robots if math.hypot(r.x - gt.ball.x, r.y - gt.ball.y) < self.hold_m]
-            if gt.t - t_kick > self.pass_timeout_s or self._game.command != "normal":
+            if gt.t - t_kick > self.pass_timeout_s or self._game.command != RefereeCommand.NORMAL:
                 self.pending_pass = None
             elif gt.t - t_kick > 0.2 and holders:
                 if any(r.team == self.team and r.id != passer for r in holders):

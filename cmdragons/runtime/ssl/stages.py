@@ -28,7 +28,16 @@ from typing import Any, Protocol, TextIO
 from google.protobuf.message import DecodeError
 
 from cmdragons.geometry import Team
-from cmdragons.messages import DetectionFrame, GroundTruth, MessageError, RobotCommand, StageSummary, TeamCommands, Tick
+from cmdragons.messages import (
+    DetectionFrame,
+    GroundTruth,
+    MessageError,
+    RefereeCommand,
+    RobotCommand,
+    StageSummary,
+    TeamCommands,
+    Tick,
+)
 from cmdragons.runtime.bus import BaseStage, Publish
 from cmdragons.runtime.proto import ssl_simulator_pb2 as sim_pb
 from cmdragons.runtime.ssl.commands import (
@@ -238,7 +247,7 @@ class RefereeInStage(SocketStage):
                 self._take(data, publish)
             return
         g, b = self.reader.last, message.ball
-        taking = g is not None and g.command in ("kickoff", "penalty") and g.ready and g.placement is not None
+        taking = g is not None and g.command.prepared and g.ready and g.placement is not None
         if taking and b is not None and self._last is not None and g is not None and g.placement is not None \
                 and math.hypot(b.x - g.placement[0], b.y - g.placement[1]) > self.moved_m:  # fmt: skip
             self.reader.ball_moved()

@@ -37,6 +37,7 @@ __all__ = [
     "Goal",
     "GroundTruth",
     "Kick",
+    "KickPurpose",
     "MessageError",
     "RefereeCommand",
     "NodeControl",
@@ -388,6 +389,16 @@ class RefereeCommand(StrEnum):
     def halted(self) -> bool:
         """A halt or a timeout: no robot moves."""
         return self in (RefereeCommand.HALT, RefereeCommand.TIMEOUT)
+
+
+class KickPurpose(StrEnum):
+    """What the strategy kicks for (a team report's actions); the values are the JSONL forms and the
+    match statistics' names."""
+
+    SHOT = "shot"
+    PASS = "pass"
+    CLEAR = "clear"
+    WAIT = "wait"  # no kick: the ball is theirs to play (in their defense area)
 
 
 class GameStage(StrEnum):
@@ -805,7 +816,7 @@ class RobotReport:
 @dataclass(frozen=True, eq=False)
 class TeamReport:
     """One team's brain in one frame, for statistics, overlays and logs: per robot what it did, each
-    robot's last action as the strategy decided it ("shot", "pass", ...), and the pass evaluation's
+    robot's last action as the strategy decided it (what its kick is for), and the pass evaluation's
     receiving points (n, 2) and values (n,) when it was redone this frame (empty in the frames
     between: the last one holds). Wall-clock times go on a topic of their own (:class:`Timing`)."""
 
@@ -813,9 +824,13 @@ class TeamReport:
     frame_number: int
     t: float
     robots: tuple[RobotReport, ...] = ()
-    actions: Mapping[int, str] = field(default_factory=dict)
+    actions: Mapping[int, KickPurpose] = field(default_factory=dict)
     pass_points: NDArray[np.float64] = field(default_factory=_no_points)
     pass_values: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+
+    def __post_init__(self) -> None:  # the JSONL and protobuf forms come as their values
+        actions = {rid: _member(KickPurpose, a, "a robot's action") for rid, a in self.actions.items()}
+        object.__setattr__(self, "actions", actions)
 
     def robot(self, robot_id: int) -> RobotReport | None:
         return next((r for r in self.robots if r.id == robot_id), None)

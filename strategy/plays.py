@@ -38,7 +38,7 @@ from strategy.game_states import (
     place_ball,
     restart_rules,
 )
-from strategy.kicking import Attacker, KickKind, KickParams
+from strategy.kicking import Attacker, KickParams, KickPurpose
 from strategy.passing import PassPlay, PassPlayParams
 from strategy.roles import Objective, Role, RoleAssigner, RoleKind, RoleParams
 from strategy.skills import Intent, SkillParams, defend, intercept, mark, receive
@@ -122,7 +122,7 @@ class Strategy:
         self.supporters = Supporters(pitch, params.passing, params.support, params.obstacle_radius_m)
         self.attacker = Attacker(pitch, params.kicking, params.passing, params.skills, params.obstacle_radius_m)
         self.frame = 0
-        self.last_action: dict[int, str] = {}  # robot id -> "shot", "pass" or "clear": what its kick is for
+        self.last_action: dict[int, KickPurpose] = {}  # robot id -> what its kick is for
         self._placing: Placing | None = None  # our ball placement, frame to frame
         self._taker: int | None = None  # the kicker of our kickoff or free kick under way
         self._barred: int | None = None  # our restart's taker, until another robot touched the ball
@@ -276,13 +276,13 @@ class Strategy:
             if role == GOALIE:
                 out[rid], clears = goalie(r, ball, f, own_sign, p.defense, p.skills)
                 if clears:
-                    self.last_action[rid] = KickKind.CLEAR.value
+                    self.last_action[rid] = KickPurpose.CLEAR
             elif role == ATTACKER and rid == self._barred:
                 out[rid] = _facing_ball(r.x, r.y, ball)  # nobody else to play it: wait for theirs to touch it
             elif role == ATTACKER:
                 out[rid], kind = self.attacker.play(t, r, own, supporters, opp_xy, ball, attack_sign, self.passes,
                                                     restart)  # fmt: skip
-                self.last_action[rid] = kind.value
+                self.last_action[rid] = kind
             elif role == RECEIVER and passing is not None and not passing.kicked:
                 out[rid] = _facing_ball(*passing.point, ball)
             elif role == RECEIVER:

@@ -42,6 +42,7 @@ from cmdragons.messages import (
     GameState,
     GroundTruth,
     Kick,
+    KickPurpose,
     RefereeCommand,
     RobotCommand,
     RobotDetection,
@@ -407,9 +408,9 @@ class StatsStage(BaseStage):
         for e in ev.events:
             if isinstance(e, Kick) and e.team == self.team:
                 action = self._actions.get(e.id)
-                if action == "shot":
+                if action is KickPurpose.SHOT:
                     self.shots += 1
-                elif action == "pass":
+                elif action is KickPurpose.PASS:
                     self.passes_tried += 1
                     self.pending_pass = (e.t, e.id)
             elif isinstance(e, Contact):

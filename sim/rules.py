@@ -16,18 +16,19 @@ from dataclasses import dataclass, field
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, Team
 from cmdragons.messages import GameEvent, GroundTruth, RefereeCommand, RobotTruth
+from sim.restarts import other
 
 __all__ = ["FOUL_RESTARTS", "FoulWatch", "RulesParams", "Situation"]
 
 Key = tuple[Team, int]
 
-# what each foul leads to: a free kick (or a penalty kick) for the other team, or nothing but the count
-FOUL_RESTARTS: dict[str, str] = {
-    "crash": "free_kick", "crash_drawn": "", "pushing": "free_kick", "ball_too_fast": "free_kick",
-    "excessive_dribbling": "free_kick", "attacker_in_defense_area": "free_kick",
-    "defender_in_defense_area": "penalty", "double_touch": "free_kick", "stop_speed": "", "stop_distance": "",
-    "kick_point_distance": "", "keeper_held_ball": "free_kick", "boundary_crossing": "free_kick",
-    "too_many_robots": "",
+# what each foul leads to: a free kick (or a penalty kick) for the other team, or (None) nothing but the count
+_FREE, _PENALTY = RefereeCommand.FREE_KICK, RefereeCommand.PENALTY
+FOUL_RESTARTS: dict[str, RefereeCommand | None] = {
+    "crash": _FREE, "crash_drawn": None, "pushing": _FREE, "ball_too_fast": _FREE, "excessive_dribbling": _FREE,
+    "attacker_in_defense_area": _FREE, "defender_in_defense_area": _PENALTY, "double_touch": _FREE,
+    "stop_speed": None, "stop_distance": None, "kick_point_distance": None, "keeper_held_ball": _FREE,
+    "boundary_crossing": _FREE, "too_many_robots": None,
 }  # fmt: skip
 
 
@@ -100,10 +101,6 @@ def _team_sign(team: Team, blue_sign: int) -> int:
     return blue_sign if team == "blue" else -blue_sign
 
 
-def _other(team: Team) -> Team:
-    return "yellow" if team == "blue" else "blue"
-
-
 class FoulWatch:
     """Frame-by-frame foul detection on the true state."""
 
@@ -153,7 +150,7 @@ class FoulWatch:
             out += self._stop(gt, robots)
         if s.command.kick_restart and s.for_team is not None and not s.in_play \
                 and gt.t - s.since >= self.p.kick_point_grace_s:  # fmt: skip
-            out += self._kick_point(gt, robots, _other(s.for_team))
+            out += self._kick_point(gt, robots, other(s.for_team))
         self._prev = {(r.team, r.id): r for r in robots}
         return out
 
@@ -181,7 +178,7 @@ class FoulWatch:
         restart = FOUL_RESTARTS[kind]
         team = None if key is None else key[0]
         return GameEvent(t, kind, team, None if key is None else key[1], value, limit, unit, restart,
-                         _other(team) if restart and team is not None else None)  # fmt: skip
+                         other(team) if restart is not None and team is not None else None)  # fmt: skip
 
     def _once(self, kind: str, key: Key) -> bool:
         """True the first time ``kind`` is called on ``key`` since the command changed."""

@@ -50,14 +50,20 @@ from sim.game_controller import Cards, GameController, shootout_kicker, stage_af
 from sim.restarts import (
     Restart,
     RestartKind,
+    aside,
     attack_sign,
+    ball_out_taker,
     defender_of,
+    entry_spot,
+    formation,
     kick_taken,
     other,
+    park,
     penalty_mark,
     restart_of_call,
+    shootout_poses,
 )
-from sim.rules import FOUL_RESTARTS, FoulWatch, RulesParams, Situation
+from sim.rules import FOUL_RESTARTS, FoulWatch, HeldBall, NoProgress, RulesParams, Situation
 
 __all__ = ["Referee", "RefereeParams"]
 
@@ -126,8 +132,8 @@ class Referee:
         self._restart: Restart | None = None  # decided while play is stopped, due after the restart delay
         self._restart_ball: tuple[float, float] | None = (0.0, 0.0)
         self._restart_t = 0.0  # when the restart in force was given
-        self._in_area_since: float | None = None  # normal play with the ball in a defense area since
-        self._still: tuple[float, tuple[float, float]] | None = None  # in play, the ball in one place since, where
+        self._held = HeldBall(field, params.keeper_held_ball_s)
+        self._no_progress = NoProgress(params.no_progress_s, params.no_progress_m)
         self.keeper_held_ball = 0
         # the full rules
         self.full = params.enabled and params.rules == "full"
@@ -242,14 +248,7 @@ class Referee:
             raise ValueError(
                 f"sim.referee.formations.{division} lists {len(poses)} poses but the team has {n} robots"
             )
-        sign = self.blue_sign if team == "blue" else -self.blue_sign
-        out = []
-        for x, y, th in poses[:n]:
-            if sign < 0:
-                out.append((x, y, th))
-            else:
-                out.append((-x, -y, math.atan2(math.sin(th + math.pi), math.cos(th + math.pi))))
-        return out
+        return formation(poses, n, self.blue_sign if team == "blue" else -self.blue_sign)
 
     def kickoff_setup(self, kicking_team: Team = "blue") -> Teleport:
         """Both teams in formation, ball on the centre spot, kickoff for ``kicking_team`` (robots
@@ -278,36 +277,7 @@ class Referee:
             return None
         dt, self._last_t = t - self._last_t, t
         for e in events:
-            if isinstance(e, Contact):
-                self.contacts.append(e)
-            elif isinstance(e, Kick):
-                self.kicks += 1
-                self.watch.kicked((e.team, e.id))
-            elif isinstance(e, Goal) and self._restart is None and self._live():
-                scorer = other(defender_of(e.x, self.blue_sign))
-                if self.stage == GameStage.PENALTY_SHOOTOUT:
-                    if self.for_team == scorer:
-                        self.shootout[scorer]["scored"] += 1
-                    self._next_shootout_kick()
-                    continue
-                self.score[scorer] += 1
-                if self.command == RefereeCommand.PENALTY and self.for_team == scorer:
-                    self.penalties[scorer]["scored"] += 1
-                self._clear_special()
-                self._set(RefereeCommand.STOP, None)
-                self._restart = Restart(t + self.params.restart_delay_s, RestartKind.KICKOFF, other(scorer), (0.0, 0.0))
-            elif isinstance(e, BallOut) and self._restart is None and self._live():
-                self.balls_out += 1
-                if self.stage == GameStage.PENALTY_SHOOTOUT:  # the kick missed
-                    self._next_shootout_kick()
-                    continue
-                taker: Team = "yellow" if e.last_touch == "blue" else "blue"
-                if e.last_touch is None:  # nobody touched it: the team defending that half
-                    taker = "blue" if (e.x < 0) == (self.blue_sign < 0) else "yellow"
-                spot = self.field.free_kick_spot(e.x, e.y, self.params.free_kick_distance_m)
-                self._clear_special()
-                self._set(RefereeCommand.STOP, None)
-                self._restart = Restart(t + self.params.restart_delay_s, RestartKind.FREE_KICK, taker, spot)
+            self._take(e)
         if truth is not None:
             self._truth = truth
         if self.full and truth is not None:
@@ -322,18 +292,50 @@ class Referee:
             due, self._restart = self._restart, None
             self._start_restart(due.kind, due.team, due.spot, ball_xy)
         teleport = self._take_teleports()
-        if teleport is not None and teleport.ball is not None:
-            ball_xy = teleport.ball
-        # a restart is taken once the ball moved: normal play; not taken in time, play goes on anyway
-        if self.command.kick_restart and self._restart_ball is not None:
-            if kick_taken(ball_xy, self._restart_ball, self.rules.ball_in_play_m):
-                self._set(RefereeCommand.NORMAL, None)
-                self._restart_ball = None
-                self.watch.restart_taken(self.watch.last_touch)
-            elif t - self._restart_t > self.params.restart_timeout_s:
-                self._set(RefereeCommand.FORCE_START if self.full else RefereeCommand.NORMAL, None)
-                self._restart_ball = None
+        self._follow_kick(teleport.ball if teleport is not None and teleport.ball is not None else ball_xy)
         return teleport
+
+    def _take(self, e: Event) -> None:
+        """One of the simulator's events: contacts and kicks counted, goals and balls out judged."""
+        if isinstance(e, Contact):
+            self.contacts.append(e)
+        elif isinstance(e, Kick):
+            self.kicks += 1
+            self.watch.kicked((e.team, e.id))
+        elif isinstance(e, Goal) and self._restart is None and self._live():
+            self._goal(other(defender_of(e.x, self.blue_sign)))
+        elif isinstance(e, BallOut) and self._restart is None and self._live():
+            self.balls_out += 1
+            if self.stage == GameStage.PENALTY_SHOOTOUT:  # the kick missed
+                self._next_shootout_kick()
+                return
+            taker = ball_out_taker(e.last_touch, e.x, self.blue_sign)
+            self._award(RestartKind.FREE_KICK, taker, self._spot(RestartKind.FREE_KICK, taker, (e.x, e.y)))
+
+    def _goal(self, scorer: Team) -> None:
+        """A goal for ``scorer``: the kickoff for the other team (in a shootout: the next kick)."""
+        if self.stage == GameStage.PENALTY_SHOOTOUT:
+            if self.for_team == scorer:
+                self.shootout[scorer]["scored"] += 1
+            self._next_shootout_kick()
+            return
+        self.score[scorer] += 1
+        if self.command == RefereeCommand.PENALTY and self.for_team == scorer:
+            self.penalties[scorer]["scored"] += 1
+        self._award(RestartKind.KICKOFF, other(scorer), (0.0, 0.0))
+
+    def _follow_kick(self, ball_xy: tuple[float, float]) -> None:
+        """A kickoff or free kick is taken once the ball moved: normal play; not taken in time, play
+        goes on anyway."""
+        if not self.command.kick_restart or self._restart_ball is None:
+            return
+        if kick_taken(ball_xy, self._restart_ball, self.rules.ball_in_play_m):
+            self._set(RefereeCommand.NORMAL, None)
+            self._restart_ball = None
+            self.watch.restart_taken(self.watch.last_touch)
+        elif self.t - self._restart_t > self.params.restart_timeout_s:
+            self._set(RefereeCommand.FORCE_START if self.full else RefereeCommand.NORMAL, None)
+            self._restart_ball = None
 
     def _clear_special(self) -> None:
         self.placement = None
@@ -387,14 +389,7 @@ class Referee:
         if self._truth is None:
             return
         clear = self.field.league.robot.radius_m + self.field.league.ball.radius_m + self.rules.placement_clear_m
-        moved = []
-        for r in self._truth.robots:
-            dx, dy = r.x - spot[0], r.y - spot[1]
-            d = math.hypot(dx, dy)
-            if d >= clear or (r.team, r.id) in self.cards.off:
-                continue
-            ux, uy = (dx / d, dy / d) if d > 1e-6 else (-attack, 0.0)
-            moved.append((r.team, r.id, spot[0] + ux * clear, spot[1] + uy * clear, r.theta))
+        moved = aside(self._truth.robots, spot, clear, attack, self.cards.off)
         if moved:
             self._teleport(moved)
 
@@ -414,21 +409,9 @@ class Referee:
         handlers take the kicking team's keeper and the other team's field player off (where robots
         sent off wait) and put the kicker ``penalty_behind_m`` behind the mark and the keeper on its
         goal line."""
-        attack = self._attack_sign(team)
-        r = self.field.league.robot.radius_m
-        moves = []
-        for key in self.robot_keys:
-            if key in self.cards.off:
-                continue
-            keeper = key[1] == self.rules.keepers.get(key[0], -1)
-            if key[0] == team and not keeper:
-                x, y, theta = mark[0] - attack * self.rules.penalty_behind_m, mark[1], 0.0 if attack > 0 else math.pi
-            elif key[0] != team and keeper:
-                x, y, theta = attack * (self.field.half_length - 0.5 * r), 0.0, math.pi if attack > 0 else 0.0
-            else:
-                (x, y), theta = self._park(key), 0.0
-            moves.append((key[0], key[1], x, y, theta))
-        self._teleport(moves)
+        parked = {key: self._park(key) for key in self.robot_keys}
+        self._teleport(shootout_poses(self.field, self.robot_keys, self.cards.off, self.rules.keepers, team, mark,
+                                      self._attack_sign(team), self.rules.penalty_behind_m, parked))  # fmt: skip
 
     def _can_place(self, team: Team) -> bool:
         return self.placement_failures[team] < self.rules.placement_failures_max
@@ -491,10 +474,7 @@ class Referee:
 
     def _park(self, key: Key) -> tuple[float, float]:
         """Where a robot off the field waits: outside the boundary, beyond the cameras' view."""
-        k = self.robot_keys.index(key)
-        side = -1.0 if key[0] == "blue" else 1.0
-        y = side * (self.field.boundary_half_width + self.params.park_distance_m)
-        return (-self.field.half_length + 0.4 * k, y)
+        return park(self.field, self.robot_keys.index(key), key[0], self.params.park_distance_m)
 
     def _send_off(self, key: Key, red: bool) -> None:
         self.cards.off[key] = red
@@ -508,20 +488,9 @@ class Referee:
             return
         for c in self.cards.run(dt):
             if self.cards.back(c):
-                x, y = self._entry_spot(truth, c.team)
+                x, y = entry_spot(self.field, truth.robots, c.team, self.blue_sign)
                 self._teleport([(c.team, c.robot, x, y, 0.0)])
                 self._call(GameEvent(self.t, "yellow_card_over", c.team, c.robot))
-
-    def _entry_spot(self, truth: GroundTruth, team: Team) -> tuple[float, float]:
-        side = -1.0 if team == "blue" else 1.0
-        own = self.blue_sign if team == "blue" else -self.blue_sign
-        r = self.field.league.robot.radius_m
-        y = side * (self.field.half_width - 2.0 * r)
-        for k in range(40):  # along the touch line into our half until free
-            x = own * (2.0 * r) * (k + 1)
-            if all(math.hypot(o.x - x, o.y - y) > 4.0 * r for o in truth.robots):
-                return (x, y)
-        return (own * 2.0 * r, y)
 
     def _count_robots(self, truth: GroundTruth) -> None:
         """Too many robots: a team with more on the field than it may have; the extra go off (a
@@ -662,15 +631,9 @@ class Referee:
     def _check_keeper_held_ball(self, t: float, ball_xy: tuple[float, float]) -> None:
         """Rules (keeper held ball): the ball in a defense area for ``keeper_held_ball_s`` of normal
         play gives the other team a free kick at the nearest legal spot."""
-        bx, by = ball_xy
-        side = self.field.in_defense_area(bx, by)
-        if not self.command.running or self._restart is not None or not side:
-            self._in_area_since = None
-            return
-        if self._in_area_since is None:
-            self._in_area_since = t
-        elif t - self._in_area_since >= self.params.keeper_held_ball_s:
-            self._in_area_since = None
+        side = self._held.held(t, ball_xy, self.command.running and self._restart is None)
+        if side:
+            bx, by = ball_xy
             self.keeper_held_ball += 1
             holder: Team = "blue" if side == self.blue_sign else "yellow"
             taker = other(holder)
@@ -686,13 +649,7 @@ class Referee:
         """Rules (no progress in game): the ball within ``no_progress_m`` of one place for
         ``no_progress_s`` while both teams may play it (two robots stuck at it, neither getting it
         away): a stop, then a force start where it lies."""
-        if not self.full or not self.command.running or self._restart is not None:
-            self._still = None
-            return
-        if self._still is None or math.dist(ball_xy, self._still[1]) > self.params.no_progress_m:
-            self._still = (t, ball_xy)
-        elif t - self._still[0] >= self.params.no_progress_s:
-            self._still = None
+        if self._no_progress.stuck(t, ball_xy, self.full and self.command.running and self._restart is None):
             self._call(GameEvent(t, "no_progress", None, None, self.params.no_progress_s, self.params.no_progress_s,
                                  "s", RefereeCommand.FORCE_START))  # fmt: skip
             self._set(RefereeCommand.STOP, None)

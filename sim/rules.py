@@ -18,7 +18,7 @@ from cmdragons.geometry import Field, Team
 from cmdragons.messages import GameEvent, GroundTruth, RefereeCommand, RobotTruth
 from sim.restarts import other
 
-__all__ = ["FOUL_RESTARTS", "FoulWatch", "RulesParams", "Situation"]
+__all__ = ["FOUL_RESTARTS", "FoulWatch", "HeldBall", "NoProgress", "RulesParams", "Situation"]
 
 Key = tuple[Team, int]
 
@@ -336,3 +336,46 @@ class FoulWatch:
             if gap < self.p.kick_point_distance_m and self._once("kick_point_distance", k):
                 out.append(self._event(gt.t, "kick_point_distance", k, gap, self.p.kick_point_distance_m, "m"))
         return out
+
+
+class HeldBall:
+    """Keeper held ball (the rules): the ball in a defense area for ``limit_s`` of normal play."""
+
+    def __init__(self, pitch: Field, limit_s: float) -> None:
+        self.field, self.limit_s = pitch, limit_s
+        self._since: float | None = None  # watched, the ball in a defense area since
+
+    def held(self, t: float, ball_xy: tuple[float, float], watched: bool) -> int:
+        """The side (-1: the area at -x) of the area the ball has been in ``limit_s`` at ``t`` while
+        ``watched`` (normal play, no restart pending), else 0; counting starts again after a call."""
+        side = self.field.in_defense_area(*ball_xy)
+        if not watched or not side:
+            self._since = None
+            return 0
+        if self._since is None:
+            self._since = t
+        elif t - self._since >= self.limit_s:
+            self._since = None
+            return side
+        return 0
+
+
+class NoProgress:
+    """No progress in game (the rules): the ball within ``within_m`` of one place for ``limit_s``
+    while both teams may play it."""
+
+    def __init__(self, limit_s: float, within_m: float) -> None:
+        self.limit_s, self.within_m = limit_s, within_m
+        self._still: tuple[float, tuple[float, float]] | None = None  # watched, the ball in one place since, where
+
+    def stuck(self, t: float, ball_xy: tuple[float, float], watched: bool) -> bool:
+        """True once the ball lay in one place ``limit_s`` while ``watched``; counting starts again after."""
+        if not watched:
+            self._still = None
+            return False
+        if self._still is None or math.dist(ball_xy, self._still[1]) > self.within_m:
+            self._still = (t, ball_xy)
+        elif t - self._still[0] >= self.limit_s:
+            self._still = None
+            return True
+        return False

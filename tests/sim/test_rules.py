@@ -12,7 +12,7 @@ import pytest
 from cmdragons.geometry import Field, LeagueParams
 from cmdragons.messages import BallTruth, GameEvent, GameStage, GroundTruth, RefereeCommand, RobotCommand, RobotTruth
 from sim.referee import Referee, RefereeParams
-from sim.rules import FoulWatch, RulesParams, Situation
+from sim.rules import FoulWatch, HeldBall, NoProgress, RulesParams, Situation
 from sim.world import BallParams, DribblerParams, KickerParams, PhysicsParams, RobotParams, World
 
 LEAGUE = LeagueParams()
@@ -442,3 +442,27 @@ def test_no_progress_in_game_stops_play_and_force_starts_it(roll: float, called:
         assert math.dist(tuple(w.ball_body.position), (0.0, 1.5)) < RefereeParams().no_progress_m  # not moved
     else:
         assert ref.command == RefereeCommand.NORMAL
+
+
+def test_the_ball_held_in_a_defense_area_is_called_after_the_limit_of_watched_play() -> None:
+    pitch = Field(LEAGUE)
+    held = HeldBall(pitch, 2.0)
+    in_area = (-(pitch.half_length - 0.3), 0.0)
+    assert pitch.in_defense_area(*in_area) == -1
+    ts = [0.5 * k for k in range(12)]
+    calls = [(t, held.held(t, in_area, watched=True)) for t in ts]
+    assert [t for t, side in calls if side] == [2.0, 4.5]  # counting again from the frame after a call
+    assert all(side in (0, -1) for _, side in calls)
+    held = HeldBall(pitch, 2.0)
+    assert [held.held(t, in_area, watched=t != 1.5) for t in ts[:9]] == [0] * 8 + [-1]  # a break starts again
+    assert HeldBall(pitch, 2.0).held(5.0, (0.0, 0.0), watched=True) == 0
+
+
+def test_no_progress_is_the_ball_within_its_distance_for_the_limit() -> None:
+    stuck = NoProgress(limit_s=3.0, within_m=0.05)
+    wobble = [(0.0, 0.0), (0.03, 0.0), (0.0, 0.04), (0.04, 0.02)]
+    assert [stuck.stuck(float(k), wobble[k % 4], watched=True) for k in range(5)] == [False] * 3 + [True, False]
+    moving = NoProgress(limit_s=3.0, within_m=0.05)
+    assert not any(moving.stuck(float(k), (0.06 * k, 0.0), watched=True) for k in range(10))
+    unwatched = NoProgress(limit_s=3.0, within_m=0.05)
+    assert not any(unwatched.stuck(float(k), (0.0, 0.0), watched=k != 2) for k in range(5))

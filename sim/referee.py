@@ -63,7 +63,7 @@ from sim.restarts import (
     restart_of_call,
     shootout_poses,
 )
-from sim.rules import FOUL_RESTARTS, FoulWatch, HeldBall, NoProgress, RulesParams, Situation
+from sim.rules import FOUL_RESTARTS, FoulWatch, HeldBall, NoProgress, RulesParams, Situation, penalty_set, placed
 
 __all__ = ["Referee", "RefereeParams"]
 
@@ -517,12 +517,10 @@ class Referee:
         pl = self.placement
         if pl is None or self.command != RefereeCommand.BALL_PLACEMENT:
             return
-        r, b = self.rules, truth.ball
-        off = math.hypot(b.x - pl.target[0], b.y - pl.target[1])
-        clear = self.field.league.robot.radius_m + self.field.league.ball.radius_m + r.placement_clear_m
-        cleared = all(math.hypot(o.x - b.x, o.y - b.y) >= clear for o in truth.robots if o.team == pl.team)
+        r = self.rules
+        off, done = placed(truth, pl.team, pl.target, self.field, r)
         took = self.t - pl.t_start
-        if off <= r.placement_tolerance_m and math.hypot(b.vx, b.vy) <= r.placement_rest_m_s and cleared:
+        if done:
             self.placements[pl.team]["tried"] += 1
             self.placements[pl.team]["succeeded"] += 1
             self.placement_s[pl.team].append(took)
@@ -536,29 +534,13 @@ class Referee:
             self._teleport(ball=pl.target)  # the referee places it
             self._award(RestartKind.PLACED_FREE_KICK, other(pl.team), pl.target)
 
-    def _penalty_set(self, truth: GroundTruth, pen: _Penalty) -> bool:
-        """Everyone but the kicker and the keeper ``penalty_behind_m`` behind the ball, the keeper on its line."""
-        attack = self._attack_sign(pen.team)
-        keeper = (other(pen.team), self.rules.keepers.get(other(pen.team), -1))
-        ours = [r for r in truth.robots if r.team == pen.team and (r.team, r.id) not in self.cards.off]
-        kicker = min(ours, key=lambda r: math.hypot(r.x - pen.mark[0], r.y - pen.mark[1]), default=None)
-        for o in truth.robots:
-            key = (o.team, o.id)
-            if key in self.cards.off or o is kicker:
-                continue
-            if key == keeper:
-                if abs(abs(o.x) - self.field.half_length) > self.field.league.robot.radius_m:
-                    return False
-            elif (o.x - pen.mark[0]) * attack > -self.rules.penalty_behind_m:
-                return False
-        return True
-
     def _follow_penalty(self, truth: GroundTruth) -> None:
         pen = self.penalty
         if pen is None or self.command != RefereeCommand.PENALTY:
             return
         if not self.ready:
-            if self.t - pen.t_start >= self.rules.prepare_timeout_s or self._penalty_set(truth, pen):
+            if self.t - pen.t_start >= self.rules.prepare_timeout_s or penalty_set(
+                    truth, pen.team, pen.mark, self._attack_sign(pen.team), self.field, self.rules, self.cards.off):
                 pen.t_run = self.t
                 self._set(RefereeCommand.PENALTY, pen.team, ready=True)
             return

@@ -36,6 +36,7 @@ __all__ = [
 
 Key = tuple[Team, int]
 Pose = tuple[float, float, float]  # x m, y m, theta rad
+Move = tuple[Team, int, float, float, float]  # a robot teleported to x m, y m, theta rad
 
 
 class RestartKind(enum.Enum):
@@ -154,7 +155,7 @@ def entry_spot(pitch: Field, robots: Sequence[RobotTruth], team: Team, blue_sign
 
 
 def aside(robots: Sequence[RobotTruth], spot: tuple[float, float], clear_m: float, attack: float,
-          off: Collection[Key]) -> list[tuple[Team, int, float, float, float]]:  # fmt: skip
+          off: Collection[Key]) -> list[Move]:  # fmt: skip
     """The robots nearer ``spot`` than ``clear_m`` (those ``off`` the field aside) moved out to that
     distance, straight away from it (toward -``attack`` along x when on it), so the ball put there
     is not put into a robot."""
@@ -171,7 +172,7 @@ def aside(robots: Sequence[RobotTruth], spot: tuple[float, float], clear_m: floa
 
 def shootout_poses(pitch: Field, keys: Sequence[Key], off: Collection[Key], keepers: Mapping[Team, int],
                    team: Team, mark: tuple[float, float], attack: float, behind_m: float,
-                   parked: Mapping[Key, tuple[float, float]]) -> list[tuple[Team, int, float, float, float]]:  # fmt: skip
+                   parked: Mapping[Key, tuple[float, float]]) -> list[Move]:  # fmt: skip
     """A shootout kick by ``team`` at ``mark`` (the rules: only the kicker and the other team's
     keeper may move; the robot handlers take the others off): its field player ``behind_m`` behind
     the mark facing the goal it attacks (``attack``: +1.0 for +x), the other keeper on its goal

@@ -10,7 +10,7 @@ leads to (a free kick, a penalty, a card) the game controller (:mod:`sim.referee
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass, field
 
 from cmdragons.config import Validated, setting
@@ -18,7 +18,7 @@ from cmdragons.geometry import Field, Team
 from cmdragons.messages import GameEvent, GroundTruth, RefereeCommand, RobotTruth
 from sim.restarts import other
 
-__all__ = ["FOUL_RESTARTS", "FoulWatch", "HeldBall", "NoProgress", "RulesParams", "Situation"]
+__all__ = ["FOUL_RESTARTS", "FoulWatch", "HeldBall", "NoProgress", "RulesParams", "Situation", "penalty_set", "placed"]
 
 Key = tuple[Team, int]
 
@@ -379,3 +379,35 @@ class NoProgress:
             self._still = None
             return True
         return False
+
+
+def placed(gt: GroundTruth, team: Team, target: tuple[float, float], pitch: Field,
+           p: RulesParams) -> tuple[float, bool]:  # fmt: skip
+    """Ball placement by ``team``: how far the ball is off ``target`` (m), and whether the
+    placement succeeded: the ball within ``placement_tolerance_m`` of it, at rest (slower than
+    ``placement_rest_m_s``), the team's robots ``placement_clear_m`` clear of it."""
+    b = gt.ball
+    off = math.hypot(b.x - target[0], b.y - target[1])
+    clear = pitch.league.robot.radius_m + pitch.league.ball.radius_m + p.placement_clear_m
+    cleared = all(math.hypot(o.x - b.x, o.y - b.y) >= clear for o in gt.robots if o.team == team)
+    return off, off <= p.placement_tolerance_m and math.hypot(b.vx, b.vy) <= p.placement_rest_m_s and cleared
+
+
+def penalty_set(gt: GroundTruth, team: Team, mark: tuple[float, float], attack: float, pitch: Field,
+                p: RulesParams, off: Collection[Key]) -> bool:  # fmt: skip
+    """A penalty by ``team`` at ``mark`` (``attack``: +1.0 toward +x) is ready for its normal start:
+    every robot on the field (those ``off`` aside) but the kicker (the team's nearest to the mark)
+    and the other keeper ``penalty_behind_m`` behind the ball, that keeper on its goal line."""
+    keeper = (other(team), p.keepers.get(other(team), -1))
+    ours = [r for r in gt.robots if r.team == team and (r.team, r.id) not in off]
+    kicker = min(ours, key=lambda r: math.hypot(r.x - mark[0], r.y - mark[1]), default=None)
+    for o in gt.robots:
+        key = (o.team, o.id)
+        if key in off or o is kicker:
+            continue
+        if key == keeper:
+            if abs(abs(o.x) - pitch.half_length) > pitch.league.robot.radius_m:
+                return False
+        elif (o.x - mark[0]) * attack > -p.penalty_behind_m:
+            return False
+    return True

@@ -9,10 +9,10 @@ from collections.abc import Callable
 
 import pytest
 
-from cmdragons.geometry import Field, LeagueParams
+from cmdragons.geometry import Field, LeagueParams, Team
 from cmdragons.messages import BallTruth, GameEvent, GameStage, GroundTruth, RefereeCommand, RobotCommand, RobotTruth
 from sim.referee import Referee, RefereeParams
-from sim.rules import FoulWatch, HeldBall, NoProgress, RulesParams, Situation
+from sim.rules import FoulWatch, HeldBall, NoProgress, RulesParams, Situation, penalty_set, placed
 from sim.world import BallParams, DribblerParams, KickerParams, PhysicsParams, RobotParams, World
 
 LEAGUE = LeagueParams()
@@ -466,3 +466,38 @@ def test_no_progress_is_the_ball_within_its_distance_for_the_limit() -> None:
     assert not any(moving.stuck(float(k), (0.06 * k, 0.0), watched=True) for k in range(10))
     unwatched = NoProgress(limit_s=3.0, within_m=0.05)
     assert not any(unwatched.stuck(float(k), (0.0, 0.0), watched=k != 2) for k in range(5))
+
+
+def _frame(ball: tuple[float, float, float, float], *robots: tuple[Team, int, float, float]) -> GroundTruth:
+    bx, by, vx, vy = ball
+    return GroundTruth(0, 0.0, BallTruth(bx, by, 0.0, vx, vy),
+                       tuple(RobotTruth(t, i, x, y, 0.0, 0.0, 0.0, 0.0) for t, i, x, y in robots))
+
+
+@pytest.mark.parametrize(("ball", "robot_at", "off_m", "done"), [
+    ((1.1, 0.0, 0.0, 0.0), (2.0, 0.0), 0.1, True),  # within the tolerance, at rest, the placer clear
+    ((1.2, 0.0, 0.0, 0.0), (2.0, 0.0), 0.2, False),  # too far off the target
+    ((1.1, 0.0, 0.2, 0.0), (2.0, 0.0), 0.1, False),  # still rolling
+    ((1.1, 0.0, 0.0, 0.0), (1.1 + R + 0.03, 0.0), 0.1, False),  # the placer still at the ball
+])  # fmt: skip
+def test_a_placement_succeeds_with_the_ball_near_the_target_at_rest_and_the_placer_clear(
+        ball: tuple[float, float, float, float], robot_at: tuple[float, float], off_m: float,
+        done: bool) -> None:  # fmt: skip
+    gt = _frame(ball, ("blue", 0, *robot_at), ("yellow", 0, 1.1 + R + 0.03, 0.1))  # the other team may stand there
+    off, ok = placed(gt, "blue", (1.0, 0.0), Field(LEAGUE), RulesParams())
+    assert off == pytest.approx(off_m) and ok is done
+
+
+@pytest.mark.parametrize(("yellow_keeper_x", "blue_mate_x", "ready"), [
+    (-4.45, 0.5, True), (-4.0, 0.5, False),  # the keeper off its line
+    (-4.45, -2.0, False),  # a team-mate of the kicker 0.5 m behind the mark (at -2.5 m): less than 1 m
+])  # fmt: skip
+def test_a_penalty_is_set_when_all_but_kicker_and_keeper_are_behind_the_mark(
+        yellow_keeper_x: float, blue_mate_x: float, ready: bool) -> None:  # fmt: skip
+    pitch = Field(LEAGUE)
+    mark = (-pitch.half_length + 2.0, 0.0)  # blue attacks -x
+    gt = _frame((*mark, 0.0, 0.0), ("blue", 1, mark[0] + 0.2, 0.0), ("blue", 2, blue_mate_x, 1.0),
+                ("yellow", 0, -pitch.half_length + (yellow_keeper_x + 4.5), 0.0), ("yellow", 1, 0.0, -1.0),
+                ("yellow", 2, mark[0] + 0.3, 0.5))  # fmt: skip
+    assert penalty_set(gt, "blue", mark, -1.0, pitch, RulesParams(), off={("yellow", 2)}) is ready
+    assert not penalty_set(gt, "blue", mark, -1.0, pitch, RulesParams(), off=set())  # yellow 2 on the field, ahead

@@ -1,6 +1,7 @@
 """The game controller's state machine: the command in force (its counter and time), the stages
-(halves, half time, the penalty shootout, the end), and the cards (fouls counted into yellow cards,
-red cards, robots off the field while their card runs).
+(halves, half time, the penalty shootout, the end), the cards (fouls counted into yellow cards,
+red cards, robots off the field while their card runs), and the placements and penalties under way
+with the match's tally of them.
 
 It decides nothing about the physics: the referee (:mod:`sim.referee`) composes it with the fouls
 (:mod:`sim.rules`), the restarts (:mod:`sim.restarts`) and the calls (:mod:`sim.calls`) and turns
@@ -13,11 +14,13 @@ import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
+import numpy as np
+
 from cmdragons.geometry import TEAMS, Team
 from cmdragons.messages import GameStage, RefereeCommand
 from sim.rules import RulesParams
 
-__all__ = ["Card", "Cards", "GameController", "shootout_kicker", "stage_after"]
+__all__ = ["Card", "Cards", "GameController", "Penalty", "Placement", "Tally", "shootout_kicker", "stage_after"]
 
 Key = tuple[Team, int]
 
@@ -158,3 +161,61 @@ class Cards:
 
     def times_left(self, team: Team) -> tuple[float, ...]:
         return tuple(max(0.0, c.left_s) for c in self.running if c.team == team)
+
+
+@dataclass
+class Placement:
+    """A ball placement under way: by ``team`` to ``target`` (field frame, m) since ``t_start`` (s)."""
+
+    team: Team
+    target: tuple[float, float]
+    t_start: float
+
+
+@dataclass
+class Penalty:
+    """A penalty kick under way: by ``team`` from ``mark``, prepared since ``t_start``, started
+    (the normal start given) at ``t_run`` (s)."""
+
+    team: Team
+    t_start: float
+    mark: tuple[float, float]
+    t_run: float | None = None
+
+
+class Tally:
+    """The match's placements (tried: ended in success or in failure when the time ran out; cut
+    short: ended by the end of a half or of the match first, neither, as the league's game controller
+    counts only failures), their durations, and the penalties and shootout kicks taken and scored
+    (the shootout decides a drawn match; the match's score stays as it was)."""
+
+    def __init__(self) -> None:
+        self.placements: dict[Team, dict[str, int]] = {t: {"tried": 0, "succeeded": 0, "cut_short": 0} for t in TEAMS}
+        self.placement_s: dict[Team, list[float]] = {"blue": [], "yellow": []}
+        self.placement_failures: dict[Team, int] = {"blue": 0, "yellow": 0}
+        self.penalties: dict[Team, dict[str, int]] = {t: {"taken": 0, "scored": 0} for t in TEAMS}
+        self.shootout: dict[Team, dict[str, int]] = {t: {"taken": 0, "scored": 0} for t in TEAMS}
+
+    def placed(self, team: Team, took_s: float) -> None:
+        self.placements[team]["tried"] += 1
+        self.placements[team]["succeeded"] += 1
+        self.placement_s[team].append(took_s)
+
+    def failed(self, team: Team) -> None:
+        self.placements[team]["tried"] += 1
+        self.placement_failures[team] += 1
+
+    def may_place(self, team: Team, failures_max: int) -> bool:
+        """``team`` places the ball until it failed ``failures_max`` placements."""
+        return self.placement_failures[team] < failures_max
+
+    def figures(self, under_way: Team | None) -> dict[str, object]:
+        """The summary's placements (``under_way``: the team whose placement the end cuts short),
+        penalties and shootout kicks per team."""
+        return {
+            "placements": {t: {**self.placements[t], "cut_short": self.placements[t]["cut_short"] + (t == under_way),
+                               "median_s": float(np.median(self.placement_s[t])) if self.placement_s[t] else None}
+                           for t in TEAMS},
+            "penalties": {t: dict(self.penalties[t]) for t in TEAMS},
+            "shootout": {t: dict(self.shootout[t]) for t in TEAMS},
+        }  # fmt: skip

@@ -27,7 +27,6 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Literal
 
-import numpy as np
 
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import TEAMS, Field, Team
@@ -46,7 +45,7 @@ from cmdragons.messages import (
     Teleport,
 )
 from sim.calls import Calls
-from sim.game_controller import Cards, GameController, shootout_kicker, stage_after
+from sim.game_controller import Cards, GameController, Penalty, Placement, Tally, shootout_kicker, stage_after
 from sim.restarts import (
     Restart,
     RestartKind,
@@ -100,21 +99,6 @@ class RefereeParams(Validated):
 Key = tuple[Team, int]
 
 
-@dataclass
-class _Placement:
-    team: Team
-    target: tuple[float, float]
-    t_start: float
-
-
-@dataclass
-class _Penalty:
-    team: Team  # the kicking team
-    t_start: float  # prepared since
-    mark: tuple[float, float]
-    t_run: float | None = None  # the normal start's time
-
-
 class Referee:
     """Keeps the score and the game state; restarts play by asking for teleports; with the full
     rules also the stages, fouls, cards, placements and penalties."""
@@ -142,17 +126,9 @@ class Referee:
         self.watch = FoulWatch(field, self.rules)
         self.calls = Calls()
         self.cards = Cards(self.rules)
-        self.placement: _Placement | None = None
-        # tried: placements that ended (succeeded, or failed when the time ran out); cut short: ended by the
-        # end of a half (or of the match) first, neither success nor failure (the game controller counts
-        # a failure only when a placement fails)
-        self.placements: dict[Team, dict[str, int]] = {t: {"tried": 0, "succeeded": 0, "cut_short": 0} for t in TEAMS}
-        self.placement_s: dict[Team, list[float]] = {"blue": [], "yellow": []}
-        self.placement_failures: dict[Team, int] = {"blue": 0, "yellow": 0}
-        self.penalty: _Penalty | None = None
-        self.penalties: dict[Team, dict[str, int]] = {t: {"taken": 0, "scored": 0} for t in TEAMS}
-        # the penalty shootout's kicks (they decide a drawn match; the match's score stays as it was)
-        self.shootout: dict[Team, dict[str, int]] = {t: {"taken": 0, "scored": 0} for t in TEAMS}
+        self.placement: Placement | None = None
+        self.penalty: Penalty | None = None
+        self.tally = Tally()
         self._last_t = 0.0
         self._teleports: list[Teleport] = []
         self._truth: GroundTruth | None = None  # the last true state seen (where the robots stand)
@@ -195,6 +171,22 @@ class Referee:
     @property
     def red_cards(self) -> dict[Team, int]:
         return self.cards.red
+
+    @property
+    def placements(self) -> dict[Team, dict[str, int]]:
+        return self.tally.placements
+
+    @property
+    def placement_failures(self) -> dict[Team, int]:
+        return self.tally.placement_failures
+
+    @property
+    def penalties(self) -> dict[Team, dict[str, int]]:
+        return self.tally.penalties
+
+    @property
+    def shootout(self) -> dict[Team, dict[str, int]]:
+        return self.tally.shootout
 
     # --- commands ---------------------------------------------------------------------------
     def _set(self, command: RefereeCommand, for_team: Team | None, ready: bool = True) -> None:
@@ -365,7 +357,7 @@ class Referee:
             self._teleports.append(self.kickoff_setup(team))
         elif kind is RestartKind.FREE_KICK and self.full and self._can_place(team):
             self._set(RefereeCommand.BALL_PLACEMENT, team)
-            self.placement = _Placement(team, spot, t)
+            self.placement = Placement(team, spot, t)
         elif kind is RestartKind.PENALTY:
             if self.stage == GameStage.PENALTY_SHOOTOUT:
                 self._shootout_kick_setup(team, spot)
@@ -373,7 +365,7 @@ class Referee:
                 self._clear_spot(spot, self._attack_sign(team))
             self._teleport(ball=spot)
             self._set(RefereeCommand.PENALTY, team, ready=False)
-            self.penalty = _Penalty(team, t, spot)
+            self.penalty = Penalty(team, t, spot)
             (self.shootout if self.stage == GameStage.PENALTY_SHOOTOUT else self.penalties)[team]["taken"] += 1
         else:
             placed = kind is RestartKind.PLACED_FREE_KICK
@@ -414,7 +406,7 @@ class Referee:
                                       self._attack_sign(team), self.rules.penalty_behind_m, parked))  # fmt: skip
 
     def _can_place(self, team: Team) -> bool:
-        return self.placement_failures[team] < self.rules.placement_failures_max
+        return self.tally.may_place(team, self.rules.placement_failures_max)
 
     def _call(self, event: GameEvent) -> None:
         self.calls.call(event)
@@ -521,14 +513,11 @@ class Referee:
         off, done = placed(truth, pl.team, pl.target, self.field, r)
         took = self.t - pl.t_start
         if done:
-            self.placements[pl.team]["tried"] += 1
-            self.placements[pl.team]["succeeded"] += 1
-            self.placement_s[pl.team].append(took)
+            self.tally.placed(pl.team, took)
             self._call(GameEvent(self.t, "placement_succeeded", pl.team, None, took, r.placement_time_s, "s"))
             self._award(RestartKind.PLACED_FREE_KICK, pl.team, pl.target)
         elif took > r.placement_time_s:
-            self.placements[pl.team]["tried"] += 1
-            self.placement_failures[pl.team] += 1
+            self.tally.failed(pl.team)
             self._call(GameEvent(self.t, "placement_failed", pl.team, None, off, r.placement_tolerance_m, "m",
                                  RefereeCommand.FREE_KICK, other(pl.team)))  # fmt: skip
             self._teleport(ball=pl.target)  # the referee places it
@@ -568,8 +557,9 @@ class Referee:
         team that did not kick off first kicks off."""
         if not self.game.stage_over(self.t):
             return
-        if self.placement is not None and self.command == RefereeCommand.BALL_PLACEMENT:
-            self.placements[self.placement.team]["cut_short"] += 1
+        under_way = self._under_way()
+        if under_way is not None:
+            self.placements[under_way]["cut_short"] += 1
         stage = stage_after(self.stage, self.rules, drawn=self.score["blue"] == self.score["yellow"])
         if stage is GameStage.POST_GAME:
             self._end_match()
@@ -682,10 +672,10 @@ class Referee:
             next_for_team=nxt_team, blue_team=self.team_info("blue"), yellow_team=self.team_info("yellow"),
         )  # fmt: skip
 
-    def _under_way(self, team: Team) -> int:
-        """1 while ``team``'s placement is under way (a match that ends now cuts it short), else 0."""
+    def _under_way(self) -> Team | None:
+        """The team whose placement is under way (a match that ends now cuts it short)."""
         pl = self.placement
-        return int(pl is not None and pl.team == team and self.command == RefereeCommand.BALL_PLACEMENT)
+        return pl.team if pl is not None and self.command == RefereeCommand.BALL_PLACEMENT else None
 
     def summary(self) -> dict[str, object]:
         """The rules' figures of the match: fouls per team by kind, cards, placements, penalties."""
@@ -695,9 +685,5 @@ class Referee:
             "game_stage": self.stage,
             "fouls": {t: {"total": self.fouls[t], **by_kind[t]} for t in TEAMS},
             "cards": {t: {"yellow": self.yellow_cards[t], "red": self.red_cards[t]} for t in TEAMS},
-            "placements": {t: {**self.placements[t], "cut_short": self.placements[t]["cut_short"] + self._under_way(t),
-                               "median_s": float(np.median(self.placement_s[t])) if self.placement_s[t] else None}
-                           for t in TEAMS},
-            "penalties": {t: dict(self.penalties[t]) for t in TEAMS},
-            "shootout": {t: dict(self.shootout[t]) for t in TEAMS},
-        }  # fmt: skip
+            **self.tally.figures(self._under_way()),
+        }

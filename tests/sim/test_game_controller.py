@@ -9,7 +9,7 @@ import pytest
 
 from cmdragons.geometry import Team
 from cmdragons.messages import GameStage, RefereeCommand
-from sim.game_controller import Card, Cards, GameController, shootout_kicker, stage_after
+from sim.game_controller import Card, Cards, GameController, Tally, shootout_kicker, stage_after
 from sim.rules import RulesParams
 
 C, S = RefereeCommand, GameStage
@@ -115,3 +115,17 @@ def test_cards_run_out_and_their_robots_come_back_unless_sent_off_for_good() -> 
     assert out == [Card("blue", 4, 0.0), Card("yellow", 1, 0.0)] and cards.running == []
     assert [cards.back(c) for c in out] == [True, False]
     assert cards.off == {("yellow", 1): True}
+
+
+def test_the_tally_counts_placements_and_cuts_short_the_one_under_way() -> None:
+    tally = Tally()
+    tally.placed("blue", 4.0)
+    tally.placed("blue", 8.0)
+    tally.failed("blue")
+    tally.failed("yellow")
+    assert tally.may_place("blue", 2) and not tally.may_place("blue", 1)
+    figures = tally.figures(under_way="yellow")
+    assert figures["placements"] == {"blue": {"tried": 3, "succeeded": 2, "cut_short": 0, "median_s": 6.0},
+                                     "yellow": {"tried": 1, "succeeded": 0, "cut_short": 1, "median_s": None}}
+    assert tally.figures(under_way=None)["placements"]["yellow"]["cut_short"] == 0  # type: ignore[index]
+    assert figures["penalties"] == figures["shootout"] == {t: {"taken": 0, "scored": 0} for t in ("blue", "yellow")}

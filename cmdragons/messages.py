@@ -13,7 +13,8 @@ import dataclasses
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any, Self
+from enum import StrEnum
+from typing import Any, Self, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -31,11 +32,14 @@ __all__ = [
     "Event",
     "GameEvent",
     "GameEvents",
+    "GameStage",
     "GameState",
     "Goal",
     "GroundTruth",
     "Kick",
+    "KickPurpose",
     "MessageError",
+    "RefereeCommand",
     "NodeControl",
     "RobotCommand",
     "RobotDetection",
@@ -357,12 +361,72 @@ class GroundTruth:
 
 # --- referee ------------------------------------------------------------------------------------
 
-# the league's Referee commands, each (but halt, stop, normal start and force start) for one team:
-# kickoff = prepare kickoff (``ready`` once the normal start is given), penalty = prepare penalty (the
-# same), free_kick = direct free kick, normal = normal start with the ball in play
-_COMMANDS = ("halt", "stop", "kickoff", "free_kick", "normal", "force_start", "penalty", "timeout", "ball_placement")
-# the league's stages (pre-game and the breaks included); extra time is not played here
-_STAGES = ("pre_game", "first_half", "half_time", "second_half", "penalty_shootout", "post_game")
+_E = TypeVar("_E", bound=StrEnum)
+
+
+class RefereeCommand(StrEnum):
+    """The league's Referee commands with the team named apart (each but halt, stop, normal and force
+    start is for one team). The values are the JSONL forms."""
+
+    HALT = "halt"
+    STOP = "stop"
+    KICKOFF = "kickoff"  # prepare kickoff (``ready`` once the normal start is given)
+    FREE_KICK = "free_kick"  # direct free kick
+    NORMAL = "normal"  # normal start, the ball in play
+    FORCE_START = "force_start"
+    PENALTY = "penalty"  # prepare penalty (``ready`` once the normal start is given)
+    TIMEOUT = "timeout"
+    BALL_PLACEMENT = "ball_placement"
+
+    @property
+    def kick_restart(self) -> bool:
+        """A kickoff or free kick: one team's kick to take, the other's robots at the rules' distance."""
+        return self in (RefereeCommand.KICKOFF, RefereeCommand.FREE_KICK)
+
+    @property
+    def running(self) -> bool:
+        """Normal play: a normal start or a force start, the ball for both teams."""
+        return self in (RefereeCommand.NORMAL, RefereeCommand.FORCE_START)
+
+    @property
+    def prepared(self) -> bool:
+        """A kickoff or penalty: prepared, then started by a normal start (``GameState.ready``)."""
+        return self in (RefereeCommand.KICKOFF, RefereeCommand.PENALTY)
+
+    @property
+    def halted(self) -> bool:
+        """A halt or a timeout: no robot moves."""
+        return self in (RefereeCommand.HALT, RefereeCommand.TIMEOUT)
+
+
+class KickPurpose(StrEnum):
+    """What the strategy kicks for (a team report's actions); the values are the JSONL forms and the
+    match statistics' names."""
+
+    SHOT = "shot"
+    PASS = "pass"
+    CLEAR = "clear"
+    WAIT = "wait"  # no kick: the ball is theirs to play (in their defense area)
+
+
+class GameStage(StrEnum):
+    """The league's stages, pre-game and the breaks included (extra time is not played here); the
+    values are the JSONL forms."""
+
+    PRE_GAME = "pre_game"
+    FIRST_HALF = "first_half"
+    HALF_TIME = "half_time"
+    SECOND_HALF = "second_half"
+    PENALTY_SHOOTOUT = "penalty_shootout"
+    POST_GAME = "post_game"
+
+
+def _member(kind: type[_E], value: object, what: str) -> _E:
+    """``value`` as a member of ``kind`` (its member or its JSONL form), else a :class:`MessageError`."""
+    try:
+        return kind(value)
+    except ValueError:
+        raise MessageError(f"{what} must be one of {', '.join(kind)}, got {value!r}") from None
 
 
 @dataclass(frozen=True)
@@ -405,30 +469,29 @@ class GameState:
     time left for the current action (a restart to be taken, a placement), and each team's info."""
 
     t: float
-    command: str = "normal"  # one of _COMMANDS
+    command: RefereeCommand = RefereeCommand.NORMAL
     for_team: Team | None = None  # the team the command is for (kickoff, free kick, penalty, placement, timeout)
     score_blue: int = 0
     score_yellow: int = 0
     blue_defends_negative_x: bool = True
     placement: tuple[float, float] | None = None  # the designated position (field frame, m)
     ready: bool = True  # kickoff or penalty: the normal start is given, the kicker may play the ball
-    stage: str = "first_half"  # one of _STAGES
+    stage: GameStage = GameStage.FIRST_HALF
     stage_time_left_s: float = math.inf
     command_counter: int = 0
     command_t: float = 0.0  # when the command was given (s)
     action_time_left_s: float = math.inf  # time left to take the restart or place the ball (s)
-    next_command: str | None = None  # what follows a placement or a stop, when known
+    next_command: RefereeCommand | None = None  # what follows a placement or a stop, when known
     next_for_team: Team | None = None
     blue_team: TeamInfo = TeamInfo()
     yellow_team: TeamInfo = TeamInfo()
 
     def __post_init__(self) -> None:
-        if self.command not in _COMMANDS:
-            raise MessageError(f"game command must be one of {', '.join(_COMMANDS)}, got {self.command!r}")
-        if self.next_command is not None and self.next_command not in _COMMANDS:
-            raise MessageError(f"next command must be one of {', '.join(_COMMANDS)}, got {self.next_command!r}")
-        if self.stage not in _STAGES:
-            raise MessageError(f"game stage must be one of {', '.join(_STAGES)}, got {self.stage!r}")
+        # the JSONL forms are taken too (a scripted scene's "stop"): held as the members
+        object.__setattr__(self, "command", _member(RefereeCommand, self.command, "game command"))
+        if self.next_command is not None:
+            object.__setattr__(self, "next_command", _member(RefereeCommand, self.next_command, "next command"))
+        object.__setattr__(self, "stage", _member(GameStage, self.stage, "game stage"))
 
     def team_info(self, team: Team) -> TeamInfo:
         return self.blue_team if team == "blue" else self.yellow_team
@@ -472,7 +535,8 @@ class GameEvent:
     """One call of the referee: a foul (``kind`` as the rules name it: "crash", "ball_too_fast", ...),
     a card, a placement's end, a stage's change. ``team`` and ``robot``: who committed it (None when
     no one); ``value`` the figure that broke the rule and ``limit`` the rule's, in ``unit``;
-    ``restart``: what play goes on with ("free_kick", "penalty", "" when the call does not change it)."""
+    ``restart``: the command play goes on with (a free kick, a penalty; None when the call does not
+    change it)."""
 
     t: float
     kind: str
@@ -481,12 +545,17 @@ class GameEvent:
     value: float = math.nan
     limit: float = math.nan
     unit: str = ""
-    restart: str = ""
+    restart: RefereeCommand | None = None  # "" in the JSONL and protobuf forms
     for_team: Team | None = None  # the team the restart is for
+
+    def __post_init__(self) -> None:
+        if self.restart is not None:
+            restart = _member(RefereeCommand, self.restart, "a call's restart") if self.restart else None
+            object.__setattr__(self, "restart", restart)
 
     def to_dict(self) -> dict[str, Any]:
         return {"t": self.t, "kind": self.kind, "team": self.team, "robot": self.robot, "value": _num(self.value),
-                "limit": _num(self.limit), "unit": self.unit, "restart": self.restart,
+                "limit": _num(self.limit), "unit": self.unit, "restart": self.restart or "",
                 "for_team": self.for_team}  # fmt: skip
 
     @classmethod
@@ -495,7 +564,7 @@ class GameEvent:
             team, robot, for_team = d.get("team"), d.get("robot"), d.get("for_team")
             return cls(_f(d, "t"), str(d["kind"]), None if team is None else _team(team),
                        None if robot is None else int(robot), _f(d, "value", math.nan), _f(d, "limit", math.nan),
-                       str(d.get("unit", "")), str(d.get("restart", "")),
+                       str(d.get("unit", "")), str(d.get("restart", "")) or None,
                        None if for_team is None else _team(for_team))  # fmt: skip
         except (KeyError, TypeError, ValueError) as exc:
             raise MessageError(f"bad game event: {exc!r}") from None
@@ -755,7 +824,7 @@ class RobotReport:
 @dataclass(frozen=True, eq=False)
 class TeamReport:
     """One team's brain in one frame, for statistics, overlays and logs: per robot what it did, each
-    robot's last action as the strategy decided it ("shot", "pass", ...), and the pass evaluation's
+    robot's last action as the strategy decided it (what its kick is for), and the pass evaluation's
     receiving points (n, 2) and values (n,) when it was redone this frame (empty in the frames
     between: the last one holds). Wall-clock times go on a topic of their own (:class:`Timing`)."""
 
@@ -763,9 +832,13 @@ class TeamReport:
     frame_number: int
     t: float
     robots: tuple[RobotReport, ...] = ()
-    actions: Mapping[int, str] = field(default_factory=dict)
+    actions: Mapping[int, KickPurpose] = field(default_factory=dict)
     pass_points: NDArray[np.float64] = field(default_factory=_no_points)
     pass_values: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+
+    def __post_init__(self) -> None:  # the JSONL and protobuf forms come as their values
+        actions = {rid: _member(KickPurpose, a, "a robot's action") for rid, a in self.actions.items()}
+        object.__setattr__(self, "actions", actions)
 
     def robot(self, robot_id: int) -> RobotReport | None:
         return next((r for r in self.robots if r.id == robot_id), None)

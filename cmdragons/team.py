@@ -29,7 +29,7 @@ from numpy.typing import NDArray
 from cmdragons.config import Validated, setting
 from cmdragons.control.motion import predict_braking
 from cmdragons.geometry import Team
-from cmdragons.messages import GameState, RobotCommand, RobotState, WorldState
+from cmdragons.messages import GameState, RefereeCommand, RobotCommand, RobotState, WorldState
 from cmdragons.navigation import (
     NAVIGATORS,
     Arrival,
@@ -283,8 +283,8 @@ class Brain:
 
     def _ball_clearance(self, game: GameState) -> float:
         """How far paths keep from the ball: the rules' distance where they ask for one."""
-        keep = game.command == "stop" or (game.command in ("kickoff", "free_kick", "ball_placement", "penalty")
-                                          and game.for_team != self.team)  # fmt: skip
+        theirs = game.command.kick_restart or game.command in (RefereeCommand.BALL_PLACEMENT, RefereeCommand.PENALTY)
+        keep = game.command == RefereeCommand.STOP or (theirs and game.for_team != self.team)
         b = self.params.brain
         return b.keep_away_clearance_m if keep else b.ball_clearance_m
 

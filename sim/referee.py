@@ -11,9 +11,12 @@ the team that takes the free kick (within the rules' time and tolerance, else by
 free kick to the other team), penalty kicks (prepared, started, over when scored, missed or timed
 out), and too many robots on the field. Every call is a :class:`~cmdragons.messages.GameEvent`.
 
-The referee never touches the physics: what it wants placed (a ball, a formation, a robot sent off
-or back) it returns as a :class:`~cmdragons.messages.Teleport`, which the simulator carries out (in
-one process or across a network alike). Formations are given for the team defending the goal at -x
+The referee is the composition of its parts: the fouls and their figures (:mod:`sim.rules`), the
+restarts (:mod:`sim.restarts`: which command comes next, where the ball goes), the game controller's
+state machine (:mod:`sim.game_controller`: commands, stages, cards) and the calls (:mod:`sim.calls`).
+It never touches the physics: what it wants placed (a ball, a formation, a robot sent off or back)
+it returns as a :class:`~cmdragons.messages.Teleport`, which the simulator carries out (in one
+process or across a network alike). Formations are given for the team defending the goal at -x
 and mirrored for the other team.
 """
 
@@ -24,7 +27,6 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Literal
 
-import numpy as np
 
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import TEAMS, Field, Team
@@ -33,14 +35,34 @@ from cmdragons.messages import (
     Contact,
     Event,
     GameEvent,
+    GameStage,
     GameState,
     Goal,
     GroundTruth,
     Kick,
+    RefereeCommand,
     TeamInfo,
     Teleport,
 )
-from sim.rules import FOUL_RESTARTS, FoulWatch, RulesParams, Situation
+from sim.calls import Calls
+from sim.game_controller import Cards, GameController, Penalty, Placement, Tally, shootout_kicker, stage_after
+from sim.restarts import (
+    Restart,
+    RestartKind,
+    aside,
+    attack_sign,
+    ball_out_taker,
+    defender_of,
+    entry_spot,
+    formation,
+    kick_taken,
+    other,
+    park,
+    penalty_mark,
+    restart_of_call,
+    shootout_poses,
+)
+from sim.rules import FOUL_RESTARTS, FoulWatch, HeldBall, NoProgress, RulesParams, Situation, penalty_set, placed
 
 __all__ = ["Referee", "RefereeParams"]
 
@@ -75,33 +97,6 @@ class RefereeParams(Validated):
 
 
 Key = tuple[Team, int]
-_LIVE = ("normal", "force_start", "kickoff", "free_kick")  # commands with the ball in play or about to be
-
-
-def _other(team: Team) -> Team:
-    return "yellow" if team == "blue" else "blue"
-
-
-@dataclass
-class _Placement:
-    team: Team
-    target: tuple[float, float]
-    t_start: float
-
-
-@dataclass
-class _Penalty:
-    team: Team  # the kicking team
-    t_start: float  # prepared since
-    mark: tuple[float, float]
-    t_run: float | None = None  # the normal start's time
-
-
-@dataclass
-class _Card:
-    team: Team
-    robot: int
-    left_s: float
 
 
 class Referee:
@@ -117,55 +112,87 @@ class Referee:
         self.balls_out = 0
         self.kicks = 0
         self.contacts: list[Contact] = []
-        self.command: str = "kickoff"
-        self.for_team: Team | None = "blue"
-        self.ready = True
         self.t = 0.0
-        self._restart: tuple[float, str, Team | None, tuple[float, float]] | None = None
+        self._restart: Restart | None = None  # decided while play is stopped, due after the restart delay
         self._restart_ball: tuple[float, float] | None = (0.0, 0.0)
         self._restart_t = 0.0  # when the restart in force was given
-        self._in_area_since: float | None = None  # normal play with the ball in a defense area since
-        self._still: tuple[float, tuple[float, float]] | None = None  # in play, the ball in one place since, where
+        self._held = HeldBall(field, params.keeper_held_ball_s)
+        self._no_progress = NoProgress(params.no_progress_s, params.no_progress_m)
         self.keeper_held_ball = 0
         # the full rules
         self.full = params.enabled and params.rules == "full"
         self.rules = params.figures
-        self.stage = "first_half"
-        self._stage_end = self.rules.half_s if self.full else math.inf
-        self.command_counter = 0
-        self.command_t = 0.0
+        self.game = GameController(self.rules, halves=self.full)
         self.watch = FoulWatch(field, self.rules)
-        self.events: list[GameEvent] = []  # every call of the match
-        self.new_events: list[GameEvent] = []  # the calls of the last frame
-        self.fouls: dict[Team, int] = {"blue": 0, "yellow": 0}
-        self.yellow_cards: dict[Team, int] = {"blue": 0, "yellow": 0}
-        self.red_cards: dict[Team, int] = {"blue": 0, "yellow": 0}
-        self.cards: list[_Card] = []  # yellow cards running
-        self.off: dict[Key, bool] = {}  # robots off the field: True for a red card (for good)
-        self.placement: _Placement | None = None
-        # tried: placements that ended (succeeded, or failed when the time ran out); cut short: ended by the
-        # end of a half (or of the match) first, neither success nor failure (the game controller counts
-        # a failure only when a placement fails)
-        self.placements: dict[Team, dict[str, int]] = {t: {"tried": 0, "succeeded": 0, "cut_short": 0} for t in TEAMS}
-        self.placement_s: dict[Team, list[float]] = {"blue": [], "yellow": []}
-        self.placement_failures: dict[Team, int] = {"blue": 0, "yellow": 0}
-        self.penalty: _Penalty | None = None
-        self.penalties: dict[Team, dict[str, int]] = {t: {"taken": 0, "scored": 0} for t in TEAMS}
-        # the penalty shootout's kicks (they decide a drawn match; the match's score stays as it was)
-        self.shootout: dict[Team, dict[str, int]] = {t: {"taken": 0, "scored": 0} for t in TEAMS}
+        self.calls = Calls()
+        self.cards = Cards(self.rules)
+        self.placement: Placement | None = None
+        self.penalty: Penalty | None = None
+        self.tally = Tally()
         self._last_t = 0.0
         self._teleports: list[Teleport] = []
         self._truth: GroundTruth | None = None  # the last true state seen (where the robots stand)
 
-    # --- commands ---------------------------------------------------------------------------
-    def _set(self, command: str, for_team: Team | None, ready: bool = True) -> None:
-        """Give a command (its counter and time move when it changes)."""
-        if (command, for_team, ready) != (self.command, self.for_team, self.ready):
-            self.command_counter += 1
-            self.command_t = self.t
-        self.command, self.for_team, self.ready = command, for_team, ready
+    # --- the parts' state, read ------------------------------------------------------------
+    @property
+    def command(self) -> RefereeCommand:
+        return self.game.command
 
-    def give(self, command: str, for_team: Team | None = None, ready: bool = True) -> None:
+    @property
+    def for_team(self) -> Team | None:
+        return self.game.for_team
+
+    @property
+    def ready(self) -> bool:
+        return self.game.ready
+
+    @property
+    def stage(self) -> GameStage:
+        return self.game.stage
+
+    @property
+    def events(self) -> list[GameEvent]:
+        """Every call of the match."""
+        return self.calls.all
+
+    @property
+    def new_events(self) -> list[GameEvent]:
+        """The calls of the last frame."""
+        return self.calls.new
+
+    @property
+    def fouls(self) -> dict[Team, int]:
+        return self.cards.fouls
+
+    @property
+    def yellow_cards(self) -> dict[Team, int]:
+        return self.cards.yellow
+
+    @property
+    def red_cards(self) -> dict[Team, int]:
+        return self.cards.red
+
+    @property
+    def placements(self) -> dict[Team, dict[str, int]]:
+        return self.tally.placements
+
+    @property
+    def placement_failures(self) -> dict[Team, int]:
+        return self.tally.placement_failures
+
+    @property
+    def penalties(self) -> dict[Team, dict[str, int]]:
+        return self.tally.penalties
+
+    @property
+    def shootout(self) -> dict[Team, dict[str, int]]:
+        return self.tally.shootout
+
+    # --- commands ---------------------------------------------------------------------------
+    def _set(self, command: RefereeCommand, for_team: Team | None, ready: bool = True) -> None:
+        self.game.give(self.t, command, for_team, ready)
+
+    def give(self, command: RefereeCommand, for_team: Team | None = None, ready: bool = True) -> None:
         """A command by hand (what a human referee or a scripted scene gives); restarts that need a
         ball in place are :meth:`free_kick`, :meth:`start_placement` and :meth:`start_penalty`."""
         self._restart = None
@@ -174,38 +201,35 @@ class Referee:
 
     def free_kick(self, team: Team, spot: tuple[float, float]) -> Teleport:
         """A free kick for ``team`` with the ball put at ``spot`` (the teleport to carry out)."""
-        self.give("stop")
-        self._start_restart("free_kick_by_referee", team, spot, spot)
+        self.give(RefereeCommand.STOP)
+        self._start_restart(RestartKind.REFEREE_FREE_KICK, team, spot, spot)
         teleport = self._take_teleports()
         assert teleport is not None
         return teleport
 
     def start_placement(self, team: Team, target: tuple[float, float]) -> None:
         """Ball placement by ``team`` to ``target`` now, a free kick for it to follow."""
-        self.give("stop")
-        self._start_restart("free_kick", team, target, target)
+        self.give(RefereeCommand.STOP)
+        self._start_restart(RestartKind.FREE_KICK, team, target, target)
 
     def start_penalty(self, team: Team) -> Teleport:
         """A penalty kick for ``team``: the ball on the mark (the teleport to carry out), prepared."""
-        self.give("stop")
-        self._start_restart("penalty", team, self._spot("penalty", team, (0.0, 0.0)), (0.0, 0.0))
+        self.give(RefereeCommand.STOP)
+        self._start_restart(RestartKind.PENALTY, team, self._mark(team), (0.0, 0.0))
         teleport = self._take_teleports()
         assert teleport is not None
         return teleport
 
-    def _in_play(self) -> bool:
-        return self.command in ("normal", "force_start") or (self.command == "penalty" and self.ready)
-
     def _live(self) -> bool:
         """Do goals and balls out count now? (Basic rules: whenever no restart is pending.)"""
-        return not self.full or self.command in _LIVE or (self.command == "penalty" and self.ready)
+        return not self.full or self.game.live()
 
     def _team_count(self, team: Team) -> int:
         return sum(1 for t, _ in self.robot_keys if t == team)
 
     def max_robots(self, team: Team) -> int:
         """Robots ``team`` may have on the field now: its count less the cards running."""
-        return self._team_count(team) - sum(1 for k, red in self.off.items() if k[0] == team)
+        return self._team_count(team) - sum(1 for k in self.cards.off if k[0] == team)
 
     def formation(self, team: Team) -> list[tuple[float, float, float]]:
         """Kickoff poses of ``team``'s robots in the field frame."""
@@ -216,14 +240,7 @@ class Referee:
             raise ValueError(
                 f"sim.referee.formations.{division} lists {len(poses)} poses but the team has {n} robots"
             )
-        sign = self.blue_sign if team == "blue" else -self.blue_sign
-        out = []
-        for x, y, th in poses[:n]:
-            if sign < 0:
-                out.append((x, y, th))
-            else:
-                out.append((-x, -y, math.atan2(math.sin(th + math.pi), math.cos(th + math.pi))))
-        return out
+        return formation(poses, n, self.blue_sign if team == "blue" else -self.blue_sign)
 
     def kickoff_setup(self, kicking_team: Team = "blue") -> Teleport:
         """Both teams in formation, ball on the centre spot, kickoff for ``kicking_team`` (robots
@@ -232,8 +249,8 @@ class Referee:
         for team in TEAMS:
             ids = [rid for t, rid in self.robot_keys if t == team]
             robots += [(team, rid, x, y, th) for rid, (x, y, th) in zip(ids, self.formation(team), strict=False)
-                       if (team, rid) not in self.off]  # fmt: skip
-        self._set("kickoff", kicking_team)
+                       if (team, rid) not in self.cards.off]  # fmt: skip
+        self._set(RefereeCommand.KICKOFF, kicking_team)
         self._restart_ball = (0.0, 0.0)
         self._restart_t = self.t
         return Teleport(self.t, tuple(robots), (0.0, 0.0))
@@ -245,43 +262,14 @@ class Referee:
         for the full rules, the true state ``truth`` the auto-referee judges; returns what a restart
         due now wants placed, or None."""
         self.t = t
-        self.new_events = []
+        self.calls.next_frame()
         if not self.params.enabled:
             self.contacts += [e for e in events if isinstance(e, Contact)]
             self.kicks += sum(isinstance(e, Kick) for e in events)
             return None
         dt, self._last_t = t - self._last_t, t
         for e in events:
-            if isinstance(e, Contact):
-                self.contacts.append(e)
-            elif isinstance(e, Kick):
-                self.kicks += 1
-                self.watch.kicked((e.team, e.id))
-            elif isinstance(e, Goal) and self._restart is None and self._live():
-                scorer = self._scorer(e.x)
-                if self.stage == "penalty_shootout":
-                    if self.for_team == scorer:
-                        self.shootout[scorer]["scored"] += 1
-                    self._next_shootout_kick()
-                    continue
-                self.score[scorer] += 1
-                if self.command == "penalty" and self.for_team == scorer:
-                    self.penalties[scorer]["scored"] += 1
-                self._clear_special()
-                self._set("stop", None)
-                self._restart = (t + self.params.restart_delay_s, "kickoff", _other(scorer), (0.0, 0.0))
-            elif isinstance(e, BallOut) and self._restart is None and self._live():
-                self.balls_out += 1
-                if self.stage == "penalty_shootout":  # the kick missed
-                    self._next_shootout_kick()
-                    continue
-                taker: Team = "yellow" if e.last_touch == "blue" else "blue"
-                if e.last_touch is None:  # nobody touched it: the team defending that half
-                    taker = "blue" if (e.x < 0) == (self.blue_sign < 0) else "yellow"
-                spot = self.field.free_kick_spot(e.x, e.y, self.params.free_kick_distance_m)
-                self._clear_special()
-                self._set("stop", None)
-                self._restart = (t + self.params.restart_delay_s, "free_kick", taker, spot)
+            self._take(e)
         if truth is not None:
             self._truth = truth
         if self.full and truth is not None:
@@ -292,30 +280,54 @@ class Referee:
             self._follow_stage()
         self._check_keeper_held_ball(t, ball_xy)
         self._check_progress(t, ball_xy)
-        if self._restart is not None and t >= self._restart[0]:
-            _, kind, team, spot = self._restart
-            self._restart = None
-            self._start_restart(kind, team, spot, ball_xy)
+        if self._restart is not None and t >= self._restart.due_t:
+            due, self._restart = self._restart, None
+            self._start_restart(due.kind, due.team, due.spot, ball_xy)
         teleport = self._take_teleports()
-        if teleport is not None and teleport.ball is not None:
-            ball_xy = teleport.ball
-        # a restart is taken once the ball moved: normal play; not taken in time, play goes on anyway
-        if self.command in ("kickoff", "free_kick") and self._restart_ball is not None:
-            bx, by = ball_xy
-            moved = math.hypot(bx - self._restart_ball[0], by - self._restart_ball[1]) > 0.05
-            if moved:
-                self._set("normal", None)
-                self._restart_ball = None
-                self.watch.restart_taken(self.watch.last_touch)
-            elif t - self._restart_t > self.params.restart_timeout_s:
-                self._set("force_start" if self.full else "normal", None)
-                self._restart_ball = None
+        self._follow_kick(teleport.ball if teleport is not None and teleport.ball is not None else ball_xy)
         return teleport
 
-    def _scorer(self, x: float) -> Team:
-        """The team attacking the goal at the side of ``x``."""
-        defender: Team = "blue" if (x < 0) == (self.blue_sign < 0) else "yellow"
-        return _other(defender)
+    def _take(self, e: Event) -> None:
+        """One of the simulator's events: contacts and kicks counted, goals and balls out judged."""
+        if isinstance(e, Contact):
+            self.contacts.append(e)
+        elif isinstance(e, Kick):
+            self.kicks += 1
+            self.watch.kicked((e.team, e.id))
+        elif isinstance(e, Goal) and self._restart is None and self._live():
+            self._goal(other(defender_of(e.x, self.blue_sign)))
+        elif isinstance(e, BallOut) and self._restart is None and self._live():
+            self.balls_out += 1
+            if self.stage == GameStage.PENALTY_SHOOTOUT:  # the kick missed
+                self._next_shootout_kick()
+                return
+            taker = ball_out_taker(e.last_touch, e.x, self.blue_sign)
+            self._award(RestartKind.FREE_KICK, taker, self._spot(RestartKind.FREE_KICK, taker, (e.x, e.y)))
+
+    def _goal(self, scorer: Team) -> None:
+        """A goal for ``scorer``: the kickoff for the other team (in a shootout: the next kick)."""
+        if self.stage == GameStage.PENALTY_SHOOTOUT:
+            if self.for_team == scorer:
+                self.shootout[scorer]["scored"] += 1
+            self._next_shootout_kick()
+            return
+        self.score[scorer] += 1
+        if self.command == RefereeCommand.PENALTY and self.for_team == scorer:
+            self.penalties[scorer]["scored"] += 1
+        self._award(RestartKind.KICKOFF, other(scorer), (0.0, 0.0))
+
+    def _follow_kick(self, ball_xy: tuple[float, float]) -> None:
+        """A kickoff or free kick is taken once the ball moved: normal play; not taken in time, play
+        goes on anyway."""
+        if not self.command.kick_restart or self._restart_ball is None:
+            return
+        if kick_taken(ball_xy, self._restart_ball, self.rules.ball_in_play_m):
+            self._set(RefereeCommand.NORMAL, None)
+            self._restart_ball = None
+            self.watch.restart_taken(self.watch.last_touch)
+        elif self.t - self._restart_t > self.params.restart_timeout_s:
+            self._set(RefereeCommand.FORCE_START if self.full else RefereeCommand.NORMAL, None)
+            self._restart_ball = None
 
     def _clear_special(self) -> None:
         self.placement = None
@@ -335,30 +347,31 @@ class Referee:
         ball = next((p.ball for p in reversed(parts) if p.ball is not None), None)
         return Teleport(self.t, tuple(r for p in parts for r in p.robots), ball)
 
-    def _start_restart(self, kind: str, team: Team | None, spot: tuple[float, float],
+    def _start_restart(self, kind: RestartKind, team: Team | None, spot: tuple[float, float],
                        ball_xy: tuple[float, float]) -> None:  # fmt: skip
+        """The restart due now: the ball (and robots) where it wants them, its command given."""
         t = self.t
-        if kind == "force_start" or team is None:  # after no progress: where the ball lies, for both
-            self._set("force_start", None)
-        elif kind == "kickoff" and self.params.place_robots_on_goal:
+        if kind is RestartKind.FORCE_START or team is None:  # after no progress: where the ball lies, for both
+            self._set(RefereeCommand.FORCE_START, None)
+        elif kind is RestartKind.KICKOFF and self.params.place_robots_on_goal:
             self._teleports.append(self.kickoff_setup(team))
-        elif kind == "free_kick" and self.full and self._can_place(team):
-            self._set("ball_placement", team)
-            self.placement = _Placement(team, spot, t)
-        elif kind == "penalty":
-            if self.stage == "penalty_shootout":
+        elif kind is RestartKind.FREE_KICK and self.full and self._can_place(team):
+            self._set(RefereeCommand.BALL_PLACEMENT, team)
+            self.placement = Placement(team, spot, t)
+        elif kind is RestartKind.PENALTY:
+            if self.stage == GameStage.PENALTY_SHOOTOUT:
                 self._shootout_kick_setup(team, spot)
             else:
                 self._clear_spot(spot, self._attack_sign(team))
             self._teleport(ball=spot)
-            self._set("penalty", team, ready=False)
-            self.penalty = _Penalty(team, t, spot)
-            (self.shootout if self.stage == "penalty_shootout" else self.penalties)[team]["taken"] += 1
+            self._set(RefereeCommand.PENALTY, team, ready=False)
+            self.penalty = Penalty(team, t, spot)
+            (self.shootout if self.stage == GameStage.PENALTY_SHOOTOUT else self.penalties)[team]["taken"] += 1
         else:
-            placed = kind == "placed_free_kick"
+            placed = kind is RestartKind.PLACED_FREE_KICK
             if not placed:
                 self._teleport(ball=spot)
-            self._set("kickoff" if kind == "kickoff" else "free_kick", team)
+            self._set(kind.command, team)
             self._restart_ball = ball_xy if placed else spot
             self._restart_t = t
 
@@ -368,14 +381,7 @@ class Referee:
         if self._truth is None:
             return
         clear = self.field.league.robot.radius_m + self.field.league.ball.radius_m + self.rules.placement_clear_m
-        moved = []
-        for r in self._truth.robots:
-            dx, dy = r.x - spot[0], r.y - spot[1]
-            d = math.hypot(dx, dy)
-            if d >= clear or (r.team, r.id) in self.off:
-                continue
-            ux, uy = (dx / d, dy / d) if d > 1e-6 else (-attack, 0.0)
-            moved.append((r.team, r.id, spot[0] + ux * clear, spot[1] + uy * clear, r.theta))
+        moved = aside(self._truth.robots, spot, clear, attack, self.cards.off)
         if moved:
             self._teleport(moved)
 
@@ -384,7 +390,7 @@ class Referee:
         keeper and the field player of the lowest id stay)."""
         for team in TEAMS:
             keeper = self.rules.keepers.get(team, -1)
-            on = sorted(rid for t, rid in self.robot_keys if t == team and (t, rid) not in self.off)
+            on = sorted(rid for t, rid in self.robot_keys if t == team and (t, rid) not in self.cards.off)
             players = [rid for rid in on if rid != keeper]
             for rid in players[1:]:
                 self._send_off((team, rid), True)
@@ -395,129 +401,88 @@ class Referee:
         handlers take the kicking team's keeper and the other team's field player off (where robots
         sent off wait) and put the kicker ``penalty_behind_m`` behind the mark and the keeper on its
         goal line."""
-        attack = self._attack_sign(team)
-        r = self.field.league.robot.radius_m
-        moves = []
-        for key in self.robot_keys:
-            if key in self.off:
-                continue
-            keeper = key[1] == self.rules.keepers.get(key[0], -1)
-            if key[0] == team and not keeper:
-                x, y, theta = mark[0] - attack * self.rules.penalty_behind_m, mark[1], 0.0 if attack > 0 else math.pi
-            elif key[0] != team and keeper:
-                x, y, theta = attack * (self.field.half_length - 0.5 * r), 0.0, math.pi if attack > 0 else 0.0
-            else:
-                (x, y), theta = self._park(key), 0.0
-            moves.append((key[0], key[1], x, y, theta))
-        self._teleport(moves)
+        parked = {key: self._park(key) for key in self.robot_keys}
+        self._teleport(shootout_poses(self.field, self.robot_keys, self.cards.off, self.rules.keepers, team, mark,
+                                      self._attack_sign(team), self.rules.penalty_behind_m, parked))  # fmt: skip
 
     def _can_place(self, team: Team) -> bool:
-        return self.placement_failures[team] < self.rules.placement_failures_max
+        return self.tally.may_place(team, self.rules.placement_failures_max)
 
     def _call(self, event: GameEvent) -> None:
-        self.events.append(event)
-        self.new_events.append(event)
+        self.calls.call(event)
 
-    def _award(self, kind: str, team: Team, spot: tuple[float, float]) -> None:
-        """Stop play; after the restart delay ``kind`` ("free_kick", "penalty") for ``team`` at ``spot``
-        (in a penalty shootout: its next kick, this one over)."""
-        if self.stage == "penalty_shootout":
+    def _award(self, kind: RestartKind, team: Team, spot: tuple[float, float]) -> None:
+        """Stop play; after the restart delay ``kind`` for ``team`` at ``spot`` (in a penalty
+        shootout: its next kick, this one over)."""
+        if self.stage == GameStage.PENALTY_SHOOTOUT:
             self._next_shootout_kick()
             return
         self._clear_special()
-        self._set("stop", None)
-        self._restart = (self.t + self.params.restart_delay_s, kind, team, spot)
+        self._set(RefereeCommand.STOP, None)
+        self._restart = Restart(self.t + self.params.restart_delay_s, kind, team, spot)
 
     def _attack_sign(self, team: Team) -> float:
-        """+1.0 when ``team`` attacks the goal at +x."""
-        return -float(self.blue_sign if team == "blue" else -self.blue_sign)
+        return attack_sign(team, self.blue_sign)
 
-    def _spot(self, kind: str, team: Team, ball: tuple[float, float]) -> tuple[float, float]:
-        if kind == "penalty":  # the mark in front of the goal ``team`` attacks
-            attack = self._attack_sign(team)
-            return (attack * (self.field.half_length - self.rules.penalty_mark_from_goal_m), 0.0)
+    def _mark(self, team: Team) -> tuple[float, float]:
+        """The penalty mark in front of the goal ``team`` attacks."""
+        return penalty_mark(self.field, self.rules.penalty_mark_from_goal_m, team, self.blue_sign)
+
+    def _spot(self, kind: RestartKind, team: Team, ball: tuple[float, float]) -> tuple[float, float]:
+        """Where the ball goes for ``kind``: the penalty mark, else the free-kick spot nearest ``ball``."""
+        if kind is RestartKind.PENALTY:
+            return self._mark(team)
         return self.field.free_kick_spot(*ball, self.params.free_kick_distance_m)
 
     # --- fouls and cards ------------------------------------------------------------------------
     def _judge(self, truth: GroundTruth) -> None:
-        situation = Situation(self.command, self.for_team, self.command_t, self.blue_sign, self._in_play())
+        situation = Situation(self.command, self.for_team, self.game.command_t, self.blue_sign, self.game.in_play())
         for ev in self.watch.judge(truth, situation):
             self._call(ev)
             if ev.team is not None:
                 self._foul(ev.team, ev.robot)
-            if ev.restart and ev.for_team is not None and self._restart is None and self._in_play():
-                self._award(ev.restart, ev.for_team, self._spot(ev.restart, ev.for_team, (truth.ball.x, truth.ball.y)))
+            if ev.restart is not None and ev.for_team is not None and self._restart is None and self.game.in_play():
+                kind = restart_of_call(ev.restart)
+                self._award(kind, ev.for_team, self._spot(kind, ev.for_team, (truth.ball.x, truth.ball.y)))
         self._count_robots(truth)
 
     def _foul(self, team: Team, robot: int | None) -> None:
         """One more foul for ``team``: every ``fouls_per_yellow_card`` one gives a yellow card."""
-        self.fouls[team] += 1
-        if self.fouls[team] % self.rules.fouls_per_yellow_card == 0:
+        if self.cards.foul(team):
             self.card(team, robot)
 
     def card(self, team: Team, robot: int | None = None) -> None:
         """A yellow card for ``team`` (the ``red_card_yellow_cards``-th running at once: a red one):
         a robot goes off, the fouling one unless it is the keeper."""
-        running = sum(1 for c in self.cards if c.team == team)
-        red = self.rules.red_card_yellow_cards > 0 and running + 1 >= self.rules.red_card_yellow_cards
-        off = self._robot_to_remove(team, robot)
+        red = self.cards.next_is_red(team)
+        off = self.cards.choose(team, robot, self.robot_keys)
+        self.cards.book(team, off, red)
         if red:
-            self.red_cards[team] += 1
             self._call(GameEvent(self.t, "red_card", team, off, unit="for the match"))
         else:
-            self.yellow_cards[team] += 1
-            self.cards.append(_Card(team, -1 if off is None else off, self.rules.yellow_card_s))
             self._call(GameEvent(self.t, "yellow_card", team, off, self.rules.yellow_card_s, unit="s"))
         if off is not None:
             self._send_off((team, off), red)
 
-    def _robot_to_remove(self, team: Team, robot: int | None) -> int | None:
-        on = [rid for t, rid in self.robot_keys if t == team and (t, rid) not in self.off]
-        keeper = self.rules.keepers.get(team, -1)
-        if robot is not None and robot in on and robot != keeper:
-            return robot
-        field_players = [rid for rid in on if rid != keeper]
-        return max(field_players) if field_players else (max(on) if on else None)
-
     def _park(self, key: Key) -> tuple[float, float]:
         """Where a robot off the field waits: outside the boundary, beyond the cameras' view."""
-        k = self.robot_keys.index(key)
-        side = -1.0 if key[0] == "blue" else 1.0
-        y = side * (self.field.boundary_half_width + self.params.park_distance_m)
-        return (-self.field.half_length + 0.4 * k, y)
+        return park(self.field, self.robot_keys.index(key), key[0], self.params.park_distance_m)
 
     def _send_off(self, key: Key, red: bool) -> None:
-        self.off[key] = red
+        self.cards.off[key] = red
         x, y = self._park(key)
         self._teleport([(key[0], key[1], x, y, 0.0)])
 
     def _follow_cards(self, dt: float, truth: GroundTruth) -> None:
         """Cards run while the game is not halted; a robot whose card ran out comes back at the
         halfway line, by the touch line, on a free spot."""
-        if self.command == "halt":
+        if self.command == RefereeCommand.HALT:
             return
-        for c in list(self.cards):
-            c.left_s -= dt
-            if c.left_s > 0.0:
-                continue
-            self.cards.remove(c)
-            key = (c.team, c.robot)
-            if self.off.get(key) is False:
-                del self.off[key]
-                x, y = self._entry_spot(truth, c.team)
+        for c in self.cards.run(dt):
+            if self.cards.back(c):
+                x, y = entry_spot(self.field, truth.robots, c.team, self.blue_sign)
                 self._teleport([(c.team, c.robot, x, y, 0.0)])
                 self._call(GameEvent(self.t, "yellow_card_over", c.team, c.robot))
-
-    def _entry_spot(self, truth: GroundTruth, team: Team) -> tuple[float, float]:
-        side = -1.0 if team == "blue" else 1.0
-        own = self.blue_sign if team == "blue" else -self.blue_sign
-        r = self.field.league.robot.radius_m
-        y = side * (self.field.half_width - 2.0 * r)
-        for k in range(40):  # along the touch line into our half until free
-            x = own * (2.0 * r) * (k + 1)
-            if all(math.hypot(o.x - x, o.y - y) > 4.0 * r for o in truth.robots):
-                return (x, y)
-        return (own * 2.0 * r, y)
 
     def _count_robots(self, truth: GroundTruth) -> None:
         """Too many robots: a team with more on the field than it may have; the extra go off (a
@@ -529,7 +494,7 @@ class Referee:
             extra = len(on) - self.max_robots(team)
             if extra <= 0:
                 continue
-            ids = sorted((r.id for r in on), key=lambda rid: ((team, rid) not in self.off, -rid))[:extra]
+            ids = sorted((r.id for r in on), key=lambda rid: ((team, rid) not in self.cards.off, -rid))[:extra]
             self._call(GameEvent(self.t, "too_many_robots", team, ids[0], float(len(on)), float(self.max_robots(team)),
                                  "robots"))  # fmt: skip
             self._foul(team, None)
@@ -542,195 +507,157 @@ class Referee:
         """A placement succeeds when the ball rests within the tolerance of the designated position
         with the placing team's robots clear of it; it fails when the time is up."""
         pl = self.placement
-        if pl is None or self.command != "ball_placement":
+        if pl is None or self.command != RefereeCommand.BALL_PLACEMENT:
             return
-        r, b = self.rules, truth.ball
-        off = math.hypot(b.x - pl.target[0], b.y - pl.target[1])
-        clear = self.field.league.robot.radius_m + self.field.league.ball.radius_m + r.placement_clear_m
-        cleared = all(math.hypot(o.x - b.x, o.y - b.y) >= clear for o in truth.robots if o.team == pl.team)
+        r = self.rules
+        off, done = placed(truth, pl.team, pl.target, self.field, r)
         took = self.t - pl.t_start
-        if off <= r.placement_tolerance_m and math.hypot(b.vx, b.vy) <= r.placement_rest_m_s and cleared:
-            self.placements[pl.team]["tried"] += 1
-            self.placements[pl.team]["succeeded"] += 1
-            self.placement_s[pl.team].append(took)
+        if done:
+            self.tally.placed(pl.team, took)
             self._call(GameEvent(self.t, "placement_succeeded", pl.team, None, took, r.placement_time_s, "s"))
-            self._award("placed_free_kick", pl.team, pl.target)
+            self._award(RestartKind.PLACED_FREE_KICK, pl.team, pl.target)
         elif took > r.placement_time_s:
-            self.placements[pl.team]["tried"] += 1
-            self.placement_failures[pl.team] += 1
+            self.tally.failed(pl.team)
             self._call(GameEvent(self.t, "placement_failed", pl.team, None, off, r.placement_tolerance_m, "m",
-                                 "free_kick", _other(pl.team)))  # fmt: skip
+                                 RefereeCommand.FREE_KICK, other(pl.team)))  # fmt: skip
             self._teleport(ball=pl.target)  # the referee places it
-            self._award("placed_free_kick", _other(pl.team), pl.target)
-
-    def _penalty_set(self, truth: GroundTruth, pen: _Penalty) -> bool:
-        """Everyone but the kicker and the keeper ``penalty_behind_m`` behind the ball, the keeper on its line."""
-        attack = self._attack_sign(pen.team)
-        keeper = (_other(pen.team), self.rules.keepers.get(_other(pen.team), -1))
-        ours = [r for r in truth.robots if r.team == pen.team and (r.team, r.id) not in self.off]
-        kicker = min(ours, key=lambda r: math.hypot(r.x - pen.mark[0], r.y - pen.mark[1]), default=None)
-        for o in truth.robots:
-            key = (o.team, o.id)
-            if key in self.off or o is kicker:
-                continue
-            if key == keeper:
-                if abs(abs(o.x) - self.field.half_length) > self.field.league.robot.radius_m:
-                    return False
-            elif (o.x - pen.mark[0]) * attack > -self.rules.penalty_behind_m:
-                return False
-        return True
+            self._award(RestartKind.PLACED_FREE_KICK, other(pl.team), pl.target)
 
     def _follow_penalty(self, truth: GroundTruth) -> None:
         pen = self.penalty
-        if pen is None or self.command != "penalty":
+        if pen is None or self.command != RefereeCommand.PENALTY:
             return
         if not self.ready:
-            if self.t - pen.t_start >= self.rules.prepare_timeout_s or self._penalty_set(truth, pen):
+            if self.t - pen.t_start >= self.rules.prepare_timeout_s or penalty_set(
+                    truth, pen.team, pen.mark, self._attack_sign(pen.team), self.field, self.rules, self.cards.off):
                 pen.t_run = self.t
-                self._set("penalty", pen.team, ready=True)
+                self._set(RefereeCommand.PENALTY, pen.team, ready=True)
             return
         assert pen.t_run is not None
         b = truth.ball
         attack = self._attack_sign(pen.team)
-        moved = math.hypot(b.x - pen.mark[0], b.y - pen.mark[1]) > self.rules.ball_in_play_m
+        moved = kick_taken((b.x, b.y), pen.mark, self.rules.ball_in_play_m)
         took = self.t - pen.t_run
         # over (the rules) after the kicker's time, or once the ball in play moves away from the goal (the
         # keeper turned it back, or the kicker broke the rule that it only ever moves toward the goal); a
         # ball at rest waits for the kicker, who may play it again
         if took > self.rules.penalty_time_s or (moved and b.vx * attack < -0.05):
-            shootout = self.stage == "penalty_shootout"
+            shootout = self.stage == GameStage.PENALTY_SHOOTOUT
             self._call(GameEvent(self.t, "penalty_over", pen.team, None, took, self.rules.penalty_time_s, "s",
-                                 "" if shootout else "free_kick", None if shootout else _other(pen.team)))  # fmt: skip
+                                 None if shootout else RefereeCommand.FREE_KICK,
+                                 None if shootout else other(pen.team)))  # fmt: skip
             if shootout:
                 self._next_shootout_kick()
             else:
-                self._award("free_kick", _other(pen.team), self._spot("free_kick", pen.team, (b.x, b.y)))
+                spot = self._spot(RestartKind.FREE_KICK, pen.team, (b.x, b.y))
+                self._award(RestartKind.FREE_KICK, other(pen.team), spot)
 
     def _follow_stage(self) -> None:
         """Halves, half time (halted) and the end; the sides change for the second half, where the
         team that did not kick off first kicks off."""
-        if self.t < self._stage_end:
+        if not self.game.stage_over(self.t):
             return
-        r = self.rules
-        if self.placement is not None and self.command == "ball_placement":
-            self.placements[self.placement.team]["cut_short"] += 1
-        if self.stage == "first_half" and r.half_time_s > 0.0:
-            self.stage, self._stage_end = "half_time", self.t + r.half_time_s
+        under_way = self._under_way()
+        if under_way is not None:
+            self.placements[under_way]["cut_short"] += 1
+        stage = stage_after(self.stage, self.rules, drawn=self.score["blue"] == self.score["yellow"])
+        if stage is GameStage.POST_GAME:
+            self._end_match()
+        else:
+            self.game.enter(stage, self.t)
+        if stage is GameStage.HALF_TIME:
             self._restart = None
             self._clear_special()
-            self._set("halt", None)
-        elif self.stage in ("first_half", "half_time"):
-            self.stage, self._stage_end = "second_half", self.t + r.half_s
+            self._set(RefereeCommand.HALT, None)
+        elif stage is GameStage.SECOND_HALF:
             self.blue_sign = -1 if self.blue_sign > 0 else 1
             self._restart = None
             self._clear_special()
             self._teleports.append(self.kickoff_setup("yellow"))
-        elif self.stage == "second_half" and r.shootout_kicks > 0 and (
-                r.shootout_always or self.score["blue"] == self.score["yellow"]):
-            self.stage, self._stage_end = "penalty_shootout", math.inf
+        elif stage is GameStage.PENALTY_SHOOTOUT:
             self._shootout_teams()
             self._call(GameEvent(self.t, f"stage_{self.stage}"))
             self._next_shootout_kick()
             return
-        elif self.stage in ("second_half", "penalty_shootout"):
-            self._end_match()
         self._call(GameEvent(self.t, f"stage_{self.stage}"))
 
     def _end_match(self) -> None:
-        self.stage, self._stage_end = "post_game", math.inf
+        self.game.enter(GameStage.POST_GAME, self.t)
         self._restart = None
         self._clear_special()
-        self._set("halt", None)
+        self._set(RefereeCommand.HALT, None)
 
     def _next_shootout_kick(self) -> None:
         """The shootout's next kick after the restart delay: the teams in turn (yellow first: blue kicked
         off the match), ``shootout_kicks`` each, then (a drawn match's shootout) one each until one
         team scored more of an equal number; then the game is over."""
         self._clear_special()
-        self._set("stop", None)
-        r, done = self.rules, self.shootout
-        taken = {t: done[t]["taken"] for t in TEAMS}
-        even = taken["blue"] == taken["yellow"]
-        decided = even and done["blue"]["scored"] != done["yellow"]["scored"]
-        if even and taken["blue"] >= r.shootout_kicks and (r.shootout_always or decided):
+        self._set(RefereeCommand.STOP, None)
+        team = shootout_kicker(self.shootout, self.rules)
+        if team is None:
             self._end_match()
             self._call(GameEvent(self.t, f"stage_{self.stage}"))
             return
-        team: Team = "yellow" if even else "blue"
-        self._restart = (self.t + self.params.restart_delay_s, "penalty", team, self._spot("penalty", team, (0.0, 0.0)))
+        self._restart = Restart(self.t + self.params.restart_delay_s, RestartKind.PENALTY, team, self._mark(team))
 
     def _check_keeper_held_ball(self, t: float, ball_xy: tuple[float, float]) -> None:
         """Rules (keeper held ball): the ball in a defense area for ``keeper_held_ball_s`` of normal
         play gives the other team a free kick at the nearest legal spot."""
-        bx, by = ball_xy
-        side = self.field.in_defense_area(bx, by)
-        if self.command not in ("normal", "force_start") or self._restart is not None or not side:
-            self._in_area_since = None
-            return
-        if self._in_area_since is None:
-            self._in_area_since = t
-        elif t - self._in_area_since >= self.params.keeper_held_ball_s:
-            self._in_area_since = None
+        side = self._held.held(t, ball_xy, self.command.running and self._restart is None)
+        if side:
+            bx, by = ball_xy
             self.keeper_held_ball += 1
             holder: Team = "blue" if side == self.blue_sign else "yellow"
-            taker = _other(holder)
+            taker = other(holder)
             spot = self.field.free_kick_spot(bx, by, self.params.free_kick_distance_m)
             if self.full:
                 self._call(GameEvent(t, "keeper_held_ball", holder, self.rules.keepers.get(holder),
                                      self.params.keeper_held_ball_s, self.params.keeper_held_ball_s, "s",
-                                     "free_kick", taker))  # fmt: skip
+                                     RefereeCommand.FREE_KICK, taker))  # fmt: skip
                 self._foul(holder, self.rules.keepers.get(holder))
-            self._award("free_kick", taker, spot)
+            self._award(RestartKind.FREE_KICK, taker, spot)
 
     def _check_progress(self, t: float, ball_xy: tuple[float, float]) -> None:
         """Rules (no progress in game): the ball within ``no_progress_m`` of one place for
         ``no_progress_s`` while both teams may play it (two robots stuck at it, neither getting it
         away): a stop, then a force start where it lies."""
-        if not self.full or self.command not in ("normal", "force_start") or self._restart is not None:
-            self._still = None
-            return
-        if self._still is None or math.dist(ball_xy, self._still[1]) > self.params.no_progress_m:
-            self._still = (t, ball_xy)
-        elif t - self._still[0] >= self.params.no_progress_s:
-            self._still = None
+        if self._no_progress.stuck(t, ball_xy, self.full and self.command.running and self._restart is None):
             self._call(GameEvent(t, "no_progress", None, None, self.params.no_progress_s, self.params.no_progress_s,
-                                 "s", "force_start"))  # fmt: skip
-            self._set("stop", None)
-            self._restart = (t + self.params.restart_delay_s, "force_start", None, ball_xy)
+                                 "s", RefereeCommand.FORCE_START))  # fmt: skip
+            self._set(RefereeCommand.STOP, None)
+            self._restart = Restart(t + self.params.restart_delay_s, RestartKind.FORCE_START, None, ball_xy)
 
     # --- out --------------------------------------------------------------------------------
     def _action_left(self) -> float:
         t, r = self.t, self.rules
-        if self.command == "ball_placement" and self.placement is not None:
+        if self.command == RefereeCommand.BALL_PLACEMENT and self.placement is not None:
             return r.placement_time_s - (t - self.placement.t_start)
-        if self.command in ("kickoff", "free_kick"):
+        if self.command.kick_restart:
             return self.params.restart_timeout_s - (t - self._restart_t)
-        if self.command == "penalty" and self.penalty is not None:
+        if self.command == RefereeCommand.PENALTY and self.penalty is not None:
             if self.penalty.t_run is None:
                 return r.prepare_timeout_s - (t - self.penalty.t_start)
             return r.penalty_time_s - (t - self.penalty.t_run)
         return math.inf
 
-    def _next(self) -> tuple[str | None, Team | None]:
+    def _next(self) -> tuple[RefereeCommand | None, Team | None]:
         if self._restart is None:
             return None, None
-        _, kind, team, _ = self._restart
-        if kind == "free_kick" and team is not None and self.full and self._can_place(team):
-            return "ball_placement", team
-        return ("free_kick" if kind == "placed_free_kick" else kind), team
+        team = self._restart.team
+        return self._restart.next_command(self.full and team is not None and self._can_place(team))
 
     def team_info(self, team: Team) -> TeamInfo:
         r = self.rules
         return TeamInfo(
             red_cards=self.red_cards[team], yellow_cards=self.yellow_cards[team],
-            yellow_card_times_s=tuple(max(0.0, c.left_s) for c in self.cards if c.team == team),
+            yellow_card_times_s=self.cards.times_left(team),
             fouls=self.fouls[team], goalkeeper=r.keepers.get(team, 0), timeouts=r.timeouts,
             timeout_time_s=r.timeout_total_s, placement_failures=self.placement_failures[team],
             can_place_ball=self.full and self._can_place(team), max_robots=self.max_robots(team),
         )  # fmt: skip
 
     def state(self) -> GameState:
-        placement = self._restart[3] if self._restart else self._restart_ball
+        placement = self._restart.spot if self._restart is not None else self._restart_ball
         if self.placement is not None:
             placement = self.placement.target
         elif self.penalty is not None:
@@ -740,30 +667,23 @@ class Referee:
             t=self.t, command=self.command, for_team=self.for_team, score_blue=self.score["blue"],
             score_yellow=self.score["yellow"], blue_defends_negative_x=self.blue_sign < 0,
             placement=placement, ready=self.ready, stage=self.stage,
-            stage_time_left_s=self._stage_end - self.t, command_counter=self.command_counter,
-            command_t=self.command_t, action_time_left_s=self._action_left(), next_command=nxt,
+            stage_time_left_s=self.game.stage_end - self.t, command_counter=self.game.counter,
+            command_t=self.game.command_t, action_time_left_s=self._action_left(), next_command=nxt,
             next_for_team=nxt_team, blue_team=self.team_info("blue"), yellow_team=self.team_info("yellow"),
         )  # fmt: skip
 
-    def _under_way(self, team: Team) -> int:
-        """1 while ``team``'s placement is under way (a match that ends now cuts it short), else 0."""
+    def _under_way(self) -> Team | None:
+        """The team whose placement is under way (a match that ends now cuts it short)."""
         pl = self.placement
-        return int(pl is not None and pl.team == team and self.command == "ball_placement")
+        return pl.team if pl is not None and self.command == RefereeCommand.BALL_PLACEMENT else None
 
     def summary(self) -> dict[str, object]:
         """The rules' figures of the match: fouls per team by kind, cards, placements, penalties."""
-        by_kind: dict[str, dict[str, int]] = {t: {} for t in TEAMS}
-        for e in self.events:
-            if e.team is not None and e.kind in FOUL_RESTARTS:
-                by_kind[e.team][e.kind] = by_kind[e.team].get(e.kind, 0) + 1
+        by_kind = self.calls.by_kind(set(FOUL_RESTARTS))
         return {
             "rules": self.params.rules if self.params.enabled else "off",
             "game_stage": self.stage,
-            "fouls": {t: {"total": self.fouls[t], **dict(sorted(by_kind[t].items()))} for t in TEAMS},
+            "fouls": {t: {"total": self.fouls[t], **by_kind[t]} for t in TEAMS},
             "cards": {t: {"yellow": self.yellow_cards[t], "red": self.red_cards[t]} for t in TEAMS},
-            "placements": {t: {**self.placements[t], "cut_short": self.placements[t]["cut_short"] + self._under_way(t),
-                               "median_s": float(np.median(self.placement_s[t])) if self.placement_s[t] else None}
-                           for t in TEAMS},
-            "penalties": {t: dict(self.penalties[t]) for t in TEAMS},
-            "shootout": {t: dict(self.shootout[t]) for t in TEAMS},
-        }  # fmt: skip
+            **self.tally.figures(self._under_way()),
+        }

@@ -10,24 +10,25 @@ leads to (a free kick, a penalty, a card) the game controller (:mod:`sim.referee
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass, field
 
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, Team
-from cmdragons.messages import GameEvent, GroundTruth, RobotTruth
+from cmdragons.messages import GameEvent, GroundTruth, RefereeCommand, RobotTruth
+from sim.restarts import other
 
-__all__ = ["FOUL_RESTARTS", "FoulWatch", "RulesParams", "Situation"]
+__all__ = ["FOUL_RESTARTS", "FoulWatch", "HeldBall", "NoProgress", "RulesParams", "Situation", "penalty_set", "placed"]
 
 Key = tuple[Team, int]
 
-# what each foul leads to: a free kick (or a penalty kick) for the other team, or nothing but the count
-FOUL_RESTARTS: dict[str, str] = {
-    "crash": "free_kick", "crash_drawn": "", "pushing": "free_kick", "ball_too_fast": "free_kick",
-    "excessive_dribbling": "free_kick", "attacker_in_defense_area": "free_kick",
-    "defender_in_defense_area": "penalty", "double_touch": "free_kick", "stop_speed": "", "stop_distance": "",
-    "kick_point_distance": "", "keeper_held_ball": "free_kick", "boundary_crossing": "free_kick",
-    "too_many_robots": "",
+# what each foul leads to: a free kick (or a penalty kick) for the other team, or (None) nothing but the count
+_FREE, _PENALTY = RefereeCommand.FREE_KICK, RefereeCommand.PENALTY
+FOUL_RESTARTS: dict[str, RefereeCommand | None] = {
+    "crash": _FREE, "crash_drawn": None, "pushing": _FREE, "ball_too_fast": _FREE, "excessive_dribbling": _FREE,
+    "attacker_in_defense_area": _FREE, "defender_in_defense_area": _PENALTY, "double_touch": _FREE,
+    "stop_speed": None, "stop_distance": None, "kick_point_distance": None, "keeper_held_ball": _FREE,
+    "boundary_crossing": _FREE, "too_many_robots": None,
 }  # fmt: skip
 
 
@@ -73,7 +74,7 @@ class RulesParams(Validated):
 class Situation:
     """What the checks need of the game controller this frame."""
 
-    command: str
+    command: RefereeCommand
     for_team: Team | None
     since: float  # when the command was given (s)
     blue_sign: int  # -1: blue defends the goal at -x
@@ -98,10 +99,6 @@ class _Contact:
 def _team_sign(team: Team, blue_sign: int) -> int:
     """The side of the goal ``team`` defends: -1 for -x."""
     return blue_sign if team == "blue" else -blue_sign
-
-
-def _other(team: Team) -> Team:
-    return "yellow" if team == "blue" else "blue"
 
 
 class FoulWatch:
@@ -138,7 +135,7 @@ class FoulWatch:
         robots = [r for r in gt.robots if self.field.in_field(r.x, r.y, -self.field.dims.boundary_width_m)]
         out: list[GameEvent] = []
         new_touches = self._touches(gt, robots)
-        if s.command != "halt":
+        if s.command != RefereeCommand.HALT:
             out += self._crashes(gt, robots)
         if s.in_play:
             out += self._ball_too_fast(gt)
@@ -147,13 +144,13 @@ class FoulWatch:
             out += self._double_touch(gt, new_touches)
         else:
             self._restart_kicker = None
-        if s.command != "halt":  # the ball crosses the boundary after the line: play is already stopped
+        if s.command != RefereeCommand.HALT:  # the ball crosses the boundary after the line: play is already stopped
             out += self._boundary(gt)
-        if s.command == "stop" and gt.t - s.since >= self.p.stop_grace_s:
+        if s.command == RefereeCommand.STOP and gt.t - s.since >= self.p.stop_grace_s:
             out += self._stop(gt, robots)
-        if s.command in ("free_kick", "kickoff") and s.for_team is not None and not s.in_play \
+        if s.command.kick_restart and s.for_team is not None and not s.in_play \
                 and gt.t - s.since >= self.p.kick_point_grace_s:  # fmt: skip
-            out += self._kick_point(gt, robots, _other(s.for_team))
+            out += self._kick_point(gt, robots, other(s.for_team))
         self._prev = {(r.team, r.id): r for r in robots}
         return out
 
@@ -181,7 +178,7 @@ class FoulWatch:
         restart = FOUL_RESTARTS[kind]
         team = None if key is None else key[0]
         return GameEvent(t, kind, team, None if key is None else key[1], value, limit, unit, restart,
-                         _other(team) if restart and team is not None else None)  # fmt: skip
+                         other(team) if restart is not None and team is not None else None)  # fmt: skip
 
     def _once(self, kind: str, key: Key) -> bool:
         """True the first time ``kind`` is called on ``key`` since the command changed."""
@@ -339,3 +336,78 @@ class FoulWatch:
             if gap < self.p.kick_point_distance_m and self._once("kick_point_distance", k):
                 out.append(self._event(gt.t, "kick_point_distance", k, gap, self.p.kick_point_distance_m, "m"))
         return out
+
+
+class HeldBall:
+    """Keeper held ball (the rules): the ball in a defense area for ``limit_s`` of normal play."""
+
+    def __init__(self, pitch: Field, limit_s: float) -> None:
+        self.field, self.limit_s = pitch, limit_s
+        self._since: float | None = None  # watched, the ball in a defense area since
+
+    def held(self, t: float, ball_xy: tuple[float, float], watched: bool) -> int:
+        """The side (-1: the area at -x) of the area the ball has been in ``limit_s`` at ``t`` while
+        ``watched`` (normal play, no restart pending), else 0; counting starts again after a call."""
+        side = self.field.in_defense_area(*ball_xy)
+        if not watched or not side:
+            self._since = None
+            return 0
+        if self._since is None:
+            self._since = t
+        elif t - self._since >= self.limit_s:
+            self._since = None
+            return side
+        return 0
+
+
+class NoProgress:
+    """No progress in game (the rules): the ball within ``within_m`` of one place for ``limit_s``
+    while both teams may play it."""
+
+    def __init__(self, limit_s: float, within_m: float) -> None:
+        self.limit_s, self.within_m = limit_s, within_m
+        self._still: tuple[float, tuple[float, float]] | None = None  # watched, the ball in one place since, where
+
+    def stuck(self, t: float, ball_xy: tuple[float, float], watched: bool) -> bool:
+        """True once the ball lay in one place ``limit_s`` while ``watched``; counting starts again after."""
+        if not watched:
+            self._still = None
+            return False
+        if self._still is None or math.dist(ball_xy, self._still[1]) > self.within_m:
+            self._still = (t, ball_xy)
+        elif t - self._still[0] >= self.limit_s:
+            self._still = None
+            return True
+        return False
+
+
+def placed(gt: GroundTruth, team: Team, target: tuple[float, float], pitch: Field,
+           p: RulesParams) -> tuple[float, bool]:  # fmt: skip
+    """Ball placement by ``team``: how far the ball is off ``target`` (m), and whether the
+    placement succeeded: the ball within ``placement_tolerance_m`` of it, at rest (slower than
+    ``placement_rest_m_s``), the team's robots ``placement_clear_m`` clear of it."""
+    b = gt.ball
+    off = math.hypot(b.x - target[0], b.y - target[1])
+    clear = pitch.league.robot.radius_m + pitch.league.ball.radius_m + p.placement_clear_m
+    cleared = all(math.hypot(o.x - b.x, o.y - b.y) >= clear for o in gt.robots if o.team == team)
+    return off, off <= p.placement_tolerance_m and math.hypot(b.vx, b.vy) <= p.placement_rest_m_s and cleared
+
+
+def penalty_set(gt: GroundTruth, team: Team, mark: tuple[float, float], attack: float, pitch: Field,
+                p: RulesParams, off: Collection[Key]) -> bool:  # fmt: skip
+    """A penalty by ``team`` at ``mark`` (``attack``: +1.0 toward +x) is ready for its normal start:
+    every robot on the field (those ``off`` aside) but the kicker (the team's nearest to the mark)
+    and the other keeper ``penalty_behind_m`` behind the ball, that keeper on its goal line."""
+    keeper = (other(team), p.keepers.get(other(team), -1))
+    ours = [r for r in gt.robots if r.team == team and (r.team, r.id) not in off]
+    kicker = min(ours, key=lambda r: math.hypot(r.x - mark[0], r.y - mark[1]), default=None)
+    for o in gt.robots:
+        key = (o.team, o.id)
+        if key in off or o is kicker:
+            continue
+        if key == keeper:
+            if abs(abs(o.x) - pitch.half_length) > pitch.league.robot.radius_m:
+                return False
+        elif (o.x - mark[0]) * attack > -p.penalty_behind_m:
+            return False
+    return True

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, Team
-from cmdragons.messages import BallState, GameState, RobotState
+from cmdragons.messages import BallState, GameState, RefereeCommand, RobotState
 from strategy.defense import DefenseParams, clear_target
 from strategy.skills import Intent, SkillParams, goalie_block, intercept, kick_to, pass_speed, waiting_point
 
@@ -197,12 +197,12 @@ def restart_rules(intents: Mapping[int, Intent], game: GameState, ours: bool, ba
     at their kickoff or free kick, our half at our kickoff (``kicker`` excepted). ``ours``: the
     restart is for our team."""
     out = dict(intents)
-    if game.command == "stop" or (game.command in ("kickoff", "free_kick") and not ours):
+    if game.command == RefereeCommand.STOP or (game.command.kick_restart and not ours):
         # slow in a stop (the rules) and at their kickoff (robots put in formation then cross round the
         # ball to their places: fast, they swing in past the rules' distance)
-        out = keep_away(out, ball, pitch, own_sign, p, radius, game.command == "kickoff",
-                        game.command in ("stop", "kickoff"))  # fmt: skip
-    if game.command == "kickoff" and ours:
+        out = keep_away(out, ball, pitch, own_sign, p, radius, game.command == RefereeCommand.KICKOFF,
+                        game.command in (RefereeCommand.STOP, RefereeCommand.KICKOFF))  # fmt: skip
+    if game.command == RefereeCommand.KICKOFF and ours:
         out = our_kickoff(out, pitch, own_sign, p, radius, kicker)
     return out
 

@@ -13,7 +13,6 @@ attacker lines up behind the ball and kicks it. Field frame, metres, seconds, ra
 
 from __future__ import annotations
 
-import enum
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -23,12 +22,12 @@ from numpy.typing import NDArray
 
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, wrap_angle
-from cmdragons.messages import BallState, RobotState
+from cmdragons.messages import BallState, KickPurpose, RobotState
 from strategy.evaluation import PassParams, best_shot, clearest_direction, one_touch_turn, pass_values
 from strategy.passing import PassPlay
 from strategy.skills import Intent, SkillParams, drive_through, intercept, kick_to, pass_speed, receive, set_kick
 
-__all__ = ["Attacker", "Kick", "KickKind", "KickParams", "StillBall", "contest_angle", "decide_kick"]
+__all__ = ["Attacker", "Kick", "KickPurpose", "KickParams", "StillBall", "contest_angle", "decide_kick"]
 
 Array = NDArray[np.float64]
 
@@ -58,20 +57,11 @@ class KickParams(Validated):
     area_wait_m: float = setting(0.15, lo=0.0, hi=2.0)  # ... the attacker waiting by it, its edge this far off the area
 
 
-class KickKind(enum.Enum):
-    """What a kick is for; the values are the match statistics' names."""
-
-    SHOT = "shot"
-    PASS = "pass"
-    CLEAR = "clear"
-    WAIT = "wait"  # no kick: the ball is theirs to play (in their defense area)
-
-
 @dataclass(frozen=True)
 class Kick:
     """The attacker's decided kick: what for, where to, how hard, and for a pass to whom."""
 
-    kind: KickKind
+    kind: KickPurpose
     target: tuple[float, float]
     speed: float
     receiver: int | None = None
@@ -95,7 +85,7 @@ def _pass_kick(ball: BallState, point: tuple[float, float], receiver: int, shoot
                skills: SkillParams) -> Kick:  # fmt: skip
     """A pass to ``point``, as fast as it must be kicked to arrive there at the receiving speed."""
     dist = math.hypot(point[0] - ball.x, point[1] - ball.y)
-    return Kick(KickKind.PASS, point, pass_speed(dist, skills), receiver, shoot_at)
+    return Kick(KickPurpose.PASS, point, pass_speed(dist, skills), receiver, shoot_at)
 
 
 def decide_kick(ball: BallState, passer: int, own: Mapping[int, RobotState], supporters: Sequence[int],
@@ -106,7 +96,7 @@ def decide_kick(ball: BallState, passer: int, own: Mapping[int, RobotState], sup
     ball_xy = np.array([ball.x, ball.y])
     _, aim, shot_value = best_shot(ball_xy, pitch, attack_sign, opponents, radius, passing)
     if shot_value >= p.shoot_value:
-        return Kick(KickKind.SHOT, aim, skills.max_kick_m_s)
+        return Kick(KickPurpose.SHOT, aim, skills.max_kick_m_s)
     planned = passes.planned_by(passer, own)
     if planned is not None:
         # a pass already decided goes to the point its receiver waits at while it stays worth playing
@@ -131,8 +121,8 @@ def decide_kick(ball: BallState, passer: int, own: Mapping[int, RobotState], sup
                                   p.clear_samples, p.clear_lane_cap_rad, p.clear_turn_cost)  # fmt: skip
     target = (ball.x + p.clear_reach_m * math.cos(angle), ball.y + p.clear_reach_m * math.sin(angle))
     if (ball.x * attack_sign) > 0 and abs(angle - toward) < p.shot_lane_rad:
-        return Kick(KickKind.SHOT, target, skills.max_kick_m_s)
-    return Kick(KickKind.CLEAR, target, p.clear_speed_m_s)
+        return Kick(KickPurpose.SHOT, target, skills.max_kick_m_s)
+    return Kick(KickPurpose.CLEAR, target, p.clear_speed_m_s)
 
 
 def contest_angle(robot: RobotState, ball: BallState, target: tuple[float, float], opponents: Array,
@@ -168,7 +158,7 @@ class Attacker:
 
     def play(self, t: float, robot: RobotState, own: Mapping[int, RobotState], supporters: Sequence[int],
              opponents: Array, ball: BallState, attack_sign: float,
-             passes: PassPlay, restart: bool = False) -> tuple[Intent, KickKind]:  # fmt: skip
+             passes: PassPlay, restart: bool = False) -> tuple[Intent, KickPurpose]:  # fmt: skip
         """Play the ball where ``robot`` can meet it: shoot, pass (planned in ``passes``) or play it
         forward; ``restart``: our restart's kick, its only touch (:func:`~strategy.skills.set_kick`).
         Returns the intent and what the kick is for."""
@@ -178,10 +168,10 @@ class Attacker:
             # the rules: an attacker touching the ball in their defense area is a foul; their keeper plays it
             passes.cancel()
             x, y = self.field.free_kick_spot(met.x, met.y, skills.robot_radius_m + p.area_wait_m)
-            return Intent(x, y, math.atan2(ball.y - y, ball.x - x)), KickKind.WAIT
+            return Intent(x, y, math.atan2(ball.y - y, ball.x - x)), KickPurpose.WAIT
         kick = decide_kick(met, robot.id, own, supporters, passes, opponents, self.field, attack_sign, self.radius, p,
                            self.passing, skills)  # fmt: skip
-        if kick.kind is KickKind.PASS and kick.receiver is not None:
+        if kick.kind is KickPurpose.PASS and kick.receiver is not None:
             passes.plan(t, robot.id, kick.receiver, kick.target, kick.shoot_at)
         else:
             passes.cancel()
@@ -205,7 +195,7 @@ class Attacker:
             passes.cancel()
             if t - self.still.since > p.stall_s:
                 # lining up got nowhere (the point behind the ball is taken): drive through it from here
-                return drive_through(met, contest, p.clear_speed_m_s, skills), KickKind.CLEAR
+                return drive_through(met, contest, p.clear_speed_m_s, skills), KickPurpose.CLEAR
             target = (met.x + p.clear_reach_m * math.cos(contest), met.y + p.clear_reach_m * math.sin(contest))
-            return kick_to(robot, met, target, p.clear_speed_m_s, skills), KickKind.CLEAR
+            return kick_to(robot, met, target, p.clear_speed_m_s, skills), KickPurpose.CLEAR
         return kick_to(robot, met, kick.target, kick.speed, skills), kick.kind

@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, Team
-from cmdragons.messages import BallState, GameState, RobotState, WorldState
+from cmdragons.messages import BallState, GameState, RefereeCommand, RobotState, WorldState
 from strategy.defense import DefenseParams, defender_slots, goalie
 from strategy.evaluation import PassParams
 from strategy.game_states import (
@@ -38,7 +38,7 @@ from strategy.game_states import (
     place_ball,
     restart_rules,
 )
-from strategy.kicking import Attacker, KickKind, KickParams
+from strategy.kicking import Attacker, KickParams, KickPurpose
 from strategy.passing import PassPlay, PassPlayParams
 from strategy.roles import Objective, Role, RoleAssigner, RoleKind, RoleParams
 from strategy.skills import Intent, SkillParams, defend, intercept, mark, receive
@@ -122,7 +122,7 @@ class Strategy:
         self.supporters = Supporters(pitch, params.passing, params.support, params.obstacle_radius_m)
         self.attacker = Attacker(pitch, params.kicking, params.passing, params.skills, params.obstacle_radius_m)
         self.frame = 0
-        self.last_action: dict[int, str] = {}  # robot id -> "shot", "pass" or "clear": what its kick is for
+        self.last_action: dict[int, KickPurpose] = {}  # robot id -> what its kick is for
         self._placing: Placing | None = None  # our ball placement, frame to frame
         self._taker: int | None = None  # the kicker of our kickoff or free kick under way
         self._barred: int | None = None  # our restart's taker, until another robot touched the ball
@@ -156,21 +156,21 @@ class Strategy:
             return {}
         own_sign = self.own_sign(game)
         ball = world.ball
-        if game.command in ("halt", "timeout"):
+        if game.command.halted:
             return halt(own)
         if ball is None:
             return hold_shape(own, self.field, own_sign, self.p.game_states)
         ours = game.for_team == self.team
-        restart = ours and game.command in ("kickoff", "free_kick")
+        restart = ours and game.command.kick_restart
         self._barred = self._double_touch_bar(game, own, opp, ball)
         intents = self._normal(world.t, own, opp, ball, own_sign, restart)
         self._taker = self._role_robot(ATTACKER) if restart else None
-        if game.command == "ball_placement" and game.placement is not None:
+        if game.command == RefereeCommand.BALL_PLACEMENT and game.placement is not None:
             return self._placement(world.t, intents, own, ball, game.placement, ours, own_sign)
-        if game.command == "penalty":
+        if game.command == RefereeCommand.PENALTY:
             return self._penalty(intents, own, opp, ball, game, ours, own_sign)
         kicker = next((rid for rid, role in self.roles.roles.items() if role == ATTACKER), None)
-        if game.command == "kickoff" and not game.ready:
+        if game.command == RefereeCommand.KICKOFF and not game.ready:
             kicker = None  # prepared, not started: nobody plays the ball yet
         return restart_rules(intents, game, ours, ball, self.field, own_sign, self.p.game_states,
                              self.p.robot_radius_m, kicker)  # fmt: skip
@@ -182,9 +182,9 @@ class Strategy:
         kick from the normal start that followed it (the ball moved: the restart was taken) until
         another robot, ours or theirs, comes within ``touched_m`` of the ball or the command changes."""
         barred = self._barred
-        if game.command == "normal" and self._taker is not None:
+        if game.command == RefereeCommand.NORMAL and self._taker is not None:
             barred = self._taker  # the command was our restart the frame before
-        if barred is None or game.command != "normal":
+        if barred is None or game.command != RefereeCommand.NORMAL:
             return None
         reach = self.p.robot_radius_m + self.p.ball_radius_m + self.p.touched_m
         others = [r for r in (*own.values(), *opp) if not (r.team == self.team and r.id == barred)]
@@ -281,13 +281,13 @@ class Strategy:
             if role == GOALIE:
                 out[rid], clears = goalie(r, ball, f, own_sign, p.defense, p.skills)
                 if clears:
-                    self.last_action[rid] = KickKind.CLEAR.value
+                    self.last_action[rid] = KickPurpose.CLEAR
             elif role == ATTACKER and rid == self._barred:
                 out[rid] = _facing_ball(r.x, r.y, ball)  # nobody else to play it: wait for theirs to touch it
             elif role == ATTACKER:
                 out[rid], kind = self.attacker.play(t, r, own, supporters, opp_xy, ball, attack_sign, self.passes,
                                                     restart)  # fmt: skip
-                self.last_action[rid] = kind.value
+                self.last_action[rid] = kind
             elif role == RECEIVER and passing is not None and not passing.kicked:
                 out[rid] = _facing_ball(*passing.point, ball)
             elif role == RECEIVER:

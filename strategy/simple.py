@@ -17,7 +17,7 @@ import numpy as np
 
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, Team, wrap_angle
-from cmdragons.messages import BallState, GameState, RobotCommand, RobotState, WorldState
+from cmdragons.messages import BallState, GameState, RefereeCommand, RobotCommand, RobotState, WorldState
 from strategy.defense import ball_to_clear, clear_target
 from strategy.evaluation import clearest_direction
 from strategy.game_states import (
@@ -72,7 +72,7 @@ class SimpleTeam:
         on = [r for r in world.robots if r.team == self.team and f.in_field(r.x, r.y, -f.dims.boundary_width_m)]
         own = sorted(on, key=lambda r: r.id)
         ball = world.ball
-        if not own or ball is None or game.command in ("halt", "timeout"):
+        if not own or ball is None or game.command.halted:
             return [RobotCommand(self.team, r.id) for r in own]
         own_sign = own_goal_sign(self.team, game)
         goal = (-own_sign * f.half_length, 0.0)
@@ -100,15 +100,15 @@ class SimpleTeam:
                 intents[r.id] = Intent(x, y, math.atan2(ball.y - y, ball.x - x))
         ours = game.for_team == self.team
         gs, radius = self.sp.game_states, self.sp.robot_radius_m
-        if game.command == "stop" or (game.command in ("kickoff", "free_kick") and not ours):
-            intents = keep_away(intents, ball, f, own_sign, gs, radius, game.command == "kickoff",
-                                game.command == "stop")  # fmt: skip
-        elif game.command == "ball_placement" and game.placement is not None:
+        if game.command == RefereeCommand.STOP or (game.command.kick_restart and not ours):
+            intents = keep_away(intents, ball, f, own_sign, gs, radius, game.command == RefereeCommand.KICKOFF,
+                                game.command == RefereeCommand.STOP)  # fmt: skip
+        elif game.command == RefereeCommand.BALL_PLACEMENT and game.placement is not None:
             intents = keep_off_line(intents, (ball.x, ball.y), game.placement, f, gs, radius)
             if ours and field_players:
                 placed = place_ball(chaser, ball, game.placement, self.sp.skills, gs, world.t, self._placing)
                 intents[chaser.id], self._placing = placed
-        elif game.command == "penalty":
+        elif game.command == RefereeCommand.PENALTY:
             intents = self._penalty(intents, own, world, ball, game.ready, ours, own_sign)
         return [steer(self.team, r.id, r.x, r.y, r.theta, intents[r.id], self.p) for r in own]
 

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from cmdragons.messages import Goal
+from cmdragons.messages import Goal, RefereeCommand
 from cmdragons.runtime.settings import Settings
 from cmdragons.team import Brain
 from sim.referee import Referee
@@ -89,7 +89,7 @@ def shoot(settings: Settings, shot: Shot, goalie: bool = True) -> bool:
     w = World(settings.field, s.physics, robot, s.ball, s.kicker, s.dribbler,
               robots_per_team={"blue": int(goalie), "yellow": 0})  # fmt: skip
     ref = Referee(w.field, w.robot_keys(), s.referee)
-    ref.give("force_start")
+    ref.give(RefereeCommand.FORCE_START)
     own = own_goal_sign("blue", ref.state())
     brain = Brain("blue", settings) if goalie else None
     goal_x = own * w.field.half_length
@@ -116,7 +116,8 @@ def shoot(settings: Settings, shot: Shot, goalie: bool = True) -> bool:
             d = math.hypot(dx, dy)
             w.place_ball(x, y, shot.speed_m_s * dx / d, shot.speed_m_s * dy / d)
             shot_at = k
-        events = w.step_frame(list(brain.step(w.ground_truth().world(), ref.state()).commands) if brain is not None else [])
+        commands = list(brain.step(w.ground_truth().world(), ref.state()).commands) if brain is not None else []
+        events = w.step_frame(commands)
         if shot_at is not None and any(isinstance(e, Goal) and e.x * own > 0 for e in events):
             return True
         if shot_at is not None and k > shot_at + round(SHOT_S * FPS):

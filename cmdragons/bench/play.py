@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from cmdragons.messages import GameState
+from cmdragons.messages import GameStage, GameState
 from cmdragons.runtime.bus import BaseStage, Publish
 from cmdragons.runtime.topics import Contract, Port
 from cmdragons.runtime.match import Match
@@ -67,7 +67,7 @@ def _shootout_row(settings: Settings, kicks: int, seed: int) -> dict[str, Any]:
     wall = time.perf_counter()
     for _ in range(limit):
         m.step()
-        if watch.stage == "post_game":
+        if watch.stage == GameStage.POST_GAME:
             break
     wall = time.perf_counter() - wall
     s = m.summary()
@@ -75,7 +75,7 @@ def _shootout_row(settings: Settings, kicks: int, seed: int) -> dict[str, Any]:
     ours, theirs = shot["blue"], shot["yellow"]
     return {"name": f"shootout_{kicks}_each_seed_{seed}", "taken_ours": ours["taken"], "scored_ours": ours["scored"],
             "taken_theirs": theirs["taken"], "saved_ours": theirs["taken"] - theirs["scored"],
-            "finished": watch.stage == "post_game", "seconds": s["seconds"], "realtime_factor": s["seconds"] / wall}
+            "finished": watch.stage == GameStage.POST_GAME, "seconds": s["seconds"], "realtime_factor": s["seconds"] / wall}
 
 
 def _match_row(settings: Settings, seed: int, seconds: float, opponent: str) -> dict[str, Any]:

@@ -120,7 +120,7 @@ def _packet_rows(settings: Settings, count: int) -> list[dict[str, Any]]:
     headings = {r.id: r.theta for r in world.robots if r.team == "blue"}
     chip = settings.sim.kicker.chip_angle_rad
     rpm = p.simulation.dribbler_full_rpm
-    game = msg.GameState(12.5, "free_kick", "blue", 1, 2, placement=(1.0, -0.5))
+    game = msg.GameState(12.5, msg.RefereeCommand.FREE_KICK, "blue", 1, 2, placement=(1.0, -0.5))
     teleport = msg.Teleport(1.0, tuple((r.team, r.id, r.x, r.y, r.theta) for r in world.robots), (0.0, 0.0))
     reader = RefereeReader()
     where = {(r.team, r.id): (r.x, r.y, r.theta) for r in world.robots}

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from cmdragons.messages import KickPurpose
 from cmdragons.runtime.bus import BaseStage, Publish
 from cmdragons.runtime.topics import ANY, Contract, Port
 
@@ -64,7 +65,7 @@ class RunCollector:
         self._ball_visible = 0
         self._ball_tracked = 0
         self._robot_visible: dict[int, int] = {}
-        self._actions: dict[int, str] = {}  # our robots' actions as the latest report had them
+        self._actions: dict[int, KickPurpose] = {}  # our robots' actions as the latest report had them
 
     def take(self, topic: str, message: Any) -> None:
         """One message of ``topic`` (one of :attr:`topics`, without the log's leading slash)."""
@@ -89,7 +90,7 @@ class RunCollector:
                 if r.team == self.ours and r.visible:
                     self._robot_visible[r.id] = self._robot_visible.get(r.id, 0) + 1
         elif topic == f"report/{self.ours}":
-            self._actions = {int(k): str(v) for k, v in message.actions.items()}
+            self._actions = dict(message.actions)
         elif topic == "referee":
             score = (message.score_blue, message.score_yellow)
             if not run.score_t or run.score_t[-1][1:] != score:
@@ -219,7 +220,8 @@ def write_report(run: RunData, summary: dict[str, Any], path: str | Path,
     # shot map: where each of our kicks started, by what it was for
     ax = fig.add_subplot(grid[0, 0])
     field_axes(ax, "Our kicks (where the ball was): shots, passes, clears; goals ringed")
-    marks = {"shot": ("o", "tab:red"), "pass": ("^", "tab:purple"), "clear": ("s", "tab:gray")}
+    marks = {KickPurpose.SHOT: ("o", "tab:red"), KickPurpose.PASS: ("^", "tab:purple"),
+             KickPurpose.CLEAR: ("s", "tab:gray")}
     for kind, (m, c) in marks.items():
         k = [e for e in run.kicks if e.get("team") == run.ours and e.get("action") == kind]
         ax.scatter([e["x"] for e in k], [e["y"] for e in k], marker=m, color=c, s=50,

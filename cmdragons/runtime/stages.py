@@ -28,6 +28,8 @@ from cmdragons.messages import (
     GameState,
     GroundTruth,
     Kick,
+    KickPurpose,
+    RefereeCommand,
     RobotCommand,
     RobotDetection,
     RobotReport,
@@ -413,9 +415,9 @@ class StatsStage(BaseStage):
         for e in ev.events:
             if isinstance(e, Kick) and e.team == self.team:
                 action = self._actions.get(e.id)
-                if action == "shot":
+                if action is KickPurpose.SHOT:
                     self.shots += 1
-                elif action == "pass":
+                elif action is KickPurpose.PASS:
                     self.passes_tried += 1
                     self.pending_pass = (e.t, e.id)
             elif isinstance(e, Contact):
@@ -430,7 +432,7 @@ class StatsStage(BaseStage):
             t_kick, passer = self.pending_pass
             gt = self._truth
             holders = [r for r in gt.robots if math.hypot(r.x - gt.ball.x, r.y - gt.ball.y) < self.hold_m]
-            if gt.t - t_kick > self.pass_timeout_s or self._game.command != "normal":
+            if gt.t - t_kick > self.pass_timeout_s or self._game.command != RefereeCommand.NORMAL:
                 self.pending_pass = None
             elif gt.t - t_kick > 0.2 and holders:
                 if any(r.team == self.team and r.id != passer for r in holders):

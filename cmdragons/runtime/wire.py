@@ -37,11 +37,13 @@ from cmdragons.messages import (
     Event,
     GameEvent,
     GameEvents,
+    GameStage,
     GameState,
     Goal,
     GroundTruth,
     Kick,
     MessageError,
+    RefereeCommand,
     NodeControl,
     RobotCommand,
     RobotDetection,
@@ -184,14 +186,11 @@ def _commands_from(m: Any) -> TeamCommands:
 
 # --- game state (the referee's word): the one place that maps GameState -------------------------
 
-_COMMAND_PB = {"halt": pb.GameState.HALT, "stop": pb.GameState.STOP, "kickoff": pb.GameState.KICKOFF,
-               "free_kick": pb.GameState.FREE_KICK, "normal": pb.GameState.NORMAL,
-               "force_start": pb.GameState.FORCE_START, "penalty": pb.GameState.PENALTY,
-               "timeout": pb.GameState.TIMEOUT, "ball_placement": pb.GameState.BALL_PLACEMENT}  # fmt: skip
+# the protobuf enums name ours in capitals: mapped by name, so a command or stage added to one and
+# not the other fails here at import
+_COMMAND_PB = {c: pb.GameState.Command.Value(c.name) for c in RefereeCommand}
 _PB_COMMAND = {v: k for k, v in _COMMAND_PB.items()}
-_STAGE_PB = {"pre_game": pb.GameState.PRE_GAME, "first_half": pb.GameState.FIRST_HALF,
-             "half_time": pb.GameState.HALF_TIME, "second_half": pb.GameState.SECOND_HALF,
-             "penalty_shootout": pb.GameState.PENALTY_SHOOTOUT, "post_game": pb.GameState.POST_GAME}  # fmt: skip
+_STAGE_PB = {s: pb.GameState.Stage.Value(s.name) for s in GameStage}
 _PB_STAGE = {v: k for k, v in _STAGE_PB.items()}
 
 
@@ -242,7 +241,7 @@ def _game_from(m: Any) -> GameState:
 
 def _game_event_to(e: GameEvent, into: Any) -> None:
     into.t, into.kind, into.value, into.limit = e.t, e.kind, e.value, e.limit
-    into.unit, into.restart = e.unit, e.restart
+    into.unit, into.restart = e.unit, e.restart or ""
     if e.team is not None:
         into.team = _TEAM_PB[e.team]
     if e.robot is not None:
@@ -253,7 +252,7 @@ def _game_event_to(e: GameEvent, into: Any) -> None:
 
 def _game_event_from(m: Any) -> GameEvent:
     return GameEvent(m.t, m.kind, _team(m.team) if m.HasField("team") else None,
-                     m.robot if m.HasField("robot") else None, m.value, m.limit, m.unit, m.restart,
+                     m.robot if m.HasField("robot") else None, m.value, m.limit, m.unit, m.restart or None,
                      _team(m.for_team) if m.HasField("for_team") else None)  # fmt: skip
 
 

@@ -15,6 +15,7 @@ from cmdragons.messages import (
     GameState,
     GroundTruth,
     Kick,
+    KickPurpose,
     RobotState,
     RobotTruth,
     SimEvents,
@@ -44,7 +45,7 @@ def write_log(path: Path, frames: int, ball_visible_every: int, robot_1_visible:
             visible = i % ball_visible_every == 0
             ball = BallState(0.0, 0.0, 0.0, 0.0, visible=visible) if visible or hidden else None
             log.write("/world/blue", t, WorldState(t, ball, seen, i))
-            log.write("/report/blue", t, TeamReport("blue", i, t, actions={0: "shot"}))
+            log.write("/report/blue", t, TeamReport("blue", i, t, actions={0: KickPurpose.SHOT}))
             kicks = (Kick(t, "blue", 0, 3.0, False),) if i == 30 else ()
             log.write("/events", t, SimEvents(i, t, (0.0, 0.0), kicks))
 

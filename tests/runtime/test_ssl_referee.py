@@ -91,14 +91,14 @@ def test_a_game_controllers_sequence_reads_as_our_commands() -> None:
         g = r.read(data)
         assert (g.command, g.for_team, g.ready) == want
     r.ball_moved()
-    assert r.read(_gc(R.NORMAL_START, 3, 3.5)).command == "normal"
+    assert r.read(_gc(R.NORMAL_START, 3, 3.5)).command == msg.RefereeCommand.NORMAL
     g = r.read(_gc(R.INDIRECT_FREE_YELLOW, 4, 9.0, stage=R.EXTRA_FIRST_HALF, blue_team_on_positive_half=True))
     assert (g.command, g.for_team, g.stage, g.blue_defends_negative_x) == ("free_kick", "yellow", "first_half", False)
     assert math.isinf(g.stage_time_left_s) and g.placement is None
     g = r.read(_gc(R.PREPARE_PENALTY_YELLOW, 5, 10.0, stage=R.PENALTY_SHOOTOUT_BREAK))
     assert (g.command, g.for_team, g.ready, g.stage) == ("penalty", "yellow", False, "half_time")
     assert (r.read(_gc(R.NORMAL_START, 6, 11.0)).command, r.read(_gc(R.STOP, 7, 12.0)).command) == ("penalty", "stop")
-    assert r.read(_gc(R.NORMAL_START, 8, 13.0)).command == "normal"  # a normal start after a stop: normal play
+    assert r.read(_gc(R.NORMAL_START, 8, 13.0)).command == msg.RefereeCommand.NORMAL  # a normal start after a stop: normal play
 
 
 @pytest.mark.parametrize("data", [b"\x08", b"garbage\xff\xff", _gc(R.HALT, 1, 1.0)[:-3]])

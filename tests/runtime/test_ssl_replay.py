@@ -98,7 +98,7 @@ def test_a_real_matchs_log_is_tracked_to_its_truth(tmp_path: Path) -> None:
     result = replay_league_log(tmp_path / "real.log", load_settings(), extra=taps)
     assert result.cameras == [0, 1, 2, 3] and result.records == {"VISION_2014": 960, "REFBOX_2013": 40}
     assert result.figures["ssl/vision_in"]["dropped"] == {} and len(worlds) >= 950
-    assert len(games) == 40 and all(g.command == "stop" for g in games)
+    assert len(games) == 40 and all(g.command == msg.RefereeCommand.STOP for g in games)
     w = worlds[-1]
     r = next(r for r in w.robots if r.team == "blue" and r.id == 2)
     # the truth at the world state's time (the tracker predicts ahead by its latency): 5 mm, 0.01 m/s

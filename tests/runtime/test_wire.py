@@ -61,7 +61,7 @@ REPORT = msg.TeamReport(
     (msg.RobotReport(0, "solved", (1.0, 2.0, 0.5), np.array([[0.0, 0.0], [1.0, 2.0]]),
                      msg.RobotCommand("blue", 0, 0.5, 0.25, 1.0), np.array([[0.0, 0.0], [0.1, 0.05]])),
      msg.RobotReport(1, "halt", (0.0, 0.0, 0.0))),
-    {0: "pass", 1: "support"}, np.array([[1.0, 1.0], [2.0, -1.0]]), np.array([0.25, 0.75]),
+    {0: msg.KickPurpose.PASS, 1: msg.KickPurpose.WAIT}, np.array([[1.0, 1.0], [2.0, -1.0]]), np.array([0.25, 0.75]),
 )  # fmt: skip
 
 

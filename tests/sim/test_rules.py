@@ -9,10 +9,10 @@ from collections.abc import Callable
 
 import pytest
 
-from cmdragons.geometry import Field, LeagueParams
-from cmdragons.messages import BallTruth, GameEvent, GroundTruth, RobotCommand, RobotTruth
+from cmdragons.geometry import Field, LeagueParams, Team
+from cmdragons.messages import BallTruth, GameEvent, GameStage, GroundTruth, RefereeCommand, RobotCommand, RobotTruth
 from sim.referee import Referee, RefereeParams
-from sim.rules import FoulWatch, RulesParams, Situation
+from sim.rules import FoulWatch, HeldBall, NoProgress, RulesParams, Situation, penalty_set, placed
 from sim.world import BallParams, DribblerParams, KickerParams, PhysicsParams, RobotParams, World
 
 LEAGUE = LeagueParams()
@@ -30,7 +30,7 @@ def scene(blue: int = 2, yellow: int = 2, brake: float = 6.0, **figures: object)
         w.place_robot(team, rid, -3.5 + 1.0 * i, -2.6, 0.0)
     w.place_ball(0.0, 1.5)
     ref = Referee(w.field, w.robot_keys(), RefereeParams(figures=RulesParams(**figures)))  # type: ignore[arg-type]
-    ref.give("normal")
+    ref.give(RefereeCommand.NORMAL)
     return w, ref
 
 
@@ -64,9 +64,9 @@ def test_crash_faster_than_the_limit_is_the_faster_robots_foul(speed: float, cal
     assert bool(crashes) == called
     if called:
         c = crashes[0]
-        assert (c.team, c.robot, c.restart, c.for_team) == ("blue", 0, "free_kick", "yellow")
+        assert (c.team, c.robot, c.restart, c.for_team) == ("blue", 0, RefereeCommand.FREE_KICK, "yellow")
         assert c.value > 1.5 and c.limit == 1.5
-        assert ref.command == "stop"  # then the free kick (placed by yellow)
+        assert ref.command == RefereeCommand.STOP  # then the free kick (placed by yellow)
 
 
 @pytest.mark.parametrize(("blue_v", "yellow_v", "called"), [
@@ -79,7 +79,7 @@ def test_crash_fault_goes_by_the_robots_own_speeds(blue_v: tuple[float, float], 
                                                     called: list[str]) -> None:  # fmt: skip
     # the rules: the velocity difference along the line decides a crash, the robots' own speeds whose it is
     watch = FoulWatch(Field(LEAGUE), RulesParams())
-    situation = Situation("normal", None, 0.0, -1, True)
+    situation = Situation(RefereeCommand.NORMAL, None, 0.0, -1, True)
     ball = BallTruth(2.0, 2.0, 0.0, 0.0, 0.0)
     calls = []
     for k, gap in enumerate((0.3, 2 * R)):  # apart, then touching
@@ -100,7 +100,7 @@ def test_pushing_an_opponent_farther_than_the_limit(push_s: float, called: bool)
     pushes = [c for c in calls if c.kind == "pushing"]
     assert bool(pushes) == called
     if called:
-        assert (pushes[0].team, pushes[0].robot, pushes[0].restart) == ("blue", 0, "free_kick")
+        assert (pushes[0].team, pushes[0].robot, pushes[0].restart) == ("blue", 0, RefereeCommand.FREE_KICK)
         assert pushes[0].value > 0.2
 
 
@@ -116,7 +116,8 @@ def test_ball_faster_than_the_limit_after_a_touch(speed: float, called: bool) ->
     fast = [c for c in calls if c.kind == "ball_too_fast"]
     assert bool(fast) == called
     if called:
-        assert (fast[0].team, fast[0].robot, fast[0].restart, fast[0].for_team) == ("blue", 1, "free_kick", "yellow")
+        assert (fast[0].team, fast[0].robot, fast[0].restart, fast[0].for_team) == \
+            ("blue", 1, RefereeCommand.FREE_KICK, "yellow")  # fmt: skip
         assert fast[0].value == pytest.approx(8.0, abs=0.3)
 
 
@@ -130,7 +131,7 @@ def test_dribbling_the_ball_farther_than_the_limit(seconds: float, called: bool)
     dribbles = [c for c in calls if c.kind == "excessive_dribbling"]
     assert bool(dribbles) == called
     if called:
-        assert dribbles[0].value > 1.0 and dribbles[0].restart == "free_kick"
+        assert dribbles[0].value > 1.0 and dribbles[0].restart is RefereeCommand.FREE_KICK
 
 
 @pytest.mark.parametrize(("ball_x", "called"), [(4.1, True), (3.0, False)])
@@ -143,7 +144,7 @@ def test_attacker_touching_the_ball_in_the_opponents_defense_area(ball_x: float,
     assert bool(fouls) == called
     if called:
         assert (fouls[0].team, fouls[0].robot, fouls[0].restart, fouls[0].for_team) == \
-            ("blue", 1, "free_kick", "yellow")  # fmt: skip
+            ("blue", 1, RefereeCommand.FREE_KICK, "yellow")  # fmt: skip
 
 
 @pytest.mark.parametrize(("rid", "called"), [(1, True), (0, False)])  # 0: the keeper may
@@ -155,8 +156,8 @@ def test_defender_in_its_own_defense_area_at_the_ball_gives_a_penalty(rid: int, 
     fouls = [c for c in calls if c.kind == "defender_in_defense_area"]
     assert bool(fouls) == called
     if called:
-        assert (fouls[0].restart, fouls[0].for_team) == ("penalty", "yellow")
-        assert ref.command == "penalty" and ref.for_team == "yellow" and not ref.ready  # the restart came
+        assert (fouls[0].restart, fouls[0].for_team) == (RefereeCommand.PENALTY, "yellow")
+        assert ref.command == RefereeCommand.PENALTY and ref.for_team == "yellow" and not ref.ready  # the restart came
         assert tuple(w.ball_body.position) == pytest.approx((-4.5 + 6.0, 0.0))  # on the mark, 6 m out
 
 
@@ -181,21 +182,21 @@ def test_double_touch_after_a_free_kick(again: bool, called: bool) -> None:
 @pytest.mark.parametrize(("speed", "called"), [(2.0, True), (1.0, False)])
 def test_robot_too_fast_in_a_stop(speed: float, called: bool) -> None:
     w, ref = scene()
-    ref.give("stop")
+    ref.give(RefereeCommand.STOP)
     w.place_robot("yellow", 1, -3.0, 0.5, 0.0)
     calls = play(w, ref, 3.0, drive("yellow", 1, vx=speed))
     fouls = [c for c in calls if c.kind == "stop_speed"]
     assert bool(fouls) == called
     if called:
         assert fouls[0].t >= 2.0  # after the rules' time to slow down
-        assert fouls[0].value == pytest.approx(2.0, abs=0.1) and fouls[0].restart == ""
-        assert ref.command == "stop"  # counted, play stays stopped
+        assert fouls[0].value == pytest.approx(2.0, abs=0.1) and fouls[0].restart is None
+        assert ref.command == RefereeCommand.STOP  # counted, play stays stopped
 
 
 @pytest.mark.parametrize(("gap", "called"), [(0.3, True), (0.8, False)])
 def test_robot_too_close_to_the_ball_in_a_stop(gap: float, called: bool) -> None:
     w, ref = scene()
-    ref.give("stop")
+    ref.give(RefereeCommand.STOP)
     w.place_robot("yellow", 1, 0.0 - gap - R, 1.5, 0.0)
     calls = play(w, ref, 2.5)
     fouls = [c for c in calls if c.kind == "stop_distance"]
@@ -220,13 +221,13 @@ def test_defender_too_close_at_a_free_kick(gap: float, called: bool) -> None:
 def test_keeper_holding_the_ball(seconds: float, called: bool) -> None:
     w, ref = scene()
     ref = Referee(w.field, w.robot_keys(), RefereeParams(keeper_held_ball_s=2.0))
-    ref.give("normal")
+    ref.give(RefereeCommand.NORMAL)
     w.place_ball(-4.2, 0.3)  # at rest in blue's area
     calls = play(w, ref, seconds)
     held = [c for c in calls if c.kind == "keeper_held_ball"]
     assert bool(held) == called
     if called:
-        assert (held[0].team, held[0].restart, held[0].for_team) == ("blue", "free_kick", "yellow")
+        assert (held[0].team, held[0].restart, held[0].for_team) == ("blue", RefereeCommand.FREE_KICK, "yellow")
 
 
 @pytest.mark.parametrize(("beyond", "called"), [(0.5, True), (-0.5, False)])
@@ -245,7 +246,7 @@ def test_ball_over_the_boundary(beyond: float, called: bool) -> None:
 
 def test_every_third_foul_is_a_yellow_card_that_sends_a_robot_off_for_its_time() -> None:
     w, ref = scene(blue=3, yellow=1, yellow_card_s=2.0)
-    ref.give("stop")
+    ref.give(RefereeCommand.STOP)
     for i, x in enumerate((-3.0, -2.5, -2.0)):
         w.place_robot("blue", i, x, -2.0, math.pi / 2)
     # three robots too fast in the stop: three fouls, a card; a robot but the keeper goes off
@@ -330,7 +331,7 @@ def test_a_placement_the_end_of_a_half_cuts_short_is_neither_tried_nor_failed() 
 def test_basic_rules_call_no_fouls() -> None:
     w, _ = scene()
     ref = Referee(w.field, w.robot_keys(), dataclasses.replace(RefereeParams(), rules="basic"))
-    ref.give("normal")
+    ref.give(RefereeCommand.NORMAL)
     w.place_robot("blue", 0, -1.0, 0.0, 0.0)
     w.place_robot("yellow", 0, 0.0, 0.0, math.pi)
     calls = play(w, ref, 1.0, drive("blue", 0, vx=2.5, until=40))
@@ -359,7 +360,7 @@ def test_a_penalty_shootout_alternates_its_kicks_and_ends_the_game() -> None:
     assert [t for t, _ in takers] == ["yellow", "blue", "yellow", "blue"]  # type: ignore[misc]
     assert ref.shootout == {"blue": {"taken": 2, "scored": 0}, "yellow": {"taken": 2, "scored": 1}}
     assert ref.score == {"blue": 0, "yellow": 0}  # the match's score stays
-    assert ref.command == "halt" and ref.stage == "post_game"
+    assert ref.command == RefereeCommand.HALT and ref.stage == GameStage.POST_GAME
 
 
 def test_no_shootout_after_a_match_decided_or_unconfigured() -> None:
@@ -368,7 +369,7 @@ def test_no_shootout_after_a_match_decided_or_unconfigured() -> None:
         if figures["shootout_kicks"]:
             ref.score["blue"] = 1  # decided: no shootout even when configured
         calls = play(w, ref, 2.5)
-        assert "stage_penalty_shootout" not in kinds(calls) and ref.stage == "post_game"
+        assert "stage_penalty_shootout" not in kinds(calls) and ref.stage == GameStage.POST_GAME
 
 
 def test_a_penalty_waits_for_a_ball_at_rest_and_ends_when_the_ball_turns_back() -> None:
@@ -381,7 +382,7 @@ def test_a_penalty_waits_for_a_ball_at_rest_and_ends_when_the_ball_turns_back() 
     assert ref.ready
     w.place_ball(mark[0] + 0.5, mark[1])  # played forward, now at rest: still the kicker's
     calls += play(w, ref, 1.0)
-    assert ref.command == "penalty" and "penalty_over" not in kinds(calls)
+    assert ref.command == RefereeCommand.PENALTY and "penalty_over" not in kinds(calls)
     w.place_ball(mark[0] + 0.5, mark[1], vx=-1.0)  # turned back toward the kicker's half
     calls += play(w, ref, 0.2)
     assert "penalty_over" in kinds(calls)
@@ -421,7 +422,7 @@ def test_a_shootout_kick_has_only_the_kicker_and_the_other_keeper_on_the_field()
     assert seen[1][1] == [("blue", 1), ("yellow", 0)]
     for _, _, ball, mark in seen:
         assert math.hypot(ball[0] - mark[0], ball[1] - mark[1]) < 0.01
-    assert ref.stage == "post_game"
+    assert ref.stage == GameStage.POST_GAME
 
 
 @pytest.mark.parametrize(("roll", "called"), [(0.0, True), (0.4, False)])
@@ -435,9 +436,68 @@ def test_no_progress_in_game_stops_play_and_force_starts_it(roll: float, called:
     assert bool(stuck) == called
     if called:
         assert stuck[0].t == pytest.approx(RefereeParams().no_progress_s, abs=0.05) and stuck[0].team is None
-        assert ref.command == "stop"
+        assert ref.command == RefereeCommand.STOP
         play(w, ref, RefereeParams().restart_delay_s + 0.1)
-        assert ref.command == "force_start"
+        assert ref.command == RefereeCommand.FORCE_START
         assert math.dist(tuple(w.ball_body.position), (0.0, 1.5)) < RefereeParams().no_progress_m  # not moved
     else:
-        assert ref.command == "normal"
+        assert ref.command == RefereeCommand.NORMAL
+
+
+def test_the_ball_held_in_a_defense_area_is_called_after_the_limit_of_watched_play() -> None:
+    pitch = Field(LEAGUE)
+    held = HeldBall(pitch, 2.0)
+    in_area = (-(pitch.half_length - 0.3), 0.0)
+    assert pitch.in_defense_area(*in_area) == -1
+    ts = [0.5 * k for k in range(12)]
+    calls = [(t, held.held(t, in_area, watched=True)) for t in ts]
+    assert [t for t, side in calls if side] == [2.0, 4.5]  # counting again from the frame after a call
+    assert all(side in (0, -1) for _, side in calls)
+    held = HeldBall(pitch, 2.0)
+    assert [held.held(t, in_area, watched=t != 1.5) for t in ts[:9]] == [0] * 8 + [-1]  # a break starts again
+    assert HeldBall(pitch, 2.0).held(5.0, (0.0, 0.0), watched=True) == 0
+
+
+def test_no_progress_is_the_ball_within_its_distance_for_the_limit() -> None:
+    stuck = NoProgress(limit_s=3.0, within_m=0.05)
+    wobble = [(0.0, 0.0), (0.03, 0.0), (0.0, 0.04), (0.04, 0.02)]
+    assert [stuck.stuck(float(k), wobble[k % 4], watched=True) for k in range(5)] == [False] * 3 + [True, False]
+    moving = NoProgress(limit_s=3.0, within_m=0.05)
+    assert not any(moving.stuck(float(k), (0.06 * k, 0.0), watched=True) for k in range(10))
+    unwatched = NoProgress(limit_s=3.0, within_m=0.05)
+    assert not any(unwatched.stuck(float(k), (0.0, 0.0), watched=k != 2) for k in range(5))
+
+
+def _frame(ball: tuple[float, float, float, float], *robots: tuple[Team, int, float, float]) -> GroundTruth:
+    bx, by, vx, vy = ball
+    return GroundTruth(0, 0.0, BallTruth(bx, by, 0.0, vx, vy),
+                       tuple(RobotTruth(t, i, x, y, 0.0, 0.0, 0.0, 0.0) for t, i, x, y in robots))
+
+
+@pytest.mark.parametrize(("ball", "robot_at", "off_m", "done"), [
+    ((1.1, 0.0, 0.0, 0.0), (2.0, 0.0), 0.1, True),  # within the tolerance, at rest, the placer clear
+    ((1.2, 0.0, 0.0, 0.0), (2.0, 0.0), 0.2, False),  # too far off the target
+    ((1.1, 0.0, 0.2, 0.0), (2.0, 0.0), 0.1, False),  # still rolling
+    ((1.1, 0.0, 0.0, 0.0), (1.1 + R + 0.03, 0.0), 0.1, False),  # the placer still at the ball
+])  # fmt: skip
+def test_a_placement_succeeds_with_the_ball_near_the_target_at_rest_and_the_placer_clear(
+        ball: tuple[float, float, float, float], robot_at: tuple[float, float], off_m: float,
+        done: bool) -> None:  # fmt: skip
+    gt = _frame(ball, ("blue", 0, *robot_at), ("yellow", 0, 1.1 + R + 0.03, 0.1))  # the other team may stand there
+    off, ok = placed(gt, "blue", (1.0, 0.0), Field(LEAGUE), RulesParams())
+    assert off == pytest.approx(off_m) and ok is done
+
+
+@pytest.mark.parametrize(("yellow_keeper_x", "blue_mate_x", "ready"), [
+    (-4.45, 0.5, True), (-4.0, 0.5, False),  # the keeper off its line
+    (-4.45, -2.0, False),  # a team-mate of the kicker 0.5 m behind the mark (at -2.5 m): less than 1 m
+])  # fmt: skip
+def test_a_penalty_is_set_when_all_but_kicker_and_keeper_are_behind_the_mark(
+        yellow_keeper_x: float, blue_mate_x: float, ready: bool) -> None:  # fmt: skip
+    pitch = Field(LEAGUE)
+    mark = (-pitch.half_length + 2.0, 0.0)  # blue attacks -x
+    gt = _frame((*mark, 0.0, 0.0), ("blue", 1, mark[0] + 0.2, 0.0), ("blue", 2, blue_mate_x, 1.0),
+                ("yellow", 0, -pitch.half_length + (yellow_keeper_x + 4.5), 0.0), ("yellow", 1, 0.0, -1.0),
+                ("yellow", 2, mark[0] + 0.3, 0.5))  # fmt: skip
+    assert penalty_set(gt, "blue", mark, -1.0, pitch, RulesParams(), off={("yellow", 2)}) is ready
+    assert not penalty_set(gt, "blue", mark, -1.0, pitch, RulesParams(), off=set())  # yellow 2 on the field, ahead

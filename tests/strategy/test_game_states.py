@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from cmdragons.geometry import Field, LeagueParams
-from cmdragons.messages import BallState, GameState, RobotState
+from cmdragons.messages import BallState, GameState, RefereeCommand, RobotState
 from strategy.game_states import (
     GameStateParams,
     halt,
@@ -156,6 +156,6 @@ def test_restart_rules_by_command() -> None:
     assert rules("free_kick", True) == intents  # ours: the attacker takes it
     for command, ours in (("stop", True), ("free_kick", False), ("kickoff", False)):
         # slow in a stop and at their kickoff
-        assert rules(command, ours) == keep_away(intents, ball, FIELD, -1.0, P, RADIUS, command == "kickoff",
-                                                 command in ("stop", "kickoff"))  # fmt: skip
+        assert rules(command, ours) == keep_away(intents, ball, FIELD, -1.0, P, RADIUS, command == RefereeCommand.KICKOFF,
+                                                 command in (RefereeCommand.STOP, RefereeCommand.KICKOFF))  # fmt: skip
     assert rules("kickoff", True) == our_kickoff(intents, FIELD, -1.0, P, RADIUS, None)

@@ -10,7 +10,7 @@ import pytest
 from cmdragons.geometry import Field, LeagueParams
 from cmdragons.messages import BallState, RobotState
 from strategy.evaluation import PassParams
-from strategy.kicking import Attacker, Kick, KickKind, KickParams, StillBall, contest_angle, decide_kick
+from strategy.kicking import Attacker, Kick, KickParams, KickPurpose, StillBall, contest_angle, decide_kick
 from strategy.passing import PassPlay, PassPlayParams
 from strategy.plays import StrategyParams
 from strategy.skills import SkillParams, pass_speed
@@ -32,13 +32,13 @@ def _decide(ball: BallState, own: dict[int, RobotState], supporters: list[int], 
 
 
 def test_the_kinds_keep_the_match_statistics_names() -> None:
-    assert [k.value for k in KickKind] == ["shot", "pass", "clear", "wait"]
+    assert [k.value for k in KickPurpose] == ["shot", "pass", "clear", "wait"]
 
 
 def test_an_open_goal_near_by_is_shot_at_full_speed() -> None:
     ball = BallState(FIELD.half_length - 1.5, 0.0, 0.0, 0.0)
     kick = _decide(ball, {1: _robot(1, ball.x - 0.2, 0.0)}, [], NONE)
-    assert kick.kind is KickKind.SHOT and kick.speed == SKILLS.max_kick_m_s
+    assert kick.kind is KickPurpose.SHOT and kick.speed == SKILLS.max_kick_m_s
     assert kick.target[0] == FIELD.half_length and abs(kick.target[1]) < FIELD.goal_half_width
 
 
@@ -47,7 +47,7 @@ def test_a_free_supporter_gets_a_pass_at_the_speed_that_arrives() -> None:
     ball = BallState(-2.0, 0.0, 0.0, 0.0)
     own = {1: _robot(1, -2.2, 0.0), 3: _robot(3, 0.5, 1.0)}
     kick = _decide(ball, own, [3], np.array([[0.0, -2.5]]))
-    assert kick.kind is KickKind.PASS and kick.receiver == 3 and kick.target == (0.5, 1.0)
+    assert kick.kind is KickPurpose.PASS and kick.receiver == 3 and kick.target == (0.5, 1.0)
     assert kick.speed == pytest.approx(pass_speed(math.hypot(2.5, 1.0), SKILLS))
 
 
@@ -55,7 +55,7 @@ def test_no_pass_far_back_and_no_supporter_means_a_clear() -> None:
     ball = BallState(-1.0, 0.0, 0.0, 0.0)
     own = {1: _robot(1, -1.2, 0.0), 3: _robot(3, -1.0 - K.max_back_pass_m - 0.5, 1.5)}  # behind the ball
     kick = _decide(ball, own, [3], NONE)
-    assert kick.kind is KickKind.CLEAR and kick.speed == K.clear_speed_m_s
+    assert kick.kind is KickPurpose.CLEAR and kick.speed == K.clear_speed_m_s
     assert math.hypot(kick.target[0] - ball.x, kick.target[1] - ball.y) == pytest.approx(K.clear_reach_m)
     assert kick.target[0] > ball.x  # forward, toward their goal
 
@@ -66,7 +66,7 @@ def test_a_decided_pass_is_kept_to_its_point() -> None:
     passes = PassPlay(PassPlayParams())
     passes.plan(0.0, passer=1, receiver=3, point=(0.5, 1.0), shoot_at=None)
     kick = _decide(ball, own, [3], np.array([[0.0, -2.5]]), passes)
-    assert kick.kind is KickKind.PASS and kick.target == (0.5, 1.0)
+    assert kick.kind is KickPurpose.PASS and kick.target == (0.5, 1.0)
 
 
 @pytest.mark.parametrize(("ball_v", "opponent", "contested"), [
@@ -115,7 +115,7 @@ def test_a_ball_coming_at_the_attacker_is_met_on_its_path() -> None:
     intent, kind = attacker.play(0.0, robot, {1: robot}, [], NONE, ball, 1.0, passes)
     assert not intent.avoid_ball  # the ball is met, not avoided
     assert abs(intent.y) < 1e-9 and -2.0 < intent.x <= 0.0  # on its path, between it and the robot
-    assert kind in (KickKind.SHOT, KickKind.CLEAR)
+    assert kind in (KickPurpose.SHOT, KickPurpose.CLEAR)
 
 
 def test_a_contested_ball_lying_still_is_driven_through_after_the_stall_time() -> None:
@@ -125,11 +125,11 @@ def test_a_contested_ball_lying_still_is_driven_through_after_the_stall_time() -
     opponents = np.array([[1.8, 0.5]])
     attacker.watch(0.0, ball)
     before, kind = attacker.play(0.0, robot, {1: robot}, [], opponents, ball, 1.0, passes)
-    assert kind is KickKind.CLEAR and before.avoid_ball  # lining up on its side, at the contest angle
+    assert kind is KickPurpose.CLEAR and before.avoid_ball  # lining up on its side, at the contest angle
     assert abs(math.remainder(before.theta - math.pi, 2 * math.pi)) == pytest.approx(K.contest_turn_rad)
     attacker.watch(K.stall_s + 0.1, ball)
     after, kind = attacker.play(K.stall_s + 0.1, robot, {1: robot}, [], opponents, ball, 1.0, passes)
-    assert kind is KickKind.CLEAR
+    assert kind is KickPurpose.CLEAR
     assert after.kick_speed == K.clear_speed_m_s and not after.avoid_ball  # through the ball from its side
     assert abs(math.remainder(after.theta - math.pi, 2 * math.pi)) == pytest.approx(K.contest_turn_rad)
     assert passes.current is None
@@ -148,7 +148,7 @@ def test_a_ball_in_or_at_their_defense_area_is_left_to_them(ball: BallState, rob
     r = _robot(1, *robot)
     attacker.watch(0.0, ball)
     intent, kind = attacker.play(0.0, r, {1: r}, [], NONE, ball, 1.0, passes)
-    assert kind is KickKind.WAIT and intent.avoid_ball and intent.kick_speed == 0.0
+    assert kind is KickPurpose.WAIT and intent.avoid_ball and intent.kick_speed == 0.0
     assert FIELD.in_defense_area(intent.x, intent.y, SKILLS.robot_radius_m + K.area_wait_m - 1e-9) == 0
     assert FIELD.in_defense_area(intent.x, intent.y, SKILLS.robot_radius_m + K.area_wait_m + 0.01) == 1  # by it
     assert intent.theta == pytest.approx(math.atan2(ball.y - intent.y, ball.x - intent.x))
@@ -161,5 +161,5 @@ def test_a_ball_clear_of_their_defense_area_is_played() -> None:
     r = _robot(1, ball.x - 0.5, 0.5)
     attacker.watch(0.0, ball)
     intent, kind = attacker.play(0.0, r, {1: r}, [], NONE, ball, 1.0, passes)
-    assert kind is KickKind.SHOT  # lining up behind the ball for it
+    assert kind is KickPurpose.SHOT  # lining up behind the ball for it
     assert math.hypot(intent.x - ball.x, intent.y - ball.y) < 0.5 and intent.x < ball.x

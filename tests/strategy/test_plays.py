@@ -9,7 +9,7 @@ import pytest
 
 from cmdragons.config import ConfigError, parse
 from cmdragons.geometry import Field, LeagueParams
-from cmdragons.messages import BallState, GameState, RobotState, WorldState
+from cmdragons.messages import BallState, GameState, RefereeCommand, RobotState, WorldState
 from strategy.defense import DefenseParams
 from strategy.plays import Strategy, StrategyParams, off_ball_line
 from strategy.roles import Role, RoleKind
@@ -53,10 +53,10 @@ def test_distance_to_the_ball_when_the_rules_ask(seed: int, command: str) -> Non
     world = random_world(rng, 6, 6)
     assert world.ball is not None
     p = StrategyParams()
-    game = GameState(0.0, command, for_team="yellow" if command == "free_kick" else None)
+    game = GameState(0.0, command, for_team="yellow" if command == RefereeCommand.FREE_KICK else None)
     for rid, it in Strategy("blue", FIELD, p).decide(world, game).items():
         assert math.hypot(it.x - world.ball.x, it.y - world.ball.y) >= 0.5 + p.robot_radius_m, rid
-        if command == "stop":
+        if command == RefereeCommand.STOP:
             assert it.max_speed_m_s is not None and it.max_speed_m_s <= 1.5
         assert it.kick_speed == 0.0
 

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from cmdragons.messages import BallState, GameEvent, RobotCommand, WorldState
+from cmdragons.messages import BallState, GameEvent, RefereeCommand, RobotCommand, WorldState
 from cmdragons.runtime.settings import load_settings
 from cmdragons.team import Brain
 from sim.referee import Referee
@@ -173,7 +173,7 @@ def test_a_robot_beside_the_ball_in_a_corner_at_a_stop_leaves_it_without_touchin
     w.place_robot("blue", 1, *robot)
     w.place_robot("blue", 2, -3.0, -2.0, 0.0)
     w.place_robot("yellow", 0, 4.0, 0.0, math.pi)
-    ref.give("stop")
+    ref.give(RefereeCommand.STOP)
     gaps: list[float] = []
 
     def each(w: World, ref: Referee) -> None:
@@ -261,7 +261,7 @@ def test_stop_keeps_every_robot_away_from_the_ball_and_slow_every_frame() -> Non
     for k in range(6):  # all around the ball, inside the rules' distance
         a = k * math.pi / 3
         w.place_robot("blue", k, ball[0] + (0.25 + R) * math.cos(a), ball[1] + (0.25 + R) * math.sin(a), a + math.pi)
-    ref.give("stop")
+    ref.give(RefereeCommand.STOP)
     worst = {"speed": 0.0, "gap": math.inf}
 
     def check(w: World, ref: Referee) -> None:
@@ -276,7 +276,7 @@ def test_stop_keeps_every_robot_away_from_the_ball_and_slow_every_frame() -> Non
     assert worst["speed"] < RULES.stop_speed_m_s
     assert worst["gap"] >= RULES.stop_distance_m
     assert not [e for e in calls if e.kind.startswith("stop_")]
-    assert ref.command == "stop"
+    assert ref.command == RefereeCommand.STOP
 
 
 @pytest.mark.parametrize(("blue", "spot", "taker"), [

@@ -18,7 +18,7 @@ from typing import Any
 from google.protobuf.message import DecodeError
 
 from cmdragons.geometry import Team
-from cmdragons.messages import GameState, MessageError, TeamInfo
+from cmdragons.messages import GameStage, GameState, MessageError, RefereeCommand, TeamInfo
 from cmdragons.runtime.proto import ssl_referee_pb2 as ref_pb
 
 __all__ = ["RefereeReader", "referee_packet", "referee_proto"]
@@ -26,36 +26,38 @@ __all__ = ["RefereeReader", "referee_packet", "referee_proto"]
 US = 1e6  # microseconds a second
 MM = 1000.0
 R = ref_pb.Referee
+C, S = RefereeCommand, GameStage
 
 # (our command, its team) <-> the league's command; kickoff and penalty as their prepare commands
-_TEAM_COMMANDS: dict[tuple[str, Team], Any] = {
-    ("kickoff", "yellow"): R.PREPARE_KICKOFF_YELLOW, ("kickoff", "blue"): R.PREPARE_KICKOFF_BLUE,
-    ("penalty", "yellow"): R.PREPARE_PENALTY_YELLOW, ("penalty", "blue"): R.PREPARE_PENALTY_BLUE,
-    ("free_kick", "yellow"): R.DIRECT_FREE_YELLOW, ("free_kick", "blue"): R.DIRECT_FREE_BLUE,
-    ("timeout", "yellow"): R.TIMEOUT_YELLOW, ("timeout", "blue"): R.TIMEOUT_BLUE,
-    ("ball_placement", "yellow"): R.BALL_PLACEMENT_YELLOW, ("ball_placement", "blue"): R.BALL_PLACEMENT_BLUE,
+_TEAM_COMMANDS: dict[tuple[RefereeCommand, Team], Any] = {
+    (C.KICKOFF, "yellow"): R.PREPARE_KICKOFF_YELLOW, (C.KICKOFF, "blue"): R.PREPARE_KICKOFF_BLUE,
+    (C.PENALTY, "yellow"): R.PREPARE_PENALTY_YELLOW, (C.PENALTY, "blue"): R.PREPARE_PENALTY_BLUE,
+    (C.FREE_KICK, "yellow"): R.DIRECT_FREE_YELLOW, (C.FREE_KICK, "blue"): R.DIRECT_FREE_BLUE,
+    (C.TIMEOUT, "yellow"): R.TIMEOUT_YELLOW, (C.TIMEOUT, "blue"): R.TIMEOUT_BLUE,
+    (C.BALL_PLACEMENT, "yellow"): R.BALL_PLACEMENT_YELLOW, (C.BALL_PLACEMENT, "blue"): R.BALL_PLACEMENT_BLUE,
 }  # fmt: skip
-_PLAIN = {"halt": R.HALT, "stop": R.STOP, "normal": R.NORMAL_START, "force_start": R.FORCE_START}
-_FROM_LEAGUE: dict[int, tuple[str, Team | None]] = {
+_PLAIN = {C.HALT: R.HALT, C.STOP: R.STOP, C.NORMAL: R.NORMAL_START, C.FORCE_START: R.FORCE_START}
+_FROM_LEAGUE: dict[int, tuple[RefereeCommand, Team | None]] = {
     **{v: k for k, v in _TEAM_COMMANDS.items()}, **{v: (k, None) for k, v in _PLAIN.items()},
-    R.INDIRECT_FREE_YELLOW: ("free_kick", "yellow"), R.INDIRECT_FREE_BLUE: ("free_kick", "blue"),
-    R.GOAL_YELLOW: ("stop", None), R.GOAL_BLUE: ("stop", None),  # deprecated: the game stopped for a goal
+    R.INDIRECT_FREE_YELLOW: (C.FREE_KICK, "yellow"), R.INDIRECT_FREE_BLUE: (C.FREE_KICK, "blue"),
+    R.GOAL_YELLOW: (C.STOP, None), R.GOAL_BLUE: (C.STOP, None),  # deprecated: the game stopped for a goal
 }  # fmt: skip
-_STAGE_TO = {"pre_game": R.NORMAL_FIRST_HALF_PRE, "first_half": R.NORMAL_FIRST_HALF, "half_time": R.NORMAL_HALF_TIME,
-             "second_half": R.NORMAL_SECOND_HALF, "penalty_shootout": R.PENALTY_SHOOTOUT,
-             "post_game": R.POST_GAME}  # fmt: skip
+_PREPARED = (C.KICKOFF, C.PENALTY)  # the commands a normal start starts
+_STAGE_TO = {S.PRE_GAME: R.NORMAL_FIRST_HALF_PRE, S.FIRST_HALF: R.NORMAL_FIRST_HALF, S.HALF_TIME: R.NORMAL_HALF_TIME,
+             S.SECOND_HALF: R.NORMAL_SECOND_HALF, S.PENALTY_SHOOTOUT: R.PENALTY_SHOOTOUT,
+             S.POST_GAME: R.POST_GAME}  # fmt: skip
 _STAGE_FROM = {**{v: k for k, v in _STAGE_TO.items()},
-               R.NORMAL_SECOND_HALF_PRE: "half_time", R.EXTRA_TIME_BREAK: "half_time",
-               R.EXTRA_FIRST_HALF_PRE: "half_time", R.EXTRA_FIRST_HALF: "first_half",
-               R.EXTRA_HALF_TIME: "half_time", R.EXTRA_SECOND_HALF_PRE: "half_time",
-               R.EXTRA_SECOND_HALF: "second_half", R.PENALTY_SHOOTOUT_BREAK: "half_time"}  # fmt: skip
+               R.NORMAL_SECOND_HALF_PRE: S.HALF_TIME, R.EXTRA_TIME_BREAK: S.HALF_TIME,
+               R.EXTRA_FIRST_HALF_PRE: S.HALF_TIME, R.EXTRA_FIRST_HALF: S.FIRST_HALF,
+               R.EXTRA_HALF_TIME: S.HALF_TIME, R.EXTRA_SECOND_HALF_PRE: S.HALF_TIME,
+               R.EXTRA_SECOND_HALF: S.SECOND_HALF, R.PENALTY_SHOOTOUT_BREAK: S.HALF_TIME}  # fmt: skip
 
 
 def _us(seconds: float) -> int:
     return round(seconds * US)
 
 
-def _command_code(command: str, team: Team | None) -> Any:
+def _command_code(command: RefereeCommand, team: Team | None) -> Any:
     if command in _PLAIN:
         return _PLAIN[command]
     if team is None:
@@ -81,7 +83,7 @@ def _team_from(m: Any) -> TeamInfo:
 
 def referee_proto(g: GameState, source: str = "cmdragons", names: tuple[str, str] = ("blue", "yellow")) -> Any:
     """The league's Referee message of our game state (``names``: the blue and yellow teams')."""
-    ready_start = g.command in ("kickoff", "penalty") and g.ready
+    ready_start = g.command in _PREPARED and g.ready
     code = R.NORMAL_START if ready_start else _command_code(g.command, g.for_team)
     m = R(packet_timestamp=_us(g.t), stage=_STAGE_TO[g.stage], command=code, command_counter=g.command_counter,
           command_timestamp=_us(g.command_t), blue_team_on_positive_half=not g.blue_defends_negative_x,
@@ -113,7 +115,7 @@ class RefereeReader:
     starts) and whether the ball has moved since."""
 
     def __init__(self) -> None:
-        self._prepared: tuple[str, Team] | None = None  # kickoff or penalty and its team
+        self._prepared: tuple[RefereeCommand, Team] | None = None  # kickoff or penalty and its team
         self._in_play = False
         self.last: GameState | None = None
 
@@ -138,7 +140,7 @@ class RefereeReader:
             raise MessageError(f"unknown referee stage code {m.stage}")
         command, team = _FROM_LEAGUE[m.command]
         ready = True
-        if command in ("kickoff", "penalty"):
+        if command in _PREPARED:
             ready = False
             if self._prepared != (command, team):
                 self._in_play = False
@@ -147,7 +149,7 @@ class RefereeReader:
         elif m.command == R.NORMAL_START:
             if m.HasField("started") and m.started in _FROM_LEAGUE:
                 kind, started_for = _FROM_LEAGUE[m.started]
-                if kind in ("kickoff", "penalty") and started_for is not None:
+                if kind in _PREPARED and started_for is not None:
                     self._prepared = (kind, started_for)
             if m.HasField("ball_in_play"):
                 self._in_play = m.ball_in_play
@@ -155,7 +157,7 @@ class RefereeReader:
                 command, team = self._prepared
         else:
             self._prepared, self._in_play = None, False
-        nxt: tuple[str | None, Team | None] = (None, None)
+        nxt: tuple[RefereeCommand | None, Team | None] = (None, None)
         if m.HasField("next_command") and m.next_command in _FROM_LEAGUE:
             nxt = _FROM_LEAGUE[m.next_command]
         p = m.designated_position

@@ -261,7 +261,7 @@ class RefereeInStage(SocketStage):
                 self._take(data, publish)
             return
         g, b = self.reader.last, message.ball
-        taking = g is not None and g.command in ("kickoff", "penalty") and g.ready and g.placement is not None
+        taking = g is not None and g.command.prepared and g.ready and g.placement is not None
         if taking and b is not None and self._last is not None and g is not None and g.placement is not None \
                 and math.hypot(b.x - g.placement[0], b.y - g.placement[1]) > self.moved_m:  # fmt: skip
             self.reader.ball_moved()

@@ -1,0 +1,131 @@
+"""The game controller's state machine alone: commands and their counter, which commands have the
+ball in play, the stages in order with their lengths, the shootout's kickers, fouls into cards."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from cmdragons.geometry import Team
+from cmdragons.messages import GameStage, RefereeCommand
+from sim.game_controller import Card, Cards, GameController, Tally, shootout_kicker, stage_after
+from sim.rules import RulesParams
+
+C, S = RefereeCommand, GameStage
+
+
+def test_the_counter_and_time_move_only_when_the_command_changes() -> None:
+    gc = GameController(RulesParams(), halves=True)
+    assert (gc.command, gc.for_team, gc.ready, gc.counter) == (C.KICKOFF, "blue", True, 0)
+    gc.give(1.0, C.KICKOFF, "blue")
+    assert (gc.counter, gc.command_t) == (0, 0.0)
+    gc.give(2.0, C.STOP, None)
+    gc.give(3.0, C.STOP, None)
+    assert (gc.counter, gc.command_t) == (1, 2.0)
+    gc.give(4.0, C.PENALTY, "yellow", ready=False)
+    gc.give(5.0, C.PENALTY, "yellow", ready=True)  # the normal start is a change
+    assert (gc.counter, gc.command_t, gc.ready) == (3, 5.0, True)
+
+
+@pytest.mark.parametrize(("command", "ready", "in_play", "live"), [
+    (C.HALT, True, False, False), (C.STOP, True, False, False), (C.TIMEOUT, True, False, False),
+    (C.BALL_PLACEMENT, True, False, False), (C.KICKOFF, False, False, True), (C.FREE_KICK, True, False, True),
+    (C.NORMAL, True, True, True), (C.FORCE_START, True, True, True), (C.PENALTY, False, False, False),
+    (C.PENALTY, True, True, True),
+])  # fmt: skip
+def test_which_commands_have_the_ball_in_play(command: RefereeCommand, ready: bool, in_play: bool,
+                                              live: bool) -> None:  # fmt: skip
+    gc = GameController(RulesParams(), halves=True)
+    gc.give(0.0, command, None if command in (C.HALT, C.STOP, C.NORMAL, C.FORCE_START) else "blue", ready)
+    assert (gc.in_play(), gc.live()) == (in_play, live)
+
+
+@pytest.mark.parametrize(("stage", "half_time_s", "kicks", "always", "drawn", "after"), [
+    (S.FIRST_HALF, 300.0, 0, False, True, S.HALF_TIME), (S.FIRST_HALF, 0.0, 0, False, True, S.SECOND_HALF),
+    (S.HALF_TIME, 300.0, 0, False, True, S.SECOND_HALF), (S.SECOND_HALF, 300.0, 0, False, True, S.POST_GAME),
+    (S.SECOND_HALF, 300.0, 5, False, True, S.PENALTY_SHOOTOUT), (S.SECOND_HALF, 300.0, 5, False, False, S.POST_GAME),
+    (S.SECOND_HALF, 300.0, 5, True, False, S.PENALTY_SHOOTOUT), (S.PENALTY_SHOOTOUT, 300.0, 5, True, True, S.POST_GAME),
+])  # fmt: skip
+def test_the_stages_follow_in_the_rules_order(stage: GameStage, half_time_s: float, kicks: int, always: bool,
+                                              drawn: bool, after: GameStage) -> None:  # fmt: skip
+    rules = RulesParams(half_time_s=half_time_s, shootout_kicks=kicks, shootout_always=always)
+    assert stage_after(stage, rules, drawn) is after
+
+
+def test_each_stage_lasts_what_the_rules_give_it() -> None:
+    rules = RulesParams(half_s=25.0, half_time_s=5.0)
+    assert GameController(rules, halves=True).stage_end == 25.0
+    assert GameController(rules, halves=False).stage_end == math.inf
+    gc = GameController(rules, halves=True)
+    assert not gc.stage_over(24.9) and gc.stage_over(25.0)
+    for stage, end in ((S.HALF_TIME, 35.0), (S.SECOND_HALF, 55.0), (S.PENALTY_SHOOTOUT, math.inf),
+                       (S.POST_GAME, math.inf)):  # fmt: skip
+        gc.enter(stage, 30.0)
+        assert (gc.stage, gc.stage_end) == (stage, end)
+
+
+def _kicks(blue: tuple[int, int], yellow: tuple[int, int]) -> dict[Team, dict[str, int]]:
+    return {"blue": {"taken": blue[0], "scored": blue[1]}, "yellow": {"taken": yellow[0], "scored": yellow[1]}}
+
+
+@pytest.mark.parametrize(("blue", "yellow", "always", "kicker"), [
+    ((0, 0), (0, 0), False, "yellow"), ((0, 0), (1, 1), False, "blue"), ((4, 2), (5, 3), False, "blue"),
+    ((5, 3), (5, 3), False, "yellow"),  # drawn after five each: one each more
+    ((6, 4), (6, 3), False, None), ((5, 3), (5, 2), False, None), ((5, 3), (5, 3), True, None),
+    ((2, 0), (3, 3), False, "blue"),  # decided already, but not over before blue's kick
+])  # fmt: skip
+def test_the_shootouts_kickers_in_turn_until_decided(blue: tuple[int, int], yellow: tuple[int, int], always: bool,
+                                                     kicker: Team | None) -> None:  # fmt: skip
+    assert shootout_kicker(_kicks(blue, yellow), RulesParams(shootout_kicks=5, shootout_always=always)) == kicker
+
+
+def test_every_third_foul_earns_a_card_and_the_third_running_is_red() -> None:
+    cards = Cards(RulesParams(fouls_per_yellow_card=3, red_card_yellow_cards=3, yellow_card_s=10.0))
+    assert [cards.foul("blue") for _ in range(7)] == [False, False, True, False, False, True, False]
+    assert cards.fouls == {"blue": 7, "yellow": 0}
+    assert not cards.next_is_red("blue")
+    cards.book("blue", 3, red=False)
+    cards.book("blue", 2, red=False)
+    assert cards.next_is_red("blue") and not cards.next_is_red("yellow")
+    assert (cards.yellow, cards.red) == ({"blue": 2, "yellow": 0}, {"blue": 0, "yellow": 0})
+
+
+def test_a_card_sends_off_the_fouling_field_player_else_the_highest_id() -> None:
+    cards = Cards(RulesParams(keepers={"blue": 0, "yellow": 1}))
+    keys = [("blue", i) for i in range(4)] + [("yellow", i) for i in range(3)]
+    assert cards.choose("blue", 2, keys) == 2
+    assert cards.choose("blue", 0, keys) == 3  # the keeper stays: the highest id goes
+    assert cards.choose("blue", None, keys) == 3
+    cards.off[("blue", 3)] = False
+    assert cards.choose("blue", 3, keys) == 2  # off already
+    cards.off.update({("yellow", 0): True, ("yellow", 2): True})
+    assert cards.choose("yellow", None, keys) == 1  # only the keeper is left
+
+
+def test_cards_run_out_and_their_robots_come_back_unless_sent_off_for_good() -> None:
+    cards = Cards(RulesParams(yellow_card_s=2.0))
+    cards.book("blue", 4, red=False)
+    cards.off[("blue", 4)] = False
+    cards.book("yellow", 1, red=False)
+    cards.off[("yellow", 1)] = True  # since sent off for good
+    assert cards.times_left("blue") == (2.0,)
+    assert cards.run(1.5) == [] and cards.times_left("blue") == pytest.approx((0.5,))
+    out = cards.run(0.5)
+    assert out == [Card("blue", 4, 0.0), Card("yellow", 1, 0.0)] and cards.running == []
+    assert [cards.back(c) for c in out] == [True, False]
+    assert cards.off == {("yellow", 1): True}
+
+
+def test_the_tally_counts_placements_and_cuts_short_the_one_under_way() -> None:
+    tally = Tally()
+    tally.placed("blue", 4.0)
+    tally.placed("blue", 8.0)
+    tally.failed("blue")
+    tally.failed("yellow")
+    assert tally.may_place("blue", 2) and not tally.may_place("blue", 1)
+    figures = tally.figures(under_way="yellow")
+    assert figures["placements"] == {"blue": {"tried": 3, "succeeded": 2, "cut_short": 0, "median_s": 6.0},
+                                     "yellow": {"tried": 1, "succeeded": 0, "cut_short": 1, "median_s": None}}
+    assert tally.figures(under_way=None)["placements"]["yellow"]["cut_short"] == 0  # type: ignore[index]
+    assert figures["penalties"] == figures["shootout"] == {t: {"taken": 0, "scored": 0} for t in ("blue", "yellow")}

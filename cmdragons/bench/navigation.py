@@ -604,7 +604,7 @@ def grid_astar_row(name: str, free: NDArray[np.bool_], start: tuple[int, int], g
 
 def _grid_astar_rows(settings: Settings, suite: list[NavScene], repeats: int) -> list[Row]:
     from cmdragons.bench.grid import default_maps
-    from cmdragons.navigation.grid import read_map, read_scenarios
+    from cmdragons.planning.grid import read_map, read_scenarios
 
     scene = suite[0]
     occ, x0, y0 = occupancy(scene, settings.field.robot.radius_m)

@@ -2,7 +2,7 @@
 and Thrun 1997), for a holonomic robot; Bug2 on an occupancy grid, the whole path in one call.
 
 Field frame, metres, seconds. Obstacles come as a compiled collision world (``obs``, ``inner``: see
-:mod:`cmdragons.planning._kernels`), grown by the robot's radius, the moving ones where they stand
+:mod:`cmdragons.planning.collision`), grown by the robot's radius, the moving ones where they stand
 now; the robot's motion is the braking trajectory of :mod:`cmdragons.control._kernels`.
 
 Plain-numpy references of these kernels live in :mod:`cmdragons.navigation._reference`.
@@ -17,7 +17,7 @@ import numpy as np
 from numba import njit
 
 from cmdragons.control._kernels import N_SEG, Limits, clip_accel, trajectory
-from cmdragons.planning._kernels import _away, clearance, obstacle_clearance
+from cmdragons.planning.collision import away, clearance, obstacle_clearance
 from cmdragons.safety._kernels import feasible, static_hits
 
 __all__ = [
@@ -169,7 +169,7 @@ def potential(
         d = obstacle_clearance(obs, j, px, py)
         if d > cfg.influence:
             continue
-        ax, ay = _away(obs, j, px, py)
+        ax, ay = away(obs, j, px, py)
         w = _weight(ax, ay, mx, my, cfg)
         if w == 0.0:
             continue
@@ -422,7 +422,7 @@ def brake_guard(
             wx, wy = wx + (closing - cap) * ax, wy + (closing - cap) * ay
     for j in range(obs.shape[0]):
         c = obstacle_clearance(obs, j, px, py)
-        ax, ay = _away(obs, j, px, py)
+        ax, ay = away(obs, j, px, py)
         closing = -(wx * ax + wy * ay)
         cap = _stop_speed(c, margin, decel, dt)
         if closing > cap:

@@ -36,7 +36,7 @@ from cmdragons.control.motion import ControlParams
 from cmdragons.messages import RobotState
 from cmdragons.navigation import _kernels as K
 from cmdragons.navigation.base import NavStatus
-from cmdragons.navigation.grid.planners import descend_nf1, nf1
+from cmdragons.planning.grid.planners import descend_nf1, nf1
 from cmdragons.navigation.reactive import ReactiveNavigator, ReactiveParams
 from cmdragons.navigation.robox import along
 from cmdragons.navigation.trajectory import TrajectoryParams

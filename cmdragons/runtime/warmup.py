@@ -39,7 +39,8 @@ __all__ = ["CompileWatch", "cold_kernels", "warm_up"]
 _PLAY_KERNELS: dict[str, tuple[str, ...]] = {
     "sim._kernels": ("_render_frame_kernel", "_plan_objects_kernel"),
     "vision._kernels": ("classify", "match_patterns", "ball_centre"),
-    "cmdragons.planning._kernels": ("build_world", "errt_grow", "point_free"),
+    "cmdragons.planning.collision": ("build_world", "point_free"),
+    "cmdragons.planning._errt_kernels": ("errt_grow",),
     "cmdragons.control._kernels": ("motion_commands",),
     "cmdragons.safety._kernels": ("dss",),
 }

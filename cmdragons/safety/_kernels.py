@@ -30,7 +30,7 @@ from numba import njit
 
 from cmdragons._kernels import argsort_stable, sort_small
 from cmdragons.control._kernels import N_SEG, Limits, clip_accel, limit_velocity, seg_at, stop_accel, trajectory
-from cmdragons.planning._kernels import clearance
+from cmdragons.planning.collision import clearance
 
 # the robot model's braking trajectory (N_SEG, trajectory, stop_accel) is used here as defined in
 # cmdragons.control._kernels, and is reachable from this module for the safety tests
@@ -226,7 +226,7 @@ def opponent_hits(tr: np.ndarray, ox: float, oy: float, ovx: float, ovy: float, 
 @njit(cache=True)
 def static_hits(tr: np.ndarray, obs: np.ndarray, inner: np.ndarray, margin: float, step: float) -> bool:
     """Does the trajectory come within ``margin`` of an obstacle of the compiled collision world
-    (``obs``, ``inner``: see :mod:`cmdragons.planning._kernels`; its clearance query)? Sampled so that
+    (``obs``, ``inner``: see :mod:`cmdragons.planning.collision`; its clearance query)? Sampled so that
     consecutive samples lie at most ``step`` apart along the path, each held to ``margin + step / 2``
     (every point of the path is within step / 2 of a sample). A start already closer only fails
     deeper."""

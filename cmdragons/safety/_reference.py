@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from cmdragons.planning._reference import obstacle_dist
+from cmdragons.planning.collision_reference import obstacle_dist
 
 FloatArray = NDArray[np.float64]
 

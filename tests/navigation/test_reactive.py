@@ -20,7 +20,7 @@ from cmdragons.navigation import NAVIGATORS, Arrival, BugParams, GridBug2Status,
 from cmdragons.navigation import _kernels as K
 from cmdragons.navigation import _reference as R
 from cmdragons.navigation.escape_evade import MovementModel, evade_config
-from cmdragons.navigation.grid.planners import descend_nf1, nf1
+from cmdragons.planning.grid.planners import descend_nf1, nf1
 from cmdragons.navigation.potential_field import potential_config
 from cmdragons.planning import CollisionWorld, deadline
 from cmdragons.team import TeamParams

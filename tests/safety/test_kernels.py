@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from cmdragons.control import _kernels as CK
-from cmdragons.planning import _kernels as PK
+from cmdragons.planning import collision as PK
 from cmdragons.planning.world import CollisionWorld
 from cmdragons.safety import _kernels as K
 from cmdragons.safety import _reference as R

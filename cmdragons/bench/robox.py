@@ -75,8 +75,9 @@ def _timing_rows(settings: Settings, steps: int) -> list[dict[str, Any]]:
     f = settings.field_geometry()
     r = settings.field.robot.radius_m
     rng = np.random.default_rng(17)
-    window = make_navigator("dynamic_window", settings.team, settings.control, r, settings.planner.collision)
-    robox = make_navigator("robox", settings.team, settings.control, r, settings.planner.collision)
+    sections = settings.team.navigator_sections
+    window = make_navigator("dynamic_window", sections, settings.control, r, settings.planner.collision)
+    robox = make_navigator("robox", sections, settings.control, r, settings.planner.collision)
     assert isinstance(window, DynamicWindowNavigator)
     xy = rng.uniform((-f.half_length + 0.5, -f.half_width + 0.5), (f.half_length - 0.5, f.half_width - 0.5),
                      (N_MOVING, 2))  # fmt: skip

@@ -46,8 +46,10 @@ from __future__ import annotations
 
 import enum
 import math
+import typing
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -65,6 +67,8 @@ __all__ = ["BugNavigator", "BugParams", "GridBug2", "GridBug2Status", "TangentBu
            "bug2_path"]
 
 Point = tuple[float, float]
+BugVariant = Literal["bug1", "bug2", "tangent_bug"]
+BUG_VARIANTS: tuple[str, ...] = typing.get_args(BugVariant)
 
 
 @dataclass(frozen=True)
@@ -146,7 +150,21 @@ def boundary_direction(c: float, gx: float, gy: float, level: float, gain: float
 class BugNavigator(ReactiveNavigator):
     """Bug1, Bug2 or the tangent bug (``variant``) for one robot."""
 
-    def __init__(self, variant: Literal["bug1", "bug2", "tangent_bug"], params: BugParams, reactive: ReactiveParams,
+    SECTIONS: ClassVar[Mapping[str, type]] = {**ReactiveNavigator.SECTIONS, "bug": BugParams,
+                                               "tangent_bug": TangentBugParams}
+
+    @classmethod
+    def configure(cls, name: str, sections: Mapping[str, Any], control: ControlParams, robot_radius_m: float,
+                  collision: CollisionParams) -> BugNavigator:
+        """``bug1``, ``bug2`` or ``tangent_bug`` (the name is the variant) from the section ``bug``; the
+        tangent bug adds its own section. All read the shared ``reactive`` and ``trajectory``."""
+        if name not in BUG_VARIANTS:
+            raise ValueError(f"a bug navigator is one of {', '.join(BUG_VARIANTS)}, not {name!r}")
+        tangent = sections["tangent_bug"] if name == "tangent_bug" else None
+        return cls(typing.cast(BugVariant, name), sections["bug"], sections["reactive"], control, robot_radius_m,
+                   collision, sections["trajectory"], tangent)  # fmt: skip
+
+    def __init__(self, variant: BugVariant, params: BugParams, reactive: ReactiveParams,
                  control: ControlParams, robot_radius_m: float, collision: CollisionParams | None = None,
                  follow: TrajectoryParams | None = None, tangent: TangentBugParams | None = None) -> None:  # fmt: skip
         super().__init__(reactive, control, robot_radius_m, collision, follow)

@@ -13,7 +13,9 @@ safe together. Work (the termination's unit): candidate velocities evaluated, th
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -55,6 +57,14 @@ class DynamicWindowNavigator:
     """The dynamic window for one robot."""
 
     name = "dynamic_window"
+
+    SECTIONS: ClassVar[Mapping[str, type]] = {"dynamic_window": DynamicWindowParams, "trajectory": TrajectoryParams}
+
+    @classmethod
+    def configure(cls, name: str, sections: Mapping[str, Any], control: ControlParams, robot_radius_m: float,
+                  collision: CollisionParams) -> DynamicWindowNavigator:
+        """From the section ``dynamic_window``; it follows the path as ``trajectory`` says."""
+        return cls(sections["dynamic_window"], control, robot_radius_m, collision, sections["trajectory"])
 
     def __init__(
         self, params: DynamicWindowParams, control: ControlParams, robot_radius_m: float,

@@ -23,7 +23,9 @@ trajectory navigator's command along the plan plus ``escape_speed_m_s`` times es
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -119,6 +121,15 @@ class EscapeEvadeNavigator(ReactiveNavigator):
     """Goal attraction along the plan plus the escape and evade vectors, for one robot."""
 
     name = "escape_evade"
+
+    SECTIONS: ClassVar[Mapping[str, type]] = {**ReactiveNavigator.SECTIONS, "escape_evade": EscapeEvadeParams}
+
+    @classmethod
+    def configure(cls, name: str, sections: Mapping[str, Any], control: ControlParams, robot_radius_m: float,
+                  collision: CollisionParams) -> EscapeEvadeNavigator:
+        """From the section ``escape_evade`` and the shared ``reactive`` and ``trajectory``."""
+        return cls(sections["escape_evade"], sections["reactive"], control, robot_radius_m, collision,
+                   sections["trajectory"])  # fmt: skip
 
     def __init__(self, params: EscapeEvadeParams, reactive: ReactiveParams, control: ControlParams,
                  robot_radius_m: float, collision: CollisionParams | None = None,

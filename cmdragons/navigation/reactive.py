@@ -21,7 +21,9 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -61,6 +63,8 @@ class ReactiveNavigator(ABC):
     for its own state)."""
 
     name = "reactive"
+    # the config sections every reactive navigator reads; each adds its own
+    SECTIONS: ClassVar[Mapping[str, type]] = {"reactive": ReactiveParams, "trajectory": TrajectoryParams}
 
     def __init__(self, reactive: ReactiveParams, control: ControlParams, robot_radius_m: float,
                  collision: CollisionParams | None = None, follow: TrajectoryParams | None = None) -> None:  # fmt: skip

@@ -39,7 +39,7 @@ def run(nav_name: str, world_at: Callable[[int], CollisionWorld], start: tuple[f
         goal: tuple[float, float], seconds: float, team: TeamParams | None = None
         ) -> tuple[np.ndarray, list[NavStatus], object]:  # fmt: skip
     """Drive ``nav_name`` kinematically: the robot's positions (k, 2), statuses, the navigator."""
-    nav = make_navigator(nav_name, team or TeamParams(), CONTROL, RADIUS)
+    nav = make_navigator(nav_name, (team or TeamParams()).navigator_sections, CONTROL, RADIUS)
     nav.set_plan(np.array([start, goal]), Arrival(0.0))
     x, y, vx, vy, th = start[0], start[1], 0.0, 0.0, 0.0
     xs, statuses = [], []
@@ -70,8 +70,8 @@ def test_every_reactive_navigator_passes_a_convex_obstacle_to_its_goal(name: str
 @pytest.mark.parametrize("obstacle", ["gaussian", "inverse"])
 def test_potential_field_descends_on_a_convex_scene(obstacle: str) -> None:
     team = TeamParams()
-    team = dataclasses.replace(team, potential_field=dataclasses.replace(team.potential_field, obstacle=obstacle,
-                                                                         escape="none"))  # fmt: skip
+    field = dataclasses.replace(team.navigator_sections["potential_field"], obstacle=obstacle, escape="none")
+    team = team.with_section("potential_field", field)
     world = CollisionWorld(BOUNDS, np.array([(-0.5, 0.1, 0.09), (0.6, -0.2, 0.2)]))
     xs, statuses, _ = run("potential_field", lambda k: world, (-2.0, 0.0), (2.0, 0.0), 8.0, team)
     assert math.dist(tuple(xs[-1]), (2.0, 0.0)) < 0.01
@@ -82,7 +82,8 @@ def test_potential_field_descends_on_a_convex_scene(obstacle: str) -> None:
 @pytest.mark.parametrize("name", ["potential_field", "extended_potential_field"])
 def test_potential_field_is_stuck_in_the_u_trap_and_says_so(name: str) -> None:
     team = TeamParams()
-    team = dataclasses.replace(team, potential_field=dataclasses.replace(team.potential_field, escape="none"))
+    team = team.with_section("potential_field", dataclasses.replace(team.navigator_sections["potential_field"],
+                                                                    escape="none"))
     world = CollisionWorld(BOUNDS, boxes=U_TRAP)
     xs, statuses, _ = run(name, lambda k: world, (0.0, 0.0), (2.0, 0.0), 6.0, team)
     assert statuses[-1] is NavStatus.LOCAL_MINIMUM
@@ -245,7 +246,7 @@ def test_potential_gradient_is_the_potential_s_gradient() -> None:
     world = random_field(1)
     cw = world.compile(RADIUS)
     for obstacle in ("gaussian", "inverse"):
-        p = dataclasses.replace(TeamParams().potential_field, obstacle=obstacle)
+        p = dataclasses.replace(TeamParams().navigator_sections["potential_field"], obstacle=obstacle)
         cfg = potential_config(p, RADIUS)
         checked = 0
         for _ in range(300):
@@ -305,7 +306,7 @@ def test_march_agrees_with_dense_sampling() -> None:
 
 
 def test_escape_and_evade_vectors_agree_with_the_seed_s_formulas() -> None:
-    p = TeamParams().escape_evade
+    p = TeamParams().navigator_sections["escape_evade"]
     cfg = evade_config(p)
     rng = np.random.default_rng(7)
     for _ in range(200):
@@ -341,7 +342,7 @@ def test_escape_and_evade_vectors_agree_with_the_seed_s_formulas() -> None:
 
 
 def test_the_movement_model_finds_a_curve_and_a_jittery_track_s_variance() -> None:
-    p = TeamParams().escape_evade
+    p = TeamParams().navigator_sections["escape_evade"]
     rng = np.random.default_rng(11)
     smooth, jitter = MovementModel(p, DT), MovementModel(p, DT)
     omega, speed = 1.0, 1.5

@@ -16,9 +16,9 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from cmdragons.control._kernels import N_SEG, Limits, clip_accel, trajectory
+from cmdragons.control.acceleration import N_SEG, Limits, clip_accel, feasible, trajectory
 from cmdragons.planning.collision import away, clearance, obstacle_clearance
-from cmdragons.safety._kernels import feasible, static_hits
+from cmdragons.safety.static_check import static_hits
 
 __all__ = [
     "BUG2_BLOCKED", "BUG2_INVALID_GOAL", "BUG2_INVALID_START", "BUG2_OUT_OF_STEPS", "BUG2_REACHED", "GAUSSIAN",

@@ -9,9 +9,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from cmdragons.control._kernels import Limits, trajectory
+from cmdragons.control.acceleration import Limits, trajectory
 from cmdragons.navigation._kernels import WindowConfig, window_velocity
-from cmdragons.safety._reference import static_min_clearance
+from cmdragons.safety.static_check import static_min_clearance
 
 FloatArray = NDArray[np.float64]
 

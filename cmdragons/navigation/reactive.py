@@ -29,8 +29,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from cmdragons.config import Validated, setting
-from cmdragons.control._kernels import heading_command, limit_velocity
+from cmdragons.control.acceleration import limit_velocity
 from cmdragons.control.motion import ControlParams
+from cmdragons.control.trapezoid import heading_command
 from cmdragons.messages import RobotState
 from cmdragons.navigation import _kernels as K
 from cmdragons.navigation.base import STOP, Arrival, NavStatus, VelocityCommand

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from cmdragons.control import ControlParams
-from cmdragons.control import _kernels as CK
+from cmdragons.control import acceleration as CK
 from cmdragons.geometry import Field, LeagueParams
 from cmdragons.messages import RobotState
 from cmdragons.navigation import Arrival, DynamicWindowNavigator, DynamicWindowParams

@@ -37,7 +37,7 @@ import numpy as np
 
 from cmdragons.messages import GameState, RobotCommand, RobotState
 from cmdragons.navigation import Arrival, DynamicWindowNavigator, make_navigator
-from cmdragons.navigation import _kernels as NK
+from cmdragons.navigation import _dynamic_window_kernels as NK
 from cmdragons.planning import deadline, field_world
 from cmdragons.runtime.match import Match
 from cmdragons.runtime.settings import Settings

@@ -33,7 +33,7 @@ from cmdragons.config import Validated, setting
 from cmdragons.control.motion import ControlParams
 from cmdragons.geometry import wrap_angle
 from cmdragons.messages import RobotState
-from cmdragons.navigation import _kernels as K
+from cmdragons.navigation import _reactive_kernels as K
 from cmdragons.navigation.base import NavStatus
 from cmdragons.navigation.reactive import ReactiveNavigator, ReactiveParams
 from cmdragons.navigation.trajectory import TrajectoryParams

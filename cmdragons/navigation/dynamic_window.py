@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 from cmdragons.config import Validated, setting
 from cmdragons.control.motion import ControlParams
 from cmdragons.messages import RobotState
-from cmdragons.navigation import _kernels as K
+from cmdragons.navigation import _dynamic_window_kernels as K
 from cmdragons.navigation.base import STOP, Arrival, VelocityCommand
 from cmdragons.navigation.trajectory import TrajectoryNavigator, TrajectoryParams
 from cmdragons.planning.termination import Termination

@@ -5,10 +5,10 @@ Field frame, metres, seconds. Both behaviours make a repelling vector of length 
 moving objects (here: every circle of the collision world moving faster than ``min_speed_m_s``):
 
 * **escape** (§5.1.1): straight away from each object within ``r_max_m``, the more the nearer and
-  the faster it is (:func:`~cmdragons.navigation._kernels.escape_vector`); it needs no prediction;
+  the faster it is (:func:`~cmdragons.navigation._escape_evade_kernels.escape_vector`); it needs no prediction;
 * **evade** (§5.1.2): across each object's predicted path toward the robot's side of it, by the
   robot's distance along (dX) and across (dY) that path, the reach across growing with the
-  variance of the object's movement model (:func:`~cmdragons.navigation._kernels.evade_vector`).
+  variance of the object's movement model (:func:`~cmdragons.navigation._escape_evade_kernels.evade_vector`).
 
 The **movement model** (:class:`MovementModel`) follows the objects from frame to frame (each
 matched to its nearest prediction within ``match_m``): its velocity, its turn rate (the change of
@@ -33,7 +33,7 @@ from numpy.typing import NDArray
 from cmdragons.config import Validated, setting
 from cmdragons.control.motion import ControlParams
 from cmdragons.messages import RobotState
-from cmdragons.navigation import _kernels as K
+from cmdragons.navigation import _escape_evade_kernels as K
 from cmdragons.navigation.base import VelocityCommand
 from cmdragons.navigation.reactive import ReactiveNavigator, ReactiveParams
 from cmdragons.navigation.trajectory import TrajectoryParams

@@ -35,7 +35,7 @@ from numpy.typing import NDArray
 from cmdragons.config import Validated, setting
 from cmdragons.control.motion import ControlParams
 from cmdragons.messages import RobotState
-from cmdragons.navigation import _kernels as K
+from cmdragons.navigation import _potential_field_kernels as K
 from cmdragons.navigation.base import NavStatus
 from cmdragons.navigation.reactive import ReactiveNavigator, ReactiveParams
 from cmdragons.navigation.robox import along

@@ -33,7 +33,7 @@ from cmdragons.control.acceleration import limit_velocity
 from cmdragons.control.motion import ControlParams
 from cmdragons.control.trapezoid import heading_command
 from cmdragons.messages import RobotState
-from cmdragons.navigation import _kernels as K
+from cmdragons.navigation import _reactive_kernels as K
 from cmdragons.navigation.base import STOP, Arrival, NavStatus, VelocityCommand
 from cmdragons.navigation.trajectory import TrajectoryNavigator, TrajectoryParams
 from cmdragons.planning.termination import Termination

@@ -3,7 +3,7 @@ as local navigators (lecture notes 001, "Obstacle Avoidance: Vector Field Histog
 
 Field frame, metres, seconds, radians. The histogram grid is the world itself: a cell is occupied
 (certainty 1) where its centre lies in an obstacle. Each occupied cell of the active window adds
-c^2 (a - b d) to the polar sector it lies in (:func:`~cmdragons.navigation._kernels.polar_histogram`).
+c^2 (a - b d) to the polar sector it lies in (:func:`~cmdragons.navigation._vfh_kernels.polar_histogram`).
 
 * **VFH**: the obstacles grown by the robot's radius; the histogram smoothed over ``smoothing``
   sectors each side; sectors under ``threshold`` are free; the valley (run of free sectors) nearest
@@ -32,7 +32,7 @@ from numpy.typing import NDArray
 from cmdragons.config import Validated, setting
 from cmdragons.control.motion import ControlParams
 from cmdragons.messages import RobotState
-from cmdragons.navigation import _kernels as K
+from cmdragons.navigation import _vfh_kernels as K
 from cmdragons.navigation.base import NavStatus
 from cmdragons.navigation.reactive import ReactiveNavigator, ReactiveParams
 from cmdragons.navigation.trajectory import TrajectoryParams

@@ -17,12 +17,16 @@ import pytest
 from cmdragons.control import ControlParams
 from cmdragons.messages import RobotState
 from cmdragons.navigation import NAVIGATORS, Arrival, BugParams, GridBug2Status, NavStatus, bug2_path, make_navigator
-from cmdragons.navigation import _kernels as K
-from cmdragons.navigation import _reference as R
+from cmdragons.navigation import _bug_kernels as BK
+from cmdragons.navigation import _bug_reference as R
+from cmdragons.navigation import _escape_evade_kernels as EK
+from cmdragons.navigation import _potential_field_kernels as PK
+from cmdragons.navigation import _reactive_kernels as RK
+from cmdragons.navigation import _vfh_kernels as VK
 from cmdragons.navigation.escape_evade import MovementModel, evade_config
-from cmdragons.planning.grid.planners import descend_nf1, nf1
 from cmdragons.navigation.potential_field import potential_config
 from cmdragons.planning import CollisionWorld, deadline
+from cmdragons.planning.grid.planners import descend_nf1, nf1
 from cmdragons.team import TeamParams
 
 CONTROL = ControlParams()
@@ -253,12 +257,12 @@ def test_potential_gradient_is_the_potential_s_gradient() -> None:
             x, y = rng.uniform(-2.8, 2.8), rng.uniform(-1.8, 1.8)
             if cw.clearance(x, y) < 0.02:
                 continue
-            _, ex, ey = K.potential(cw.obs, cw.inner, x, y, 2.0, 0.5, 0.0, 0.0, cfg)
+            _, ex, ey = PK.potential(cw.obs, cw.inner, x, y, 2.0, 0.5, 0.0, 0.0, cfg)
             h = 1e-6
-            fx = (K.potential(cw.obs, cw.inner, x + h, y, 2.0, 0.5, 0.0, 0.0, cfg)[0]
-                  - K.potential(cw.obs, cw.inner, x - h, y, 2.0, 0.5, 0.0, 0.0, cfg)[0]) / (2 * h)  # fmt: skip
-            fy = (K.potential(cw.obs, cw.inner, x, y + h, 2.0, 0.5, 0.0, 0.0, cfg)[0]
-                  - K.potential(cw.obs, cw.inner, x, y - h, 2.0, 0.5, 0.0, 0.0, cfg)[0]) / (2 * h)  # fmt: skip
+            fx = (PK.potential(cw.obs, cw.inner, x + h, y, 2.0, 0.5, 0.0, 0.0, cfg)[0]
+                  - PK.potential(cw.obs, cw.inner, x - h, y, 2.0, 0.5, 0.0, 0.0, cfg)[0]) / (2 * h)  # fmt: skip
+            fy = (PK.potential(cw.obs, cw.inner, x, y + h, 2.0, 0.5, 0.0, 0.0, cfg)[0]
+                  - PK.potential(cw.obs, cw.inner, x, y - h, 2.0, 0.5, 0.0, 0.0, cfg)[0]) / (2 * h)  # fmt: skip
             if abs(fx - ex) + abs(fy - ey) > 1e-4 * (1.0 + abs(ex) + abs(ey)):
                 # a kink: where the nearest part of a box switches, or a source's influence ends
                 continue
@@ -276,7 +280,7 @@ def test_grid_bug2_kernel_agrees_with_the_reference() -> None:
         goal = (int(rng.integers(w)), int(rng.integers(h)))
         max_steps = int(rng.choice([5, 40, 100_000]))
         for turn in (1, -1):
-            status, cells = K.bug2_grid(occupied, *start, *goal, turn, max_steps)
+            status, cells = BK.bug2_grid(occupied, *start, *goal, turn, max_steps)
             name, ref = R.bug2_grid(occupied, start, goal, turn, max_steps)
             assert GridBug2Status(int(status)).name.lower() == name
             assert [tuple(c) for c in cells.tolist()] == ref
@@ -293,7 +297,7 @@ def test_march_agrees_with_dense_sampling() -> None:
         if cw.clearance(x, y) <= 0.05:
             continue
         th, kappa = rng.uniform(-math.pi, math.pi), rng.choice([0.0, rng.uniform(-3.0, 3.0)])
-        s = K.march(cw.obs, cw.inner, x, y, th, kappa, 2.0, 0.02, 1e-4)
+        s = RK.march(cw.obs, cw.inner, x, y, th, kappa, 2.0, 0.02, 1e-4)
         ts = np.linspace(0.0, 2.0, 4001)
         if kappa == 0.0:
             px, py = x + ts * math.cos(th), y + ts * math.sin(th)
@@ -323,7 +327,7 @@ def test_escape_and_evade_vectors_agree_with_the_seed_s_formulas() -> None:
             if d < p.r_max_m and v >= p.min_speed_m_s:
                 s += (np.array([px, py]) - o[:2]) / d * (p.r_max_m - d) / p.r_max_m * min(v / p.v_max_m_s, 1.0)
         s = s / max(1.0, np.linalg.norm(s))
-        assert np.allclose(K.escape_vector(px, py, objs, cfg), s, atol=1e-12)
+        assert np.allclose(EK.escape_vector(px, py, objs, cfg), s, atol=1e-12)
         # evade (5.8)-(5.15)
         s = np.zeros(2)
         for o in objs:
@@ -338,7 +342,7 @@ def test_escape_and_evade_vectors_agree_with_the_seed_s_formulas() -> None:
             normal = np.array([-u[1], u[0]]) * (1.0 if cross >= 0.0 else -1.0)
             s += normal * f * min(v / p.v_max_m_s, 1.0)
         s = s / max(1.0, np.linalg.norm(s))
-        assert np.allclose(K.evade_vector(px, py, objs, cfg), s, atol=1e-12)
+        assert np.allclose(EK.evade_vector(px, py, objs, cfg), s, atol=1e-12)
 
 
 def test_the_movement_model_finds_a_curve_and_a_jittery_track_s_variance() -> None:
@@ -363,7 +367,7 @@ def test_polar_histogram_counts_the_cells_inside_discs_and_boxes() -> None:
     cw = CollisionWorld(BOUNDS, discs, boxes=boxes).compile(0.0)
     px, py = 0.013, -0.021
     for enlarge in (0.0, 0.14):
-        cfg = K.HistogramConfig(1.0, 0.05, 72, enlarge)
+        cfg = VK.HistogramConfig(1.0, 0.05, 72, enlarge)
         ks = np.arange(-20, 21)
         cx, cy = (px + ks * 0.05)[None, :], (py + ks * 0.05)[:, None]
         cx, cy = np.broadcast_to(cx, (41, 41)).ravel(), np.broadcast_to(cy, (41, 41)).ravel()
@@ -379,5 +383,5 @@ def test_polar_histogram_counts_the_cells_inside_discs_and_boxes() -> None:
             for s in range(int(math.floor((beta - gam + math.pi) / (2 * math.pi / 72))),
                            int(math.floor((beta + gam + math.pi) / (2 * math.pi / 72))) + 1):  # fmt: skip
                 ref[s % 72] += 1.0 - r / 1.0
-        assert np.allclose(K.polar_histogram(cw.obs, cw.inner, px, py, cfg), ref, atol=1e-9)
+        assert np.allclose(VK.polar_histogram(cw.obs, cw.inner, px, py, cfg), ref, atol=1e-9)
         assert ref[int((math.pi + math.pi) / (2 * math.pi / 72)) % 72] > 1.0  # the box at -x is in it

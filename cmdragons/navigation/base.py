@@ -25,7 +25,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import Enum
 from collections.abc import Mapping
-from typing import Any, ClassVar, Protocol
+from typing import Any, Protocol
 
 from numpy.typing import ArrayLike
 
@@ -87,7 +87,10 @@ class Navigator(Protocol):
 class NavigatorType(Protocol):
     """A navigator as the registry holds it: the sections it reads, and how it builds itself."""
 
-    SECTIONS: ClassVar[Mapping[str, type]]  # config section name -> its params type, each with defaults
+    @property
+    def SECTIONS(self) -> Mapping[str, type]:
+        """Config section name -> its params type (each with defaults): its own, and shared ones."""
+        ...
 
     def configure(self, name: str, sections: Mapping[str, Any], control: ControlParams, robot_radius_m: float,
                   collision: CollisionParams) -> Navigator:  # fmt: skip

@@ -14,6 +14,10 @@ Ranges and choices are declared on the dataclass fields with :func:`setting`::
     @dataclass(frozen=True)
     class MotorParams:
         max_speed_m_s: float = setting(3.0, lo=0.0, hi=10.0)
+
+Choices may be a function that names them when asked (a registry that plugins join), and a
+concern may hold plugin sections beside its own keys (:func:`sections`): each plugin's section is
+parsed into the type it declares, with the same errors.
 """
 
 from __future__ import annotations
@@ -40,6 +44,7 @@ __all__ = [
     "load_yaml",
     "parse",
     "resolve_derived",
+    "sections",
     "setting",
     "to_plain",
 ]
@@ -93,10 +98,11 @@ def setting(
     *,
     lo: float | None = None,
     hi: float | None = None,
-    choices: tuple[Any, ...] | None = None,
+    choices: tuple[Any, ...] | typing.Callable[[], typing.Iterable[Any]] | None = None,
     default_factory: Any = dataclasses.MISSING,
 ) -> Any:
-    """A dataclass field with an allowed closed range ``[lo, hi]`` or a set of choices."""
+    """A dataclass field with an allowed closed range ``[lo, hi]`` or a set of choices (or a function
+    that names them when a value is checked: the names of a registry)."""
     meta = {"lo": lo, "hi": hi, "choices": choices}
     if default_factory is not dataclasses.MISSING:
         return dataclasses.field(default_factory=default_factory, metadata=meta)
@@ -109,6 +115,20 @@ def derived(source: str, default: Any, *, lo: float | None = None, hi: float | N
     an error naming the source. Built in code, it holds what is given (default ``default``), checked
     against ``[lo, hi]`` like any :func:`setting`."""
     return dataclasses.field(default=default, metadata={"source": source, "lo": lo, "hi": hi, "choices": None})
+
+
+def sections(known: typing.Callable[[], Mapping[str, type]]) -> Any:
+    """A field that holds plugin sections: the mapping's keys that ``known()`` names (a registry's
+    sections, asked when the mapping is parsed or the object built), each parsed into its type; a
+    section left out takes its type's defaults. In YAML the sections sit beside the concern's own
+    keys (not under the field's name); any other key is an unknown key. The value is a
+    :class:`FrozenMap` section name -> params, in ``known()``'s order."""
+
+    def defaults() -> FrozenMap[str, Any]:
+        return FrozenMap({name: tp() for name, tp in known().items()})
+
+    return dataclasses.field(default_factory=defaults, metadata={"sections": known, "lo": None, "hi": None,
+                                                                 "choices": None})  # fmt: skip
 
 
 def resolve_derived(obj: T, lookup: typing.Callable[[str], Any]) -> T:
@@ -220,7 +240,14 @@ def parse(cls: type[T], data: Any, *, file: str | Path, key: str = "") -> T:
 def to_plain(obj: Any) -> Any:
     """A dataclass (tree) as plain dicts, lists and scalars, ready for YAML or JSON."""
     if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
-        return {f.name: to_plain(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
+        out: dict[str, Any] = {}
+        for f in dataclasses.fields(obj):
+            value = to_plain(getattr(obj, f.name))
+            if "sections" in f.metadata:
+                out.update(value)  # beside the concern's own keys, as in its YAML
+            else:
+                out[f.name] = value
+        return out
     if isinstance(obj, Mapping):
         return {str(k): to_plain(v) for k, v in obj.items()}
     if isinstance(obj, list | tuple):
@@ -319,20 +346,28 @@ def _convert_dataclass(cls: type, value: Any, file: str, key: str) -> Any:
         raise ConfigError(file, key, f"expected a mapping, got {value!r}")
     hints = get_type_hints(cls)
     fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
+    plugins = next((f for f in fields.values() if "sections" in f.metadata), None)
+    known: Mapping[str, type] = plugins.metadata["sections"]() if plugins is not None else {}
+    own = [name for name, f in fields.items() if f is not plugins]
     for k in value:
         source = fields[k].metadata.get("source") if k in fields else None
         if source is not None:
             raise ConfigError(file, _join(key, str(k)), f"configured once, as {source}: set that instead")
-    unknown = [k for k in value if k not in fields]
+    unknown = [k for k in value if k not in own and k not in known]
     if unknown:
-        close = difflib.get_close_matches(str(unknown[0]), list(fields), n=1)
+        allowed = [*own, *known]
+        close = difflib.get_close_matches(str(unknown[0]), allowed, n=1)
         hint = f"; did you mean {close[0]}?" if close else ""
         raise ConfigError(
-            file, _join(key, str(unknown[0])), f"unknown key; allowed keys: {', '.join(sorted(fields))}{hint}"
+            file, _join(key, str(unknown[0])), f"unknown key; allowed keys: {', '.join(sorted(allowed))}{hint}"
         )
     kwargs = {}
     for name, f in fields.items():
         sub = _join(key, name)
+        if f is plugins:
+            kwargs[name] = FrozenMap({s: _convert(tp, value[s], file, _join(key, s)) if s in value else tp()
+                                      for s, tp in known.items()})  # fmt: skip
+            continue
         if name not in value:
             if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
                 raise ConfigError(file, sub, "missing required key")
@@ -367,6 +402,8 @@ class Validated:
 
 def _check_limits(f: dataclasses.Field[Any], value: Any, file: str, key: str) -> None:
     lo, hi, choices = f.metadata.get("lo"), f.metadata.get("hi"), f.metadata.get("choices")
+    if callable(choices):
+        choices = tuple(choices())
     items = value if isinstance(value, tuple) else (value,)
     for i, item in enumerate(items):
         where = _join(key, i) if isinstance(value, tuple) else key

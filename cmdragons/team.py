@@ -21,35 +21,16 @@ import math
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Literal, Protocol
+from typing import TYPE_CHECKING, Any, Literal, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 
-from cmdragons.config import Validated, setting
+from cmdragons.config import FrozenMap, Validated, sections, setting
 from cmdragons.control.motion import predict_braking
 from cmdragons.geometry import Team
 from cmdragons.messages import GameState, RefereeCommand, RobotCommand, RobotState, WorldState
-from cmdragons.navigation import (
-    NAVIGATORS,
-    Arrival,
-    BandParams,
-    BugParams,
-    CurvatureParams,
-    DynamicWindowParams,
-    EscapeEvadeParams,
-    ExtendedFieldParams,
-    LaneParams,
-    Navigator,
-    PotentialFieldParams,
-    ReactiveParams,
-    RoboxParams,
-    TangentBugParams,
-    TrajectoryParams,
-    VFHParams,
-    VFHPlusParams,
-    make_navigator,
-)
+from cmdragons.navigation import NAVIGATORS, Arrival, Navigator, config_sections, make_navigator
 from cmdragons.planning import (
     CollisionWorld,
     Planner,
@@ -95,26 +76,19 @@ class BrainParams(Validated):
 
 @dataclass(frozen=True)
 class TeamParams(Validated):
-    """configs/team.yaml: our brain, its navigator (one section per navigator, named like it), and the
-    built-in simple opponent."""
+    """configs/team.yaml: our brain, its navigator, and the built-in simple opponent. Beside them sit
+    the registered navigators' config sections (each navigator declares the ones it reads:
+    cmdragons/navigation/registry.py); they are parsed and checked with the file, and the navigator
+    reads its own when it is built."""
 
-    navigator: str = setting("trajectory", choices=tuple(NAVIGATORS))  # which of NAVIGATORS drives each robot
-    trajectory: TrajectoryParams = TrajectoryParams()
-    dynamic_window: DynamicWindowParams = DynamicWindowParams()
-    elastic_band: BandParams = BandParams()  # the Robox stack's band
-    robox: RoboxParams = RoboxParams()
-    reactive: ReactiveParams = ReactiveParams()  # shared by the reactive navigators below
-    potential_field: PotentialFieldParams = PotentialFieldParams()
-    extended_potential_field: ExtendedFieldParams = ExtendedFieldParams()
-    bug: BugParams = BugParams()  # bug1, bug2, tangent_bug
-    tangent_bug: TangentBugParams = TangentBugParams()
-    vfh: VFHParams = VFHParams()
-    vfh_plus: VFHPlusParams = VFHPlusParams()
-    curvature_velocity: CurvatureParams = CurvatureParams()
-    lane_curvature: LaneParams = LaneParams()
-    escape_evade: EscapeEvadeParams = EscapeEvadeParams()
+    navigator: str = setting("trajectory", choices=lambda: tuple(NAVIGATORS))  # which of NAVIGATORS drives each robot
+    navigator_sections: FrozenMap[str, Any] = sections(config_sections)  # section name -> its navigator's params
     brain: BrainParams = BrainParams()
     simple_opponent: SimpleTeamParams = SimpleTeamParams()
+
+    def with_section(self, name: str, params: Any) -> TeamParams:
+        """These params with navigator section ``name`` replaced by ``params``."""
+        return dataclasses.replace(self, navigator_sections=FrozenMap({**self.navigator_sections, name: params}))
 
 
 class RobotPlanStatus(enum.Enum):
@@ -238,8 +212,9 @@ class Brain:
     def _navigator(self, rid: int) -> Navigator:
         nav = self.navigators.get(rid)
         if nav is None:
-            nav = self.navigators[rid] = make_navigator(self.params.navigator, self.params, self.settings.control,
-                                                        self.radius, self.settings.planner.collision)  # fmt: skip
+            nav = self.navigators[rid] = make_navigator(self.params.navigator, self.params.navigator_sections,
+                                                        self.settings.control, self.radius,
+                                                        self.settings.planner.collision)  # fmt: skip
         return nav
 
     def step(self, world: WorldState, game: GameState) -> BrainOutput:

@@ -27,7 +27,7 @@ def main(steps: int = 300) -> None:
         rng = np.random.default_rng(0)
         xy = rng.uniform((-3.5, -2.5), (3.5, 2.5), (21, 2))
         vel = rng.uniform(-1.0, 1.0, (21, 2))
-        nav = make_navigator(name, TeamParams(), control, 0.09)
+        nav = make_navigator(name, TeamParams().navigator_sections, control, 0.09)
         start, goal = (-4.0, 0.3), (4.0, -0.3)
         nav.set_plan(np.array([start, goal]), Arrival(0.0))
         x, y, vx, vy = start[0], start[1], 0.0, 0.0

@@ -1,4 +1,4 @@
-"""The floor's sorts and median (cmdragons._kernels), which the other kernels use instead of numba's,
+"""The floor's sorts and median (cmdragons.sorting), which the other kernels use instead of numba's,
 against numpy: exact agreement, ties included."""
 
 from __future__ import annotations
@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cmdragons import _kernels as kern
+from cmdragons import sorting as kern
 
 
 def values_with_ties(rng: np.random.Generator, n: int, levels: int) -> np.ndarray:

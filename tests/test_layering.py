@@ -19,7 +19,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 FLOOR = {"cmdragons.config", "cmdragons.geometry", "cmdragons.messages", "cmdragons.camera", "cmdragons.recording",
-         "cmdragons.videoio", "cmdragons._kernels"}
+         "cmdragons.videoio", "cmdragons._kernels", "cmdragons.sorting"}
 PROJECT = ("cmdragons", "vision", "strategy", "sim")
 COMPOSITION = ("cmdragons.runtime", "cmdragons.team", "cmdragons.bench", "cmdragons.cli")
 # library -> the module prefixes allowed to import it
@@ -118,41 +118,107 @@ def test_heavy_io_libraries_stay_with_their_owners(path: Path) -> None:
         assert not any(f"cv2.{name}" in text for name in CV2_VIDEO), f"{path} opens video files with OpenCV"
 
 
-CYCLE_FREE = ("cmdragons.runtime", "cmdragons.cli", "cmdragons.team", "cmdragons.bench")
+# --- private modules, planning below navigation, import cycles ----------------------------------------------
+def package_of(module: str, path: Path) -> str:
+    return module if path.name == "__init__.py" else module.rpartition(".")[0]
 
 
-def import_cycle(modules: dict[str, set[str]]) -> list[str] | None:
-    """One cycle of the import graph ``modules`` (module -> the modules it imports), or None."""
-    done: set[str] = set()
-    path: list[str] = []
-
-    def visit(m: str) -> list[str] | None:
-        if m in path:
-            return [*path[path.index(m):], m]
-        if m in done:
-            return None
-        path.append(m)
-        for n in sorted(modules.get(m, ())):
-            if (found := visit(n)) is not None:
-                return found
-        path.pop()
-        done.add(m)
-        return None
-
-    for m in sorted(modules):
-        if (found := visit(m)) is not None:
-            return found
+def private_owner(module: str) -> str | None:
+    """The package a private module (``pkg._kernels``, ``pkg._reference`` ...) belongs to, or None."""
+    parts = module.split(".")
+    for i, part in enumerate(parts):
+        if part.startswith("_") and not part.startswith("__"):
+            return ".".join(parts[:i])
     return None
 
 
-def test_import_cycles_are_found() -> None:
-    assert import_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
-    assert import_cycle({"a": {"b"}, "b": {"c"}, "c": set()}) is None
+def test_private_owner() -> None:
+    assert private_owner("cmdragons.planning._errt_kernels") == "cmdragons.planning"
+    assert private_owner("cmdragons.planning._errt_kernels.errt_grow") == "cmdragons.planning"
+    assert private_owner("cmdragons.planning.collision.away") is None
 
 
-def test_the_composition_imports_without_cycles() -> None:
-    """Every import counts, at the top of a module, inside a function or for types only: a module
-    that needs another's helper and is needed by it wants the helper in a module of its own."""
-    paths = {module_name(p): p for p in ALL if under(module_name(p), CYCLE_FREE)}
-    graph = {m: {n for n in project_imports(p) if n in paths and n != m} for m, p in paths.items()}
-    assert import_cycle(graph) is None
+@pytest.mark.parametrize("path", STAGE_PACKAGES, ids=lambda p: str(p.relative_to(ROOT)))
+def test_no_stage_package_imports_another_packages_private_module(path: Path) -> None:
+    """A kernel two packages share lives in a public module of the lower one; a package's private
+    modules (its kernels, their references) are its own and its subpackages'. (The composition's
+    warm-up and benchmarks compile and time kernels by name, so they may reach them.)"""
+    module = module_name(path)
+    package = package_of(module, path)
+    bad = set()
+    for m in project_imports(path):
+        owner = private_owner(m)
+        if owner is not None and not under(package, (owner,)):
+            bad.add(m)
+    assert not bad, f"{path} imports another package's private modules: {sorted(bad)}"
+
+
+@pytest.mark.parametrize("path", sources("cmdragons.planning"), ids=lambda p: str(p.relative_to(ROOT)))
+def test_planning_never_imports_navigation(path: Path) -> None:
+    bad = {m for m in project_imports(path) if under(m, ("cmdragons.navigation",))}
+    assert not bad, f"{path} imports {bad}"
+
+
+def module_graph() -> dict[str, set[str]]:
+    """Module -> the project modules it imports (a ``from pkg import name`` counts as an import of
+    ``pkg.name`` when that is a module, else of ``pkg``), over every module of the project, the
+    imports inside functions and under TYPE_CHECKING included: a cycle there is still a knot."""
+    modules = {module_name(p): p for p in ALL}
+    graph: dict[str, set[str]] = {}
+    for name, path in modules.items():
+        targets = set()
+        for m in project_imports(path):
+            while m and m not in modules:
+                m = m.rpartition(".")[0]
+            if m and m != name:
+                targets.add(m)
+        graph[name] = targets
+    return graph
+
+
+def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected components of more than one module (Tarjan), each sorted; a package's
+    ``__init__`` importing its own modules is not a cycle by itself, so edges from a module to a
+    package that contains it are left out."""
+    edges = {a: {b for b in bs if not a.startswith(b + ".")} for a, bs in graph.items()}
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on: set[str] = set()
+    out: list[list[str]] = []
+
+    def visit(v: str) -> None:  # recursion depth is bounded by the number of modules (a few hundred)
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in sorted(edges.get(v, ())):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                out.append(sorted(comp))
+
+    for v in sorted(edges):
+        if v not in index:
+            visit(v)
+    return sorted(out)
+
+
+def test_the_cycle_finder_finds_a_cycle_and_ignores_a_package_importing_its_modules() -> None:
+    graph = {"a": {"a.x"}, "a.x": {"b"}, "b": {"a.x"}, "c": {"c.y"}, "c.y": {"c"}}
+    assert cycles(graph) == [["a.x", "b"]]
+
+
+def test_no_import_cycles() -> None:
+    found = cycles(module_graph())
+    assert not found, "import cycles: " + "; ".join(" <-> ".join(c) for c in found)

@@ -77,11 +77,11 @@ def test_a_robot_held_back_keeps_pressing_on() -> None:
         return float(np.hypot(cmds[-1].vx, cmds[-1].vy))
 
     accel = SETTINGS.control.motion.max_accel_m_s2
-    slip = SETTINGS.team.trajectory.command_slip_m_s
+    slip = SETTINGS.team.navigator_sections["trajectory"].command_slip_m_s
     assert speed(Brain("blue", SETTINGS), 10) == pytest.approx(min(10 * accel / 60, slip), rel=0.05)
     # from the measured velocity alone: one frame of acceleration from rest, each time
-    no_slip = dataclasses.replace(SETTINGS.team.trajectory, command_slip_m_s=0.0)
-    restarting = Brain("blue", SETTINGS, dataclasses.replace(SETTINGS.team, trajectory=no_slip))
+    no_slip = dataclasses.replace(SETTINGS.team.navigator_sections["trajectory"], command_slip_m_s=0.0)
+    restarting = Brain("blue", SETTINGS, SETTINGS.team.with_section("trajectory", no_slip))
     assert speed(restarting, 10) == pytest.approx(accel / 60, rel=0.05)
 
 

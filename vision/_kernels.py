@@ -6,7 +6,7 @@ Pixel coordinates are (u, v) = (column, row) of the pixel's top-left corner; cen
 reported at pixel centres (+0.5) by the wrappers, not here.
 
 First-run compile: arrays are made by ``np.empty`` and filled in loops, and sorting and the median
-are the floor's (:func:`cmdragons._kernels.argsort_stable`, :func:`cmdragons._kernels.median`),
+are the floor's (:func:`cmdragons.sorting.argsort_stable`, :func:`cmdragons.sorting.median`),
 because numba compiles each use of
 ``np.zeros``, ``np.ones``, ``np.full``, ``np.arange``, ``np.argsort`` and ``np.median`` (per
 signature) anew, a tenth of a second to seconds each, for no run-time gain.
@@ -19,7 +19,7 @@ import math
 import numba
 import numpy as np
 
-from cmdragons._kernels import argsort_stable, median
+from cmdragons.sorting import argsort_stable, median
 
 # region table columns (float64), filled by `region_stats` and `merge_regions`
 R_CLASS, R_AREA, R_SUM_U, R_SUM_V, R_SUM_UU, R_SUM_VV, R_SUM_UV, R_U0, R_V0, R_U1, R_V1 = range(11)

@@ -40,7 +40,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from cmdragons.navigation.grid import EStar, nf1, octile_path, read_map, read_scenarios
+from cmdragons.planning.grid import EStar, nf1, octile_path, read_map, read_scenarios
 from cmdragons.runtime.settings import Settings
 
 __all__ = ["default_maps", "run"]

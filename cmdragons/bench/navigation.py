@@ -296,7 +296,7 @@ def drive(settings: Settings, name: str, scene: NavScene, timeout_s: float) -> t
     docstring). Returns (arrived without contact, the trajectory (k, 2), ms per step, least
     clearance m, time to the goal s or nan)."""
     radius = settings.field.robot.radius_m
-    nav = make_navigator(name, settings.team, settings.control, radius, settings.planner.collision)
+    nav = make_navigator(name, settings.team.navigator_sections, settings.control, radius, settings.planner.collision)
     dt = 1.0 / settings.control.motion.frame_rate_hz
     scene = scene.fresh()
     x, y, theta, vx, vy, omega = scene.start[0], scene.start[1], 0.0, 0.0, 0.0, 0.0
@@ -481,12 +481,13 @@ def _bug2_path_row(settings: Settings, fixed: list[NavScene], optimum: dict[str,
     theirs, ours = Tally(), Tally()
     first = fixed[0]
     occ, x0, y0 = occupancy(first, radius)
-    bug2_path(occ, _cell(first.start, x0, y0), _cell(first.goal, x0, y0), settings.team.bug)  # loads the kernel
+    bug = settings.team.navigator_sections["bug"]
+    bug2_path(occ, _cell(first.start, x0, y0), _cell(first.goal, x0, y0), bug)  # loads the kernel
     for scene in fixed:
         occ, x0, y0 = occupancy(scene, radius)
         start, goal = _cell(scene.start, x0, y0), _cell(scene.goal, x0, y0)
         problem = _problem(scene, radius, settings)
-        our_query = functools.partial(bug2_path, occ, start, goal, settings.team.bug)
+        our_query = functools.partial(bug2_path, occ, start, goal, bug)
         their_query = functools.partial(_toolbox_planner, "Bug2", occ, start, goal, 0)
         ours_ms, theirs_ms = _paired_ms([our_query, their_query], repeats)
         found, cells = our_query(), their_query()
@@ -604,7 +605,7 @@ def grid_astar_row(name: str, free: NDArray[np.bool_], start: tuple[int, int], g
 
 def _grid_astar_rows(settings: Settings, suite: list[NavScene], repeats: int) -> list[Row]:
     from cmdragons.bench.grid import default_maps
-    from cmdragons.navigation.grid import read_map, read_scenarios
+    from cmdragons.planning.grid import read_map, read_scenarios
 
     scene = suite[0]
     occ, x0, y0 = occupancy(scene, settings.field.robot.radius_m)

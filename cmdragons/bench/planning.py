@@ -40,7 +40,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cmdragons.geometry import Field
-from cmdragons.planning import _kernels as K
+from cmdragons.planning import _errt_kernels as K
+from cmdragons.planning import collision
 from cmdragons.planning.problem import Planner, PlanProblem, PlanResult, PlanStatus
 from cmdragons.planning.registry import PlannerParams, make_planner
 from cmdragons.planning.scenes import CrowdScene, MovingScene, random_free_point, random_scene
@@ -114,7 +115,7 @@ def collision_rows(field: Field, n_queries: int) -> list[Row]:
             p = CollisionParams(broad_phase=bp)  # type: ignore[arg-type]
             cw = CollisionWorld(world.bounds, world.circles, world.velocities, world.boxes).compile(0.09, params=p)
             build_us = _median_us(functools.partial(_build, world, p))
-            ns = _ns_per_query(functools.partial(K.segments_free, cw.cw, seg), n_queries)
+            ns = _ns_per_query(functools.partial(collision.segments_free, cw.cw, seg), n_queries)
             rows.append({"name": f"collision_{bp}_{n}", "ns_per_query": ns, "build_us": build_us, "n_obstacles": n})
     return rows
 

@@ -37,7 +37,7 @@ import numpy as np
 
 from cmdragons.messages import GameState, RobotCommand, RobotState
 from cmdragons.navigation import Arrival, DynamicWindowNavigator, make_navigator
-from cmdragons.navigation import _kernels as NK
+from cmdragons.navigation import _dynamic_window_kernels as NK
 from cmdragons.planning import deadline, field_world
 from cmdragons.runtime.match import Match
 from cmdragons.runtime.settings import Settings
@@ -74,8 +74,9 @@ def _timing_rows(settings: Settings, steps: int) -> list[dict[str, Any]]:
     f = settings.field_geometry()
     r = settings.field.robot.radius_m
     rng = np.random.default_rng(17)
-    window = make_navigator("dynamic_window", settings.team, settings.control, r, settings.planner.collision)
-    robox = make_navigator("robox", settings.team, settings.control, r, settings.planner.collision)
+    sections = settings.team.navigator_sections
+    window = make_navigator("dynamic_window", sections, settings.control, r, settings.planner.collision)
+    robox = make_navigator("robox", sections, settings.control, r, settings.planner.collision)
     assert isinstance(window, DynamicWindowNavigator)
     xy = rng.uniform((-f.half_length + 0.5, -f.half_width + 0.5), (f.half_length - 0.5, f.half_width - 0.5),
                      (N_MOVING, 2))  # fmt: skip

@@ -1,6 +1,7 @@
-"""numba kernels of motion control: the time-optimal 1D trapezoidal profile, its 2D split, the robot's
-acceleration model and the braking trajectory that predicts where a robot will be (Bruce 2006
-appendix B.4, §5.1, §5.3).
+"""numba kernels of motion control: the time-optimal 1D trapezoidal profile, its 2D split, the
+heading's profile and the frame's motion commands (Bruce 2006 appendix B.4); the robot's
+acceleration model and braking trajectory, which navigation and safety share, are
+:mod:`cmdragons.control.acceleration`'s.
 
 Units: metres, seconds, radians. A 1D problem is "move a distance ``d`` starting at velocity ``v0``
 and arrive with velocity ``vt``" under a speed limit ``vmax``, an acceleration ``a`` while the speed
@@ -15,29 +16,19 @@ Plain-numpy references of these kernels live in :mod:`cmdragons.control._referen
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
-from cmdragons._kernels import sort_small
+# the acceleration model's names motion.py calls through this module
+from cmdragons.control.acceleration import Limits, limit_velocity, stop_accel, trajectory, trajectory_state  # noqa: F401
 from cmdragons.geometry import wrap_angle as _wrap_angle
+from cmdragons.sorting import sort_small
 
 N_PHASES = 5  # ramp through zero (2) + cruise (1) + ramp through zero (2)
-N_SEG = 4  # segments of a braking trajectory: reaching the command, holding it to the period's end, braking, rest
 _EPS = 1e-12
 
 wrap_angle = njit(cache=True)(_wrap_angle)  # the project's one angle wrap, compiled for the kernels
-
-
-class Limits(NamedTuple):
-    """The robot's limits, by name (configs/control.yaml ``motion``)."""
-
-    vmax: float  # m/s
-    accel: float  # m/s^2 speeding up or turning the velocity
-    brake: float  # m/s^2 slowing down
-    omega_max: float  # rad/s
-    alpha_max: float  # rad/s^2
 
 
 @njit(cache=True)
@@ -210,46 +201,6 @@ def command_2d(
     return phases_state(phx, v0x, period)[1], phases_state(phy, v0y, period)[1], max(tx, ty)
 
 
-# --- the robot's acceleration model, Bruce 2006 §5.1 ------------------------------------------------
-@njit(cache=True)
-def clip_accel(vx: float, vy: float, ax: float, ay: float, accel: float, brake: float) -> tuple[float, float]:
-    """Scale the acceleration (ax, ay) into A(v): a disc of radius ``accel`` on the half that does
-    not oppose the velocity; on the braking half an ellipse with semi-axis ``brake`` against v and
-    ``accel`` across it (Bruce 2006 fig. 5.2). The direction is kept."""
-    speed = math.hypot(vx, vy)
-    mag = math.hypot(ax, ay)
-    if mag <= 0.0:
-        return 0.0, 0.0
-    along = (ax * vx + ay * vy) / speed if speed > 1e-9 else 0.0
-    if along >= 0.0:
-        k = mag / accel if accel > 0.0 else math.inf
-    else:
-        across2 = max(mag * mag - along * along, 0.0)
-        ka = along / brake if brake > 0.0 else math.inf
-        kc2 = across2 / (accel * accel) if accel > 0.0 else (0.0 if across2 == 0.0 else math.inf)
-        k = math.sqrt(ka * ka + kc2)
-    if k <= 1.0:
-        return ax, ay
-    if not math.isfinite(k):
-        return 0.0, 0.0
-    return ax / k, ay / k
-
-
-@njit(cache=True)
-def limit_velocity(
-    v0x: float, v0y: float, vx: float, vy: float, vmax: float, accel: float, brake: float, period: float
-) -> tuple[float, float]:
-    """The velocity command nearest in direction to (vx, vy) that keeps within the speed limit (or
-    does not speed up past it when the robot is already faster) and reaches it from (v0x, v0y) within
-    A(v) in one ``period``."""
-    speed = math.hypot(vx, vy)
-    cap = max(vmax, math.hypot(v0x, v0y))
-    if speed > cap:
-        vx, vy = vx * cap / speed, vy * cap / speed
-    ax, ay = clip_accel(v0x, v0y, (vx - v0x) / period, (vy - v0y) / period, accel, brake)
-    return v0x + ax * period, v0y + ay * period
-
-
 @njit(cache=True)
 def heading_command(theta: float, omega: float, target_theta: float, wmax: float, alpha: float,
                     period: float) -> float:  # fmt: skip
@@ -279,63 +230,3 @@ def motion_commands(
         out[i, 0], out[i, 1] = limit_velocity(vx, vy, cx, cy, vmax, accel, brake, period)
         out[i, 2] = heading_command(th, w, targets[i, 4], wmax, alpha, period)
     return out
-
-
-# --- the robot's braking trajectory (Bruce 2006 §5.1, §5.3): where it will be ---------------------------
-@njit(cache=True)
-def _put(tr: np.ndarray, k: int, t0: float, t1: float, px: float, py: float, vx: float, vy: float,
-         ax: float, ay: float) -> tuple[float, float, float, float]:  # fmt: skip
-    # write segment k and return the position and velocity at its end
-    tr[k, 0], tr[k, 1], tr[k, 2], tr[k, 3], tr[k, 4], tr[k, 5], tr[k, 6], tr[k, 7] = t0, t1, px, py, vx, vy, ax, ay
-    h = t1 - t0
-    return px + vx * h + 0.5 * ax * h * h, py + vy * h + 0.5 * ay * h * h, vx + ax * h, vy + ay * h
-
-
-@njit(cache=True)
-def trajectory(
-    px: float, py: float, vx: float, vy: float, ax: float, ay: float, dt: float, accel: float, brake: float
-) -> np.ndarray:
-    """Segments (N_SEG, 8) of the command v + a dt held for one period ``dt``, then braking at
-    ``brake`` to rest. The motors reach a commanded velocity as fast as they can (at ``brake`` when
-    it slows the robot against its motion, else at ``accel``) and then hold it, as the simulator's
-    motor model does; the stop command (a = -v / dt) thus brakes at full strength."""
-    tr = np.zeros((N_SEG, 8))
-    cx, cy = vx + ax * dt, vy + ay * dt
-    dvx, dvy = cx - vx, cy - vy
-    dv = math.hypot(dvx, dvy)
-    slowing = dvx * vx + dvy * vy < 0.0 and cx * cx + cy * cy < vx * vx + vy * vy
-    rate = brake if slowing else accel
-    t_reach = min(dv / rate, dt) if rate > 0.0 and dv > 0.0 else 0.0
-    ux, uy = (dvx / dv * rate, dvy / dv * rate) if dv > 0.0 and rate > 0.0 else (0.0, 0.0)
-    qx, qy, wx, wy = _put(tr, 0, 0.0, t_reach, px, py, vx, vy, ux, uy)
-    qx, qy, wx, wy = _put(tr, 1, t_reach, dt, qx, qy, wx, wy, 0.0, 0.0)
-    w = math.hypot(wx, wy)
-    t_brake = w / brake if brake > 0.0 else 0.0
-    bx, by = (-brake * wx / w, -brake * wy / w) if w > 0.0 else (0.0, 0.0)
-    qx, qy, _, _ = _put(tr, 2, dt, dt + t_brake, qx, qy, wx, wy, bx, by)
-    _put(tr, 3, dt + t_brake, math.inf, qx, qy, 0.0, 0.0, 0.0, 0.0)
-    return tr
-
-
-@njit(cache=True)
-def stop_accel(vx: float, vy: float, dt: float) -> tuple[float, float]:
-    """The acceleration that names the stop command (velocity zero): the motors brake at full
-    strength until the robot rests (see :func:`trajectory`)."""
-    return -vx / dt, -vy / dt
-
-
-@njit(cache=True)
-def seg_at(tr: np.ndarray, k: int, t: float) -> tuple[float, float, float, float]:
-    """Position and velocity of segment k of a trajectory at absolute time t (inside the segment)."""
-    h = t - tr[k, 0]
-    return (tr[k, 2] + tr[k, 4] * h + 0.5 * tr[k, 6] * h * h, tr[k, 3] + tr[k, 5] * h + 0.5 * tr[k, 7] * h * h,
-            tr[k, 4] + tr[k, 6] * h, tr[k, 5] + tr[k, 7] * h)  # fmt: skip
-
-
-@njit(cache=True)
-def trajectory_state(tr: np.ndarray, t: float) -> tuple[float, float, float, float]:
-    """Position and velocity (x, y, vx, vy) of a trajectory at time ``t`` >= 0 (at rest after it)."""
-    for k in range(N_SEG - 1):
-        if t <= tr[k, 1]:
-            return seg_at(tr, k, max(t, tr[k, 0]))
-    return tr[N_SEG - 1, 2], tr[N_SEG - 1, 3], 0.0, 0.0

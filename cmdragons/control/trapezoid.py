@@ -15,8 +15,9 @@ from numpy.typing import NDArray
 
 from cmdragons.config import Validated, setting
 from cmdragons.control import _kernels as K
+from cmdragons.control._kernels import heading_command  # public here: the heading's profile
 
-__all__ = ["Profile1D", "Profile2D", "TrapezoidParams", "trapezoid_1d", "trapezoid_2d"]
+__all__ = ["Profile1D", "Profile2D", "TrapezoidParams", "heading_command", "trapezoid_1d", "trapezoid_2d"]
 
 
 @dataclass(frozen=True)

@@ -5,7 +5,7 @@ following with trapezoidal profiles (Bruce 2006 B.4), the dynamic window (§5.2)
 reactive methods of the lecture notes: potential fields (plain and extended), Bug1, Bug2, the
 tangent bug, VFH, VFH+, the curvature velocity and lane curvature methods, escape and evade."""
 
-from cmdragons.navigation.base import STOP, Arrival, Navigator, NavStatus, VelocityCommand
+from cmdragons.navigation.base import STOP, Arrival, Navigator, NavigatorType, NavStatus, VelocityCommand
 from cmdragons.navigation.bug import BugNavigator, BugParams, GridBug2, GridBug2Status, TangentBugParams, bug2_path
 from cmdragons.navigation.curvature_velocity import CurvatureParams, CurvatureVelocityNavigator, LaneParams
 from cmdragons.navigation.dynamic_window import DynamicWindowNavigator, DynamicWindowParams
@@ -13,7 +13,7 @@ from cmdragons.navigation.elastic_band import BandParams
 from cmdragons.navigation.escape_evade import EscapeEvadeNavigator, EscapeEvadeParams, MovementModel, reflex
 from cmdragons.navigation.potential_field import ExtendedFieldParams, PotentialFieldNavigator, PotentialFieldParams
 from cmdragons.navigation.reactive import ReactiveNavigator, ReactiveParams
-from cmdragons.navigation.registry import NAVIGATORS, make_navigator
+from cmdragons.navigation.registry import NAVIGATORS, config_sections, make_navigator
 from cmdragons.navigation.robox import RoboxNavigator, RoboxParams
 from cmdragons.navigation.trajectory import TrajectoryNavigator, TrajectoryParams
 from cmdragons.navigation.vfh import VFHNavigator, VFHParams, VFHPlusParams
@@ -38,6 +38,7 @@ __all__ = [
     "MovementModel",
     "NavStatus",
     "Navigator",
+    "NavigatorType",
     "PotentialFieldNavigator",
     "PotentialFieldParams",
     "ReactiveNavigator",
@@ -52,6 +53,7 @@ __all__ = [
     "VFHPlusParams",
     "VelocityCommand",
     "bug2_path",
+    "config_sections",
     "make_navigator",
     "reflex",
 ]

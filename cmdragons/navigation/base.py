@@ -14,21 +14,27 @@ radians; it never commands beyond the robot's limits (configs/control.yaml ``mot
 * :meth:`Navigator.sent` tells it the command that safety let through to the robot, the start of
   its next frame's profile;
 * :meth:`Navigator.reset` forgets the plan and the command history.
+
+A navigator type (:class:`NavigatorType`, after Nav2's ``configure(parent, name)``) names the config
+sections it reads (configs/team.yaml: its own, and shared ones such as ``reactive`` or
+``trajectory``) and builds itself from them for one robot: the registry maps a name to the type.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from enum import Enum
-from typing import Protocol
+from collections.abc import Mapping
+from typing import Any, Protocol
 
 from numpy.typing import ArrayLike
 
+from cmdragons.control.motion import ControlParams
 from cmdragons.messages import RobotState
 from cmdragons.planning.termination import Termination
-from cmdragons.planning.world import CollisionWorld
+from cmdragons.planning.world import CollisionParams, CollisionWorld
 
-__all__ = ["STOP", "Arrival", "NavStatus", "Navigator", "VelocityCommand"]
+__all__ = ["STOP", "Arrival", "NavStatus", "Navigator", "NavigatorType", "VelocityCommand"]
 
 VelocityCommand = tuple[float, float, float]  # vx, vy (field frame, m/s), omega (rad/s)
 STOP: VelocityCommand = (0.0, 0.0, 0.0)
@@ -76,3 +82,19 @@ class Navigator(Protocol):
 
     def reset(self) -> None:
         """Forget the plan and everything learnt from earlier frames."""
+
+
+class NavigatorType(Protocol):
+    """A navigator as the registry holds it: the sections it reads, and how it builds itself."""
+
+    @property
+    def SECTIONS(self) -> Mapping[str, type]:
+        """Config section name -> its params type (each with defaults): its own, and shared ones."""
+        ...
+
+    def configure(self, name: str, sections: Mapping[str, Any], control: ControlParams, robot_radius_m: float,
+                  collision: CollisionParams) -> Navigator:  # fmt: skip
+        """A fresh navigator for one robot, registered as ``name``, from ``sections`` (each of
+        :attr:`SECTIONS` by name, parsed), the robot model, its radius (m) and the collision queries'
+        parameters."""
+        ...

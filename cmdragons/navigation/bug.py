@@ -46,8 +46,10 @@ from __future__ import annotations
 
 import enum
 import math
+import typing
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -55,7 +57,8 @@ from numpy.typing import NDArray
 from cmdragons.config import Validated, setting
 from cmdragons.control.motion import ControlParams
 from cmdragons.messages import RobotState
-from cmdragons.navigation import _kernels as K
+from cmdragons.navigation import _bug_kernels as K
+from cmdragons.navigation import _reactive_kernels as RK
 from cmdragons.navigation.base import NavStatus
 from cmdragons.navigation.reactive import ReactiveNavigator, ReactiveParams, toward
 from cmdragons.navigation.trajectory import TrajectoryParams
@@ -65,6 +68,8 @@ __all__ = ["BugNavigator", "BugParams", "GridBug2", "GridBug2Status", "TangentBu
            "bug2_path"]
 
 Point = tuple[float, float]
+BugVariant = Literal["bug1", "bug2", "tangent_bug"]
+BUG_VARIANTS: tuple[str, ...] = typing.get_args(BugVariant)
 
 
 @dataclass(frozen=True)
@@ -117,7 +122,7 @@ class GridBug2:
 def bug2_path(occupied: NDArray[np.bool_], start: tuple[int, int], goal: tuple[int, int],
               params: BugParams | None = None) -> GridBug2:  # fmt: skip
     """Bug2's whole path on the occupancy grid ``occupied`` (row = y) from cell ``start`` to cell
-    ``goal`` (each (column, row)), one cell a step (:func:`cmdragons.navigation._kernels.bug2_grid`:
+    ``goal`` (each (column, row)), one cell a step (:func:`cmdragons.navigation._bug_kernels.bug2_grid`:
     along the m-line; round an obstacle it meets with it on the right (``params.side`` left) or
     left, until on the m-line nearer the goal than the hit point; blocked when back round at the hit
     point), at most ``params.grid_max_steps`` moves."""
@@ -146,7 +151,21 @@ def boundary_direction(c: float, gx: float, gy: float, level: float, gain: float
 class BugNavigator(ReactiveNavigator):
     """Bug1, Bug2 or the tangent bug (``variant``) for one robot."""
 
-    def __init__(self, variant: Literal["bug1", "bug2", "tangent_bug"], params: BugParams, reactive: ReactiveParams,
+    SECTIONS: ClassVar[Mapping[str, type]] = {**ReactiveNavigator.SECTIONS, "bug": BugParams,
+                                               "tangent_bug": TangentBugParams}
+
+    @classmethod
+    def configure(cls, name: str, sections: Mapping[str, Any], control: ControlParams, robot_radius_m: float,
+                  collision: CollisionParams) -> BugNavigator:
+        """``bug1``, ``bug2`` or ``tangent_bug`` (the name is the variant) from the section ``bug``; the
+        tangent bug adds its own section. All read the shared ``reactive`` and ``trajectory``."""
+        if name not in BUG_VARIANTS:
+            raise ValueError(f"a bug navigator is one of {', '.join(BUG_VARIANTS)}, not {name!r}")
+        tangent = sections["tangent_bug"] if name == "tangent_bug" else None
+        return cls(typing.cast(BugVariant, name), sections["bug"], sections["reactive"], control, robot_radius_m,
+                   collision, sections["trajectory"], tangent)  # fmt: skip
+
+    def __init__(self, variant: BugVariant, params: BugParams, reactive: ReactiveParams,
                  control: ControlParams, robot_radius_m: float, collision: CollisionParams | None = None,
                  follow: TrajectoryParams | None = None, tangent: TangentBugParams | None = None) -> None:  # fmt: skip
         super().__init__(reactive, control, robot_radius_m, collision, follow)
@@ -320,13 +339,13 @@ class BugNavigator(ReactiveNavigator):
         are one to the sensor: a ray through a narrower gap than the band's stops at it."""
         level = self.params.follow_clearance_m
         band = max(min(c, level) - self.tangent.band_margin_m, 0.0)
-        r = K.ranges(cw.obs, cw.inner, here[0], here[1], self.angles, self.tangent.sensor_range_m, band, 1e-3)
+        r = RK.ranges(cw.obs, cw.inner, here[0], here[1], self.angles, self.tangent.sensor_range_m, band, 1e-3)
         return r, level - band
 
     def _sees(self, cw: CompiledWorld, here: Point, goal: Point, length: float) -> float:
         """How far (m) the straight way toward the goal keeps the level line's clearance, up to ``length``."""
         a = math.atan2(goal[1] - here[1], goal[0] - here[0])
-        return K.march(cw.obs, cw.inner, here[0], here[1], a, 0.0, length, self.params.follow_clearance_m, 1e-3)
+        return RK.march(cw.obs, cw.inner, here[0], here[1], a, 0.0, length, self.params.follow_clearance_m, 1e-3)
 
     def _d_followed(self, here: Point, goal: Point, r: np.ndarray, inside: float, gx: float, gy: float) -> float:
         """The least distance to the goal of the followed obstacle's sensed boundary: the rays from the

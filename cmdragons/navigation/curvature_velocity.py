@@ -23,7 +23,9 @@ long where every arc toward the goal is short).
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -31,7 +33,7 @@ from cmdragons.config import Validated, setting
 from cmdragons.control.motion import ControlParams
 from cmdragons.geometry import wrap_angle
 from cmdragons.messages import RobotState
-from cmdragons.navigation import _kernels as K
+from cmdragons.navigation import _reactive_kernels as K
 from cmdragons.navigation.base import NavStatus
 from cmdragons.navigation.reactive import ReactiveNavigator, ReactiveParams
 from cmdragons.navigation.trajectory import TrajectoryParams
@@ -74,6 +76,18 @@ class LaneParams(Validated):
 
 class CurvatureVelocityNavigator(ReactiveNavigator):
     """CVM, or LCM (``lanes`` given), for one robot."""
+
+    SECTIONS: ClassVar[Mapping[str, type]] = {**ReactiveNavigator.SECTIONS, "curvature_velocity": CurvatureParams,
+                                               "lane_curvature": LaneParams}
+
+    @classmethod
+    def configure(cls, name: str, sections: Mapping[str, Any], control: ControlParams, robot_radius_m: float,
+                  collision: CollisionParams) -> CurvatureVelocityNavigator:
+        """``curvature_velocity`` from its section; ``lane_curvature`` adds its own section to it. Both
+        read the shared ``reactive`` and ``trajectory``."""
+        lanes = sections["lane_curvature"] if name == "lane_curvature" else None
+        return cls(sections["curvature_velocity"], sections["reactive"], control, robot_radius_m, collision,
+                   sections["trajectory"], lanes)  # fmt: skip
 
     def __init__(self, params: CurvatureParams, reactive: ReactiveParams, control: ControlParams,
                  robot_radius_m: float, collision: CollisionParams | None = None,

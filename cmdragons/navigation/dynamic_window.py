@@ -13,7 +13,9 @@ safe together. Work (the termination's unit): candidate velocities evaluated, th
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -21,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 from cmdragons.config import Validated, setting
 from cmdragons.control.motion import ControlParams
 from cmdragons.messages import RobotState
-from cmdragons.navigation import _kernels as K
+from cmdragons.navigation import _dynamic_window_kernels as K
 from cmdragons.navigation.base import STOP, Arrival, VelocityCommand
 from cmdragons.navigation.trajectory import TrajectoryNavigator, TrajectoryParams
 from cmdragons.planning.termination import Termination
@@ -55,6 +57,14 @@ class DynamicWindowNavigator:
     """The dynamic window for one robot."""
 
     name = "dynamic_window"
+
+    SECTIONS: ClassVar[Mapping[str, type]] = {"dynamic_window": DynamicWindowParams, "trajectory": TrajectoryParams}
+
+    @classmethod
+    def configure(cls, name: str, sections: Mapping[str, Any], control: ControlParams, robot_radius_m: float,
+                  collision: CollisionParams) -> DynamicWindowNavigator:
+        """From the section ``dynamic_window``; it follows the path as ``trajectory`` says."""
+        return cls(sections["dynamic_window"], control, robot_radius_m, collision, sections["trajectory"])
 
     def __init__(
         self, params: DynamicWindowParams, control: ControlParams, robot_radius_m: float,

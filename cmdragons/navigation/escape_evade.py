@@ -5,10 +5,10 @@ Field frame, metres, seconds. Both behaviours make a repelling vector of length 
 moving objects (here: every circle of the collision world moving faster than ``min_speed_m_s``):
 
 * **escape** (§5.1.1): straight away from each object within ``r_max_m``, the more the nearer and
-  the faster it is (:func:`~cmdragons.navigation._kernels.escape_vector`); it needs no prediction;
+  the faster it is (:func:`~cmdragons.navigation._escape_evade_kernels.escape_vector`); it needs no prediction;
 * **evade** (§5.1.2): across each object's predicted path toward the robot's side of it, by the
   robot's distance along (dX) and across (dY) that path, the reach across growing with the
-  variance of the object's movement model (:func:`~cmdragons.navigation._kernels.evade_vector`).
+  variance of the object's movement model (:func:`~cmdragons.navigation._escape_evade_kernels.evade_vector`).
 
 The **movement model** (:class:`MovementModel`) follows the objects from frame to frame (each
 matched to its nearest prediction within ``match_m``): its velocity, its turn rate (the change of
@@ -23,7 +23,9 @@ trajectory navigator's command along the plan plus ``escape_speed_m_s`` times es
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -31,7 +33,7 @@ from numpy.typing import NDArray
 from cmdragons.config import Validated, setting
 from cmdragons.control.motion import ControlParams
 from cmdragons.messages import RobotState
-from cmdragons.navigation import _kernels as K
+from cmdragons.navigation import _escape_evade_kernels as K
 from cmdragons.navigation.base import VelocityCommand
 from cmdragons.navigation.reactive import ReactiveNavigator, ReactiveParams
 from cmdragons.navigation.trajectory import TrajectoryParams
@@ -119,6 +121,15 @@ class EscapeEvadeNavigator(ReactiveNavigator):
     """Goal attraction along the plan plus the escape and evade vectors, for one robot."""
 
     name = "escape_evade"
+
+    SECTIONS: ClassVar[Mapping[str, type]] = {**ReactiveNavigator.SECTIONS, "escape_evade": EscapeEvadeParams}
+
+    @classmethod
+    def configure(cls, name: str, sections: Mapping[str, Any], control: ControlParams, robot_radius_m: float,
+                  collision: CollisionParams) -> EscapeEvadeNavigator:
+        """From the section ``escape_evade`` and the shared ``reactive`` and ``trajectory``."""
+        return cls(sections["escape_evade"], sections["reactive"], control, robot_radius_m, collision,
+                   sections["trajectory"])  # fmt: skip
 
     def __init__(self, params: EscapeEvadeParams, reactive: ReactiveParams, control: ControlParams,
                  robot_radius_m: float, collision: CollisionParams | None = None,

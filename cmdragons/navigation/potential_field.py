@@ -25,8 +25,9 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -34,12 +35,12 @@ from numpy.typing import NDArray
 from cmdragons.config import Validated, setting
 from cmdragons.control.motion import ControlParams
 from cmdragons.messages import RobotState
-from cmdragons.navigation import _kernels as K
+from cmdragons.navigation import _potential_field_kernels as K
 from cmdragons.navigation.base import NavStatus
-from cmdragons.navigation.grid.planners import descend_nf1, nf1
 from cmdragons.navigation.reactive import ReactiveNavigator, ReactiveParams
 from cmdragons.navigation.robox import along
 from cmdragons.navigation.trajectory import TrajectoryParams
+from cmdragons.planning.grid.planners import descend_nf1, nf1
 from cmdragons.planning.world import CollisionParams, CompiledWorld
 
 __all__ = ["ExtendedFieldParams", "PotentialFieldNavigator", "PotentialFieldParams", "escape_path",
@@ -115,6 +116,18 @@ class PotentialFieldNavigator(ReactiveNavigator):
     """Gradient descent on the potential field, with local-minimum detection and the NF1 escape."""
 
     name = "potential_field"
+
+    SECTIONS: ClassVar[Mapping[str, type]] = {**ReactiveNavigator.SECTIONS, "potential_field": PotentialFieldParams,
+                                               "extended_potential_field": ExtendedFieldParams}
+
+    @classmethod
+    def configure(cls, name: str, sections: Mapping[str, Any], control: ControlParams, robot_radius_m: float,
+                  collision: CollisionParams) -> PotentialFieldNavigator:
+        """``potential_field`` from its section; ``extended_potential_field`` adds its own section to it.
+        Both read the shared ``reactive`` and ``trajectory``."""
+        extended = sections["extended_potential_field"] if name == "extended_potential_field" else None
+        return cls(sections["potential_field"], sections["reactive"], control, robot_radius_m, collision,
+                   sections["trajectory"], extended)  # fmt: skip
 
     def __init__(self, params: PotentialFieldParams, reactive: ReactiveParams, control: ControlParams,
                  robot_radius_m: float, collision: CollisionParams | None = None,

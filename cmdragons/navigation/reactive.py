@@ -21,16 +21,19 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from cmdragons.config import Validated, setting
-from cmdragons.control._kernels import heading_command, limit_velocity
+from cmdragons.control.acceleration import limit_velocity
 from cmdragons.control.motion import ControlParams
+from cmdragons.control.trapezoid import heading_command
 from cmdragons.messages import RobotState
-from cmdragons.navigation import _kernels as K
+from cmdragons.navigation import _reactive_kernels as K
 from cmdragons.navigation.base import STOP, Arrival, NavStatus, VelocityCommand
 from cmdragons.navigation.trajectory import TrajectoryNavigator, TrajectoryParams
 from cmdragons.planning.termination import Termination
@@ -61,6 +64,8 @@ class ReactiveNavigator(ABC):
     for its own state)."""
 
     name = "reactive"
+    # the config sections every reactive navigator reads; each adds its own
+    SECTIONS: ClassVar[Mapping[str, type]] = {"reactive": ReactiveParams, "trajectory": TrajectoryParams}
 
     def __init__(self, reactive: ReactiveParams, control: ControlParams, robot_radius_m: float,
                  collision: CollisionParams | None = None, follow: TrajectoryParams | None = None) -> None:  # fmt: skip

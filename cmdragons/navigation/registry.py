@@ -1,20 +1,19 @@
-"""Navigator registry: ``team.navigator`` in configs/team.yaml picks one of :data:`NAVIGATORS`; each
-navigator has its config section there (``team.trajectory``, ``team.dynamic_window``, ``team.robox`` with
-``team.elastic_band``; the reactive methods ``team.reactive`` and their own: ``potential_field``,
-``extended_potential_field``, ``bug``, ``tangent_bug``, ``vfh``, ``vfh_plus``, ``curvature_velocity``,
-``lane_curvature``, ``escape_evade``).
+"""Navigator registry: ``navigator`` in configs/team.yaml picks one of :data:`NAVIGATORS` by name.
 
-A new navigator is one module, one line here and one config section (a field of
-:class:`cmdragons.team.TeamParams` named like its registry key).
+A navigator is one module, one line here and one config section: each navigator type declares the
+sections of configs/team.yaml it reads (``SECTIONS``: its own, and shared ones such as ``reactive``
+or ``trajectory``) and builds itself from them (``configure``, after Nav2's plugins); the team's
+config holds the sections of every registered navigator (:func:`config_sections`) beside
+``navigator``, checked when it is loaded. Nothing outside this package knows a navigator's params.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Mapping
 from typing import Any
 
 from cmdragons.control.motion import ControlParams
-from cmdragons.navigation.base import Navigator
+from cmdragons.navigation.base import Navigator, NavigatorType
 from cmdragons.navigation.bug import BugNavigator
 from cmdragons.navigation.curvature_velocity import CurvatureVelocityNavigator
 from cmdragons.navigation.dynamic_window import DynamicWindowNavigator
@@ -25,46 +24,47 @@ from cmdragons.navigation.trajectory import TrajectoryNavigator
 from cmdragons.navigation.vfh import VFHNavigator
 from cmdragons.planning.world import CollisionParams
 
-__all__ = ["NAVIGATORS", "make_navigator"]
+__all__ = ["NAVIGATORS", "config_sections", "make_navigator"]
 
-# name -> factory(the config sections by navigator name, the robot model, the robot radius m, the
-# collision queries); a navigator reads its own section and may build on another's
-Factory = Callable[[Any, ControlParams, float, CollisionParams], Navigator]
-
-NAVIGATORS: dict[str, Factory] = {
-    "trajectory": lambda s, control, r, collision: TrajectoryNavigator(s.trajectory, control, r),
-    "dynamic_window": lambda s, control, r, collision: DynamicWindowNavigator(s.dynamic_window, control, r, collision,
-                                                                              s.trajectory),  # fmt: skip
-    "robox": lambda s, control, r, collision: RoboxNavigator(s.robox, s.elastic_band, s.dynamic_window, control, r,
-                                                             collision, s.trajectory),  # fmt: skip
+NAVIGATORS: dict[str, NavigatorType] = {
+    "trajectory": TrajectoryNavigator,
+    "dynamic_window": DynamicWindowNavigator,
+    "robox": RoboxNavigator,
     # the reactive methods of the lecture notes (navigation/reactive.py: the shared section ``reactive``)
-    "potential_field": lambda s, control, r, collision: PotentialFieldNavigator(
-        s.potential_field, s.reactive, control, r, collision, s.trajectory),
-    "extended_potential_field": lambda s, control, r, collision: PotentialFieldNavigator(
-        s.potential_field, s.reactive, control, r, collision, s.trajectory, s.extended_potential_field),
-    "bug1": lambda s, control, r, collision: BugNavigator("bug1", s.bug, s.reactive, control, r, collision,
-                                                          s.trajectory),  # fmt: skip
-    "bug2": lambda s, control, r, collision: BugNavigator("bug2", s.bug, s.reactive, control, r, collision,
-                                                          s.trajectory),  # fmt: skip
-    "tangent_bug": lambda s, control, r, collision: BugNavigator("tangent_bug", s.bug, s.reactive, control, r,
-                                                                 collision, s.trajectory, s.tangent_bug),  # fmt: skip
-    "vfh": lambda s, control, r, collision: VFHNavigator(s.vfh, s.reactive, control, r, collision, s.trajectory),
-    "vfh_plus": lambda s, control, r, collision: VFHNavigator(s.vfh, s.reactive, control, r, collision, s.trajectory,
-                                                              s.vfh_plus),  # fmt: skip
-    "curvature_velocity": lambda s, control, r, collision: CurvatureVelocityNavigator(
-        s.curvature_velocity, s.reactive, control, r, collision, s.trajectory),
-    "lane_curvature": lambda s, control, r, collision: CurvatureVelocityNavigator(
-        s.curvature_velocity, s.reactive, control, r, collision, s.trajectory, s.lane_curvature),
-    "escape_evade": lambda s, control, r, collision: EscapeEvadeNavigator(s.escape_evade, s.reactive, control, r,
-                                                                          collision, s.trajectory),  # fmt: skip
+    "potential_field": PotentialFieldNavigator,
+    "extended_potential_field": PotentialFieldNavigator,
+    "bug1": BugNavigator,
+    "bug2": BugNavigator,
+    "tangent_bug": BugNavigator,
+    "vfh": VFHNavigator,
+    "vfh_plus": VFHNavigator,
+    "curvature_velocity": CurvatureVelocityNavigator,
+    "lane_curvature": CurvatureVelocityNavigator,
+    "escape_evade": EscapeEvadeNavigator,
 }
 
 
+def config_sections() -> dict[str, type]:
+    """The config sections of every registered navigator, name -> params type, in registry order
+    (a section two navigators share must have one type)."""
+    out: dict[str, type] = {}
+    for name, nav in NAVIGATORS.items():
+        for section, params in nav.SECTIONS.items():
+            if out.setdefault(section, params) is not params:
+                raise TypeError(f"navigator {name!r} reads section {section!r} as {params.__name__}, "
+                                f"another as {out[section].__name__}")  # fmt: skip
+    return out
+
+
 def make_navigator(
-    name: str, sections: Any, control: ControlParams, robot_radius_m: float, collision: CollisionParams | None = None
-) -> Navigator:
-    """A fresh navigator ``name`` for one robot; ``sections`` holds each navigator's config section as
-    the attribute of its name (configs/team.yaml: :class:`cmdragons.team.TeamParams`)."""
+    name: str, sections: Mapping[str, Any], control: ControlParams, robot_radius_m: float,
+    collision: CollisionParams | None = None,
+) -> Navigator:  # fmt: skip
+    """A fresh navigator ``name`` for one robot, configured from ``sections`` (the team config's
+    sections by name: :attr:`cmdragons.team.TeamParams.navigator_sections`); a section it reads that
+    ``sections`` lacks takes its defaults."""
     if name not in NAVIGATORS:
         raise KeyError(f"unknown navigator {name!r}; known: {', '.join(sorted(NAVIGATORS))}")
-    return NAVIGATORS[name](sections, control, robot_radius_m, collision or CollisionParams())
+    nav = NAVIGATORS[name]
+    own = {section: sections[section] if section in sections else params() for section, params in nav.SECTIONS.items()}
+    return nav.configure(name, own, control, robot_radius_m, collision or CollisionParams())

@@ -22,7 +22,9 @@ fixed number of force steps (``elastic_band.iterations``).
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -58,6 +60,17 @@ class RoboxNavigator:
     """The elastic band over the global path, executed by the dynamic window, for one robot."""
 
     name = "robox"
+
+    SECTIONS: ClassVar[Mapping[str, type]] = {"elastic_band": BandParams, "robox": RoboxParams,
+                                               "dynamic_window": DynamicWindowParams, "trajectory": TrajectoryParams}
+
+    @classmethod
+    def configure(cls, name: str, sections: Mapping[str, Any], control: ControlParams, robot_radius_m: float,
+                  collision: CollisionParams) -> RoboxNavigator:
+        """From the sections ``robox`` and ``elastic_band`` (its band), ``dynamic_window`` and ``trajectory``
+        (the window that executes the band)."""
+        return cls(sections["robox"], sections["elastic_band"], sections["dynamic_window"], control, robot_radius_m,
+                   collision, sections["trajectory"])  # fmt: skip
 
     def __init__(
         self, params: RoboxParams, band: BandParams, window: DynamicWindowParams, control: ControlParams,

@@ -13,7 +13,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -23,7 +25,7 @@ from cmdragons.control.motion import ControlParams, MotionTarget, follow_path, m
 from cmdragons.messages import RobotState
 from cmdragons.navigation.base import STOP, Arrival, VelocityCommand
 from cmdragons.planning.termination import Termination
-from cmdragons.planning.world import CollisionWorld
+from cmdragons.planning.world import CollisionParams, CollisionWorld
 
 __all__ = ["TrajectoryNavigator", "TrajectoryParams", "capped_control"]
 
@@ -50,6 +52,14 @@ class TrajectoryNavigator:
     """Path following with trapezoidal profiles for one robot (work: one profile a frame)."""
 
     name = "trajectory"
+
+    SECTIONS: ClassVar[Mapping[str, type]] = {"trajectory": TrajectoryParams}
+
+    @classmethod
+    def configure(cls, name: str, sections: Mapping[str, Any], control: ControlParams, robot_radius_m: float,
+                  collision: CollisionParams) -> TrajectoryNavigator:
+        """From the section ``trajectory``."""
+        return cls(sections["trajectory"], control, robot_radius_m)
 
     def __init__(self, params: TrajectoryParams, control: ControlParams, robot_radius_m: float) -> None:
         self.params = params

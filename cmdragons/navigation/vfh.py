@@ -3,7 +3,7 @@ as local navigators (lecture notes 001, "Obstacle Avoidance: Vector Field Histog
 
 Field frame, metres, seconds, radians. The histogram grid is the world itself: a cell is occupied
 (certainty 1) where its centre lies in an obstacle. Each occupied cell of the active window adds
-c^2 (a - b d) to the polar sector it lies in (:func:`~cmdragons.navigation._kernels.polar_histogram`).
+c^2 (a - b d) to the polar sector it lies in (:func:`~cmdragons.navigation._vfh_kernels.polar_histogram`).
 
 * **VFH**: the obstacles grown by the robot's radius; the histogram smoothed over ``smoothing``
   sectors each side; sectors under ``threshold`` are free; the valley (run of free sectors) nearest
@@ -22,7 +22,9 @@ c^2 (a - b d) to the polar sector it lies in (:func:`~cmdragons.navigation._kern
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -30,7 +32,7 @@ from numpy.typing import NDArray
 from cmdragons.config import Validated, setting
 from cmdragons.control.motion import ControlParams
 from cmdragons.messages import RobotState
-from cmdragons.navigation import _kernels as K
+from cmdragons.navigation import _vfh_kernels as K
 from cmdragons.navigation.base import NavStatus
 from cmdragons.navigation.reactive import ReactiveNavigator, ReactiveParams
 from cmdragons.navigation.trajectory import TrajectoryParams
@@ -94,6 +96,17 @@ def _gap(a: float, b: float, n: int) -> float:
 
 class VFHNavigator(ReactiveNavigator):
     """VFH or VFH+ (``plus``) for one robot."""
+
+    SECTIONS: ClassVar[Mapping[str, type]] = {**ReactiveNavigator.SECTIONS, "vfh": VFHParams, "vfh_plus": VFHPlusParams}
+
+    @classmethod
+    def configure(cls, name: str, sections: Mapping[str, Any], control: ControlParams, robot_radius_m: float,
+                  collision: CollisionParams) -> VFHNavigator:
+        """``vfh`` from its section; ``vfh_plus`` adds its own section to it. Both read the shared
+        ``reactive`` and ``trajectory``."""
+        plus = sections["vfh_plus"] if name == "vfh_plus" else None
+        return cls(sections["vfh"], sections["reactive"], control, robot_radius_m, collision, sections["trajectory"],
+                   plus)  # fmt: skip
 
     def __init__(self, params: VFHParams, reactive: ReactiveParams, control: ControlParams, robot_radius_m: float,
                  collision: CollisionParams | None = None, follow: TrajectoryParams | None = None,

@@ -26,7 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cmdragons.config import setting
-from cmdragons.planning import _kernels as K
+from cmdragons.planning import _graphsearch_kernels as K
 from cmdragons.planning.graphsearch import Graph
 from cmdragons.planning.roadmap import GraphPlanner, GraphSearchParams
 from cmdragons.planning.world import CompiledWorld

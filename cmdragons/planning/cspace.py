@@ -3,7 +3,7 @@ decompositions that need a polygonal free space) and as points along their bound
 generators of the Voronoi road map).
 
 Field frame, metres. A compiled world's obstacles are already grown by the robot's radius
-(:mod:`cmdragons.planning._kernels`): capsules (a moving robot swept over the query's window, a disc
+(:mod:`cmdragons.planning.collision`): capsules (a moving robot swept over the query's window, a disc
 when it stands) and boxes with a clearance. Each becomes the shapely buffer of its core with the
 radius scaled by ``1 / cos(pi / (4 quad_segs))``, so that the polygon's straight edges are tangent to
 the true round boundary or outside it: the polygon contains the obstacle, and a point outside every

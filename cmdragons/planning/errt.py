@@ -30,7 +30,8 @@ from numpy.typing import NDArray
 
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import path_length
-from cmdragons.planning import _kernels as K
+from cmdragons.planning import _errt_kernels as K
+from cmdragons.planning import _smoothing_kernels as S
 from cmdragons.planning.problem import PlanProblem, PlanResult, PlanStatus, RobustEnds, prepare
 from cmdragons.planning.termination import Termination
 from cmdragons.planning.world import CompiledWorld
@@ -53,9 +54,9 @@ class SmoothingParams(Validated):
 
 def smooth(cw: CompiledWorld, path: FloatArray, params: SmoothingParams) -> FloatArray:
     """Shortcut and pull taut a collision-free polyline (k, 2); the ends stay where they are."""
-    out = K.shortcut(cw.cw, np.ascontiguousarray(path, dtype=np.float64))
+    out = S.shortcut(cw.cw, np.ascontiguousarray(path, dtype=np.float64))
     if params.passes > 0 and len(out) > 2:
-        out = K.pull_taut(cw.cw, out, params.passes, params.bisections, params.subdivide_m)
+        out = S.pull_taut(cw.cw, out, params.passes, params.bisections, params.subdivide_m)
     return np.asarray(out)
 
 
@@ -132,10 +133,11 @@ class ERRTPlanner:
         self.last_goal: tuple[float, float] | None = None
         self._allocate(p.work_budget)
         self._roots = np.array([0, 1], dtype=np.int32)
-        self._state = np.zeros(5, dtype=np.int64)
+        self._counts = np.zeros(K.N_COUNTS, dtype=np.int64)
         self._bridges = np.zeros((p.max_bridges, 3))
-        self._p_way = p.p_waypoint if p.waypoint_cache else 0.0
-        self._nn = K.NN_KDTREE if p.nearest == "kdtree" else K.NN_BRUTE
+        nn = K.NN_KDTREE if p.nearest == "kdtree" else K.NN_BRUTE
+        self._config = K.GrowConfig(p.p_goal, p.p_waypoint if p.waypoint_cache else 0.0, p.step_m, p.connect_radius_m,
+                                    p.max_extensions, p.bidirectional, p.max_bridges, p.extra_iterations, nn)
         self._no_waypoints = np.zeros((0, 2))
         self._rand = np.zeros((0, 3))
         self._rand_next = 0
@@ -182,9 +184,11 @@ class ERRTPlanner:
             return self._done(ends, path, PlanStatus.SOLVED, {"reused": False, "iterations": 0}, t0)
         waypoints = self.cache.view() if self.params.waypoint_cache else self._no_waypoints
         code, timed_out = self._grow(cw, s, g, waypoints, termination)
-        n_nodes, n_bridges, iterations = (int(v) for v in self._state[:3])
-        stats: dict[str, object] = {"reused": False, "iterations": iterations, "nodes": n_nodes, "bridges": n_bridges,
-                                    "waypoint_targets": int(self._state[4]), "cached": len(waypoints)}  # fmt: skip
+        counts = self._counts
+        n_bridges = int(counts[K.N_BRIDGES])
+        stats: dict[str, object] = {"reused": False, "iterations": int(counts[K.ITERATIONS]),
+                                    "nodes": int(counts[K.N_NODES]), "bridges": n_bridges,
+                                    "waypoint_targets": int(counts[K.WAYPOINT_TARGETS]), "cached": len(waypoints)}
         if n_bridges == 0:
             self.last_path = None
             status = PlanStatus.TIMEOUT if timed_out else PlanStatus.NO_PATH
@@ -228,19 +232,17 @@ class ERRTPlanner:
         self._cost[:2] = 0.0
         self._kdc[:2] = -1
         self._kdd[:2] = 0
-        self._state[:] = (2, 0, 0, 0, 0)
+        self._counts[:] = 0
+        self._counts[K.N_NODES] = 2  # the two roots
         chunk = self.params.chunk_iterations
         limit = termination.work_left(0, MAX_NODES)
         while True:
             rand = self._random_rows(chunk)
-            before = int(self._state[2])
-            arrays = (self._nodes, self._parent, self._tree, self._cost, self._kdc, self._kdd, self._roots,
-                      self._stack, self._state, self._bridges)  # fmt: skip
-            p = self.params
-            code = K.errt_grow(cw.cw, *arrays, rand, waypoints, p.p_goal, self._p_way, p.step_m, p.connect_radius_m,
-                               p.max_extensions, p.bidirectional, p.max_bridges, p.extra_iterations, self._nn,
-                               min(limit, len(self._nodes)))  # fmt: skip
-            self._rand_next += int(self._state[2]) - before
+            before = int(self._counts[K.ITERATIONS])
+            trees = K.Trees(self._nodes, self._parent, self._tree, self._cost, self._kdc, self._kdd, self._roots,
+                            self._stack, self._counts, self._bridges)  # fmt: skip
+            code = K.errt_grow(cw.cw, trees, rand, waypoints, self._config, min(limit, len(self._nodes)))
+            self._rand_next += int(self._counts[K.ITERATIONS]) - before
             if code == K.GROW_FULL and len(self._nodes) < min(limit, MAX_NODES):
                 self._grow_room()  # the budget allows more nodes than there is room for
                 continue
@@ -271,7 +273,7 @@ class ERRTPlanner:
         return self._nodes[idx].copy()
 
     def _closest_to(self, g: tuple[float, float]) -> int:
-        n = int(self._state[0])
+        n = int(self._counts[K.N_NODES])
         d = np.hypot(self._nodes[:n, 0] - g[0], self._nodes[:n, 1] - g[1])
         d[self._tree[:n] != 0] = np.inf
         return int(np.argmin(d))

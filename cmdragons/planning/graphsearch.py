@@ -13,7 +13,7 @@ their length, held as CSR arrays; every road map (Voronoi, visibility) and every
   of axis and diagonal moves it takes the octile distance, which is too).
 
 Work (a termination's unit): nodes expanded. The search runs in chunks of ``chunk`` expansions
-(:func:`cmdragons.planning._kernels.graph_search`), checking the termination between them.
+(:func:`cmdragons.planning._graphsearch_kernels.graph_search`), checking the termination between them.
 :func:`grid_search` is the same search on a uniform grid's graph without building it (the cells'
 neighbours found by index), for large grids.
 """
@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from cmdragons.planning import _kernels as K
+from cmdragons.planning import _graphsearch_kernels as K
 from cmdragons.planning.termination import Termination
 from cmdragons.planning.world import CompiledWorld
 
@@ -182,8 +182,8 @@ def grid_search(free: NDArray[np.bool_], start: tuple[int, int], goal: tuple[int
     cells (row, column), ``resolution_m`` apart, 4 or 8 neighbours; the heuristic the octile
     distance), without building the graph: the same search as over
     :func:`cmdragons.planning.cells.grid_graph`, faster. Dijkstra and A* count each cost in axis and
-    diagonal moves and keep the frontier in a radix heap (:func:`cmdragons.planning._kernels.grid_astar`);
-    the others run :func:`cmdragons.planning._kernels.graph_search` on the grid. ``route`` is cell
+    diagonal moves and keep the frontier in a radix heap (:func:`cmdragons.planning._graphsearch_kernels.grid_astar`);
+    the others run :func:`cmdragons.planning._graphsearch_kernels.graph_search` on the grid. ``route`` is cell
     indices row * nx + column."""
     ny, nx = free.shape
     mode = _mode(method)
@@ -209,7 +209,7 @@ def grid_search(free: NDArray[np.bool_], start: tuple[int, int], goal: tuple[int
 
 class _GridFrontier:
     """The state of one Dijkstra or A* search on a grid (with a blocked border), as
-    :func:`cmdragons.planning._kernels.grid_astar` takes it."""
+    :func:`cmdragons.planning._graphsearch_kernels.grid_astar` takes it."""
 
     def __init__(self, free: NDArray[np.bool_], src: int, connectivity: int) -> None:
         ny, nx = free.shape

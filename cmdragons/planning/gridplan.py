@@ -2,7 +2,7 @@
 
 Field frame, metres. Each frame the problem's compiled world (its obstacles grown by the robot's
 radius: the configuration space) is rasterised to a clearance grid and turned into a cost grid
-(:class:`~cmdragons.navigation.grid.costgrid.CostGrid`): obstacle cells where the clearance is
+(:class:`~cmdragons.planning.grid.costgrid.CostGrid`): obstacle cells where the clearance is
 below ``grid.min_clearance_m``, a soft cost near every obstacle, and the weighted regions of
 ``grid`` on top (the boxes of the world, i.e. the defense areas and goal walls, and its circles,
 i.e. the other robots and the ball: the problem does not tell teams apart). The planner works from
@@ -37,8 +37,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cmdragons.config import Validated, setting
-from cmdragons.navigation.grid.costgrid import CostGrid, CostParams, Region
-from cmdragons.navigation.grid.planners import EStar, descend_nf1, nf1
+from cmdragons.planning.grid.costgrid import CostGrid, CostParams, Region
+from cmdragons.planning.grid.planners import EStar, descend_nf1, nf1
 from cmdragons.planning.errt import SmoothingParams, smooth
 from cmdragons.planning.problem import PlanProblem, PlanResult, PlanStatus, RobustEnds, prepare
 from cmdragons.planning.termination import Termination

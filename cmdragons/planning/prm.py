@@ -19,7 +19,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cmdragons.config import Validated, setting
-from cmdragons.planning import _kernels as K
+from cmdragons.planning import _graphsearch_kernels as G
+from cmdragons.planning import _prm_kernels as K
 from cmdragons.planning.errt import SmoothingParams, smooth
 from cmdragons.planning.problem import PlanProblem, PlanResult, PlanStatus, RobustEnds, prepare
 from cmdragons.planning.termination import Termination
@@ -127,8 +128,8 @@ class DynamicPRMPlanner:
         while True:
             pts, start, adj, w = rm.csr(np.array([s, g]))
             src, dst = len(pts) - 2, len(pts) - 1
-            cost, prev = K.astar(cw.cw, pts, start, adj, w, src, dst, np.zeros(len(adj), dtype=np.int8))
-            route: NDArray[np.int64] = K.route_to(prev, dst) if np.isfinite(cost[dst]) else np.zeros(0, np.int64)
+            cost, prev = G.astar(cw.cw, pts, start, adj, w, src, dst, np.zeros(len(adj), dtype=np.int8))
+            route: NDArray[np.int64] = G.route_to(prev, dst) if np.isfinite(cost[dst]) else np.zeros(0, np.int64)
             searches += 1
             stats: dict[str, object] = {"searches": searches, "roadmap_nodes": len(rm.pts), "added": added}
             if len(route):

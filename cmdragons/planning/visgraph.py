@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cmdragons.config import Validated, setting
-from cmdragons.planning import _kernels as K
+from cmdragons.planning import _visgraph_kernels as K
 from cmdragons.planning.problem import PlanProblem, PlanResult, PlanStatus, Stateless, path_length, prepare
 from cmdragons.planning.termination import Termination
 

@@ -31,7 +31,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field
-from cmdragons.planning import _kernels as K
+from cmdragons.planning import collision as K
 
 __all__ = ["BROAD_PHASES", "ClearanceGrid", "CollisionParams", "CollisionWorld", "CompiledWorld", "field_world"]
 

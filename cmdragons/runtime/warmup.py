@@ -39,7 +39,8 @@ __all__ = ["CompileWatch", "cold_kernels", "warm_up"]
 _PLAY_KERNELS: dict[str, tuple[str, ...]] = {
     "sim._kernels": ("_render_frame_kernel", "_plan_objects_kernel"),
     "vision._kernels": ("classify", "match_patterns", "ball_centre"),
-    "cmdragons.planning._kernels": ("build_world", "errt_grow", "point_free"),
+    "cmdragons.planning.collision": ("build_world", "point_free"),
+    "cmdragons.planning._errt_kernels": ("errt_grow",),
     "cmdragons.control._kernels": ("motion_commands",),
     "cmdragons.safety._kernels": ("dss",),
 }
@@ -260,7 +261,8 @@ def _warm_motion(settings: Any) -> None:
     theirs = [RobotState("yellow", i, -0.9 + 0.25 * i, 0.3, math.pi, -1.0, 0.0, 0.0) for i in range(3)]
     world = WorldState(0.0, BallState(0.0, 0.0, 0.0, 0.0), tuple(ours + theirs))
     others = field_world(geometry, np.array([[r.x, r.y] for r in theirs]), np.array([[r.vx, r.vy] for r in theirs]))
-    nav = make_navigator(settings.team.navigator, settings.team, settings.control, radius, settings.planner.collision)
+    nav = make_navigator(settings.team.navigator, settings.team.navigator_sections, settings.control, radius,
+                         settings.planner.collision)
     commands = []
     for r in ours:
         nav.set_plan(np.array([(r.x, r.y), (1.0, 1.0), (2.0, 1.0)]), Arrival(0.0))

@@ -28,9 +28,9 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from cmdragons._kernels import argsort_stable, sort_small
-from cmdragons.control._kernels import N_SEG, Limits, clip_accel, limit_velocity, seg_at, stop_accel, trajectory
-from cmdragons.planning._kernels import clearance
+from cmdragons.control.acceleration import N_SEG, Limits, clip_accel, feasible, seg_at, stop_accel, trajectory
+from cmdragons.safety.static_check import static_hits
+from cmdragons.sorting import argsort_stable, sort_small
 
 # the robot model's braking trajectory (N_SEG, trajectory, stop_accel) is used here as defined in
 # cmdragons.control._kernels, and is reachable from this module for the safety tests
@@ -224,29 +224,6 @@ def opponent_hits(tr: np.ndarray, ox: float, oy: float, ovx: float, ovy: float, 
 
 
 @njit(cache=True)
-def static_hits(tr: np.ndarray, obs: np.ndarray, inner: np.ndarray, margin: float, step: float) -> bool:
-    """Does the trajectory come within ``margin`` of an obstacle of the compiled collision world
-    (``obs``, ``inner``: see :mod:`cmdragons.planning._kernels`; its clearance query)? Sampled so that
-    consecutive samples lie at most ``step`` apart along the path, each held to ``margin + step / 2``
-    (every point of the path is within step / 2 of a sample). A start already closer only fails
-    deeper."""
-    c0 = clearance(obs, inner, tr[0, 2], tr[0, 3])
-    need = min(margin + 0.5 * step, c0 - 1e-9)
-    for k in range(N_SEG - 1):
-        t0, t1 = tr[k, 0], tr[k, 1]
-        if t1 - t0 <= 0.0:
-            continue
-        vmax = max(math.hypot(tr[k, 4], tr[k, 5]), math.hypot(tr[k, 4] + tr[k, 6] * (t1 - t0),
-                                                              tr[k, 5] + tr[k, 7] * (t1 - t0)))  # fmt: skip
-        n = max(1, int(math.ceil(vmax * (t1 - t0) / step)))
-        for i in range(1, n + 1):
-            px, py, _, _ = seg_at(tr, k, t0 + (t1 - t0) * i / n)
-            if clearance(obs, inner, px, py) < need:
-                return True
-    return False
-
-
-@njit(cache=True)
 def exposed(states: np.ndarray, opp: np.ndarray, reach: float) -> np.ndarray:
     """Per own robot: is an opponent's centre within ``reach`` of its centre, near enough to push it
     into a team-mate before anyone can react?"""
@@ -273,13 +250,6 @@ def _trajectory_hits(
         if opponent_hits(tr, opp[j, 0], opp[j, 1], opp[j, 2], opp[j, 3], cfg.opponent_radius, cfg.opponent_accel):
             return True
     return static_hits(tr, obs, inner, cfg.static_margin, cfg.static_step)
-
-
-@njit(cache=True)
-def feasible(vx: float, vy: float, ax: float, ay: float, lim: Limits, dt: float) -> tuple[float, float]:
-    """The acceleration (ax, ay) held to A(v) and the speed limit for one period ``dt``."""
-    cx, cy = limit_velocity(vx, vy, vx + ax * dt, vy + ay * dt, lim.vmax, lim.accel, lim.brake, dt)
-    return (cx - vx) / dt, (cy - vy) / dt
 
 
 @njit(cache=True)

@@ -9,7 +9,6 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from cmdragons.planning._reference import obstacle_dist
 
 FloatArray = NDArray[np.float64]
 
@@ -56,13 +55,3 @@ def opponent_min_gap(tr: FloatArray, opponent: FloatArray, accel: float, n: int 
     t = np.linspace(0.0, float(tr[-1, 0]), n)
     q = opponent[:2] + np.outer(t, opponent[2:4])
     return float(np.min(np.linalg.norm(positions(tr, t) - q, axis=1) - 0.5 * accel * t * t))
-
-
-def static_min_clearance(tr: FloatArray, obs: FloatArray, inner: FloatArray, n: int = 4001) -> float:
-    """The least clearance of the trajectory from the walls and the obstacles of a compiled collision
-    world (``obs``, ``inner``), by brute force over dense samples."""
-    p = positions(tr, np.linspace(0.0, float(tr[-1, 0]), n))
-    c = np.minimum.reduce([p[:, 0] - inner[0], inner[2] - p[:, 0], p[:, 1] - inner[1], inner[3] - p[:, 1]])
-    if len(obs):
-        c = np.minimum(c, np.min(obstacle_dist(obs, p) - obs[:, 5:6], axis=0))
-    return float(np.min(c))

@@ -15,8 +15,8 @@ from cmdragons.control import (
     motion_command,
     motion_commands,
 )
-from cmdragons.control import _kernels as K
 from cmdragons.control import _reference as R
+from cmdragons.control import acceleration as A
 from cmdragons.geometry import LeagueParams, wrap_angle
 from cmdragons.messages import RobotCommand, RobotState
 from sim.world import BallParams, DribblerParams, KickerParams, PhysicsParams, RobotParams, World
@@ -30,7 +30,7 @@ def test_clip_accel_agrees_with_reference_and_stays_in_the_model() -> None:
     v = rng.normal(0, 1.5, (400, 2))
     v[:20] = 0.0
     a = rng.normal(0, 8, (400, 2))
-    got = np.array([K.clip_accel(*v[i], *a[i], 3.0, 6.0) for i in range(len(v))])
+    got = np.array([A.clip_accel(*v[i], *a[i], 3.0, 6.0) for i in range(len(v))])
     np.testing.assert_allclose(got, R.clip_accel(v, a, 3.0, 6.0), atol=1e-12)
     # inside A(v): at most 3 m/s^2 unless braking; never more than 6; direction kept
     mags = np.linalg.norm(got, axis=1)

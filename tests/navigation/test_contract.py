@@ -38,7 +38,7 @@ def drive(name: str, start: tuple[float, float, float], path: list[tuple[float, 
               DribblerParams(), robots_per_team={"blue": 1, "yellow": 0})  # fmt: skip
     w.place_ball(0.0, 3.1)
     w.place_robot("blue", 0, *start)
-    nav = make_navigator(name, TeamParams(), CONTROL, RADIUS)
+    nav = make_navigator(name, TeamParams().navigator_sections, CONTROL, RADIUS)
     nav.set_plan(np.array(path), Arrival(heading))
     world = field_world(FIELD)
     commands, states = [], []
@@ -80,7 +80,7 @@ def test_every_navigator_reaches_a_free_goal_within_the_limits_and_rests_there(
 
 @pytest.mark.parametrize("name", NAMES)
 def test_a_speed_cap_is_kept(name: str) -> None:
-    nav = make_navigator(name, TeamParams(), CONTROL, RADIUS)
+    nav = make_navigator(name, TeamParams().navigator_sections, CONTROL, RADIUS)
     nav.set_plan(np.array([(0.0, 0.0), (3.0, 0.0)]), Arrival(0.0, max_speed_m_s=1.0))
     robot = RobotState("blue", 0, 0.0, 0.0, 0.0, 1.0, 0.0)
     for _ in range(30):
@@ -90,7 +90,7 @@ def test_a_speed_cap_is_kept(name: str) -> None:
 
 @pytest.mark.parametrize("name", NAMES)
 def test_no_work_allowed_is_the_stop(name: str) -> None:
-    nav = make_navigator(name, TeamParams(), CONTROL, RADIUS)
+    nav = make_navigator(name, TeamParams().navigator_sections, CONTROL, RADIUS)
     nav.set_plan(np.array([(0.0, 0.0), (3.0, 0.0)]), Arrival(0.0))
     robot = RobotState("blue", 0, 0.0, 0.0, 0.0, 2.0, 0.0)
     world = field_world(FIELD)
@@ -98,4 +98,4 @@ def test_no_work_allowed_is_the_stop(name: str) -> None:
     assert nav.command(robot, world, deadline(-1.0)) == STOP
     assert nav.command(robot, world, deadline(60.0)) != STOP
     with pytest.raises(KeyError, match="unknown navigator"):
-        make_navigator("magic", TeamParams(), CONTROL, RADIUS)
+        make_navigator("magic", TeamParams().navigator_sections, CONTROL, RADIUS)

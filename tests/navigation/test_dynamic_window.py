@@ -10,12 +10,12 @@ import numpy as np
 import pytest
 
 from cmdragons.control import ControlParams
-from cmdragons.control import _kernels as CK
+from cmdragons.control import acceleration as CK
 from cmdragons.geometry import Field, LeagueParams
 from cmdragons.messages import RobotState
 from cmdragons.navigation import Arrival, DynamicWindowNavigator, DynamicWindowParams
-from cmdragons.navigation import _kernels as K
-from cmdragons.navigation import _reference as R
+from cmdragons.navigation import _dynamic_window_kernels as K
+from cmdragons.navigation import _dynamic_window_reference as R
 from cmdragons.navigation.dynamic_window import window_points
 from cmdragons.planning import deadline, field_world
 from cmdragons.runtime.match import Match

@@ -17,12 +17,16 @@ import pytest
 from cmdragons.control import ControlParams
 from cmdragons.messages import RobotState
 from cmdragons.navigation import NAVIGATORS, Arrival, BugParams, GridBug2Status, NavStatus, bug2_path, make_navigator
-from cmdragons.navigation import _kernels as K
-from cmdragons.navigation import _reference as R
+from cmdragons.navigation import _bug_kernels as BK
+from cmdragons.navigation import _bug_reference as R
+from cmdragons.navigation import _escape_evade_kernels as EK
+from cmdragons.navigation import _potential_field_kernels as PK
+from cmdragons.navigation import _reactive_kernels as RK
+from cmdragons.navigation import _vfh_kernels as VK
 from cmdragons.navigation.escape_evade import MovementModel, evade_config
-from cmdragons.navigation.grid.planners import descend_nf1, nf1
 from cmdragons.navigation.potential_field import potential_config
 from cmdragons.planning import CollisionWorld, deadline
+from cmdragons.planning.grid.planners import descend_nf1, nf1
 from cmdragons.team import TeamParams
 
 CONTROL = ControlParams()
@@ -39,7 +43,7 @@ def run(nav_name: str, world_at: Callable[[int], CollisionWorld], start: tuple[f
         goal: tuple[float, float], seconds: float, team: TeamParams | None = None
         ) -> tuple[np.ndarray, list[NavStatus], object]:  # fmt: skip
     """Drive ``nav_name`` kinematically: the robot's positions (k, 2), statuses, the navigator."""
-    nav = make_navigator(nav_name, team or TeamParams(), CONTROL, RADIUS)
+    nav = make_navigator(nav_name, (team or TeamParams()).navigator_sections, CONTROL, RADIUS)
     nav.set_plan(np.array([start, goal]), Arrival(0.0))
     x, y, vx, vy, th = start[0], start[1], 0.0, 0.0, 0.0
     xs, statuses = [], []
@@ -70,8 +74,8 @@ def test_every_reactive_navigator_passes_a_convex_obstacle_to_its_goal(name: str
 @pytest.mark.parametrize("obstacle", ["gaussian", "inverse"])
 def test_potential_field_descends_on_a_convex_scene(obstacle: str) -> None:
     team = TeamParams()
-    team = dataclasses.replace(team, potential_field=dataclasses.replace(team.potential_field, obstacle=obstacle,
-                                                                         escape="none"))  # fmt: skip
+    field = dataclasses.replace(team.navigator_sections["potential_field"], obstacle=obstacle, escape="none")
+    team = team.with_section("potential_field", field)
     world = CollisionWorld(BOUNDS, np.array([(-0.5, 0.1, 0.09), (0.6, -0.2, 0.2)]))
     xs, statuses, _ = run("potential_field", lambda k: world, (-2.0, 0.0), (2.0, 0.0), 8.0, team)
     assert math.dist(tuple(xs[-1]), (2.0, 0.0)) < 0.01
@@ -82,7 +86,8 @@ def test_potential_field_descends_on_a_convex_scene(obstacle: str) -> None:
 @pytest.mark.parametrize("name", ["potential_field", "extended_potential_field"])
 def test_potential_field_is_stuck_in_the_u_trap_and_says_so(name: str) -> None:
     team = TeamParams()
-    team = dataclasses.replace(team, potential_field=dataclasses.replace(team.potential_field, escape="none"))
+    team = team.with_section("potential_field", dataclasses.replace(team.navigator_sections["potential_field"],
+                                                                    escape="none"))
     world = CollisionWorld(BOUNDS, boxes=U_TRAP)
     xs, statuses, _ = run(name, lambda k: world, (0.0, 0.0), (2.0, 0.0), 6.0, team)
     assert statuses[-1] is NavStatus.LOCAL_MINIMUM
@@ -245,19 +250,19 @@ def test_potential_gradient_is_the_potential_s_gradient() -> None:
     world = random_field(1)
     cw = world.compile(RADIUS)
     for obstacle in ("gaussian", "inverse"):
-        p = dataclasses.replace(TeamParams().potential_field, obstacle=obstacle)
+        p = dataclasses.replace(TeamParams().navigator_sections["potential_field"], obstacle=obstacle)
         cfg = potential_config(p, RADIUS)
         checked = 0
         for _ in range(300):
             x, y = rng.uniform(-2.8, 2.8), rng.uniform(-1.8, 1.8)
             if cw.clearance(x, y) < 0.02:
                 continue
-            _, ex, ey = K.potential(cw.obs, cw.inner, x, y, 2.0, 0.5, 0.0, 0.0, cfg)
+            _, ex, ey = PK.potential(cw.obs, cw.inner, x, y, 2.0, 0.5, 0.0, 0.0, cfg)
             h = 1e-6
-            fx = (K.potential(cw.obs, cw.inner, x + h, y, 2.0, 0.5, 0.0, 0.0, cfg)[0]
-                  - K.potential(cw.obs, cw.inner, x - h, y, 2.0, 0.5, 0.0, 0.0, cfg)[0]) / (2 * h)  # fmt: skip
-            fy = (K.potential(cw.obs, cw.inner, x, y + h, 2.0, 0.5, 0.0, 0.0, cfg)[0]
-                  - K.potential(cw.obs, cw.inner, x, y - h, 2.0, 0.5, 0.0, 0.0, cfg)[0]) / (2 * h)  # fmt: skip
+            fx = (PK.potential(cw.obs, cw.inner, x + h, y, 2.0, 0.5, 0.0, 0.0, cfg)[0]
+                  - PK.potential(cw.obs, cw.inner, x - h, y, 2.0, 0.5, 0.0, 0.0, cfg)[0]) / (2 * h)  # fmt: skip
+            fy = (PK.potential(cw.obs, cw.inner, x, y + h, 2.0, 0.5, 0.0, 0.0, cfg)[0]
+                  - PK.potential(cw.obs, cw.inner, x, y - h, 2.0, 0.5, 0.0, 0.0, cfg)[0]) / (2 * h)  # fmt: skip
             if abs(fx - ex) + abs(fy - ey) > 1e-4 * (1.0 + abs(ex) + abs(ey)):
                 # a kink: where the nearest part of a box switches, or a source's influence ends
                 continue
@@ -275,7 +280,7 @@ def test_grid_bug2_kernel_agrees_with_the_reference() -> None:
         goal = (int(rng.integers(w)), int(rng.integers(h)))
         max_steps = int(rng.choice([5, 40, 100_000]))
         for turn in (1, -1):
-            status, cells = K.bug2_grid(occupied, *start, *goal, turn, max_steps)
+            status, cells = BK.bug2_grid(occupied, *start, *goal, turn, max_steps)
             name, ref = R.bug2_grid(occupied, start, goal, turn, max_steps)
             assert GridBug2Status(int(status)).name.lower() == name
             assert [tuple(c) for c in cells.tolist()] == ref
@@ -292,7 +297,7 @@ def test_march_agrees_with_dense_sampling() -> None:
         if cw.clearance(x, y) <= 0.05:
             continue
         th, kappa = rng.uniform(-math.pi, math.pi), rng.choice([0.0, rng.uniform(-3.0, 3.0)])
-        s = K.march(cw.obs, cw.inner, x, y, th, kappa, 2.0, 0.02, 1e-4)
+        s = RK.march(cw.obs, cw.inner, x, y, th, kappa, 2.0, 0.02, 1e-4)
         ts = np.linspace(0.0, 2.0, 4001)
         if kappa == 0.0:
             px, py = x + ts * math.cos(th), y + ts * math.sin(th)
@@ -305,7 +310,7 @@ def test_march_agrees_with_dense_sampling() -> None:
 
 
 def test_escape_and_evade_vectors_agree_with_the_seed_s_formulas() -> None:
-    p = TeamParams().escape_evade
+    p = TeamParams().navigator_sections["escape_evade"]
     cfg = evade_config(p)
     rng = np.random.default_rng(7)
     for _ in range(200):
@@ -322,7 +327,7 @@ def test_escape_and_evade_vectors_agree_with_the_seed_s_formulas() -> None:
             if d < p.r_max_m and v >= p.min_speed_m_s:
                 s += (np.array([px, py]) - o[:2]) / d * (p.r_max_m - d) / p.r_max_m * min(v / p.v_max_m_s, 1.0)
         s = s / max(1.0, np.linalg.norm(s))
-        assert np.allclose(K.escape_vector(px, py, objs, cfg), s, atol=1e-12)
+        assert np.allclose(EK.escape_vector(px, py, objs, cfg), s, atol=1e-12)
         # evade (5.8)-(5.15)
         s = np.zeros(2)
         for o in objs:
@@ -337,11 +342,11 @@ def test_escape_and_evade_vectors_agree_with_the_seed_s_formulas() -> None:
             normal = np.array([-u[1], u[0]]) * (1.0 if cross >= 0.0 else -1.0)
             s += normal * f * min(v / p.v_max_m_s, 1.0)
         s = s / max(1.0, np.linalg.norm(s))
-        assert np.allclose(K.evade_vector(px, py, objs, cfg), s, atol=1e-12)
+        assert np.allclose(EK.evade_vector(px, py, objs, cfg), s, atol=1e-12)
 
 
 def test_the_movement_model_finds_a_curve_and_a_jittery_track_s_variance() -> None:
-    p = TeamParams().escape_evade
+    p = TeamParams().navigator_sections["escape_evade"]
     rng = np.random.default_rng(11)
     smooth, jitter = MovementModel(p, DT), MovementModel(p, DT)
     omega, speed = 1.0, 1.5
@@ -362,7 +367,7 @@ def test_polar_histogram_counts_the_cells_inside_discs_and_boxes() -> None:
     cw = CollisionWorld(BOUNDS, discs, boxes=boxes).compile(0.0)
     px, py = 0.013, -0.021
     for enlarge in (0.0, 0.14):
-        cfg = K.HistogramConfig(1.0, 0.05, 72, enlarge)
+        cfg = VK.HistogramConfig(1.0, 0.05, 72, enlarge)
         ks = np.arange(-20, 21)
         cx, cy = (px + ks * 0.05)[None, :], (py + ks * 0.05)[:, None]
         cx, cy = np.broadcast_to(cx, (41, 41)).ravel(), np.broadcast_to(cy, (41, 41)).ravel()
@@ -378,5 +383,5 @@ def test_polar_histogram_counts_the_cells_inside_discs_and_boxes() -> None:
             for s in range(int(math.floor((beta - gam + math.pi) / (2 * math.pi / 72))),
                            int(math.floor((beta + gam + math.pi) / (2 * math.pi / 72))) + 1):  # fmt: skip
                 ref[s % 72] += 1.0 - r / 1.0
-        assert np.allclose(K.polar_histogram(cw.obs, cw.inner, px, py, cfg), ref, atol=1e-9)
+        assert np.allclose(VK.polar_histogram(cw.obs, cw.inner, px, py, cfg), ref, atol=1e-9)
         assert ref[int((math.pi + math.pi) / (2 * math.pi / 72)) % 72] > 1.0  # the box at -x is in it

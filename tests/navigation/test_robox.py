@@ -27,7 +27,7 @@ CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 CONTROL = ControlParams()
 FIELD = Field(LeagueParams())
 RADIUS = 0.09
-MARGIN = TeamParams().dynamic_window.margin_m
+MARGIN = TeamParams().navigator_sections["dynamic_window"].margin_m
 
 
 def run(obstacle_path: list[tuple[float, float]], plan: list[tuple[float, float]], seconds: float) -> tuple[
@@ -38,7 +38,7 @@ def run(obstacle_path: list[tuple[float, float]], plan: list[tuple[float, float]
               DribblerParams(), robots_per_team={"blue": 1, "yellow": 1})  # fmt: skip
     w.place_ball(0.0, 3.1)
     w.place_robot("blue", 0, *plan[0], 0.0)
-    nav = make_navigator("robox", TeamParams(), CONTROL, RADIUS)
+    nav = make_navigator("robox", TeamParams().navigator_sections, CONTROL, RADIUS)
     assert isinstance(nav, RoboxNavigator)
     ours, theirs = [], []
     for k in range(round(seconds * 60)):

@@ -7,7 +7,7 @@ import pytest
 
 from cmdragons.geometry import Field
 from cmdragons.planning import CollisionParams, CollisionWorld, field_world
-from cmdragons.planning import _reference as PR
+from cmdragons.planning import collision_reference as PR
 
 R = 0.09
 

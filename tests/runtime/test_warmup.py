@@ -35,6 +35,6 @@ def test_a_fresh_cache_makes_every_play_kernel_cold(tmp_path: Path) -> None:
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
     images, brain = json.loads(out.stdout)
     assert "sim._kernels._render_frame_kernel" in images and "vision._kernels.classify" in images
-    assert "cmdragons.safety._kernels.dss" in brain and "cmdragons.planning._kernels.errt_grow" in brain
+    assert "cmdragons.safety._kernels.dss" in brain and "cmdragons.planning._errt_kernels.errt_grow" in brain
     assert not any(name.startswith(("sim.", "vision.")) for name in brain)
     assert set(brain) < set(images)

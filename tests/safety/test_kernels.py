@@ -5,11 +5,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cmdragons.control import _kernels as CK
-from cmdragons.planning import _kernels as PK
+from cmdragons.control import acceleration as CK
+from cmdragons.planning import collision as PK
 from cmdragons.planning.world import CollisionWorld
 from cmdragons.safety import _kernels as K
 from cmdragons.safety import _reference as R
+from cmdragons.safety import static_check
 
 DT, ACCEL, BRAKE = 1 / 60, 3.0, 6.0
 
@@ -88,14 +89,14 @@ def test_static_check_is_conservative_by_at_most_one_step() -> None:
     for _ in range(400):
         tr = random_trajectory(rng)
         c0 = PK.clearance(cw.obs, cw.inner, tr[0, 2], tr[0, 3])
-        low = R.static_min_clearance(tr, cw.obs, cw.inner)
+        low = static_check.static_min_clearance(tr, cw.obs, cw.inner)
         need = min(margin, c0)
-        hit = K.static_hits(tr, cw.obs, cw.inner, margin, step)
+        hit = static_check.static_hits(tr, cw.obs, cw.inner, margin, step)
         if low < need - 1e-3:
             assert hit  # a real intrusion is always caught
         if low > need + step + 1e-3:
             assert not hit  # and the check is never stricter than one step
-        assert c0 == pytest.approx(R.static_min_clearance(np.array([[0, np.inf, *tr[0, 2:4], 0, 0, 0, 0]]), cw.obs,
+        assert c0 == pytest.approx(static_check.static_min_clearance(np.array([[0, np.inf, *tr[0, 2:4], 0, 0, 0, 0]]), cw.obs,
                                                           cw.inner, n=1))  # fmt: skip
 
 

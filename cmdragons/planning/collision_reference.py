@@ -1,7 +1,8 @@
-"""Plain-numpy references of the planning kernels, for the tests that check both agree.
+"""Plain-numpy references of the collision kernels (:mod:`cmdragons.planning.collision`), for the tests
+that check both agree, and for the references of the packages that share those kernels.
 
 They favour the obvious over the fast: distances by dense sampling or by formulas over all pairs,
-collision by scanning every obstacle, nearest neighbours by argmin.
+collision by scanning every obstacle.
 """
 
 from __future__ import annotations
@@ -9,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from cmdragons.planning._kernels import EPS_M
+from cmdragons.planning.collision import EPS_M
 
 FloatArray = NDArray[np.float64]
 
@@ -65,29 +66,3 @@ def segment_clearance(obs: FloatArray, inner: FloatArray, a: FloatArray, b: Floa
 def segment_free(obs: FloatArray, inner: FloatArray, a: FloatArray, b: FloatArray, samples: int = 1001) -> bool:
     """Swept-circle check by sampling the segment densely against every obstacle."""
     return segment_clearance(obs, inner, a, b, samples) >= -EPS_M
-
-
-def nearest(nodes: FloatArray, q: FloatArray) -> int:
-    """Index of the row of ``nodes`` nearest to q."""
-    return int(np.argmin(np.hypot(*(nodes - q).T)))
-
-
-def cache_add(points: FloatArray, count: int, nxt: int, pts: FloatArray, u: FloatArray, fifo: bool) -> tuple[int, int]:
-    """The waypoint cache's replacement with numpy slices: fill the free slots, then overwrite the
-    oldest (fifo) or the slots ``u * size`` picks. Returns the new (count, next)."""
-    size = len(points)
-    pts = pts[-size:]
-    room = min(size - count, len(pts))
-    points[count : count + room] = pts[:room]
-    count += room
-    rest = pts[room:]
-    if len(rest) == 0:
-        return count, nxt
-    if fifo:
-        idx = (nxt + np.arange(len(rest))) % size
-        nxt = int((nxt + len(rest)) % size)
-    else:
-        idx = np.minimum(size - 1, (u[: len(rest)] * size).astype(np.int64))
-    for i, k in zip(idx, rest, strict=True):  # in order: a later point wins a slot drawn twice
-        points[i] = k
-    return count, nxt

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from cmdragons.cli import main
-from cmdragons.navigation.grid import octile_path
+from cmdragons.planning.grid import octile_path
 
 
 def write_map(folder: Path, name: str, free: np.ndarray, pairs: list[tuple[tuple[int, int], tuple[int, int]]]) -> None:

@@ -3,7 +3,7 @@
 All work on a cost grid, shape (rows, cols): each free cell's traversal cost per cell length (>= 1),
 ``inf`` for an obstacle. Cells are addressed as (row, col); points on paths as (x, y) in cell units
 with x along columns and y along rows, cell centres at integers. Converting to the field frame is the
-grid's business (:class:`cmdragons.navigation.grid.costgrid.CostGrid`).
+grid's business (:class:`cmdragons.planning.grid.costgrid.CostGrid`).
 
 - :func:`nf1`: the wavefront of Latombe's NF1 (thesis §3.6, A.2): steps to the goal over 4- or
   8-connected moves, the path by steepest descent.
@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cmdragons.geometry import path_length
-from cmdragons.navigation.grid import _kernels as k
+from cmdragons.planning.grid import _kernels as k
 
 __all__ = ["EStar", "GridPath", "descend_nf1", "nf1", "octile_path"]
 

@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cmdragons.navigation.grid import EStar, descend_nf1, nf1, octile_path, read_map, read_scenarios
-from cmdragons.navigation.grid import _reference as ref
+from cmdragons.planning.grid import EStar, descend_nf1, nf1, octile_path, read_map, read_scenarios
+from cmdragons.planning.grid import _reference as ref
 
 BENCH = Path(__file__).resolve().parents[3] / "shared" / "benchdata" / "moving_ai"
 

@@ -1,44 +1,17 @@
-"""Plain-numpy references of the navigation kernels, for the tests that check both agree.
-
-They favour the obvious over the fast: a trajectory's clearance by dense sampling and brute-force
-distances to every grown obstacle, every candidate of the window scored.
-"""
+"""Plain-numpy reference of Bug2 on an occupancy grid, for the test that checks it agrees with the
+kernel: the same moves, written out step by step."""
 
 from __future__ import annotations
 
 import numpy as np
 from numpy.typing import NDArray
 
-from cmdragons.control._kernels import Limits, trajectory
-from cmdragons.navigation._kernels import WindowConfig, window_velocity
-from cmdragons.safety._reference import static_min_clearance
-
 FloatArray = NDArray[np.float64]
-
-
-def window_scores(
-    obs: FloatArray, inner: FloatArray, px: float, py: float, vx: float, vy: float, dx: float, dy: float,
-    window: FloatArray, lim: Limits, cfg: WindowConfig,
-) -> tuple[FloatArray, FloatArray, FloatArray]:  # fmt: skip
-    """Per candidate of the window (the desired velocity first): the velocity (k, 2), the least
-    clearance of its trajectory minus the clearance it needs (k,; < 0 not admissible: it needs
-    ``margin``, or to come no closer where it starts closer), and its score (k,)."""
-    vel, slack, score = [], [], []
-    for r in range(len(window) + 1):
-        cx, cy = window_velocity(vx, vy, dx, dy, r, window, lim, cfg.dt)
-        tr = trajectory(px, py, cx, cy, 0.0, 0.0, cfg.dt, lim.accel, lim.brake)
-        start = static_min_clearance(tr[:1], obs, inner, n=1)
-        low = static_min_clearance(tr, obs, inner)
-        rest = static_min_clearance(tr[3:4], obs, inner, n=1)
-        vel.append((cx, cy))
-        slack.append(low - min(cfg.margin, start))
-        score.append(-np.hypot(cx - dx, cy - dy) + cfg.clearance_weight * min(max(rest, 0.0), cfg.clearance_cap))
-    return np.array(vel), np.array(slack), np.array(score)
 
 
 def bug2_grid(occupied: NDArray[np.bool_], start: tuple[int, int], goal: tuple[int, int], turn: int,
               max_steps: int) -> tuple[str, list[tuple[int, int]]]:  # fmt: skip
-    """Bug2 on the occupancy grid as :func:`cmdragons.navigation._kernels.bug2_grid` states it,
+    """Bug2 on the occupancy grid as :func:`cmdragons.navigation._bug_kernels.bug2_grid` states it,
     written the obvious way: a neighbour's direction by its angle, the boundary followed by sorting
     the eight neighbours by their angle from the obstacle cell last touched, a loop found by a set of
     the (cell, obstacle cell) states seen, distances in floats. Returns the status's name

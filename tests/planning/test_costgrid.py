@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
-from cmdragons.navigation.grid.costgrid import CostGrid, CostParams, Region, SoftCost
+from cmdragons.planning.grid.costgrid import CostGrid, CostParams, Region, SoftCost
 
 
 @dataclass

@@ -31,7 +31,7 @@ wrap_angle = njit(cache=True)(_wrap_angle)  # the project's one angle wrap, comp
 
 
 class Limits(NamedTuple):
-    """The robot's limits, by name (configs/control.yaml ``motion``)."""
+    """The robot's limits, by name (configs/field.yaml ``robot``)."""
 
     vmax: float  # m/s
     accel: float  # m/s^2 speeding up or turning the velocity

@@ -201,7 +201,7 @@ class World:
         self.space.on_collision(_WALL, _BALL, pre_solve=self._ball_wall, separate=self._ball_separate)
         self._goal_pending = False
         self._out_pending = False
-        # the sign of x of the goal blue defends; the referee sets it
+        # the sign of x of the goal blue defends: the simulator follows the referee's game state
         self.blue_defends: Literal[-1, 1] = -1
 
     # --- construction -----------------------------------------------------------------------

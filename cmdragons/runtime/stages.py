@@ -7,7 +7,7 @@ Topics (what each stage reads -> writes):
     truth              GroundTruth          sim -> simple opponent, truth perception, statistics
     events             SimEvents            sim -> referee, statistics
     teleport           Teleport             referee -> sim
-    referee            GameState            referee -> brains, opponent, statistics
+    referee            GameState            referee -> sim (the sides), brains, opponent, statistics
     referee/gc         GameState            a game controller's Referee packets -> brains (referee.source)
     referee/events     GameEvents           referee -> logs (its calls: fouls, cards, placements)
     detections/<id>    DetectionFrame       vision/<id> -> trackers
@@ -90,7 +90,8 @@ def truth_world(gt: GroundTruth) -> WorldState:
 class SimStage(BaseStage):
     """The simulator with its cameras. On a tick it captures the frame (truth, then each camera's
     image); once every playing team's commands for that frame came, it steps the physics and
-    publishes the frame's events; teleports it carries out at once.
+    publishes the frame's events; teleports it carries out at once; the referee's game state tells
+    it which goal each team defends (the sides change at half time), so that a goal names its scorer.
 
     Commands that answer an older frame (they came after that frame was stepped without them: a
     team slower than the free-running clock, or silent past the lock-step wait) are what a real
@@ -98,7 +99,7 @@ class SimStage(BaseStage):
     commands of its own frame from that team, once."""
 
     name = "sim"
-    inputs = ("clock", "commands/*", "teleport")
+    inputs = ("clock", "commands/*", "teleport", "referee")
 
     def __init__(self, sim: Simulator, teams: Sequence[Team]) -> None:
         self.sim = sim
@@ -113,6 +114,8 @@ class SimStage(BaseStage):
             self._capture(publish)
         elif topic == "teleport":
             self.sim.teleport(message)
+        elif topic == "referee":
+            self.sim.follow(message)
         elif isinstance(message, TeamCommands) and message.team in self.teams:
             if message.frame_number == self.frame_number:
                 self._commands[message.team] = message

@@ -1,5 +1,5 @@
 """numba kernels of the floor: the colour conversion between BGR and H.264's planar 4:2:0, and the
-sorts and the median the other kernels use.
+sorts, the median and the angle wrap the other kernels use.
 
 BT.601 in the limited range, chroma at the MPEG-2 sites (on the even luma columns, between each
 pair of luma rows). The planar frame is flat: H * W luma bytes, then the (H / 2) x (W / 2) Cb
@@ -12,6 +12,11 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
+
+from cmdragons.geometry import wrap_angle as _wrap_angle
+
+# the project's one angle wrap (:func:`cmdragons.geometry.wrap_angle`, its very formula), compiled for the kernels
+wrap_angle = njit(cache=True)(_wrap_angle)
 
 
 @njit(cache=True, inline="always")

@@ -30,7 +30,7 @@ import pymunk
 from numpy.typing import NDArray
 
 from cmdragons.config import Validated, derived, setting
-from cmdragons.geometry import TEAMS, Field, LeagueParams, Team
+from cmdragons.geometry import TEAMS, Field, LeagueParams, Team, wrap_angle
 from cmdragons.messages import BallOut, BallTruth, Contact, Goal, GroundTruth, Kick, RobotCommand, RobotTruth, Teleport
 from sim.snapshot import Snapshot
 
@@ -592,7 +592,7 @@ class World:
             b = r.body
             p, v = b.position, b.velocity
             rows[i] = (0.0 if r.team == "blue" else 1.0, r.id, p.x, p.y, b.angle, v.x, v.y, b.angular_velocity)
-        rows[:, 4] = (rows[:, 4] + math.pi) % (2.0 * math.pi) - math.pi
+        rows[:, 4] = wrap_angle(rows[:, 4])
         bp, bv = self.ball_body.position, self.ball_body.velocity
         ball = np.array([bp.x, bp.y, self._ball.z + self.league.ball.radius_m, bv.x, bv.y, self._ball.vz])
         return Snapshot(self.t, self.frame_number, ball, rows)

@@ -20,14 +20,11 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from cmdragons._kernels import sort_small
-from cmdragons.geometry import wrap_angle as _wrap_angle
+from cmdragons._kernels import sort_small, wrap_angle
 
 N_PHASES = 5  # ramp through zero (2) + cruise (1) + ramp through zero (2)
 N_SEG = 4  # segments of a braking trajectory: reaching the command, holding it to the period's end, braking, rest
 _EPS = 1e-12
-
-wrap_angle = njit(cache=True)(_wrap_angle)  # the project's one angle wrap, compiled for the kernels
 
 
 class Limits(NamedTuple):

@@ -21,13 +21,12 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
 import pymunk
-from numpy.typing import NDArray
 
 from cmdragons.config import Validated, derived, setting
 from cmdragons.geometry import TEAMS, Field, LeagueParams, Team, wrap_angle
@@ -614,13 +613,3 @@ class World:
         bx, by, bz, bvx, bvy, bvz = (float(v) for v in b)
         ball = BallTruth(bx, by, bz, bvx, bvy, bvz, dict(ball_pixels or {}))
         return GroundTruth(s.frame_number, s.t, ball, tuple(robots))
-
-
-def robot_rows(snapshot: Snapshot, team: Team) -> NDArray[np.float64]:
-    """The snapshot rows of one team."""
-    rows: NDArray[np.float64] = snapshot.robots[snapshot.robots[:, 0] == TEAMS.index(team)]
-    return rows
-
-
-def commands_by_robot(commands: Sequence[RobotCommand]) -> dict[tuple[Team, int], RobotCommand]:
-    return {(c.team, c.id): c for c in commands}

@@ -7,7 +7,6 @@ boxes), which class plays which role, and the region, pattern and ball parameter
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
@@ -155,8 +154,3 @@ class VisionPipeline:
         if min(reach) > 2.0:
             return None
         return reach[0] < reach[1]
-
-
-def angle_error(a: float, b: float) -> float:
-    """Smallest signed difference a - b of two angles, radians."""
-    return math.remainder(a - b, 2.0 * math.pi)

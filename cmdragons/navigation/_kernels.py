@@ -16,6 +16,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from cmdragons._kernels import wrap_angle
 from cmdragons.control._kernels import N_SEG, Limits, clip_accel, trajectory
 from cmdragons.planning._kernels import _away, clearance, obstacle_clearance
 from cmdragons.safety._kernels import feasible, static_hits
@@ -295,7 +296,7 @@ def turning_limits(
             if clearance(obs, inner, cx, cy) > 0.0:
                 continue
             b = math.atan2(cy - py, cx - px) - theta
-            b = (b + math.pi) % (2.0 * math.pi) - math.pi
+            b = wrap_angle(b)
             if b >= 0.0 and b < left and (cx - clx) ** 2 + (cy - cly) ** 2 < reach:
                 left = b
             if b <= 0.0 and b > right and (cx - crx) ** 2 + (cy - cry) ** 2 < reach:
@@ -364,7 +365,7 @@ def path_offset(px: float, py: float, ox: float, oy: float, vx: float, vy: float
     a0 = math.atan2(oy - cy, ox - cx)
     a1 = math.atan2(qy, qx)
     da = a1 - a0
-    da = (da + math.pi) % (2.0 * math.pi) - math.pi
+    da = wrap_angle(da)
     if kappa < 0.0:
         da = -da
     dist = q - abs(rad)

@@ -1,5 +1,6 @@
 """numba kernels of the floor's video module: the colour conversion between BGR and H.264's planar
-4:2:0 (the sorts and the median the other kernels use are :mod:`cmdragons.sorting`'s).
+4:2:0 (the sorts and the median the other kernels use are :mod:`cmdragons.sorting`'s, the angle wrap
+:mod:`cmdragons.angles`').
 
 BT.601 in the limited range, chroma at the MPEG-2 sites (on the even luma columns, between each
 pair of luma rows). The planar frame is flat: H * W luma bytes, then the (H / 2) x (W / 2) Cb

@@ -261,20 +261,6 @@ def _join(key: str, sub: str | int) -> str:
     return f"{key}.{sub}" if key else sub
 
 
-def _type_name(tp: Any) -> str:
-    if tp is float:
-        return "a number"
-    if tp is int:
-        return "an integer"
-    if tp is bool:
-        return "true or false"
-    if tp is str:
-        return "a string"
-    if dataclasses.is_dataclass(tp):
-        return "a mapping"
-    return str(tp).replace("typing.", "")
-
-
 def _convert(tp: Any, value: Any, file: str, key: str) -> Any:
     origin = get_origin(tp)
     if dataclasses.is_dataclass(tp) and isinstance(tp, type):

@@ -91,11 +91,11 @@ class RobotShape(Validated):
     radius_m: float = setting(0.09, lo=0.02, hi=0.5)
     height_m: float = setting(0.15, lo=0.02, hi=0.5)
     front_distance_m: float = setting(0.07, lo=0.01, hi=0.5)  # centre to the flat front face
-    max_speed_m_s: float = setting(3.0, lo=0.0, hi=10.0)
-    max_accel_m_s2: float = setting(3.0, lo=0.0, hi=50.0)  # speeding up or turning the velocity
-    max_brake_m_s2: float = setting(6.0, lo=0.0, hi=50.0)  # slowing down
-    max_omega_rad_s: float = setting(20.0, lo=0.0, hi=100.0)
-    max_alpha_rad_s2: float = setting(60.0, lo=0.0, hi=1000.0)  # angular acceleration and braking
+    max_speed_m_s: float = setting(3.0, lo=0.01, hi=10.0)
+    max_accel_m_s2: float = setting(3.0, lo=0.01, hi=50.0)  # speeding up or turning the velocity
+    max_brake_m_s2: float = setting(6.0, lo=0.01, hi=50.0)  # slowing down
+    max_omega_rad_s: float = setting(20.0, lo=0.01, hi=100.0)
+    max_alpha_rad_s2: float = setting(60.0, lo=0.01, hi=1000.0)  # angular acceleration and braking
     command_latency_s: float = setting(0.03, lo=0.0, hi=1.0)  # command sent -> wheels act on it
 
     def __post_init__(self) -> None:

@@ -125,6 +125,7 @@ class Simulator:
             teleport = self.referee.observe(self.world.t, events, self.ball_xy())
             if teleport is not None:
                 self.world.apply(teleport)
+            self.follow(self.referee.state())
         self.times.physics_ms.append((time.perf_counter() - t0) * 1e3)
         return events
 
@@ -136,6 +137,11 @@ class Simulator:
     def teleport(self, teleport: Teleport) -> None:
         """Put objects in place at once (a referee's restart)."""
         self.world.apply(teleport)
+
+    def follow(self, game: GameState) -> None:
+        """Take the referee's word on which goal each team defends (the sides change at half
+        time): a goal is the team's that attacks it."""
+        self.world.blue_defends = -1 if game.blue_defends_negative_x else 1
 
     def summary(self) -> dict[str, object]:
         """Facts of the run so far, for summary.json (the referee's too when it judges here)."""

@@ -21,16 +21,15 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
 import pymunk
-from numpy.typing import NDArray
 
 from cmdragons.config import Validated, derived, setting
-from cmdragons.geometry import TEAMS, Field, LeagueParams, Team
+from cmdragons.geometry import TEAMS, Field, LeagueParams, Team, wrap_angle
 from cmdragons.messages import BallOut, BallTruth, Contact, Goal, GroundTruth, Kick, RobotCommand, RobotTruth, Teleport
 from sim.snapshot import Snapshot
 
@@ -201,7 +200,7 @@ class World:
         self.space.on_collision(_WALL, _BALL, pre_solve=self._ball_wall, separate=self._ball_separate)
         self._goal_pending = False
         self._out_pending = False
-        # the sign of x of the goal blue defends; the referee sets it
+        # the sign of x of the goal blue defends: the simulator follows the referee's game state
         self.blue_defends: Literal[-1, 1] = -1
 
     # --- construction -----------------------------------------------------------------------
@@ -592,7 +591,7 @@ class World:
             b = r.body
             p, v = b.position, b.velocity
             rows[i] = (0.0 if r.team == "blue" else 1.0, r.id, p.x, p.y, b.angle, v.x, v.y, b.angular_velocity)
-        rows[:, 4] = (rows[:, 4] + math.pi) % (2.0 * math.pi) - math.pi
+        rows[:, 4] = wrap_angle(rows[:, 4])
         bp, bv = self.ball_body.position, self.ball_body.velocity
         ball = np.array([bp.x, bp.y, self._ball.z + self.league.ball.radius_m, bv.x, bv.y, self._ball.vz])
         return Snapshot(self.t, self.frame_number, ball, rows)
@@ -614,13 +613,3 @@ class World:
         bx, by, bz, bvx, bvy, bvz = (float(v) for v in b)
         ball = BallTruth(bx, by, bz, bvx, bvy, bvz, dict(ball_pixels or {}))
         return GroundTruth(s.frame_number, s.t, ball, tuple(robots))
-
-
-def robot_rows(snapshot: Snapshot, team: Team) -> NDArray[np.float64]:
-    """The snapshot rows of one team."""
-    rows: NDArray[np.float64] = snapshot.robots[snapshot.robots[:, 0] == TEAMS.index(team)]
-    return rows
-
-
-def commands_by_robot(commands: Sequence[RobotCommand]) -> dict[tuple[Team, int], RobotCommand]:
-    return {(c.team, c.id): c for c in commands}

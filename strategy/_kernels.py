@@ -10,9 +10,7 @@ import math
 import numpy as np
 from numba import njit
 
-from cmdragons.geometry import wrap_angle as _wrap_angle
-
-wrap_angle = njit(cache=True)(_wrap_angle)  # the project's one angle wrap, compiled for the kernel
+from cmdragons.angles import wrap_angle
 
 
 @njit(cache=True)

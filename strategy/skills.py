@@ -23,7 +23,6 @@ __all__ = [
     "SkillParams",
     "defend",
     "dribble",
-    "go_to_pose",
     "goalie_block",
     "intercept",
     "kick_to",
@@ -117,10 +116,6 @@ _BISECTIONS = 40  # halvings of the kick speed range in pass_speed: far below a 
 
 def _angle(dx: float, dy: float) -> float:
     return math.atan2(dy, dx)
-
-
-def go_to_pose(x: float, y: float, theta: float, max_speed: float | None = None) -> Intent:
-    return Intent(x, y, theta, max_speed_m_s=max_speed)
 
 
 def waiting_point(ball: BallState, aim: float, p: SkillParams) -> tuple[float, float]:

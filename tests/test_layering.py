@@ -19,7 +19,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 FLOOR = {"cmdragons.config", "cmdragons.geometry", "cmdragons.messages", "cmdragons.camera", "cmdragons.recording",
-         "cmdragons.videoio", "cmdragons._kernels", "cmdragons.sorting"}
+         "cmdragons.videoio", "cmdragons._kernels", "cmdragons.sorting", "cmdragons.angles"}
 PROJECT = ("cmdragons", "vision", "strategy", "sim")
 COMPOSITION = ("cmdragons.runtime", "cmdragons.team", "cmdragons.bench", "cmdragons.cli")
 # library -> the module prefixes allowed to import it

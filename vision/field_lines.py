@@ -133,9 +133,6 @@ def rough_start(base: CameraParams, height_m: float, sees: tuple[float, float, f
     )  # fmt: skip
 
 
-_POSE = ("yaw_rad", "tilt_x_rad", "tilt_y_rad", "x", "y", "focal_px", "k1", "k2")
-
-
 def _params(x: F64, base: CameraParams, n: int) -> CameraParams:
     """``base`` with the first ``n`` of (yaw, tilt x, tilt y, x, y, focal, k1, k2) from ``x``."""
     full = [base.yaw_rad, base.tilt_x_rad, base.tilt_y_rad, base.position_m[0], base.position_m[1], base.focal_px,

@@ -185,8 +185,3 @@ class VisionPipeline:
         if min(reach) > 2.0 or min(reach) > 0.75 * max(reach):
             return None
         return reach[0] < reach[1]
-
-
-def angle_error(a: float, b: float) -> float:
-    """Smallest signed difference a - b of two angles, radians."""
-    return math.remainder(a - b, 2.0 * math.pi)

@@ -20,15 +20,14 @@ import math
 import numpy as np
 from numba import njit
 
+from cmdragons.angles import wrap_angle
+
 # the acceleration model's names motion.py calls through this module
 from cmdragons.control.acceleration import Limits, limit_velocity, stop_accel, trajectory, trajectory_state  # noqa: F401
-from cmdragons.geometry import wrap_angle as _wrap_angle
 from cmdragons.sorting import sort_small
 
 N_PHASES = 5  # ramp through zero (2) + cruise (1) + ramp through zero (2)
 _EPS = 1e-12
-
-wrap_angle = njit(cache=True)(_wrap_angle)  # the project's one angle wrap, compiled for the kernels
 
 
 @njit(cache=True)

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from cmdragons.config import Validated, setting
+from cmdragons.config import Validated, derived, setting
 from cmdragons.control import _kernels as K
 from cmdragons.control.trapezoid import TrapezoidParams
 from cmdragons.geometry import path_length
@@ -41,14 +41,16 @@ FloatArray = NDArray[np.float64]
 
 @dataclass(frozen=True)
 class MotionParams(Validated):
-    """The robot model the controller and the safety search assume (defaults: the simulator's
-    robots) and the control period."""
+    """The robot model the controller, the navigators and the safety search assume, and the
+    control period. The limits are the robots' own, configured once in field.yaml ``robot``
+    (defaults: the simulator's robots); the period is control's."""
 
-    max_speed_m_s: float = setting(3.0, lo=0.01, hi=10.0)
-    max_accel_m_s2: float = setting(3.0, lo=0.01, hi=50.0)  # speeding up or turning the velocity
-    max_brake_m_s2: float = setting(6.0, lo=0.01, hi=50.0)  # slowing down
-    max_omega_rad_s: float = setting(20.0, lo=0.01, hi=100.0)
-    max_alpha_rad_s2: float = setting(60.0, lo=0.01, hi=1000.0)  # angular acceleration and braking
+    max_speed_m_s: float = derived("field.robot.max_speed_m_s", 3.0, lo=0.01, hi=10.0)
+    max_accel_m_s2: float = derived("field.robot.max_accel_m_s2", 3.0, lo=0.01, hi=50.0)  # speeding up, turning
+    max_brake_m_s2: float = derived("field.robot.max_brake_m_s2", 6.0, lo=0.01, hi=50.0)  # slowing down
+    max_omega_rad_s: float = derived("field.robot.max_omega_rad_s", 20.0, lo=0.01, hi=100.0)
+    # angular acceleration and braking
+    max_alpha_rad_s2: float = derived("field.robot.max_alpha_rad_s2", 60.0, lo=0.01, hi=1000.0)
     frame_rate_hz: float = setting(60.0, lo=1.0, hi=1000.0)  # one command per camera frame
 
     @property

@@ -41,11 +41,6 @@ class Profile1D:
         x, v = K.phases_state(self.phases, self.v0, float(t_s))
         return float(x), float(v)
 
-    @property
-    def max_accel(self) -> float:
-        return float(np.max(np.abs(self.phases[self.phases[:, 0] > 0, 1]), initial=0.0))
-
-
 def trapezoid_1d(distance: float, v0: float, v_target: float, v_max: float, accel: float, decel: float) -> Profile1D:
     """The time-optimal profile covering ``distance`` from velocity ``v0`` and arriving at
     ``v_target`` (clamped to ``v_max``): speeds up at ``accel``, slows down at ``decel`` (Bruce 2006

@@ -9,6 +9,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from cmdragons.angles import wrap_angle
+
 
 class EvadeConfig(NamedTuple):
     """The escape and evade behaviours' numbers, by name (configs/team.yaml ``escape_evade``)."""
@@ -71,7 +73,7 @@ def path_offset(px: float, py: float, ox: float, oy: float, vx: float, vy: float
     a0 = math.atan2(oy - cy, ox - cx)
     a1 = math.atan2(qy, qx)
     da = a1 - a0
-    da = (da + math.pi) % (2.0 * math.pi) - math.pi
+    da = wrap_angle(da)
     if kappa < 0.0:
         da = -da
     dist = q - abs(rad)

@@ -13,7 +13,6 @@ from numba import njit
 from cmdragons.navigation._reactive_kernels import wall
 from cmdragons.planning.collision import away, obstacle_clearance
 
-
 GAUSSIAN = 0  # PotentialConfig.kind: a Gaussian source on the distance to the obstacle's core
 INVERSE = 1  # ... the inverse-distance (FIRAS) potential on the clearance, zero beyond the influence
 

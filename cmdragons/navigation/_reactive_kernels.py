@@ -11,7 +11,6 @@ from numba import njit
 
 from cmdragons.planning.collision import away, clearance, obstacle_clearance
 
-
 # Every query below is about a robot centre in the compiled world of the robot's radius (the
 # C-space) unless it says otherwise; ``radius`` where a method needs the real obstacles' cores.
 

@@ -9,6 +9,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from cmdragons.angles import wrap_angle
 from cmdragons.planning.collision import clearance
 
 
@@ -79,7 +80,7 @@ def turning_limits(
             if clearance(obs, inner, cx, cy) > 0.0:
                 continue
             b = math.atan2(cy - py, cx - px) - theta
-            b = (b + math.pi) % (2.0 * math.pi) - math.pi
+            b = wrap_angle(b)
             if b >= 0.0 and b < left and (cx - clx) ** 2 + (cy - cly) ** 2 < reach:
                 left = b
             if b <= 0.0 and b > right and (cx - crx) ** 2 + (cy - cry) ** 2 < reach:

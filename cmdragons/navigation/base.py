@@ -22,9 +22,9 @@ sections it reads (configs/team.yaml: its own, and shared ones such as ``reactiv
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from enum import Enum
-from collections.abc import Mapping
 from typing import Any, Protocol
 
 from numpy.typing import ArrayLike

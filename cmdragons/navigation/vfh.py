@@ -31,6 +31,7 @@ from numpy.typing import NDArray
 
 from cmdragons.config import Validated, setting
 from cmdragons.control.motion import ControlParams
+from cmdragons.geometry import wrap_angle
 from cmdragons.messages import RobotState
 from cmdragons.navigation import _vfh_kernels as K
 from cmdragons.navigation.base import NavStatus
@@ -159,7 +160,7 @@ class VFHNavigator(ReactiveNavigator):
                 left, right = K.turning_limits(src.obs, src.inner, here[0], here[1], theta, r_turn,
                                                self.cfg.enlarge, self.cfg)  # fmt: skip
                 centres = (np.arange(n) + 0.5) * alpha - math.pi
-                rel = (centres - theta + math.pi) % (2.0 * math.pi) - math.pi
+                rel = wrap_angle(centres - theta)
                 masked |= (rel > left) | (rel < right)
             motion = ((math.atan2(robot.vy, robot.vx) + math.pi) / alpha) % n if speed_now > 0.05 else target
             choice = self._vfh_plus_direction(masked, target, motion)

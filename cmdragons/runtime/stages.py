@@ -20,7 +20,6 @@ from numpy.typing import NDArray
 from cmdragons.geometry import TEAMS, Team
 from cmdragons.messages import (
     BallDetection,
-    BallState,
     CameraFrame,
     Contact,
     DetectionFrame,
@@ -33,19 +32,18 @@ from cmdragons.messages import (
     RobotCommand,
     RobotDetection,
     RobotReport,
-    RobotState,
     SimEvents,
     StageSummary,
     TeamCommands,
-    Teleport,
     TeamReport,
+    Teleport,
     Tick,
     Timing,
     WorldState,
 )
 from cmdragons.runtime.bus import BaseStage, Publish
-from cmdragons.runtime.topics import ANY, Contract, Port, summary_port, topic_matches
 from cmdragons.runtime.log import RunLog
+from cmdragons.runtime.topics import ANY, Contract, Port, summary_port, topic_matches
 from cmdragons.team import Brain, BrainOutput
 from cmdragons.tracking import Tracker
 from sim.referee import Referee
@@ -72,7 +70,8 @@ __all__ = [
 class SimStage(BaseStage):
     """The simulator with its cameras. On a tick it captures the frame (truth, then each camera's
     image); once every playing team's commands for that frame came, it steps the physics and
-    publishes the frame's events; teleports it carries out at once.
+    publishes the frame's events; teleports it carries out at once; the referee's game state tells
+    it which goal each team defends (the sides change at half time), so that a goal names its scorer.
 
     Commands that answer an older frame (they came after that frame was stepped without them: a
     team slower than the free-running clock, or silent past the lock-step wait) are what a real
@@ -81,7 +80,8 @@ class SimStage(BaseStage):
 
     @staticmethod
     def declare(camera_ids: Sequence[int]) -> Contract:
-        return Contract("sim", (Port("clock", Tick), Port("commands/*", TeamCommands), Port("teleport", Teleport)),
+        return Contract("sim", (Port("clock", Tick), Port("commands/*", TeamCommands), Port("teleport", Teleport),
+                                 Port("referee", GameState)),
                         (Port("truth", GroundTruth), *(Port(f"camera/{c}/frame", CameraFrame) for c in camera_ids),
                          Port("events", SimEvents), summary_port("sim")))  # fmt: skip
 
@@ -99,6 +99,8 @@ class SimStage(BaseStage):
             self._capture(publish)
         elif topic == "teleport":
             self.sim.teleport(message)
+        elif topic == "referee":
+            self.sim.follow(message)
         elif isinstance(message, TeamCommands) and message.team in self.teams:
             if message.frame_number == self.frame_number:
                 self._commands[message.team] = message

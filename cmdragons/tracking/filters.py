@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cmdragons.config import Validated, derived, setting
+from cmdragons.geometry import wrap_angle
 
 __all__ = [
     "BallFilter",
@@ -302,10 +303,6 @@ class BallFilter:
         self.held = None
 
 
-def _wrap(a: float) -> float:
-    return (a + math.pi) % (2.0 * math.pi) - math.pi
-
-
 class RobotFilter:
     """One robot: (x, y, theta, vx, vy, omega); the last command in force is the control input."""
 
@@ -364,7 +361,7 @@ class RobotFilter:
             now, command = t_effect, cmd
         if t > now:
             x = self._advance(x, t - now, command)
-        x[2] = _wrap(x[2])
+        x[2] = wrap_angle(x[2])
         return np.array(x)
 
     def _advance(self, x: list[float], dt: float, command: tuple[float, float, float] | None) -> list[float]:
@@ -397,20 +394,20 @@ class RobotFilter:
             self._leave_steady()
             self.kf.predict(u=u, B=b, F=f, Q=q)
             self._dt = dt
-        self.kf.x[2] = _wrap(self.kf.x[2])
+        self.kf.x[2] = wrap_angle(self.kf.x[2])
         self.t = t
         self._pending_update = True
 
     def innovation(self, z: Vec) -> Vec:
         y = cast(Vec, z - self.kf.x[:3])
-        y[2] = _wrap(y[2])
+        y[2] = wrap_angle(y[2])
         return y
 
     def nis(self, z: Vec | tuple[float, float, float]) -> float:
         if self._steady is not None and self._pending_update:
             # the settled gate: y' S^-1 y in plain floats (called for every detection, every frame)
             x0, x1, x2 = cast(list[float], self.kf.x[:3].tolist())
-            y0, y1, y2 = z[0] - x0, z[1] - x1, _wrap(z[2] - x2)
+            y0, y1, y2 = z[0] - x0, z[1] - x1, wrap_angle(z[2] - x2)
             si = self._steady_list
             return (y0 * (si[0] * y0 + si[1] * y1 + si[2] * y2) + y1 * (si[3] * y0 + si[4] * y1 + si[5] * y2)
                     + y2 * (si[6] * y0 + si[7] * y1 + si[8] * y2))  # fmt: skip
@@ -429,7 +426,7 @@ class RobotFilter:
             self._regular = self._regular + 1 if self._pending_update else 0
             if self._regular >= self.p.steady_after_updates:
                 self._enter_steady()
-        self.kf.x[2] = _wrap(self.kf.x[2])
+        self.kf.x[2] = wrap_angle(self.kf.x[2])
         self._pending_update = False
 
     def miss(self) -> None:
@@ -474,7 +471,7 @@ def predict_robots(filters: Sequence[RobotFilter], t: float) -> None:
             if f.command is not None:  # the accelerations toward our command; none for the opponents
                 u[:, i] = f._accel_tuple(float(x[3, i]), float(x[4, i]), float(x[5, i]), dt, f.command)
         x = kalman().predict_steadystate(x, F=fm, u=u, B=bm)
-        x[2] = (x[2] + math.pi) % (2.0 * math.pi) - math.pi
+        x[2] = wrap_angle(x[2])
         rows = np.ascontiguousarray(x.T)
         for f, row in zip(group, rows, strict=True):
             f.kf.x = row
@@ -504,7 +501,7 @@ class SteadyUpdates:
             return np.zeros(0, dtype=bool)
         x = np.array([f.kf.x for f in robots])
         y = np.array(z) - x[:, :3]
-        y[:, 2] = (y[:, 2] + math.pi) % (2.0 * math.pi) - math.pi  # the heading next to the prediction
+        y[:, 2] = wrap_angle(y[:, 2])  # the heading next to the prediction
         key = tuple(f._steady_epoch for f in robots)
         if key != self._gate_key:
             self._s_inv = np.array([f._steady for f in robots])
@@ -520,7 +517,7 @@ class SteadyUpdates:
             self._gain_key = key
         xs = kalman().update_steadystate(x[ok].ravel(), (x[ok, :3] + y[ok]).ravel(), self._gain, self._h)
         n = x.shape[1]
-        xs[2::n] = (xs[2::n] + math.pi) % (2.0 * math.pi) - math.pi
+        xs[2::n] = wrap_angle(xs[2::n])
         for i, f in enumerate(taken):
             f.kf.x = xs[i * n : (i + 1) * n]
             f._pending_update = False
@@ -550,7 +547,7 @@ def predicted_states(filters: Sequence[RobotFilter], t: float,
         x = np.array([filters[i].kf.x for i in free])
         dt = np.maximum(t - np.array([filters[i].t for i in free]), 0.0)
         x[:, :3] += dt[:, None] * x[:, 3:]
-        x[:, 2] = (x[:, 2] + math.pi) % (2.0 * math.pi) - math.pi
+        x[:, 2] = wrap_angle(x[:, 2])
         out[free] = x
     if len(free) < len(filters):
         for i in sorted(set(range(len(filters))) - set(free)):

@@ -7,11 +7,17 @@ import shutil
 from collections.abc import Mapping
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from cmdragons.config import ConfigError, Validated
+from cmdragons.control import motion_commands
+from cmdragons.messages import BallState, GameState, RobotState, WorldState
 from cmdragons.runtime.settings import CONCERNS, load_settings
+from cmdragons.safety.registry import make_safety
+from cmdragons.team import Brain
 from sim.params import SimParams
+from strategy.skills import Intent
 
 REPO_CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 
@@ -39,6 +45,32 @@ def test_each_fact_is_configured_once_and_reaches_every_user() -> None:
     assert s.sim.ball.acc_roll_m_s2 == s.tracker.ball.acc_roll_m_s2 == 0.3
 
 
+@pytest.mark.parametrize("brake", [4.0, 6.0])
+def test_the_robots_braking_reaches_control_the_brains_path_following_and_safety(brake: float) -> None:
+    # one source: field.yaml robot; a robot at 2 m/s along +x, dt one control period
+    s = load_settings(REPO_CONFIGS, [f"field.robot.max_brake_m_s2={brake}"])
+    v, dt = 2.0, s.control.motion.period_s
+    # control: told to stop where it is, it brakes at full strength for one period
+    cmd = motion_commands([[0.0, 0.0, 0.0, v, 0.0, 0.0]], [[0.0, 0.0, 0.0, 0.0, 0.0]], s.control)
+    assert cmd[0] == pytest.approx((v - brake * dt, 0.0, 0.0), abs=1e-12)
+    # the brain (planner, navigator, safety) driving it to a goal 0.3 m ahead, nearer than it can stop
+    # at either figure (v^2 / 2 brake: 0.5 and 0.33 m): it brakes at full strength
+    w = WorldState(0.0, BallState(3.0, 2.0, 0.0, 0.0), (RobotState("blue", 0, -1.0, 0.0, 0.0, v, 0.0),))
+    (out,) = Brain("blue", s).drive(w, {0: Intent(-0.7, 0.0, 0.0)}, GameState(0.0))
+    assert (out.vx, out.vy) == pytest.approx((v - brake * dt, 0.0), abs=1e-12)
+    # the safety search: a robot asked to stop rests v^2 / (2 brake) on; one that keeps its speed, a
+    # period later plus that
+    safety = make_safety(s.safety, s.control, s.field.robot.radius_m, None)
+    for asked, rest_m in (((0.0, 0.0), v * v / (2 * brake)), ((v, 0.0), v * dt + v * v / (2 * brake))):
+        braking = safety.filter([[0.0, 0.0, v, 0.0]], [asked], np.zeros((0, 4))).braking[0]
+        assert braking[-1] == pytest.approx((rest_m, 0.0), abs=1e-12)
+
+
+def test_control_yaml_refuses_the_robots_limits() -> None:
+    with pytest.raises(ConfigError, match="configured once, as field.robot.max_brake_m_s2"):
+        load_settings(REPO_CONFIGS, ["control.motion.max_brake_m_s2=4"])
+
+
 def test_a_derived_value_built_in_code_is_still_range_checked() -> None:
     from sim.world import RobotParams
 
@@ -52,7 +84,7 @@ def test_a_derived_value_built_in_code_is_still_range_checked() -> None:
         ("sim.yaml", "physics:\n  substepz: 4\n", "physics.substepz", "unknown key; allowed keys:"),
         ("sim.yaml", "physics:\n  substeps: fast\n", "physics.substeps", "expected an integer"),
         ("sim.yaml", "physics:\n  substeps: 0\n", "physics.substeps", "out of range; allowed: 1 to 100"),
-        ("field.yaml", "robot:\n  max_speed_m_s: -1.0\n", "robot.max_speed_m_s", "allowed: 0.0 to 10.0"),
+        ("field.yaml", "robot:\n  max_speed_m_s: -1.0\n", "robot.max_speed_m_s", "allowed: 0.01 to 10.0"),
         ("sim.yaml", "robot:\n  max_speed_m_s: 2.0\n", "robot.max_speed_m_s", "configured once, as field.robot"),
         ("tracker.yaml", "ball:\n  acc_roll_m_s2: 0.3\n", "ball.acc_roll_m_s2", "as field.ball.acc_roll_m_s2"),
         ("field.yaml", "division: C\n", "division", "allowed: 'A', 'B'"),

@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from cmdragons import angles as kern
 from cmdragons.camera import (
     AutoLayout,
     CameraModel,
@@ -15,7 +16,19 @@ from cmdragons.camera import (
     cameras_from_config,
     smallest_ball_px,
 )
-from cmdragons.geometry import Field, LeagueParams
+from cmdragons.geometry import Field, LeagueParams, wrap_angle
+
+
+def test_the_angle_wrap_is_in_range_and_the_kernels_is_the_same_to_the_bit() -> None:
+    edges = [0.0, -0.0, math.pi, -math.pi, 2.0 * math.pi, -2.0 * math.pi, 3.0 * math.pi, 1e-300, 1e6]
+    a = np.concatenate([np.random.default_rng(3).uniform(-50.0, 50.0, 2000), np.nextafter(edges, np.inf),
+                        np.nextafter(edges, -np.inf), edges])  # fmt: skip
+    w = wrap_angle(a)
+    assert np.all(np.abs(w) <= math.pi)  # [-pi, pi): rounding may give pi itself for an angle just under -pi
+    np.testing.assert_allclose(np.cos(w), np.cos(a), atol=1e-9)  # the same direction (the 1e6 loses ~1e-10)
+    np.testing.assert_allclose(np.sin(w), np.sin(a), atol=1e-9)
+    # each element alone, through the array and through the compiled kernel: one formula, one result
+    assert [wrap_angle(float(x)) for x in a] == w.tolist() == [kern.wrap_angle(float(x)) for x in a]
 
 
 @pytest.mark.parametrize(

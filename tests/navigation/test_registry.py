@@ -88,7 +88,7 @@ def test_a_registered_navigator_drives_the_brains_robots_toward_their_goals() ->
     start: dict[int, float] = {}
     for k in range(90):  # 1.5 s: robots that act on the command they get at once
         robots = tuple(RobotState("blue", i, x, y, 0.0) for i, (x, y) in xy.items())
-        commands = brain.step(WorldState(k * DT_S, ball, robots), GameState(k * DT_S))
+        commands = brain.step(WorldState(k * DT_S, ball, robots), GameState(k * DT_S)).commands
         if k == 0:
             goals = {i: nav.goal for i, nav in brain.navigators.items() if isinstance(nav, ToyNavigator)}
             start = {i: math.dist(xy[i], g) for i, g in goals.items() if g is not None}

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import cv2
@@ -13,6 +14,7 @@ from cmdragons.messages import (
     BallState,
     BallTruth,
     GameState,
+    Goal,
     GroundTruth,
     Kick,
     KickPurpose,
@@ -22,11 +24,11 @@ from cmdragons.messages import (
     TeamReport,
     WorldState,
 )
-from cmdragons.runtime.log import RunLog
+from cmdragons.runtime.log import RunLog, read_log
 from cmdragons.runtime.match import Match
 from cmdragons.runtime.report import ReportStage, load_run, run_warnings, write_report
 from cmdragons.runtime.settings import load_settings
-from cmdragons.runtime.stages import LoggerStage
+from cmdragons.runtime.stages import LoggerStage, Tap
 
 
 def write_log(path: Path, frames: int, ball_visible_every: int, robot_1_visible: bool, hidden: bool = False) -> None:
@@ -110,3 +112,31 @@ def test_the_report_stage_gathers_what_the_log_reads_back(tmp_path: Path) -> Non
                                                                        back.score_t)  # fmt: skip
     assert (live.ball_seen, live.ball_tracked, live.robot_seen) == (back.ball_seen, back.ball_tracked, back.robot_seen)
     assert live.kicks  # the match kicked: the comparison covers the kick events
+
+
+@pytest.mark.parametrize(("side", "scorer"), [(-1.0, "blue"), (1.0, "yellow")])
+def test_a_goal_after_half_time_is_the_scorers_in_summary_report_and_log(tmp_path: Path, side: float,
+                                                                         scorer: str) -> None:  # fmt: skip
+    # halves of 1 s: blue defends -x in the first, +x in the second (the sides change); in the second
+    # the ball is rolled into the goal at x of sign ``side``, away from every robot
+    settings = load_settings(Path(__file__).resolve().parents[2] / "configs",
+                             ["sim.referee.figures.half_s=1.0", "sim.referee.figures.half_time_s=0.5"])  # fmt: skip
+    log = RunLog(tmp_path / "run.mcap")
+    report = ReportStage("blue")
+    match = Match(settings, "none", "truth", seed=1, extra=[LoggerStage(log), report])
+    games: list[GameState] = []
+    match.bus.add(Tap("test:referee", ("referee",), lambda _t, g: games.append(g)))
+    while not games or games[-1].stage != "second_half":
+        match.step()
+    assert not games[-1].blue_defends_negative_x  # blue defends +x now
+    match.sim.world.place_ball(side * (match.sim.world.field.half_length - 0.1), 0.3, vx=side * 3.0)
+    match.run(0.5)
+    summary = match.summary()
+    log.close()
+    assert summary["score"] == {"blue": int(scorer == "blue"), "yellow": int(scorer == "yellow")}
+    goals = [e for _topic, _t, ev in read_log(tmp_path / "run.mcap", {"/events"}) for e in ev.events
+             if isinstance(e, Goal)]  # fmt: skip
+    assert [(g.scoring_team, math.copysign(1.0, g.x)) for g in goals] == [(scorer, side)]
+    for run in (report.collector.result(), load_run(tmp_path / "run.mcap")):
+        assert [g["scoring_team"] for g in run.goals] == [scorer]
+        assert run.score_t[-1][1:] == (summary["score"]["blue"], summary["score"]["yellow"])

@@ -23,12 +23,9 @@ and mirrored for the other team.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Sequence
 from typing import Literal
 
-
-from cmdragons.config import Validated, setting
 from cmdragons.geometry import TEAMS, Field, Team
 from cmdragons.messages import (
     BallOut,
@@ -62,39 +59,10 @@ from sim.restarts import (
     restart_of_call,
     shootout_poses,
 )
-from sim.rules import FOUL_RESTARTS, FoulWatch, HeldBall, NoProgress, RulesParams, Situation, penalty_set, placed
+from sim.referee_params import RefereeParams
+from sim.rules import FOUL_RESTARTS, FoulWatch, HeldBall, NoProgress, Situation, penalty_set, placed
 
-__all__ = ["Referee", "RefereeParams"]
-
-_Pose = tuple[float, float, float]
-_DEFAULT_FORMATIONS: dict[Literal["A", "B"], tuple[_Pose, ...]] = {
-    "B": ((-4.2, 0.0, 0.0), (-3.0, 1.0, 0.0), (-3.0, -1.0, 0.0), (-2.0, 0.0, 0.0), (-1.0, 1.6, 0.0),
-          (-1.0, -1.6, 0.0)),
-    "A": ((-5.7, 0.0, 0.0), (-4.2, 1.2, 0.0), (-4.2, -1.2, 0.0), (-4.2, 0.0, 0.0), (-3.2, 2.5, 0.0),
-          (-3.2, -2.5, 0.0), (-2.4, 0.8, 0.0), (-2.4, -0.8, 0.0), (-1.2, 3.0, 0.0), (-1.2, -3.0, 0.0),
-          (-1.0, 0.0, 0.0)),
-}  # fmt: skip
-
-
-@dataclass(frozen=True)
-class RefereeParams(Validated):
-    enabled: bool = True  # off: no restarts, the ball bounces off the boundary walls
-    rules: Literal["full", "basic"] = "full"  # full: the league's game controller and auto-referee
-    blue_defends: Literal["negative_x", "positive_x"] = "negative_x"
-    restart_delay_s: float = setting(1.0, lo=0.0, hi=30.0)  # goal or out -> ball placed
-    place_robots_on_goal: bool = True  # put both teams in their kickoff formation after a goal
-    free_kick_distance_m: float = setting(0.2, lo=0.0, hi=2.0)  # from the lines and defense areas
-    restart_timeout_s: float = setting(10.0, lo=0.1, hi=600.0)  # a restart not taken by then: play on
-    keeper_held_ball_s: float = setting(10.0, lo=0.1, hi=600.0)  # ball this long in a defense area: free kick
-    no_progress_s: float = setting(10.0, lo=0.1, hi=600.0)  # the ball this long in one place in play: stop, force start
-    no_progress_m: float = setting(0.05, lo=0.0, hi=5.0)  # ... within this of it
-    # start poses (x m, y m, theta rad) of the team defending -x, per division; mirrored for the other
-    formations: Mapping[Literal["A", "B"], tuple[tuple[float, float, float], ...]] = field(
-        default_factory=lambda: dict(_DEFAULT_FORMATIONS)
-    )
-    figures: RulesParams = RulesParams()  # the league's figures for the full rules
-    park_distance_m: float = setting(3.0, lo=0.5, hi=50.0)  # robots sent off wait this far outside the boundary
-
+__all__ = ["Referee"]
 
 Key = tuple[Team, int]
 
@@ -132,61 +100,6 @@ class Referee:
         self._last_t = 0.0
         self._teleports: list[Teleport] = []
         self._truth: GroundTruth | None = None  # the last true state seen (where the robots stand)
-
-    # --- the parts' state, read ------------------------------------------------------------
-    @property
-    def command(self) -> RefereeCommand:
-        return self.game.command
-
-    @property
-    def for_team(self) -> Team | None:
-        return self.game.for_team
-
-    @property
-    def ready(self) -> bool:
-        return self.game.ready
-
-    @property
-    def stage(self) -> GameStage:
-        return self.game.stage
-
-    @property
-    def events(self) -> list[GameEvent]:
-        """Every call of the match."""
-        return self.calls.all
-
-    @property
-    def new_events(self) -> list[GameEvent]:
-        """The calls of the last frame."""
-        return self.calls.new
-
-    @property
-    def fouls(self) -> dict[Team, int]:
-        return self.cards.fouls
-
-    @property
-    def yellow_cards(self) -> dict[Team, int]:
-        return self.cards.yellow
-
-    @property
-    def red_cards(self) -> dict[Team, int]:
-        return self.cards.red
-
-    @property
-    def placements(self) -> dict[Team, dict[str, int]]:
-        return self.tally.placements
-
-    @property
-    def placement_failures(self) -> dict[Team, int]:
-        return self.tally.placement_failures
-
-    @property
-    def penalties(self) -> dict[Team, dict[str, int]]:
-        return self.tally.penalties
-
-    @property
-    def shootout(self) -> dict[Team, dict[str, int]]:
-        return self.tally.shootout
 
     # --- commands ---------------------------------------------------------------------------
     def _set(self, command: RefereeCommand, for_team: Team | None, ready: bool = True) -> None:
@@ -298,7 +211,7 @@ class Referee:
             self._goal(other(defender_of(e.x, self.blue_sign)))
         elif isinstance(e, BallOut) and self._restart is None and self._live():
             self.balls_out += 1
-            if self.stage == GameStage.PENALTY_SHOOTOUT:  # the kick missed
+            if self.game.stage == GameStage.PENALTY_SHOOTOUT:  # the kick missed
                 self._next_shootout_kick()
                 return
             taker = ball_out_taker(e.last_touch, e.x, self.blue_sign)
@@ -306,20 +219,20 @@ class Referee:
 
     def _goal(self, scorer: Team) -> None:
         """A goal for ``scorer``: the kickoff for the other team (in a shootout: the next kick)."""
-        if self.stage == GameStage.PENALTY_SHOOTOUT:
-            if self.for_team == scorer:
-                self.shootout[scorer]["scored"] += 1
+        if self.game.stage == GameStage.PENALTY_SHOOTOUT:
+            if self.game.for_team == scorer:
+                self.tally.shootout[scorer]["scored"] += 1
             self._next_shootout_kick()
             return
         self.score[scorer] += 1
-        if self.command == RefereeCommand.PENALTY and self.for_team == scorer:
-            self.penalties[scorer]["scored"] += 1
+        if self.game.command == RefereeCommand.PENALTY and self.game.for_team == scorer:
+            self.tally.penalties[scorer]["scored"] += 1
         self._award(RestartKind.KICKOFF, other(scorer), (0.0, 0.0))
 
     def _follow_kick(self, ball_xy: tuple[float, float]) -> None:
         """A kickoff or free kick is taken once the ball moved: normal play; not taken in time, play
         goes on anyway."""
-        if not self.command.kick_restart or self._restart_ball is None:
+        if not self.game.command.kick_restart or self._restart_ball is None:
             return
         if kick_taken(ball_xy, self._restart_ball, self.rules.ball_in_play_m):
             self._set(RefereeCommand.NORMAL, None)
@@ -359,14 +272,15 @@ class Referee:
             self._set(RefereeCommand.BALL_PLACEMENT, team)
             self.placement = Placement(team, spot, t)
         elif kind is RestartKind.PENALTY:
-            if self.stage == GameStage.PENALTY_SHOOTOUT:
+            if self.game.stage == GameStage.PENALTY_SHOOTOUT:
                 self._shootout_kick_setup(team, spot)
             else:
                 self._clear_spot(spot, self._attack_sign(team))
             self._teleport(ball=spot)
             self._set(RefereeCommand.PENALTY, team, ready=False)
             self.penalty = Penalty(team, t, spot)
-            (self.shootout if self.stage == GameStage.PENALTY_SHOOTOUT else self.penalties)[team]["taken"] += 1
+            kicks = self.tally.shootout if self.game.stage == GameStage.PENALTY_SHOOTOUT else self.tally.penalties
+            kicks[team]["taken"] += 1
         else:
             placed = kind is RestartKind.PLACED_FREE_KICK
             if not placed:
@@ -414,7 +328,7 @@ class Referee:
     def _award(self, kind: RestartKind, team: Team, spot: tuple[float, float]) -> None:
         """Stop play; after the restart delay ``kind`` for ``team`` at ``spot`` (in a penalty
         shootout: its next kick, this one over)."""
-        if self.stage == GameStage.PENALTY_SHOOTOUT:
+        if self.game.stage == GameStage.PENALTY_SHOOTOUT:
             self._next_shootout_kick()
             return
         self._clear_special()
@@ -436,7 +350,8 @@ class Referee:
 
     # --- fouls and cards ------------------------------------------------------------------------
     def _judge(self, truth: GroundTruth) -> None:
-        situation = Situation(self.command, self.for_team, self.game.command_t, self.blue_sign, self.game.in_play())
+        g = self.game
+        situation = Situation(g.command, g.for_team, g.command_t, self.blue_sign, g.in_play())
         for ev in self.watch.judge(truth, situation):
             self._call(ev)
             if ev.team is not None:
@@ -476,7 +391,7 @@ class Referee:
     def _follow_cards(self, dt: float, truth: GroundTruth) -> None:
         """Cards run while the game is not halted; a robot whose card ran out comes back at the
         halfway line, by the touch line, on a free spot."""
-        if self.command == RefereeCommand.HALT:
+        if self.game.command == RefereeCommand.HALT:
             return
         for c in self.cards.run(dt):
             if self.cards.back(c):
@@ -507,7 +422,7 @@ class Referee:
         """A placement succeeds when the ball rests within the tolerance of the designated position
         with the placing team's robots clear of it; it fails when the time is up."""
         pl = self.placement
-        if pl is None or self.command != RefereeCommand.BALL_PLACEMENT:
+        if pl is None or self.game.command != RefereeCommand.BALL_PLACEMENT:
             return
         r = self.rules
         off, done = placed(truth, pl.team, pl.target, self.field, r)
@@ -525,9 +440,9 @@ class Referee:
 
     def _follow_penalty(self, truth: GroundTruth) -> None:
         pen = self.penalty
-        if pen is None or self.command != RefereeCommand.PENALTY:
+        if pen is None or self.game.command != RefereeCommand.PENALTY:
             return
-        if not self.ready:
+        if not self.game.ready:
             if self.t - pen.t_start >= self.rules.prepare_timeout_s or penalty_set(
                     truth, pen.team, pen.mark, self._attack_sign(pen.team), self.field, self.rules, self.cards.off):
                 pen.t_run = self.t
@@ -541,8 +456,8 @@ class Referee:
         # over (the rules) after the kicker's time, or once the ball in play moves away from the goal (the
         # keeper turned it back, or the kicker broke the rule that it only ever moves toward the goal); a
         # ball at rest waits for the kicker, who may play it again
-        if took > self.rules.penalty_time_s or (moved and b.vx * attack < -0.05):
-            shootout = self.stage == GameStage.PENALTY_SHOOTOUT
+        if took > self.rules.penalty_time_s or (moved and b.vx * attack < -self.rules.penalty_back_m_s):
+            shootout = self.game.stage == GameStage.PENALTY_SHOOTOUT
             self._call(GameEvent(self.t, "penalty_over", pen.team, None, took, self.rules.penalty_time_s, "s",
                                  None if shootout else RefereeCommand.FREE_KICK,
                                  None if shootout else other(pen.team)))  # fmt: skip
@@ -559,8 +474,8 @@ class Referee:
             return
         under_way = self._under_way()
         if under_way is not None:
-            self.placements[under_way]["cut_short"] += 1
-        stage = stage_after(self.stage, self.rules, drawn=self.score["blue"] == self.score["yellow"])
+            self.tally.placements[under_way]["cut_short"] += 1
+        stage = stage_after(self.game.stage, self.rules, drawn=self.score["blue"] == self.score["yellow"])
         if stage is GameStage.POST_GAME:
             self._end_match()
         else:
@@ -576,10 +491,10 @@ class Referee:
             self._teleports.append(self.kickoff_setup("yellow"))
         elif stage is GameStage.PENALTY_SHOOTOUT:
             self._shootout_teams()
-            self._call(GameEvent(self.t, f"stage_{self.stage}"))
+            self._call(GameEvent(self.t, f"stage_{self.game.stage}"))
             self._next_shootout_kick()
             return
-        self._call(GameEvent(self.t, f"stage_{self.stage}"))
+        self._call(GameEvent(self.t, f"stage_{self.game.stage}"))
 
     def _end_match(self) -> None:
         self.game.enter(GameStage.POST_GAME, self.t)
@@ -593,17 +508,17 @@ class Referee:
         team scored more of an equal number; then the game is over."""
         self._clear_special()
         self._set(RefereeCommand.STOP, None)
-        team = shootout_kicker(self.shootout, self.rules)
+        team = shootout_kicker(self.tally.shootout, self.rules)
         if team is None:
             self._end_match()
-            self._call(GameEvent(self.t, f"stage_{self.stage}"))
+            self._call(GameEvent(self.t, f"stage_{self.game.stage}"))
             return
         self._restart = Restart(self.t + self.params.restart_delay_s, RestartKind.PENALTY, team, self._mark(team))
 
     def _check_keeper_held_ball(self, t: float, ball_xy: tuple[float, float]) -> None:
         """Rules (keeper held ball): the ball in a defense area for ``keeper_held_ball_s`` of normal
         play gives the other team a free kick at the nearest legal spot."""
-        side = self._held.held(t, ball_xy, self.command.running and self._restart is None)
+        side = self._held.held(t, ball_xy, self.game.command.running and self._restart is None)
         if side:
             bx, by = ball_xy
             self.keeper_held_ball += 1
@@ -621,7 +536,7 @@ class Referee:
         """Rules (no progress in game): the ball within ``no_progress_m`` of one place for
         ``no_progress_s`` while both teams may play it (two robots stuck at it, neither getting it
         away): a stop, then a force start where it lies."""
-        if self._no_progress.stuck(t, ball_xy, self.full and self.command.running and self._restart is None):
+        if self._no_progress.stuck(t, ball_xy, self.full and self.game.command.running and self._restart is None):
             self._call(GameEvent(t, "no_progress", None, None, self.params.no_progress_s, self.params.no_progress_s,
                                  "s", RefereeCommand.FORCE_START))  # fmt: skip
             self._set(RefereeCommand.STOP, None)
@@ -630,11 +545,11 @@ class Referee:
     # --- out --------------------------------------------------------------------------------
     def _action_left(self) -> float:
         t, r = self.t, self.rules
-        if self.command == RefereeCommand.BALL_PLACEMENT and self.placement is not None:
+        if self.game.command == RefereeCommand.BALL_PLACEMENT and self.placement is not None:
             return r.placement_time_s - (t - self.placement.t_start)
-        if self.command.kick_restart:
+        if self.game.command.kick_restart:
             return self.params.restart_timeout_s - (t - self._restart_t)
-        if self.command == RefereeCommand.PENALTY and self.penalty is not None:
+        if self.game.command == RefereeCommand.PENALTY and self.penalty is not None:
             if self.penalty.t_run is None:
                 return r.prepare_timeout_s - (t - self.penalty.t_start)
             return r.penalty_time_s - (t - self.penalty.t_run)
@@ -649,10 +564,10 @@ class Referee:
     def team_info(self, team: Team) -> TeamInfo:
         r = self.rules
         return TeamInfo(
-            red_cards=self.red_cards[team], yellow_cards=self.yellow_cards[team],
+            red_cards=self.cards.red[team], yellow_cards=self.cards.yellow[team],
             yellow_card_times_s=self.cards.times_left(team),
-            fouls=self.fouls[team], goalkeeper=r.keepers.get(team, 0), timeouts=r.timeouts,
-            timeout_time_s=r.timeout_total_s, placement_failures=self.placement_failures[team],
+            fouls=self.cards.fouls[team], goalkeeper=r.keepers.get(team, 0), timeouts=r.timeouts,
+            timeout_time_s=r.timeout_total_s, placement_failures=self.tally.placement_failures[team],
             can_place_ball=self.full and self._can_place(team), max_robots=self.max_robots(team),
         )  # fmt: skip
 
@@ -664,9 +579,9 @@ class Referee:
             placement = self.penalty.mark
         nxt, nxt_team = self._next()
         return GameState(
-            t=self.t, command=self.command, for_team=self.for_team, score_blue=self.score["blue"],
+            t=self.t, command=self.game.command, for_team=self.game.for_team, score_blue=self.score["blue"],
             score_yellow=self.score["yellow"], blue_defends_negative_x=self.blue_sign < 0,
-            placement=placement, ready=self.ready, stage=self.stage,
+            placement=placement, ready=self.game.ready, stage=self.game.stage,
             stage_time_left_s=self.game.stage_end - self.t, command_counter=self.game.counter,
             command_t=self.game.command_t, action_time_left_s=self._action_left(), next_command=nxt,
             next_for_team=nxt_team, blue_team=self.team_info("blue"), yellow_team=self.team_info("yellow"),
@@ -675,15 +590,15 @@ class Referee:
     def _under_way(self) -> Team | None:
         """The team whose placement is under way (a match that ends now cuts it short)."""
         pl = self.placement
-        return pl.team if pl is not None and self.command == RefereeCommand.BALL_PLACEMENT else None
+        return pl.team if pl is not None and self.game.command == RefereeCommand.BALL_PLACEMENT else None
 
     def summary(self) -> dict[str, object]:
         """The rules' figures of the match: fouls per team by kind, cards, placements, penalties."""
         by_kind = self.calls.by_kind(set(FOUL_RESTARTS))
         return {
             "rules": self.params.rules if self.params.enabled else "off",
-            "game_stage": self.stage,
-            "fouls": {t: {"total": self.fouls[t], **by_kind[t]} for t in TEAMS},
-            "cards": {t: {"yellow": self.yellow_cards[t], "red": self.red_cards[t]} for t in TEAMS},
+            "game_stage": self.game.stage,
+            "fouls": {t: {"total": self.cards.fouls[t], **by_kind[t]} for t in TEAMS},
+            "cards": {t: {"yellow": self.cards.yellow[t], "red": self.cards.red[t]} for t in TEAMS},
             **self.tally.figures(self._under_way()),
         }

@@ -22,7 +22,6 @@ and mirrored for the other team.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from typing import Literal
 
@@ -38,11 +37,20 @@ from cmdragons.messages import (
     GroundTruth,
     Kick,
     RefereeCommand,
-    TeamInfo,
     Teleport,
 )
 from sim.calls import Calls
-from sim.game_controller import Cards, GameController, Penalty, Placement, Tally, shootout_kicker, stage_after
+from sim.game_controller import (
+    Cards,
+    GameController,
+    Penalty,
+    Placement,
+    Tally,
+    shootout_kicker,
+    stage_after,
+    team_info,
+)
+from sim.referee_params import RefereeParams
 from sim.restarts import (
     Restart,
     RestartKind,
@@ -59,7 +67,6 @@ from sim.restarts import (
     restart_of_call,
     shootout_poses,
 )
-from sim.referee_params import RefereeParams
 from sim.rules import FOUL_RESTARTS, FoulWatch, HeldBall, NoProgress, Situation, penalty_set, placed
 
 __all__ = ["Referee"]
@@ -94,8 +101,6 @@ class Referee:
         self.watch = FoulWatch(field, self.rules)
         self.calls = Calls()
         self.cards = Cards(self.rules)
-        self.placement: Placement | None = None
-        self.penalty: Penalty | None = None
         self.tally = Tally()
         self._last_t = 0.0
         self._teleports: list[Teleport] = []
@@ -109,7 +114,7 @@ class Referee:
         """A command by hand (what a human referee or a scripted scene gives); restarts that need a
         ball in place are :meth:`free_kick`, :meth:`start_placement` and :meth:`start_penalty`."""
         self._restart = None
-        self._clear_special()
+        self.game.clear_special()
         self._set(command, for_team, ready)
 
     def free_kick(self, team: Team, spot: tuple[float, float]) -> Teleport:
@@ -136,13 +141,6 @@ class Referee:
     def _live(self) -> bool:
         """Do goals and balls out count now? (Basic rules: whenever no restart is pending.)"""
         return not self.full or self.game.live()
-
-    def _team_count(self, team: Team) -> int:
-        return sum(1 for t, _ in self.robot_keys if t == team)
-
-    def max_robots(self, team: Team) -> int:
-        """Robots ``team`` may have on the field now: its count less the cards running."""
-        return self._team_count(team) - sum(1 for k in self.cards.off if k[0] == team)
 
     def formation(self, team: Team) -> list[tuple[float, float, float]]:
         """Kickoff poses of ``team``'s robots in the field frame."""
@@ -242,10 +240,6 @@ class Referee:
             self._set(RefereeCommand.FORCE_START if self.full else RefereeCommand.NORMAL, None)
             self._restart_ball = None
 
-    def _clear_special(self) -> None:
-        self.placement = None
-        self.penalty = None
-
     def _teleport(self, robots: Sequence[tuple[Team, int, float, float, float]] = (),
                   ball: tuple[float, float] | None = None) -> None:  # fmt: skip
         self._teleports.append(Teleport(self.t, tuple(robots), ball))
@@ -270,7 +264,7 @@ class Referee:
             self._teleports.append(self.kickoff_setup(team))
         elif kind is RestartKind.FREE_KICK and self.full and self._can_place(team):
             self._set(RefereeCommand.BALL_PLACEMENT, team)
-            self.placement = Placement(team, spot, t)
+            self.game.placement = Placement(team, spot, t)
         elif kind is RestartKind.PENALTY:
             if self.game.stage == GameStage.PENALTY_SHOOTOUT:
                 self._shootout_kick_setup(team, spot)
@@ -278,7 +272,7 @@ class Referee:
                 self._clear_spot(spot, self._attack_sign(team))
             self._teleport(ball=spot)
             self._set(RefereeCommand.PENALTY, team, ready=False)
-            self.penalty = Penalty(team, t, spot)
+            self.game.penalty = Penalty(team, t, spot)
             kicks = self.tally.shootout if self.game.stage == GameStage.PENALTY_SHOOTOUT else self.tally.penalties
             kicks[team]["taken"] += 1
         else:
@@ -331,7 +325,7 @@ class Referee:
         if self.game.stage == GameStage.PENALTY_SHOOTOUT:
             self._next_shootout_kick()
             return
-        self._clear_special()
+        self.game.clear_special()
         self._set(RefereeCommand.STOP, None)
         self._restart = Restart(self.t + self.params.restart_delay_s, kind, team, spot)
 
@@ -406,11 +400,12 @@ class Referee:
         for team in TEAMS:
             on = [r for r in truth.robots if r.team == team and (team, r.id) not in leaving
                   and self.field.in_field(r.x, r.y, -self.field.dims.boundary_width_m)]  # fmt: skip
-            extra = len(on) - self.max_robots(team)
+            allowed = self.cards.max_robots(team, self.robot_keys)
+            extra = len(on) - allowed
             if extra <= 0:
                 continue
             ids = sorted((r.id for r in on), key=lambda rid: ((team, rid) not in self.cards.off, -rid))[:extra]
-            self._call(GameEvent(self.t, "too_many_robots", team, ids[0], float(len(on)), float(self.max_robots(team)),
+            self._call(GameEvent(self.t, "too_many_robots", team, ids[0], float(len(on)), float(allowed),
                                  "robots"))  # fmt: skip
             self._foul(team, None)
             for rid in ids:  # off (its card's robot back for good, any other until the end)
@@ -421,7 +416,7 @@ class Referee:
     def _follow_placement(self, truth: GroundTruth) -> None:
         """A placement succeeds when the ball rests within the tolerance of the designated position
         with the placing team's robots clear of it; it fails when the time is up."""
-        pl = self.placement
+        pl = self.game.placement
         if pl is None or self.game.command != RefereeCommand.BALL_PLACEMENT:
             return
         r = self.rules
@@ -439,7 +434,7 @@ class Referee:
             self._award(RestartKind.PLACED_FREE_KICK, other(pl.team), pl.target)
 
     def _follow_penalty(self, truth: GroundTruth) -> None:
-        pen = self.penalty
+        pen = self.game.penalty
         if pen is None or self.game.command != RefereeCommand.PENALTY:
             return
         if not self.game.ready:
@@ -472,7 +467,7 @@ class Referee:
         team that did not kick off first kicks off."""
         if not self.game.stage_over(self.t):
             return
-        under_way = self._under_way()
+        under_way = self.game.placing()
         if under_way is not None:
             self.tally.placements[under_way]["cut_short"] += 1
         stage = stage_after(self.game.stage, self.rules, drawn=self.score["blue"] == self.score["yellow"])
@@ -482,12 +477,12 @@ class Referee:
             self.game.enter(stage, self.t)
         if stage is GameStage.HALF_TIME:
             self._restart = None
-            self._clear_special()
+            self.game.clear_special()
             self._set(RefereeCommand.HALT, None)
         elif stage is GameStage.SECOND_HALF:
             self.blue_sign = -1 if self.blue_sign > 0 else 1
             self._restart = None
-            self._clear_special()
+            self.game.clear_special()
             self._teleports.append(self.kickoff_setup("yellow"))
         elif stage is GameStage.PENALTY_SHOOTOUT:
             self._shootout_teams()
@@ -499,14 +494,14 @@ class Referee:
     def _end_match(self) -> None:
         self.game.enter(GameStage.POST_GAME, self.t)
         self._restart = None
-        self._clear_special()
+        self.game.clear_special()
         self._set(RefereeCommand.HALT, None)
 
     def _next_shootout_kick(self) -> None:
         """The shootout's next kick after the restart delay: the teams in turn (yellow first: blue kicked
         off the match), ``shootout_kicks`` each, then (a drawn match's shootout) one each until one
         team scored more of an equal number; then the game is over."""
-        self._clear_special()
+        self.game.clear_special()
         self._set(RefereeCommand.STOP, None)
         team = shootout_kicker(self.tally.shootout, self.rules)
         if team is None:
@@ -543,54 +538,18 @@ class Referee:
             self._restart = Restart(t + self.params.restart_delay_s, RestartKind.FORCE_START, None, ball_xy)
 
     # --- out --------------------------------------------------------------------------------
-    def _action_left(self) -> float:
-        t, r = self.t, self.rules
-        if self.game.command == RefereeCommand.BALL_PLACEMENT and self.placement is not None:
-            return r.placement_time_s - (t - self.placement.t_start)
-        if self.game.command.kick_restart:
-            return self.params.restart_timeout_s - (t - self._restart_t)
-        if self.game.command == RefereeCommand.PENALTY and self.penalty is not None:
-            if self.penalty.t_run is None:
-                return r.prepare_timeout_s - (t - self.penalty.t_start)
-            return r.penalty_time_s - (t - self.penalty.t_run)
-        return math.inf
-
     def _next(self) -> tuple[RefereeCommand | None, Team | None]:
         if self._restart is None:
             return None, None
         team = self._restart.team
         return self._restart.next_command(self.full and team is not None and self._can_place(team))
 
-    def team_info(self, team: Team) -> TeamInfo:
-        r = self.rules
-        return TeamInfo(
-            red_cards=self.cards.red[team], yellow_cards=self.cards.yellow[team],
-            yellow_card_times_s=self.cards.times_left(team),
-            fouls=self.cards.fouls[team], goalkeeper=r.keepers.get(team, 0), timeouts=r.timeouts,
-            timeout_time_s=r.timeout_total_s, placement_failures=self.tally.placement_failures[team],
-            can_place_ball=self.full and self._can_place(team), max_robots=self.max_robots(team),
-        )  # fmt: skip
-
     def state(self) -> GameState:
-        placement = self._restart.spot if self._restart is not None else self._restart_ball
-        if self.placement is not None:
-            placement = self.placement.target
-        elif self.penalty is not None:
-            placement = self.penalty.mark
-        nxt, nxt_team = self._next()
-        return GameState(
-            t=self.t, command=self.game.command, for_team=self.game.for_team, score_blue=self.score["blue"],
-            score_yellow=self.score["yellow"], blue_defends_negative_x=self.blue_sign < 0,
-            placement=placement, ready=self.game.ready, stage=self.game.stage,
-            stage_time_left_s=self.game.stage_end - self.t, command_counter=self.game.counter,
-            command_t=self.game.command_t, action_time_left_s=self._action_left(), next_command=nxt,
-            next_for_team=nxt_team, blue_team=self.team_info("blue"), yellow_team=self.team_info("yellow"),
-        )  # fmt: skip
-
-    def _under_way(self) -> Team | None:
-        """The team whose placement is under way (a match that ends now cuts it short)."""
-        pl = self.placement
-        return pl.team if pl is not None and self.game.command == RefereeCommand.BALL_PLACEMENT else None
+        """The game state now, as the league's game controller sends it."""
+        spot = self._restart.spot if self._restart is not None else self._restart_ball
+        kick_left_s = self.params.restart_timeout_s - (self.t - self._restart_t)
+        teams = {team: team_info(team, self.cards, self.tally, self.robot_keys, self.full) for team in TEAMS}
+        return self.game.state(self.t, self.score, self.blue_sign, spot, kick_left_s, self._next(), teams)
 
     def summary(self) -> dict[str, object]:
         """The rules' figures of the match: fouls per team by kind, cards, placements, penalties."""
@@ -600,5 +559,5 @@ class Referee:
             "game_stage": self.game.stage,
             "fouls": {t: {"total": self.cards.fouls[t], **by_kind[t]} for t in TEAMS},
             "cards": {t: {"yellow": self.cards.yellow[t], "red": self.cards.red[t]} for t in TEAMS},
-            **self.tally.figures(self._under_way()),
+            **self.tally.figures(self.game.placing()),
         }

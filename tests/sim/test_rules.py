@@ -349,7 +349,7 @@ def test_a_penalty_shootout_alternates_its_kicks_and_ends_the_game() -> None:
     def commands(k: int) -> list[RobotCommand]:
         # yellow's first kick: the ball sent into the goal past the still keeper at the normal start
         # (nobody moves otherwise; the mark lies in the kicking team's own half)
-        pen = ref.penalty
+        pen = ref.game.penalty
         if pen is not None and ref.game.ready and pen.team == "yellow" and not scored["n"]:
             w.place_ball(pen.mark[0], pen.mark[1], vx=-6.0 * math.copysign(1.0, pen.mark[0]), vy=0.35)
             scored["n"] = 1
@@ -379,7 +379,7 @@ def test_a_penalty_waits_for_a_ball_at_rest_and_ends_when_the_ball_turns_back() 
     # toward the goal; a keeper turning it back ends the kick
     w, ref = scene(prepare_timeout_s=0.5, penalty_time_s=5.0)
     w.apply(ref.start_penalty("blue"))
-    mark = ref.penalty.mark if ref.penalty else (0.0, 0.0)
+    mark = ref.game.penalty.mark if ref.game.penalty else (0.0, 0.0)
     calls = play(w, ref, 1.0)
     assert ref.game.ready
     w.place_ball(mark[0] + 0.5, mark[1])  # played forward, now at rest: still the kicker's
@@ -388,6 +388,17 @@ def test_a_penalty_waits_for_a_ball_at_rest_and_ends_when_the_ball_turns_back() 
     w.place_ball(mark[0] + 0.5, mark[1], vx=-1.0)  # turned back toward the kicker's half
     calls += play(w, ref, 0.2)
     assert "penalty_over" in kinds(calls)
+
+
+def test_a_penalty_ball_rolling_back_slower_than_the_rules_speed_leaves_the_kick_on() -> None:
+    w, ref = scene(prepare_timeout_s=0.5, penalty_time_s=5.0, penalty_back_m_s=1.5)
+    w.apply(ref.start_penalty("blue"))
+    assert ref.game.penalty is not None
+    mark = ref.game.penalty.mark
+    play(w, ref, 1.0)
+    w.place_ball(mark[0] + 0.5, mark[1], vx=-1.0)  # back toward the kicker's half, slower than 1.5 m/s
+    calls = play(w, ref, 0.2)
+    assert ref.game.command == RefereeCommand.PENALTY and "penalty_over" not in kinds(calls)
 
 
 def test_the_ball_is_not_put_into_a_robot_on_the_penalty_mark() -> None:
@@ -411,7 +422,7 @@ def test_a_shootout_kick_has_only_the_kicker_and_the_other_keeper_on_the_field()
     seen = []
 
     def look(k: int) -> list[RobotCommand]:
-        pen = ref.penalty
+        pen = ref.game.penalty
         if pen is not None and (not seen or seen[-1][0] != pen.team):
             truth = w.ground_truth()
             on = sorted((r.team, r.id) for r in truth.robots if w.field.in_field(r.x, r.y))

@@ -12,12 +12,14 @@ free kick to the other team), penalty kicks (prepared, started, over when scored
 out), and too many robots on the field. Every call is a :class:`~cmdragons.messages.GameEvent`.
 
 The referee is the composition of its parts: the fouls and their figures (:mod:`sim.rules`), the
-restarts (:mod:`sim.restarts`: which command comes next, where the ball goes), the game controller's
-state machine (:mod:`sim.game_controller`: commands, stages, cards) and the calls (:mod:`sim.calls`).
-It never touches the physics: what it wants placed (a ball, a formation, a robot sent off or back)
-it returns as a :class:`~cmdragons.messages.Teleport`, which the simulator carries out (in one
-process or across a network alike). Formations are given for the team defending the goal at -x
-and mirrored for the other team.
+restarts (:mod:`sim.restarts`: which command comes next, where the ball and the robots go, the
+frame's moves gathered into one teleport), the game controller's state machine
+(:mod:`sim.game_controller`: commands, stages, cards, the game state it tells) and the calls
+(:mod:`sim.calls`); what is left here turns what the parts decide into commands and moves. It never
+touches the physics: what it wants placed (a ball, a formation, a robot sent off or back) it returns
+as a :class:`~cmdragons.messages.Teleport`, which the simulator carries out (in one process or
+across a network alike). Formations are given for the team defending the goal at -x and mirrored for
+the other team.
 """
 
 from __future__ import annotations
@@ -52,20 +54,17 @@ from sim.game_controller import (
 )
 from sim.referee_params import RefereeParams
 from sim.restarts import (
+    Moves,
     Restart,
     RestartKind,
-    aside,
     attack_sign,
     ball_out_taker,
     defender_of,
     entry_spot,
-    formation,
     kick_taken,
     other,
-    park,
     penalty_mark,
     restart_of_call,
-    shootout_poses,
 )
 from sim.rules import FOUL_RESTARTS, FoulWatch, HeldBall, NoProgress, Situation, penalty_set, placed
 
@@ -103,7 +102,7 @@ class Referee:
         self.cards = Cards(self.rules)
         self.tally = Tally()
         self._last_t = 0.0
-        self._teleports: list[Teleport] = []
+        self.moves = Moves(field, robot_keys, params.formations, params.park_distance_m)
         self._truth: GroundTruth | None = None  # the last true state seen (where the robots stand)
 
     # --- commands ---------------------------------------------------------------------------
@@ -121,7 +120,7 @@ class Referee:
         """A free kick for ``team`` with the ball put at ``spot`` (the teleport to carry out)."""
         self.give(RefereeCommand.STOP)
         self._start_restart(RestartKind.REFEREE_FREE_KICK, team, spot, spot)
-        teleport = self._take_teleports()
+        teleport = self.moves.take(self.t)
         assert teleport is not None
         return teleport
 
@@ -134,7 +133,7 @@ class Referee:
         """A penalty kick for ``team``: the ball on the mark (the teleport to carry out), prepared."""
         self.give(RefereeCommand.STOP)
         self._start_restart(RestartKind.PENALTY, team, self._mark(team), (0.0, 0.0))
-        teleport = self._take_teleports()
+        teleport = self.moves.take(self.t)
         assert teleport is not None
         return teleport
 
@@ -142,29 +141,14 @@ class Referee:
         """Do goals and balls out count now? (Basic rules: whenever no restart is pending.)"""
         return not self.full or self.game.live()
 
-    def formation(self, team: Team) -> list[tuple[float, float, float]]:
-        """Kickoff poses of ``team``'s robots in the field frame."""
-        division = self.field.league.division
-        poses = self.params.formations.get(division, ())
-        n = sum(1 for t, _ in self.robot_keys if t == team)
-        if len(poses) < n:
-            raise ValueError(
-                f"sim.referee.formations.{division} lists {len(poses)} poses but the team has {n} robots"
-            )
-        return formation(poses, n, self.blue_sign if team == "blue" else -self.blue_sign)
-
     def kickoff_setup(self, kicking_team: Team = "blue") -> Teleport:
         """Both teams in formation, ball on the centre spot, kickoff for ``kicking_team`` (robots
         sent off stay off)."""
-        robots = []
-        for team in TEAMS:
-            ids = [rid for t, rid in self.robot_keys if t == team]
-            robots += [(team, rid, x, y, th) for rid, (x, y, th) in zip(ids, self.formation(team), strict=False)
-                       if (team, rid) not in self.cards.off]  # fmt: skip
+        teleport = self.moves.kickoff(self.t, self.blue_sign, self.cards.off)
         self._set(RefereeCommand.KICKOFF, kicking_team)
         self._restart_ball = (0.0, 0.0)
         self._restart_t = self.t
-        return Teleport(self.t, tuple(robots), (0.0, 0.0))
+        return teleport
 
     # --- one frame --------------------------------------------------------------------------
     def observe(self, t: float, events: Sequence[Event], ball_xy: tuple[float, float],
@@ -194,7 +178,7 @@ class Referee:
         if self._restart is not None and t >= self._restart.due_t:
             due, self._restart = self._restart, None
             self._start_restart(due.kind, due.team, due.spot, ball_xy)
-        teleport = self._take_teleports()
+        teleport = self.moves.take(self.t)
         self._follow_kick(teleport.ball if teleport is not None and teleport.ball is not None else ball_xy)
         return teleport
 
@@ -240,20 +224,6 @@ class Referee:
             self._set(RefereeCommand.FORCE_START if self.full else RefereeCommand.NORMAL, None)
             self._restart_ball = None
 
-    def _teleport(self, robots: Sequence[tuple[Team, int, float, float, float]] = (),
-                  ball: tuple[float, float] | None = None) -> None:  # fmt: skip
-        self._teleports.append(Teleport(self.t, tuple(robots), ball))
-
-    def _take_teleports(self) -> Teleport | None:
-        """This frame's teleports as one (robots in order, the last ball)."""
-        if not self._teleports:
-            return None
-        parts, self._teleports = self._teleports, []
-        if len(parts) == 1:
-            return parts[0]
-        ball = next((p.ball for p in reversed(parts) if p.ball is not None), None)
-        return Teleport(self.t, tuple(r for p in parts for r in p.robots), ball)
-
     def _start_restart(self, kind: RestartKind, team: Team | None, spot: tuple[float, float],
                        ball_xy: tuple[float, float]) -> None:  # fmt: skip
         """The restart due now: the ball (and robots) where it wants them, its command given."""
@@ -261,16 +231,17 @@ class Referee:
         if kind is RestartKind.FORCE_START or team is None:  # after no progress: where the ball lies, for both
             self._set(RefereeCommand.FORCE_START, None)
         elif kind is RestartKind.KICKOFF and self.params.place_robots_on_goal:
-            self._teleports.append(self.kickoff_setup(team))
+            self.moves.append(self.kickoff_setup(team))
         elif kind is RestartKind.FREE_KICK and self.full and self._can_place(team):
             self._set(RefereeCommand.BALL_PLACEMENT, team)
             self.game.placement = Placement(team, spot, t)
         elif kind is RestartKind.PENALTY:
             if self.game.stage == GameStage.PENALTY_SHOOTOUT:
-                self._shootout_kick_setup(team, spot)
+                self.moves.shootout_kick(self.t, self.cards.off, self.rules.keepers, team, spot,
+                                         self._attack_sign(team), self.rules.penalty_behind_m)  # fmt: skip
             else:
                 self._clear_spot(spot, self._attack_sign(team))
-            self._teleport(ball=spot)
+            self.moves.add(self.t, ball=spot)
             self._set(RefereeCommand.PENALTY, team, ready=False)
             self.game.penalty = Penalty(team, t, spot)
             kicks = self.tally.shootout if self.game.stage == GameStage.PENALTY_SHOOTOUT else self.tally.penalties
@@ -278,7 +249,7 @@ class Referee:
         else:
             placed = kind is RestartKind.PLACED_FREE_KICK
             if not placed:
-                self._teleport(ball=spot)
+                self.moves.add(self.t, ball=spot)
             self._set(kind.command, team)
             self._restart_ball = ball_xy if placed else spot
             self._restart_t = t
@@ -289,9 +260,7 @@ class Referee:
         if self._truth is None:
             return
         clear = self.field.league.robot.radius_m + self.field.league.ball.radius_m + self.rules.placement_clear_m
-        moved = aside(self._truth.robots, spot, clear, attack, self.cards.off)
-        if moved:
-            self._teleport(moved)
+        self.moves.clear_spot(self.t, self._truth.robots, spot, clear, attack, self.cards.off)
 
     def _shootout_teams(self) -> None:
         """The rules: in a shootout one attacker and the keeper per team; the others go off (the
@@ -302,16 +271,6 @@ class Referee:
             players = [rid for rid in on if rid != keeper]
             for rid in players[1:]:
                 self._send_off((team, rid), True)
-
-    def _shootout_kick_setup(self, team: Team, mark: tuple[float, float]) -> None:
-        """The rules: during a shootout attempt only the kicker and the other team's keeper may move
-        (the others must not interfere; robots may be substituted between attempts). The robot
-        handlers take the kicking team's keeper and the other team's field player off (where robots
-        sent off wait) and put the kicker ``penalty_behind_m`` behind the mark and the keeper on its
-        goal line."""
-        parked = {key: self._park(key) for key in self.robot_keys}
-        self._teleport(shootout_poses(self.field, self.robot_keys, self.cards.off, self.rules.keepers, team, mark,
-                                      self._attack_sign(team), self.rules.penalty_behind_m, parked))  # fmt: skip
 
     def _can_place(self, team: Team) -> bool:
         return self.tally.may_place(team, self.rules.placement_failures_max)
@@ -373,14 +332,9 @@ class Referee:
         if off is not None:
             self._send_off((team, off), red)
 
-    def _park(self, key: Key) -> tuple[float, float]:
-        """Where a robot off the field waits: outside the boundary, beyond the cameras' view."""
-        return park(self.field, self.robot_keys.index(key), key[0], self.params.park_distance_m)
-
     def _send_off(self, key: Key, red: bool) -> None:
         self.cards.off[key] = red
-        x, y = self._park(key)
-        self._teleport([(key[0], key[1], x, y, 0.0)])
+        self.moves.send_off(self.t, key)
 
     def _follow_cards(self, dt: float, truth: GroundTruth) -> None:
         """Cards run while the game is not halted; a robot whose card ran out comes back at the
@@ -390,13 +344,13 @@ class Referee:
         for c in self.cards.run(dt):
             if self.cards.back(c):
                 x, y = entry_spot(self.field, truth.robots, c.team, self.blue_sign)
-                self._teleport([(c.team, c.robot, x, y, 0.0)])
+                self.moves.add(self.t, [(c.team, c.robot, x, y, 0.0)])
                 self._call(GameEvent(self.t, "yellow_card_over", c.team, c.robot))
 
     def _count_robots(self, truth: GroundTruth) -> None:
         """Too many robots: a team with more on the field than it may have; the extra go off (a
         robot sent off that came back first)."""
-        leaving = {(t, rid) for p in self._teleports for t, rid, *_ in p.robots}  # sent off this frame
+        leaving = self.moves.moving()  # sent off this frame
         for team in TEAMS:
             on = [r for r in truth.robots if r.team == team and (team, r.id) not in leaving
                   and self.field.in_field(r.x, r.y, -self.field.dims.boundary_width_m)]  # fmt: skip
@@ -409,8 +363,7 @@ class Referee:
                                  "robots"))  # fmt: skip
             self._foul(team, None)
             for rid in ids:  # off (its card's robot back for good, any other until the end)
-                x, y = self._park((team, rid))
-                self._teleport([(team, rid, x, y, 0.0)])
+                self.moves.send_off(self.t, (team, rid))
 
     # --- placement, penalty, stages ----------------------------------------------------------
     def _follow_placement(self, truth: GroundTruth) -> None:
@@ -430,7 +383,7 @@ class Referee:
             self.tally.failed(pl.team)
             self._call(GameEvent(self.t, "placement_failed", pl.team, None, off, r.placement_tolerance_m, "m",
                                  RefereeCommand.FREE_KICK, other(pl.team)))  # fmt: skip
-            self._teleport(ball=pl.target)  # the referee places it
+            self.moves.add(self.t, ball=pl.target)  # the referee places it
             self._award(RestartKind.PLACED_FREE_KICK, other(pl.team), pl.target)
 
     def _follow_penalty(self, truth: GroundTruth) -> None:
@@ -483,7 +436,7 @@ class Referee:
             self.blue_sign = -1 if self.blue_sign > 0 else 1
             self._restart = None
             self.game.clear_special()
-            self._teleports.append(self.kickoff_setup("yellow"))
+            self.moves.append(self.kickoff_setup("yellow"))
         elif stage is GameStage.PENALTY_SHOOTOUT:
             self._shootout_teams()
             self._call(GameEvent(self.t, f"stage_{self.game.stage}"))

@@ -5,7 +5,8 @@ with the match's tally of them.
 
 It decides nothing about the physics: the referee (:mod:`sim.referee`) composes it with the fouls
 (:mod:`sim.rules`), the restarts (:mod:`sim.restarts`) and the calls (:mod:`sim.calls`) and turns
-what it decides into teleports. Times in seconds.
+what it decides into teleports. What the teams hear of it is its :meth:`GameController.state`, the
+league's game state with each team's :func:`team_info`. Times in seconds.
 """
 
 from __future__ import annotations
@@ -17,17 +18,27 @@ from dataclasses import dataclass
 import numpy as np
 
 from cmdragons.geometry import TEAMS, Team
-from cmdragons.messages import GameStage, RefereeCommand
+from cmdragons.messages import GameStage, GameState, RefereeCommand, TeamInfo
 from sim.rules import RulesParams
 
-__all__ = ["Card", "Cards", "GameController", "Penalty", "Placement", "Tally", "shootout_kicker", "stage_after"]
+__all__ = [
+    "Card",
+    "Cards",
+    "GameController",
+    "Penalty",
+    "Placement",
+    "Tally",
+    "shootout_kicker",
+    "stage_after",
+    "team_info",
+]
 
 Key = tuple[Team, int]
 
 
 class GameController:
     """The command in force, for which team, whether its normal start is given (``ready``), its
-    counter and time; the stage and when it ends."""
+    counter and time; the stage and when it ends; the placement or penalty under way."""
 
     def __init__(self, rules: RulesParams, halves: bool) -> None:
         """``halves``: the match has the rules' halves (the full rules), else one endless stage."""
@@ -39,6 +50,8 @@ class GameController:
         self.command_t = 0.0
         self.stage = GameStage.FIRST_HALF
         self.stage_end = rules.half_s if halves else math.inf
+        self.placement: Placement | None = None
+        self.penalty: Penalty | None = None
 
     def give(self, t: float, command: RefereeCommand, for_team: Team | None, ready: bool = True) -> None:
         """Give a command at ``t`` (its counter and time move when it changes)."""
@@ -54,6 +67,51 @@ class GameController:
     def live(self) -> bool:
         """Goals and balls out count: the ball in play, or a kickoff or free kick about to be taken."""
         return self.command.kick_restart or self.in_play()
+
+    def clear_special(self) -> None:
+        """Neither a placement nor a penalty under way any more."""
+        self.placement = None
+        self.penalty = None
+
+    def placing(self) -> Team | None:
+        """The team whose placement is under way (a match that ends now cuts it short)."""
+        pl = self.placement
+        return pl.team if pl is not None and self.command == RefereeCommand.BALL_PLACEMENT else None
+
+    def action_left(self, t: float, kick_left_s: float) -> float:
+        """The time left at ``t`` for the action under way: the ball placement, a kickoff or free kick
+        (``kick_left_s``: the referee's, till it lets play go on), the penalty's preparation or kick;
+        inf for none."""
+        r = self.rules
+        if self.command == RefereeCommand.BALL_PLACEMENT and self.placement is not None:
+            return r.placement_time_s - (t - self.placement.t_start)
+        if self.command.kick_restart:
+            return kick_left_s
+        if self.command == RefereeCommand.PENALTY and self.penalty is not None:
+            if self.penalty.t_run is None:
+                return r.prepare_timeout_s - (t - self.penalty.t_start)
+            return r.penalty_time_s - (t - self.penalty.t_run)
+        return math.inf
+
+    def state(self, t: float, score: Mapping[Team, int], blue_sign: float, spot: tuple[float, float] | None,
+              kick_left_s: float, upcoming: tuple[RefereeCommand | None, Team | None],
+              teams: Mapping[Team, TeamInfo]) -> GameState:  # fmt: skip
+        """The game state at ``t`` as the league's game controller sends it: the ball's designated
+        position the placement's target or the penalty mark under way, else ``spot`` (the restart's);
+        ``upcoming`` the next command and its team; ``blue_sign`` -1 while blue defends the goal at -x."""
+        placement = spot
+        if self.placement is not None:
+            placement = self.placement.target
+        elif self.penalty is not None:
+            placement = self.penalty.mark
+        nxt, nxt_team = upcoming
+        return GameState(
+            t=t, command=self.command, for_team=self.for_team, score_blue=score["blue"], score_yellow=score["yellow"],
+            blue_defends_negative_x=blue_sign < 0, placement=placement, ready=self.ready, stage=self.stage,
+            stage_time_left_s=self.stage_end - t, command_counter=self.counter, command_t=self.command_t,
+            action_time_left_s=self.action_left(t, kick_left_s), next_command=nxt, next_for_team=nxt_team,
+            blue_team=teams["blue"], yellow_team=teams["yellow"],
+        )  # fmt: skip
 
     def stage_over(self, t: float) -> bool:
         return t >= self.stage_end
@@ -162,6 +220,10 @@ class Cards:
     def times_left(self, team: Team) -> tuple[float, ...]:
         return tuple(max(0.0, c.left_s) for c in self.running if c.team == team)
 
+    def max_robots(self, team: Team, keys: Sequence[Key]) -> int:
+        """Robots ``team`` may have on the field now: its count in ``keys`` less the cards running."""
+        return sum(1 for t, _ in keys if t == team) - sum(1 for k in self.off if k[0] == team)
+
 
 @dataclass
 class Placement:
@@ -219,3 +281,17 @@ class Tally:
             "penalties": {t: dict(self.penalties[t]) for t in TEAMS},
             "shootout": {t: dict(self.shootout[t]) for t in TEAMS},
         }  # fmt: skip
+
+
+def team_info(team: Team, cards: Cards, tally: Tally, keys: Sequence[Key], full: bool) -> TeamInfo:
+    """What the game controller tells of ``team`` (of ``keys``' robots): its cards and fouls, its
+    keeper and timeouts, its failed placements and whether it still places the ball (``full``: only
+    with the full rules), how many robots it may have on the field."""
+    r = cards.rules
+    return TeamInfo(
+        red_cards=cards.red[team], yellow_cards=cards.yellow[team], yellow_card_times_s=cards.times_left(team),
+        fouls=cards.fouls[team], goalkeeper=r.keepers.get(team, 0), timeouts=r.timeouts,
+        timeout_time_s=r.timeout_total_s, placement_failures=tally.placement_failures[team],
+        can_place_ball=full and tally.may_place(team, r.placement_failures_max),
+        max_robots=cards.max_robots(team, keys),
+    )  # fmt: skip

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Team
-from sim.referee import RefereeParams
+from sim.referee_params import RefereeParams
 from sim.render import RenderParams
 from sim.script import ScriptParams
 from sim.world import BallParams, DribblerParams, KickerParams, PhysicsParams, RobotParams

@@ -12,23 +12,21 @@ free kick to the other team), penalty kicks (prepared, started, over when scored
 out), and too many robots on the field. Every call is a :class:`~cmdragons.messages.GameEvent`.
 
 The referee is the composition of its parts: the fouls and their figures (:mod:`sim.rules`), the
-restarts (:mod:`sim.restarts`: which command comes next, where the ball goes), the game controller's
-state machine (:mod:`sim.game_controller`: commands, stages, cards) and the calls (:mod:`sim.calls`).
-It never touches the physics: what it wants placed (a ball, a formation, a robot sent off or back)
-it returns as a :class:`~cmdragons.messages.Teleport`, which the simulator carries out (in one
-process or across a network alike). Formations are given for the team defending the goal at -x
-and mirrored for the other team.
+restarts (:mod:`sim.restarts`: which command comes next, where the ball and the robots go, the
+frame's moves gathered into one teleport), the game controller's state machine
+(:mod:`sim.game_controller`: commands, stages, cards, the game state it tells) and the calls
+(:mod:`sim.calls`); what is left here turns what the parts decide into commands and moves. It never
+touches the physics: what it wants placed (a ball, a formation, a robot sent off or back) it returns
+as a :class:`~cmdragons.messages.Teleport`, which the simulator carries out (in one process or
+across a network alike). Formations are given for the team defending the goal at -x and mirrored for
+the other team.
 """
 
 from __future__ import annotations
 
-import math
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Sequence
 from typing import Literal
 
-
-from cmdragons.config import Validated, setting
 from cmdragons.geometry import TEAMS, Field, Team
 from cmdragons.messages import (
     BallOut,
@@ -41,60 +39,36 @@ from cmdragons.messages import (
     GroundTruth,
     Kick,
     RefereeCommand,
-    TeamInfo,
     Teleport,
 )
 from sim.calls import Calls
-from sim.game_controller import Cards, GameController, Penalty, Placement, Tally, shootout_kicker, stage_after
+from sim.game_controller import (
+    Cards,
+    GameController,
+    Penalty,
+    Placement,
+    Tally,
+    shootout_kicker,
+    stage_after,
+    team_info,
+)
+from sim.referee_params import RefereeParams
 from sim.restarts import (
+    Moves,
     Restart,
     RestartKind,
-    aside,
     attack_sign,
     ball_out_taker,
     defender_of,
     entry_spot,
-    formation,
     kick_taken,
     other,
-    park,
     penalty_mark,
     restart_of_call,
-    shootout_poses,
 )
-from sim.rules import FOUL_RESTARTS, FoulWatch, HeldBall, NoProgress, RulesParams, Situation, penalty_set, placed
+from sim.rules import FOUL_RESTARTS, FoulWatch, HeldBall, NoProgress, Situation, penalty_set, placed
 
-__all__ = ["Referee", "RefereeParams"]
-
-_Pose = tuple[float, float, float]
-_DEFAULT_FORMATIONS: dict[Literal["A", "B"], tuple[_Pose, ...]] = {
-    "B": ((-4.2, 0.0, 0.0), (-3.0, 1.0, 0.0), (-3.0, -1.0, 0.0), (-2.0, 0.0, 0.0), (-1.0, 1.6, 0.0),
-          (-1.0, -1.6, 0.0)),
-    "A": ((-5.7, 0.0, 0.0), (-4.2, 1.2, 0.0), (-4.2, -1.2, 0.0), (-4.2, 0.0, 0.0), (-3.2, 2.5, 0.0),
-          (-3.2, -2.5, 0.0), (-2.4, 0.8, 0.0), (-2.4, -0.8, 0.0), (-1.2, 3.0, 0.0), (-1.2, -3.0, 0.0),
-          (-1.0, 0.0, 0.0)),
-}  # fmt: skip
-
-
-@dataclass(frozen=True)
-class RefereeParams(Validated):
-    enabled: bool = True  # off: no restarts, the ball bounces off the boundary walls
-    rules: Literal["full", "basic"] = "full"  # full: the league's game controller and auto-referee
-    blue_defends: Literal["negative_x", "positive_x"] = "negative_x"
-    restart_delay_s: float = setting(1.0, lo=0.0, hi=30.0)  # goal or out -> ball placed
-    place_robots_on_goal: bool = True  # put both teams in their kickoff formation after a goal
-    free_kick_distance_m: float = setting(0.2, lo=0.0, hi=2.0)  # from the lines and defense areas
-    restart_timeout_s: float = setting(10.0, lo=0.1, hi=600.0)  # a restart not taken by then: play on
-    keeper_held_ball_s: float = setting(10.0, lo=0.1, hi=600.0)  # ball this long in a defense area: free kick
-    no_progress_s: float = setting(10.0, lo=0.1, hi=600.0)  # the ball this long in one place in play: stop, force start
-    no_progress_m: float = setting(0.05, lo=0.0, hi=5.0)  # ... within this of it
-    # start poses (x m, y m, theta rad) of the team defending -x, per division; mirrored for the other
-    formations: Mapping[Literal["A", "B"], tuple[tuple[float, float, float], ...]] = field(
-        default_factory=lambda: dict(_DEFAULT_FORMATIONS)
-    )
-    figures: RulesParams = RulesParams()  # the league's figures for the full rules
-    park_distance_m: float = setting(3.0, lo=0.5, hi=50.0)  # robots sent off wait this far outside the boundary
-
+__all__ = ["Referee"]
 
 Key = tuple[Team, int]
 
@@ -126,67 +100,10 @@ class Referee:
         self.watch = FoulWatch(field, self.rules)
         self.calls = Calls()
         self.cards = Cards(self.rules)
-        self.placement: Placement | None = None
-        self.penalty: Penalty | None = None
         self.tally = Tally()
         self._last_t = 0.0
-        self._teleports: list[Teleport] = []
+        self.moves = Moves(field, robot_keys, params.formations, params.park_distance_m)
         self._truth: GroundTruth | None = None  # the last true state seen (where the robots stand)
-
-    # --- the parts' state, read ------------------------------------------------------------
-    @property
-    def command(self) -> RefereeCommand:
-        return self.game.command
-
-    @property
-    def for_team(self) -> Team | None:
-        return self.game.for_team
-
-    @property
-    def ready(self) -> bool:
-        return self.game.ready
-
-    @property
-    def stage(self) -> GameStage:
-        return self.game.stage
-
-    @property
-    def events(self) -> list[GameEvent]:
-        """Every call of the match."""
-        return self.calls.all
-
-    @property
-    def new_events(self) -> list[GameEvent]:
-        """The calls of the last frame."""
-        return self.calls.new
-
-    @property
-    def fouls(self) -> dict[Team, int]:
-        return self.cards.fouls
-
-    @property
-    def yellow_cards(self) -> dict[Team, int]:
-        return self.cards.yellow
-
-    @property
-    def red_cards(self) -> dict[Team, int]:
-        return self.cards.red
-
-    @property
-    def placements(self) -> dict[Team, dict[str, int]]:
-        return self.tally.placements
-
-    @property
-    def placement_failures(self) -> dict[Team, int]:
-        return self.tally.placement_failures
-
-    @property
-    def penalties(self) -> dict[Team, dict[str, int]]:
-        return self.tally.penalties
-
-    @property
-    def shootout(self) -> dict[Team, dict[str, int]]:
-        return self.tally.shootout
 
     # --- commands ---------------------------------------------------------------------------
     def _set(self, command: RefereeCommand, for_team: Team | None, ready: bool = True) -> None:
@@ -196,14 +113,14 @@ class Referee:
         """A command by hand (what a human referee or a scripted scene gives); restarts that need a
         ball in place are :meth:`free_kick`, :meth:`start_placement` and :meth:`start_penalty`."""
         self._restart = None
-        self._clear_special()
+        self.game.clear_special()
         self._set(command, for_team, ready)
 
     def free_kick(self, team: Team, spot: tuple[float, float]) -> Teleport:
         """A free kick for ``team`` with the ball put at ``spot`` (the teleport to carry out)."""
         self.give(RefereeCommand.STOP)
         self._start_restart(RestartKind.REFEREE_FREE_KICK, team, spot, spot)
-        teleport = self._take_teleports()
+        teleport = self.moves.take(self.t)
         assert teleport is not None
         return teleport
 
@@ -216,7 +133,7 @@ class Referee:
         """A penalty kick for ``team``: the ball on the mark (the teleport to carry out), prepared."""
         self.give(RefereeCommand.STOP)
         self._start_restart(RestartKind.PENALTY, team, self._mark(team), (0.0, 0.0))
-        teleport = self._take_teleports()
+        teleport = self.moves.take(self.t)
         assert teleport is not None
         return teleport
 
@@ -224,36 +141,14 @@ class Referee:
         """Do goals and balls out count now? (Basic rules: whenever no restart is pending.)"""
         return not self.full or self.game.live()
 
-    def _team_count(self, team: Team) -> int:
-        return sum(1 for t, _ in self.robot_keys if t == team)
-
-    def max_robots(self, team: Team) -> int:
-        """Robots ``team`` may have on the field now: its count less the cards running."""
-        return self._team_count(team) - sum(1 for k in self.cards.off if k[0] == team)
-
-    def formation(self, team: Team) -> list[tuple[float, float, float]]:
-        """Kickoff poses of ``team``'s robots in the field frame."""
-        division = self.field.league.division
-        poses = self.params.formations.get(division, ())
-        n = sum(1 for t, _ in self.robot_keys if t == team)
-        if len(poses) < n:
-            raise ValueError(
-                f"sim.referee.formations.{division} lists {len(poses)} poses but the team has {n} robots"
-            )
-        return formation(poses, n, self.blue_sign if team == "blue" else -self.blue_sign)
-
     def kickoff_setup(self, kicking_team: Team = "blue") -> Teleport:
         """Both teams in formation, ball on the centre spot, kickoff for ``kicking_team`` (robots
         sent off stay off)."""
-        robots = []
-        for team in TEAMS:
-            ids = [rid for t, rid in self.robot_keys if t == team]
-            robots += [(team, rid, x, y, th) for rid, (x, y, th) in zip(ids, self.formation(team), strict=False)
-                       if (team, rid) not in self.cards.off]  # fmt: skip
+        teleport = self.moves.kickoff(self.t, self.blue_sign, self.cards.off)
         self._set(RefereeCommand.KICKOFF, kicking_team)
         self._restart_ball = (0.0, 0.0)
         self._restart_t = self.t
-        return Teleport(self.t, tuple(robots), (0.0, 0.0))
+        return teleport
 
     # --- one frame --------------------------------------------------------------------------
     def observe(self, t: float, events: Sequence[Event], ball_xy: tuple[float, float],
@@ -283,7 +178,7 @@ class Referee:
         if self._restart is not None and t >= self._restart.due_t:
             due, self._restart = self._restart, None
             self._start_restart(due.kind, due.team, due.spot, ball_xy)
-        teleport = self._take_teleports()
+        teleport = self.moves.take(self.t)
         self._follow_kick(teleport.ball if teleport is not None and teleport.ball is not None else ball_xy)
         return teleport
 
@@ -298,7 +193,7 @@ class Referee:
             self._goal(other(defender_of(e.x, self.blue_sign)))
         elif isinstance(e, BallOut) and self._restart is None and self._live():
             self.balls_out += 1
-            if self.stage == GameStage.PENALTY_SHOOTOUT:  # the kick missed
+            if self.game.stage == GameStage.PENALTY_SHOOTOUT:  # the kick missed
                 self._next_shootout_kick()
                 return
             taker = ball_out_taker(e.last_touch, e.x, self.blue_sign)
@@ -306,20 +201,20 @@ class Referee:
 
     def _goal(self, scorer: Team) -> None:
         """A goal for ``scorer``: the kickoff for the other team (in a shootout: the next kick)."""
-        if self.stage == GameStage.PENALTY_SHOOTOUT:
-            if self.for_team == scorer:
-                self.shootout[scorer]["scored"] += 1
+        if self.game.stage == GameStage.PENALTY_SHOOTOUT:
+            if self.game.for_team == scorer:
+                self.tally.shootout[scorer]["scored"] += 1
             self._next_shootout_kick()
             return
         self.score[scorer] += 1
-        if self.command == RefereeCommand.PENALTY and self.for_team == scorer:
-            self.penalties[scorer]["scored"] += 1
+        if self.game.command == RefereeCommand.PENALTY and self.game.for_team == scorer:
+            self.tally.penalties[scorer]["scored"] += 1
         self._award(RestartKind.KICKOFF, other(scorer), (0.0, 0.0))
 
     def _follow_kick(self, ball_xy: tuple[float, float]) -> None:
         """A kickoff or free kick is taken once the ball moved: normal play; not taken in time, play
         goes on anyway."""
-        if not self.command.kick_restart or self._restart_ball is None:
+        if not self.game.command.kick_restart or self._restart_ball is None:
             return
         if kick_taken(ball_xy, self._restart_ball, self.rules.ball_in_play_m):
             self._set(RefereeCommand.NORMAL, None)
@@ -329,24 +224,6 @@ class Referee:
             self._set(RefereeCommand.FORCE_START if self.full else RefereeCommand.NORMAL, None)
             self._restart_ball = None
 
-    def _clear_special(self) -> None:
-        self.placement = None
-        self.penalty = None
-
-    def _teleport(self, robots: Sequence[tuple[Team, int, float, float, float]] = (),
-                  ball: tuple[float, float] | None = None) -> None:  # fmt: skip
-        self._teleports.append(Teleport(self.t, tuple(robots), ball))
-
-    def _take_teleports(self) -> Teleport | None:
-        """This frame's teleports as one (robots in order, the last ball)."""
-        if not self._teleports:
-            return None
-        parts, self._teleports = self._teleports, []
-        if len(parts) == 1:
-            return parts[0]
-        ball = next((p.ball for p in reversed(parts) if p.ball is not None), None)
-        return Teleport(self.t, tuple(r for p in parts for r in p.robots), ball)
-
     def _start_restart(self, kind: RestartKind, team: Team | None, spot: tuple[float, float],
                        ball_xy: tuple[float, float]) -> None:  # fmt: skip
         """The restart due now: the ball (and robots) where it wants them, its command given."""
@@ -354,23 +231,25 @@ class Referee:
         if kind is RestartKind.FORCE_START or team is None:  # after no progress: where the ball lies, for both
             self._set(RefereeCommand.FORCE_START, None)
         elif kind is RestartKind.KICKOFF and self.params.place_robots_on_goal:
-            self._teleports.append(self.kickoff_setup(team))
+            self.moves.append(self.kickoff_setup(team))
         elif kind is RestartKind.FREE_KICK and self.full and self._can_place(team):
             self._set(RefereeCommand.BALL_PLACEMENT, team)
-            self.placement = Placement(team, spot, t)
+            self.game.placement = Placement(team, spot, t)
         elif kind is RestartKind.PENALTY:
-            if self.stage == GameStage.PENALTY_SHOOTOUT:
-                self._shootout_kick_setup(team, spot)
+            if self.game.stage == GameStage.PENALTY_SHOOTOUT:
+                self.moves.shootout_kick(self.t, self.cards.off, self.rules.keepers, team, spot,
+                                         self._attack_sign(team), self.rules.penalty_behind_m)  # fmt: skip
             else:
                 self._clear_spot(spot, self._attack_sign(team))
-            self._teleport(ball=spot)
+            self.moves.add(self.t, ball=spot)
             self._set(RefereeCommand.PENALTY, team, ready=False)
-            self.penalty = Penalty(team, t, spot)
-            (self.shootout if self.stage == GameStage.PENALTY_SHOOTOUT else self.penalties)[team]["taken"] += 1
+            self.game.penalty = Penalty(team, t, spot)
+            kicks = self.tally.shootout if self.game.stage == GameStage.PENALTY_SHOOTOUT else self.tally.penalties
+            kicks[team]["taken"] += 1
         else:
             placed = kind is RestartKind.PLACED_FREE_KICK
             if not placed:
-                self._teleport(ball=spot)
+                self.moves.add(self.t, ball=spot)
             self._set(kind.command, team)
             self._restart_ball = ball_xy if placed else spot
             self._restart_t = t
@@ -381,9 +260,7 @@ class Referee:
         if self._truth is None:
             return
         clear = self.field.league.robot.radius_m + self.field.league.ball.radius_m + self.rules.placement_clear_m
-        moved = aside(self._truth.robots, spot, clear, attack, self.cards.off)
-        if moved:
-            self._teleport(moved)
+        self.moves.clear_spot(self.t, self._truth.robots, spot, clear, attack, self.cards.off)
 
     def _shootout_teams(self) -> None:
         """The rules: in a shootout one attacker and the keeper per team; the others go off (the
@@ -395,16 +272,6 @@ class Referee:
             for rid in players[1:]:
                 self._send_off((team, rid), True)
 
-    def _shootout_kick_setup(self, team: Team, mark: tuple[float, float]) -> None:
-        """The rules: during a shootout attempt only the kicker and the other team's keeper may move
-        (the others must not interfere; robots may be substituted between attempts). The robot
-        handlers take the kicking team's keeper and the other team's field player off (where robots
-        sent off wait) and put the kicker ``penalty_behind_m`` behind the mark and the keeper on its
-        goal line."""
-        parked = {key: self._park(key) for key in self.robot_keys}
-        self._teleport(shootout_poses(self.field, self.robot_keys, self.cards.off, self.rules.keepers, team, mark,
-                                      self._attack_sign(team), self.rules.penalty_behind_m, parked))  # fmt: skip
-
     def _can_place(self, team: Team) -> bool:
         return self.tally.may_place(team, self.rules.placement_failures_max)
 
@@ -414,10 +281,10 @@ class Referee:
     def _award(self, kind: RestartKind, team: Team, spot: tuple[float, float]) -> None:
         """Stop play; after the restart delay ``kind`` for ``team`` at ``spot`` (in a penalty
         shootout: its next kick, this one over)."""
-        if self.stage == GameStage.PENALTY_SHOOTOUT:
+        if self.game.stage == GameStage.PENALTY_SHOOTOUT:
             self._next_shootout_kick()
             return
-        self._clear_special()
+        self.game.clear_special()
         self._set(RefereeCommand.STOP, None)
         self._restart = Restart(self.t + self.params.restart_delay_s, kind, team, spot)
 
@@ -436,7 +303,8 @@ class Referee:
 
     # --- fouls and cards ------------------------------------------------------------------------
     def _judge(self, truth: GroundTruth) -> None:
-        situation = Situation(self.command, self.for_team, self.game.command_t, self.blue_sign, self.game.in_play())
+        g = self.game
+        situation = Situation(g.command, g.for_team, g.command_t, self.blue_sign, g.in_play())
         for ev in self.watch.judge(truth, situation):
             self._call(ev)
             if ev.team is not None:
@@ -464,50 +332,45 @@ class Referee:
         if off is not None:
             self._send_off((team, off), red)
 
-    def _park(self, key: Key) -> tuple[float, float]:
-        """Where a robot off the field waits: outside the boundary, beyond the cameras' view."""
-        return park(self.field, self.robot_keys.index(key), key[0], self.params.park_distance_m)
-
     def _send_off(self, key: Key, red: bool) -> None:
         self.cards.off[key] = red
-        x, y = self._park(key)
-        self._teleport([(key[0], key[1], x, y, 0.0)])
+        self.moves.send_off(self.t, key)
 
     def _follow_cards(self, dt: float, truth: GroundTruth) -> None:
         """Cards run while the game is not halted; a robot whose card ran out comes back at the
         halfway line, by the touch line, on a free spot."""
-        if self.command == RefereeCommand.HALT:
+        if self.game.command == RefereeCommand.HALT:
             return
         for c in self.cards.run(dt):
             if self.cards.back(c):
                 x, y = entry_spot(self.field, truth.robots, c.team, self.blue_sign)
-                self._teleport([(c.team, c.robot, x, y, 0.0)])
+                self.moves.add(self.t, [(c.team, c.robot, x, y, 0.0)])
                 self._call(GameEvent(self.t, "yellow_card_over", c.team, c.robot))
 
     def _count_robots(self, truth: GroundTruth) -> None:
         """Too many robots: a team with more on the field than it may have; the extra go off (a
         robot sent off that came back first)."""
-        leaving = {(t, rid) for p in self._teleports for t, rid, *_ in p.robots}  # sent off this frame
+        leaving = self.moves.moving()  # sent off this frame
         for team in TEAMS:
             on = [r for r in truth.robots if r.team == team and (team, r.id) not in leaving
                   and self.field.in_field(r.x, r.y, -self.field.dims.boundary_width_m)]  # fmt: skip
-            extra = len(on) - self.max_robots(team)
+            allowed = self.cards.max_robots(team, self.robot_keys)
+            extra = len(on) - allowed
             if extra <= 0:
                 continue
             ids = sorted((r.id for r in on), key=lambda rid: ((team, rid) not in self.cards.off, -rid))[:extra]
-            self._call(GameEvent(self.t, "too_many_robots", team, ids[0], float(len(on)), float(self.max_robots(team)),
+            self._call(GameEvent(self.t, "too_many_robots", team, ids[0], float(len(on)), float(allowed),
                                  "robots"))  # fmt: skip
             self._foul(team, None)
             for rid in ids:  # off (its card's robot back for good, any other until the end)
-                x, y = self._park((team, rid))
-                self._teleport([(team, rid, x, y, 0.0)])
+                self.moves.send_off(self.t, (team, rid))
 
     # --- placement, penalty, stages ----------------------------------------------------------
     def _follow_placement(self, truth: GroundTruth) -> None:
         """A placement succeeds when the ball rests within the tolerance of the designated position
         with the placing team's robots clear of it; it fails when the time is up."""
-        pl = self.placement
-        if pl is None or self.command != RefereeCommand.BALL_PLACEMENT:
+        pl = self.game.placement
+        if pl is None or self.game.command != RefereeCommand.BALL_PLACEMENT:
             return
         r = self.rules
         off, done = placed(truth, pl.team, pl.target, self.field, r)
@@ -520,14 +383,14 @@ class Referee:
             self.tally.failed(pl.team)
             self._call(GameEvent(self.t, "placement_failed", pl.team, None, off, r.placement_tolerance_m, "m",
                                  RefereeCommand.FREE_KICK, other(pl.team)))  # fmt: skip
-            self._teleport(ball=pl.target)  # the referee places it
+            self.moves.add(self.t, ball=pl.target)  # the referee places it
             self._award(RestartKind.PLACED_FREE_KICK, other(pl.team), pl.target)
 
     def _follow_penalty(self, truth: GroundTruth) -> None:
-        pen = self.penalty
-        if pen is None or self.command != RefereeCommand.PENALTY:
+        pen = self.game.penalty
+        if pen is None or self.game.command != RefereeCommand.PENALTY:
             return
-        if not self.ready:
+        if not self.game.ready:
             if self.t - pen.t_start >= self.rules.prepare_timeout_s or penalty_set(
                     truth, pen.team, pen.mark, self._attack_sign(pen.team), self.field, self.rules, self.cards.off):
                 pen.t_run = self.t
@@ -541,8 +404,8 @@ class Referee:
         # over (the rules) after the kicker's time, or once the ball in play moves away from the goal (the
         # keeper turned it back, or the kicker broke the rule that it only ever moves toward the goal); a
         # ball at rest waits for the kicker, who may play it again
-        if took > self.rules.penalty_time_s or (moved and b.vx * attack < -0.05):
-            shootout = self.stage == GameStage.PENALTY_SHOOTOUT
+        if took > self.rules.penalty_time_s or (moved and b.vx * attack < -self.rules.penalty_back_m_s):
+            shootout = self.game.stage == GameStage.PENALTY_SHOOTOUT
             self._call(GameEvent(self.t, "penalty_over", pen.team, None, took, self.rules.penalty_time_s, "s",
                                  None if shootout else RefereeCommand.FREE_KICK,
                                  None if shootout else other(pen.team)))  # fmt: skip
@@ -557,53 +420,53 @@ class Referee:
         team that did not kick off first kicks off."""
         if not self.game.stage_over(self.t):
             return
-        under_way = self._under_way()
+        under_way = self.game.placing()
         if under_way is not None:
-            self.placements[under_way]["cut_short"] += 1
-        stage = stage_after(self.stage, self.rules, drawn=self.score["blue"] == self.score["yellow"])
+            self.tally.placements[under_way]["cut_short"] += 1
+        stage = stage_after(self.game.stage, self.rules, drawn=self.score["blue"] == self.score["yellow"])
         if stage is GameStage.POST_GAME:
             self._end_match()
         else:
             self.game.enter(stage, self.t)
         if stage is GameStage.HALF_TIME:
             self._restart = None
-            self._clear_special()
+            self.game.clear_special()
             self._set(RefereeCommand.HALT, None)
         elif stage is GameStage.SECOND_HALF:
             self.blue_sign = -1 if self.blue_sign > 0 else 1
             self._restart = None
-            self._clear_special()
-            self._teleports.append(self.kickoff_setup("yellow"))
+            self.game.clear_special()
+            self.moves.append(self.kickoff_setup("yellow"))
         elif stage is GameStage.PENALTY_SHOOTOUT:
             self._shootout_teams()
-            self._call(GameEvent(self.t, f"stage_{self.stage}"))
+            self._call(GameEvent(self.t, f"stage_{self.game.stage}"))
             self._next_shootout_kick()
             return
-        self._call(GameEvent(self.t, f"stage_{self.stage}"))
+        self._call(GameEvent(self.t, f"stage_{self.game.stage}"))
 
     def _end_match(self) -> None:
         self.game.enter(GameStage.POST_GAME, self.t)
         self._restart = None
-        self._clear_special()
+        self.game.clear_special()
         self._set(RefereeCommand.HALT, None)
 
     def _next_shootout_kick(self) -> None:
         """The shootout's next kick after the restart delay: the teams in turn (yellow first: blue kicked
         off the match), ``shootout_kicks`` each, then (a drawn match's shootout) one each until one
         team scored more of an equal number; then the game is over."""
-        self._clear_special()
+        self.game.clear_special()
         self._set(RefereeCommand.STOP, None)
-        team = shootout_kicker(self.shootout, self.rules)
+        team = shootout_kicker(self.tally.shootout, self.rules)
         if team is None:
             self._end_match()
-            self._call(GameEvent(self.t, f"stage_{self.stage}"))
+            self._call(GameEvent(self.t, f"stage_{self.game.stage}"))
             return
         self._restart = Restart(self.t + self.params.restart_delay_s, RestartKind.PENALTY, team, self._mark(team))
 
     def _check_keeper_held_ball(self, t: float, ball_xy: tuple[float, float]) -> None:
         """Rules (keeper held ball): the ball in a defense area for ``keeper_held_ball_s`` of normal
         play gives the other team a free kick at the nearest legal spot."""
-        side = self._held.held(t, ball_xy, self.command.running and self._restart is None)
+        side = self._held.held(t, ball_xy, self.game.command.running and self._restart is None)
         if side:
             bx, by = ball_xy
             self.keeper_held_ball += 1
@@ -621,69 +484,33 @@ class Referee:
         """Rules (no progress in game): the ball within ``no_progress_m`` of one place for
         ``no_progress_s`` while both teams may play it (two robots stuck at it, neither getting it
         away): a stop, then a force start where it lies."""
-        if self._no_progress.stuck(t, ball_xy, self.full and self.command.running and self._restart is None):
+        if self._no_progress.stuck(t, ball_xy, self.full and self.game.command.running and self._restart is None):
             self._call(GameEvent(t, "no_progress", None, None, self.params.no_progress_s, self.params.no_progress_s,
                                  "s", RefereeCommand.FORCE_START))  # fmt: skip
             self._set(RefereeCommand.STOP, None)
             self._restart = Restart(t + self.params.restart_delay_s, RestartKind.FORCE_START, None, ball_xy)
 
     # --- out --------------------------------------------------------------------------------
-    def _action_left(self) -> float:
-        t, r = self.t, self.rules
-        if self.command == RefereeCommand.BALL_PLACEMENT and self.placement is not None:
-            return r.placement_time_s - (t - self.placement.t_start)
-        if self.command.kick_restart:
-            return self.params.restart_timeout_s - (t - self._restart_t)
-        if self.command == RefereeCommand.PENALTY and self.penalty is not None:
-            if self.penalty.t_run is None:
-                return r.prepare_timeout_s - (t - self.penalty.t_start)
-            return r.penalty_time_s - (t - self.penalty.t_run)
-        return math.inf
-
     def _next(self) -> tuple[RefereeCommand | None, Team | None]:
         if self._restart is None:
             return None, None
         team = self._restart.team
         return self._restart.next_command(self.full and team is not None and self._can_place(team))
 
-    def team_info(self, team: Team) -> TeamInfo:
-        r = self.rules
-        return TeamInfo(
-            red_cards=self.red_cards[team], yellow_cards=self.yellow_cards[team],
-            yellow_card_times_s=self.cards.times_left(team),
-            fouls=self.fouls[team], goalkeeper=r.keepers.get(team, 0), timeouts=r.timeouts,
-            timeout_time_s=r.timeout_total_s, placement_failures=self.placement_failures[team],
-            can_place_ball=self.full and self._can_place(team), max_robots=self.max_robots(team),
-        )  # fmt: skip
-
     def state(self) -> GameState:
-        placement = self._restart.spot if self._restart is not None else self._restart_ball
-        if self.placement is not None:
-            placement = self.placement.target
-        elif self.penalty is not None:
-            placement = self.penalty.mark
-        nxt, nxt_team = self._next()
-        return GameState(
-            t=self.t, command=self.command, for_team=self.for_team, score_blue=self.score["blue"],
-            score_yellow=self.score["yellow"], blue_defends_negative_x=self.blue_sign < 0,
-            placement=placement, ready=self.ready, stage=self.stage,
-            stage_time_left_s=self.game.stage_end - self.t, command_counter=self.game.counter,
-            command_t=self.game.command_t, action_time_left_s=self._action_left(), next_command=nxt,
-            next_for_team=nxt_team, blue_team=self.team_info("blue"), yellow_team=self.team_info("yellow"),
-        )  # fmt: skip
-
-    def _under_way(self) -> Team | None:
-        """The team whose placement is under way (a match that ends now cuts it short)."""
-        pl = self.placement
-        return pl.team if pl is not None and self.command == RefereeCommand.BALL_PLACEMENT else None
+        """The game state now, as the league's game controller sends it."""
+        spot = self._restart.spot if self._restart is not None else self._restart_ball
+        kick_left_s = self.params.restart_timeout_s - (self.t - self._restart_t)
+        teams = {team: team_info(team, self.cards, self.tally, self.robot_keys, self.full) for team in TEAMS}
+        return self.game.state(self.t, self.score, self.blue_sign, spot, kick_left_s, self._next(), teams)
 
     def summary(self) -> dict[str, object]:
         """The rules' figures of the match: fouls per team by kind, cards, placements, penalties."""
         by_kind = self.calls.by_kind(set(FOUL_RESTARTS))
         return {
             "rules": self.params.rules if self.params.enabled else "off",
-            "game_stage": self.stage,
-            "fouls": {t: {"total": self.fouls[t], **by_kind[t]} for t in TEAMS},
-            "cards": {t: {"yellow": self.yellow_cards[t], "red": self.red_cards[t]} for t in TEAMS},
-            **self.tally.figures(self._under_way()),
+            "game_stage": self.game.stage,
+            "fouls": {t: {"total": self.cards.fouls[t], **by_kind[t]} for t in TEAMS},
+            "cards": {t: {"yellow": self.cards.yellow[t], "red": self.cards.red[t]} for t in TEAMS},
+            **self.tally.figures(self.game.placing()),
         }

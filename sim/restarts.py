@@ -4,7 +4,9 @@ A :class:`Restart` is what the referee has decided while play is stopped (a kick
 free kick after the ball left the field or a foul, a penalty, a force start after no progress), due
 after the restart delay. The functions here answer the rules' geometric questions (which team defends
 the half the ball is in, where the penalty mark is, whether a kick is taken) in the field frame,
-metres; ``blue_sign`` is -1 while blue defends the goal at -x.
+metres; ``blue_sign`` is -1 while blue defends the goal at -x. :class:`Moves` gathers what the referee
+wants placed in one frame (the ball, robots into formation, off the field, aside, for a shootout kick)
+into the :class:`~cmdragons.messages.Teleport` the simulator carries out.
 """
 
 from __future__ import annotations
@@ -13,11 +15,13 @@ import enum
 import math
 from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
+from typing import Literal
 
-from cmdragons.geometry import Field, Team
-from cmdragons.messages import RefereeCommand, RobotTruth
+from cmdragons.geometry import TEAMS, Field, Team
+from cmdragons.messages import RefereeCommand, RobotTruth, Teleport
 
 __all__ = [
+    "Moves",
     "Restart",
     "RestartKind",
     "aside",
@@ -191,3 +195,84 @@ def shootout_poses(pitch: Field, keys: Sequence[Key], off: Collection[Key], keep
             (x, y), theta = parked[key], 0.0
         moves.append((key[0], key[1], x, y, theta))
     return moves
+
+
+class Moves:
+    """What the referee wants placed this frame, gathered into one teleport, and where it puts the
+    match's robots (``keys``): its kickoff ``formations`` (per division, the poses of the team
+    defending the goal at -x), off the field ``park_distance_m`` outside the boundary, aside from a
+    ball put down, for a shootout kick."""
+
+    def __init__(self, pitch: Field, keys: Sequence[Key], formations: Mapping[Literal["A", "B"], Sequence[Pose]],
+                 park_distance_m: float) -> None:  # fmt: skip
+        self.field = pitch
+        self.keys = list(keys)
+        self.formations = formations
+        self.park_distance_m = park_distance_m
+        self.pending: list[Teleport] = []
+
+    def add(self, t: float, robots: Sequence[Move] = (), ball: tuple[float, float] | None = None) -> None:
+        self.pending.append(Teleport(t, tuple(robots), ball))
+
+    def append(self, teleport: Teleport) -> None:
+        self.pending.append(teleport)
+
+    def moving(self) -> set[Key]:
+        """The robots placed this frame so far."""
+        return {(team, rid) for p in self.pending for team, rid, *_ in p.robots}
+
+    def take(self, t: float) -> Teleport | None:
+        """This frame's teleports as one at ``t`` (robots in order, the last ball), or None."""
+        if not self.pending:
+            return None
+        parts, self.pending = self.pending, []
+        if len(parts) == 1:
+            return parts[0]
+        ball = next((p.ball for p in reversed(parts) if p.ball is not None), None)
+        return Teleport(t, tuple(r for p in parts for r in p.robots), ball)
+
+    def formation(self, team: Team, blue_sign: int) -> list[Pose]:
+        """Kickoff poses of ``team``'s robots in the field frame."""
+        division = self.field.league.division
+        poses = self.formations.get(division, ())
+        n = sum(1 for t, _ in self.keys if t == team)
+        if len(poses) < n:
+            raise ValueError(
+                f"sim.referee.formations.{division} lists {len(poses)} poses but the team has {n} robots"
+            )
+        return formation(poses, n, blue_sign if team == "blue" else -blue_sign)
+
+    def kickoff(self, t: float, blue_sign: int, off: Collection[Key]) -> Teleport:
+        """Both teams in formation (the robots ``off`` the field stay off), the ball on the centre spot."""
+        robots = []
+        for team in TEAMS:
+            ids = [rid for t_, rid in self.keys if t_ == team]
+            poses = self.formation(team, blue_sign)
+            robots += [(team, rid, x, y, th) for rid, (x, y, th) in zip(ids, poses, strict=False)
+                       if (team, rid) not in off]  # fmt: skip
+        return Teleport(t, tuple(robots), (0.0, 0.0))
+
+    def park(self, key: Key) -> tuple[float, float]:
+        """Where a robot off the field waits: outside the boundary, beyond the cameras' view."""
+        return park(self.field, self.keys.index(key), key[0], self.park_distance_m)
+
+    def send_off(self, t: float, key: Key) -> None:
+        x, y = self.park(key)
+        self.add(t, [(key[0], key[1], x, y, 0.0)])
+
+    def clear_spot(self, t: float, robots: Sequence[RobotTruth], spot: tuple[float, float], clear_m: float,
+                   attack: float, off: Collection[Key]) -> None:  # fmt: skip
+        """The ``robots`` nearer ``spot`` than ``clear_m`` moved aside first (:func:`aside`)."""
+        moved = aside(robots, spot, clear_m, attack, off)
+        if moved:
+            self.add(t, moved)
+
+    def shootout_kick(self, t: float, off: Collection[Key], keepers: Mapping[Team, int], team: Team,
+                      mark: tuple[float, float], attack: float, behind_m: float) -> None:  # fmt: skip
+        """The rules: during a shootout attempt only the kicker and the other team's keeper may move
+        (the others must not interfere; robots may be substituted between attempts). The robot
+        handlers take the kicking team's keeper and the other team's field player off (where robots
+        sent off wait) and put the kicker ``behind_m`` behind ``mark`` and the keeper on its goal line
+        (:func:`shootout_poses`)."""
+        parked = {key: self.park(key) for key in self.keys}
+        self.add(t, shootout_poses(self.field, self.keys, off, keepers, team, mark, attack, behind_m, parked))

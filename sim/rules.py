@@ -63,6 +63,7 @@ class RulesParams(Validated):
     penalty_mark_from_goal_m: float = setting(6.0, lo=0.5, hi=20.0)
     penalty_behind_m: float = setting(1.0, lo=0.0, hi=10.0)
     penalty_time_s: float = setting(10.0, lo=0.5, hi=600.0)
+    penalty_back_m_s: float = setting(0.05, lo=0.0, hi=5.0)
     shootout_kicks: int = setting(0, lo=0, hi=100)  # penalty shootout after a drawn match: kicks per team; 0: none
     shootout_always: bool = False  # the shootout after any match (a benchmark's), its kicks only
     touch_margin_m: float = setting(0.015, lo=0.0, hi=0.2)

@@ -366,8 +366,8 @@ class RefereeStage(BaseStage):
             return
         ev: SimEvents = message
         teleport = self.referee.observe(ev.t, ev.events, ev.ball_xy, self._truth)
-        if self.referee.new_events:
-            publish("referee/events", GameEvents(ev.t, tuple(self.referee.new_events)))
+        if self.referee.calls.new:
+            publish("referee/events", GameEvents(ev.t, tuple(self.referee.calls.new)))
         if teleport is not None:
             publish("teleport", teleport)
         publish("referee", self.referee.state())

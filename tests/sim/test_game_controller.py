@@ -1,5 +1,6 @@
 """The game controller's state machine alone: commands and their counter, which commands have the
-ball in play, the stages in order with their lengths, the shootout's kickers, fouls into cards."""
+ball in play, the stages in order with their lengths, the shootout's kickers, fouls into cards, the
+game state and team info it tells."""
 
 from __future__ import annotations
 
@@ -7,9 +8,19 @@ import math
 
 import pytest
 
-from cmdragons.geometry import Team
-from cmdragons.messages import GameStage, RefereeCommand
-from sim.game_controller import Card, Cards, GameController, Tally, shootout_kicker, stage_after
+from cmdragons.geometry import TEAMS, Team
+from cmdragons.messages import GameStage, GameState, RefereeCommand
+from sim.game_controller import (
+    Card,
+    Cards,
+    GameController,
+    Penalty,
+    Placement,
+    Tally,
+    shootout_kicker,
+    stage_after,
+    team_info,
+)
 from sim.rules import RulesParams
 
 C, S = RefereeCommand, GameStage
@@ -129,3 +140,53 @@ def test_the_tally_counts_placements_and_cuts_short_the_one_under_way() -> None:
                                      "yellow": {"tried": 1, "succeeded": 0, "cut_short": 1, "median_s": None}}
     assert tally.figures(under_way=None)["placements"]["yellow"]["cut_short"] == 0  # type: ignore[index]
     assert figures["penalties"] == figures["shootout"] == {t: {"taken": 0, "scored": 0} for t in ("blue", "yellow")}
+
+
+def test_the_game_state_names_the_designated_position_and_the_time_left_of_the_action_under_way() -> None:
+    r = RulesParams()
+    gc = GameController(r, halves=True)
+    teams = {t: team_info(t, Cards(r), Tally(), [(t, 0)], full=True) for t in TEAMS}
+
+    def state(t: float, spot: tuple[float, float] | None = (0.5, 0.5)) -> GameState:
+        return gc.state(t, {"blue": 2, "yellow": 1}, -1, spot, 7.5, (C.FREE_KICK, "blue"), teams)
+
+    gc.give(1.0, C.BALL_PLACEMENT, "blue")
+    gc.placement = Placement("blue", (1.0, 2.0), 1.0)
+    g = state(4.0)
+    assert g.placement == (1.0, 2.0) and g.action_time_left_s == pytest.approx(r.placement_time_s - 3.0)
+    assert (g.score_blue, g.score_yellow, g.blue_defends_negative_x) == (2, 1, True)
+    assert (g.next_command, g.next_for_team, g.stage_time_left_s) == (C.FREE_KICK, "blue", r.half_s - 4.0)
+    assert gc.placing() == "blue"
+    gc.clear_special()
+    gc.give(10.0, C.PENALTY, "yellow", ready=False)
+    gc.penalty = Penalty("yellow", 10.0, (3.0, 0.0))
+    g = state(12.0)
+    assert g.placement == (3.0, 0.0) and g.action_time_left_s == pytest.approx(r.prepare_timeout_s - 2.0)
+    gc.penalty.t_run = 13.0
+    assert state(15.0).action_time_left_s == pytest.approx(r.penalty_time_s - 2.0)
+    assert gc.placing() is None
+    gc.clear_special()
+    gc.give(20.0, C.FREE_KICK, "blue")
+    assert state(21.0).action_time_left_s == 7.5  # a kick restart's time is the referee's
+    gc.give(22.0, C.STOP, None)
+    g = state(23.0, None)
+    assert g.placement is None and math.isinf(g.action_time_left_s)
+
+
+def test_team_info_counts_cards_robots_off_and_whether_the_team_still_places_the_ball() -> None:
+    r = RulesParams(placement_failures_max=2)
+    keys: list[tuple[Team, int]] = [("blue", 0), ("blue", 1), ("blue", 2), ("yellow", 0)]
+    cards, tally = Cards(r), Tally()
+    cards.book("blue", 2, red=False)
+    cards.off[("blue", 2)] = False
+    cards.book("blue", 1, red=True)
+    cards.off[("blue", 1)] = True
+    cards.foul("blue")
+    tally.failed("blue")
+    info = team_info("blue", cards, tally, keys, full=True)
+    assert (info.yellow_cards, info.red_cards, info.fouls, info.max_robots) == (1, 1, 1, 1)
+    assert info.yellow_card_times_s == (r.yellow_card_s,) and info.placement_failures == 1 and info.can_place_ball
+    tally.failed("blue")
+    assert not team_info("blue", cards, tally, keys, full=True).can_place_ball  # failed too often
+    assert not team_info("yellow", cards, tally, keys, full=False).can_place_ball  # basic rules: the referee places
+    assert team_info("yellow", cards, tally, keys, full=True).max_robots == 1

@@ -1,5 +1,6 @@
 """Restarts alone: the command each kind leads to, the placement before a free kick, the calls'
-restarts, which team defends a half, the penalty mark and when a kick is taken (field frame, m)."""
+restarts, which team defends a half, the penalty mark and when a kick is taken, where the robots go
+and one frame's moves gathered into a teleport (field frame, m)."""
 
 from __future__ import annotations
 
@@ -8,8 +9,9 @@ import math
 import pytest
 
 from cmdragons.geometry import Field, LeagueParams, Team
-from cmdragons.messages import RefereeCommand, RobotTruth
+from cmdragons.messages import RefereeCommand, RobotTruth, Teleport
 from sim.restarts import (
+    Moves,
     Restart,
     RestartKind,
     aside,
@@ -147,3 +149,32 @@ def test_a_shootout_kick_puts_the_kicker_behind_the_mark_and_the_other_keeper_on
         ("yellow", 0, 2.0, 9.0, 0.0),  # off: the kicking team's keeper
         ("yellow", 1, pytest.approx(mark[0] + 1.0), 0.0, math.pi),  # the kicker, facing -x
     ]
+
+
+def test_a_frames_moves_are_one_teleport_robots_in_order_the_last_ball() -> None:
+    keys: list[tuple[Team, int]] = [("blue", 0), ("blue", 1), ("yellow", 0)]
+    moves = Moves(FIELD, keys, {"B": ((-4.0, 0.0, 0.0), (-2.0, 1.0, 0.0))}, 3.0)
+    assert moves.take(1.0) is None
+    moves.add(1.0, ball=(1.0, 1.0))
+    only = moves.pending[0]
+    assert moves.take(1.0) is only  # one part: itself
+    moves.send_off(2.0, ("blue", 1))
+    moves.add(2.0, [("yellow", 0, 0.5, 0.5, 0.0)], ball=(2.0, 0.0))
+    moves.add(2.0, ball=(3.0, 0.0))
+    moves.add(2.0, [("blue", 0, -1.0, 0.0, 0.0)])
+    assert moves.moving() == {("blue", 1), ("yellow", 0), ("blue", 0)}
+    px, py = park(FIELD, 1, "blue", 3.0)
+    assert moves.take(2.5) == Teleport(2.5, (("blue", 1, px, py, 0.0), ("yellow", 0, 0.5, 0.5, 0.0),
+                                             ("blue", 0, -1.0, 0.0, 0.0)), (3.0, 0.0))  # fmt: skip
+    assert moves.take(3.0) is None and moves.moving() == set()
+
+
+def test_the_kickoff_puts_both_teams_in_formation_and_leaves_robots_off_the_field_off() -> None:
+    keys: list[tuple[Team, int]] = [("blue", 0), ("blue", 1), ("yellow", 3), ("yellow", 4)]
+    poses = ((-4.0, 0.0, 0.0), (-2.0, 1.0, 0.0))
+    kickoff = Moves(FIELD, keys, {"B": poses}, 3.0).kickoff(1.0, -1, off={("yellow", 4)})
+    mirrored = formation(poses, 1, 1)[0]
+    assert kickoff.ball == (0.0, 0.0) and kickoff.robots == (("blue", 0, *poses[0]), ("blue", 1, *poses[1]),
+                                                             ("yellow", 3, *mirrored))  # fmt: skip
+    with pytest.raises(ValueError, match=r"sim.referee.formations.B lists 1 poses but the team has 2"):
+        Moves(FIELD, keys, {"B": poses[:1]}, 3.0).kickoff(1.0, -1, off=())

@@ -11,7 +11,8 @@ import pytest
 
 from cmdragons.geometry import Field, LeagueParams, Team
 from cmdragons.messages import BallTruth, GameEvent, GameStage, GroundTruth, RefereeCommand, RobotCommand, RobotTruth
-from sim.referee import Referee, RefereeParams
+from sim.referee import Referee
+from sim.referee_params import RefereeParams
 from sim.rules import FoulWatch, HeldBall, NoProgress, RulesParams, Situation, penalty_set, placed
 from sim.world import BallParams, DribblerParams, KickerParams, PhysicsParams, RobotParams, World
 
@@ -40,7 +41,7 @@ def play(w: World, ref: Referee, seconds: float, commands: Commands | None = Non
     for k in range(round(seconds * 60)):
         events = w.step_frame(commands(k) if commands else [])
         teleport = ref.observe(w.t, events, tuple(w.ball_body.position), w.ground_truth())
-        calls += ref.new_events
+        calls += ref.calls.new
         if teleport is not None:
             w.apply(teleport)
     return calls
@@ -66,7 +67,7 @@ def test_crash_faster_than_the_limit_is_the_faster_robots_foul(speed: float, cal
         c = crashes[0]
         assert (c.team, c.robot, c.restart, c.for_team) == ("blue", 0, RefereeCommand.FREE_KICK, "yellow")
         assert c.value > 1.5 and c.limit == 1.5
-        assert ref.command == RefereeCommand.STOP  # then the free kick (placed by yellow)
+        assert ref.game.command == RefereeCommand.STOP  # then the free kick (placed by yellow)
 
 
 @pytest.mark.parametrize(("blue_v", "yellow_v", "called"), [
@@ -157,7 +158,8 @@ def test_defender_in_its_own_defense_area_at_the_ball_gives_a_penalty(rid: int, 
     assert bool(fouls) == called
     if called:
         assert (fouls[0].restart, fouls[0].for_team) == (RefereeCommand.PENALTY, "yellow")
-        assert ref.command == RefereeCommand.PENALTY and ref.for_team == "yellow" and not ref.ready  # the restart came
+        g = ref.game
+        assert g.command == RefereeCommand.PENALTY and g.for_team == "yellow" and not g.ready  # the restart came
         assert tuple(w.ball_body.position) == pytest.approx((-4.5 + 6.0, 0.0))  # on the mark, 6 m out
 
 
@@ -190,7 +192,7 @@ def test_robot_too_fast_in_a_stop(speed: float, called: bool) -> None:
     if called:
         assert fouls[0].t >= 2.0  # after the rules' time to slow down
         assert fouls[0].value == pytest.approx(2.0, abs=0.1) and fouls[0].restart is None
-        assert ref.command == RefereeCommand.STOP  # counted, play stays stopped
+        assert ref.game.command == RefereeCommand.STOP  # counted, play stays stopped
 
 
 @pytest.mark.parametrize(("gap", "called"), [(0.3, True), (0.8, False)])
@@ -252,7 +254,7 @@ def test_every_third_foul_is_a_yellow_card_that_sends_a_robot_off_for_its_time()
     # three robots too fast in the stop: three fouls, a card; a robot but the keeper goes off
     calls = play(w, ref, 2.5, lambda k: [RobotCommand("blue", i, vy=2.0) for i in (0, 1, 2)])
     cards = [c for c in calls if c.kind == "yellow_card"]
-    assert ref.fouls["blue"] == 3 and len(cards) == 1 and cards[0].team == "blue"
+    assert ref.cards.fouls["blue"] == 3 and len(cards) == 1 and cards[0].team == "blue"
     off = cards[0].robot
     assert off is not None and off != 0  # never the keeper
     x, y = tuple(w.robots[w.robot_keys().index(("blue", off))].body.position)
@@ -282,7 +284,7 @@ def test_the_third_card_running_at_once_is_red() -> None:
     w, ref = scene(blue=4, yellow=1)
     for _ in range(3):
         ref.card("blue")
-    assert ref.yellow_cards["blue"] == 2 and ref.red_cards["blue"] == 1
+    assert ref.cards.yellow["blue"] == 2 and ref.cards.red["blue"] == 1
     assert ref.state().blue_team.max_robots == 1
 
 
@@ -307,13 +309,13 @@ def test_ball_placement_succeeds_in_tolerance_and_fails_when_time_is_up(carry: b
     if succeeded:
         done = [c for c in calls if c.kind == "placement_succeeded"]
         assert done and done[0].team == "blue" and done[0].value <= 8.0
-        assert ref.placements["blue"] == {"tried": 1, "succeeded": 1, "cut_short": 0}
+        assert ref.tally.placements["blue"] == {"tried": 1, "succeeded": 1, "cut_short": 0}
     else:
         failed = [c for c in calls if c.kind == "placement_failed"]
         assert failed and failed[0].for_team == "yellow"
         assert tuple(w.ball_body.position) == pytest.approx(target)  # the referee placed it
-        assert ref.placement_failures["blue"] == 1
-        assert ref.placements["blue"] == {"tried": 1, "succeeded": 0, "cut_short": 0}
+        assert ref.tally.placement_failures["blue"] == 1
+        assert ref.tally.placements["blue"] == {"tried": 1, "succeeded": 0, "cut_short": 0}
 
 
 def test_a_placement_the_end_of_a_half_cuts_short_is_neither_tried_nor_failed() -> None:
@@ -321,8 +323,8 @@ def test_a_placement_the_end_of_a_half_cuts_short_is_neither_tried_nor_failed() 
     ref.start_placement("blue", (1.0, 0.0))  # nobody carries the ball: the half ends first
     calls = play(w, ref, 3.5)
     assert "stage_second_half" in kinds(calls) and not [k for k in kinds(calls) if k.startswith("placement_")]
-    assert ref.placements["blue"] == {"tried": 0, "succeeded": 0, "cut_short": 1}
-    assert ref.placement_failures["blue"] == 0
+    assert ref.tally.placements["blue"] == {"tried": 0, "succeeded": 0, "cut_short": 1}
+    assert ref.tally.placement_failures["blue"] == 0
     ref.start_placement("blue", (1.0, 0.0))  # and one the match's end finds under way
     placed = ref.summary()["placements"]
     assert isinstance(placed, dict) and placed["blue"]["cut_short"] == 2 and placed["blue"]["tried"] == 0
@@ -347,8 +349,8 @@ def test_a_penalty_shootout_alternates_its_kicks_and_ends_the_game() -> None:
     def commands(k: int) -> list[RobotCommand]:
         # yellow's first kick: the ball sent into the goal past the still keeper at the normal start
         # (nobody moves otherwise; the mark lies in the kicking team's own half)
-        pen = ref.penalty
-        if pen is not None and ref.ready and pen.team == "yellow" and not scored["n"]:
+        pen = ref.game.penalty
+        if pen is not None and ref.game.ready and pen.team == "yellow" and not scored["n"]:
             w.place_ball(pen.mark[0], pen.mark[1], vx=-6.0 * math.copysign(1.0, pen.mark[0]), vy=0.35)
             scored["n"] = 1
         if pen is not None and (not takers or takers[-1][1] != pen.t_start):
@@ -358,9 +360,9 @@ def test_a_penalty_shootout_alternates_its_kicks_and_ends_the_game() -> None:
     calls = play(w, ref, 2.0 + 4 * (1.0 + 0.5 + 3.0) + 2.0, commands)
     assert "stage_penalty_shootout" in kinds(calls) and kinds(calls)[-1] == "stage_post_game"
     assert [t for t, _ in takers] == ["yellow", "blue", "yellow", "blue"]  # type: ignore[misc]
-    assert ref.shootout == {"blue": {"taken": 2, "scored": 0}, "yellow": {"taken": 2, "scored": 1}}
+    assert ref.tally.shootout == {"blue": {"taken": 2, "scored": 0}, "yellow": {"taken": 2, "scored": 1}}
     assert ref.score == {"blue": 0, "yellow": 0}  # the match's score stays
-    assert ref.command == RefereeCommand.HALT and ref.stage == GameStage.POST_GAME
+    assert ref.game.command == RefereeCommand.HALT and ref.game.stage == GameStage.POST_GAME
 
 
 def test_no_shootout_after_a_match_decided_or_unconfigured() -> None:
@@ -369,7 +371,7 @@ def test_no_shootout_after_a_match_decided_or_unconfigured() -> None:
         if figures["shootout_kicks"]:
             ref.score["blue"] = 1  # decided: no shootout even when configured
         calls = play(w, ref, 2.5)
-        assert "stage_penalty_shootout" not in kinds(calls) and ref.stage == GameStage.POST_GAME
+        assert "stage_penalty_shootout" not in kinds(calls) and ref.game.stage == GameStage.POST_GAME
 
 
 def test_a_penalty_waits_for_a_ball_at_rest_and_ends_when_the_ball_turns_back() -> None:
@@ -377,15 +379,26 @@ def test_a_penalty_waits_for_a_ball_at_rest_and_ends_when_the_ball_turns_back() 
     # toward the goal; a keeper turning it back ends the kick
     w, ref = scene(prepare_timeout_s=0.5, penalty_time_s=5.0)
     w.apply(ref.start_penalty("blue"))
-    mark = ref.penalty.mark if ref.penalty else (0.0, 0.0)
+    mark = ref.game.penalty.mark if ref.game.penalty else (0.0, 0.0)
     calls = play(w, ref, 1.0)
-    assert ref.ready
+    assert ref.game.ready
     w.place_ball(mark[0] + 0.5, mark[1])  # played forward, now at rest: still the kicker's
     calls += play(w, ref, 1.0)
-    assert ref.command == RefereeCommand.PENALTY and "penalty_over" not in kinds(calls)
+    assert ref.game.command == RefereeCommand.PENALTY and "penalty_over" not in kinds(calls)
     w.place_ball(mark[0] + 0.5, mark[1], vx=-1.0)  # turned back toward the kicker's half
     calls += play(w, ref, 0.2)
     assert "penalty_over" in kinds(calls)
+
+
+def test_a_penalty_ball_rolling_back_slower_than_the_rules_speed_leaves_the_kick_on() -> None:
+    w, ref = scene(prepare_timeout_s=0.5, penalty_time_s=5.0, penalty_back_m_s=1.5)
+    w.apply(ref.start_penalty("blue"))
+    assert ref.game.penalty is not None
+    mark = ref.game.penalty.mark
+    play(w, ref, 1.0)
+    w.place_ball(mark[0] + 0.5, mark[1], vx=-1.0)  # back toward the kicker's half, slower than 1.5 m/s
+    calls = play(w, ref, 0.2)
+    assert ref.game.command == RefereeCommand.PENALTY and "penalty_over" not in kinds(calls)
 
 
 def test_the_ball_is_not_put_into_a_robot_on_the_penalty_mark() -> None:
@@ -409,7 +422,7 @@ def test_a_shootout_kick_has_only_the_kicker_and_the_other_keeper_on_the_field()
     seen = []
 
     def look(k: int) -> list[RobotCommand]:
-        pen = ref.penalty
+        pen = ref.game.penalty
         if pen is not None and (not seen or seen[-1][0] != pen.team):
             truth = w.ground_truth()
             on = sorted((r.team, r.id) for r in truth.robots if w.field.in_field(r.x, r.y))
@@ -422,7 +435,7 @@ def test_a_shootout_kick_has_only_the_kicker_and_the_other_keeper_on_the_field()
     assert seen[1][1] == [("blue", 1), ("yellow", 0)]
     for _, _, ball, mark in seen:
         assert math.hypot(ball[0] - mark[0], ball[1] - mark[1]) < 0.01
-    assert ref.stage == GameStage.POST_GAME
+    assert ref.game.stage == GameStage.POST_GAME
 
 
 @pytest.mark.parametrize(("roll", "called"), [(0.0, True), (0.4, False)])
@@ -436,12 +449,12 @@ def test_no_progress_in_game_stops_play_and_force_starts_it(roll: float, called:
     assert bool(stuck) == called
     if called:
         assert stuck[0].t == pytest.approx(RefereeParams().no_progress_s, abs=0.05) and stuck[0].team is None
-        assert ref.command == RefereeCommand.STOP
+        assert ref.game.command == RefereeCommand.STOP
         play(w, ref, RefereeParams().restart_delay_s + 0.1)
-        assert ref.command == RefereeCommand.FORCE_START
+        assert ref.game.command == RefereeCommand.FORCE_START
         assert math.dist(tuple(w.ball_body.position), (0.0, 1.5)) < RefereeParams().no_progress_m  # not moved
     else:
-        assert ref.command == RefereeCommand.NORMAL
+        assert ref.game.command == RefereeCommand.NORMAL
 
 
 def test_the_ball_held_in_a_defense_area_is_called_after_the_limit_of_watched_play() -> None:

@@ -10,7 +10,8 @@ import pytest
 
 from cmdragons.geometry import LeagueParams
 from cmdragons.messages import RefereeCommand, RobotCommand
-from sim.referee import Referee, RefereeParams
+from sim.referee import Referee
+from sim.referee_params import RefereeParams
 from sim.world import (
     BallOut,
     BallParams,
@@ -204,7 +205,7 @@ def test_goal_counted_and_kickoff_restart() -> None:
     assert ref.score == {"blue": 1, "yellow": 0}
     # after the restart delay: ball on the centre spot, yellow kicks off
     assert tuple(w.ball_body.position) == pytest.approx((0.0, 0.0))
-    assert ref.command == RefereeCommand.KICKOFF and ref.for_team == "yellow"
+    assert ref.game.command == RefereeCommand.KICKOFF and ref.game.for_team == "yellow"
 
 
 def test_ball_out_gives_a_free_kick_at_a_legal_spot() -> None:
@@ -221,7 +222,7 @@ def test_ball_out_gives_a_free_kick_at_a_legal_spot() -> None:
     assert len(outs) == 1 and outs[0].last_touch == "yellow"
     x, y = w.ball_body.position
     assert (x, y) == pytest.approx((1.0, 3.0 - 0.2), abs=1e-6)
-    assert ref.command == RefereeCommand.FREE_KICK and ref.for_team == "blue"
+    assert ref.game.command == RefereeCommand.FREE_KICK and ref.game.for_team == "blue"
 
 
 def test_ball_held_in_a_defense_area_gives_the_other_team_a_free_kick() -> None:
@@ -231,11 +232,11 @@ def test_ball_held_in_a_defense_area_gives_the_other_team_a_free_kick() -> None:
     w.place_ball(4.2, 0.3)  # at rest in the defense area at +x: yellow defends it
     for _ in range(round(1.9 * 60)):
         judge(ref, w, w.step_frame())
-    assert ref.command == RefereeCommand.NORMAL  # not yet
+    assert ref.game.command == RefereeCommand.NORMAL  # not yet
     for _ in range(round(0.7 * 60)):
         judge(ref, w, w.step_frame())
     assert ref.keeper_held_ball == 1
-    assert ref.command == RefereeCommand.FREE_KICK and ref.for_team == "blue"
+    assert ref.game.command == RefereeCommand.FREE_KICK and ref.game.for_team == "blue"
     x, y = w.ball_body.position
     assert w.field.in_defense_area(x, y, margin=0.2 - 1e-6) == 0  # placed outside the area, at the rules' distance
     assert math.hypot(x - 4.2, y - 0.3) < 1.0

@@ -55,7 +55,7 @@ def play(w: World, ref: Referee, brain: Brain, seconds: float,
         commands += opponent(w, ref, world) if opponent else []
         events = w.step_frame(commands)
         teleport = ref.observe(w.t, events, tuple(w.ball_body.position), w.ground_truth())
-        calls += ref.new_events
+        calls += ref.calls.new
         if teleport is not None:
             w.apply(teleport)
         if each is not None:
@@ -204,7 +204,7 @@ def test_penalty_scores_against_a_still_keeper() -> None:
     calls = play(w, ref, brain, RULES.prepare_timeout_s + RULES.penalty_time_s,
                  until=lambda c: ref.score["blue"] > 0 or any(e.kind == "penalty_over" for e in c))  # fmt: skip
     assert ref.score == {"blue": 1, "yellow": 0}, [e.kind for e in calls]
-    assert ref.penalties["blue"] == {"taken": 1, "scored": 1}
+    assert ref.tally.penalties["blue"] == {"taken": 1, "scored": 1}
 
 
 def test_our_keeper_stops_a_penalty_kicked_at_its_body() -> None:
@@ -215,7 +215,7 @@ def test_our_keeper_stops_a_penalty_kicked_at_its_body() -> None:
 
     def kicker(k: int) -> list[RobotCommand]:
         # prepared: wait; started: drive through the ball at the goal's centre, where our keeper stands
-        if not ref.ready:
+        if not ref.game.ready:
             return [RobotCommand("yellow", 0)]
         return [RobotCommand("yellow", 0, vx=-0.8, kick_speed=4.0)]
 
@@ -240,7 +240,7 @@ def test_our_penalty_beats_the_simple_opponents_keeper(keeper_y: float) -> None:
     w.apply(ref.start_penalty("blue"))
     calls = play(w, ref, brain, RULES.prepare_timeout_s + RULES.penalty_time_s, opponent=simple_opponent(),
                  until=lambda c: ref.score["blue"] > 0 or any(e.kind == "penalty_over" for e in c))  # fmt: skip
-    assert ref.penalties["blue"] == {"taken": 1, "scored": 1}, [e.kind for e in calls]
+    assert ref.tally.penalties["blue"] == {"taken": 1, "scored": 1}, [e.kind for e in calls]
     assert not [e for e in calls if e.team == "blue" and e.kind != "penalty_over"]  # no foul of ours
 
 
@@ -249,7 +249,7 @@ def test_our_keeper_saves_the_simple_opponents_penalty() -> None:
     w.apply(ref.start_penalty("yellow"))
     calls = play(w, ref, brain, RULES.prepare_timeout_s + RULES.penalty_time_s, opponent=simple_opponent(),
                  until=lambda c: ref.score["yellow"] > 0 or any(e.kind == "penalty_over" for e in c))  # fmt: skip
-    assert ref.penalties["yellow"] == {"taken": 1, "scored": 0}, [e.kind for e in calls]
+    assert ref.tally.penalties["yellow"] == {"taken": 1, "scored": 0}, [e.kind for e in calls]
     assert any(e.kind == "penalty_over" for e in calls)
     assert not [e for e in calls if e.team == "blue" and e.kind != "penalty_over"]  # no foul of ours
 
@@ -276,7 +276,7 @@ def test_stop_keeps_every_robot_away_from_the_ball_and_slow_every_frame() -> Non
     assert worst["speed"] < RULES.stop_speed_m_s
     assert worst["gap"] >= RULES.stop_distance_m
     assert not [e for e in calls if e.kind.startswith("stop_")]
-    assert ref.command == RefereeCommand.STOP
+    assert ref.game.command == RefereeCommand.STOP
 
 
 @pytest.mark.parametrize(("blue", "spot", "taker"), [

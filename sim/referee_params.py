@@ -1,0 +1,42 @@
+"""configs/sim.yaml's ``referee``: how the simulator's referee runs (which rules, the restarts' delays
+and timeouts, the kickoff formations) and the league's figures it judges by (:class:`sim.rules.RulesParams`)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Literal
+
+from cmdragons.config import Validated, setting
+from sim.rules import RulesParams
+
+__all__ = ["RefereeParams"]
+
+_Pose = tuple[float, float, float]
+_DEFAULT_FORMATIONS: dict[Literal["A", "B"], tuple[_Pose, ...]] = {
+    "B": ((-4.2, 0.0, 0.0), (-3.0, 1.0, 0.0), (-3.0, -1.0, 0.0), (-2.0, 0.0, 0.0), (-1.0, 1.6, 0.0),
+          (-1.0, -1.6, 0.0)),
+    "A": ((-5.7, 0.0, 0.0), (-4.2, 1.2, 0.0), (-4.2, -1.2, 0.0), (-4.2, 0.0, 0.0), (-3.2, 2.5, 0.0),
+          (-3.2, -2.5, 0.0), (-2.4, 0.8, 0.0), (-2.4, -0.8, 0.0), (-1.2, 3.0, 0.0), (-1.2, -3.0, 0.0),
+          (-1.0, 0.0, 0.0)),
+}  # fmt: skip
+
+
+@dataclass(frozen=True)
+class RefereeParams(Validated):
+    enabled: bool = True  # off: no restarts, the ball bounces off the boundary walls
+    rules: Literal["full", "basic"] = "full"  # full: the league's game controller and auto-referee
+    blue_defends: Literal["negative_x", "positive_x"] = "negative_x"
+    restart_delay_s: float = setting(1.0, lo=0.0, hi=30.0)  # goal or out -> ball placed
+    place_robots_on_goal: bool = True  # put both teams in their kickoff formation after a goal
+    free_kick_distance_m: float = setting(0.2, lo=0.0, hi=2.0)  # from the lines and defense areas
+    restart_timeout_s: float = setting(10.0, lo=0.1, hi=600.0)  # a restart not taken by then: play on
+    keeper_held_ball_s: float = setting(10.0, lo=0.1, hi=600.0)  # ball this long in a defense area: free kick
+    no_progress_s: float = setting(10.0, lo=0.1, hi=600.0)  # the ball this long in one place in play: stop, force start
+    no_progress_m: float = setting(0.05, lo=0.0, hi=5.0)  # ... within this of it
+    # start poses (x m, y m, theta rad) of the team defending -x, per division; mirrored for the other
+    formations: Mapping[Literal["A", "B"], tuple[tuple[float, float, float], ...]] = field(
+        default_factory=lambda: dict(_DEFAULT_FORMATIONS)
+    )
+    figures: RulesParams = RulesParams()  # the league's figures for the full rules
+    park_distance_m: float = setting(3.0, lo=0.5, hi=50.0)  # robots sent off wait this far outside the boundary

@@ -47,7 +47,9 @@ def _parser(command: str) -> argparse.ArgumentParser:
         p.add_argument("--overlay", metavar="FILE.png", default=None,
                        help="--lines: the fitted field drawn on the image (default IMAGE_calibration.png beside it)")
         p.add_argument("--resolution", type=int, nargs=2, default=None, metavar=("W", "H"))
-        p.add_argument("--focal", type=float, default=None, help="focal length guess, px (default: from configs)")
+        p.add_argument("--focal", type=float, default=None,
+                       help="focal length, px (default: from configs); with --lines it is taken as known: a fit "
+                       "more than 5%% off it is refused")
         p.add_argument("--fit-principal-point", action="store_true", help="also fit the principal point")
         p.add_argument("--out", metavar="FILE", default=None, help="cameras.yaml to write (default: the config's)")
     else:
@@ -115,15 +117,17 @@ def _calibrate(args: argparse.Namespace, settings: object) -> int:
         if args.focal:
             start = dataclasses.replace(start, focal_px=args.focal)
         try:
-            fit_params = LineFitParams(reach_m=args.reach)
+            fit_params = LineFitParams(reach_m=args.reach, known_focal_px=args.focal or 0.0)
         except ValueError as exc:
             raise ValueError(f"--reach: {exc}") from None
         fit = calibrate_from_lines(image, settings.field, start, fit_params)  # type: ignore[attr-defined]
-        params, rms, worst, what = fit.params, fit.rms_px, fit.max_px, f"{fit.points} line points"
+        params, rms, worst = fit.params, fit.rms_px, fit.max_px
+        what = (f"{fit.points} line centres on {fit.lines_seen} lines ({fit.found:.0%} of those in view found; "
+                f"tape {fit.line_width_px:.1f} px wide)")  # fmt: skip
         overlay = Path(args.overlay) if args.overlay else Path(args.lines).with_name(
             Path(args.lines).stem + "_calibration.png")  # fmt: skip
         overlay.parent.mkdir(parents=True, exist_ok=True)
-        if not cv2.imwrite(str(overlay), draw_field(image, params, settings.field)):  # type: ignore[attr-defined]
+        if not cv2.imwrite(str(overlay), draw_field(image, params, settings.field, fit)):  # type: ignore[attr-defined]
             raise ValueError(f"could not write {overlay}")
     else:
         pixels, field = read_correspondences(args.points)
@@ -137,7 +141,9 @@ def _calibrate(args: argparse.Namespace, settings: object) -> int:
           f"{p.yaw_rad:.4f} rad, tilts {p.tilt_x_rad:.4f} {p.tilt_y_rad:.4f} rad, focal {p.focal_px:.2f} px, "
           f"k1 {p.k1:.4f} k2 {p.k2:.4f}; reprojection RMS {rms:.3f} px (max {worst:.3f}) -> {out}")  # fmt: skip
     if image is not None:
-        print(f"calibrate: the fitted field drawn on the image -> {overlay}")
+        for note in fit.notes:
+            print(f"calibrate: note: {note}")
+        print(f"calibrate: the fitted field, the line centres used and each line's RMS drawn on the image -> {overlay}")
     return 0
 
 

@@ -275,7 +275,7 @@ def _tune(args: argparse.Namespace, settings: object) -> int:
         n = sum(len(p) for p in samples.get(name, []))
         entry = colours.get(name)
         was = f"lo {list(entry['lo'])} hi {list(entry['hi'])}" if entry and "lo" in entry and "hi" in entry else "(new)"
-        why = f"{n:7d} sampled pixels" if n else "  kept apart from the others"
+        why = f"{n:7d} {'sampled' if args.auto else 'labelled'} pixels" if n else "  kept apart from the others"
         print(f"tune: {name:8s} {why}: {was} -> lo {list(box.lo)} hi {list(box.hi)}")
         if entry is None:
             entry = colours[name] = _flow(CommentedMap(min_area_px=box.min_area_px))

@@ -5,6 +5,7 @@ apart, and the warning where they overlap."""
 from __future__ import annotations
 
 import dataclasses
+import json
 import shutil
 from pathlib import Path
 
@@ -108,3 +109,39 @@ def test_tune_auto_command_writes_the_boxes_and_warns(cameras: list[CameraModel]
     assert "of the orange samples fall in yellow's box" in err and "still" not in err
     kept = yaml.safe_load((config / "vision.yaml").read_text())["colours"]
     assert kept["yellow"] != yaml.safe_load(before)["colours"]["yellow"]  # cut back, written
+
+
+REAL = Path(__file__).resolve().parents[3] / "shared" / "realdata"
+
+
+@pytest.mark.skipif(not (REAL / "lab_frame_lights_on.jpg").exists(), reason=f"the real lab frame is not here ({REAL})")
+def test_the_real_lab_frame_calibrated_and_coloured_with_nothing_labelled() -> None:
+    """A webcam's frame of a lab field: the camera from the lines, every colour from the frame,
+    then the covers read against the hand-checked truth beside the frame (three dots of four
+    read, as one cover's dot is hidden)."""
+    from cmdragons.camera import CameraParams
+    from cmdragons.geometry import BallShape, FieldDims
+    from vision.field_lines import calibrate_from_lines, rough_start
+    from vision.patterns import BallParams, PatternParams
+
+    image = np.asarray(cv2.imread(str(REAL / "lab_frame_lights_on.jpg")), dtype=np.uint8)
+    truth = json.loads((REAL / "ground_truth.json").read_text())["lab_frame_lights_on.jpg"]
+    lab = FieldDims(length_m=5.54, width_m=3.77, boundary_width_m=0.0, goal_width_m=1.0, defense_width_m=2.0,
+                    defense_depth_m=1.0, center_circle=False, goal_to_goal_line=False, outer_lines="walls")  # fmt: skip
+    league = dataclasses.replace(LEAGUE, divisions={"B": lab, "A": LEAGUE.divisions["A"]}, ball=BallShape(radius_m=0.042))
+    base = CameraParams(id=0, resolution_px=(1920, 1080), principal_point_px=(960.0, 540.0))
+    model = CameraModel(calibrate_from_lines(image, league, rough_start(base, 4.0, (-3.45, -1.94, 3.45, 1.94))).params)
+    rep = auto_samples([image], model, league, "yuv")
+    names = {"ball": "orange", "blue": "blue", "yellow": "yellow", "pink": "pink", "green": "green"}
+    boxes = {**VisionParams().colours, **{names[r]: widen_for_light(b, rep.light[r], "yuv")
+                                          for r, b in boxes_from_samples(rep.samples, margin=16).items()}}  # fmt: skip
+    pooled = {**{names[r]: np.concatenate(v) for r, v in rep.samples.items()}, **rep.background}
+    boxes = keep_apart(boxes, pooled, set(boxes))
+    params = dataclasses.replace(VisionParams(), colours=boxes, patterns=PatternParams(min_dots=3),
+                                 ball=BallParams(max_balls=4))  # fmt: skip
+    det = VisionPipeline(params, league, model).process(image, 0, 0.0)
+    right = sum(any(r.id == t["id"] and np.hypot(*np.subtract(r.pixel, t["pixel"])) < 10 for r in det.robots)
+                for t in truth["robots"])  # fmt: skip
+    assert right >= 5 and len(det.robots) == right  # measured: 5 of 6 (one cover's segment merges with a dot)
+    on_field = truth["balls"][0]["pixel"]
+    assert any(np.hypot(*np.subtract(b.pixel, on_field)) < 5 for b in det.balls)

@@ -294,7 +294,7 @@ def _auto_samples(args: argparse.Namespace,
     """``tune --auto``: samples per colour name from the frames given, the background's, and per
     colour name the light's spread its box must reach."""
     from cmdragons.camera import CameraModel
-    from cmdragons.videoio import read_video
+    from cmdragons.videoio import read_video, video_info
     from vision.tune import auto_samples
 
     images: list[np.ndarray] = []
@@ -303,10 +303,14 @@ def _auto_samples(args: argparse.Namespace,
         if img is not None:
             images.append(np.asarray(img, dtype=np.uint8))
             continue
-        for k, frame in read_video(name):  # a video: --frames frames over its first 3 s (at 30 frames/s or more)
-            if k >= 90 or len(images) >= args.frames:
+        info = video_info(name)  # a video: --frames frames spread over its first 3 s
+        span = int(3.0 * (info["fps"] or 30.0))
+        if info["frames"]:
+            span = min(span, info["frames"])
+        for k, frame in read_video(name):
+            if k >= span or len(images) >= args.frames:
                 break
-            if k % max(1, 90 // args.frames) == 0:
+            if k % max(1, span // args.frames) == 0:
                 images.append(frame)
     if not images:
         raise ValueError(f"{', '.join(args.images)}: no frame could be read")

@@ -202,3 +202,20 @@ def test_the_real_lab_frame() -> None:
     assert 35 < mm < 55 and fit.lines_seen == 7 and fit.found > 0.9 and fit.rms_px < 1.6
     fov = math.degrees(2 * math.atan(960 / fit.params.focal_px))
     assert 60 < fov < 100  # the BRIO's 16:9 field of view: 65 to 90 degrees
+
+
+def test_calibrate_lines_command_refuses_the_default_field_on_a_lab_frame(
+        lab_render: tuple[NDArray[np.uint8], CameraParams], tmp_path: Path,
+        capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
+    """No --config: the league's 9 x 6 m field against a 5.54 x 3.77 m lab field. Exit 2, the
+    reason in one line, cameras.yaml untouched."""
+    config = tmp_path / "configs"
+    shutil.copytree(CONFIGS, config)
+    before = (config / "cameras.yaml").read_text()
+    frame = tmp_path / "lab.png"
+    cv2.imwrite(str(frame), lab_render[0])
+    assert main(["vision", "calibrate", "--lines", str(frame), "--config", str(config), "--height", "3.2",
+                 "--sees", "-3.3", "-1.7", "3.1", "1.9"]) == 2  # fmt: skip
+    err = capsys.readouterr().err
+    assert "not the one in the image" in err and len(err.strip().splitlines()) == 1
+    assert (config / "cameras.yaml").read_text() == before

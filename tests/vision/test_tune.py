@@ -145,3 +145,20 @@ def test_the_real_lab_frame_calibrated_and_coloured_with_nothing_labelled() -> N
     assert right >= 5 and len(det.robots) == right  # measured: 5 of 6 (one cover's segment merges with a dot)
     on_field = truth["balls"][0]["pixel"]
     assert any(np.hypot(*np.subtract(b.pixel, on_field)) < 5 for b in det.balls)
+
+
+def test_tune_auto_on_a_video_learns_from_its_first_seconds(cameras: list[CameraModel], tmp_path: Path,
+                                                           capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
+    """An H.264 video (4:2:0, as webcams record): frames spread over its first 3 s, each robot
+    seen in several of them."""
+    from cmdragons.videoio import VideoWriter
+
+    config = tmp_path / "configs"
+    shutil.copytree(CONFIGS, config)
+    video = tmp_path / "camera_0.mp4"
+    with VideoWriter(video, cameras[0].width, cameras[0].height, 10.0, "h264", crf=18) as out:  # 3 s
+        for k in range(30):
+            moved = [[t, i, x + 0.01 * k, y, th + 0.05 * k] for t, i, x, y, th in SCENE]
+            out.write(render(cameras[0], snapshot(moved, ball=(-2.5 + 0.02 * k, -0.6, 0.0215)), WARM, seed=k)[0])
+    assert main(["vision", "tune", "--auto", str(video), "--frames", "3", "--config", str(config)]) == 0
+    assert "3 frame(s): 18 robot patterns, 3 balls found" in capsys.readouterr().out

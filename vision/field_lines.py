@@ -2,26 +2,33 @@
 
 From a rough start (the camera's height, measured, and the part of the field it sees) the camera
 model of :mod:`cmdragons.camera` (pose, focal length, radial distortion k1, k2) is fitted to the
-white-line pixels of one image, in three steps:
+white-line pixels of one image, in five steps:
 
 1. **Line pixels** (:func:`line_strength`): a white top-hat of the image's brightness (what is
    brighter than its surroundings over a few line widths), kept where the pixel is not coloured
    (the robots' dots, the ball and the team colours are brighter than the carpet too).
 2. **Coarse search**: the field model (every straight line and the centre circle of
    configs/field.yaml, sampled along their centre lines) projected through candidate cameras
-   around the rough start (position, the half turn the field's symmetry leaves open, the focal
+   around the rough start (position, the four quarter turns, the focal
    length), scored by the chamfer distance to the line pixels (truncated, so that a
    line hidden by a robot costs no more than a fixed amount); the best few are refined by least
    squares on the same distance.
-3. **Fine fit**: for every model point, the line's centre is measured across the projected line
-   (the strength profile along its normal, the peak's weighted centroid: sub-pixel), and all
-   parameters are fitted by least squares to the normal distances (point to line, robust loss),
-   the correspondences measured again from each new fit until it settles.
+3. **Tape width**: the width of the lines in the image is measured across the coarse fit's lines
+   (configs/field.yaml's line_width_m is only where the search starts: labs tape 45 mm lines).
+4. **Fine fit**: for every model point, the line's centre is measured across the projected line
+   (the strength profile along its normal, its weighted centroid over the tape's width:
+   sub-pixel, the middle of the tape), and all parameters are fitted by least squares to the
+   normal distances (point to line, robust loss), the correspondences measured again from each
+   new fit until it settles.
+5. **Checks**: a fit that cannot be right is refused with the reason (:func:`_check`): lines the
+   fit puts in view that the image does not show, too few lines or all one way, a field of view
+   or a tape width implausible, a known focal length missed. The field's quarter turns are
+   searched in step 2; its half turn looks the same to the lines and the rough start decides.
 
 A camera looking at one plane sees the same from height h with focal length f (and k1, k2) as
 from k h with k f (k^2 k1, k^4 k2): the height is kept from the rough start, as in
-:func:`vision.calibrate.calibrate`. The reprojection error is the RMS of the measured line
-centres' distances to the fitted model's lines (px).
+:func:`vision.calibrate.calibrate`. The reprojection error is the RMS of every measured line
+centre's distance to the fitted model's lines (px), measured with the fitted camera.
 """
 
 from __future__ import annotations

@@ -1,9 +1,13 @@
-"""Colour tuning: threshold boxes (thesis A.1.3) from labelled pixels.
+"""Colour tuning: threshold boxes (thesis A.1.3) from sampled pixels.
 
-Samples come from a user's labels -- a few spots clicked on a real frame, each a colour name, a
-pixel position and a radius -- or from a recording's truth, where every visible dot and the ball
-are known exactly. Each colour's box spans a central share of its samples per channel of the
-colour space, widened by a margin for light the samples did not see.
+Samples come with nothing labelled from a calibrated camera's frames (:func:`auto_samples`: the
+robots' patterns and the ball found by their sizes and the pattern's geometry), from a user's
+labels -- a few spots clicked on a real frame, each a colour name, a pixel position and a radius
+-- or from a recording's truth, where every visible dot and the ball are known exactly. Each
+colour's box spans a central share of its samples per channel of the colour space, widened by a
+margin for light the samples did not see (and, learnt automatically, by the light's spread over
+the field seen on the carpet: :func:`widen_for_light`); boxes that hold another class's samples,
+or the carpet's or the lines', are cut apart (:func:`keep_apart`).
 """
 
 from __future__ import annotations
@@ -285,9 +289,9 @@ def auto_samples(images: Sequence[NDArray[np.uint8]], model: CameraModel, league
         conv = convert_colour(image, space)
         if not blobs:
             continue
-        ppm = np.array([model.pixels_per_metre(tuple(model.unproject(b.pixel, h)), h) for b in blobs])
-        area = np.array([b.area for b in blobs])
         ground = np.array([model.unproject(b.pixel, h) for b in blobs])
+        ppm = np.array([model.pixels_per_metre((float(g[0]), float(g[1])), h) for g in ground])
+        area = np.array([b.area for b in blobs])
         is_centre = (area >= lo_a * math.pi * (r_centre * ppm) ** 2) & (area <= hi_a * math.pi * (r_centre * ppm) ** 2)
         is_id = (area >= lo_a * math.pi * (r_id * ppm) ** 2) & (area <= hi_a * math.pi * (r_id * ppm) ** 2)
         used = np.zeros(len(blobs), bool)
@@ -319,7 +323,8 @@ def auto_samples(images: Sequence[NDArray[np.uint8]], model: CameraModel, league
                 take("pink" if blobs[j].colour[2] > 128.0 else "green", j, r_id)
         for k in np.flatnonzero(~used):
             b = blobs[k]
-            expect = math.pi * (r_ball * model.pixels_per_metre(tuple(model.unproject(b.pixel, r_ball)), r_ball)) ** 2
+            g = model.unproject(b.pixel, r_ball)
+            expect = math.pi * (r_ball * model.pixels_per_metre((float(g[0]), float(g[1])), r_ball)) ** 2
             orange = b.colour[1] < 128.0 and b.colour[2] > 140.0
             ys, xs = np.nonzero(labels == b.label)
             fill = b.area / max(1.0, float((np.ptp(xs) + 1) * (np.ptp(ys) + 1)))

@@ -73,6 +73,11 @@ class FieldDims(Validated):
     center_circle_radius_m: float = setting(0.5, lo=0.05, hi=5.0)
     line_width_m: float = setting(0.01, lo=0.001, hi=0.2)
     robots_per_team: int = setting(6, lo=0, hi=16)  # the league's count for this division
+    center_circle: bool = True  # painted; false on a lab field without one
+    goal_to_goal_line: bool = True  # the line along x through the centre spot; false where it is not painted
+    # the touch and goal lines: painted, or the bases of walls standing where they would be
+    # (a lab field: line calibration then leaves them out)
+    outer_lines: Literal["painted", "walls"] = "painted"
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -225,6 +230,14 @@ class Field:
             x0, x1 = s * hl, s * (hl - dd)
             segs += [Segment((x0, -dw), (x1, -dw)), Segment((x0, dw), (x1, dw)), Segment((x1, -dw), (x1, dw))]
         return segs
+
+    def painted_segments(self, outer: bool = True) -> list[Segment]:
+        """The straight markings painted on this field: :meth:`line_segments` without the line
+        from goal to goal where field.yaml says none is painted, and without the touch and goal
+        lines when ``outer`` is false."""
+        segs = self.line_segments()
+        keep = [outer] * 4 + [True, self.dims.goal_to_goal_line] + [True] * (len(segs) - 6)
+        return [s for s, k in zip(segs, keep, strict=True) if k]
 
     def goal_walls(self, side: float) -> list[tuple[float, float, float, float]]:
         """Goal walls of the goal at x = side * half_length as axis-aligned boxes (x0, y0, x1, y1)."""

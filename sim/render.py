@@ -258,9 +258,9 @@ def _static_background(model: CameraModel, field: Field, params: RenderParams, r
     a_line = np.zeros(gx.shape)
     ring = np.linspace(0.0, 2.0 * np.pi, 65)
     win = _window(model, np.stack([radius * np.cos(ring), radius * np.sin(ring), 0.0 * ring], 1))
-    if win is not None:
+    if win is not None and field.dims.center_circle:
         a_line[win] = _coverage(np.abs(np.hypot(gx[win], gy[win]) - radius) - half_w, pix[win])
-    for seg in field.line_segments():
+    for seg in field.painted_segments():
         along = np.linspace(0.0, 1.0, 33)[:, None]
         pts = np.array(seg.a) + along * (np.array(seg.b) - np.array(seg.a))
         win = _window(model, np.concatenate([pts, np.zeros((33, 1))], 1))

@@ -2,26 +2,33 @@
 
 From a rough start (the camera's height, measured, and the part of the field it sees) the camera
 model of :mod:`cmdragons.camera` (pose, focal length, radial distortion k1, k2) is fitted to the
-white-line pixels of one image, in three steps:
+white-line pixels of one image, in five steps:
 
 1. **Line pixels** (:func:`line_strength`): a white top-hat of the image's brightness (what is
    brighter than its surroundings over a few line widths), kept where the pixel is not coloured
    (the robots' dots, the ball and the team colours are brighter than the carpet too).
 2. **Coarse search**: the field model (every straight line and the centre circle of
    configs/field.yaml, sampled along their centre lines) projected through candidate cameras
-   around the rough start (position, the half turn the field's symmetry leaves open, the focal
+   around the rough start (position, the four quarter turns, the focal
    length), scored by the chamfer distance to the line pixels (truncated, so that a
    line hidden by a robot costs no more than a fixed amount); the best few are refined by least
    squares on the same distance.
-3. **Fine fit**: for every model point, the line's centre is measured across the projected line
-   (the strength profile along its normal, the peak's weighted centroid: sub-pixel), and all
-   parameters are fitted by least squares to the normal distances (point to line, robust loss),
-   the correspondences measured again from each new fit until it settles.
+3. **Tape width**: the width of the lines in the image is measured across the coarse fit's lines
+   (configs/field.yaml's line_width_m is only where the search starts: labs tape 45 mm lines).
+4. **Fine fit**: for every model point, the line's centre is measured across the projected line
+   (the strength profile along its normal, its weighted centroid over the tape's width:
+   sub-pixel, the middle of the tape), and all parameters are fitted by least squares to the
+   normal distances (point to line, robust loss), the correspondences measured again from each
+   new fit until it settles.
+5. **Checks**: a fit that cannot be right is refused with the reason (:func:`_check`): lines the
+   fit puts in view that the image does not show, too few lines or all one way, a field of view
+   or a tape width implausible, a known focal length missed. The field's quarter turns are
+   searched in step 2; its half turn looks the same to the lines and the rough start decides.
 
 A camera looking at one plane sees the same from height h with focal length f (and k1, k2) as
 from k h with k f (k^2 k1, k^4 k2): the height is kept from the rough start, as in
-:func:`vision.calibrate.calibrate`. The reprojection error is the RMS of the measured line
-centres' distances to the fitted model's lines (px).
+:func:`vision.calibrate.calibrate`. The reprojection error is the RMS of every measured line
+centre's distance to the fitted model's lines (px), measured with the fitted camera.
 """
 
 from __future__ import annotations
@@ -41,10 +48,12 @@ from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, LeagueParams
 
 __all__ = [
+    "CalibrationRefused",
     "LineCalibration",
     "LineFitParams",
     "calibrate_from_lines",
     "draw_field",
+    "field_lines",
     "field_samples",
     "line_strength",
     "rough_start",
@@ -65,36 +74,78 @@ class LineFitParams(Validated):
     coarse_cap_px: float = setting(20.0, lo=2.0, hi=200.0)  # chamfer distances truncated here in the search
     refine_cap_px: float = setting(6.0, lo=1.0, hi=50.0)  # ... and here in its refinement
     search_px: float = setting(5.0, lo=1.0, hi=50.0)  # line centres looked for this far across a projected line
+    widest_line_m: float = setting(0.08, lo=0.005, hi=0.3)  # the tape's width is measured up to this
+    min_found: float = setting(0.6, lo=0.0, hi=1.0)  # share of the model's points in view whose line is found
+    min_lines: int = setting(4, lo=2, hi=40)  # field lines seen (half their length in view found), at least
+    fov_deg: tuple[float, float] = (30.0, 150.0)  # the horizontal field of view a fitted focal length may give
+    # a focal length known beforehand (the lens's): the fit's may be off by this share at most. A field
+    # scaled as a whole looks the same as a camera of another focal length at the height kept: only
+    # this catches a field.yaml or a --height off by a common factor
+    known_focal_px: float = setting(0.0, lo=0.0, hi=1e5)  # 0: not known
+    known_focal_tolerance: float = setting(0.05, lo=0.0, hi=1.0)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if not 1.0 <= self.fov_deg[0] < self.fov_deg[1] <= 179.0:
+            raise ValueError(f"fov_deg must be [lo, hi] within 1..179 degrees, lo < hi, got {list(self.fov_deg)}")
+
+
+class CalibrationRefused(ValueError):
+    """A fit that cannot be right (the reason in the message): the field model does not match
+    what the image shows, or the camera it implies is impossible."""
 
 
 @dataclass(frozen=True)
 class LineCalibration:
     params: CameraParams
-    rms_px: float  # measured line centres to the fitted lines
+    rms_px: float  # every measured line centre to the fitted model's lines (normal distance)
     max_px: float
-    points: int  # line centres measured in the last fit
+    points: int  # line centres measured with the fitted model
     line_pixels: int  # pixels the line detector found
+    line_width_px: float  # the tape's width measured in the image (median over the lines)
+    found: float  # share of the model's points in view whose line centre was found
+    lines_seen: int  # field lines with at least half their length in view found
+    centres: F64  # the measured line centres (n, 2), px
+    residuals_px: F64  # each centre's signed normal distance to the fitted line, px
+    line_of: NDArray[np.int64]  # each centre's field line (index into field_samples' lines)
+    notes: tuple[str, ...] = ()  # what the fit decided that the lines alone could not
 
 
-def field_samples(league: LeagueParams, step_m: float) -> tuple[F64, F64]:
-    """Points along the centre lines of every field marking (n, 3) at z = 0 and each point's unit
-    tangent (n, 2) in the field frame, about ``step_m`` apart."""
+def field_lines(league: LeagueParams) -> list[tuple[float, float, float, float] | float]:
+    """The painted markings a line calibration looks for: straight lines as (x0, y0, x1, y1) and
+    the centre circle as its radius, m; without what field.yaml says is not painted (the centre
+    circle, the line from goal to goal, the touch and goal lines where walls stand)."""
     f = Field(league)
-    pts, tan = [], []
-    for seg in f.line_segments():
-        a, b = np.array(seg.a), np.array(seg.b)
-        length = float(np.hypot(*(b - a)))
-        n = max(2, int(math.ceil(length / step_m)) + 1)
-        t = np.linspace(0.0, 1.0, n)[:, None]
-        pts.append(a + t * (b - a))
-        tan.append(np.repeat(((b - a) / length)[None], n, axis=0))
-    r = f.dims.center_circle_radius_m
-    n = max(8, int(math.ceil(2 * math.pi * r / step_m)))
-    phi = np.arange(n) * 2 * math.pi / n
-    pts.append(np.stack([r * np.cos(phi), r * np.sin(phi)], axis=1))
-    tan.append(np.stack([-np.sin(phi), np.cos(phi)], axis=1))
+    d = f.dims
+    out: list[tuple[float, float, float, float] | float] = [
+        (*s.a, *s.b) for s in f.painted_segments(outer=d.outer_lines == "painted")
+    ]
+    if d.center_circle:
+        out.append(d.center_circle_radius_m)
+    return out
+
+
+def field_samples(league: LeagueParams, step_m: float) -> tuple[F64, F64, NDArray[np.int64]]:
+    """Points along the centre lines of every painted marking (:func:`field_lines`) (n, 3) at
+    z = 0, each point's unit tangent (n, 2) in the field frame and its line's index (n,), about
+    ``step_m`` apart."""
+    pts, tan, ids = [], [], []
+    for k, line in enumerate(field_lines(league)):
+        if isinstance(line, tuple):
+            a, b = np.array(line[:2]), np.array(line[2:])
+            length = float(np.hypot(*(b - a)))
+            n = max(2, int(math.ceil(length / step_m)) + 1)
+            s = np.linspace(0.0, 1.0, n)[:, None]
+            pts.append(a + s * (b - a))
+            tan.append(np.repeat(((b - a) / length)[None], n, axis=0))
+        else:
+            n = max(8, int(math.ceil(2 * math.pi * line / step_m)))
+            phi = np.arange(n) * 2 * math.pi / n
+            pts.append(np.stack([line * np.cos(phi), line * np.sin(phi)], axis=1))
+            tan.append(np.stack([-np.sin(phi), np.cos(phi)], axis=1))
+        ids.append(np.full(n, k, np.int64))
     xy = np.concatenate(pts)
-    return np.concatenate([xy, np.zeros((len(xy), 1))], axis=1), np.concatenate(tan)
+    return np.concatenate([xy, np.zeros((len(xy), 1))], axis=1), np.concatenate(tan), np.concatenate(ids)
 
 
 def line_strength(image: NDArray[np.uint8], line_width_px: float, white_chroma: float = 60.0) -> NDArray[np.float32]:
@@ -194,7 +245,7 @@ def _coarse(start: CameraParams, pts: F64, dist: NDArray[np.float32], line_px: F
     x0, y0 = start.position_m[:2]
     steps = np.linspace(-fit.reach_m, fit.reach_m, fit.grid_steps)
     cap0, cap1 = fit.coarse_cap_px, fit.refine_cap_px
-    for turn in (0.0, math.pi):
+    for turn in (0.0, math.pi / 2.0, math.pi, -math.pi / 2.0):  # which way the image lies: from the lines
         for fs in 1.0 + np.linspace(-fit.focal_range, fit.focal_range, 5):
             for dx in steps:
                 for dy in steps:
@@ -225,45 +276,90 @@ def _normals(model: CameraModel, pts: F64, tan: F64) -> tuple[F64, F64]:
     return px, np.stack([-d[:, 1], d[:, 0]], axis=1)
 
 
-def _centres(model: CameraModel, pts: F64, tan: F64, strength: NDArray[np.float32], level: float,
-             reach_px: float) -> tuple[NDArray[np.int64], F64, F64]:  # fmt: skip
-    """Where the line of each model point really is: along the projected normal within
-    ``reach_px``, the strength profile's peak and the weighted centroid of the profile around it
-    (+- 1.5 px). Returns the model points kept, the measured centres (n, 2) and the normals."""
+def _profiles(model: CameraModel, pts: F64, tan: F64, strength: NDArray[np.float32],
+              reach_px: float) -> tuple[NDArray[np.int64], F64, F64, F64, F64]:  # fmt: skip
+    """The strength profile across the projected line at each model point in view: the points
+    kept, their pixels (k, 2) and normals (k, 2), the offsets (m,) px and the profiles (k, m)."""
     px, nrm = _normals(model, pts, tan)
     ok = np.isfinite(px).all(axis=1) & np.isfinite(nrm).all(axis=1)
     ok &= model.in_image(np.nan_to_num(px, nan=-1.0), margin=reach_px + 2.0)
     idx = np.flatnonzero(ok)
-    if idx.size == 0:
-        return idx, np.zeros((0, 2)), np.zeros((0, 2))
     offs = np.arange(-reach_px, reach_px + 1e-9, 0.25)
     grid = px[idx, None, :] + offs[None, :, None] * nrm[idx, None, :]
-    prof = _sample(strength, grid.reshape(-1, 2)).reshape(len(idx), len(offs))
+    prof = _sample(strength, grid.reshape(-1, 2)).reshape(len(idx), len(offs)) if idx.size else np.zeros((0, len(offs)))
+    return idx, px[idx], nrm[idx], offs, prof
+
+
+def _weighted_centre(prof: F64, offs: F64, around: F64, half: float, floor: F64) -> F64:
+    """The centroid of each profile's part above ``floor`` within ``half`` px of ``around``."""
+    wts = np.where(np.abs(offs[None, :] - around[:, None]) <= half, np.maximum(prof - floor[:, None], 0.0), 0.0)
+    out: F64 = (wts * offs[None, :]).sum(axis=1) / np.maximum(wts.sum(axis=1), 1e-12)
+    return out
+
+
+def _centres(model: CameraModel, pts: F64, tan: F64, strength: NDArray[np.float32], level: float,
+             reach_px: float, width_px: float) -> tuple[NDArray[np.int64], F64, F64]:  # fmt: skip
+    """Where the line of each model point really is: along the projected normal within
+    ``reach_px``, the strength profile's peak, then the weighted centroid of the profile over
+    the tape's width (``width_px``) around it, taken twice (on a wide tape's flat top the peak
+    can be anywhere: the first centroid finds the middle). Returns the model points kept, the
+    measured centres (n, 2) and the normals."""
+    idx, px, nrm, offs, prof = _profiles(model, pts, tan, strength, reach_px)
+    if idx.size == 0:
+        return idx, np.zeros((0, 2)), np.zeros((0, 2))
     peak = np.argmax(prof, axis=1)
     top = prof[np.arange(len(idx)), peak]
-    near = np.abs(offs[None, :] - offs[peak][:, None]) <= 1.5
-    wts = np.where(near, np.maximum(prof - 0.3 * top[:, None], 0.0), 0.0)
-    t = (wts * offs[None, :]).sum(axis=1) / np.maximum(wts.sum(axis=1), 1e-12)
-    # a peak at the window's edge is another line or none; one below the line level is no line
-    keep = (top > level) & (np.abs(offs[peak]) < reach_px - 0.5)
+    half = max(1.5, 0.5 * width_px + 1.0)
+    t = _weighted_centre(prof, offs, offs[peak], 2.0 * half, 0.5 * top)
+    t = _weighted_centre(prof, offs, t, half, 0.3 * top)
+    # a line at the window's edge is another line or none; one below the line level is no line
+    keep = (top > level) & (np.abs(t) < reach_px - 0.5 * width_px - 0.5)
     # a second strong peak in the window (a parallel line, a goal wall's edge): ambiguous
-    other = np.where(~(np.abs(offs[None, :] - offs[peak][:, None]) <= 3.0), prof, 0.0).max(axis=1)
+    other = np.where(np.abs(offs[None, :] - t[:, None]) > max(3.0, width_px + 2.0), prof, 0.0).max(axis=1)
     keep &= other < 0.6 * top
-    idx, t = idx[keep], t[keep]
-    return idx, px[idx] + t[:, None] * nrm[idx], nrm[idx]
+    # wider than the tape: where another line joins or crosses, or a white thing lies on it
+    keep &= _run_width(prof, offs, peak, top) <= 1.5 * width_px + 2.0
+    return idx[keep], px[keep] + t[keep, None] * nrm[keep], nrm[keep]
+
+
+def _run_width(prof: F64, offs: F64, peak: NDArray[np.int64], top: F64) -> F64:
+    """The width (px) of each profile's run at or above half its height that holds its peak;
+    infinite where the run reaches the window's edge."""
+    above = prof >= 0.5 * top[:, None]
+    pos = np.arange(len(offs))[None, :]
+    left = np.where(~above & (pos < peak[:, None]), pos, -1).max(axis=1)
+    right = np.where(~above & (pos > peak[:, None]), pos, len(offs)).min(axis=1)
+    out: F64 = np.where((left >= 0) & (right < len(offs)), (right - left - 1) * float(offs[1] - offs[0]), np.inf)
+    return out
+
+
+def _line_width(model: CameraModel, pts: F64, tan: F64, strength: NDArray[np.float32], level: float,
+                reach_px: float) -> float:
+    """The tape's width in the image, px: the median over the model points in view of the
+    profile's width at half its height around the peak (the profiles of points whose line is
+    missing or cut by the window's edge left out)."""
+    idx, _, _, offs, prof = _profiles(model, pts, tan, strength, reach_px)
+    if idx.size == 0:
+        return 0.0
+    peak = np.argmax(prof, axis=1)
+    top = prof[np.arange(len(idx)), peak]
+    widths = _run_width(prof, offs, peak, top)
+    widths = widths[np.isfinite(widths) & (top > level)]
+    return float(np.median(widths)) if widths.size >= 20 else 0.0
 
 
 def _fine(start: CameraParams, pts: F64, tan: F64, strength: NDArray[np.float32], level: float,
-          search_px: float) -> tuple[CameraParams, F64]:  # fmt: skip
+          search_px: float, width_px: float) -> CameraParams:  # fmt: skip
     """Point-to-line least squares on measured line centres, measured again after each fit: the
-    first time ``search_px`` across each line and without distortion, then ever closer with it."""
+    first time ``search_px`` (plus half the tape) across each line and without distortion, then
+    ever closer with it."""
     p = start
-    res = np.zeros(0)
     near = min(search_px, 2.0)
     for reach, n_fit in ((search_px, 6), (min(search_px, 3.0), 8), (near, 8), (near, 8), (near, 8)):
-        idx, centres, nrm = _centres(CameraModel(p), pts, tan, strength, level, reach)
+        idx, centres, nrm = _centres(CameraModel(p), pts, tan, strength, level, reach + width_px, width_px)
         if len(idx) < 20:
-            raise ValueError(f"only {len(idx)} line points found near the model: the rough start is too far off")
+            raise CalibrationRefused(f"only {len(idx)} line points found near the model: the rough start is too far "
+                                     "off, or this is not the field in field.yaml")  # fmt: skip
         sub = pts[idx]
 
         def resid(x: F64, sub: F64 = sub, centres: F64 = centres, nrm: F64 = nrm, n_fit: int = n_fit,
@@ -273,63 +369,168 @@ def _fine(start: CameraParams, pts: F64, tan: F64, strength: NDArray[np.float32]
             return out
 
         lo, hi = _bounds(p, n_fit, 0.1)
-        sol = least_squares(resid, np.clip(_vector(p)[:n_fit], lo, hi), bounds=(lo, hi), loss="soft_l1", f_scale=1.0,
+        sol = least_squares(resid, np.clip(_vector(p)[:n_fit], lo, hi), bounds=(lo, hi), loss="soft_l1",
+                            f_scale=max(1.0, 0.1 * width_px),
                             x_scale=np.array([1e-3, 1e-3, 1e-3, 2e-3, 2e-3, 1.0, 1e-3, 1e-3])[:n_fit])  # fmt: skip
         p = _params(sol.x, p, n_fit)
-        res = resid(sol.x)
-    return p, res
+    return p
+
+
+@dataclass(frozen=True)
+class _Match:
+    """How well one camera's projection of the field model matches the image's lines."""
+
+    idx: NDArray[np.int64]  # model points whose line centre was found
+    centres: F64
+    residuals: F64  # signed normal distances, px
+    found: float  # share of the model points in view found
+    lines_seen: int
+    directions: int  # 1: all lines seen run one way; 2: both
+    missing: tuple[int, ...]  # lines mostly in view of which little was found
+
+
+def _match(params: CameraParams, pts: F64, tan: F64, ids: NDArray[np.int64], strength: NDArray[np.float32],
+           level: float, reach_px: float, width_px: float) -> _Match:  # fmt: skip
+    model = CameraModel(params)
+    idx, centres, nrm = _centres(model, pts, tan, strength, level, reach_px + width_px, width_px)
+    res = np.sum((model.project(pts[idx]) - centres) * nrm, axis=1) if idx.size else np.zeros(0)
+    px = model.project(pts)
+    view = np.isfinite(px).all(axis=1) & model.in_image(np.nan_to_num(px, nan=-1.0), margin=reach_px + width_px + 2.0)
+    n_view = np.bincount(ids[view], minlength=int(ids.max()) + 1)
+    n_found = np.bincount(ids[idx], minlength=int(ids.max()) + 1)
+    seen = (n_found >= np.maximum(8, 0.5 * n_view)) & (n_view > 0)
+    along_x = np.array([abs(tan[ids == k][:, 0]).mean() > 0.7 for k in range(len(n_view))])
+    circle = np.array([np.ptp(tan[ids == k][:, 0]) > 1.0 for k in range(len(n_view))])
+    dirs = int((seen & along_x & ~circle).any()) + int((seen & ~along_x & ~circle).any()) + 2 * int((seen & circle).any())
+    missing = np.flatnonzero((n_view >= 20) & (n_found < 0.25 * n_view))
+    return _Match(idx, centres, res, float(idx.size / max(1, int(view.sum()))), int(seen.sum()), min(dirs, 2),
+                  tuple(int(k) for k in missing))  # fmt: skip
+
+
+def _half_turn(p: CameraParams) -> CameraParams:
+    """The same camera on the field turned by a half turn about the centre spot: the field's
+    lines look exactly the same to it."""
+    x, y, z = p.position_m
+    return dataclasses.replace(p, position_m=(-x, -y, z), yaw_rad=math.remainder(p.yaw_rad + math.pi, 2 * math.pi))
+
+
+def _describe(line: tuple[float, float, float, float] | float) -> str:
+    if isinstance(line, tuple):
+        return f"the line from ({line[0]:.2f}, {line[1]:.2f}) to ({line[2]:.2f}, {line[3]:.2f}) m"
+    return f"the centre circle of radius {line:.2f} m"
+
+
+def _check(p: CameraParams, m: _Match, width_px: float, league: LeagueParams, fit: LineFitParams) -> None:
+    """Refuse a fit that cannot be right, with the reason (CalibrationRefused)."""
+    fov = math.degrees(2.0 * math.atan(p.resolution_px[0] / 2.0 / p.focal_px))
+    lo, hi = fit.fov_deg
+    if not lo <= fov <= hi:
+        raise CalibrationRefused(f"the fit's focal length {p.focal_px:.0f} px gives a {fov:.0f} degree field of view "
+                                 f"(plausible: {lo:.0f}-{hi:.0f}): wrong --height or field size")  # fmt: skip
+    known = fit.known_focal_px
+    if known > 0.0 and abs(p.focal_px / known - 1.0) > fit.known_focal_tolerance:
+        raise CalibrationRefused(f"the fit's focal length {p.focal_px:.0f} px is {p.focal_px / known - 1.0:+.0%} off "
+                                 f"the known {known:.0f} px (at most {fit.known_focal_tolerance:.0%}): the field's "
+                                 "size in field.yaml or the --height is off by that share")  # fmt: skip
+    metres = width_px / max(CameraModel(p).pixels_per_metre((p.position_m[0], p.position_m[1]), 0.0), 1e-9)
+    if not 0.3 * league.dims.line_width_m <= metres <= max(fit.widest_line_m, 3.0 * league.dims.line_width_m):
+        raise CalibrationRefused(f"the lines measure {metres * 1000:.0f} mm across at the fitted scale, field.yaml's "
+                                 f"line_width_m is {league.dims.line_width_m * 1000:.0f} mm: the scale is wrong "
+                                 "(--height, the field's size) or line_width_m is")  # fmt: skip
+    if m.found < fit.min_found:
+        raise CalibrationRefused(f"only {m.found:.0%} of the field lines the fit puts in view are in the image (at "
+                                 f"least {fit.min_found:.0%} needed): the field in field.yaml (its size, lines, centre "
+                                 "circle) is not the one in the image, or the rough start is too far off")  # fmt: skip
+    if m.missing:
+        lines = field_lines(league)
+        what = "; ".join(_describe(lines[k]) for k in m.missing)
+        raise CalibrationRefused(f"the fit puts field lines in view that the image does not show ({what}): the "
+                                 "field in field.yaml (its size, lines, centre circle) is not the one in the image")  # fmt: skip
+    if m.lines_seen < fit.min_lines or m.directions < 2:
+        raise CalibrationRefused(f"{m.lines_seen} field lines seen{'' if m.directions >= 2 else ', all one way'}: too "
+                                 f"few to fix the camera (at least {fit.min_lines}, both ways or the centre circle)")  # fmt: skip
 
 
 def calibrate_from_lines(image: NDArray[np.uint8], league: LeagueParams, start: CameraParams,
                          fit: LineFitParams | None = None) -> LineCalibration:  # fmt: skip
     """Fit one camera to the field lines in ``image`` (H, W, 3) BGR uint8, from ``start`` (its
     height is kept; its position may be off by up to about ``fit.reach_m``, its focal length by
-    ``fit.focal_range``, its yaw by a few degrees or a half turn). Raises ValueError when the
-    lines cannot be found."""
+    ``fit.focal_range``, its yaw by a few degrees or a half turn).
+
+    The tape's width is measured in the image (field.yaml's line_width_m is where the search
+    starts, ``fit.widest_line_m`` its end) and the line centres are the middles of the tape. The
+    reported error is every measured centre's distance to the fitted lines. A fit that cannot be
+    right raises :class:`CalibrationRefused` with the reason (:func:`_check`); lines that cannot
+    be found raise ValueError."""
     fit = fit or LineFitParams()
     if image.shape[:2] != (start.resolution_px[1], start.resolution_px[0]):
         w, h = start.resolution_px
         raise ValueError(f"the image is {image.shape[1]}x{image.shape[0]} px, the camera {w}x{h}: give its resolution")
     scale = start.focal_px / start.position_m[2]  # px per metre on the carpet, roughly
-    strength = line_strength(image, league.dims.line_width_m * scale, fit.white_chroma)
-    mask = _line_mask(strength, fit.min_strength_grey)
+    widest_px = max(league.dims.line_width_m, fit.widest_line_m) * scale
+    wide = line_strength(image, widest_px, fit.white_chroma)
+    mask = _line_mask(wide, fit.min_strength_grey)
     if int(mask.sum()) < 200:
         raise ValueError(f"only {int(mask.sum())} line pixels found: is the field in view and lit?")
     dist = cv2.distanceTransform((1 - mask).astype(np.uint8), cv2.DIST_L2, 5).astype(np.float32)
-    coarse_pts, _ = field_samples(league, max(0.02, 8.0 / scale))
+    coarse_pts, _, _ = field_samples(league, max(0.02, 8.0 / scale))
     v, u = np.nonzero(mask)
     pick = np.random.default_rng(0).permutation(len(u))[:1500]  # a fixed sample: the same fit every run
     line_px = np.stack([u[pick] + 0.5, v[pick] + 0.5], axis=1).astype(np.float64)
     p = _coarse(start, coarse_pts, dist, line_px, fit)
-    pts, tan = field_samples(league, max(0.005, 3.0 / scale))
-    nz = strength[mask > 0]
-    level = 0.5 * float(np.median(nz))
-    p, res = _fine(p, pts, tan, strength, level, fit.search_px)
-    err = np.abs(res)
-    return LineCalibration(p, float(np.sqrt(np.mean(err**2))), float(err.max()), len(res), int(mask.sum()))
+    pts, tan, ids = field_samples(league, max(0.005, 3.0 / scale))
+    level = 0.5 * float(np.median(wide[mask > 0]))
+    width_px = _line_width(CameraModel(p), pts, tan, wide, level, 1.5 * widest_px + fit.search_px)
+    if width_px <= 0.0:
+        raise CalibrationRefused("the field lines were not found where the rough start puts them: too few to "
+                                 "measure their width")  # fmt: skip
+    strength = line_strength(image, width_px, fit.white_chroma)
+    level = 0.5 * float(np.median(strength[_line_mask(strength, fit.min_strength_grey) > 0]))
+    p = _fine(p, pts, tan, strength, level, fit.search_px, width_px)
+    near = min(fit.search_px, 2.0)
+    m = _match(p, pts, tan, ids, strength, level, near, width_px)
+    notes: list[str] = []
+    # every field looks the same turned half a turn about the centre spot: the rough start decides
+    other = _half_turn(p)
+    off = [abs(math.remainder(q.yaw_rad - start.yaw_rad, 2 * math.pi)) for q in (p, other)]
+    if off[1] < off[0]:
+        p, m = other, _match(other, pts, tan, ids, strength, level, near, width_px)
+    if abs(off[1] - off[0]) < math.radians(30.0):
+        notes.append(f"the rough start's yaw is {math.degrees(min(off)):.0f} and {math.degrees(max(off)):.0f} "
+                     "degrees from the two half turns the lines allow: check which goal is +x")  # fmt: skip
+    _check(p, m, width_px, league, fit)
+    err = np.abs(m.residuals)
+    return LineCalibration(p, float(np.sqrt(np.mean(err**2))), float(err.max()), len(err), int(mask.sum()), width_px,
+                           m.found, m.lines_seen, m.centres, m.residuals, ids[m.idx], tuple(notes))  # fmt: skip
 
 
-def draw_field(image: NDArray[np.uint8], params: CameraParams, league: LeagueParams) -> NDArray[np.uint8]:
-    """A copy of ``image`` with the field model drawn through the camera (magenta, 1 px)."""
+def draw_field(image: NDArray[np.uint8], params: CameraParams, league: LeagueParams,
+               fit: LineCalibration | None = None) -> NDArray[np.uint8]:  # fmt: skip
+    """A copy of ``image`` with the field model drawn through the camera (magenta, 1 px); with
+    ``fit``, the line centres it used (green within 1 px of the fitted line, red beyond) and each
+    line's RMS residual in px written beside it."""
     out = image.copy()
     model = CameraModel(params)
-    pts, _ = field_samples(league, 0.01)
+    pts, _, ids = field_samples(league, 0.01)
     px = model.project(pts)
-    f = Field(league)
-    start = 0
-    lengths = []
-    for seg in f.line_segments():
-        length = float(np.hypot(seg.b[0] - seg.a[0], seg.b[1] - seg.a[1]))
-        lengths.append(max(2, int(math.ceil(length / 0.01)) + 1))
-    r = f.dims.center_circle_radius_m
-    lengths.append(max(8, int(math.ceil(2 * math.pi * r / 0.01))))
-    for k, n in enumerate(lengths):
-        piece = px[start : start + n]
-        if k == len(lengths) - 1:
+    lines = field_lines(league)
+    for k, line in enumerate(lines):
+        piece = px[ids == k]
+        if not isinstance(line, tuple):
             piece = np.concatenate([piece, piece[:1]])
-        start += n
         good = np.isfinite(piece).all(axis=1)
         if good.sum() >= 2:
             poly = np.round((piece[good] - 0.5) * 16).astype(np.int32)  # OpenCV's pixel centres, 4 fractional bits
             cv2.polylines(out, [poly.reshape(-1, 1, 2)], False, (255, 0, 255), 1, cv2.LINE_AA, shift=4)
+    if fit is None:
+        return out
+    for c, r in zip(fit.centres, fit.residuals_px, strict=True):
+        colour = (0, 200, 0) if abs(r) <= 1.0 else (0, 0, 255)
+        cv2.circle(out, (int(c[0]), int(c[1])), 1, colour, -1)
+    for k in np.unique(fit.line_of):
+        sel = fit.line_of == k
+        at = fit.centres[sel][len(fit.centres[sel]) // 2]
+        rms = float(np.sqrt(np.mean(fit.residuals_px[sel] ** 2)))
+        cv2.putText(out, f"{rms:.2f} px", (int(at[0]) + 6, int(at[1]) - 6), cv2.FONT_HERSHEY_SIMPLEX, 0.45,
+                    (255, 255, 255), 1, cv2.LINE_AA)  # fmt: skip
     return out

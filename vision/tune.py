@@ -1,9 +1,13 @@
-"""Colour tuning: threshold boxes (thesis A.1.3) from labelled pixels.
+"""Colour tuning: threshold boxes (thesis A.1.3) from sampled pixels.
 
-Samples come from a user's labels -- a few spots clicked on a real frame, each a colour name, a
-pixel position and a radius -- or from a recording's truth, where every visible dot and the ball
-are known exactly. Each colour's box spans a central share of its samples per channel of the
-colour space, widened by a margin for light the samples did not see.
+Samples come with nothing labelled from a calibrated camera's frames (:func:`auto_samples`: the
+robots' patterns and the ball found by their sizes and the pattern's geometry), from a user's
+labels -- a few spots clicked on a real frame, each a colour name, a pixel position and a radius
+-- or from a recording's truth, where every visible dot and the ball are known exactly. Each
+colour's box spans a central share of its samples per channel of the colour space, widened by a
+margin for light the samples did not see (and, learnt automatically, by the light's spread over
+the field seen on the carpet: :func:`widen_for_light`); boxes that hold another class's samples,
+or the carpet's or the lines', are cut apart (:func:`keep_apart`).
 """
 
 from __future__ import annotations
@@ -14,18 +18,32 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import cv2
 import numpy as np
 import yaml
 from numpy.typing import NDArray
 
 from cmdragons.camera import CameraModel
-from cmdragons.config import ConfigError
-from cmdragons.geometry import LeagueParams
+from cmdragons.config import ConfigError, Validated, setting
+from cmdragons.geometry import Field, LeagueParams
 from cmdragons.recording import RecordingReader
 from vision.cmvision import ColourClass, ColourSpace, convert_colour
 from vision.sources import open_sources
 
-__all__ = ["Label", "read_yaml_any", "boxes_from_samples", "read_labels", "samples_from_labels", "samples_from_truth"]
+__all__ = [
+    "AutoTuneParams",
+    "AutoTuneReport",
+    "Label",
+    "auto_samples",
+    "boxes_from_samples",
+    "keep_apart",
+    "overlaps",
+    "read_labels",
+    "read_yaml_any",
+    "samples_from_labels",
+    "samples_from_truth",
+    "widen_for_light",
+]
 
 Samples = dict[str, list[NDArray[np.int32]]]
 
@@ -148,4 +166,246 @@ def boxes_from_samples(samples: Samples, share: float = 0.998, margin: int = 8,
         hi = np.clip(np.ceil(np.percentile(px, 100.0 - tail, axis=0)) + margin, 0, 255).astype(int)
         out[name] = ColourClass(lo=(int(lo[0]), int(lo[1]), int(lo[2])), hi=(int(hi[0]), int(hi[1]), int(hi[2])),
                                 min_area_px=min_area_px)  # fmt: skip
+    return out
+
+
+@dataclass(frozen=True)
+class AutoTuneParams(Validated):
+    """What ``tune --auto`` takes for a coloured marker, a dot and a ball (grey levels, shares)."""
+
+    min_contrast: float = setting(40.0, lo=1.0, hi=255.0)  # colour distance from the carpet's (Y counts half)
+    min_saturation: float = setting(20.0, lo=0.0, hi=255.0)  # distance from grey in U, V: not white, grey, black
+    area_range: tuple[float, float] = (0.3, 2.5)  # a blob's area against the dot's or ball's expected area
+    dot_distance_tolerance_m: float = setting(0.015, lo=0.001, hi=0.05)  # id dots from the centre dot
+    inner_fraction: float = setting(0.6, lo=0.1, hi=1.0)  # sampled within this share of a blob's expected radius
+    max_overlap: float = setting(0.01, lo=0.0, hi=1.0)  # share of a class's samples in another's box: warned
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if not 0.0 < self.area_range[0] < 1.0 < self.area_range[1]:
+            raise ValueError(f"area_range must be [lo, hi] with 0 < lo < 1 < hi, got {list(self.area_range)}")
+
+
+@dataclass(frozen=True)
+class AutoTuneReport:
+    """What ``tune --auto`` found: samples per role, and the background's (carpet, lines)."""
+
+    samples: dict[str, list[NDArray[np.int32]]]  # role (ball, blue, yellow, pink, green) -> samples
+    background: dict[str, NDArray[np.int32]]  # carpet, lines -> samples
+    patterns: int  # standard patterns found (a centre dot with three or four id dots around it)
+    balls: int
+    # per role, how much darker and brighter the carpet gets over the field in view than it is
+    # around the blobs sampled (the light's spread the role's box must reach)
+    light: dict[str, tuple[float, float]]
+
+
+@dataclass(frozen=True)
+class _Blob:
+    label: int
+    area: float
+    pixel: NDArray[np.float64]  # centroid (u, v), px
+    colour: NDArray[np.float64]  # mean Y, U, V
+
+
+def _blobs(image: NDArray[np.uint8], model: CameraModel, league: LeagueParams,
+           p: AutoTuneParams) -> tuple[list[_Blob], NDArray[np.int32], dict[str, NDArray[np.int32]]]:  # fmt: skip
+    """Coloured blobs on the field (its boundary included): pixels far from the carpet's colour
+    and from grey, grouped 8-connected. Returns the blobs, the label image and the background's
+    samples (YUV): the carpet (the field's pixels near its median colour, off the lines) and the
+    lines (pixels on the centres of the painted lines)."""
+    yuv = convert_colour(image, "yuv")
+    ground = model.center[:2] + model.center[2] * model.pixel_rays_grid().astype(np.float64)
+    f = Field(league)
+    inside = (np.abs(ground[..., 0]) <= f.boundary_half_length) & (np.abs(ground[..., 1]) <= f.boundary_half_width)
+    if inside.sum() < 1000:
+        raise ValueError("the calibrated camera sees almost none of the field: calibrate it first (vision calibrate)")
+    carpet = np.median(yuv[inside], axis=0)
+    d = yuv.astype(np.float64) - carpet
+    contrast = np.sqrt((0.5 * d[..., 0]) ** 2 + d[..., 1] ** 2 + d[..., 2] ** 2)
+    sat = np.hypot(yuv[..., 1] - 128.0, yuv[..., 2] - 128.0)
+    coloured = inside & (contrast > p.min_contrast) & (sat > p.min_saturation)
+    n, labels, stats, cents = cv2.connectedComponentsWithStats(coloured.astype(np.uint8), connectivity=8)
+    blobs = []
+    sums = np.zeros((n, 3))
+    flat = labels.ravel()
+    for c in range(3):
+        sums[:, c] = np.bincount(flat, weights=yuv[..., c].ravel().astype(np.float64), minlength=n)
+    for k in range(1, n):
+        area = float(stats[k, cv2.CC_STAT_AREA])
+        if area >= 4:
+            blobs.append(_Blob(k, area, cents[k] + 0.5, sums[k] / area))
+    # the background: carpet near its median colour, and the painted lines' middles
+    near_carpet = inside & (contrast < 0.5 * p.min_contrast)
+    line_px = _line_pixels(model, league)
+    background = {"carpet": yuv[near_carpet][:: max(1, int(near_carpet.sum()) // 20000)]}
+    # the carpet's brightness around each pixel (its mean over about a robot's width), where it is seen
+    win = max(9, int(0.4 * model.pixels_per_metre((float(model.center[0]), float(model.center[1])), 0.0)) | 1)
+    seen = cv2.boxFilter(near_carpet.astype(np.float32), -1, (win, win), normalize=False)
+    total = cv2.boxFilter(np.where(near_carpet, yuv[..., 0], 0).astype(np.float32), -1, (win, win), normalize=False)
+    background["light"] = np.where(seen > 0, total / np.maximum(seen, 1.0), 0.0).astype(np.int32)
+    if line_px.size:
+        on_line = yuv[line_px[:, 1], line_px[:, 0]]
+        background["lines"] = on_line[sat[line_px[:, 1], line_px[:, 0]] <= p.min_saturation]  # not a dot on it
+    return blobs, labels.astype(np.int32), background
+
+
+def _line_pixels(model: CameraModel, league: LeagueParams) -> NDArray[np.int64]:
+    """Integer pixels (n, 2) (u, v) on the middles of the painted lines in view."""
+    from vision.field_lines import field_samples  # calibration's field model: one description of the lines
+
+    pts, _, _ = field_samples(league, 0.01)
+    px = model.project(pts)
+    ok = np.isfinite(px).all(axis=1) & model.in_image(np.nan_to_num(px, nan=-1.0), margin=1.0)
+    return np.floor(px[ok]).astype(np.int64).clip(0, [model.width - 1, model.height - 1])
+
+
+def auto_samples(images: Sequence[NDArray[np.uint8]], model: CameraModel, league: LeagueParams, space: ColourSpace,
+                 params: AutoTuneParams | None = None) -> AutoTuneReport:  # fmt: skip
+    """Colour samples of every role with nothing labelled, from frames of a calibrated camera
+    (after Gunnarsson et al., "The Color and the Shape": regions matched to the shapes expected).
+
+    Coloured blobs on the field are matched to the standard pattern's geometry (configs/field.yaml):
+    a blob of the centre dot's size with three or four blobs of the id dots' size at the id dots'
+    distance around it is a robot; its centre dot samples the team colour (blue when its U is
+    above grey's, yellow below), its id dots pink (V above grey's) or green. A round blob of the
+    ball's size (field.yaml's ball radius) that is no pattern's, orange (U below and V above
+    grey's), samples the ball. Each blob is sampled within ``inner_fraction`` of its expected
+    radius, in the colour space ``space``."""
+    p = params or AutoTuneParams()
+    pat, h = league.pattern, league.robot.height_m
+    dots = np.array(pat.dot_positions_m)
+    dot_dist = float(np.median(np.hypot(dots[:, 0], dots[:, 1])))
+    r_centre, r_id, r_ball = pat.center_dot_diameter_m / 2, pat.id_dot_diameter_m / 2, league.ball.radius_m
+    lo_a, hi_a = p.area_range
+    samples: dict[str, list[NDArray[np.int32]]] = {}
+    lit: dict[str, list[float]] = {}
+    background: dict[str, list[NDArray[np.int32]]] = {}
+    n_patterns = n_balls = 0
+    for image in images:
+        blobs, labels, back = _blobs(image, model, league, p)
+        light_img = back.pop("light")
+        for key, value in back.items():
+            background.setdefault(key, []).append(value)
+        conv = convert_colour(image, space)
+        if not blobs:
+            continue
+        ground = np.array([model.unproject(b.pixel, h) for b in blobs])
+        ppm = np.array([model.pixels_per_metre((float(g[0]), float(g[1])), h) for g in ground])
+        area = np.array([b.area for b in blobs])
+        is_centre = (area >= lo_a * math.pi * (r_centre * ppm) ** 2) & (area <= hi_a * math.pi * (r_centre * ppm) ** 2)
+        is_id = (area >= lo_a * math.pi * (r_id * ppm) ** 2) & (area <= hi_a * math.pi * (r_id * ppm) ** 2)
+        used = np.zeros(len(blobs), bool)
+
+        def take(role: str, k: int, r_m: float) -> None:
+            b = blobs[k]
+            r_px = max(1.0, p.inner_fraction * r_m * ppm[k])
+            i0, i1 = max(0, int(b.pixel[1] - r_px)), min(image.shape[0], int(b.pixel[1] + r_px) + 1)
+            j0, j1 = max(0, int(b.pixel[0] - r_px)), min(image.shape[1], int(b.pixel[0] + r_px) + 1)
+            vv, uu = np.mgrid[i0:i1, j0:j1] + 0.5
+            sel = ((uu - b.pixel[0]) ** 2 + (vv - b.pixel[1]) ** 2 <= r_px * r_px) & (labels[i0:i1, j0:j1] == b.label)
+            if sel.any():
+                samples.setdefault(role, []).append(conv[i0:i1, j0:j1][sel])
+                local = float(light_img[min(int(b.pixel[1]), image.shape[0] - 1), min(int(b.pixel[0]), image.shape[1] - 1)])
+                if local > 0.0:
+                    lit.setdefault(role, []).append(local)
+
+        for k in np.flatnonzero(is_centre):
+            dist = np.hypot(*(ground - ground[k]).T)
+            ring = np.flatnonzero(is_id & (np.abs(dist - dot_dist) <= p.dot_distance_tolerance_m) & ~used)
+            ring = ring[ring != k]
+            if not 3 <= len(ring) <= 4:
+                continue
+            used[k] = True
+            used[ring] = True
+            n_patterns += 1
+            take("blue" if blobs[k].colour[1] > 128.0 else "yellow", k, r_centre)
+            for j in ring:
+                take("pink" if blobs[j].colour[2] > 128.0 else "green", j, r_id)
+        for k in np.flatnonzero(~used):
+            b = blobs[k]
+            g = model.unproject(b.pixel, r_ball)
+            expect = math.pi * (r_ball * model.pixels_per_metre((float(g[0]), float(g[1])), r_ball)) ** 2
+            orange = b.colour[1] < 128.0 and b.colour[2] > 140.0
+            ys, xs = np.nonzero(labels == b.label)
+            fill = b.area / max(1.0, float((np.ptp(xs) + 1) * (np.ptp(ys) + 1)))
+            if orange and lo_a * expect <= b.area <= hi_a * expect and fill >= 0.5:
+                n_balls += 1
+                take("ball", k, r_ball)
+    back_all = {k: np.concatenate(v) for k, v in background.items()}
+    y = back_all["carpet"][:, 0].astype(np.float64)
+    dark, bright = (float(np.percentile(y, q)) for q in (0.5, 99.5))
+    light = {r: (min(1.0, dark / min(v)), max(1.0, bright / max(v))) for r, v in lit.items()}
+    return AutoTuneReport(samples, back_all, n_patterns, n_balls, light)
+
+
+def widen_for_light(box: ColourClass, light: tuple[float, float], space: ColourSpace) -> ColourClass:
+    """``box`` stretched for light ``light`` (darker, brighter) times the light it was sampled in:
+    every channel scales with the light (U and V about grey in YUV); a colour sampled in one part
+    of the field is then found in the darker and brighter parts too."""
+    lo, hi = np.array(box.lo, np.float64), np.array(box.hi, np.float64)
+    grey = np.array([0.0, 128.0, 128.0]) if space == "yuv" else np.zeros(3)
+    ends = [grey + (v - grey) * r for v in (lo, hi) for r in light]
+    new_lo = np.clip(np.floor(np.min(ends, axis=0)), 0, 255).astype(int)
+    new_hi = np.clip(np.ceil(np.max(ends, axis=0)), 0, 255).astype(int)
+    return ColourClass(lo=(int(new_lo[0]), int(new_lo[1]), int(new_lo[2])),
+                       hi=(int(new_hi[0]), int(new_hi[1]), int(new_hi[2])), min_area_px=box.min_area_px)  # fmt: skip
+
+
+def overlaps(boxes: Mapping[str, ColourClass], samples: Mapping[str, NDArray[np.int32]],
+             max_share: float) -> list[tuple[str, str, float]]:  # fmt: skip
+    """(what, box, share): where more than ``max_share`` of ``what``'s samples fall in another
+    class's ``box`` (a colour class's or the carpet's or lines' samples)."""
+    out = []
+    for name, px in samples.items():
+        for other, box in boxes.items():
+            if other == name or not len(px):
+                continue
+            share = float(np.mean(np.all((px >= box.lo) & (px <= box.hi), axis=1)))
+            if share > max_share:
+                out.append((name, other, share))
+    return out
+
+
+def keep_apart(boxes: dict[str, ColourClass], samples: Mapping[str, NDArray[np.int32]], movable: set[str],
+               min_share: float = 0.01, space: ColourSpace = "yuv") -> dict[str, ColourClass]:  # fmt: skip
+    """``boxes`` with each box of ``movable`` cut back, where more than ``min_share`` of another's
+    samples (a class's, the carpet's, the lines') fall in it: the cut along one channel that misplaces the fewest
+    samples of either, and of those the one that gives up the least of the box."""
+    out = dict(boxes)
+    for name in movable:
+        own = samples.get(name)
+        if own is None or not len(own):
+            own = np.zeros((0, 3), np.int32)  # nothing seen of it: the cut keeps the most of the box instead
+        for other, px in samples.items():
+            box = out[name]
+            lo, hi = np.array(box.lo), np.array(box.hi)
+            if other == name or not len(px) or np.mean(np.all((px >= lo) & (px <= hi), axis=1)) <= min_share:
+                continue
+            best: tuple[int, int, int, int] | None = None  # misplaced, channel, side, cut
+            theirs = px[np.all((px >= lo) & (px <= hi), axis=1)]
+            for c in range(3):
+                cuts = np.arange(int(lo[c]), int(hi[c]) + 1)
+                mine_at = np.searchsorted(np.sort(own[:, c]), cuts)  # own samples below each cut
+                theirs_at = np.searchsorted(np.sort(theirs[:, c]), cuts)
+                mine_above = len(own) - np.searchsorted(np.sort(own[:, c]), cuts, side="right")
+                theirs_above = len(theirs) - np.searchsorted(np.sort(theirs[:, c]), cuts, side="right")
+                # side 0: lo raised to the cut (the other lies below); 1: hi lowered to it
+                width = max(1, int(hi[c]) - int(lo[c]))
+                for side, cost in ((0, mine_at + (len(theirs) - theirs_at)), (1, mine_above + (len(theirs) - theirs_above))):
+                    # misplaced samples first, then the share of the box given up (twice in brightness, the
+                    # channel the light moves most)
+                    given_up = np.abs(cuts - (lo[c] if side == 0 else hi[c])) * (999 if c or space != "yuv" else 1998)
+                    cost = cost * 2000 + given_up // width
+                    k = int(np.argmin(cost))
+                    if best is None or int(cost[k]) < best[0]:
+                        best = (int(cost[k]), c, side, int(cuts[k]))
+            if best is None:
+                continue
+            _, c, side, cut = best
+            if side == 0:
+                lo[c] = cut
+            else:
+                hi[c] = cut
+            out[name] = ColourClass(lo=(int(lo[0]), int(lo[1]), int(lo[2])), hi=(int(hi[0]), int(hi[1]), int(hi[2])),
+                                    min_area_px=box.min_area_px)  # fmt: skip
     return out

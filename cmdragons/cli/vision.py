@@ -47,13 +47,23 @@ def _parser(command: str) -> argparse.ArgumentParser:
         p.add_argument("--overlay", metavar="FILE.png", default=None,
                        help="--lines: the fitted field drawn on the image (default IMAGE_calibration.png beside it)")
         p.add_argument("--resolution", type=int, nargs=2, default=None, metavar=("W", "H"))
-        p.add_argument("--focal", type=float, default=None, help="focal length guess, px (default: from configs)")
+        p.add_argument("--focal", type=float, default=None,
+                       help="focal length, px (default: from configs); with --lines it is taken as known: a fit "
+                       "more than 5%% off it is refused")
         p.add_argument("--fit-principal-point", action="store_true", help="also fit the principal point")
         p.add_argument("--out", metavar="FILE", default=None, help="cameras.yaml to write (default: the config's)")
     else:
-        about = "derive colour threshold boxes from labelled spots or a recording's truth"
+        about = ("derive colour threshold boxes with nothing labelled (--auto: from a calibrated camera's frames), "
+                 "from labelled spots or from a recording's truth; warns where two classes overlap")
         p = argparse.ArgumentParser(prog="cmdragons vision tune", description=about)
-        p.add_argument("images", nargs="+", metavar="IMAGE", help="images, or one recording folder with truth.jsonl")
+        p.add_argument("images", nargs="+", metavar="IMAGE",
+                       help="images (or with --auto a video), or one recording folder with truth.jsonl")
+        p.add_argument("--auto", action="store_true",
+                       help="learn every colour from the frames of a calibrated camera (cameras.yaml, --camera): the "
+                       "robots' patterns and the ball found by their sizes and the pattern's geometry")
+        p.add_argument("--camera", type=int, default=0, help="--auto: the camera id in cameras.yaml (default 0)")
+        p.add_argument("--frames", type=int, default=10, help="--auto: frames of a video used, spread over its "
+                       "first 3 s (default 10)")
         p.add_argument(
             "--labels", metavar="FILE", default=None, help="YAML/JSON list of {colour, pixel, radius, image}"
         )
@@ -115,15 +125,17 @@ def _calibrate(args: argparse.Namespace, settings: object) -> int:
         if args.focal:
             start = dataclasses.replace(start, focal_px=args.focal)
         try:
-            fit_params = LineFitParams(reach_m=args.reach)
+            fit_params = LineFitParams(reach_m=args.reach, known_focal_px=args.focal or 0.0)
         except ValueError as exc:
             raise ValueError(f"--reach: {exc}") from None
         fit = calibrate_from_lines(image, settings.field, start, fit_params)  # type: ignore[attr-defined]
-        params, rms, worst, what = fit.params, fit.rms_px, fit.max_px, f"{fit.points} line points"
+        params, rms, worst = fit.params, fit.rms_px, fit.max_px
+        what = (f"{fit.points} line centres on {fit.lines_seen} lines ({fit.found:.0%} of those in view found; "
+                f"tape {fit.line_width_px:.1f} px wide)")  # fmt: skip
         overlay = Path(args.overlay) if args.overlay else Path(args.lines).with_name(
             Path(args.lines).stem + "_calibration.png")  # fmt: skip
         overlay.parent.mkdir(parents=True, exist_ok=True)
-        if not cv2.imwrite(str(overlay), draw_field(image, params, settings.field)):  # type: ignore[attr-defined]
+        if not cv2.imwrite(str(overlay), draw_field(image, params, settings.field, fit)):  # type: ignore[attr-defined]
             raise ValueError(f"could not write {overlay}")
     else:
         pixels, field = read_correspondences(args.points)
@@ -137,7 +149,9 @@ def _calibrate(args: argparse.Namespace, settings: object) -> int:
           f"{p.yaw_rad:.4f} rad, tilts {p.tilt_x_rad:.4f} {p.tilt_y_rad:.4f} rad, focal {p.focal_px:.2f} px, "
           f"k1 {p.k1:.4f} k2 {p.k2:.4f}; reprojection RMS {rms:.3f} px (max {worst:.3f}) -> {out}")  # fmt: skip
     if image is not None:
-        print(f"calibrate: the fitted field drawn on the image -> {overlay}")
+        for note in fit.notes:
+            print(f"calibrate: note: {note}")
+        print(f"calibrate: the fitted field, the line centres used and each line's RMS drawn on the image -> {overlay}")
     return 0
 
 
@@ -207,11 +221,24 @@ def _check_cameras(data: dict[str, Any], path: Path) -> None:
 
 
 def _tune(args: argparse.Namespace, settings: object) -> int:
-    from vision.tune import boxes_from_samples, read_labels, samples_from_labels, samples_from_truth
+    from vision.tune import (
+        AutoTuneParams,
+        boxes_from_samples,
+        keep_apart,
+        overlaps,
+        read_labels,
+        samples_from_labels,
+        samples_from_truth,
+        widen_for_light,
+    )
 
     vis = settings.vision  # type: ignore[attr-defined]
     first = Path(args.images[0])
-    if args.labels is None:
+    background: dict[str, np.ndarray] = {}
+    light: dict[str, tuple[float, float]] = {}
+    if args.auto:
+        samples, background, light = _auto_samples(args, settings)
+    elif args.labels is None:
         if not (first.is_dir() and (first / "truth.jsonl").exists()):
             raise ValueError("give --labels, or recording folders with truth.jsonl")
         roles = {r: getattr(vis.roles, r) for r in ("ball", "blue", "yellow", "pink", "green")}
@@ -227,16 +254,29 @@ def _tune(args: argparse.Namespace, settings: object) -> int:
                 raise ValueError(f"{name}: cannot be read as an image")
             images.append(np.asarray(img, dtype=np.uint8))
         samples = samples_from_labels(images, read_labels(args.labels), vis.colour_space)
-    boxes = boxes_from_samples(samples, margin=args.margin)
+    learnt = boxes_from_samples(samples, margin=args.margin)
+    boxes = {**vis.colours, **{n: widen_for_light(b, light[n], vis.colour_space) if n in light else b
+                               for n, b in learnt.items()}}  # fmt: skip
+    pooled = {**{n: np.concatenate(p) for n, p in samples.items()}, **background}
+    share = AutoTuneParams().max_overlap
+    for what, other, part in overlaps(boxes, pooled, share):
+        print(f"tune: warning: {part:.0%} of the {what} samples fall in {other}'s box (lo {list(boxes[other].lo)} hi "
+              f"{list(boxes[other].hi)}): the boxes are cut apart", file=sys.stderr)  # fmt: skip
+    boxes = keep_apart(boxes, pooled, set(boxes), share, vis.colour_space)
+    for what, other, part in overlaps(boxes, pooled, share):
+        print(f"tune: warning: still {part:.0%} of the {what} samples in {other}'s box: those pixels are misread; "
+              "label more or other spots", file=sys.stderr)  # fmt: skip
+    changed = {n for n, b in boxes.items() if n in samples or b != vis.colours.get(n)}
     source = settings.config_dir / "vision.yaml"  # type: ignore[attr-defined]
     out = Path(args.out) if args.out else source
     doc = _load_round_trip(out if out.exists() else source)
     colours = doc.setdefault("colours", CommentedMap())
-    for name, box in boxes.items():
-        n = sum(len(p) for p in samples[name])
+    for name, box in ((n, boxes[n]) for n in boxes if n in changed):
+        n = sum(len(p) for p in samples.get(name, []))
         entry = colours.get(name)
         was = f"lo {list(entry['lo'])} hi {list(entry['hi'])}" if entry and "lo" in entry and "hi" in entry else "(new)"
-        print(f"tune: {name:8s} {n:7d} labelled pixels: {was} -> lo {list(box.lo)} hi {list(box.hi)}")
+        why = f"{n:7d} {'sampled' if args.auto else 'labelled'} pixels" if n else "  kept apart from the others"
+        print(f"tune: {name:8s} {why}: {was} -> lo {list(box.lo)} hi {list(box.hi)}")
         if entry is None:
             entry = colours[name] = _flow(CommentedMap(min_area_px=box.min_area_px))
         for key, value in (("lo", box.lo), ("hi", box.hi)):
@@ -247,6 +287,55 @@ def _tune(args: argparse.Namespace, settings: object) -> int:
     _write_round_trip(doc, out, _check_vision)
     print(f"tune: only the colour boxes changed -> {out}")
     return 0
+
+
+def _auto_samples(args: argparse.Namespace,
+                  settings: Any) -> tuple[dict[str, list[np.ndarray]], dict[str, np.ndarray], dict[str, tuple[float, float]]]:  # fmt: skip
+    """``tune --auto``: samples per colour name from the frames given, the background's, and per
+    colour name the light's spread its box must reach."""
+    from cmdragons.camera import CameraModel
+    from cmdragons.videoio import read_video, video_info
+    from vision.tune import auto_samples
+
+    images: list[np.ndarray] = []
+    for name in args.images:
+        img = cv2.imread(name, cv2.IMREAD_COLOR)
+        if img is not None:
+            images.append(np.asarray(img, dtype=np.uint8))
+            continue
+        info = video_info(name)  # a video: --frames frames spread over its first 3 s
+        span = int(3.0 * (info["fps"] or 30.0))
+        if info["frames"]:
+            span = min(span, info["frames"])
+        for k, frame in read_video(name):
+            if k >= span or len(images) >= args.frames:
+                break
+            if k % max(1, span // args.frames) == 0:
+                images.append(frame)
+    if not images:
+        raise ValueError(f"{', '.join(args.images)}: no frame could be read")
+    models = {m.id: m for m in settings.camera_models()}
+    if args.camera not in models:
+        raise ValueError(f"camera {args.camera} is not in cameras.yaml: calibrate it first (vision calibrate)")
+    params = models[args.camera].params
+    h, w = images[0].shape[:2]
+    if (w, h) != tuple(params.resolution_px):
+        s = w / params.resolution_px[0]
+        if abs(h / params.resolution_px[1] - s) > 1e-3:
+            raise ValueError(f"the frames are {w}x{h} px, camera {args.camera} is {params.resolution_px[0]}x"
+                             f"{params.resolution_px[1]}: calibrate it at this size (vision calibrate --lines)")  # fmt: skip
+        params = dataclasses.replace(params, resolution_px=(w, h), focal_px=params.focal_px * s,
+                                     principal_point_px=(params.principal_point_px[0] * s,
+                                                         params.principal_point_px[1] * s))  # fmt: skip
+    vis = settings.vision
+    rep = auto_samples(images, CameraModel(params), settings.field, vis.colour_space)
+    print(f"tune: --auto: {len(images)} frame(s): {rep.patterns} robot patterns, {rep.balls} balls found")
+    names = {role: getattr(vis.roles, role) for role in ("ball", "blue", "yellow", "pink", "green")}
+    for role in names:
+        if role not in rep.samples:
+            print(f"tune: --auto: nothing seen of {role} ({names[role]}): its box stays as it is", file=sys.stderr)
+    return ({names[r]: parts for r, parts in rep.samples.items()}, rep.background,
+            {names[r]: v for r, v in rep.light.items()})  # fmt: skip
 
 
 def _yaml() -> YAML:

@@ -12,12 +12,13 @@ import cv2
 import numpy as np
 import pytest
 import yaml
+from numpy.typing import NDArray
 
 from cmdragons.camera import CameraModel, CameraParams, CamerasParams, cameras_from_config
 from cmdragons.cli import main
-from cmdragons.geometry import FieldDims
+from cmdragons.geometry import FieldDims, LeagueParams
 from sim.render import CameraRenderer, RenderParams
-from vision.field_lines import calibrate_from_lines, rough_start
+from vision.field_lines import CalibrationRefused, LineFitParams, calibrate_from_lines, field_samples, rough_start
 
 from .conftest import LEAGUE, render, snapshot
 
@@ -118,3 +119,103 @@ def test_calibrate_lines_command_keeps_comments_and_draws_the_overlay(cameras: l
     # bad input: one line on stderr, exit code 2
     assert main(["vision", "calibrate", "--lines", str(tmp_path / "none.png"), "--config", str(config)]) == 2
     assert main(["vision", "calibrate", "--config", str(config)]) == 2
+
+
+LAB = FieldDims(length_m=5.54, width_m=3.77, boundary_width_m=0.3, goal_width_m=1.0, defense_width_m=2.0,
+                defense_depth_m=1.0, line_width_m=0.045, center_circle=False, goal_to_goal_line=False)  # fmt: skip
+
+
+def _league(dims: FieldDims) -> LeagueParams:
+    return dataclasses.replace(LEAGUE, divisions={"B": dims, "A": LEAGUE.divisions["A"]})
+
+
+def true_error_px(got: CameraParams, true: CameraParams, league: LeagueParams) -> float:
+    """RMS normal distance (px) between the fitted and the true projections of the field's line
+    centres in view: the fit's error against the true centres."""
+    pts, tan, _ = field_samples(league, 0.01)
+    a, b = CameraModel(got), CameraModel(true)
+    pa, pb = a.project(pts), b.project(pts)
+    ahead = b.project(pts + np.concatenate([tan * 0.01, np.zeros((len(tan), 1))], axis=1))
+    d = ahead - pb
+    nrm = np.stack([-d[:, 1], d[:, 0]], axis=1) / np.linalg.norm(d, axis=1, keepdims=True)
+    view = b.in_image(np.nan_to_num(pb, nan=-1.0), margin=2.0)
+    return float(np.sqrt(np.mean(np.sum((pa[view] - pb[view]) * nrm[view], axis=1) ** 2)))
+
+
+@pytest.fixture(scope="module")
+def lab_render() -> tuple[NDArray[np.uint8], CameraParams]:
+    """A lab field (5.54 x 3.77 m, 45 mm tape, no centre circle, no line from goal to goal) seen
+    whole by one slightly tilted, distorted 1280x720 camera at 3.2 m."""
+    true = CameraParams(id=0, position_m=(0.05, -0.04, 3.2), yaw_rad=0.01, tilt_x_rad=0.01, tilt_y_rad=-0.015,
+                        focal_px=700.0, principal_point_px=(640.0, 360.0), k1=-0.03, k2=0.0,
+                        resolution_px=(1280, 720))  # fmt: skip
+    image, _ = CameraRenderer(CameraModel(true), _league(LAB), RenderParams(noise_sigma_grey=2.0), seed=3).render(
+        snapshot(ROBOTS[:3], ball=(1.0, 0.3, 0.0215)))  # fmt: skip
+    return image.copy(), true
+
+
+def test_wide_tape_centres_and_an_honest_error(lab_render: tuple[NDArray[np.uint8], CameraParams]) -> None:
+    """field.yaml's line width at the league's 10 mm, the tape 45 mm: the width is measured, the
+    fit runs along the tape's middle and the error it reports is its error against the truth."""
+    image, true = lab_render
+    told = _league(dataclasses.replace(LAB, line_width_m=0.01))
+    rough = rough_start(true, 3.2, (-3.3, -1.7, 3.1, 1.9))
+    fit = calibrate_from_lines(image, told, rough)
+    dist, angle = pose_errors(fit.params, true)
+    assert dist < 0.01 and angle < 0.5
+    scale = true.focal_px / 3.2
+    assert fit.line_width_px == pytest.approx(0.045 * scale, rel=0.15)  # 9.8 px
+    truth = true_error_px(fit.params, true, told)
+    assert truth < 0.5 and abs(fit.rms_px - truth) < 0.3
+    assert fit.lines_seen >= 7 and fit.found > 0.9
+
+
+BIGGER = {"length_m": 6.2, "width_m": 4.22, "defense_depth_m": 1.12, "defense_width_m": 2.24}  # all 12 % more
+
+
+@pytest.mark.parametrize(("field", "focal", "reason"), [
+    (dataclasses.replace(LAB, length_m=6.2), 0.0, "not the one in the image"),  # 12 % too long
+    (dataclasses.replace(LAB, **BIGGER), 700.0, "off the known 700 px"),  # all 12 % too big, the lens known
+    (dataclasses.replace(LAB, center_circle=True), 0.0, "not the one in the image"),
+    (FieldDims(), 0.0, "not the one in the image"),  # the league's 9 x 6 m field
+])  # fmt: skip
+def test_a_wrong_field_is_refused_with_its_reason(lab_render: tuple[NDArray[np.uint8], CameraParams],
+                                                  field: FieldDims, focal: float, reason: str) -> None:  # fmt: skip
+    image, true = lab_render
+    with pytest.raises(CalibrationRefused, match=reason):
+        calibrate_from_lines(image, _league(field), rough_start(true, 3.2, (-3.3, -1.7, 3.1, 1.9)),
+                             LineFitParams(known_focal_px=focal))  # fmt: skip
+
+
+REAL = Path(__file__).resolve().parents[3] / "shared" / "realdata" / "lab_frame_lights_on.jpg"
+
+
+@pytest.mark.skipif(not REAL.exists(), reason=f"the real lab frame is not here ({REAL})")
+def test_the_real_lab_frame() -> None:
+    """A webcam's frame of a hand-taped lab field: every line found, the tape's 45 mm measured,
+    the residual about a pixel (hand-laid tape is not straight), a plausible webcam."""
+    image = np.asarray(cv2.imread(str(REAL)), dtype=np.uint8)
+    base = CameraParams(id=0, resolution_px=(1920, 1080), principal_point_px=(960.0, 540.0))
+    fit = calibrate_from_lines(image, _league(dataclasses.replace(LAB, line_width_m=0.01, outer_lines="walls")),
+                               rough_start(base, 4.0, (-3.45, -1.94, 3.45, 1.94)))  # fmt: skip
+    mm = fit.line_width_px / CameraModel(fit.params).pixels_per_metre((0.0, 0.0), 0.0) * 1000
+    assert 35 < mm < 55 and fit.lines_seen == 7 and fit.found > 0.9 and fit.rms_px < 1.6
+    fov = math.degrees(2 * math.atan(960 / fit.params.focal_px))
+    assert 60 < fov < 100  # the BRIO's 16:9 field of view: 65 to 90 degrees
+
+
+def test_calibrate_lines_command_refuses_the_default_field_on_a_lab_frame(
+        lab_render: tuple[NDArray[np.uint8], CameraParams], tmp_path: Path,
+        capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
+    """No --config: the league's 9 x 6 m field against a 5.54 x 3.77 m lab field. Exit 2, the
+    reason in one line, cameras.yaml untouched."""
+    config = tmp_path / "configs"
+    shutil.copytree(CONFIGS, config)
+    before = (config / "cameras.yaml").read_text()
+    frame = tmp_path / "lab.png"
+    cv2.imwrite(str(frame), lab_render[0])
+    assert main(["vision", "calibrate", "--lines", str(frame), "--config", str(config), "--height", "3.2",
+                 "--sees", "-3.3", "-1.7", "3.1", "1.9"]) == 2  # fmt: skip
+    err = capsys.readouterr().err
+    assert "not the one in the image" in err and len(err.strip().splitlines()) == 1
+    assert (config / "cameras.yaml").read_text() == before

@@ -147,3 +147,27 @@ def test_a_distributed_play_on_a_taken_router_port_says_so(tmp_path: Path, capsy
     assert code == 2
     assert err.strip().count("\n") == 0
     assert f"cannot listen on tcp/127.0.0.1:{port}" in err and "runtime.zenoh.router" in err
+
+
+@pytest.mark.parametrize("cut", [False, True], ids=["closed", "cut_short"])
+def test_a_run_log_without_a_message_does_not_block_the_folder(tmp_path: Path, cut: bool,
+                                                                 capsys: pytest.CaptureFixture[str]) -> None:
+    """A run stopped before its first frame (Ctrl-C while compiling) leaves a run.mcap with no message,
+    closed or cut short: the same --out is taken again without --overwrite; a log with messages is not."""
+    from cmdragons.runtime.log import RunLog
+
+    out = tmp_path / "run"
+    out.mkdir()
+    RunLog(out / "run.mcap").close()
+    if cut:
+        data = (out / "run.mcap").read_bytes()
+        (out / "run.mcap").write_bytes(data[: len(data) // 2])
+    argv = ["play", "--seconds", "0.2", "--perception", "truth", "--opponent", "none", "--no-progress", "--out",
+            str(out)]  # fmt: skip
+    code, stdout, err = run(argv, capsys)
+    assert code == 0, err
+    assert json.loads((out / "summary.json").read_text())["seconds"] > 0
+    for name in ("summary.json", "report.png"):
+        (out / name).unlink(missing_ok=True)  # only the played log left: it holds a run
+    code, _, err = run(argv, capsys)
+    assert code == 2 and "holds another run (run.mcap)" in one_line(err)

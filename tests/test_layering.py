@@ -21,8 +21,7 @@ ROOT = Path(__file__).resolve().parents[1]
 FLOOR = {"cmdragons.config", "cmdragons.geometry", "cmdragons.messages", "cmdragons.camera", "cmdragons.recording",
          "cmdragons.videoio", "cmdragons._kernels"}
 PROJECT = ("cmdragons", "vision", "strategy", "sim")
-COMPOSITION = ("cmdragons.runtime", "cmdragons.team", "cmdragons.bench", "cmdragons.cli", "cmdragons.cli_vision",
-               "cmdragons.cli_runtime")
+COMPOSITION = ("cmdragons.runtime", "cmdragons.team", "cmdragons.bench", "cmdragons.cli")
 # library -> the module prefixes allowed to import it
 OWNERS: dict[str, tuple[str, ...]] = {
     "zenoh": ("cmdragons.runtime",),

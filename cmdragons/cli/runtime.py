@@ -282,7 +282,7 @@ def cmd_log(args: argparse.Namespace) -> int:
 
 def cmd_replay(args: argparse.Namespace, stop: Interrupt) -> int:
     """``cmdragons replay LOG.mcap``: the log's messages on zenoh again, paced as recorded."""
-    from cmdragons.cli import _progress
+    from cmdragons.cli.progress import progress_bar
     from cmdragons.runtime.log import LogError
     from cmdragons.runtime.replay import replay, replay_span
     from cmdragons.runtime.settings import load_settings
@@ -307,7 +307,7 @@ def cmd_replay(args: argparse.Namespace, stop: Interrupt) -> int:
     try:
         wait = [r for r in args.wait.split(",") if r] if args.wait else []
         span = last - first - args.start
-        with _progress(not args.no_progress, counts=False) as progress, stop.soft():
+        with progress_bar(not args.no_progress, counts=False) as progress, stop.soft():
             task = progress.add_task("replay", total=max(span, 1e-9), info="")
             shown = [0.0]
 
@@ -339,7 +339,7 @@ def cmd_replay(args: argparse.Namespace, stop: Interrupt) -> int:
 def _replay_league(args: argparse.Namespace, path: Path, stop: Interrupt) -> int:
     """``cmdragons replay match.log.gz``: the league log's vision and referee packets into our
     tracker and brain, in-process and as fast as they go; run.mcap and summary.json."""
-    from cmdragons.cli import _progress
+    from cmdragons.cli.progress import progress_bar
     from cmdragons.runtime.log import LogError, RunLog, run_folder
     from cmdragons.runtime.settings import load_settings
     from cmdragons.runtime.ssl.logfile import LogFileError
@@ -358,7 +358,7 @@ def _replay_league(args: argparse.Namespace, path: Path, stop: Interrupt) -> int
     log = RunLog(folder / "run.mcap")
     total = path.stat().st_size
     try:
-        with _progress(not args.no_progress) as progress, stop.soft():
+        with progress_bar(not args.no_progress) as progress, stop.soft():
             task = progress.add_task("replay", total=None, info=f"{path.name} ({total / 1e6:.1f} MB)")
 
             def show(_t_ns: int, n: int) -> None:

@@ -1,8 +1,4 @@
-"""``cmdragons`` command line: play | sim | vision | bench.
-
-Every command takes ``--config DIR`` (default ``./configs``) and repeatable
-``--set concern.key.path=value`` overrides.
-"""
+"""The embedded commands (``cmdragons play | sim | vision | bench``) and the parser of every command."""
 
 from __future__ import annotations
 
@@ -17,8 +13,9 @@ from typing import TYPE_CHECKING, Any, NoReturn
 
 import numpy as np
 
-from cmdragons.cli_runtime import add_parsers as add_runtime_parsers
-from cmdragons.cli_runtime import cmd_log, cmd_node, cmd_replay, play_distributed
+from cmdragons.cli.progress import progress_bar
+from cmdragons.cli.runtime import add_parsers as add_runtime_parsers
+from cmdragons.cli.runtime import cmd_log, cmd_node, cmd_replay, play_distributed
 from cmdragons.config import ConfigError
 from cmdragons.runtime.interrupt import Interrupt
 from cmdragons.runtime.log import OutputError
@@ -174,7 +171,7 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     if len(argv) >= 2 and argv[0] == "vision" and argv[1] in ("calibrate", "tune"):
-        from cmdragons.cli_vision import main as vision_command
+        from cmdragons.cli.vision import main as vision_command
 
         try:
             return vision_command(argv[1], argv[2:], _common)
@@ -223,24 +220,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     return 2
 
 
-def _progress(enabled: bool, counts: bool = True):  # type: ignore[no-untyped-def]
-    """A progress bar with a task's description, ``info`` field and times; ``counts``: "done/total"."""
-    from rich.progress import (
-        BarColumn,
-        MofNCompleteColumn,
-        Progress,
-        TextColumn,
-        TimeElapsedColumn,
-        TimeRemainingColumn,
-    )
-
-    return Progress(
-        TextColumn("[bold]{task.description}"), BarColumn(), *([MofNCompleteColumn()] if counts else []),
-        TextColumn("{task.fields[info]}"), TimeElapsedColumn(), TimeRemainingColumn(), disable=not enabled,
-        transient=False,
-    )  # fmt: skip
-
-
 def _cmd_sim(args: argparse.Namespace, stop: Interrupt) -> int:
     import dataclasses
 
@@ -270,7 +249,7 @@ def _cmd_sim(args: argparse.Namespace, stop: Interrupt) -> int:
     wall0 = time.perf_counter()
     frame = None
     try:
-        with _progress(not args.no_progress) as progress, stop.soft():
+        with progress_bar(not args.no_progress) as progress, stop.soft():
             task = progress.add_task("sim", total=n_frames, info="")
             for i in range(n_frames):
                 if stop.requested:
@@ -393,7 +372,7 @@ def _cmd_play(args: argparse.Namespace, stop: Interrupt) -> int:
         match = built[0] if built else build()
         built[:] = [match]
         started = time.time()
-        with _progress(not args.no_progress) as progress, stop.soft():
+        with progress_bar(not args.no_progress) as progress, stop.soft():
             task = progress.add_task("play", total=n_frames, info="")
             watch.on_compile = lambda name: progress.update(task, info=f"compiling {name} (first run only)")
             wall0 = time.perf_counter()
@@ -525,7 +504,7 @@ def _compile_kernels(args: argparse.Namespace, settings: Settings, images: bool,
     title = "compiling kernels (first run only)"
     if args.no_progress:
         print(f"{args.command}: {title} ...", file=sys.stderr, flush=True)
-    with _progress(not args.no_progress) as progress:
+    with progress_bar(not args.no_progress) as progress:
         task = progress.add_task(title, total=None, info="")
         counted = [0]
 
@@ -557,7 +536,7 @@ def _cmd_vision(args: argparse.Namespace) -> int:
     folder = run_folder("vision", args.out, overwrite=args.overwrite)
     fps = args.fps or settings.sim.physics.frame_rate_hz
     total = sum(len(s.paths) for s in sources if s.kind == "images") or None
-    with _progress(not args.no_progress) as progress:
+    with progress_bar(not args.no_progress) as progress:
         task = progress.add_task("vision", total=total, info="")
         try:
             summary = run_vision(sources, {m.id: m for m in settings.camera_models()}, settings.vision, settings.field,
@@ -625,6 +604,3 @@ def _cmd_bench(args: argparse.Namespace) -> int:
             return 2
     return 0
 
-
-if __name__ == "__main__":
-    sys.exit(main())

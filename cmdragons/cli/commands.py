@@ -547,8 +547,9 @@ def _cmd_vision(args: argparse.Namespace) -> int:
     d = summary.as_dict()
     bad = summary.unreadable + summary.empty + summary.wrong_size
     ms = d["ms_per_frame"]["median"]
-    print(f"vision: {summary.frames} frames from {len(sources)} camera(s), {d['robots_per_frame']:.2f} robots and "
-          f"{d['balls_per_frame']:.2f} balls per frame, " + (f"{ms:.2f} ms per frame (median)" if ms else "no frame")
+    print(f"vision: {summary.frames} frames from {len(sources)} camera(s), {d['captures']} captures; the whole "
+          f"field per capture (any camera): {d['robots_per_capture']:.2f} robots, the ball in "
+          f"{100 * d['ball_seen_share']:.0f} %; " + (f"{ms:.2f} ms per frame (median)" if ms else "no frame")
           + f" -> {folder}")  # fmt: skip
     for name, frames in d["bad_frames"].items():
         if frames:

@@ -109,6 +109,15 @@ def run_vision(sources: Sequence[FrameSource], cameras: dict[int, CameraModel], 
         raise SourceError(f"{len(sources)} sources but only {len(cameras)} camera model(s) in the config: "
                           f"{missing[0].name} would be camera {missing[0].camera_id}; give one source per camera "
                           "(or a config whose cameras.yaml lists more)")  # fmt: skip
+    for src in sources:  # a file that is no video at all is bad input, said before any work
+        if src.kind == "video":
+            frames = src.frames()
+            try:
+                next(frames, None)
+            except VideoError as exc:
+                raise SourceError(f"{exc}; give a video file (H.264 .mp4, .mkv, .avi)") from None
+            finally:
+                frames.close()
     truth: dict[int, GroundTruth] = {}
     if recording is not None:
         reader = RecordingReader(recording)

@@ -73,20 +73,24 @@ def _count_or_none(text: str) -> int:
     return int(text)
 
 
-def _common(parser: argparse.ArgumentParser) -> None:
+def _common(parser: argparse.ArgumentParser, example: str) -> None:
+    """--config and --set; ``example``: a --set a user of this command would give (a key it reads)."""
     parser.add_argument("--config", metavar="DIR", default=None, help="config folder (default: ./configs)")
     parser.add_argument(
         "--set", metavar="KEY=VALUE", action="append", default=[],
-        help="override one config value, e.g. --set sim.physics.substeps=8 (repeatable)",
+        help=f"override one config value, e.g. --set {example} (repeatable)",
     )  # fmt: skip
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from importlib.metadata import version
+
     parser = _Parser(prog="cmdragons", description="RoboCup small-size team and simulator")
+    parser.add_argument("--version", action="version", version=f"cmdragons {version('cmdragons')}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     p = sub.add_parser("sim", help="run the simulator with scripted motion; record camera frames and truth")
-    _common(p)
+    _common(p, "sim.physics.substeps=8")
     p.add_argument("--seconds", type=_positive, default=10.0, help="simulated seconds (default 10)")
     p.add_argument("--record", action="store_true", help="write camera frames, cameras.yaml and truth.jsonl")
     p.add_argument("--format", choices=("h264", "ffv1", "png"), default=None,
@@ -101,7 +105,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
     p = sub.add_parser("play", help="play a match in the simulator; our team sees only the camera images")
-    _common(p)
+    _common(p, "strategy.kicking.shoot_value=0.1")
     p.add_argument("--opponent", choices=("simple", "self", "none", "outside", "simulation"), default="simple",
                    help="the built-in simple team (on the true state), a copy of our team, nobody, (with "
                    "--distributed) a team outside on commands/yellow (examples/outside_team.py), or a team outside "
@@ -134,7 +138,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="SOURCE: a recording folder, a video file, an image folder or a glob (one per camera). "
         "`cmdragons vision calibrate -h` and `cmdragons vision tune -h` for the other two commands.",
     )  # fmt: skip
-    _common(p)
+    _common(p, "vision.regions.merge_gap_px=2")
     p.add_argument("source", nargs="+", metavar="SOURCE")
     p.add_argument("--out", metavar="DIR", default=None, help="output folder (default logs/<time>-vision)")
     p.add_argument("--overwrite", action="store_true", help="let --out replace the run already in that folder")
@@ -146,9 +150,14 @@ def build_parser() -> argparse.ArgumentParser:
                    "(default: the estimate at each frame's capture time)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
-    p = sub.add_parser("bench", help="run a benchmark suite and print its table")
-    _common(p)
-    p.add_argument("suite", help="suite name (see `cmdragons bench --help`: sim, planning, safety, ...)")
+    from cmdragons.bench import ABOUT
+
+    width = max(len(name) for name in ABOUT)
+    p = sub.add_parser("bench", help="run a benchmark suite and print its table",
+                       formatter_class=argparse.RawDescriptionHelpFormatter,
+                       epilog="suites:\n" + "\n".join(f"  {name:<{width}}  {line}" for name, line in ABOUT.items()))
+    _common(p, "planner.errt.step_m=0.2")
+    p.add_argument("suite", metavar="SUITE", help="which suite (listed below)")
     p.add_argument("--quick", action="store_true", help="a reduced suite, well under a minute")
     p.add_argument("--json", metavar="PATH", default=None, help="also write the rows as JSON")
     p.add_argument("--maps", metavar="DIR", default=None,
@@ -527,6 +536,9 @@ def _cmd_vision(args: argparse.Namespace) -> int:
     from vision.run import run_vision
     from vision.sources import SourceError, open_sources
 
+    if args.track_ahead and not args.track:
+        print("cmdragons vision: --track-ahead predicts the tracks of --track: add --track", file=sys.stderr)
+        return 2
     settings = load_settings(args.config, args.set)
     try:
         sources, recording = open_sources(args.source)

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any, NoReturn
 
 import numpy as np
 
-from cmdragons.cli.progress import progress_bar
+from cmdragons.cli.progress import compile_bar, progress_bar, starting
 from cmdragons.cli.runtime import add_parsers as add_runtime_parsers
 from cmdragons.cli.runtime import cmd_log, cmd_node, cmd_replay, play_distributed
 from cmdragons.config import ConfigError
@@ -326,6 +326,15 @@ def _finish_sim(args: argparse.Namespace, stop: Interrupt, sim: Any, models: Seq
 
 
 def _cmd_play(args: argparse.Namespace, stop: Interrupt) -> int:
+    # a line at once: loading the simulator, vision and the team takes seconds (more on a fresh clone)
+    status = starting(not args.no_progress, "play: loading the simulator, vision and the team ...")
+    try:
+        return _play(args, stop, status)
+    finally:
+        status.stop()
+
+
+def _play(args: argparse.Namespace, stop: Interrupt, status: Any) -> int:
     from cmdragons.messages import GameState
     from cmdragons.runtime.bus import Stage
     from cmdragons.runtime.log import RunLog, run_folder
@@ -377,6 +386,7 @@ def _cmd_play(args: argparse.Namespace, stop: Interrupt) -> int:
             kalman()
             pyplot()
 
+        status.stop()
         compile_s = _compile_kernels(args, settings, images, prepare)
         match = built[0] if built else build()
         built[:] = [match]
@@ -506,23 +516,26 @@ def _compile_kernels(args: argparse.Namespace, settings: Settings, images: bool,
     """Compile the play's numba kernels before the match when they have no cache yet, with a
     progress line, running ``meanwhile`` as it goes; returns the wall seconds it took (0 when every
     kernel was cached, and then ``meanwhile`` is not run)."""
-    from cmdragons.runtime.warmup import cold_kernels, warm_up
+    from cmdragons.runtime.warmup import cold_kernels, warm_up, warm_up_parts
 
     if not cold_kernels(images):
         return 0.0
-    title = "compiling kernels (first run only)"
+    title = "compiling kernels (first run)"
     if args.no_progress:
         print(f"{args.command}: {title} ...", file=sys.stderr, flush=True)
-    with progress_bar(not args.no_progress) as progress:
-        task = progress.add_task(title, total=None, info="")
+    parts = warm_up_parts(images)
+    # a total from the start (the parts compiled side by side, the match built meanwhile the last), the
+    # kernels counted as they come; short columns, so that the line fits 80 columns
+    with compile_bar(not args.no_progress) as progress:
+        task = progress.add_task(title, total=parts, info="")
         counted = [0]
 
         def show(n: int, name: str) -> None:
             counted[0] = n
-            progress.update(task, info=f"{n} kernels, now {name}")
+            progress.update(task, info=f"{n} kernels")
 
-        seconds = warm_up(settings, images, show, meanwhile)
-        progress.update(task, total=1, completed=1, info=f"{counted[0]} kernels in {seconds:.0f} s, cached")
+        seconds = warm_up(settings, images, show, meanwhile, lambda k: progress.update(task, completed=k))
+        progress.update(task, completed=parts, info=f"{counted[0]} kernels, cached")
     if args.no_progress:
         print(f"{args.command}: compiled {counted[0]} kernels in {seconds:.0f} s (cached for next time)",
               file=sys.stderr, flush=True)  # fmt: skip

@@ -39,11 +39,14 @@ def compile_bar(enabled: bool, console: Any = None):  # type: ignore[no-untyped-
 
 def starting(enabled: bool, text: str) -> Any:
     """A spinner with ``text`` on stderr, shown at once while a command loads (stop() it before
-    another live line; stopping twice is harmless); with ``enabled`` false nothing shows."""
+    another live line; stopping twice is harmless); with ``enabled`` false, or stderr no terminal
+    (a pipe, a file, a test), nothing shows."""
+    import sys
+
     from rich.console import Console
     from rich.status import Status
 
     status = Status(text, console=Console(stderr=True))
-    if enabled:
+    if enabled and sys.stderr.isatty():
         status.start()
     return status

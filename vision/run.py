@@ -1,7 +1,8 @@
 """``cmdragons vision SOURCE...``: every camera frame of the sources through the pipeline, into
 detections.jsonl (DESIGN.md), optional overlays (each frame with its detections and the fitted field
 drawn on it: a PNG per still image, a video per video source or, with ``video``, per camera), and a
-summary.
+summary. The summary's robots and ball count the whole field per capture: the frames of one number
+from all cameras.
 
 Frames of another size than the camera model's, at the same aspect ratio, are processed through
 the model scaled to them (:func:`cmdragons.camera.scaled_to`); a source whose first frame has
@@ -45,19 +46,27 @@ class RunSummary:
     empty: list[str] = field(default_factory=list)
     wrong_size: list[str] = field(default_factory=list)
     broken_off: list[str] = field(default_factory=list)  # a video's message: file, first frame not read
-    robots: int = 0
-    balls: int = 0
+    # the whole field per capture (the frames of one number from all cameras): the robots any camera
+    # saw, and whether any saw the ball (a camera sees part of the field: its own counts read as misses)
+    robots_seen: dict[int, set[tuple[str, int]]] = field(default_factory=dict)
+    ball_seen: dict[int, bool] = field(default_factory=dict)
     ms: list[float] = field(default_factory=list)
     score: dict[str, float] | None = None
 
+    def saw(self, det: DetectionFrame) -> None:
+        """Count one camera's detections into its capture's whole-field figures."""
+        self.robots_seen.setdefault(det.frame_number, set()).update((r.team, r.id) for r in det.robots)
+        self.ball_seen[det.frame_number] = self.ball_seen.get(det.frame_number, False) or bool(det.balls)
+
     def as_dict(self) -> dict[str, Any]:
-        n = max(1, self.frames)
+        n = max(1, len(self.ball_seen))
         return {
             "frames": self.frames,
+            "captures": len(self.ball_seen),
             "bad_frames": {"unreadable": self.unreadable, "empty": self.empty, "wrong_size": self.wrong_size},
             "broken_off": self.broken_off,
-            "robots_per_frame": self.robots / n,
-            "balls_per_frame": self.balls / n,
+            "robots_per_capture": sum(len(r) for r in self.robots_seen.values()) / n,
+            "ball_seen_share": sum(self.ball_seen.values()) / n,
             "ms_per_frame": {
                 "median": float(np.median(self.ms)) if self.ms else None,
                 "p95": float(np.percentile(self.ms, 95)) if self.ms else None,
@@ -119,7 +128,11 @@ def _first_frame(src: FrameSource) -> tuple[Iterator[Frame], NDArray[np.uint8] |
     frames = src.frames()
     try:
         first = next(frames)
-    except (StopIteration, VideoError):
+    except StopIteration:
+        return src.frames(), None
+    except VideoError as exc:
+        if src.kind == "video":  # a file that is no video at all is bad input, said before any work
+            raise SourceError(f"{exc}; give a video file (H.264 .mp4, .mkv, .avi)") from None
         return src.frames(), None  # read again in the run, which reports the break
     image = first[1]
     return itertools.chain([first], frames), image if image is not None and image.size else None
@@ -198,8 +211,7 @@ def run_vision(sources: Sequence[FrameSource], cameras: dict[int, CameraModel], 
                 t0 = time.perf_counter()
                 det = pipe.process(image, k, t_capture)
                 summary.ms.append((time.perf_counter() - t0) * 1e3)
-                summary.robots += len(det.robots)
-                summary.balls += len(det.balls)
+                summary.saw(det)
                 jsonl.write(json.dumps(det.to_dict(), separators=(",", ":")) + "\n")
                 if score is not None and k in truth:
                     score.add(det, truth[k])

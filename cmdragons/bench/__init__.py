@@ -14,7 +14,7 @@ from typing import Any
 
 from cmdragons.runtime.settings import Settings
 
-__all__ = ["SUITES", "TABLE_WIDTH", "header", "print_table", "write_json"]
+__all__ = ["ABOUT", "SUITES", "TABLE_WIDTH", "header", "print_table", "write_json"]
 
 Row = dict[str, Any]
 
@@ -46,6 +46,22 @@ SUITES: dict[str, Suite] = {
     "goalie": _lazy("cmdragons.bench.goalie"),
     "runtime": _lazy("cmdragons.bench.runtime"),
     "protocols": _lazy("cmdragons.bench.protocols"),
+}
+# what each suite measures, one line each (``cmdragons bench -h``)
+ABOUT: dict[str, str] = {
+    "sim": "physics per frame, rendering per camera frame beside OpenCV, the simulator against real time",
+    "planning": "the planners and collision queries on seeded small-size scenes",
+    "safety": "the dynamics safety search in the simulator (Bruce 2006 5.6.1): collisions with and without",
+    "tracking": "the tracker on the rendered cameras through vision, against the truth",
+    "play": "seeded full-rules matches against the simple opponent (--opponent self), and the brain's cycle",
+    "vision": "detection quality against truth (noise, light, video, 1920x1200) and time beside OpenCV",
+    "grid": "the grid planners on Moving AI maps beside their peers (--maps DIR)",
+    "robox": "Philippsen's Robox stack (E*, elastic band, dynamic window) beside ERRT and DSS",
+    "navigation": "every planner and navigator on one seeded scene suite beside known implementations (--figures)",
+    "estimation": "EKF localisation, EKF-SLAM and the particle filter beside the Robotics Toolbox's",
+    "goalie": "what the goalie's escape/evade reflex is worth on seeded shots",
+    "runtime": "the distributed runtime on zenoh against the embedded one",
+    "protocols": "the league's packets through loopback: size, encode and decode time, none lost",
 }
 # the options each suite takes
 OPTIONS: dict[str, tuple[str, ...]] = {"grid": ("maps",), "navigation": ("figures",),

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any, NoReturn
 
 import numpy as np
 
-from cmdragons.cli.progress import progress_bar
+from cmdragons.cli.progress import compile_bar, progress_bar, starting
 from cmdragons.cli.runtime import add_parsers as add_runtime_parsers
 from cmdragons.cli.runtime import cmd_log, cmd_node, cmd_replay, play_distributed
 from cmdragons.config import ConfigError
@@ -73,20 +73,24 @@ def _count_or_none(text: str) -> int:
     return int(text)
 
 
-def _common(parser: argparse.ArgumentParser) -> None:
+def _common(parser: argparse.ArgumentParser, example: str) -> None:
+    """--config and --set; ``example``: a --set a user of this command would give (a key it reads)."""
     parser.add_argument("--config", metavar="DIR", default=None, help="config folder (default: ./configs)")
     parser.add_argument(
         "--set", metavar="KEY=VALUE", action="append", default=[],
-        help="override one config value, e.g. --set sim.physics.substeps=8 (repeatable)",
+        help=f"override one config value, e.g. --set {example} (repeatable)",
     )  # fmt: skip
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from importlib.metadata import version
+
     parser = _Parser(prog="cmdragons", description="RoboCup small-size team and simulator")
+    parser.add_argument("--version", action="version", version=f"cmdragons {version('cmdragons')}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     p = sub.add_parser("sim", help="run the simulator with scripted motion; record camera frames and truth")
-    _common(p)
+    _common(p, "sim.physics.substeps=8")
     p.add_argument("--seconds", type=_positive, default=10.0, help="simulated seconds (default 10)")
     p.add_argument("--record", action="store_true", help="write camera frames, cameras.yaml and truth.jsonl")
     p.add_argument("--format", choices=("h264", "ffv1", "png"), default=None,
@@ -101,7 +105,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
     p = sub.add_parser("play", help="play a match in the simulator; our team sees only the camera images")
-    _common(p)
+    _common(p, "strategy.kicking.shoot_value=0.1")
     p.add_argument("--opponent", choices=("simple", "self", "none", "outside", "simulation"), default="simple",
                    help="the built-in simple team (on the true state), a copy of our team, nobody, (with "
                    "--distributed) a team outside on commands/yellow (examples/outside_team.py), or a team outside "
@@ -134,7 +138,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="SOURCE: a recording folder, a video file, an image folder or a glob (one per camera). "
         "`cmdragons vision calibrate -h` and `cmdragons vision tune -h` for the other two commands.",
     )  # fmt: skip
-    _common(p)
+    _common(p, "vision.regions.merge_gap_px=2")
     p.add_argument("source", nargs="+", metavar="SOURCE")
     p.add_argument("--out", metavar="DIR", default=None, help="output folder (default logs/<time>-vision)")
     p.add_argument("--overwrite", action="store_true", help="let --out replace the run already in that folder")
@@ -149,9 +153,14 @@ def build_parser() -> argparse.ArgumentParser:
                    "(default: the estimate at each frame's capture time)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
-    p = sub.add_parser("bench", help="run a benchmark suite and print its table")
-    _common(p)
-    p.add_argument("suite", help="suite name (see `cmdragons bench --help`: sim, planning, safety, ...)")
+    from cmdragons.bench import ABOUT
+
+    width = max(len(name) for name in ABOUT)
+    p = sub.add_parser("bench", help="run a benchmark suite and print its table",
+                       formatter_class=argparse.RawDescriptionHelpFormatter,
+                       epilog="suites:\n" + "\n".join(f"  {name:<{width}}  {line}" for name, line in ABOUT.items()))
+    _common(p, "planner.errt.step_m=0.2")
+    p.add_argument("suite", metavar="SUITE", help="which suite (listed below)")
     p.add_argument("--quick", action="store_true", help="a reduced suite, well under a minute")
     p.add_argument("--json", metavar="PATH", default=None, help="also write the rows as JSON")
     p.add_argument("--maps", metavar="DIR", default=None,
@@ -320,6 +329,15 @@ def _finish_sim(args: argparse.Namespace, stop: Interrupt, sim: Any, models: Seq
 
 
 def _cmd_play(args: argparse.Namespace, stop: Interrupt) -> int:
+    # a line at once: loading the simulator, vision and the team takes seconds (more on a fresh clone)
+    status = starting(not args.no_progress, "play: loading the simulator, vision and the team ...")
+    try:
+        return _play(args, stop, status)
+    finally:
+        status.stop()
+
+
+def _play(args: argparse.Namespace, stop: Interrupt, status: Any) -> int:
     from cmdragons.messages import GameState
     from cmdragons.runtime.bus import Stage
     from cmdragons.runtime.log import RunLog, run_folder
@@ -371,6 +389,7 @@ def _cmd_play(args: argparse.Namespace, stop: Interrupt) -> int:
             kalman()
             pyplot()
 
+        status.stop()
         compile_s = _compile_kernels(args, settings, images, prepare)
         match = built[0] if built else build()
         built[:] = [match]
@@ -500,23 +519,26 @@ def _compile_kernels(args: argparse.Namespace, settings: Settings, images: bool,
     """Compile the play's numba kernels before the match when they have no cache yet, with a
     progress line, running ``meanwhile`` as it goes; returns the wall seconds it took (0 when every
     kernel was cached, and then ``meanwhile`` is not run)."""
-    from cmdragons.runtime.warmup import cold_kernels, warm_up
+    from cmdragons.runtime.warmup import cold_kernels, warm_up, warm_up_parts
 
     if not cold_kernels(images):
         return 0.0
-    title = "compiling kernels (first run only)"
+    title = "compiling kernels (first run)"
     if args.no_progress:
         print(f"{args.command}: {title} ...", file=sys.stderr, flush=True)
-    with progress_bar(not args.no_progress) as progress:
-        task = progress.add_task(title, total=None, info="")
+    parts = warm_up_parts(images)
+    # a total from the start (the parts compiled side by side, the match built meanwhile the last), the
+    # kernels counted as they come; short columns, so that the line fits 80 columns
+    with compile_bar(not args.no_progress) as progress:
+        task = progress.add_task(title, total=parts, info="")
         counted = [0]
 
         def show(n: int, name: str) -> None:
             counted[0] = n
-            progress.update(task, info=f"{n} kernels, now {name}")
+            progress.update(task, info=f"{n} kernels")
 
-        seconds = warm_up(settings, images, show, meanwhile)
-        progress.update(task, total=1, completed=1, info=f"{counted[0]} kernels in {seconds:.0f} s, cached")
+        seconds = warm_up(settings, images, show, meanwhile, lambda k: progress.update(task, completed=k))
+        progress.update(task, completed=parts, info=f"{counted[0]} kernels, cached")
     if args.no_progress:
         print(f"{args.command}: compiled {counted[0]} kernels in {seconds:.0f} s (cached for next time)",
               file=sys.stderr, flush=True)  # fmt: skip
@@ -530,6 +552,9 @@ def _cmd_vision(args: argparse.Namespace) -> int:
     from vision.run import run_vision
     from vision.sources import SourceError, open_sources
 
+    if args.track_ahead and not args.track:
+        print("cmdragons vision: --track-ahead predicts the tracks of --track: add --track", file=sys.stderr)
+        return 2
     settings = load_settings(args.config, args.set)
     try:
         sources, recording = open_sources(args.source)
@@ -551,8 +576,9 @@ def _cmd_vision(args: argparse.Namespace) -> int:
     d = summary.as_dict()
     bad = summary.unreadable + summary.empty + summary.wrong_size
     ms = d["ms_per_frame"]["median"]
-    print(f"vision: {summary.frames} frames from {len(sources)} camera(s), {d['robots_per_frame']:.2f} robots and "
-          f"{d['balls_per_frame']:.2f} balls per frame, " + (f"{ms:.2f} ms per frame (median)" if ms else "no frame")
+    print(f"vision: {summary.frames} frames from {len(sources)} camera(s), {d['captures']} captures; the whole "
+          f"field per capture (any camera): {d['robots_per_capture']:.2f} robots, the ball in "
+          f"{100 * d['ball_seen_share']:.0f} %; " + (f"{ms:.2f} ms per frame (median)" if ms else "no frame")
           + f" -> {folder}")  # fmt: skip
     if args.overlay:
         pngs = len(list((folder / "overlay").glob("*.png"))) if (folder / "overlay").is_dir() else 0

@@ -43,11 +43,11 @@ def _speed(text: str) -> float:
     return value
 
 
-def add_parsers(sub: Any, common: Callable[[argparse.ArgumentParser], None]) -> None:
+def add_parsers(sub: Any, common: Callable[[argparse.ArgumentParser, str], None]) -> None:
     from cmdragons.runtime.params import ROLES
 
     p = sub.add_parser("node", help="run one part of a match as a process on zenoh (see configs/runtime.yaml)")
-    common(p)
+    common(p, "runtime.lockstep_wait_s=5")
     p.add_argument("role", choices=ROLES, help="which part: " + ", ".join(ROLES))
     _match_args(p)
     p.add_argument("--seconds", type=float, default=30.0, help="sim: match time in simulated seconds (default 30)")
@@ -60,7 +60,7 @@ def add_parsers(sub: Any, common: Callable[[argparse.ArgumentParser], None]) -> 
 
     p = sub.add_parser("replay", help="publish a run's MCAP log on zenoh again (for a team node, a viewer, ...); "
                        "a league log (.log, .log.gz) plays into our tracker and brain")
-    common(p)
+    common(p, "runtime.field_name=lab")
     p.add_argument("path", metavar="LOG", help="a run's run.mcap, or a league log (SSL_LOG_FILE: .log or .log.gz)")
     p.add_argument("--team", choices=("blue", "yellow"), default="blue",
                    help="league log: the team our tracker and brain play (default blue)")

@@ -72,12 +72,12 @@ def _parser(command: str) -> argparse.ArgumentParser:
     return p
 
 
-def main(command: str, argv: Sequence[str], common: Callable[[argparse.ArgumentParser], None]) -> int:
+def main(command: str, argv: Sequence[str], common: Callable[[argparse.ArgumentParser, str], None]) -> int:
     """Run ``cmdragons vision <command> ARGV``; ``common`` adds the --config and --set options."""
     from cmdragons.runtime.settings import load_settings
 
     parser = _parser(command)
-    common(parser)
+    common(parser, "vision.colour_space=bgr" if command == "tune" else "cameras.auto.height_m=3.5")
     args = parser.parse_args(list(argv))
     settings = load_settings(args.config, args.set)
     try:

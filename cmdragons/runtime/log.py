@@ -35,14 +35,15 @@ def run_folder(command: str, out: str | Path | None = None, logs: str | Path = "
 
     An ``out`` folder holding another run's files is refused (:class:`OutputError`) unless
     ``overwrite``, which deletes those files and folders (:data:`RUN_FILES`) and leaves any other
-    file alone."""
+    file alone. A run log without a message (a run stopped before its first frame: nothing was
+    played) is not a run: it is replaced without ``overwrite``."""
     if out is not None:
         folder = Path(out)
         if folder.exists() and not folder.is_dir():
             raise OutputError(f"--out {folder}: is a file, not a folder; give a new folder name")
         if folder.is_dir():
             old = sorted({p for pattern in RUN_FILES for p in folder.glob(pattern)})
-            if old and not overwrite:
+            if old and not overwrite and any(p.name != "run.mcap" or holds_messages(p) for p in old):
                 raise OutputError(f"--out {folder}: holds another run ({old[0].name}); give a new folder, "
                                   "or add --overwrite to replace that run")  # fmt: skip
             for p in old:
@@ -70,6 +71,21 @@ def run_folder(command: str, out: str | Path | None = None, logs: str | Path = "
                           "give a writable one with --out DIR") from None  # fmt: skip
     _check_folder_writable(folder)
     return folder
+
+
+def holds_messages(path: Path) -> bool:
+    """Whether the MCAP file at ``path`` holds a message, read from its start (so a file cut
+    short, without its summary, counts what it has); a file that is not MCAP holds none."""
+    from mcap.exceptions import McapError
+    from mcap.reader import NonSeekingReader
+
+    with open(path, "rb") as f:
+        try:
+            for _ in NonSeekingReader(f).iter_messages():
+                return True
+        except (McapError, EOFError, ValueError, struct.error):
+            pass
+    return False
 
 
 def _file_in_the_way(folder: Path) -> Path | None:

@@ -33,7 +33,7 @@ from typing import TYPE_CHECKING, Any, TextIO
 if TYPE_CHECKING:
     from cmdragons.runtime.settings import Settings
 
-__all__ = ["CompileWatch", "cold_kernels", "warm_up"]
+__all__ = ["CompileWatch", "cold_kernels", "warm_up", "warm_up_parts"]
 
 # the top-level kernels of a play, by module: if any has no cache index, the run compiles
 _PLAY_KERNELS: dict[str, tuple[str, ...]] = {
@@ -117,15 +117,26 @@ def _kernel_name(ev: Any) -> str:
     return f"{fn.__module__.rsplit('.', 2)[-2]}.{fn.__name__}"
 
 
-def warm_up(settings: Settings, images: bool,
-            on_progress: Callable[[int, str], None], meanwhile: Callable[[], None] | None = None) -> float:  # fmt: skip
+def warm_up_parts(images: bool, meanwhile: bool = True) -> int:
+    """How many parts :func:`warm_up` compiles in (its total, known before it starts): the
+    children, vision (``images``) and the caller's ``meanwhile``."""
+    return len(_CHILD_PARTS[images]) + int(images) + int(meanwhile)
+
+
+_CHILD_PARTS = {True: ("planning", "motion", "render"), False: ("planning", "motion")}
+
+
+def warm_up(settings: Settings, images: bool, on_progress: Callable[[int, str], None],
+            meanwhile: Callable[[], None] | None = None,
+            on_part: Callable[[int], None] | None = None) -> float:  # fmt: skip
     """Compile the play's kernels now (see the module docstring); returns the wall seconds it took.
     ``on_progress(kernels compiled so far, last kernel's name)`` is called from this thread and a
-    reader thread. ``meanwhile`` runs in this thread while the children compile (the caller builds
-    its match there, so that the two cores stay busy to the end). A child that fails only leaves its
-    kernels to compile during the match."""
+    reader thread; ``on_part(parts done)`` as each part ends (of :func:`warm_up_parts`). ``meanwhile``
+    runs in this thread while the children compile (the caller builds its match there, so that the
+    two cores stay busy to the end). A child that fails only leaves its kernels to compile during
+    the match."""
     t0 = time.perf_counter()
-    done = [0]
+    done = [0, 0]  # kernels, parts
     lock = threading.Lock()
 
     def tick(name: str) -> None:
@@ -133,13 +144,19 @@ def warm_up(settings: Settings, images: bool,
             done[0] += 1
             on_progress(done[0], name)
 
-    children = [_fork(part, settings) for part in (("planning", "motion", "render") if images
-                                                   else ("planning", "motion"))]
+    def part_done() -> None:
+        with lock:
+            done[1] += 1
+            if on_part is not None:
+                on_part(done[1])
+
+    children = [_fork(part, settings) for part in _CHILD_PARTS[images]]
 
     def read(child: _Child) -> None:
         with os.fdopen(child.fd, encoding="utf-8") as lines:
             for line in lines:
                 tick(line.strip())
+        part_done()  # the child closed its pipe: it has ended
 
     readers = [threading.Thread(target=read, args=(c,), daemon=True) for c in children]
     for r in readers:
@@ -148,8 +165,10 @@ def warm_up(settings: Settings, images: bool,
         with CompileWatch(tick):
             if images:
                 _warm_vision(settings)
+                part_done()
             if meanwhile is not None:  # after vision: the children have cached the world's kernels by now
                 meanwhile()
+                part_done()
         for c in children:
             os.waitpid(c.pid, 0)
             c.done = True

@@ -31,6 +31,7 @@ def test_offline_tracks_are_estimates_at_capture_time_that_beat_raw_detections(t
         ahead = 0.0 if name == "capture" else 0.03  # configs/tracker.yaml latency_s
         assert all(d["ahead_s"] == ahead and math.isclose(d["t"], d["t_capture"] + ahead) for d in lines)
         assert [round(d["t_capture"] * 60) for d in lines] == sorted(truth)  # one line per frame, at its time
+        assert [d["frame_number"] for d in lines] == sorted(truth)  # numbered as the frames it follows
         err: dict[str, list[float]] = {"ball": [], "robot": []}
         for k, d in enumerate(lines[10:], start=10):  # past the filters' start
             world, t = WorldState.from_dict(d), truth[k]

@@ -38,3 +38,35 @@ def test_a_fresh_cache_makes_every_play_kernel_cold(tmp_path: Path) -> None:
     assert "cmdragons.safety._kernels.dss" in brain and "cmdragons.planning._errt_kernels.errt_grow" in brain
     assert not any(name.startswith(("sim.", "vision.")) for name in brain)
     assert set(brain) < set(images)
+
+
+def test_the_compile_step_counts_its_parts_to_the_total_it_shows_from_the_start() -> None:
+    from cmdragons.runtime.settings import load_settings
+    from cmdragons.runtime.warmup import warm_up, warm_up_parts
+
+    parts: list[int] = []
+    ran: list[bool] = []
+    warm_up(load_settings(None, []), False, lambda n, name: None, lambda: ran.append(True), parts.append)
+    assert ran == [True]
+    assert parts == list(range(1, warm_up_parts(False) + 1)) and warm_up_parts(False) == 3  # two children, the match
+    assert warm_up_parts(True) == 5 and warm_up_parts(True, meanwhile=False) == 4
+
+
+def test_the_compile_line_fits_80_columns_whole() -> None:
+    import io
+
+    from rich.console import Console
+
+    from cmdragons.cli.progress import compile_bar
+
+    out = io.StringIO()
+    console = Console(file=out, width=80, force_terminal=True, color_system=None)
+    with compile_bar(True, console) as progress:
+        task = progress.add_task("compiling kernels (first run)", total=5, info="0 kernels")
+        progress.update(task, completed=5, info="123 kernels, cached")
+    import re
+
+    text = re.sub(r"\x1b\[[0-9;?]*[A-Za-z]", "", out.getvalue())  # the terminal's control sequences
+    last = [line for line in text.replace("\r", "\n").splitlines() if line.strip()][-1]
+    assert "5/5 parts, 123 kernels, cached" in last and "…" not in last
+    assert last.startswith("compiling kernels (first run)")

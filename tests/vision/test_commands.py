@@ -59,6 +59,23 @@ def test_vision_on_a_recording_counts_bad_frames_and_scores_truth(recording: Pat
     assert (out / "annotated_camera_0.mp4").stat().st_size > 0
 
 
+def test_the_summary_counts_the_whole_field_per_capture(tmp_path: Path, capsys: Capture) -> None:
+    """Each camera sees part of the field: the summary's robots and ball are those any camera saw in a
+    capture (the frames of one number), not counts per camera frame (a ball in one camera's half read
+    as 0.5 balls per frame); the ball lies at the centre spot, in both cameras' views, and counts once."""
+    rec, out = tmp_path / "rec", tmp_path / "out"
+    assert main(["sim", "--config", str(CONFIGS), "--seconds", "0.1", "--record", "--format", "png",
+                 "--out", str(rec), "--no-progress"]) == 0  # fmt: skip
+    truth = [json.loads(s) for s in (rec / "truth.jsonl").read_text().splitlines()]
+    capsys.readouterr()
+    assert main(["vision", str(rec), "--config", str(CONFIGS), "--out", str(out), "--no-progress"]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["frames"] == 2 * len(truth) and summary["captures"] == len(truth) == 6
+    assert summary["robots_per_capture"] == len(truth[0]["robots"])  # every robot, once, whichever camera saw it
+    assert summary["ball_seen_share"] == 1.0  # the ball on the field, in some camera's view, every capture
+    assert "the ball in 100 %" in capsys.readouterr().out
+
+
 def test_vision_on_a_glob_and_a_video(recording: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     import cv2
 

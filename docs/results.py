@@ -52,7 +52,8 @@ def headline_table(results: list[dict[str, Any]] | None = None) -> str:
     results = load() if results is None else results
     lines = ["| bench | result | commit | date | machine |", "|---|---|---|---|---|"]
     for data in results:
-        lines.append(f"| `{data['suite']}` | {headline(data)} | `{data['commit']}` | {data['date']} | {data['machine']} |")
+        where = f"`{data['commit']}` | {data['date']} | {data['machine']}"
+        lines.append(f"| `{data['suite']}` | {headline(data)} | {where} |")
     return "\n".join(lines)
 
 

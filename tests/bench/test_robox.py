@@ -6,6 +6,8 @@ from __future__ import annotations
 import dataclasses
 from pathlib import Path
 
+import pytest
+
 from cmdragons.bench.robox import crossing, robox_settings
 from cmdragons.runtime.settings import load_settings
 
@@ -20,6 +22,7 @@ def test_the_robox_settings_change_the_planner_and_the_navigator_only() -> None:
     assert robox_settings(s, safety=False).safety.method == "none"
 
 
+@pytest.mark.slow
 def test_a_crossing_is_the_same_for_the_same_seed() -> None:
     # the deadlines are the safety net of a stalled machine (a first call compiling, a loaded CI
     # box): raised out of reach, only the work budgets bound each frame, as the property needs

@@ -80,6 +80,7 @@ def test_snapshot_checked_before_the_run(tmp_path: Path, a_file: Path, capsys: p
     assert not (tmp_path / "s").exists()  # nothing made: the run never started
 
 
+@pytest.mark.slow
 def test_out_refuses_another_run_unless_overwrite(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "run"
     argv = ["play", "--seconds", "0.2", "--perception", "truth", "--opponent", "none", "--no-progress", "--out",
@@ -105,6 +106,7 @@ def _recording(tmp_path: Path) -> Path:
     return rec
 
 
+@pytest.mark.slow
 def test_a_truth_file_cut_mid_line_keeps_the_frames_before(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     rec = _recording(tmp_path)
     truth = rec / "truth.jsonl"
@@ -123,6 +125,7 @@ def test_a_truth_file_cut_mid_line_keeps_the_frames_before(tmp_path: Path, capsy
     assert len(err) == 1 and "truth.jsonl: line 4 is not a frame's truth" in err[0]
 
 
+@pytest.mark.slow
 def test_more_sources_than_cameras_is_one_line_before_any_work(tmp_path: Path,
                                                                capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
     rec = _recording(tmp_path)

@@ -46,6 +46,7 @@ def mcap_messages(path: Path) -> int:
         return sum(1 for _ in reader.iter_messages())
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
 def test_play_interrupted_keeps_everything(tmp_path: Path, sig: signal.Signals) -> None:
     out = tmp_path / "run"
@@ -68,6 +69,7 @@ def test_play_interrupted_keeps_everything(tmp_path: Path, sig: signal.Signals) 
     assert lines[-1].endswith(str(out))
 
 
+@pytest.mark.slow
 def test_sim_record_interrupted_keeps_the_camera_videos(tmp_path: Path) -> None:
     out = tmp_path / "rec"
     child = start(["sim", "--seconds", "600", "--record", "--no-progress", "--out", str(out)])

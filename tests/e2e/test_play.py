@@ -15,6 +15,7 @@ from cmdragons.runtime.settings import load_settings
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 
 
+@pytest.mark.slow
 def test_alone_on_the_field_the_team_scores() -> None:
     summary = Match(load_settings(CONFIGS), opponent="none", perception="vision", seed=1).run(30.0)
     assert summary["score"]["blue"] >= 1
@@ -26,6 +27,7 @@ def against_simple() -> dict[str, Any]:
     return Match(load_settings(CONFIGS), opponent="simple", perception="vision", seed=2).run(30.0)
 
 
+@pytest.mark.slow
 def test_against_the_simple_opponent_runs(against_simple: dict[str, Any]) -> None:
     assert against_simple["seconds"] == pytest.approx(30.0)
     assert against_simple["command_faults"]["non_finite"] == 0
@@ -35,6 +37,7 @@ def test_against_the_simple_opponent_no_own_collision(against_simple: dict[str, 
     assert against_simple["collisions"]["own"] == 0
 
 
+@pytest.mark.slow
 def test_play_cli_writes_the_summary(tmp_path: Path) -> None:
     out = tmp_path / "play"
     assert main(["play", "--seconds", "1", "--out", str(out), "--no-progress", "--video", "--opponent", "self"]) == 0

@@ -13,6 +13,7 @@ from cmdragons.cli import main
 from cmdragons.recording import RecordingReader
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fmt", ["h264", "ffv1", "png"])
 def test_sim_record_reads_back(tmp_path: Path, fmt: str) -> None:
     out = tmp_path / "run"
@@ -44,6 +45,7 @@ def test_sim_record_reads_back(tmp_path: Path, fmt: str) -> None:
     assert {"/truth", "/referee", "/commands/blue", "/commands/yellow", "/events"} <= topics
 
 
+@pytest.mark.slow
 def test_same_seed_same_run(tmp_path: Path) -> None:
     for name in ("a", "b"):
         assert main(["sim", "--seconds", "0.5", "--record", "--format", "png", "--out", str(tmp_path / name),

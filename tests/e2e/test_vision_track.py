@@ -8,6 +8,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from cmdragons.cli import main
 from cmdragons.messages import DetectionFrame, GroundTruth, WorldState
@@ -17,6 +18,7 @@ def _rms(v: list[float]) -> float:
     return float(np.sqrt(np.mean(np.square(v))))
 
 
+@pytest.mark.slow
 def test_offline_tracks_are_estimates_at_capture_time_that_beat_raw_detections(tmp_path: Path) -> None:
     rec = tmp_path / "rec"
     assert main(["sim", "--seconds", "2", "--record", "--format", "png", "--out", str(rec), "--no-progress"]) == 0

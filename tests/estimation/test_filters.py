@@ -90,6 +90,7 @@ def _start(run, seed: int = 0):  # type: ignore[no-untyped-def]
     return run.truth[0] + np.random.default_rng(100 + seed).multivariate_normal(np.zeros(3), p0), p0
 
 
+@pytest.mark.slow
 def test_ekf_localisation_nees_lies_within_its_chi_square_bounds() -> None:
     # the NEES averaged over N independent runs: within the two-sided 95% bounds of chi2(3N)/N
     n_runs, steps = 20, 300
@@ -111,6 +112,7 @@ def test_ekf_localisation_nees_lies_within_its_chi_square_bounds() -> None:
     assert float(np.median(errors)) < 0.1
 
 
+@pytest.mark.slow
 def test_the_steered_vehicle_ekf_is_consistent_and_beats_dead_reckoning() -> None:
     # the NEES averaged over N runs within the 95% bounds of chi2(3N)/N, as for EKF localisation
     n_runs, steps, wheelbase = 20, 300, 0.5

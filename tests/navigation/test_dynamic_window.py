@@ -32,6 +32,7 @@ PARAMS = DynamicWindowParams()
 CFG = K.WindowConfig(M.period_s, PARAMS.margin_m, PARAMS.step_m, PARAMS.clearance_weight_1_s, PARAMS.clearance_cap_m)
 
 
+@pytest.mark.slow
 def test_kernel_agrees_with_the_reference() -> None:
     # every candidate the reference finds admissible with a step to spare is admissible to the kernel,
     # none it finds inadmissible is; the kernel's choice scores at least the best of the former
@@ -96,6 +97,7 @@ def test_a_robot_in_front_is_not_sped_into() -> None:
     assert vx < 2.5 - 0.05
 
 
+@pytest.mark.slow
 def test_a_match_driven_by_the_dynamic_window_has_no_own_collision() -> None:
     # what `cmdragons play --set team.navigator=dynamic_window` runs (on truth, for speed)
     settings = load_settings(CONFIGS, ["team.navigator=dynamic_window"])

@@ -8,6 +8,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from cmdragons.control import ControlParams
 from cmdragons.geometry import Field, LeagueParams
@@ -82,6 +83,7 @@ def test_along_a_polyline() -> None:
     np.testing.assert_allclose(along(path, 9.0), (1.0, 2.0))
 
 
+@pytest.mark.slow
 def test_a_match_of_the_errt_team_against_the_robox_stack() -> None:
     # what `cmdragons play --opponent self --opponent-set team.navigator=robox --opponent-set
     # planner.planner=estar` runs (on truth, for speed): each team plans and navigates with its own

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 from cmdragons.bench import SUITES
 from cmdragons.bench.planning import Sizes, run
 from cmdragons.runtime.settings import load_settings
@@ -11,6 +13,7 @@ from cmdragons.runtime.settings import load_settings
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 
 
+@pytest.mark.slow
 def test_tiny_planning_suite_reports_every_planner() -> None:
     assert "planning" in SUITES
     sizes = Sizes(static_scenes=4, moving_scenes=1, frames=6, optimum_every=3, collision_queries=50, crowd_scenes=2)

@@ -50,6 +50,7 @@ def test_segment_distances_agree_with_dense_sampling(kind: str) -> None:
         assert ref - 1e-3 <= got <= ref + 1e-12
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("broad_phase", sorted(BROAD_PHASES))
 @pytest.mark.parametrize(
     ("n_circles", "n_boxes", "window"), [(0, 0, 0.0), (10, 2, 0.0), (21, 8, 0.0), (40, 4, 0.3), (50, 3, 0.1)]

@@ -61,6 +61,7 @@ def test_octile_search_is_exact(weighted: bool, seed: int) -> None:
             assert p.length == pytest.approx(expected, abs=1e-9) if math.isfinite(expected) else not p.found
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not BENCH.is_dir(), reason="the Moving AI benchmark data (../shared/benchdata) is not here")
 @pytest.mark.parametrize("name", ["8room_000", "random512-10-0"])
 def test_octile_search_matches_the_moving_ai_optima(name: str) -> None:

@@ -98,6 +98,7 @@ def _play(tmp: Path, seconds: float, seed: int, images: bool = False) -> Path:
     return path
 
 
+@pytest.mark.slow
 def test_same_seed_gives_a_byte_identical_log(tmp_path: Path) -> None:
     a = tmp_path / "a"
     b = tmp_path / "b"
@@ -106,6 +107,7 @@ def test_same_seed_gives_a_byte_identical_log(tmp_path: Path) -> None:
     assert digest[0] == digest[1]
 
 
+@pytest.mark.slow
 def test_the_log_holds_every_topic_each_readable_as_its_message(tmp_path: Path) -> None:
     path = _play(tmp_path, 5.0, seed=2, images=True)
     types = {"truth": msg.GroundTruth, "referee": msg.GameState, "events": msg.SimEvents, "teleport": msg.Teleport,
@@ -129,6 +131,7 @@ def test_the_log_holds_every_topic_each_readable_as_its_message(tmp_path: Path) 
     assert {"/summary/sim", "/summary/referee", "/summary/tracker/blue", "/summary/stats/blue"} <= set(counts)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("synchronized", [False, True])
 def test_the_tracker_stage_on_a_recorded_detection_topic_equals_the_direct_call(synchronized: bool) -> None:
     m = Match(SETTINGS, "simple", "vision", seed=4)

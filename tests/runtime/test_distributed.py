@@ -137,6 +137,7 @@ def _until(done: Callable[[], bool], what: str, timeout_s: float = 120.0) -> Non
     pytest.fail(f"never: {what}")
 
 
+@pytest.mark.slow
 def test_a_killed_team_node_rejoins_and_the_match_goes_on(router: Any) -> None:
     import dataclasses
 

@@ -97,6 +97,7 @@ def test_report_png_is_one_page(tmp_path: Path) -> None:
     assert img is not None and img.shape == (1000, 1400, 3)
 
 
+@pytest.mark.slow
 def test_the_report_stage_gathers_what_the_log_reads_back(tmp_path: Path) -> None:
     settings = load_settings(Path(__file__).resolve().parents[2] / "configs")
     log = RunLog(tmp_path / "run.mcap")

@@ -72,6 +72,7 @@ def test_not_a_log_is_an_error(tmp_path: Path) -> None:
         list(LogReader(tmp_path / "v.log"))
 
 
+@pytest.mark.slow
 def test_convert_a_match_log_to_a_league_log_and_back(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["play", "--seconds", "0.3", "--no-progress", "--out", str(tmp_path / "run")]) == 0
     mcap = tmp_path / "run" / "run.mcap"

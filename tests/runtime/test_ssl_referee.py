@@ -116,6 +116,7 @@ def test_referee_bytes_decode_with_protoc() -> None:
         assert line in out, (line, out)
 
 
+@pytest.mark.slow
 def test_a_match_plays_to_our_referees_packets_over_loopback(udp_port: int) -> None:
     settings = load_settings(None, [f"protocols.referee.port={udp_port}", "protocols.referee.send=true",
                                     "protocols.referee.source=game_controller"])  # fmt: skip

@@ -35,6 +35,7 @@ def _topic(path: Path, topic: str) -> list[object]:
     return [m for t, _, m in read_log(path) if t == topic]
 
 
+@pytest.mark.slow
 def test_a_league_log_of_a_match_replays_to_the_same_tracks(match: tuple[Path, Path], tmp_path: Path) -> None:
     mcap, league = match
     gz = tmp_path / "match.log.gz"
@@ -75,6 +76,7 @@ def test_a_league_replay_refuses_the_zenoh_options_in_one_line(
     shutil.rmtree(tmp_path / "y", ignore_errors=True)
 
 
+@pytest.mark.slow
 def test_a_real_matchs_log_is_tracked_to_its_truth(tmp_path: Path) -> None:
     t0 = 1_700_000_000.0  # Unix time, as SSL-Vision stamps its frames
     counters = {0: 1000, 1: 52000, 2: 7, 3: 999_999}  # each camera counts its own frames

@@ -157,6 +157,7 @@ def _worlds(settings_overrides: list[str], seconds: float) -> tuple[list[msg.Wor
     return worlds, summary
 
 
+@pytest.mark.slow
 def test_a_match_on_our_own_ssl_vision_packets_plays_as_the_in_process_one(udp_port: int) -> None:
     seconds = 1.0
     direct, s0 = _worlds([], seconds)

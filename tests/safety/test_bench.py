@@ -25,6 +25,7 @@ def test_layout_crosses_the_field_from_both_sides_on_the_field(n: int) -> None:
         assert np.abs(np.vstack([starts, goals])[:, 1]).max() <= half_width - 0.1
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", [0, 1])
 def test_dss_traversal_has_no_collisions_and_completes(seed: int) -> None:
     dss = run_trial(SETTINGS, 6, "dss", "default", seed)

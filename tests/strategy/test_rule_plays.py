@@ -68,6 +68,7 @@ def play(w: World, ref: Referee, brain: Brain, seconds: float,
 Pose = tuple[int, float, float, float]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("ball", "target", "ours", "theirs"), [
     ((-2.0, 2.6), (-2.0, 2.8), (), ()),  # out by the touch line: a short way
     ((3.0, -1.0), (1.0, 0.5), (), ()),  # across, the robots' side
@@ -101,6 +102,7 @@ def test_ball_placement_ends_in_tolerance_in_time(ball: tuple[float, float], tar
     assert not [e for e in calls if e.team == "blue" and e.kind not in ("placement_succeeded",)]  # no foul
 
 
+@pytest.mark.slow
 def test_ball_placement_backwards_with_the_ball_seen_nearer_than_it_is() -> None:
     """The cameras see a ball by a robot up to a centimetre or so nearer it than it is: seen on the
     face, it may not be on the dribbler yet. The placer presses on until it holds it, then pulls it
@@ -161,6 +163,7 @@ def test_ball_placement_lets_go_with_the_ball_seen_to_follow_the_robot() -> None
     assert max(dribbler[let_go:]) == 0.0  # not taken again
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("robot", [(-4.42, 1.48, -0.21), (-4.5, 2.1, -1.0)])
 def test_a_robot_beside_the_ball_in_a_corner_at_a_stop_leaves_it_without_touching_it(
         robot: tuple[float, float, float]) -> None:  # fmt: skip
@@ -254,6 +257,7 @@ def test_our_keeper_saves_the_simple_opponents_penalty() -> None:
     assert not [e for e in calls if e.team == "blue" and e.kind != "penalty_over"]  # no foul of ours
 
 
+@pytest.mark.slow
 def test_stop_keeps_every_robot_away_from_the_ball_and_slow_every_frame() -> None:
     w, ref, brain = scene(blue=6, yellow=0)
     ball = (0.5, 0.5)

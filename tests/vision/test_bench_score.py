@@ -39,6 +39,7 @@ def test_score_counts_found_false_and_wrong_ids() -> None:
     assert s["false_per_frame"] == 2.0  # the blue robot at (-1, -1) and the second ball
 
 
+@pytest.mark.slow
 def test_tiny_vision_bench_meets_the_quality_targets() -> None:
     from cmdragons.bench.vision import run
 

@@ -210,6 +210,7 @@ def test_density_merge_joins_fragments_and_min_area_drops_specks() -> None:
     assert sorted(unmerged.area.tolist()) == [40.0, 50.0]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("space", ["yuv", "bgr"])
 def test_kernel_colour_conversion_equals_reference_for_every_colour(space: str) -> None:
     from vision.cmvision import convert_colour
@@ -240,6 +241,7 @@ def speckled_stats(seed: int) -> NDArray[np.float64]:
     return kern.region_stats(flat, label, int(n[0]))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", [0, 1, 2])
 @pytest.mark.parametrize(("gap", "density"), [(1.0, 0.6), (0.0, 0.3), (2.5, 0.4), (40.0, 0.05)])
 def test_merge_kernel_equals_reference_among_many_specks(seed: int, gap: float, density: float) -> None:

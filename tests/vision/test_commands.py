@@ -42,6 +42,7 @@ def recording(tmp_path_factory: pytest.TempPathFactory) -> Path:
 Capture = pytest.CaptureFixture[str]
 
 
+@pytest.mark.slow
 def test_vision_on_a_recording_counts_bad_frames_and_scores_truth(recording: Path, tmp_path: Path,
                                                                   capsys: Capture) -> None:  # fmt: skip
     out = tmp_path / "out"
@@ -93,6 +94,7 @@ def test_vision_on_a_glob_and_a_video(recording: Path, tmp_path: Path, capsys: p
     assert main(["vision", str(tmp_path / "nothing*.png"), "--config", str(CONFIGS), "--out", str(out)]) == 2
 
 
+@pytest.mark.slow
 def test_vision_on_a_cut_off_video_processes_every_frame_before_the_break(tmp_path: Path, capsys: Capture) -> None:
     rec = tmp_path / "rec"
     assert main(["sim", "--config", str(CONFIGS), "--seconds", "0.5", "--record", "--out", str(rec),

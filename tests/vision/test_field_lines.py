@@ -44,6 +44,7 @@ def off_start(true: CameraParams, dx: float, dy: float) -> CameraParams:
     return rough_start(true, true.position_m[2], sees)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("cam", [0, 1])
 def test_lines_recover_the_simulators_cameras(cameras: list[CameraModel], cam: int) -> None:
     true = cameras[cam].params
@@ -56,6 +57,7 @@ def test_lines_recover_the_simulators_cameras(cameras: list[CameraModel], cam: i
     assert fit.params.k1 == pytest.approx(true.k1, abs=2e-3)
 
 
+@pytest.mark.slow
 def test_lines_on_a_frame_of_other_colours_tilt_and_distortion(cameras: list[CameraModel]) -> None:
     base = cameras[0].params
     true = dataclasses.replace(base, k1=-0.07, k2=0.01, tilt_x_rad=0.03, tilt_y_rad=-0.02, yaw_rad=base.yaw_rad + 0.02,
@@ -72,6 +74,7 @@ def test_lines_on_a_frame_of_other_colours_tilt_and_distortion(cameras: list[Cam
     assert (fit.params.k1, fit.params.k2) == pytest.approx((-0.07, 0.01), abs=5e-3)
 
 
+@pytest.mark.slow
 def test_lines_on_a_small_custom_field() -> None:
     """A 6.05 x 4.05 m field (an older size, as a custom division in field.yaml)."""
     small = FieldDims(length_m=6.05, width_m=4.05, goal_width_m=0.7, defense_width_m=1.4, defense_depth_m=0.8,
@@ -86,6 +89,7 @@ def test_lines_on_a_small_custom_field() -> None:
     assert dist < 0.01 and angle < 0.5 and fit.rms_px <= 0.5
 
 
+@pytest.mark.slow
 def test_calibrate_lines_command_keeps_comments_and_draws_the_overlay(cameras: list[CameraModel],
                                                                       tmp_path: Path) -> None:  # fmt: skip
     config = tmp_path / "configs"

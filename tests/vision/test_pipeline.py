@@ -82,6 +82,7 @@ def test_bad_vision_config_names_the_problem(tmp_path: Path, text: str, fragment
     assert fragment in str(err.value)
 
 
+@pytest.mark.slow
 def test_calibrated_blob_height_leaves_no_radial_ball_bias(cameras: list[CameraModel]) -> None:
     """Balls at rest across the whole image of each camera: with the configured blob height the
     detections lie neither outward nor inward of the truth (within 1 mm of height), and the

@@ -113,6 +113,12 @@ def _walk(cls: type, shipped: Any, prefix: str, default_obj: Any = None) -> Iter
     for f in dataclasses.fields(cls):
         if not f.init:
             continue
+        known = f.metadata.get("sections")
+        if known is not None:  # plugin sections (a registry's): beside the concern's own keys, each as its type
+            for name, section_type in known().items():
+                here = shipped.get(name) if isinstance(shipped, Mapping) else None
+                yield from _walk(section_type, here, f"{prefix}{name}.")
+            continue
         key, tp = prefix + f.name, hints[f.name]
         here = shipped.get(f.name) if isinstance(shipped, Mapping) else None
         comment = _comment(shipped, f.name)
@@ -197,6 +203,8 @@ def _unit(name: str) -> str:
 
 def _range(f: dataclasses.Field[Any], tp: Any) -> str:
     lo, hi, choices = f.metadata.get("lo"), f.metadata.get("hi"), f.metadata.get("choices")
+    if callable(choices):  # choices that follow a registry (a plugin's name)
+        choices = tuple(choices())
     if choices is not None:
         return " | ".join(f"`{c}`" for c in choices)
     literal = _literal(tp)

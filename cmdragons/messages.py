@@ -424,7 +424,7 @@ class GameStage(StrEnum):
 def _member(kind: type[_E], value: object, what: str) -> _E:
     """``value`` as a member of ``kind`` (its member or its JSONL form), else a :class:`MessageError`."""
     try:
-        return kind(value)
+        return kind(value)  # type: ignore[arg-type]  # (a member, or a value to look up)
     except ValueError:
         raise MessageError(f"{what} must be one of {', '.join(kind)}, got {value!r}") from None
 
@@ -516,11 +516,11 @@ class GameState:
             teams = d.get("teams", {})
             stage_left, action_left = d.get("stage_time_left", math.inf), d.get("action_time_left", math.inf)
             return cls(
-                _f(d, "t"), str(d.get("command", "normal")), None if team is None else _team(team),
+                _f(d, "t"), RefereeCommand(str(d.get("command", "normal"))), None if team is None else _team(team),
                 int(d.get("score", {}).get("blue", 0)), int(d.get("score", {}).get("yellow", 0)),
                 d.get("blue_defends", "negative_x") == "negative_x",
                 None if placement is None else (float(placement[0]), float(placement[1])),
-                bool(d.get("ready", True)), str(d.get("stage", "first_half")),
+                bool(d.get("ready", True)), GameStage(str(d.get("stage", "first_half"))),
                 math.inf if stage_left is None else float(stage_left), int(d.get("command_counter", 0)),
                 float(d.get("command_t", 0.0)), math.inf if action_left is None else float(action_left),
                 d.get("next_command"), None if nxt is None else _team(nxt),
@@ -564,7 +564,7 @@ class GameEvent:
             team, robot, for_team = d.get("team"), d.get("robot"), d.get("for_team")
             return cls(_f(d, "t"), str(d["kind"]), None if team is None else _team(team),
                        None if robot is None else int(robot), _f(d, "value", math.nan), _f(d, "limit", math.nan),
-                       str(d.get("unit", "")), str(d.get("restart", "")) or None,
+                       str(d.get("unit", "")), RefereeCommand(str(d["restart"])) if d.get("restart") else None,
                        None if for_team is None else _team(for_team))  # fmt: skip
         except (KeyError, TypeError, ValueError) as exc:
             raise MessageError(f"bad game event: {exc!r}") from None
@@ -855,7 +855,7 @@ class TeamReport:
         try:
             return cls(_team(d["team"]), int(d["frame_number"]), _f(d, "t"),
                        tuple(RobotReport.from_dict(r) for r in d.get("robots", ())),
-                       {int(k): str(v) for k, v in d.get("actions", {}).items()}, _points(d.get("pass_points", ())),
+                       {int(k): KickPurpose(str(v)) for k, v in d.get("actions", {}).items()}, _points(d.get("pass_points", ())),
                        np.asarray(d.get("pass_values", ()), dtype=np.float64))  # fmt: skip
         except (KeyError, TypeError, ValueError) as exc:
             raise MessageError(f"bad team report: {exc!r}") from None

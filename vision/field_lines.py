@@ -401,7 +401,8 @@ def _match(params: CameraParams, pts: F64, tan: F64, ids: NDArray[np.int64], str
     seen = (n_found >= np.maximum(8, 0.5 * n_view)) & (n_view > 0)
     along_x = np.array([abs(tan[ids == k][:, 0]).mean() > 0.7 for k in range(len(n_view))])
     circle = np.array([np.ptp(tan[ids == k][:, 0]) > 1.0 for k in range(len(n_view))])
-    dirs = int((seen & along_x & ~circle).any()) + int((seen & ~along_x & ~circle).any()) + 2 * int((seen & circle).any())
+    dirs = (int((seen & along_x & ~circle).any()) + int((seen & ~along_x & ~circle).any())
+            + 2 * int((seen & circle).any()))
     missing = np.flatnonzero((n_view >= 20) & (n_found < 0.25 * n_view))
     return _Match(idx, centres, res, float(idx.size / max(1, int(view.sum()))), int(seen.sum()), min(dirs, 2),
                   tuple(int(k) for k in missing))  # fmt: skip
@@ -445,10 +446,10 @@ def _check(p: CameraParams, m: _Match, width_px: float, league: LeagueParams, fi
         lines = field_lines(league)
         what = "; ".join(_describe(lines[k]) for k in m.missing)
         raise CalibrationRefused(f"the fit puts field lines in view that the image does not show ({what}): the "
-                                 "field in field.yaml (its size, lines, centre circle) is not the one in the image")  # fmt: skip
+                                 "field in field.yaml (its size, lines, centre circle) is not the one in the image")
     if m.lines_seen < fit.min_lines or m.directions < 2:
         raise CalibrationRefused(f"{m.lines_seen} field lines seen{'' if m.directions >= 2 else ', all one way'}: too "
-                                 f"few to fix the camera (at least {fit.min_lines}, both ways or the centre circle)")  # fmt: skip
+                                 f"few to fix the camera (at least {fit.min_lines}, both ways or the centre circle)")
 
 
 def calibrate_from_lines(image: NDArray[np.uint8], league: LeagueParams, start: CameraParams,

@@ -296,19 +296,6 @@ def auto_samples(images: Sequence[NDArray[np.uint8]], model: CameraModel, league
         is_id = (area >= lo_a * math.pi * (r_id * ppm) ** 2) & (area <= hi_a * math.pi * (r_id * ppm) ** 2)
         used = np.zeros(len(blobs), bool)
 
-        def take(role: str, k: int, r_m: float) -> None:
-            b = blobs[k]
-            r_px = max(1.0, p.inner_fraction * r_m * ppm[k])
-            i0, i1 = max(0, int(b.pixel[1] - r_px)), min(image.shape[0], int(b.pixel[1] + r_px) + 1)
-            j0, j1 = max(0, int(b.pixel[0] - r_px)), min(image.shape[1], int(b.pixel[0] + r_px) + 1)
-            vv, uu = np.mgrid[i0:i1, j0:j1] + 0.5
-            sel = ((uu - b.pixel[0]) ** 2 + (vv - b.pixel[1]) ** 2 <= r_px * r_px) & (labels[i0:i1, j0:j1] == b.label)
-            if sel.any():
-                samples.setdefault(role, []).append(conv[i0:i1, j0:j1][sel])
-                local = float(light_img[min(int(b.pixel[1]), image.shape[0] - 1), min(int(b.pixel[0]), image.shape[1] - 1)])
-                if local > 0.0:
-                    lit.setdefault(role, []).append(local)
-
         for k in np.flatnonzero(is_centre):
             dist = np.hypot(*(ground - ground[k]).T)
             ring = np.flatnonzero(is_id & (np.abs(dist - dot_dist) <= p.dot_distance_tolerance_m) & ~used)
@@ -318,9 +305,11 @@ def auto_samples(images: Sequence[NDArray[np.uint8]], model: CameraModel, league
             used[k] = True
             used[ring] = True
             n_patterns += 1
-            take("blue" if blobs[k].colour[1] > 128.0 else "yellow", k, r_centre)
+            _take(samples, lit, "blue" if blobs[k].colour[1] > 128.0 else "yellow", blobs[k],
+                  max(1.0, p.inner_fraction * r_centre * ppm[k]), labels, conv, light_img)
             for j in ring:
-                take("pink" if blobs[j].colour[2] > 128.0 else "green", j, r_id)
+                _take(samples, lit, "pink" if blobs[j].colour[2] > 128.0 else "green", blobs[j],
+                      max(1.0, p.inner_fraction * r_id * ppm[j]), labels, conv, light_img)
         for k in np.flatnonzero(~used):
             b = blobs[k]
             g = model.unproject(b.pixel, r_ball)
@@ -330,12 +319,28 @@ def auto_samples(images: Sequence[NDArray[np.uint8]], model: CameraModel, league
             fill = b.area / max(1.0, float((np.ptp(xs) + 1) * (np.ptp(ys) + 1)))
             if orange and lo_a * expect <= b.area <= hi_a * expect and fill >= 0.5:
                 n_balls += 1
-                take("ball", k, r_ball)
+                _take(samples, lit, "ball", b, max(1.0, p.inner_fraction * r_ball * ppm[k]), labels, conv, light_img)
     back_all = {k: np.concatenate(v) for k, v in background.items()}
     y = back_all["carpet"][:, 0].astype(np.float64)
     dark, bright = (float(np.percentile(y, q)) for q in (0.5, 99.5))
     light = {r: (min(1.0, dark / min(v)), max(1.0, bright / max(v))) for r, v in lit.items()}
     return AutoTuneReport(samples, back_all, n_patterns, n_balls, light)
+
+
+def _take(samples: dict[str, list[NDArray[np.int32]]], lit: dict[str, list[float]], role: str, b: _Blob,
+          r_px: float, labels: NDArray[np.int32], conv: NDArray[Any], light_img: NDArray[Any]) -> None:
+    """Sample blob ``b`` for colour class ``role``: its pixels (in ``conv``'s colour space) within
+    ``r_px`` of its centre, and the light at its centre (``light_img``)."""
+    h, w = labels.shape[:2]
+    i0, i1 = max(0, int(b.pixel[1] - r_px)), min(h, int(b.pixel[1] + r_px) + 1)
+    j0, j1 = max(0, int(b.pixel[0] - r_px)), min(w, int(b.pixel[0] + r_px) + 1)
+    vv, uu = np.mgrid[i0:i1, j0:j1] + 0.5
+    sel = ((uu - b.pixel[0]) ** 2 + (vv - b.pixel[1]) ** 2 <= r_px * r_px) & (labels[i0:i1, j0:j1] == b.label)
+    if sel.any():
+        samples.setdefault(role, []).append(conv[i0:i1, j0:j1][sel])
+        local = float(light_img[min(int(b.pixel[1]), h - 1), min(int(b.pixel[0]), w - 1)])
+        if local > 0.0:
+            lit.setdefault(role, []).append(local)
 
 
 def widen_for_light(box: ColourClass, light: tuple[float, float], space: ColourSpace) -> ColourClass:
@@ -391,7 +396,8 @@ def keep_apart(boxes: dict[str, ColourClass], samples: Mapping[str, NDArray[np.i
                 theirs_above = len(theirs) - np.searchsorted(np.sort(theirs[:, c]), cuts, side="right")
                 # side 0: lo raised to the cut (the other lies below); 1: hi lowered to it
                 width = max(1, int(hi[c]) - int(lo[c]))
-                for side, cost in ((0, mine_at + (len(theirs) - theirs_at)), (1, mine_above + (len(theirs) - theirs_above))):
+                costs = ((0, mine_at + (len(theirs) - theirs_at)), (1, mine_above + (len(theirs) - theirs_above)))
+                for side, cost in costs:
                     # misplaced samples first, then the share of the box given up (twice in brightness, the
                     # channel the light moves most)
                     given_up = np.abs(cuts - (lo[c] if side == 0 else hi[c])) * (999 if c or space != "yuv" else 1998)

@@ -23,9 +23,9 @@ import numpy as np
 
 from cmdragons.messages import GameStage, GameState
 from cmdragons.runtime.bus import BaseStage, Publish
-from cmdragons.runtime.topics import Contract, Port
 from cmdragons.runtime.match import Match
 from cmdragons.runtime.settings import Settings
+from cmdragons.runtime.topics import Contract, Port
 
 __all__ = ["SHOOTOUT_KICKS", "run"]
 
@@ -75,7 +75,8 @@ def _shootout_row(settings: Settings, kicks: int, seed: int) -> dict[str, Any]:
     ours, theirs = shot["blue"], shot["yellow"]
     return {"name": f"shootout_{kicks}_each_seed_{seed}", "taken_ours": ours["taken"], "scored_ours": ours["scored"],
             "taken_theirs": theirs["taken"], "saved_ours": theirs["taken"] - theirs["scored"],
-            "finished": watch.stage == GameStage.POST_GAME, "seconds": s["seconds"], "realtime_factor": s["seconds"] / wall}
+            "finished": watch.stage == GameStage.POST_GAME, "seconds": s["seconds"],
+            "realtime_factor": s["seconds"] / wall}
 
 
 def _match_row(settings: Settings, seed: int, seconds: float, opponent: str) -> dict[str, Any]:

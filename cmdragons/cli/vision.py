@@ -290,7 +290,8 @@ def _tune(args: argparse.Namespace, settings: object) -> int:
 
 
 def _auto_samples(args: argparse.Namespace,
-                  settings: Any) -> tuple[dict[str, list[np.ndarray]], dict[str, np.ndarray], dict[str, tuple[float, float]]]:  # fmt: skip
+                  settings: Any) -> tuple[dict[str, list[np.ndarray]], dict[str, np.ndarray],
+                                          dict[str, tuple[float, float]]]:
     """``tune --auto``: samples per colour name from the frames given, the background's, and per
     colour name the light's spread its box must reach."""
     from cmdragons.camera import CameraModel
@@ -323,7 +324,7 @@ def _auto_samples(args: argparse.Namespace,
         s = w / params.resolution_px[0]
         if abs(h / params.resolution_px[1] - s) > 1e-3:
             raise ValueError(f"the frames are {w}x{h} px, camera {args.camera} is {params.resolution_px[0]}x"
-                             f"{params.resolution_px[1]}: calibrate it at this size (vision calibrate --lines)")  # fmt: skip
+                             f"{params.resolution_px[1]}: calibrate it at this size (vision calibrate --lines)")
         params = dataclasses.replace(params, resolution_px=(w, h), focal_px=params.focal_px * s,
                                      principal_point_px=(params.principal_point_px[0] * s,
                                                          params.principal_point_px[1] * s))  # fmt: skip

@@ -55,7 +55,8 @@ def simulate_1d(d: float, v0: float, phases: FloatArray, steps_per_s: int = 2000
 
 
 def clip_accel(v: FloatArray, a: FloatArray, accel: float, brake: float) -> FloatArray:
-    """Accelerations (n, 2) scaled into A(v) for velocities (n, 2), as :func:`cmdragons.control.acceleration.clip_accel`."""
+    """Accelerations (n, 2) scaled into A(v) for velocities (n, 2), as
+    :func:`cmdragons.control.acceleration.clip_accel`."""
     speed = np.linalg.norm(v, axis=1)
     unit = np.where(speed[:, None] > 1e-9, v / np.maximum(speed, 1e-300)[:, None], 0.0)
     along = np.einsum("ij,ij->i", a, unit)

@@ -21,6 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from cmdragons.config import Validated, derived, setting
 from cmdragons.control import _kernels as K
+from cmdragons.control.acceleration import Limits, stop_accel, trajectory, trajectory_state
 from cmdragons.control.trapezoid import TrapezoidParams
 from cmdragons.geometry import path_length
 from cmdragons.messages import RobotCommand, RobotState
@@ -58,9 +59,9 @@ class MotionParams(Validated):
         """The control period: one command holds for this long."""
         return 1.0 / self.frame_rate_hz
 
-    def limits(self) -> K.Limits:
+    def limits(self) -> Limits:
         """The limits by name, for the kernels."""
-        return K.Limits(self.max_speed_m_s, self.max_accel_m_s2, self.max_brake_m_s2, self.max_omega_rad_s,
+        return Limits(self.max_speed_m_s, self.max_accel_m_s2, self.max_brake_m_s2, self.max_omega_rad_s,
                         self.max_alpha_rad_s2)  # fmt: skip
 
 
@@ -149,6 +150,6 @@ def predict_braking(
     how fast it moves: braking at full strength to rest (the robot model's braking trajectory, the
     one DSS checks; field frame, m, m/s)."""
     dt = motion.period_s
-    tr = K.trajectory(x, y, vx, vy, *K.stop_accel(vx, vy, dt), dt, motion.max_accel_m_s2, motion.max_brake_m_s2)
-    px, py, wx, wy = K.trajectory_state(tr, max(float(t_s), 0.0))
+    tr = trajectory(x, y, vx, vy, *stop_accel(vx, vy, dt), dt, motion.max_accel_m_s2, motion.max_brake_m_s2)
+    px, py, wx, wy = trajectory_state(tr, max(float(t_s), 0.0))
     return float(px), float(py), float(wx), float(wy)

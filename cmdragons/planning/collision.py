@@ -34,7 +34,6 @@ import numpy as np
 from numba import njit
 
 
-
 class CW(NamedTuple):
     """A compiled collision world, by name (see the module docstring)."""
 

@@ -37,9 +37,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cmdragons.config import Validated, setting
+from cmdragons.planning.errt import SmoothingParams, smooth
 from cmdragons.planning.grid.costgrid import CostGrid, CostParams, Region
 from cmdragons.planning.grid.planners import EStar, descend_nf1, nf1
-from cmdragons.planning.errt import SmoothingParams, smooth
 from cmdragons.planning.problem import PlanProblem, PlanResult, PlanStatus, RobustEnds, prepare
 from cmdragons.planning.termination import Termination
 from cmdragons.planning.world import CompiledWorld

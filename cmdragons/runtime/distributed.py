@@ -44,7 +44,6 @@ from typing import Any, TextIO
 from cmdragons.messages import NodeControl, Tick
 from cmdragons.runtime.bus import Bus, Stage
 from cmdragons.runtime.match import (
-    THEIRS,
     Entry,
     Match,
     Opponent,

@@ -46,8 +46,8 @@ from cmdragons.runtime.stages import (
 from cmdragons.runtime.topics import Contract, Port, WiringError, check_wiring
 from cmdragons.team import Brain
 from cmdragons.tracking import Tracker
-from sim.referee import Referee
 from sim.params import SimParams
+from sim.referee import Referee
 from sim.simulator import Simulator, robot_keys
 from strategy.simple import SimpleTeam
 

@@ -21,8 +21,8 @@ from typing import Any
 
 from cmdragons.messages import MessageError, NodeControl
 from cmdragons.runtime.bus import Transport
-from cmdragons.runtime.topics import topic_matches
 from cmdragons.runtime.log import LogError, log_channels, log_span, read_log
+from cmdragons.runtime.topics import topic_matches
 
 __all__ = ["ReplayResult", "replay", "replay_span", "replay_topics"]
 

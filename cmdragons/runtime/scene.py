@@ -22,8 +22,8 @@ import numpy as np
 from cmdragons.geometry import Field
 from cmdragons.messages import GroundTruth, TeamReport
 from cmdragons.runtime.bus import BaseStage, Publish
-from cmdragons.runtime.topics import ANY, Contract, Port
 from cmdragons.runtime.log import RunLog
+from cmdragons.runtime.topics import ANY, Contract, Port
 
 __all__ = ["FRAME", "SceneStage"]
 

@@ -3,7 +3,8 @@
 Detections of all cameras with the same frame number are one tracker step (they come from one
 capture). A line that cannot be read is counted and skipped, never fatal.
 
-Each line is a world state (DESIGN.md tracks format), its ``frame_number`` the detections', with two more keys saying what it holds:
+Each line is a world state (DESIGN.md tracks format), its ``frame_number`` the detections', with two
+more keys saying what it holds:
 ``t_capture``, the capture time of the frame it follows, and ``ahead_s``, how far past it the
 state is predicted (``t = t_capture + ahead_s``). Offline the default is 0: the filtered estimate
 at each frame's capture time; the live loop's look-ahead (the tracker's ``latency_s``) only on

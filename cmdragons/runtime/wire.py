@@ -43,8 +43,8 @@ from cmdragons.messages import (
     GroundTruth,
     Kick,
     MessageError,
-    RefereeCommand,
     NodeControl,
+    RefereeCommand,
     RobotCommand,
     RobotDetection,
     RobotReport,
@@ -60,11 +60,11 @@ from cmdragons.messages import (
     Timing,
     WorldState,
 )
-from cmdragons.runtime.topics import topic_matches
 from cmdragons.runtime.proto import cmdragons_pb2 as pb
 from cmdragons.runtime.proto import ssl_detection_pb2 as det_pb
 from cmdragons.runtime.proto import ssl_simulation_control_pb2 as ctl_pb
 from cmdragons.runtime.proto import ssl_tracked_pb2 as trk_pb
+from cmdragons.runtime.topics import topic_matches
 
 __all__ = ["CODECS", "LOSSY", "TOPICS", "Codec", "canonical", "canonical_and_chunks", "decode", "encode",
            "encode_chunks", "from_proto", "message_type", "parse", "to_proto"]  # fmt: skip

@@ -30,8 +30,8 @@ from typing import Any, TextIO
 from cmdragons.messages import MessageError
 from cmdragons.runtime import wire
 from cmdragons.runtime.bus import Handler
-from cmdragons.runtime.topics import topic_matches
 from cmdragons.runtime.params import RuntimeParams
+from cmdragons.runtime.topics import topic_matches
 
 __all__ = ["LATEST_ONLY", "RouterError", "ZenohTransport", "key_expr", "open_router", "round_trips"]
 

@@ -14,11 +14,11 @@ from mcap_protobuf.decoder import DecoderFactory
 from cmdragons import messages as msg
 from cmdragons.runtime import wire
 from cmdragons.runtime.bus import BaseStage, Bus, InProcessTransport, Publish
-from cmdragons.runtime.topics import ANY, Contract, Port, topic_matches
 from cmdragons.runtime.log import RunLog, read_log
 from cmdragons.runtime.match import Match
 from cmdragons.runtime.settings import load_settings
 from cmdragons.runtime.stages import LoggerStage, Tap, TrackerStage
+from cmdragons.runtime.topics import ANY, Contract, Port, topic_matches
 from cmdragons.tracking import Tracker
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"

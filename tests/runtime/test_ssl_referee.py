@@ -98,7 +98,8 @@ def test_a_game_controllers_sequence_reads_as_our_commands() -> None:
     g = r.read(_gc(R.PREPARE_PENALTY_YELLOW, 5, 10.0, stage=R.PENALTY_SHOOTOUT_BREAK))
     assert (g.command, g.for_team, g.ready, g.stage) == ("penalty", "yellow", False, "half_time")
     assert (r.read(_gc(R.NORMAL_START, 6, 11.0)).command, r.read(_gc(R.STOP, 7, 12.0)).command) == ("penalty", "stop")
-    assert r.read(_gc(R.NORMAL_START, 8, 13.0)).command == msg.RefereeCommand.NORMAL  # a normal start after a stop: normal play
+    # a normal start after a stop: normal play
+    assert r.read(_gc(R.NORMAL_START, 8, 13.0)).command == msg.RefereeCommand.NORMAL
 
 
 @pytest.mark.parametrize("data", [b"\x08", b"garbage\xff\xff", _gc(R.HALT, 1, 1.0)[:-3]])

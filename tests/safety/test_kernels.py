@@ -96,8 +96,8 @@ def test_static_check_is_conservative_by_at_most_one_step() -> None:
             assert hit  # a real intrusion is always caught
         if low > need + step + 1e-3:
             assert not hit  # and the check is never stricter than one step
-        assert c0 == pytest.approx(static_check.static_min_clearance(np.array([[0, np.inf, *tr[0, 2:4], 0, 0, 0, 0]]), cw.obs,
-                                                          cw.inner, n=1))  # fmt: skip
+        start = np.array([[0, np.inf, *tr[0, 2:4], 0, 0, 0, 0]])
+        assert c0 == pytest.approx(static_check.static_min_clearance(start, cw.obs, cw.inner, n=1))
 
 
 def test_trajectory_state_follows_the_segments() -> None:

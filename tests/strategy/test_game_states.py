@@ -156,6 +156,7 @@ def test_restart_rules_by_command() -> None:
     assert rules("free_kick", True) == intents  # ours: the attacker takes it
     for command, ours in (("stop", True), ("free_kick", False), ("kickoff", False)):
         # slow in a stop and at their kickoff
-        assert rules(command, ours) == keep_away(intents, ball, FIELD, -1.0, P, RADIUS, command == RefereeCommand.KICKOFF,
-                                                 command in (RefereeCommand.STOP, RefereeCommand.KICKOFF))  # fmt: skip
+        slow = command in (RefereeCommand.STOP, RefereeCommand.KICKOFF)
+        assert rules(command, ours) == keep_away(intents, ball, FIELD, -1.0, P, RADIUS,
+                                                 command == RefereeCommand.KICKOFF, slow)
     assert rules("kickoff", True) == our_kickoff(intents, FIELD, -1.0, P, RADIUS, None)

@@ -128,7 +128,8 @@ def test_the_real_lab_frame_calibrated_and_coloured_with_nothing_labelled() -> N
     truth = json.loads((REAL / "ground_truth.json").read_text())["lab_frame_lights_on.jpg"]
     lab = FieldDims(length_m=5.54, width_m=3.77, boundary_width_m=0.0, goal_width_m=1.0, defense_width_m=2.0,
                     defense_depth_m=1.0, center_circle=False, goal_to_goal_line=False, outer_lines="walls")  # fmt: skip
-    league = dataclasses.replace(LEAGUE, divisions={"B": lab, "A": LEAGUE.divisions["A"]}, ball=BallShape(radius_m=0.042))
+    league = dataclasses.replace(LEAGUE, divisions={"B": lab, "A": LEAGUE.divisions["A"]},
+                                 ball=BallShape(radius_m=0.042))
     base = CameraParams(id=0, resolution_px=(1920, 1080), principal_point_px=(960.0, 540.0))
     model = CameraModel(calibrate_from_lines(image, league, rough_start(base, 4.0, (-3.45, -1.94, 3.45, 1.94))).params)
     rep = auto_samples([image], model, league, "yuv")

@@ -13,11 +13,11 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from cmdragons.messages import DetectionFrame, GameState, MessageError
-from cmdragons.runtime.topics import topic_matches
 from cmdragons.runtime.log import RunLog, read_log
 from cmdragons.runtime.ssl.logfile import LogReader, LogRecord, MessageType, write_log
 from cmdragons.runtime.ssl.referee import RefereeReader, referee_packet
 from cmdragons.runtime.ssl.vision import decode_wrapper, detection_packet
+from cmdragons.runtime.topics import topic_matches
 
 __all__ = ["is_league_log", "league_to_mcap", "mcap_to_league"]
 

@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from cmdragons.geometry import Team
-from cmdragons.messages import MessageError, Tick
+from cmdragons.messages import MessageError
 from cmdragons.runtime.bus import Bus, Stage
 from cmdragons.runtime.settings import Settings
 from cmdragons.runtime.ssl.logfile import LogReader, MessageType
@@ -98,8 +98,7 @@ def replay_league_log(path: str | Path, settings: Settings, team: Team = "blue",
         queue = {MessageType.VISION_2014: vision_q, MessageType.REFBOX_2013: referee_q}.get(r.type)  # type: ignore[call-overload]
         if queue is not None:
             queue.push(r.payload)
-            bus.publish("clock", Tick(n))
-            bus.spin()
+            bus.tick(n)
         n += 1
         if on_record is not None:
             on_record(r.receive_time_ns, n)

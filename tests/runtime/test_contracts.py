@@ -102,6 +102,17 @@ def test_every_declared_topic_crosses_the_wire_as_its_declared_type() -> None:
             assert message_type(p.topic.replace("*", "0")) is p.type, f"{c.name} writes {p.topic}"
 
 
+def test_the_wire_carries_the_topics_the_contracts_write_and_no_other() -> None:
+    """The wire's key space is the contracts' (and the runtime's own node control): a topic no
+    stage declares has no place on it."""
+    from cmdragons.messages import NodeControl
+    from cmdragons.runtime.topics import key_space
+    from cmdragons.runtime.wire import TOPICS
+
+    runtime = Contract("runtime", (), (Port("control/*", NodeControl),))
+    assert dict(TOPICS) == dict(key_space([*_docs_topics().contracts(), runtime]))
+
+
 def test_the_sim_command_is_a_table_of_declared_stages_on_the_bus() -> None:
     from cmdragons.messages import GameState, GroundTruth, SimEvents, TeamCommands
     from cmdragons.runtime.bus import Bus, run_frames

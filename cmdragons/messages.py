@@ -855,7 +855,8 @@ class TeamReport:
         try:
             return cls(_team(d["team"]), int(d["frame_number"]), _f(d, "t"),
                        tuple(RobotReport.from_dict(r) for r in d.get("robots", ())),
-                       {int(k): KickPurpose(str(v)) for k, v in d.get("actions", {}).items()}, _points(d.get("pass_points", ())),
+                       {int(k): KickPurpose(str(v)) for k, v in d.get("actions", {}).items()},
+                       _points(d.get("pass_points", ())),
                        np.asarray(d.get("pass_values", ()), dtype=np.float64))  # fmt: skip
         except (KeyError, TypeError, ValueError) as exc:
             raise MessageError(f"bad team report: {exc!r}") from None

@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from cmdragons.messages import GameStage, GameState
-from cmdragons.runtime.bus import BaseStage, Publish
+from cmdragons.runtime.bus import BaseStage, Publish, run_frames
 from cmdragons.runtime.match import Match
 from cmdragons.runtime.settings import Settings
 from cmdragons.runtime.topics import Contract, Port
@@ -65,10 +65,7 @@ def _shootout_row(settings: Settings, kicks: int, seed: int) -> dict[str, Any]:
     per_kick = r.restart_delay_s + r.figures.prepare_timeout_s + r.figures.penalty_time_s
     limit = round((2.0 * _SHOOTOUT_HALF_S + 2 * kicks * per_kick + 2.0) * settings.sim.physics.frame_rate_hz)
     wall = time.perf_counter()
-    for _ in range(limit):
-        m.step()
-        if watch.stage == GameStage.POST_GAME:
-            break
+    run_frames(lambda _i: m.step(), limit, should_stop=lambda: watch.stage == GameStage.POST_GAME)
     wall = time.perf_counter() - wall
     s = m.summary()
     shot = s["rules"]["shootout"]

@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from cmdragons import messages as msg
+from cmdragons.runtime.bus import run_frames
 from cmdragons.runtime.proto import grsim_pb2 as grsim_pb
 from cmdragons.runtime.settings import Settings
 from cmdragons.runtime.ssl.commands import (
@@ -176,12 +177,13 @@ def _match_rows(settings: Settings, seconds: float) -> list[dict[str, Any]]:
                               ("match_all_protocols", on, seconds)):  # fmt: skip
             match = Match(s, "simple", "vision", seed=1)
             try:
-                frames = max(1, round(secs * _FPS))
-                for _ in range(frames):
+                def frame(_i: int, match: Match = match) -> None:
                     match.step()
                     sink.sock.setblocking(False)
                     while sink.receive() is not None:
                         pass
+
+                run_frames(frame, max(1, round(secs * _FPS)))
                 summary = match.summary()
             finally:
                 match.close()

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any, NoReturn
 
 import numpy as np
 
-from cmdragons.cli.progress import compile_bar, progress_bar, starting
+from cmdragons.cli.progress import compile_bar, progress_bar, run_shown, starting
 from cmdragons.cli.runtime import add_parsers as add_runtime_parsers
 from cmdragons.cli.runtime import cmd_log, cmd_node, cmd_replay, play_distributed
 from cmdragons.config import ConfigError
@@ -235,11 +235,13 @@ def main(argv: Sequence[str] | None = None) -> int:
 def _cmd_sim(args: argparse.Namespace, stop: Interrupt) -> int:
     import dataclasses
 
-    from cmdragons.geometry import TEAMS
-    from cmdragons.messages import GameState, SimEvents, TeamCommands
+    from cmdragons.messages import GameState
     from cmdragons.recording import RecordingWriter
+    from cmdragons.runtime.bus import Bus
     from cmdragons.runtime.log import RunLog, check_writable_file, run_folder
+    from cmdragons.runtime.match import build, scripted_wiring
     from cmdragons.runtime.settings import load_settings
+    from cmdragons.runtime.stages import LoggerStage, RecorderStage, Tap
     from sim.script import ScriptedPlay
     from sim.simulator import Simulator
 
@@ -258,41 +260,32 @@ def _cmd_sim(args: argparse.Namespace, stop: Interrupt) -> int:
     rec = dataclasses.replace(rec, codec=args.format or rec.codec, crf=rec.crf if args.crf is None else args.crf)
     recorder = RecordingWriter(folder, models, fps, rec) if args.record else None
     log = RunLog(folder / "run.mcap")
+    game = [GameState(0.0)]  # the referee's latest word, for the progress bar
+    bus = Bus()
+    stages = build(scripted_wiring(sim, script, recorder),
+                   [LoggerStage(log), Tap("progress", ("referee",), lambda _topic, g: game.__setitem__(0, g))])
+    for stage in stages:
+        bus.add(stage)
+    bus.start()
     wall0 = time.perf_counter()
-    frame = None
     try:
         with progress_bar(not args.no_progress) as progress, stop.soft():
             task = progress.add_task("sim", total=n_frames, info="")
-            for i in range(n_frames):
-                if stop.requested:
-                    break
-                frame = sim.capture()
-                if recorder is not None:
-                    recorder.write(frame.frame_number, frame.images, frame.truth)
-                g = frame.game if frame.game is not None else GameState(frame.t_capture)
-                log.write("/truth", frame.t_capture, frame.truth)
-                log.write("/referee", frame.t_capture, g)
-                commands = script.commands(sim.world.snapshot())
-                for team in TEAMS:
-                    mine = tuple(c for c in commands if c.team == team)
-                    log.write(f"/commands/{team}", frame.t_capture,
-                              TeamCommands(team, frame.frame_number, frame.t_capture, mine))  # fmt: skip
-                events = tuple(sim.advance(commands))
-                log.write("/events", sim.t, SimEvents(frame.frame_number, sim.t, sim.ball_xy(), events))
-                if i % 15 == 0 or i == n_frames - 1:
-                    progress.update(task, completed=i + 1,
-                                    info=f"t={sim.t:6.2f}s  blue {g.score_blue}:{g.score_yellow} yellow")  # fmt: skip
+            run_shown(bus.tick, n_frames, stop, progress, task,
+                      lambda _i: f"t={sim.t:6.2f}s  blue {game[0].score_blue}:{game[0].score_yellow} yellow")
     finally:
         with stop.shield():
             log.close()
             if recorder is not None:
                 recorder.close()
+    images = next(s for s in stages if isinstance(s, RecorderStage)).images
     with stop.shield():
-        return _finish_sim(args, stop, sim, models, folder, frame, time.perf_counter() - wall0, n_frames)
+        return _finish_sim(args, stop, sim, models, folder, images, time.perf_counter() - wall0, n_frames)
 
 
 def _finish_sim(args: argparse.Namespace, stop: Interrupt, sim: Any, models: Sequence[Any], folder: Path,
-                frame: Any, wall: float, n_frames: int) -> int:  # fmt: skip
+                images: dict[int, Any], wall: float, n_frames: int) -> int:  # fmt: skip
+    """summary.json, the line that sums the run up, and the snapshot of the last frame's ``images``."""
     import cv2
 
     from cmdragons.runtime.overlay import tile_cameras
@@ -317,7 +310,7 @@ def _finish_sim(args: argparse.Namespace, stop: Interrupt, sim: Any, models: Seq
         f"{_plural(faults, 'command fault')}"
     )
     code = stop.exit_code
-    if args.snapshot and frame is not None and not cv2.imwrite(args.snapshot, tile_cameras(frame.images, models)):
+    if args.snapshot and images and not cv2.imwrite(args.snapshot, tile_cameras(images, models)):
         print(f"sim: could not write the snapshot {args.snapshot} (summary.json is written); give a .png path",
               file=sys.stderr)  # fmt: skip
         code = code or 1
@@ -399,14 +392,9 @@ def _play(args: argparse.Namespace, stop: Interrupt, status: Any) -> int:
             watch.on_compile = lambda name: progress.update(task, info=f"compiling {name} (first run only)")
             wall0 = time.perf_counter()
             watch.start()
-            for i in range(n_frames):
-                if stop.requested:
-                    break
-                match.step()
-                if i % 15 == 0 or i == n_frames - 1:
-                    g = game[0]
-                    progress.update(task, completed=i + 1, info=f"t={g.t:6.1f}s  blue {g.score_blue}:"
-                                                                 f"{g.score_yellow} yellow  {g.command}")  # fmt: skip
+            run_shown(lambda _i: match.step(), n_frames, stop, progress, task,
+                      lambda _i: f"t={game[0].t:6.1f}s  blue {game[0].score_blue}:{game[0].score_yellow} yellow  "
+                                 f"{game[0].command}")  # fmt: skip
         with stop.shield():
             wall = time.perf_counter() - wall0
             summary = match.summary()  # the stages' summaries go into the log as well

@@ -2,9 +2,14 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
-__all__ = ["compile_bar", "progress_bar", "starting"]
+from cmdragons.runtime.interrupt import Interrupt
+
+__all__ = ["compile_bar", "progress_bar", "run_shown", "starting"]
+
+EVERY_FRAMES = 15  # the bar's refresh: every half second of a 30 fps match
 
 
 def progress_bar(enabled: bool, counts: bool = True):  # type: ignore[no-untyped-def]
@@ -50,3 +55,17 @@ def starting(enabled: bool, text: str) -> Any:
     if enabled and sys.stderr.isatty():
         status.start()
     return status
+
+
+def run_shown(step: Callable[[int], None], n: int, stop: Interrupt, progress: Any, task: Any,
+              info: Callable[[int], str]) -> int:  # fmt: skip
+    """:func:`~cmdragons.runtime.bus.run_frames` with the bar ``task`` of ``progress`` moved on
+    (``info(i)``: its text after frame ``i``) every few frames and on the last, until ``stop`` is
+    requested; the frames run."""
+    from cmdragons.runtime.bus import run_frames
+
+    def shown(i: int) -> None:
+        if i % EVERY_FRAMES == 0 or i == n - 1:
+            progress.update(task, completed=i + 1, info=info(i))
+
+    return run_frames(step, n, lambda: stop.requested, shown)

@@ -23,7 +23,7 @@ from typing import Any, Protocol
 
 from cmdragons.runtime.topics import Contract, topic_matches
 
-__all__ = ["BaseStage", "Bus", "InProcessTransport", "Publish", "Stage", "Transport"]
+__all__ = ["BaseStage", "Bus", "InProcessTransport", "Publish", "Stage", "Transport", "run_frames"]
 
 Handler = Callable[[str, Any], None]
 Publish = Callable[[str, Any], None]
@@ -147,6 +147,13 @@ class Bus:
     def spin(self) -> int:
         return self.transport.spin()
 
+    def tick(self, frame: int) -> None:
+        """One frame of a lock-step set-up: the clock's tick, and all that follows it delivered."""
+        from cmdragons.messages import Tick
+
+        self.transport.publish("clock", Tick(frame))
+        self.transport.spin()
+
     def summarize(self) -> None:
         for stage in self.stages:
             stage.summarize(self.transport.publish)
@@ -160,6 +167,19 @@ class Bus:
 
     def close(self) -> None:
         self.transport.close()
+
+
+def run_frames(step: Callable[[int], None], n: int, should_stop: Callable[[], bool] = lambda: False,
+               on_frame: Callable[[int], None] | None = None) -> int:  # fmt: skip
+    """The frame loop of every set-up: ``step(i)`` for the frames 0 .. ``n`` - 1, ``on_frame(i)``
+    after each, until ``should_stop()`` says so before a frame; the frames run."""
+    for i in range(n):
+        if should_stop():
+            return i
+        step(i)
+        if on_frame is not None:
+            on_frame(i)
+    return n
 
 
 class BaseStage:

@@ -41,8 +41,8 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
-from cmdragons.messages import NodeControl, Tick
-from cmdragons.runtime.bus import Bus, Stage
+from cmdragons.messages import NodeControl
+from cmdragons.runtime.bus import Bus, Stage, run_frames
 from cmdragons.runtime.match import (
     Entry,
     Match,
@@ -184,8 +184,7 @@ def rehearse(spec: MatchSpec, role: str) -> None:
         opponent: Opponent = spec.opponent if spec.opponent in ("simple", "self") else "none"
         match = Match(settings, opponent, "truth", seed=spec.seed,
                       opponent_settings=spec.opponent_settings if opponent == "self" else None)  # fmt: skip
-        for _ in range(frames):
-            match.step()
+        run_frames(lambda _i: match.step(), frames)
         match.close()
         return
     from sim.simulator import Simulator
@@ -337,15 +336,15 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
     fps = spec.settings.sim.physics.frame_rate_hz
     n = max(1, round(seconds * fps))
     frame_ms: list[float] = []
-    silent = 0
+    silent = [0]  # frames stepped without a team's commands
     wall0 = time.perf_counter()
-    for i in range(n):
-        if should_stop():
-            break
+
+    def frame(i: int) -> None:
+        """Frame ``i`` of the distributed match: the tick, then (free-running) the step at its wall
+        time, or (lock-step) once the referee judged it, stepped without the commands that did not come."""
         f0 = time.perf_counter()
         before = judged[0]
-        bus.publish("clock", Tick(i))
-        transport.spin()
+        bus.tick(i)
         if realtime:
             _pace(transport, wall0 + (i + 1) / fps)
             sim_stage.advance_without_missing(transport.publish)
@@ -357,13 +356,13 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
                 if time.monotonic() - waited > params.lockstep_wait_s:
                     missing = sim_stage.advance_without_missing(transport.publish)
                     if missing:
-                        silent += 1
+                        silent[0] += 1
                         print(f"sim: frame {i}: no commands from {', '.join(missing)} within "
                               f"{params.lockstep_wait_s} s: stepped without", file=err)  # fmt: skip
                     waited = time.monotonic()
         frame_ms.append((time.perf_counter() - f0) * 1e3)
-        if on_frame is not None:
-            on_frame(i)
+
+    run_frames(frame, n, should_stop, on_frame)
     wall = time.perf_counter() - wall0
     nodes = spec.nodes()
     wanted = {s for s in summary_stages(spec.opponent) if nodes[s] in roles}
@@ -380,7 +379,7 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
         summary = {"seed": sim.seed, "opponent": spec.opponent, "perception": spec.perception,
                    "missing_nodes": sorted(set(spec.roles(log=False)) - set(roles)),
                    "score": f["referee"]["score"], "command_faults": f["sim"]["command_faults"]}  # fmt: skip
-    summary.update(frames=len(frame_ms), wall_seconds=round(wall, 3), frames_stepped_without_a_team=silent,
+    summary.update(frames=len(frame_ms), wall_seconds=round(wall, 3), frames_stepped_without_a_team=silent[0],
                    realtime_factor=round(sim.t / wall, 2) if wall > 0 else None,
                    dropped_messages=transport.dropped)  # fmt: skip
     return summary

@@ -22,17 +22,19 @@ import functools
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
 from cmdragons.camera import CameraModel
-from cmdragons.geometry import Team
+from cmdragons.geometry import TEAMS, Team
 from cmdragons.messages import Tick
-from cmdragons.runtime.bus import Bus, Stage, Transport
+from cmdragons.runtime.bus import Bus, Stage, Transport, run_frames
 from cmdragons.runtime.settings import Settings
 from cmdragons.runtime.stages import (
+    RecorderStage,
     RefereeStage,
+    ScriptStage,
     SimpleOpponentStage,
     SimStage,
     StatsStage,
@@ -51,8 +53,12 @@ from sim.referee import Referee
 from sim.simulator import Simulator, robot_keys
 from strategy.simple import SimpleTeam
 
+if TYPE_CHECKING:
+    from cmdragons.recording import RecordingWriter
+    from sim.script import ScriptedPlay
+
 __all__ = ["CLOCK", "OURS", "THEIRS", "Entry", "Match", "Opponent", "Perception", "build", "match_sim_params",
-           "match_summary", "summary_stages", "timing_keys", "wiring"]
+           "match_summary", "scripted_wiring", "summary_stages", "timing_keys", "wiring"]
 
 Opponent = Literal["simple", "self", "none", "outside", "simulation"]
 Perception = Literal["vision", "truth"]
@@ -157,6 +163,16 @@ def wiring(settings: Settings, opponent: Opponent, perception: Perception, seed:
         theirs_s = (opponent_settings or settings).strategy.pass_timeout_s
         entries.append(Entry(StatsStage.declare(THEIRS), "opponent", lambda: StatsStage(THEIRS, theirs_s)))
     return entries
+
+
+def scripted_wiring(sim: Simulator, script: ScriptedPlay, recorder: RecordingWriter | None) -> list[Entry]:
+    """The table of ``cmdragons sim``: the simulator judging its own game (its referee inside),
+    both teams' scripted robots, and the recorder of the camera images and truth (``None``: it
+    only keeps the newest images)."""
+    ids = [r.model.id for r in sim.renderers]
+    return [Entry(SimStage.declare(ids, referee=True), "sim", lambda: SimStage(sim, TEAMS)),
+            Entry(ScriptStage.contract, "sim", lambda: ScriptStage(script, sim.world)),
+            Entry(RecorderStage.declare(ids), "sim", lambda: RecorderStage(recorder, ids))]  # fmt: skip
 
 
 def _protocol(cls: Any, *args: Any) -> Entry:
@@ -293,8 +309,7 @@ class Match:
     def step(self) -> None:
         """One camera frame of the match: capture, see, decide, act, judge."""
         t0 = time.perf_counter()
-        self.bus.publish("clock", Tick(self.frames))
-        self.bus.spin()
+        self.bus.tick(self.frames)
         frame_ms = (time.perf_counter() - t0) * 1e3
         self.frames += 1
         times = self.bus.take_times()
@@ -305,12 +320,12 @@ class Match:
             self.stage_ms.setdefault("opponent_brain", []).append(times.get(f"team/{THEIRS}", 0.0))
 
     def run(self, seconds: float, on_frame: Callable[[int], None] | None = None) -> dict[str, Any]:
-        n = max(1, round(seconds * self.settings.sim.physics.frame_rate_hz))
-        for i in range(n):
-            self.step()
-            if on_frame is not None:
-                on_frame(i)
+        run_frames(lambda _i: self.step(), self.frames_in(seconds), on_frame=on_frame)
         return self.summary()
+
+    def frames_in(self, seconds: float) -> int:
+        """The camera frames of ``seconds`` of match (at least one)."""
+        return max(1, round(seconds * self.settings.sim.physics.frame_rate_hz))
 
     def summary(self) -> dict[str, Any]:
         """The figures of the match so far, gathered from the stages' summaries on the bus."""

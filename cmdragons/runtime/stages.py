@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -50,9 +50,16 @@ from sim.referee import Referee
 from sim.simulator import Simulator
 from strategy.simple import SimpleTeam
 
+if TYPE_CHECKING:
+    from cmdragons.recording import RecordingWriter
+    from sim.script import ScriptedPlay
+    from sim.world import World
+
 __all__ = [
     "LoggerStage",
+    "RecorderStage",
     "RefereeStage",
+    "ScriptStage",
     "SimStage",
     "SimpleOpponentStage",
     "StatsStage",
@@ -79,14 +86,20 @@ class SimStage(BaseStage):
     commands of its own frame from that team, once."""
 
     @staticmethod
-    def declare(camera_ids: Sequence[int]) -> Contract:
-        return Contract("sim", (Port("clock", Tick), Port("commands/*", TeamCommands), Port("teleport", Teleport),
-                                 Port("referee", GameState)),
-                        (Port("truth", GroundTruth), *(Port(f"camera/{c}/frame", CameraFrame) for c in camera_ids),
+    def declare(camera_ids: Sequence[int], referee: bool = False) -> Contract:
+        """``referee``: the simulator judges the game itself (``cmdragons sim``): it publishes the
+        referee's word after the truth and carries out its restarts, so it takes no teleports (and
+        follows its own referee's sides); else it follows the referee's word on topic ``referee``."""
+        outside = (Port("teleport", Teleport), Port("referee", GameState))
+        reads = (Port("clock", Tick), Port("commands/*", TeamCommands), *(() if referee else outside))
+        return Contract("sim", reads,
+                        (Port("truth", GroundTruth), *((Port("referee", GameState),) if referee else ()),
+                         *(Port(f"camera/{c}/frame", CameraFrame) for c in camera_ids),
                          Port("events", SimEvents), summary_port("sim")))  # fmt: skip
 
     def __init__(self, sim: Simulator, teams: Sequence[Team]) -> None:
-        self.contract = self.declare([r.model.id for r in sim.renderers])  # the cameras it draws
+        # the cameras it draws; the referee when the simulator judges
+        self.contract = self.declare([r.model.id for r in sim.renderers], sim.referee is not None)
         self.sim = sim
         self.teams = tuple(t for t in TEAMS if t in teams)
         self.frame_number = -1
@@ -116,6 +129,8 @@ class SimStage(BaseStage):
         self.frame_number = frame.frame_number
         self._commands = {}
         publish("truth", frame.truth)
+        if frame.game is not None:
+            publish("referee", frame.game)
         for cam, image in sorted(frame.images.items()):
             publish(f"camera/{cam}/frame", CameraFrame(cam, frame.frame_number, frame.t_capture, image))
         if not self.teams:
@@ -145,6 +160,51 @@ class SimStage(BaseStage):
         figures = dict(self.sim.summary())
         figures["open_contacts"] = [[list(c.a), list(c.b)] for c in self.sim.world.open_contacts()]
         publish(f"summary/{self.name}", StageSummary(self.name, figures))
+
+
+class ScriptStage(BaseStage):
+    """The scripted robots of ``cmdragons sim`` (both teams): on each frame's truth, every team's
+    commands. They are the simulator's own players and read its world as it stands."""
+
+    contract = Contract("script", (Port("truth", GroundTruth),),
+                        tuple(Port(f"commands/{team}", TeamCommands) for team in TEAMS))  # fmt: skip
+
+    def __init__(self, script: ScriptedPlay, world: World) -> None:
+        self.script = script
+        self.world = world
+
+    def on_message(self, topic: str, message: Any, publish: Publish) -> None:
+        truth: GroundTruth = message
+        commands = self.script.commands(self.world.snapshot())
+        for team in TEAMS:
+            mine = tuple(c for c in commands if c.team == team)
+            publish(f"commands/{team}", TeamCommands(team, truth.frame_number, truth.t, mine))
+
+
+class RecorderStage(BaseStage):
+    """Writes each frame's camera images and truth (:class:`~cmdragons.recording.RecordingWriter`)
+    once every camera of the frame came; keeps the newest images (a snapshot)."""
+
+    @staticmethod
+    def declare(camera_ids: Sequence[int]) -> Contract:
+        return Contract("recorder", (Port("truth", GroundTruth),
+                                     *(Port(f"camera/{c}/frame", CameraFrame) for c in camera_ids)))  # fmt: skip
+
+    def __init__(self, writer: RecordingWriter | None, camera_ids: Sequence[int]) -> None:
+        self.contract = self.declare(camera_ids)
+        self.writer = writer
+        self.camera_ids = tuple(camera_ids)
+        self.images: dict[int, NDArray[np.uint8]] = {}
+        self._truth: GroundTruth | None = None
+
+    def on_message(self, topic: str, message: Any, publish: Publish) -> None:
+        if isinstance(message, GroundTruth):
+            self._truth, self.images = message, {}
+            return
+        f: CameraFrame = message
+        self.images[f.camera_id] = f.image
+        if self.writer is not None and self._truth is not None and len(self.images) == len(self.camera_ids):
+            self.writer.write(f.frame_number, {c: self.images[c] for c in self.camera_ids}, self._truth)
 
 
 class VisionStage(BaseStage):

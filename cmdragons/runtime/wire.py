@@ -476,7 +476,9 @@ _BY_NAME: dict[str, Codec] = {c.proto.DESCRIPTOR.full_name: c for c in CODECS.va
 # the messages whose wire form rounds (32-bit floats): what a remote stage receives is not what was sent
 LOSSY: frozenset[type[Any]] = frozenset({DetectionFrame, WorldState, TeamCommands})
 
-# the key space: topic pattern -> the message it carries (first match wins)
+# the key space: topic pattern -> the message it carries (first match wins). It is the stages'
+# contracts' key space (runtime/topics.py key_space) with the runtime's node control, held equal by
+# a test: the wire lies below the stages (the bus delivers through it), so it cannot import them
 TOPICS: tuple[tuple[str, type[Any]], ...] = (
     ("clock", Tick),
     ("camera/*", CameraFrame),

@@ -13,7 +13,7 @@ from mcap_protobuf.decoder import DecoderFactory
 
 from cmdragons import messages as msg
 from cmdragons.runtime import wire
-from cmdragons.runtime.bus import BaseStage, Bus, InProcessTransport, Publish
+from cmdragons.runtime.bus import BaseStage, Bus, InProcessTransport, Publish, run_frames
 from cmdragons.runtime.log import RunLog, read_log
 from cmdragons.runtime.match import Match
 from cmdragons.runtime.settings import load_settings
@@ -172,3 +172,15 @@ def test_the_tracker_stage_on_a_recorded_detection_topic_equals_the_direct_call(
     live = [x for t, x in recorded if t == "world/blue"]
     assert len(worlds) == len(expected) == len(live) == 90
     assert worlds == expected == live
+
+
+def test_the_frame_loop_stops_before_the_frame_after_its_stop_was_asked() -> None:
+    stepped: list[int] = []
+    shown: list[int] = []
+    assert run_frames(stepped.append, 10, on_frame=shown.append) == 10
+    assert stepped == shown == list(range(10))
+    stepped.clear()
+    # a condition a step sets (a game over) ends the loop before the next frame: that step is the last
+    assert run_frames(stepped.append, 10, should_stop=lambda: 4 in stepped) == 5
+    assert stepped == [0, 1, 2, 3, 4]
+    assert run_frames(stepped.append, 10, should_stop=lambda: True) == 0

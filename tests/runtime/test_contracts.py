@@ -67,7 +67,8 @@ def test_the_match_table_is_checked_when_a_match_is_built() -> None:
 
 
 def _simulators() -> int:
-    return sum(type(o) is Simulator for o in gc.get_objects())  # (type(): a dead weak proxy is not asked)
+    # (by exact type: isinstance asks a dead weak proxy among the objects for its class, which raises)
+    return sum(type(o) is Simulator for o in gc.get_objects())
 
 
 @pytest.mark.parametrize("role", ["team", "opponent", "referee", "vision"])
@@ -100,3 +101,51 @@ def test_every_declared_topic_crosses_the_wire_as_its_declared_type() -> None:
     for c in _docs_topics().contracts():
         for p in c.writes:
             assert message_type(p.topic.replace("*", "0")) is p.type, f"{c.name} writes {p.topic}"
+
+
+def test_the_wire_carries_the_topics_the_contracts_write_and_no_other() -> None:
+    """The wire's key space is the contracts' (and the runtime's own node control): a topic no
+    stage declares has no place on it."""
+    from cmdragons.messages import NodeControl
+    from cmdragons.runtime.topics import key_space
+    from cmdragons.runtime.wire import TOPICS
+
+    runtime = Contract("runtime", (), (Port("control/*", NodeControl),))
+    assert dict(TOPICS) == dict(key_space([*_docs_topics().contracts(), runtime]))
+
+
+def test_the_sim_command_is_a_table_of_declared_stages_on_the_bus() -> None:
+    from cmdragons.messages import GameState, GroundTruth, SimEvents, TeamCommands
+    from cmdragons.runtime.bus import Bus, run_frames
+    from cmdragons.runtime.match import build, scripted_wiring
+    from cmdragons.runtime.stages import RecorderStage
+    from sim.script import ScriptedPlay
+
+    sim = Simulator(SETTINGS.field, SETTINGS.camera_models(), SETTINGS.sim, seed=3)
+    script = ScriptedPlay(SETTINGS.field_geometry(), SETTINGS.field.robot.radius_m, SETTINGS.sim.script, sim.rng)
+    seen: list[tuple[str, Any]] = []
+    bus = Bus()
+    stages = build(scripted_wiring(sim, script, None), [Tap("every", ("*",), lambda t, m: seen.append((t, m)))])
+    for s in stages:
+        bus.add(s)
+    bus.start()
+    assert run_frames(bus.tick, 20, should_stop=lambda: sim.world.frame_number >= 12) == 12  # stopped before frame 12
+    declared = [p for s in stages for p in s.contract.writes] + list(CLOCK)
+    for topic, m in seen:
+        ports = [p for p in declared if topic_matches(p.topic, topic)]
+        assert ports and type(m) is ports[0].type, topic
+    # each frame in the order the log keeps: truth, the referee's word, each camera, both teams' commands
+    # for that frame, the events of the step they were sent with
+    frames = [t for t, _ in seen if t != "clock"]
+    per_frame = ["truth", "referee", "camera/0/frame", "camera/1/frame", "commands/blue", "commands/yellow", "events"]
+    assert frames == per_frame * 12
+    truths = [m for t, m in seen if t == "truth"]
+    assert all(isinstance(m, GroundTruth) for m in truths) and [m.frame_number for m in truths] == list(range(12))
+    assert [m.frame_number for t, m in seen if isinstance(m, TeamCommands)] == [i for i in range(12) for _ in "by"]
+    assert [m.frame_number for t, m in seen if isinstance(m, SimEvents)] == list(range(12))
+    assert all(isinstance(m, GameState) for t, m in seen if t == "referee")
+    recorder = next(s for s in stages if isinstance(s, RecorderStage))
+    assert sorted(recorder.images) == [0, 1]  # the last frame's images, for the snapshot
+    # the simulator judges its own game: a table that adds a second referee is refused
+    with pytest.raises(WiringError, match="'referee'"):
+        check_wiring([*(s.contract for s in stages), Contract("judge", (), (Port("referee", Tick),))])

@@ -106,3 +106,28 @@ def test_a_real_matchs_log_is_tracked_to_its_truth(tmp_path: Path) -> None:
     # the truth at the world state's time (the tracker predicts ahead by its latency): 5 mm, 0.01 m/s
     assert (r.x, r.y) == pytest.approx((-1.0 + 0.5 * (w.t - t0), 0.3), abs=0.005)
     assert (r.vx, r.vy) == pytest.approx((0.5, 0.0), abs=0.01)
+
+
+def test_a_league_replay_is_a_table_of_declared_stages_checked_when_built(tmp_path: Path) -> None:
+    from cmdragons.runtime.bus import BaseStage
+    from cmdragons.runtime.match import CLOCK
+    from cmdragons.runtime.ssl.replay import league_replay_wiring
+    from cmdragons.runtime.ssl.udp import DatagramQueue
+    from cmdragons.runtime.topics import Contract, Port, WiringError, check_wiring
+
+    settings = load_settings()
+    for own in (False, True):
+        table = league_replay_wiring(settings, "blue", [0, 1], own, DatagramQueue(), DatagramQueue())
+        assert [e.contract.name for e in table] == ["ssl/vision_in", "ssl/referee_in", "tracker/blue", "team/blue"]
+        tracker = table[2].contract
+        assert ("commands/blue" in tracker.inputs) == own  # the brain's commands as control input: our own match's log
+        check_wiring([e.contract for e in table], CLOCK)
+
+    class Viewer(BaseStage):  # a viewer of the other team's world, which nobody in a replay tracks
+        contract = Contract("viewer", (Port("world/yellow", msg.WorldState),))
+
+    det = msg.DetectionFrame(0, 1, 1.0, 1.004, (), ())
+    write_log(tmp_path / "one.log", [LogRecord(1_000_000_000, MessageType.VISION_2014, detection_packet(det))])
+    with pytest.raises(WiringError, match=r"'viewer' reads topic 'world/yellow'"):
+        replay_league_log(tmp_path / "one.log", settings, extra=(Viewer(),))
+    assert replay_league_log(tmp_path / "one.log", settings).records == {"VISION_2014": 1}

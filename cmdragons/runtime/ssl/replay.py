@@ -16,14 +16,15 @@ whole record.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from cmdragons.geometry import Team
-from cmdragons.messages import MessageError, Tick
+from cmdragons.messages import MessageError
 from cmdragons.runtime.bus import Bus, Stage
+from cmdragons.runtime.match import Entry, build
 from cmdragons.runtime.settings import Settings
 from cmdragons.runtime.ssl.logfile import LogReader, MessageType
 from cmdragons.runtime.ssl.stages import RefereeInStage, VisionInStage
@@ -31,7 +32,7 @@ from cmdragons.runtime.ssl.udp import DatagramQueue
 from cmdragons.runtime.ssl.vision import decode_wrapper
 from cmdragons.runtime.stages import SummaryCollector, TeamStage, TrackerStage
 
-__all__ = ["LeagueReplay", "camera_ids", "replay_league_log"]
+__all__ = ["LeagueReplay", "camera_ids", "league_replay_wiring", "replay_league_log"]
 
 
 @dataclass
@@ -61,6 +62,27 @@ def camera_ids(path: str | Path) -> list[int]:
     return sorted(ids)
 
 
+def league_replay_wiring(settings: Settings, team: Team, cameras: Sequence[int], own: bool, vision: DatagramQueue,
+                         referee: DatagramQueue) -> list[Entry]:  # fmt: skip
+    """The table of a league log's replay: the log's SSL-Vision packets (``cameras``) and Referee
+    packets, fed from the queues ``vision`` and ``referee``, into the receiving stages that read
+    them from the network; ``team``'s tracker on them (taking the brain's commands for a log of
+    our own match, ``own``) and its brain on the game controller's word."""
+    p = settings.protocols
+    world_topic = f"world/{team}"
+    topics = [f"ssl/vision/{c}" for c in cameras]
+    moved_m = settings.sim.referee.figures.ball_in_play_m
+    return [
+        Entry(VisionInStage.declare(p, cameras, False), "",
+              lambda: VisionInStage(p, cameras, lockstep=False, receiver=vision)),
+        Entry(RefereeInStage.declare(p, world_topic), "",
+              lambda: RefereeInStage(p, world_topic, moved_m, receiver=referee)),
+        Entry(TrackerStage.declare(team, topics, own), "",
+              lambda: TrackerStage(team, _tracker(settings), topics, take_commands=own)),
+        Entry(TeamStage.declare(team, "referee/gc"), "", lambda: TeamStage(team, _brain(team, settings), "referee/gc")),
+    ]  # fmt: skip
+
+
 def replay_league_log(path: str | Path, settings: Settings, team: Team = "blue", extra: tuple[Stage, ...] = (),
                       own: bool = False, should_stop: Callable[[], bool] = lambda: False,
                       on_record: Callable[[int, int], None] | None = None) -> LeagueReplay:  # fmt: skip
@@ -70,19 +92,11 @@ def replay_league_log(path: str | Path, settings: Settings, team: Team = "blue",
     the match; else it follows the robots by their detections alone (a real match's robots did not
     follow our brain). ``on_record(receive_time_ns, n)`` after each record."""
     out = LeagueReplay(cameras=camera_ids(path))
-    p = settings.protocols
     vision_q, referee_q = DatagramQueue(), DatagramQueue()
-    world_topic = f"world/{team}"
-    stages: list[Stage] = [
-        VisionInStage(p, out.cameras, lockstep=False, receiver=vision_q),
-        RefereeInStage(p, world_topic, settings.sim.referee.figures.ball_in_play_m, receiver=referee_q),
-        TrackerStage(team, _tracker(settings), [f"ssl/vision/{c}" for c in out.cameras], take_commands=own),
-        TeamStage(team, _brain(team, settings), "referee/gc"),
-        *extra,
-    ]
     summaries = SummaryCollector()
     bus = Bus()
-    for stage in [*stages, summaries]:
+    for stage in build(league_replay_wiring(settings, team, out.cameras, own, vision_q, referee_q),
+                       [*extra, summaries]):  # fmt: skip
         bus.add(stage)
     bus.start()
     reader = LogReader(path)
@@ -98,8 +112,7 @@ def replay_league_log(path: str | Path, settings: Settings, team: Team = "blue",
         queue = {MessageType.VISION_2014: vision_q, MessageType.REFBOX_2013: referee_q}.get(r.type)  # type: ignore[call-overload]
         if queue is not None:
             queue.push(r.payload)
-            bus.publish("clock", Tick(n))
-            bus.spin()
+            bus.tick(n)
         n += 1
         if on_record is not None:
             on_record(r.receive_time_ns, n)

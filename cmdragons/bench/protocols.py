@@ -177,13 +177,13 @@ def _match_rows(settings: Settings, seconds: float) -> list[dict[str, Any]]:
                               ("match_all_protocols", on, seconds)):  # fmt: skip
             match = Match(s, "simple", "vision", seed=1)
             try:
-                def frame(_i: int, match: Match = match) -> None:
+                def one_frame(_i: int, match: Match = match) -> None:
                     match.step()
                     sink.sock.setblocking(False)
                     while sink.receive() is not None:
                         pass
 
-                run_frames(frame, max(1, round(secs * _FPS)))
+                frames = run_frames(one_frame, max(1, round(secs * _FPS)))
                 summary = match.summary()
             finally:
                 match.close()

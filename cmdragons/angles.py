@@ -4,10 +4,12 @@ wherever it is computed."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from numba import njit
 
 from cmdragons.geometry import wrap_angle as _wrap_angle
 
 __all__ = ["wrap_angle"]
 
-wrap_angle = njit(cache=True)(_wrap_angle)
+wrap_angle: Callable[[float], float] = njit(cache=True)(_wrap_angle)  # type: ignore[assignment]  # (numba: a float in, a float out)

@@ -29,7 +29,7 @@ from numpy.typing import NDArray
 from cmdragons.config import FrozenMap, Validated, sections, setting
 from cmdragons.control.motion import predict_braking
 from cmdragons.geometry import Team
-from cmdragons.messages import GameState, RefereeCommand, RobotCommand, RobotState, WorldState
+from cmdragons.messages import GameState, KickPurpose, RefereeCommand, RobotCommand, RobotState, WorldState
 from cmdragons.navigation import NAVIGATORS, Arrival, Navigator, config_sections, make_navigator
 from cmdragons.planning import (
     CollisionWorld,
@@ -132,7 +132,7 @@ class BrainOutput:
     # the pass evaluation over the candidate grid, points (n, 2) m and values (n,): only on the
     # frames it was redone
     pass_heat: tuple[NDArray[np.float64], NDArray[np.float64]] | None
-    last_actions: Mapping[int, str]  # robot id -> what its last kick was for ("shot", "pass", "clear")
+    last_actions: Mapping[int, KickPurpose]  # robot id -> what its last kick was for ("shot", "pass", "clear")
     times_ms: Mapping[str, float]  # each part's wall-clock time this frame (strategy, planning_control, safety, brain)
 
 

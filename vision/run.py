@@ -84,7 +84,7 @@ def field_layer(pipe: VisionPipeline) -> tuple[NDArray[np.uint8], NDArray[np.boo
     from vision.field_lines import draw_field
 
     layer = draw_field(np.zeros(pipe.shape, np.uint8), pipe.camera.params, pipe.league)
-    return layer, layer.any(axis=2)
+    return layer, np.asarray(layer.any(axis=2), dtype=np.bool_)
 
 
 def annotate(image: NDArray[np.uint8], pipe: VisionPipeline, det: DetectionFrame,

@@ -236,13 +236,14 @@ def _tune(args: argparse.Namespace, settings: object) -> int:
     first = Path(args.images[0])
     background: dict[str, np.ndarray] = {}
     light: dict[str, tuple[float, float]] = {}
+    samples: dict[str, list[np.ndarray]]
     if args.auto:
         samples, background, light = _auto_samples(args, settings)
     elif args.labels is None:
         if not (first.is_dir() and (first / "truth.jsonl").exists()):
             raise ValueError("give --labels, or recording folders with truth.jsonl")
         roles = {r: getattr(vis.roles, r) for r in ("ball", "blue", "yellow", "pink", "green")}
-        samples: dict[str, list[np.ndarray]] = {}
+        samples = {}
         for folder in args.images:
             for name, parts in samples_from_truth(Path(folder), settings.field, roles, vis.colour_space).items():  # type: ignore[attr-defined]
                 samples.setdefault(name, []).extend(parts)

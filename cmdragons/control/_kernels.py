@@ -205,7 +205,7 @@ def heading_command(theta: float, omega: float, target_theta: float, wmax: float
                     period: float) -> float:  # fmt: skip
     """The turn rate (rad/s) one ``period`` ahead on the heading's trapezoid from ``theta`` (rad),
     turning at ``omega``, to rest at ``target_theta``, under ``wmax`` and the angular ``alpha``."""
-    dth: float = wrap_angle(target_theta - theta)  # type: ignore[arg-type]  # the jitted generic helper
+    dth: float = wrap_angle(target_theta - theta)
     ph, _ = profile_1d(dth, omega, 0.0, wmax, alpha, alpha)
     return phases_state(ph, omega, period)[1]
 

@@ -159,7 +159,7 @@ class VFHNavigator(ReactiveNavigator):
                 r_turn = speed_now**2 / self.control.motion.max_accel_m_s2
                 left, right = K.turning_limits(src.obs, src.inner, here[0], here[1], theta, r_turn,
                                                self.cfg.enlarge, self.cfg)  # fmt: skip
-                centres = (np.arange(n) + 0.5) * alpha - math.pi
+                centres = ((np.arange(n) + 0.5) * alpha - math.pi).astype(np.float64)
                 rel = wrap_angle(centres - theta)
                 masked |= (rel > left) | (rel < right)
             motion = ((math.atan2(robot.vy, robot.vx) + math.pi) / alpha) % n if speed_now > 0.05 else target

@@ -146,10 +146,9 @@ def wiring(settings: Settings, opponent: Opponent, perception: Perception, seed:
         own = opponent_settings if team == THEIRS and opponent_settings is not None else settings
         node = "team" if team == OURS else "opponent"
         entries += [Entry(TrackerStage.declare(team, topics[team]), node,
-                          lambda team=team, own=own: TrackerStage(team, Tracker(own.tracker), topics[team],
-                                                                  synchronized=synchronized)),
+                          functools.partial(_tracker_stage, team, own, topics[team], synchronized)),
                     Entry(TeamStage.declare(team, referee_topic), node,
-                          lambda team=team, own=own: TeamStage(team, Brain(team, own), referee_topic))]  # fmt: skip
+                          functools.partial(_team_stage, team, own, referee_topic))]
     entries += _ssl_out_stages(settings)
     if opponent == "simple":
         simple = functools.partial(SimpleTeam, THEIRS, settings.field_geometry(), settings.team.simple_opponent,
@@ -163,6 +162,14 @@ def wiring(settings: Settings, opponent: Opponent, perception: Perception, seed:
         theirs_s = (opponent_settings or settings).strategy.pass_timeout_s
         entries.append(Entry(StatsStage.declare(THEIRS), "opponent", lambda: StatsStage(THEIRS, theirs_s)))
     return entries
+
+
+def _tracker_stage(team: Team, own: Settings, topics: Sequence[str], synchronized: bool) -> Stage:
+    return TrackerStage(team, Tracker(own.tracker), topics, synchronized=synchronized)
+
+
+def _team_stage(team: Team, own: Settings, referee_topic: str) -> Stage:
+    return TeamStage(team, Brain(team, own), referee_topic)
 
 
 def scripted_wiring(sim: Simulator, script: ScriptedPlay, recorder: RecordingWriter | None) -> list[Entry]:

@@ -21,9 +21,7 @@ import numpy as np
 from numba import njit
 
 from cmdragons.angles import wrap_angle
-
-# the acceleration model's names motion.py calls through this module
-from cmdragons.control.acceleration import Limits, limit_velocity, stop_accel, trajectory, trajectory_state  # noqa: F401
+from cmdragons.control.acceleration import limit_velocity
 from cmdragons.sorting import sort_small
 
 N_PHASES = 5  # ramp through zero (2) + cruise (1) + ramp through zero (2)
@@ -219,8 +217,8 @@ def motion_commands(
     velocity, the heading's trapezoid toward the target heading, both then held to the limits.
 
     ``states`` (n, 6): x, y, theta, vx, vy, omega; ``targets`` (n, 5): x, y, vx, vy, theta; the limits
-    by name as in :class:`Limits` (scalars: the kernel runs once per robot and frame, and numba's
-    dispatch is quickest on them)."""
+    by name as in :class:`~cmdragons.control.acceleration.Limits` (scalars: the kernel runs once per
+    robot and frame, and numba's dispatch is quickest on them)."""
     out = np.empty((states.shape[0], 3))
     for i in range(states.shape[0]):
         x, y, th, vx, vy, w = states[i, 0], states[i, 1], states[i, 2], states[i, 3], states[i, 4], states[i, 5]

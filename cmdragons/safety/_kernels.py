@@ -3,7 +3,7 @@
 Field frame, metres, seconds. A robot's command is modelled as one control period ``dt`` of
 acceleration ``a`` (the velocity command v + a dt, reached as fast as the motors can and then held)
 followed by braking at the maximum deceleration ``brake`` along its velocity until it rests (§5.1,
-§5.3): the robot model's :func:`~cmdragons.control._kernels.trajectory`, a short list of parabolic
+§5.3): the robot model's :func:`~cmdragons.control.acceleration.trajectory`, a short list of parabolic
 segments ``(t0, t1, px, py, vx, vy, ax, ay)``.
 
 Two trajectories collide when their centres come closer than ``R`` (two radii plus a margin) at
@@ -32,8 +32,8 @@ from cmdragons.control.acceleration import N_SEG, Limits, clip_accel, feasible, 
 from cmdragons.safety.static_check import static_hits
 from cmdragons.sorting import argsort_stable, sort_small
 
-# the robot model's braking trajectory (N_SEG, trajectory, stop_accel) is used here as defined in
-# cmdragons.control._kernels, and is reachable from this module for the safety tests
+# the robot model's braking trajectory (N_SEG, trajectory, stop_accel) is the one of
+# cmdragons.control.acceleration, shared with the navigators
 
 _BISECT = 40
 

@@ -226,6 +226,7 @@ def run_node(role: str, spec: MatchSpec, transport: ZenohTransport, extra: Seque
     params = spec.settings.runtime
     rehearse(spec, role)
     stages = spec.stages(role) if role != "log" else []
+    transport.expect(s.contract for s in [*stages, *extra])
     bus = Bus(transport)
     commands: list[str] = []
     bus.add(Tap(f"control:{role}", ("control/clock",), lambda _t, c: commands.append(c.command)))
@@ -284,6 +285,7 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
     elif spec.perception == "vision":  # camera frames go through shared memory
         transport.reserve_shared_memory()
     stages = spec.stages("sim")
+    transport.expect(s.contract for s in [*stages, *extra])
     bus = Bus(transport)
     ready: set[str] = set()
     judged = [0]  # the referee's words so far

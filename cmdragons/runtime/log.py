@@ -253,9 +253,11 @@ def log_span(path: str | Path) -> tuple[float, float]:
     return st.message_start_time / 1e9, st.message_end_time / 1e9
 
 
-def log_channels(path: str | Path) -> list[Any]:
-    """A finished MCAP log's channels (each with its ``topic``); :class:`LogError` else."""
-    return list(_summary(path).channels.values())
+def log_channels(path: str | Path) -> dict[str, str]:
+    """A finished MCAP log's topics, each with the name of its schema ("" for none);
+    :class:`LogError` for a file that is not one."""
+    summary = _summary(path)
+    return {ch.topic: (s.name if (s := summary.schemas.get(ch.schema_id)) else "") for ch in summary.channels.values()}
 
 
 def log_info(path: str | Path) -> list[str]:

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from cmdragons.messages import MessageError, NodeControl
+from cmdragons.messages import NodeControl
 from cmdragons.runtime.bus import Transport
 from cmdragons.runtime.log import LogError, log_channels, log_span, read_log
 from cmdragons.runtime.topics import topic_matches
@@ -43,8 +43,11 @@ class ReplayResult:
 
 def replay_topics(path: str | Path, skip: Sequence[str] = ()) -> list[str]:
     """The bus topics of a log that a replay publishes (without the log's leading ``/``)."""
-    topics = sorted({c.topic.lstrip("/") for c in log_channels(path)})
-    return [t for t in topics if _replayed(t, skip)]
+    from cmdragons.runtime.wire import is_known
+
+    channels = log_channels(path)
+    topics = sorted(t.lstrip("/") for t, schema in channels.items() if is_known(schema))
+    return [t for t in topics if not any(topic_matches(p, t) for p in (*NEVER_REPLAYED, *skip))]
 
 
 def replay_span(path: str | Path, start_s: float) -> tuple[float, float]:
@@ -54,16 +57,6 @@ def replay_span(path: str | Path, start_s: float) -> tuple[float, float]:
     if not 0 <= start_s <= last - first:
         raise LogError(f"{path}: --from {start_s:g} s is beyond the log's end ({last - first:.2f} s)")
     return first, last
-
-
-def _replayed(topic: str, skip: Sequence[str]) -> bool:
-    from cmdragons.runtime.wire import message_type
-
-    try:
-        message_type(topic)
-    except MessageError:
-        return False
-    return not any(topic_matches(p, topic) for p in (*NEVER_REPLAYED, *skip))
 
 
 def replay(path: str | Path, transport: Transport, start_s: float = 0.0, speed: float = 1.0,

@@ -12,7 +12,10 @@ bit. What a stage on another process would receive is what every stage receives:
 :func:`canonical` passes detections and commands through their wire form, and the in-process
 transport delivers them so, which keeps an embedded match and a distributed one the same.
 
-:data:`TOPICS` is the key space: which message each topic carries.
+:func:`schema` names a message's protobuf type; a transport sends it with the bytes (zenoh's encoding;
+an MCAP channel's schema), and :func:`decode` reads bytes by it. So the wire keeps no list of
+topics: which message a topic carries is the stages' contracts' word (runtime/topics.py), checked
+when a set-up's table is built.
 """
 
 from __future__ import annotations
@@ -64,10 +67,9 @@ from cmdragons.runtime.proto import cmdragons_pb2 as pb
 from cmdragons.runtime.proto import ssl_detection_pb2 as det_pb
 from cmdragons.runtime.proto import ssl_simulation_control_pb2 as ctl_pb
 from cmdragons.runtime.proto import ssl_tracked_pb2 as trk_pb
-from cmdragons.runtime.topics import topic_matches
 
-__all__ = ["CODECS", "LOSSY", "TOPICS", "Codec", "canonical", "canonical_and_chunks", "decode", "encode",
-           "encode_chunks", "from_proto", "message_type", "parse", "to_proto"]  # fmt: skip
+__all__ = ["CODECS", "LOSSY", "Codec", "canonical", "canonical_and_chunks", "decode", "encode",
+           "encode_chunks", "from_proto", "is_known", "parse", "schema", "to_proto"]  # fmt: skip
 
 MM = 1000.0  # millimetres a metre: the league's vision speaks millimetres
 
@@ -476,37 +478,15 @@ _BY_NAME: dict[str, Codec] = {c.proto.DESCRIPTOR.full_name: c for c in CODECS.va
 # the messages whose wire form rounds (32-bit floats): what a remote stage receives is not what was sent
 LOSSY: frozenset[type[Any]] = frozenset({DetectionFrame, WorldState, TeamCommands})
 
-# the key space: topic pattern -> the message it carries (first match wins). It is the stages'
-# contracts' key space (runtime/topics.py key_space) with the runtime's node control, held equal by
-# a test: the wire lies below the stages (the bus delivers through it), so it cannot import them
-TOPICS: tuple[tuple[str, type[Any]], ...] = (
-    ("clock", Tick),
-    ("camera/*", CameraFrame),
-    ("truth", GroundTruth),
-    ("events", SimEvents),
-    ("teleport", Teleport),
-    ("referee", GameState),
-    ("referee/gc", GameState),  # the game controller's word, from its Referee packets
-    ("referee/events", GameEvents),
-    ("detections/*", DetectionFrame),
-    ("perception/*", DetectionFrame),
-    ("ssl/vision/sent", Tick),  # our SSL-Vision packets of a frame are out
-    ("ssl/vision/*", DetectionFrame),  # detections that came as SSL-Vision packets
-    ("world/*", WorldState),
-    ("commands/*", TeamCommands),
-    ("report/*", TeamReport),
-    ("timing/*", Timing),
-    ("summary/*", StageSummary),
-    ("control/*", NodeControl),
-)
+
+def schema(message: Any) -> str:
+    """The full name of ``message``'s protobuf type: what :func:`decode` reads its bytes by."""
+    return _codec(message).proto.DESCRIPTOR.full_name  # type: ignore[no-any-return]
 
 
-def message_type(topic: str) -> type[Any]:
-    """The message a topic carries (:data:`TOPICS`); :class:`MessageError` for a topic outside it."""
-    for pattern, cls in TOPICS:
-        if topic_matches(pattern, topic):
-            return cls
-    raise MessageError(f"no message is defined for topic {topic!r}")
+def is_known(schema_name: str) -> bool:
+    """Whether :func:`decode` reads bytes of the protobuf type ``schema_name`` into one of our messages."""
+    return schema_name in _BY_NAME
 
 
 def _codec(message: Any) -> Codec:
@@ -554,19 +534,22 @@ def canonical_and_chunks(message: Any) -> tuple[Any, tuple[bytes, ...]]:
     return message, encode_chunks(message)
 
 
-def decode(topic: str, data: bytes | bytearray | memoryview) -> Any:
-    """The message on ``topic`` from its protobuf bytes; :class:`MessageError` for bytes that are not one."""
+def decode(schema_name: str, data: bytes | bytearray | memoryview) -> Any:
+    """One of our messages from its protobuf bytes and the full name of their type (:func:`schema`);
+    :class:`MessageError` for bytes that are not one, or a type that is not ours."""
     from google.protobuf.message import DecodeError
 
-    codec = CODECS[message_type(topic)]
+    codec = _BY_NAME.get(schema_name)
+    if codec is None:
+        raise MessageError(f"{schema_name!r} is not one of our messages' protobuf types")
     proto = codec.proto()
     try:
         proto.ParseFromString(bytes(data) if isinstance(data, memoryview) else data)
         return codec.from_proto(proto)
     except DecodeError as exc:
-        raise MessageError(f"{topic}: not a {codec.proto.DESCRIPTOR.full_name}: {exc}") from None
+        raise MessageError(f"not a {codec.proto.DESCRIPTOR.full_name}: {exc}") from None
     except (ValueError, TypeError, KeyError) as exc:  # a required field missing, a value out of range
-        raise MessageError(f"{topic}: bad {codec.proto.DESCRIPTOR.full_name}: {exc}") from None
+        raise MessageError(f"bad {codec.proto.DESCRIPTOR.full_name}: {exc}") from None
 
 
 def parse(proto_type: Any, data: bytes) -> Any:
@@ -592,4 +575,3 @@ def canonical(message: Any) -> Any:
         codec = CODECS[type(message)]
         return codec.from_proto(codec.to_proto(message))
     return message
-

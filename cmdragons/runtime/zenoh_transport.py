@@ -24,14 +24,14 @@ import queue
 import sys
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from typing import Any, TextIO
 
 from cmdragons.messages import MessageError
 from cmdragons.runtime import wire
 from cmdragons.runtime.bus import Handler
 from cmdragons.runtime.params import RuntimeParams
-from cmdragons.runtime.topics import topic_matches
+from cmdragons.runtime.topics import ANY, Contract, topic_matches
 
 __all__ = ["LATEST_ONLY", "RouterError", "ZenohTransport", "key_expr", "open_router", "round_trips"]
 
@@ -91,6 +91,7 @@ class _Outlet:
     def __init__(self, key: str, publisher: Any) -> None:
         self.key = key
         self.publisher = publisher
+        self.encoding: Any = None  # the protobuf type of the topic's messages (set by the first)
         self.since = time.monotonic()  # when it was declared
         self.young = True  # until settle(): it may not know its subscribers yet
         self.heard = True
@@ -146,6 +147,9 @@ class ZenohTransport:
         # behind skips ahead, as a real team does; a logger keeps every message: ())
         self.latest_only: tuple[str, ...] = ()
         self.local_only: tuple[str, ...] = ()  # topic patterns published to this process's stages only
+        # topic pattern -> the message type this node's stages read there (:meth:`expect`): how bytes
+        # that come without their protobuf type (a client outside cmdragons) are read
+        self._expected: list[tuple[str, type[Any]]] = []
         self.received = 0
         self.sent = 0  # messages put on the wire (a topic no other node hears is not)
         self.last_received = time.monotonic()
@@ -166,10 +170,15 @@ class ZenohTransport:
             self._declared[p] = self.session.declare_subscriber(
                 key_expr(self.prefix, p), self._receive, allowed_origin=self._zenoh.Locality.REMOTE)
 
+    def expect(self, contracts: Iterable[Contract]) -> None:
+        """Read bytes that come without their protobuf type (a client outside cmdragons, e.g. the
+        league's RobotControl from a team's own code) as the type ``contracts`` read on their topic."""
+        self._expected = [(p.topic, p.type) for c in contracts for p in c.reads if p.type is not ANY]
+
     def _receive(self, sample: Any) -> None:
         """Zenoh's thread: queue the raw payload (decoded in :meth:`spin`)."""
         topic = str(sample.key_expr)[len(self.prefix) + 1 :]
-        self._queue.put((topic, sample.payload.to_bytes(), True))
+        self._queue.put((topic, (str(sample.encoding), sample.payload.to_bytes()), True))
 
     def _handlers(self, topic: str) -> list[Handler]:
         hs = self._routes.get(topic)
@@ -181,7 +190,7 @@ class ZenohTransport:
 
     def publish(self, topic: str, message: Any) -> None:
         here = bool(self._handlers(topic))
-        put = None if any(topic_matches(p, topic) for p in self.local_only) else self._sender(topic)
+        put = None if any(topic_matches(p, topic) for p in self.local_only) else self._sender(topic, message)
         if put is None:  # nobody else hears it: neither encoded nor sent
             if here:
                 self._queue.put((topic, wire.canonical(message), False))
@@ -199,19 +208,20 @@ class ZenohTransport:
         else:
             put(chunks[0] if len(chunks) == 1 else b"".join(chunks))
 
-    def _sender(self, topic: str) -> Callable[[Any], None] | None:
+    def _sender(self, topic: str, message: Any) -> Callable[[Any], None] | None:
         """How a message on ``topic`` goes out, or None when no other node hears it. A publisher
         learns who subscribes within ``settle_s`` (and drops what it is given before): until then
         the session's put, which routes by what the session knows already; after, the publisher's,
         which costs a quarter less, while a remote subscriber matches."""
-        out = self._outlet(topic)
+        out = self._outlet(topic, message)
         if out.young and time.monotonic() - out.since < self.params.settle_s:
             z = self._zenoh
-            return lambda payload: self.session.put(out.key, payload, congestion_control=z.CongestionControl.BLOCK,
+            return lambda payload: self.session.put(out.key, payload, encoding=out.encoding,
+                                                    congestion_control=z.CongestionControl.BLOCK,
                                                     allowed_destination=z.Locality.REMOTE)  # fmt: skip
         if out.young:
             out.settle()
-        return out.publisher.put if out.heard else None
+        return (lambda payload: out.publisher.put(payload, encoding=out.encoding)) if out.heard else None
 
     def reserve_shared_memory(self) -> None:
         """Make this node's shared-memory pool now (it is made on the first large payload otherwise,
@@ -237,7 +247,10 @@ class ZenohTransport:
         """Whether a remote subscriber matches ``topic`` now (a peer is there to hear it)."""
         return bool(self._outlet(topic).publisher.matching_status.matching)
 
-    def _outlet(self, topic: str) -> _Outlet:
+    def _outlet(self, topic: str, message: Any = None) -> _Outlet:
+        """``topic``'s publisher; once a message is given, it also holds the message's protobuf
+        type (a topic carries one type, the contracts say which) as the encoding its bytes go
+        with: the receiving node decodes by it."""
         out = self._outlets.get(topic)
         if out is None:
             z = self._zenoh
@@ -245,6 +258,8 @@ class ZenohTransport:
             pub = self.session.declare_publisher(key, congestion_control=z.CongestionControl.BLOCK,
                                                  allowed_destination=z.Locality.REMOTE)  # fmt: skip
             out = self._outlets[topic] = _Outlet(key, pub)
+        if out.encoding is None and message is not None:
+            out.encoding = self._zenoh.Encoding.APPLICATION_PROTOBUF.with_schema(wire.schema(message))
         return out
 
     # --- delivering ------------------------------------------------------------------------------
@@ -284,14 +299,21 @@ class ZenohTransport:
             self.last_received = time.monotonic()
             if not handlers:
                 return 0
+            encoding, data = payload
             try:
-                payload = wire.decode(topic, payload)
+                payload = wire.decode(encoding.partition(";")[2] or self._expected_schema(topic), data)
             except MessageError as exc:
                 self._drop(exc)
                 return 0
         for handler in handlers:
             handler(topic, payload)
         return len(handlers)
+
+    def _expected_schema(self, topic: str) -> str:
+        for pattern, cls in self._expected:
+            if topic_matches(pattern, topic):
+                return wire.CODECS[cls].proto.DESCRIPTOR.full_name  # type: ignore[no-any-return]
+        raise MessageError(f"{topic}: bytes without their type, and no stage here reads the topic as a message")
 
     def _drop(self, exc: MessageError) -> None:
         self.dropped += 1

@@ -4,9 +4,10 @@ A stage states its contract once (:class:`Contract`: its name, the topics it rea
 writes, each a :class:`Port` with its message type), from the same arguments it is built with. A
 set-up (the embedded match, a distributed node, replay, ...) is a table of contracts
 (:func:`check_wiring` refuses one where a topic read has no writer, or is written with another
-type than it is read with, naming both stages), and the key space of the bus and the logs
-(:func:`key_space`) and the topic reference of docs/architecture.md (:func:`topic_table`) are
-derived from the contracts, never written again.
+type than it is read with, naming both stages), and the topic reference of docs/architecture.md
+(:func:`topic_table`, over the key space :func:`key_space`) is derived from the contracts, never
+written again; the wire reads a message by the protobuf type it travels with, and a node takes the
+type of plain bytes from an outside client from its stages' contracts.
 
 Topic patterns: an exact topic (``world/blue``), a prefix ending in ``/*`` (``detections/*`` matches
 ``detections/0`` and ``detections/1``), or ``*`` for every topic.

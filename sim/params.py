@@ -6,13 +6,13 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from cmdragons.config import Validated, setting
-from cmdragons.geometry import Team
+from cmdragons.geometry import TEAMS, LeagueParams, Team
 from sim.referee_params import RefereeParams
 from sim.render import RenderParams
 from sim.script import ScriptParams
 from sim.world import BallParams, DribblerParams, KickerParams, PhysicsParams, RobotParams
 
-__all__ = ["SimParams"]
+__all__ = ["SimParams", "robot_counts", "robot_keys"]
 
 
 @dataclass(frozen=True)
@@ -34,3 +34,13 @@ class SimParams(Validated):
         for team, n in self.robots_per_team.items():
             if not 0 <= n <= 16:
                 raise ValueError(f"robots_per_team.{team} must be 0 to 16 (the pattern has 16 ids), got {n}")
+
+
+def robot_counts(league: LeagueParams, params: SimParams) -> dict[Team, int]:
+    """How many robots each team has on the field (the sim's own count, else the league's)."""
+    return {t: params.robots_per_team.get(t, league.dims.robots_per_team) for t in TEAMS}
+
+
+def robot_keys(league: LeagueParams, params: SimParams) -> list[tuple[Team, int]]:
+    """Every robot on the field as (team, id), in the simulator's order."""
+    return [(t, rid) for t, n in robot_counts(league, params).items() for rid in range(n)]

@@ -17,22 +17,12 @@ from numpy.typing import NDArray
 from cmdragons.camera import CameraModel
 from cmdragons.geometry import TEAMS, LeagueParams, Team
 from cmdragons.messages import BallOut, Contact, GameState, Goal, GroundTruth, Kick, RobotCommand, Teleport
-from sim.params import SimParams
+from sim.params import SimParams, robot_counts
 from sim.referee import Referee
 from sim.render import CameraRenderer
 from sim.world import World
 
-__all__ = ["Frame", "Simulator", "referee_summary", "robot_counts", "robot_keys"]
-
-
-def robot_counts(league: LeagueParams, params: SimParams) -> dict[Team, int]:
-    """How many robots each team has on the field (the sim's own count, else the league's)."""
-    return {t: params.robots_per_team.get(t, league.dims.robots_per_team) for t in TEAMS}
-
-
-def robot_keys(league: LeagueParams, params: SimParams) -> list[tuple[Team, int]]:
-    """Every robot on the field as (team, id), in the simulator's order."""
-    return [(t, rid) for t, n in robot_counts(league, params).items() for rid in range(n)]
+__all__ = ["Frame", "Simulator", "referee_summary"]
 
 
 @dataclass(frozen=True)

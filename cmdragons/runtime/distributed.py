@@ -39,13 +39,14 @@ import threading
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any, TextIO
+from typing import TYPE_CHECKING, Any, TextIO
 
-from cmdragons.messages import NodeControl
+from cmdragons.messages import DetectionFrame, NodeControl
 from cmdragons.runtime.bus import Bus, Stage, run_frames
 from cmdragons.runtime.match import (
+    OURS,
+    THEIRS,
     Entry,
-    Match,
     Opponent,
     Perception,
     build,
@@ -58,6 +59,10 @@ from cmdragons.runtime.params import ROLES, RuntimeParams
 from cmdragons.runtime.settings import Settings
 from cmdragons.runtime.stages import SimStage, SummaryCollector, Tap
 from cmdragons.runtime.zenoh_transport import LATEST_ONLY, ZenohTransport
+from sim.params import robot_counts
+
+if TYPE_CHECKING:
+    from sim.simulator import Simulator
 
 __all__ = ["FRAME_PATH", "ROLES", "MatchSpec", "frame_path_priority", "node_roles", "rehearse", "run_clock",
            "run_node", "wait_for_processes", "write_summary"]
@@ -139,9 +144,9 @@ class MatchSpec:
     def table(self) -> list[Entry]:
         """The match's table: every stage's contract and node (nothing built; the sim node's
         simulator is built by its row)."""
-        from sim.simulator import Simulator
-
         def simulator() -> Simulator:
+            from sim.simulator import Simulator  # (built, and loaded, by the sim node alone)
+
             return Simulator(self.settings.field, self.settings.camera_models(),
                              match_sim_params(self.settings, self.opponent), seed=self.seed,
                              render=self.perception == "vision", referee=False)  # fmt: skip
@@ -168,24 +173,29 @@ class MatchSpec:
 
 
 def rehearse(spec: MatchSpec, role: str) -> None:
-    """Play the first frames of a throwaway match with ``role``'s kind of stages in this process:
+    """Play the first frames of a throwaway scene with ``role``'s kind of work in this process:
     what a stage does only on its first frames (lazy imports such as the tracker's filterpy, loading
     numba's cached kernels, the planners' first queries; seconds on a busy machine) is done before
     the node says it is ready, so a free-running match does not start with its teams a second
-    behind. Trackers and brains play ``runtime.rehearsal_frames`` frames (their first plans come a
-    few frames in), the simulator and vision two (their kernels load on the first); the referee,
-    the logger and the simple opponent need none. Throwaway: its own simulator, vision, trackers
-    and brains, nothing published."""
+    behind. The team's (and a copy's) tracker and brain play ``runtime.rehearsal_frames`` frames of
+    a scene made up from the field alone (:func:`rehearsal_scene`: no simulator; their first plans
+    come a few frames in); the simulator and vision two (their kernels load on the first); the
+    referee, the logger and the simple opponent need none. Throwaway: nothing published."""
     frames = spec.settings.runtime.rehearsal_frames
     if frames == 0 or role in ("referee", "log") or (role == "opponent" and spec.opponent != "self"):
         return  # (the simple opponent's first frame costs what its others do)
     settings = spec.settings
-    if role in ("team", "opponent"):  # trackers and brains on the truth: the same work as on detections
-        opponent: Opponent = spec.opponent if spec.opponent in ("simple", "self") else "none"
-        match = Match(settings, opponent, "truth", seed=spec.seed,
-                      opponent_settings=spec.opponent_settings if opponent == "self" else None)  # fmt: skip
-        run_frames(lambda _i: match.step(), frames)
-        match.close()
+    if role in ("team", "opponent"):
+        from cmdragons.messages import GameState
+        from cmdragons.team import Brain
+        from cmdragons.tracking import Tracker
+
+        team = OURS if role == "team" else THEIRS
+        own = spec.opponent_settings if role == "opponent" and spec.opponent_settings is not None else settings
+        tracker, brain = Tracker(own.tracker), Brain(team, own)
+        dt = 1.0 / settings.sim.physics.frame_rate_hz
+        for k, detections in enumerate(rehearsal_scene(settings, frames)):
+            brain.step(tracker.step([detections]), GameState(k * dt))
         return
     from sim.simulator import Simulator
 
@@ -202,6 +212,27 @@ def rehearse(spec: MatchSpec, role: str) -> None:
         for pipeline, (_, image) in zip(pipelines, sorted(frame.images.items()), strict=False):
             pipeline.process(image, frame.frame_number, frame.t_capture)
         sim.advance()
+
+
+def rehearsal_scene(settings: Settings, frames: int) -> list[DetectionFrame]:
+    """``frames`` camera frames of a made-up scene on the configured field: each team's robots in a
+    row across its own half, the ball rolling slowly from the centre: what a tracker and a brain
+    rehearse on (positions and paths to plan, a ball to go for)."""
+    from cmdragons.messages import BallDetection, RobotDetection
+
+    dims = settings.field.dims
+    counts = robot_counts(settings.field, settings.sim)
+    dt = 1.0 / settings.sim.physics.frame_rate_hz
+    out = []
+    for k in range(frames):
+        t = k * dt
+        robots = tuple(RobotDetection(team, i, side * dims.length_m * (0.1 + 0.3 * (i % 2)),
+                                      dims.width_m * ((i + 0.5) / n - 0.5) * 0.8, 0.0, 1.0, (0.0, 0.0))
+                       for team, side in ((OURS, -1.0), (THEIRS, 1.0)) for n in [counts[team]]
+                       for i in range(n))  # fmt: skip
+        ball = BallDetection(0.3 * t, 0.1 * t, 1.0, (0.0, 0.0))
+        out.append(DetectionFrame(0, k, t, t, (ball,), robots))
+    return out
 
 
 def _settle_heap() -> None:

@@ -48,14 +48,12 @@ from cmdragons.runtime.stages import (
 from cmdragons.runtime.topics import Contract, Port, WiringError, check_wiring
 from cmdragons.team import Brain
 from cmdragons.tracking import Tracker
-from sim.params import SimParams
-from sim.referee import Referee
-from sim.simulator import Simulator, robot_keys
-from strategy.simple import SimpleTeam
+from sim.params import SimParams, robot_keys
 
 if TYPE_CHECKING:
     from cmdragons.recording import RecordingWriter
     from sim.script import ScriptedPlay
+    from sim.simulator import Simulator
 
 __all__ = ["CLOCK", "OURS", "THEIRS", "Entry", "Match", "Opponent", "Perception", "build", "match_sim_params",
            "match_summary", "scripted_wiring", "summary_stages", "timing_keys", "wiring"]
@@ -102,8 +100,7 @@ def wiring(settings: Settings, opponent: Opponent, perception: Perception, seed:
     keys = robot_keys(settings.field, match_sim_params(settings, opponent))
     entries = [
         Entry(SimStage.declare(drawn), "sim", lambda: SimStage(sim(), playing)),
-        Entry(RefereeStage.contract, "referee",
-              lambda: RefereeStage(Referee(settings.field_geometry(), keys, settings.sim.referee))),
+        Entry(RefereeStage.contract, "referee", functools.partial(_referee_stage, settings, keys)),
     ]  # fmt: skip
     brains: list[Team] = [OURS, THEIRS] if opponent == "self" else [OURS]
     # who is given detections: our team, its copy, or a team outside (``outside``: its own client on
@@ -151,10 +148,8 @@ def wiring(settings: Settings, opponent: Opponent, perception: Perception, seed:
                           functools.partial(_team_stage, team, own, referee_topic))]
     entries += _ssl_out_stages(settings)
     if opponent == "simple":
-        simple = functools.partial(SimpleTeam, THEIRS, settings.field_geometry(), settings.team.simple_opponent,
-                                   settings.strategy)  # fmt: skip
         entries.append(Entry(SimpleOpponentStage.declare(THEIRS), "opponent",
-                             lambda: SimpleOpponentStage(THEIRS, simple())))  # fmt: skip
+                             functools.partial(_simple_opponent_stage, settings)))  # fmt: skip
     pass_timeout_s = settings.strategy.pass_timeout_s
     entries += [Entry(StatsStage.declare(OURS), "team", lambda: StatsStage(OURS, pass_timeout_s)),
                 Entry(TimingStage.contract, "team", TimingStage)]  # fmt: skip
@@ -162,6 +157,19 @@ def wiring(settings: Settings, opponent: Opponent, perception: Perception, seed:
         theirs_s = (opponent_settings or settings).strategy.pass_timeout_s
         entries.append(Entry(StatsStage.declare(THEIRS), "opponent", lambda: StatsStage(THEIRS, theirs_s)))
     return entries
+
+
+def _referee_stage(settings: Settings, keys: list[tuple[Team, int]]) -> Stage:
+    from sim.referee import Referee  # (only the node that judges loads it)
+
+    return RefereeStage(Referee(settings.field_geometry(), keys, settings.sim.referee))
+
+
+def _simple_opponent_stage(settings: Settings) -> Stage:
+    from strategy.simple import SimpleTeam  # (only the opponent's node loads it)
+
+    simple = SimpleTeam(THEIRS, settings.field_geometry(), settings.team.simple_opponent, settings.strategy)
+    return SimpleOpponentStage(THEIRS, simple)
 
 
 def _tracker_stage(team: Team, own: Settings, topics: Sequence[str], synchronized: bool) -> Stage:
@@ -299,6 +307,8 @@ class Match:
         self.settings = settings
         self.opponent: Opponent = opponent
         self.perception: Perception = perception
+        from sim.simulator import Simulator  # (a distributed node that runs no simulator never loads it)
+
         self.sim = Simulator(settings.field, settings.camera_models(), match_sim_params(settings, opponent), seed=seed,
                              render=render or perception == "vision", referee=False)  # fmt: skip
         self.seed = self.sim.seed

@@ -46,14 +46,14 @@ from cmdragons.runtime.log import RunLog
 from cmdragons.runtime.topics import ANY, Contract, Port, summary_port, topic_matches
 from cmdragons.team import Brain, BrainOutput
 from cmdragons.tracking import Tracker
-from sim.referee import Referee
-from sim.simulator import Simulator
-from strategy.simple import SimpleTeam
 
 if TYPE_CHECKING:
     from cmdragons.recording import RecordingWriter
+    from sim.referee import Referee
     from sim.script import ScriptedPlay
+    from sim.simulator import Simulator
     from sim.world import World
+    from strategy.simple import SimpleTeam
 
 __all__ = [
     "LoggerStage",

@@ -144,3 +144,22 @@ def test_the_sim_command_is_a_table_of_declared_stages_on_the_bus() -> None:
     # the simulator judges its own game: a table that adds a second referee is refused
     with pytest.raises(WiringError, match="'referee'"):
         check_wiring([*(s.contract for s in stages), Contract("judge", (), (Port("referee", Tick),))])
+
+
+def test_the_team_node_starts_without_loading_the_simulator() -> None:
+    """A fresh process that builds the team node's stages and rehearses them (what ``cmdragons node
+    team`` does before it is ready) never loads the simulator's module."""
+    import subprocess
+    import sys
+
+    code = ("import sys, dataclasses\n"
+            "from cmdragons.runtime.distributed import MatchSpec, rehearse\n"
+            "from cmdragons.runtime.settings import load_settings\n"
+            f"s = load_settings({str(ROOT / 'configs')!r})\n"
+            "s = dataclasses.replace(s, runtime=dataclasses.replace(s.runtime, rehearsal_frames=3))\n"
+            "spec = MatchSpec(s, 'self', 'truth', 1)\n"
+            "for role in ('team', 'opponent'):\n"
+            "    spec.stages(role); rehearse(spec, role)\n"
+            "print('sim.simulator' in sys.modules)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=ROOT)
+    assert out.stdout.strip() == "False"

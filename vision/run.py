@@ -1,26 +1,14 @@
-"""``cmdragons vision SOURCE...``: every camera frame of the sources through the pipeline, into
-detections.jsonl (DESIGN.md), optional overlays (each frame with its detections and the fitted field
-drawn on it: a PNG per still image, a video per video source or, with ``video``, per camera), and a
-summary. The summary's robots and ball count the whole field per capture: the frames of one number
-from all cameras.
-
-Frames of another size than the camera model's, at the same aspect ratio, are processed through
-the model scaled to them (:func:`cmdragons.camera.scaled_to`); a source whose first frame has
-another aspect ratio stops the run before any frame is processed (:class:`FrameSizeError`, one
-line: the size found, the size expected, the command that fixes it). A later frame that cannot be
-read, is empty or has another size than the first is counted and reported by number; it never
-stops the run. A video that breaks off (truncated, corrupt) is processed up to its last good
-frame and the break is reported by file and frame.
+"""What ``cmdragons vision SOURCE...`` needs of vision: a run's figures (:class:`RunSummary`,
+:class:`CaptureCount`), a frame drawn with its detections and the fitted field (:func:`annotate`),
+and each source's camera model checked against its first frame (:func:`model_for_frames`). The
+command's stages and loop are :mod:`cmdragons.runtime.vision_command`.
 """
 
 from __future__ import annotations
 
 import itertools
-import json
-import time
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Iterator
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import cv2
@@ -28,30 +16,22 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cmdragons.camera import CameraModel, scaled_to
-from cmdragons.geometry import LeagueParams
-from cmdragons.messages import DetectionFrame, GroundTruth
-from cmdragons.recording import RecordingReader
-from cmdragons.videoio import VideoError, VideoWriter
-from vision.pipeline import VisionParams, VisionPipeline
-from vision.score import Score
+from cmdragons.messages import DetectionFrame
+from cmdragons.videoio import VideoError
+from vision.pipeline import VisionPipeline
 from vision.sources import Frame, FrameSizeError, FrameSource, SourceError
 
-__all__ = ["RunSummary", "annotate", "run_vision"]
+__all__ = ["CaptureCount", "RunSummary", "annotate", "field_layer", "first_frame", "model_for_frames"]
 
 
 @dataclass
-class RunSummary:
-    frames: int = 0
-    unreadable: list[str] = field(default_factory=list)  # "<source>#<frame>"
-    empty: list[str] = field(default_factory=list)
-    wrong_size: list[str] = field(default_factory=list)
-    broken_off: list[str] = field(default_factory=list)  # a video's message: file, first frame not read
-    # the whole field per capture (the frames of one number from all cameras): the robots any camera
-    # saw, and whether any saw the ball (a camera sees part of the field: its own counts read as misses)
+class CaptureCount:
+    """The whole field per capture (the frames of one number from all cameras): the robots any
+    camera saw, and whether any saw the ball (a camera sees part of the field: its own counts read
+    as misses)."""
+
     robots_seen: dict[int, set[tuple[str, int]]] = field(default_factory=dict)
     ball_seen: dict[int, bool] = field(default_factory=dict)
-    ms: list[float] = field(default_factory=list)
-    score: dict[str, float] | None = None
 
     def saw(self, det: DetectionFrame) -> None:
         """Count one camera's detections into its capture's whole-field figures."""
@@ -60,19 +40,40 @@ class RunSummary:
 
     def as_dict(self) -> dict[str, Any]:
         n = max(1, len(self.ball_seen))
+        return {"captures": len(self.ball_seen),
+                "robots_per_capture": sum(len(r) for r in self.robots_seen.values()) / n,
+                "ball_seen_share": sum(self.ball_seen.values()) / n}  # fmt: skip
+
+
+@dataclass
+class RunSummary:
+    """What a run of ``cmdragons vision`` did: frames read, the bad ones by where they are, the
+    whole field per capture (:class:`CaptureCount`'s figures), vision's time per frame (ms) and
+    the score against a recording's truth."""
+
+    frames: int = 0
+    unreadable: list[str] = field(default_factory=list)  # "<source>#<frame>"
+    empty: list[str] = field(default_factory=list)
+    wrong_size: list[str] = field(default_factory=list)
+    broken_off: list[str] = field(default_factory=list)  # a video's message: file, first frame not read
+    captures: int = 0
+    robots_per_capture: float = 0.0
+    ball_seen_share: float = 0.0
+    ms: list[float] = field(default_factory=list)
+    score: dict[str, float] | None = None
+
+    def as_dict(self) -> dict[str, Any]:
         return {
             "frames": self.frames,
-            "captures": len(self.ball_seen),
+            "captures": self.captures,
             "bad_frames": {"unreadable": self.unreadable, "empty": self.empty, "wrong_size": self.wrong_size},
             "broken_off": self.broken_off,
-            "robots_per_capture": sum(len(r) for r in self.robots_seen.values()) / n,
-            "ball_seen_share": sum(self.ball_seen.values()) / n,
-            "ms_per_frame": {
-                "median": float(np.median(self.ms)) if self.ms else None,
-                "p95": float(np.percentile(self.ms, 95)) if self.ms else None,
-            },  # fmt: skip
+            "robots_per_capture": self.robots_per_capture,
+            "ball_seen_share": self.ball_seen_share,
+            "ms_per_frame": {"median": float(np.median(self.ms)) if self.ms else None,
+                             "p95": float(np.percentile(self.ms, 95)) if self.ms else None},
             "score": self.score,
-        }
+        }  # fmt: skip
 
 
 COLOURS_BGR = {"blue": (255, 160, 0), "yellow": (0, 230, 255), "ball": (0, 140, 255)}
@@ -122,7 +123,7 @@ def annotate(image: NDArray[np.uint8], pipe: VisionPipeline, det: DetectionFrame
     return out
 
 
-def _first_frame(src: FrameSource) -> tuple[Iterator[Frame], NDArray[np.uint8] | None]:
+def first_frame(src: FrameSource) -> tuple[Iterator[Frame], NDArray[np.uint8] | None]:
     """The source's frames (the first read ahead and put back) and its first image (None when the
     first frame cannot be read or the source has none)."""
     frames = src.frames()
@@ -151,83 +152,3 @@ def model_for_frames(src: FrameSource, model: CameraModel, image: NDArray[np.uin
     raise FrameSizeError(f"{src.name}: frames are {w}x{h}, camera {model.id}'s model is {model.width}x"
                          f"{model.height} (another aspect ratio, cannot be scaled); calibrate the camera at this "
                          f"size: cmdragons vision calibrate --lines {frame} --camera {model.id}")  # fmt: skip
-
-
-def run_vision(sources: Sequence[FrameSource], cameras: dict[int, CameraModel], params: VisionParams,
-               league: LeagueParams, out: Path, video: bool, fps: float, recording: Path | None = None,
-               progress: Callable[[int], None] | None = None, overlay: bool = False) -> RunSummary:  # fmt: skip
-    """Process every frame of every source; ``cameras`` gives the model of a source that brings
-    none (by its camera id). Writes ``out/detections.jsonl``; with ``video``, and with
-    ``overlay`` for a video source, ``out/annotated_camera_<id>.mp4``; with ``overlay`` for still
-    images, ``out/overlay/camera_<id>_<frame>.png`` each (:func:`annotate`). With a recording's
-    truth, the detections are scored."""
-    out.mkdir(parents=True, exist_ok=True)
-    summary = RunSummary()
-    missing = [s for s in sources if s.camera is None and s.camera_id not in cameras]
-    if missing:  # before any frame is processed
-        raise SourceError(f"{len(sources)} sources but only {len(cameras)} camera model(s) in the config: "
-                          f"{missing[0].name} would be camera {missing[0].camera_id}; give one source per camera "
-                          "(or a config whose cameras.yaml lists more)")  # fmt: skip
-    # every source's first frame read and its size checked before any frame is processed
-    opened = []
-    for src in sources:
-        frames, first = _first_frame(src)
-        opened.append((src, frames, model_for_frames(src, src.camera or cameras[src.camera_id], first)))
-    truth: dict[int, GroundTruth] = {}
-    if recording is not None:
-        reader = RecordingReader(recording)
-        truth = {t.frame_number: t for t in reader.truth()}
-        if reader.truth_broken:
-            summary.broken_off.append(reader.truth_broken)
-    score = Score() if truth else None
-    with open(out / "detections.jsonl", "w", encoding="utf-8") as jsonl:
-        for src, frames, model in opened:
-            pipe = VisionPipeline(params, league, model)
-            writer: VideoWriter | None = None
-            as_video, as_png = video or (overlay and src.kind == "video"), overlay and src.kind != "video"
-            field = field_layer(pipe) if as_video or as_png else None
-            while True:
-                try:
-                    k, image = next(frames)
-                except StopIteration:
-                    break
-                except VideoError as exc:
-                    summary.broken_off.append(f"{exc}; the frames before it were processed")
-                    break
-                where = f"{src.name}#{k}"
-                summary.frames += 1
-                if progress is not None:
-                    progress(1)
-                if image is None:
-                    summary.unreadable.append(where)
-                    continue
-                if image.size == 0:
-                    summary.empty.append(where)
-                    continue
-                if image.shape != pipe.shape:
-                    summary.wrong_size.append(where)
-                    continue
-                t_capture = k / fps
-                t0 = time.perf_counter()
-                det = pipe.process(image, k, t_capture)
-                summary.ms.append((time.perf_counter() - t0) * 1e3)
-                summary.saw(det)
-                jsonl.write(json.dumps(det.to_dict(), separators=(",", ":")) + "\n")
-                if score is not None and k in truth:
-                    score.add(det, truth[k])
-                if as_png:
-                    (out / "overlay").mkdir(exist_ok=True)
-                    cv2.imwrite(str(out / "overlay" / f"camera_{src.camera_id}_{k:06d}.png"),
-                                annotate(image, pipe, det, field))  # fmt: skip
-                if as_video:
-                    # H.264 in 4:2:0 takes even sizes: an odd last column or row is left out
-                    w2, h2 = model.width // 2 * 2, model.height // 2 * 2
-                    if writer is None:
-                        writer = VideoWriter(out / f"annotated_camera_{src.camera_id}.mp4", w2, h2, fps, "h264", 23)
-                    writer.write(np.ascontiguousarray(annotate(image, pipe, det, field)[:h2, :w2]))
-            if writer is not None:
-                writer.close()
-    if score is not None:
-        summary.score = score.summary()
-    (out / "summary.json").write_text(json.dumps(summary.as_dict(), indent=2) + "\n", encoding="utf-8")
-    return summary

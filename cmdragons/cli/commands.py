@@ -537,7 +537,7 @@ def _cmd_vision(args: argparse.Namespace) -> int:
     from cmdragons.recording import RecordingError
     from cmdragons.runtime.log import run_folder
     from cmdragons.runtime.settings import load_settings
-    from vision.run import run_vision
+    from cmdragons.runtime.vision_command import run_vision
     from vision.sources import SourceError, open_sources
 
     if args.track_ahead and not args.track:

@@ -10,6 +10,7 @@ from typing import Any
 
 import pytest
 
+from cmdragons import messages as msg
 from cmdragons.messages import DetectionFrame, Tick, WorldState
 from cmdragons.runtime.distributed import MatchSpec
 from cmdragons.runtime.match import CLOCK, Match
@@ -163,3 +164,30 @@ def test_the_team_node_starts_without_loading_the_simulator() -> None:
             "print('sim.simulator' in sys.modules)\n")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=ROOT)
     assert out.stdout.strip() == "False"
+
+
+def test_the_vision_command_is_a_table_of_declared_stages_fed_by_its_sources(tmp_path: Path) -> None:
+    """``cmdragons vision``'s stages come from a table: a vision stage per camera (drawing overlays
+    on its own detections where asked), the detections written by one stage; the camera frames are
+    the set-up's outside (the sources): without them the table is refused naming the reader."""
+    import io
+
+    import cv2
+    import numpy as np
+
+    from cmdragons.runtime.match import build
+    from cmdragons.runtime.vision_command import OverlaidVisionStage, vision_wiring
+    from vision.sources import open_sources
+
+    models = SETTINGS.camera_models()
+    for cam, m in enumerate(models):
+        cv2.imwrite(str(tmp_path / f"cam{cam}.png"), np.zeros((m.height, m.width, 3), np.uint8))
+    sources, _ = open_sources([str(tmp_path / f"cam{cam}.png") for cam in range(len(models))])
+    table = vision_wiring(list(zip(sources, models, strict=True)), SETTINGS.vision, SETTINGS.field, tmp_path,
+                          io.StringIO(), {}, video=False, overlay=True, fps=60.0)  # fmt: skip
+    assert [e.contract.name for e in table] == [f"vision/{m.id}" for m in models] + ["vision_out"]
+    with pytest.raises(WiringError, match=r"'vision/0' reads topic 'camera/0/frame'"):
+        build(table)
+    frames = [Port(f"camera/{m.id}/frame", msg.CameraFrame) for m in models]
+    stages = build(table, outside=frames)
+    assert all(isinstance(s, OverlaidVisionStage) for s in stages[:-1])  # still images: PNG overlays

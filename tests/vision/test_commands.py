@@ -89,7 +89,8 @@ def test_vision_on_a_glob_and_a_video(recording: Path, tmp_path: Path, capsys: p
     glob = str(recording / "camera_0" / "00000[4-5].png")
     assert main(["vision", glob, str(video), "--config", str(CONFIGS), "--out", str(out), "--no-progress"]) == 0
     lines = [json.loads(s) for s in (out / "detections.jsonl").read_text().splitlines()]
-    assert [d["camera_id"] for d in lines] == [0, 0] + [1] * 6
+    # capture by capture: each source's next frame, camera 0's two images beside the video's first two
+    assert [d["camera_id"] for d in lines] == [0, 1, 0, 1] + [1] * 4
     assert all(len(d["robots"]) >= 1 for d in lines)  # mp4v smears colours, but the patterns survive
     assert main(["vision", str(tmp_path / "nothing*.png"), "--config", str(CONFIGS), "--out", str(out)]) == 2
 

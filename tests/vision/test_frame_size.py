@@ -15,8 +15,8 @@ import pytest
 from cmdragons.camera import CameraModel, CameraParams, scaled_to
 from cmdragons.cli import main
 from cmdragons.geometry import TEAMS
+from cmdragons.runtime.vision_command import run_vision
 from vision.pipeline import VisionParams
-from vision.run import run_vision
 from vision.sources import FrameSizeError, open_sources
 
 from .conftest import LEAGUE, grid_of_robots, render, snapshot

@@ -25,8 +25,6 @@ import uuid
 from collections.abc import Sequence
 from typing import Any, Protocol, TextIO
 
-from google.protobuf.message import DecodeError
-
 from cmdragons.geometry import Team
 from cmdragons.messages import (
     DetectionFrame,
@@ -41,10 +39,13 @@ from cmdragons.messages import (
     WorldState,
 )
 from cmdragons.runtime.bus import BaseStage, Publish
-from cmdragons.runtime.proto import ssl_simulator_pb2 as sim_pb
 from cmdragons.runtime.ssl.commands import (
+    UNSUPPORTED,
+    Feedback,
+    SimError,
     grsim_packet,
     read_robot_control,
+    read_robot_control_response,
     read_simulator_command,
     robot_control_packet,
     robot_control_response,
@@ -337,7 +338,7 @@ class CommandsOutStage(SocketStage):
         self.chip_angle_rad = chip_angle_rad
         self.full_rpm = sim.dribbler_full_rpm
         self.headings: dict[int, float] = {}
-        self.sent = self.teleports = self.answers = self.answer_errors = 0
+        self.sent = self.teleports = self.answers = self.answer_errors = self.answers_earlier_layout = 0
         self.drops = DropLog(f"{self.to} answers", params.drop_report_interval_s, err)
 
     def on_message(self, topic: str, message: Any, publish: Publish) -> None:
@@ -359,19 +360,20 @@ class CommandsOutStage(SocketStage):
         """The simulation protocol answers each packet (grSim does not): count them and their errors."""
         while (got := self.endpoint.receive()) is not None:
             data, _peer = got
-            answer = sim_pb.RobotControlResponse()
             try:
-                answer.ParseFromString(data)
-            except DecodeError as exc:
+                answer = read_robot_control_response(data)
+            except MessageError as exc:
                 self.drops.drop("undecodable", f"{len(data)} bytes, {exc}")
                 continue
             self.answers += 1
             self.answer_errors += len(answer.errors)
+            self.answers_earlier_layout += answer.earlier_layout
 
     def summarize(self, publish: Publish) -> None:
         publish(f"summary/{self.name}", StageSummary(self.name, {
             "to": self.to, "packets": self.sent, "teleports": self.teleports, "answers": self.answers,
-            "answer_errors": self.answer_errors, "dropped": dict(sorted(self.drops.counts.items()))}))  # fmt: skip
+            "answer_errors": self.answer_errors, "answers_earlier_layout": self.answers_earlier_layout,
+            "dropped": dict(sorted(self.drops.counts.items()))}))  # fmt: skip
 
     def close(self) -> None:
         self.endpoint.close()
@@ -433,8 +435,8 @@ class SimulationInStage(SocketStage):
         self.packets += 1
         for _, why in read.errors:
             self._refuse(why)
-        self.robots.send_to(robot_control_response(self.team, [c.id for c in read.commands],
-                                                   [why for _, why in read.errors]), peer)  # fmt: skip
+        self.robots.send_to(robot_control_response([Feedback(c.id) for c in read.commands],
+                                                   [SimError(UNSUPPORTED, why) for _, why in read.errors]), peer)
         return read.commands
 
     def _teleport(self, got: tuple[bytes, tuple[str, int]], gt: GroundTruth,
@@ -450,7 +452,7 @@ class SimulationInStage(SocketStage):
         if tp is not None:
             self.teleports += 1
             publish("teleport", tp)
-        self.control.send_to(simulator_response(refused), peer)
+        self.control.send_to(simulator_response([SimError(UNSUPPORTED, why) for why in refused]), peer)
 
     def _refuse(self, why: str) -> None:
         key = why.split(":")[0]

@@ -235,9 +235,11 @@ class RefereeOutStage(SocketStage):
 
 class RefereeInStage(SocketStage):
     """A game controller's Referee packets from multicast -> ``referee/gc`` game states, on every
-    clock tick each packet that came since. On
-    ``world_topic`` it watches the ball: once a kickoff's or penalty's restart is taken (the ball
-    ``moved_m`` from the designated position), play is normal."""
+    clock tick each packet that came since. On ``world_topic`` it watches the ball: once a
+    kickoff's or penalty's restart is taken (the ball moved ``moved_m``, the rules' ball-in-play
+    distance, from its spot), play is normal. The spot is the designated position of the packet
+    that started it, or (a game controller clears the designated position at NORMAL_START) of the
+    prepare command before it, or else where the ball was first seen after the normal start."""
 
     @staticmethod
     def declare(params: ProtocolParams, world_topic: str, moved_m: float = 0.0) -> Contract:
@@ -253,8 +255,9 @@ class RefereeInStage(SocketStage):
         self.moved_m = moved_m
         self.reader = RefereeReader()
         self.drops = DropLog(f"referee {r.group}:{r.port}", params.drop_report_interval_s, err)
-        self.received = 0
+        self.received = self.restarts_taken = 0
         self._last: bytes | None = None
+        self._spot: tuple[float, float] | None = None  # where the restart under way was set (field, m)
 
     def on_message(self, topic: str, message: Any, publish: Publish) -> None:
         if topic == "clock":
@@ -262,10 +265,14 @@ class RefereeInStage(SocketStage):
                 self._take(data, publish)
             return
         g, b = self.reader.last, message.ball
-        taking = g is not None and g.command.prepared and g.ready and g.placement is not None
-        if taking and b is not None and self._last is not None and g is not None and g.placement is not None \
-                and math.hypot(b.x - g.placement[0], b.y - g.placement[1]) > self.moved_m:  # fmt: skip
+        if g is None or not (g.command.prepared and g.ready) or b is None or self._last is None:
+            return
+        if self._spot is None:
+            self._spot = (b.x, b.y)
+        elif math.hypot(b.x - self._spot[0], b.y - self._spot[1]) > self.moved_m:
             self.reader.ball_moved()
+            self.restarts_taken += 1
+            self._spot = None
             publish("referee/gc", self.reader.read(self._last))
 
     def _take(self, data: bytes, publish: Publish) -> None:
@@ -276,11 +283,16 @@ class RefereeInStage(SocketStage):
             self.drops.drop("undecodable", f"{len(data)} bytes, {exc}")
             return
         self._last = data
+        if not game.command.prepared:
+            self._spot = None
+        elif game.placement is not None:  # the prepare's spot, or the start's when it says one
+            self._spot = game.placement
         publish("referee/gc", game)
 
     def summarize(self, publish: Publish) -> None:
         publish(f"summary/{self.name}", StageSummary(self.name, {
-            "packets": self.received, "dropped": dict(sorted(self.drops.counts.items()))}))  # fmt: skip
+            "packets": self.received, "restarts_taken": self.restarts_taken,
+            "dropped": dict(sorted(self.drops.counts.items()))}))  # fmt: skip
 
     def close(self) -> None:
         self.receiver.close()

@@ -9,13 +9,17 @@ import dataclasses
 import shutil
 import subprocess
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
 from cmdragons.camera import CameraModel
-from cmdragons.runtime.proto.ssl_wrapper_pb2 import SSL_WrapperPacket
+from cmdragons.messages import Tick
+from cmdragons.runtime.proto import ssl_tracked_pb2 as trk_pb
+from cmdragons.runtime.proto import ssl_tracker_wrapper_pb2 as tw_pb
+from cmdragons.runtime.proto import ssl_wrapper_pb2 as wrap_pb
 from cmdragons.runtime.settings import load_settings
 
 from cmdragons.runtime.ssl.commands import (
@@ -27,8 +31,13 @@ from cmdragons.runtime.ssl.commands import (
     robot_control_response,
     simulator_response,
 )
-from cmdragons.runtime.ssl.vision import CameraCalibration, decode_wrapper, geometry_packet
+from cmdragons.runtime.ssl.clock import UnixEpoch
+from cmdragons.runtime.ssl.stages import VisionInStage
+from cmdragons.runtime.ssl.tracker import read_tracker
+from cmdragons.runtime.ssl.udp import DatagramQueue
+from cmdragons.runtime.ssl.vision import CameraCalibration, decode_wrapper, geometry_packet, read_wrapper
 
+EPOCH = UnixEpoch(1_764_000_000)  # a Unix time of 2025, whole seconds
 NO_PROTOC = "Debian's protoc (apt-get install protobuf-compiler) is the independent parser"
 needs_protoc = pytest.mark.skipif(shutil.which("protoc") is None, reason=NO_PROTOC)
 
@@ -165,8 +174,8 @@ def test_an_ssl_vision_calibration_reads_as_our_lens_model(distortion: float, ma
     with the (k1, k2) we read from it, where SSL-Vision's model puts the points (to ``max_px`` over
     the image: two terms follow its model closely, not exactly, for a strong lens)."""
     base = load_settings().camera_models()[0]
-    wrapper = SSL_WrapperPacket()
-    wrapper.geometry.field.CopyFrom(SSL_WrapperPacket.FromString(
+    wrapper = wrap_pb.SSL_WrapperPacket()
+    wrapper.geometry.field.CopyFrom(wrap_pb.SSL_WrapperPacket.FromString(
         geometry_packet(load_settings().field_geometry(), [base])).geometry.field)  # fmt: skip
     q = Rotation.from_matrix(base.R_cam_to_field.T).as_quat()
     t = -base.R_cam_to_field.T @ base.center * 1000.0
@@ -182,3 +191,42 @@ def test_an_ssl_vision_calibration_reads_as_our_lens_model(distortion: float, ma
     assert off.max() < max_px, (distortion, cal.k1, cal.k2, off.max())
     if distortion <= 0.0:
         assert (cal.k1, cal.k2) == (0.0, 0.0)
+
+
+def test_a_tracker_packet_with_a_robot_of_no_team_keeps_the_rest() -> None:
+    """The league's RobotId may say team UNKNOWN (0): that robot is left out and counted, the
+    packet's other robots and ball read as sent (it was refused whole)."""
+    m = tw_pb.TrackerWrapperPacket(uuid="u", source_name="autoref")
+    f = m.tracked_frame
+    f.frame_number, f.timestamp = 9, EPOCH.to_unix(2.5)
+    for rid, team in ((1, trk_pb.BLUE), (4, trk_pb.UNKNOWN), (2, trk_pb.YELLOW)):
+        f.robots.add(robot_id=trk_pb.RobotId(id=rid, team=team), pos=trk_pb.Vector2(x=rid, y=0.5), orientation=0.25)
+    f.balls.add(pos=trk_pb.Vector3(x=1.0, y=-1.0, z=0.0))
+    got = read_tracker(m.SerializeToString(), EPOCH)
+    assert got.unknown_team == 1 and got.world is not None and got.world.t == 2.5
+    assert [(r.team, r.id, r.x) for r in got.world.robots] == [("blue", 1, 1.0), ("yellow", 2, 2.0)]
+    assert got.world.ball is not None and (got.world.ball.x, got.world.ball.y) == (1.0, -1.0)
+
+
+def test_detections_without_id_or_orientation_are_left_out_and_counted(udp_port: int) -> None:
+    """SSL-Vision's robot_id and orientation are optional: a robot without either is not read as id
+    0 or heading 0; it is left out, counted by reason in the receiving stage's summary."""
+    w = wrap_pb.SSL_WrapperPacket()
+    d = w.detection
+    d.frame_number, d.t_capture, d.t_sent, d.camera_id = 5, EPOCH.to_unix(1.0), EPOCH.to_unix(1.004), 6
+    d.robots_blue.add(confidence=0.9, robot_id=3, x=100.0, y=200.0, orientation=1.5, pixel_x=1.0, pixel_y=2.0)
+    d.robots_blue.add(confidence=0.9, x=300.0, y=200.0, orientation=0.5, pixel_x=1.0, pixel_y=2.0)  # no id
+    d.robots_yellow.add(confidence=0.9, robot_id=0, x=-100.0, y=0.0, pixel_x=1.0, pixel_y=2.0)  # no orientation
+    d.robots_yellow.add(confidence=0.8, robot_id=7, x=-500.0, y=0.0, orientation=-1.0, pixel_x=1.0, pixel_y=2.0)
+    got = read_wrapper(w.SerializeToString(), EPOCH)
+    assert got.robots_left_out == {"no id": 1, "no orientation": 1} and got.detection is not None
+    assert [(r.team, r.id, r.theta) for r in got.detection.robots] == [("blue", 3, 1.5), ("yellow", 7, -1.0)]
+    queue = DatagramQueue()
+    stage = VisionInStage(load_settings().protocols, [], lockstep=False, receiver=queue, epoch=EPOCH)
+    queue.push(w.SerializeToString())
+    published: list[tuple[str, Any]] = []
+    stage.on_message("clock", Tick(0), lambda topic, m: published.append((topic, m)))
+    figures: list[Any] = []
+    stage.summarize(lambda _t, s: figures.append(s.figures))
+    assert [t for t, _ in published] == ["ssl/vision/6"]  # camera 6: not in any config of ours, taken
+    assert figures[0]["robots_left_out"] == {"no id": 1, "no orientation": 1}

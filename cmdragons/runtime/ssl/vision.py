@@ -14,6 +14,7 @@ the nearest such value over the image and come back as the (k1, k2) nearest to i
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -22,14 +23,17 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from cmdragons.camera import CameraModel, from_ssl_vision_distortion, ssl_vision_distortion
-from cmdragons.geometry import BallShape, Field
-from cmdragons.messages import DetectionFrame
+from cmdragons.geometry import BallShape, Field, FieldDims
+from cmdragons.messages import DetectionFrame, MessageError
 from cmdragons.runtime import wire
 from cmdragons.runtime.proto import ssl_geometry_pb2 as geo_pb
 from cmdragons.runtime.proto import ssl_wrapper_pb2 as wrap_pb
+from cmdragons.runtime.settings import Settings
+from cmdragons.runtime.ssl.clock import UnixEpoch, run_epoch
 
 __all__ = ["CameraCalibration", "FieldArc", "FieldLine", "VisionGeometry", "decode_wrapper", "detection_packet",
-           "geometry_of", "geometry_packet"]  # fmt: skip
+           "WrapperContents", "field_dims_of", "geometry_of", "geometry_packet", "read_wrapper",
+           "settings_on_geometry"]  # fmt: skip
 
 MM = wire.MM
 
@@ -138,10 +142,15 @@ def geometry_packet(field: Field, cameras: list[CameraModel]) -> bytes:
     return g.SerializeToString(deterministic=True)  # type: ignore[no-any-return]
 
 
-def detection_packet(det: DetectionFrame) -> bytes:
-    """An SSL_WrapperPacket with one camera frame's detections (mm)."""
+def detection_packet(det: DetectionFrame, epoch: UnixEpoch | None = None) -> bytes:
+    """An SSL_WrapperPacket with one camera frame's detections (mm): ``t_capture`` and ``t_sent``
+    in Unix time (``epoch``, by default the run's), ``t_capture_camera`` the match time (our
+    cameras' own clock)."""
+    e = run_epoch() if epoch is None else epoch
     g = wrap_pb.SSL_WrapperPacket()
     g.detection.CopyFrom(wire.to_proto(det))
+    d = g.detection
+    d.t_capture, d.t_sent, d.t_capture_camera = e.to_unix(det.t_capture), e.to_unix(det.t_sent), det.t_capture
     return g.SerializeToString(deterministic=True)  # type: ignore[no-any-return]
 
 
@@ -182,10 +191,84 @@ def _camera_position(c: Any) -> tuple[float, float, float]:
     return (float(p[0]), float(p[1]), float(p[2]))
 
 
-def decode_wrapper(data: bytes) -> tuple[DetectionFrame | None, VisionGeometry | None]:
-    """The detections and the geometry of an SSL_WrapperPacket's bytes (either may be absent);
-    :class:`MessageError` for bytes that are not one (garbage, cut short, a required field missing)."""
+@dataclass(frozen=True)
+class WrapperContents:
+    """An SSL_WrapperPacket read: its detections and geometry (either may be absent) and the robot
+    detections left out by rule, by reason: ``no id`` (a robot SSL-Vision could not identify) and
+    ``no orientation`` (our tracker follows a robot's heading: a detection without one is not
+    guessed as 0)."""
+
+    detection: DetectionFrame | None
+    geometry: VisionGeometry | None
+    robots_left_out: dict[str, int]
+
+
+def _keep_whole_robots(m: Any) -> dict[str, int]:
+    """Take the robot detections without an id or an orientation out of an SSL_DetectionFrame; how
+    many of each."""
+    out = {"no id": 0, "no orientation": 0}
+    for rows in (m.robots_blue, m.robots_yellow):
+        keep = []
+        for r in rows:
+            if not r.HasField("robot_id"):
+                out["no id"] += 1
+            elif not r.HasField("orientation"):
+                out["no orientation"] += 1
+            else:
+                keep.append(r)
+        if len(keep) < len(rows):
+            del rows[:]
+            rows.extend(keep)
+    return {k: v for k, v in out.items() if v}
+
+
+def read_wrapper(data: bytes, epoch: UnixEpoch | None = None, camera_clock: bool = False) -> WrapperContents:
+    """An SSL_WrapperPacket's bytes read; :class:`MessageError` for bytes that are not one
+    (garbage, cut short, a required field missing). Times in match time: the packet's Unix times
+    less ``epoch`` (by default the run's), or with ``camera_clock`` (packets known to be our own)
+    ``t_capture_camera`` as the capture time when sent. Robots without id or orientation are left
+    out and counted (:class:`WrapperContents`)."""
     g = wire.parse(wrap_pb.SSL_WrapperPacket, data)
-    det = wire.from_proto(g.detection) if g.HasField("detection") else None
+    det = None
+    left_out: dict[str, int] = {}
+    if g.HasField("detection"):
+        e = run_epoch() if epoch is None else epoch
+        m = g.detection
+        left_out = _keep_whole_robots(m)
+        t = m.t_capture_camera if camera_clock and m.HasField("t_capture_camera") else e.to_match(m.t_capture)
+        det = dataclasses.replace(wire.from_proto(m), t_capture=t, t_sent=e.to_match(m.t_sent))
     geo = geometry_of(g.geometry) if g.HasField("geometry") else None
-    return det, geo
+    return WrapperContents(det, geo, left_out)
+
+
+def decode_wrapper(data: bytes, epoch: UnixEpoch | None = None,
+                   camera_clock: bool = False) -> tuple[DetectionFrame | None, VisionGeometry | None]:  # fmt: skip
+    """:func:`read_wrapper`'s detections and geometry."""
+    got = read_wrapper(data, epoch, camera_clock)
+    return got.detection, got.geometry
+
+
+def field_dims_of(geo: VisionGeometry, base: FieldDims) -> FieldDims:
+    """``base`` with the sizes of a geometry packet's field (metres): the required ones always, an
+    optional one (defense area, centre circle, lines, goal height) where it was sent; what a
+    packet does not say (the robots a team, the goal walls' thickness) stays ``base``'s.
+    :class:`MessageError` for sizes that make no field."""
+    sent = {"defense_depth_m": geo.penalty_area_depth_m, "defense_width_m": geo.penalty_area_width_m,
+            "center_circle_radius_m": geo.center_circle_radius_m, "line_width_m": geo.line_thickness_m,
+            "goal_height_m": geo.goal_height_m}  # fmt: skip
+    try:
+        return dataclasses.replace(
+            base, length_m=geo.field_length_m, width_m=geo.field_width_m, goal_width_m=geo.goal_width_m,
+            goal_depth_m=geo.goal_depth_m, boundary_width_m=geo.boundary_width_m,
+            **{k: v for k, v in sent.items() if v > 0.0})  # fmt: skip
+    except ValueError as exc:
+        raise MessageError(f"the geometry's field ({geo.field_length_m:g} x {geo.field_width_m:g} m) is not one we "
+                           f"can play on: {exc}") from None  # fmt: skip
+
+
+def settings_on_geometry(settings: Settings, geo: VisionGeometry) -> Settings:
+    """``settings`` with the division in force sized as the geometry's field (:func:`field_dims_of`)."""
+    league = settings.field
+    dims = field_dims_of(geo, league.dims)
+    return dataclasses.replace(settings, field=dataclasses.replace(league, divisions={**league.divisions,
+                                                                                     league.division: dims}))

@@ -6,8 +6,11 @@ for our readers."""
 from __future__ import annotations
 
 import dataclasses
+import json
+import os
 import shutil
 import subprocess
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -230,3 +233,53 @@ def test_detections_without_id_or_orientation_are_left_out_and_counted(udp_port:
     stage.summarize(lambda _t, s: figures.append(s.figures))
     assert [t for t, _ in published] == ["ssl/vision/6"]  # camera 6: not in any config of ours, taken
     assert figures[0]["robots_left_out"] == {"no id": 1, "no orientation": 1}
+
+
+# Answers recorded on this machine to a RobotControl for blue robot 0 (local velocity; then a global
+# velocity, which the ER-Force simulator does not take), in the league's current layout.
+GRSIM_ANSWER = bytes.fromhex("120408001000")  # grSim fe2bd29: feedback { id: 0 dribbler_ball_contact: false }
+ERFORCE_REFUSAL = bytes.fromhex(
+    "0a620a0d56454c4f434954595f545950451251546865207265636569766564206d6573736167652068616420612076656c6f6369"
+    "7479207479706520756e737570706f7274656420627920746869732073696d756c61746f722028526f626f74203a3029")
+
+
+def test_answers_of_grsim_and_the_erforce_simulator_read_with_the_robots_id() -> None:
+    answer = read_robot_control_response(GRSIM_ANSWER)
+    assert answer.feedback == (Feedback(0, False),) and not answer.errors and not answer.earlier_layout
+    refusal = read_robot_control_response(ERFORCE_REFUSAL)
+    assert not refusal.feedback and [e.code for e in refusal.errors] == ["VELOCITY_TYPE"]
+    assert "velocity type unsupported" in refusal.errors[0].message
+
+
+PEERS = Path(os.environ.get("CMDRAGONS_PEERS", Path(__file__).resolve().parents[3] / "shared" / "peers"))
+ERFORCE = Path(os.environ.get("ERFORCE", "/opt/erforce/bin/erforce-simulator-cli"))
+PROBE = """
+import json, sys
+from cmdragons.runtime.proto import ssl_simulation_control_pb2 as ctl_pb
+from cmdragons.runtime.ssl.commands import read_robot_control_response
+from cmdragons.runtime.ssl.udp import UdpEndpoint
+ep, out = UdpEndpoint("127.0.0.1"), []
+for kind in ("local_velocity", "global_velocity", "local_velocity"):
+    m = ctl_pb.RobotControl()
+    move = getattr(m.robot_commands.add(id=3).move_command, kind)
+    for name in ("forward", "left", "angular") if kind == "local_velocity" else ("vel_x", "vel_y", "vel_angular"):
+        setattr(move, name, 0.0)
+    ep.send_to(m.SerializeToString(), ("127.0.0.1", 10301))
+    got = ep.receive(2.0)
+    a = read_robot_control_response(got[0]) if got else None
+    out.append(None if a is None else [[f.id for f in a.feedback], [e.code for e in a.errors], a.earlier_layout])
+print(json.dumps(out))
+"""
+
+
+@pytest.mark.skipif(not (ERFORCE.exists() and (PEERS / "erforce-netns.sh").exists()),
+                    reason=f"the ER-Force simulator ({ERFORCE}) and its network-namespace script "
+                    f"({PEERS}/erforce-netns.sh) are needed")  # fmt: skip
+def test_the_erforce_simulator_answers_our_commands_with_the_robots_id() -> None:
+    """The league's reference simulator, run in a private network namespace: its answers read with
+    the robot's id, and its refusal of a global velocity as its error code."""
+    out = subprocess.run([str(PEERS / "erforce-netns.sh"), sys.executable, "-c", PROBE], capture_output=True,
+                         text=True, timeout=120, check=True).stdout  # fmt: skip
+    local, refused, again = json.loads(out.strip().splitlines()[-1])
+    assert local == [[3], [], False] and again == [[3], [], False]
+    assert refused == [[], ["VELOCITY_TYPE"], False]

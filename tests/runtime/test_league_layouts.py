@@ -283,3 +283,17 @@ def test_the_erforce_simulator_answers_our_commands_with_the_robots_id() -> None
     local, refused, again = json.loads(out.strip().splitlines()[-1])
     assert local == [[3], [], False] and again == [[3], [], False]
     assert refused == [[], ["VELOCITY_TYPE"], False]
+
+
+def test_a_calibration_read_back_is_our_camera_model() -> None:
+    """A geometry packet's calibration as our camera model (the pose from SSL-Vision's quaternion
+    and translation): the same pixels as the camera it was sent for, to 0.5 px over the image."""
+    settings = load_settings()
+    cams = settings.camera_models()
+    _, geo = decode_wrapper(geometry_packet(settings.field_geometry(), cams))
+    assert geo is not None
+    for cal, cam in zip(geo.cameras, cams, strict=True):
+        back = CameraModel(cal.camera_params())
+        field_mm, ours = _image_points(cam)
+        assert np.hypot(*(back.project(field_mm / 1000.0) - ours).T).max() < 0.5
+        assert back.center == pytest.approx(cam.center, abs=1e-3)

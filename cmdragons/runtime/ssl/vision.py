@@ -22,7 +22,13 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from cmdragons.camera import CameraModel, from_ssl_vision_distortion, ssl_vision_distortion
+from cmdragons.camera import (
+    CameraModel,
+    CameraParams,
+    from_ssl_vision_distortion,
+    params_from_opencv,
+    ssl_vision_distortion,
+)
 from cmdragons.geometry import BallShape, Field, FieldDims
 from cmdragons.messages import DetectionFrame, MessageError
 from cmdragons.runtime import wire
@@ -73,6 +79,21 @@ class CameraCalibration:
     resolution_px: tuple[int, int]  # (0, 0): not sent
     k1: float = 0.0  # our lens model's radial terms nearest to ``distortion`` over the image
     k2: float = 0.0
+
+    def camera_params(self) -> CameraParams:
+        """Our camera model's parameters of this calibration (its pose from the quaternion and
+        translation, our k1 and k2; an image size not sent taken as twice the principal point's);
+        :class:`MessageError` for a calibration our model cannot hold (a camera tilted more than
+        0.5 rad, below 0.3 m)."""
+        pp = self.principal_point_px
+        size = self.resolution_px if min(self.resolution_px) > 0 else (round(2.0 * pp[0]), round(2.0 * pp[1]))
+        try:
+            base = CameraParams(id=self.camera_id, focal_px=self.focal_px, principal_point_px=pp, k1=self.k1,
+                                k2=self.k2, resolution_px=size)  # fmt: skip
+            rvec = Rotation.from_quat(self.quaternion).as_rotvec()
+            return params_from_opencv(rvec, np.asarray(self.translation_m, dtype=np.float64), base)
+        except ValueError as exc:
+            raise MessageError(f"camera {self.camera_id}'s calibration does not fit our camera model: {exc}") from None
 
 
 @dataclass(frozen=True)

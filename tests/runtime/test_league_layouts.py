@@ -5,7 +5,6 @@ for our readers."""
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import os
 import shutil
@@ -38,7 +37,7 @@ from cmdragons.runtime.ssl.clock import UnixEpoch
 from cmdragons.runtime.ssl.stages import VisionInStage
 from cmdragons.runtime.ssl.tracker import read_tracker
 from cmdragons.runtime.ssl.udp import DatagramQueue
-from cmdragons.runtime.ssl.vision import CameraCalibration, decode_wrapper, geometry_packet, read_wrapper
+from cmdragons.runtime.ssl.vision import PIXEL_ORIGIN, decode_wrapper, geometry_packet, read_wrapper
 
 EPOCH = UnixEpoch(1_764_000_000)  # a Unix time of 2025, whole seconds
 NO_PROTOC = "Debian's protoc (apt-get install protobuf-compiler) is the independent parser"
@@ -121,15 +120,16 @@ def test_our_answer_reads_back_and_a_feedback_naming_no_robot_is_counted() -> No
     assert answer.unnamed == 1 and len(answer.feedback) == 2 and answer.errors == (SimError("C", "text"),)
 
 
-def _ssl_vision_pixels(cal: CameraCalibration, field_mm: np.ndarray) -> np.ndarray:
+def _ssl_vision_pixels(cal: Any, field_mm: np.ndarray, distortion: float | None = None) -> np.ndarray:
     """SSL-Vision's published camera model (field2image of its camera_calibration.cpp, the classic
-    model), field points in mm -> pixels: camera coordinates R(q) p + t, the normalised point, its
-    radius distorted by solving r_u = r_d (1 + d r_d^2) in closed form (none for d <= 0), then
-    f * p_d + the principal point."""
-    pc = Rotation.from_quat(cal.quaternion).apply(field_mm) + np.asarray(cal.translation_m) * 1000.0
+    model) on an SSL_GeometryCameraCalibration as it is on the wire, field points in mm -> its
+    pixels (counted from the centre of the top-left pixel): camera coordinates R(q) p + t, the
+    normalised point, its radius distorted by solving r_u = r_d (1 + d r_d^2) in closed form (none
+    for d <= 0), then f * p_d + the principal point."""
+    pc = Rotation.from_quat([cal.q0, cal.q1, cal.q2, cal.q3]).apply(field_mm) + np.array([cal.tx, cal.ty, cal.tz])
     pu = pc[:, :2] / pc[:, 2:3]
     ru = np.hypot(pu[:, 0], pu[:, 1])
-    a = cal.distortion
+    a = cal.distortion if distortion is None else distortion
     if a <= np.finfo(float).tiny:
         rd = ru
     else:
@@ -137,7 +137,7 @@ def _ssl_vision_pixels(cal: CameraCalibration, field_mm: np.ndarray) -> np.ndarr
         b = np.cbrt(b)
         rd = (2.0 / 3.0) ** (1.0 / 3.0) / b - b / (18.0 ** (1.0 / 3.0) * a)
     pd = pu * (rd / ru)[:, None]
-    return cal.focal_px * pd + np.asarray(cal.principal_point_px)
+    return cal.focal_length * pd + np.array([cal.principal_point_x, cal.principal_point_y])
 
 
 def _image_points(cam: CameraModel) -> tuple[np.ndarray, np.ndarray]:
@@ -160,79 +160,40 @@ def test_our_calibrations_project_through_ssl_visions_model_as_through_ours(lens
     k1, k2 = lens
     settings = load_settings(None, [f"cameras.auto.k1={k1}", f"cameras.auto.k2={k2}"])
     cams = settings.camera_models()
-    _, geo = decode_wrapper(geometry_packet(settings.field_geometry(), cams))
-    assert geo is not None
-    for cal, cam in zip(geo.cameras, cams, strict=True):
+    sent = wrap_pb.SSL_WrapperPacket.FromString(geometry_packet(settings.field_geometry(), cams)).geometry.calib
+    for cal, cam in zip(sent, cams, strict=True):
         field_mm, ours = _image_points(cam)
-        off = np.hypot(*(_ssl_vision_pixels(cal, field_mm) - ours).T)
+        off = np.hypot(*(_ssl_vision_pixels(cal, field_mm) + PIXEL_ORIGIN - ours).T)
         assert off.max() < max_px and np.sqrt(np.mean(off**2)) < rms_px, (lens, off.max())
         if k1 < 0.0:  # our k1 as it went before (SSL-Vision reads a negative value as no distortion)
-            before = _ssl_vision_pixels(dataclasses.replace(cal, distortion=k1), field_mm)
+            before = _ssl_vision_pixels(cal, field_mm, distortion=k1) + PIXEL_ORIGIN
             assert np.hypot(*(before - ours).T).max() > 5.0
 
 
 @pytest.mark.parametrize("distortion, max_px", [(0.0, 1e-3), (0.03, 0.1), (0.1, 0.7), (-0.05, 1e-3)])
 def test_an_ssl_vision_calibration_reads_as_our_lens_model(distortion: float, max_px: float) -> None:
-    """A calibration as SSL-Vision sends it (its own distortion) projects through our camera model,
-    with the (k1, k2) we read from it, where SSL-Vision's model puts the points (to ``max_px`` over
-    the image: two terms follow its model closely, not exactly, for a strong lens)."""
+    """A calibration as SSL-Vision sends it (its own distortion and pixels) projects through our
+    camera model of what we read from it where SSL-Vision's model puts the points (to ``max_px``
+    over the image: two terms follow its model closely, not exactly, for a strong lens)."""
     base = load_settings().camera_models()[0]
+    q = Rotation.from_matrix(base.R_cam_to_field.T).as_quat()
+    t = -base.R_cam_to_field.T @ base.center * 1000.0
     wrapper = wrap_pb.SSL_WrapperPacket()
     wrapper.geometry.field.CopyFrom(wrap_pb.SSL_WrapperPacket.FromString(
         geometry_packet(load_settings().field_geometry(), [base])).geometry.field)  # fmt: skip
-    q = Rotation.from_matrix(base.R_cam_to_field.T).as_quat()
-    t = -base.R_cam_to_field.T @ base.center * 1000.0
-    wrapper.geometry.calib.add(camera_id=3, focal_length=base.f, principal_point_x=base.cx, principal_point_y=base.cy,
-                               distortion=distortion, q0=q[0], q1=q[1], q2=q[2], q3=q[3], tx=t[0], ty=t[1], tz=t[2],
-                               pixel_image_width=base.width, pixel_image_height=base.height)  # fmt: skip
+    cal = wrapper.geometry.calib.add(camera_id=3, focal_length=base.f, principal_point_x=511.5, principal_point_y=383.5,
+                                     distortion=distortion, q0=q[0], q1=q[1], q2=q[2], q3=q[3], tx=t[0], ty=t[1],
+                                     tz=t[2], pixel_image_width=base.width, pixel_image_height=base.height)  # fmt: skip
     _, geo = decode_wrapper(wrapper.SerializeToString())
     assert geo is not None
-    cal = geo.cameras[0]
-    ours = CameraModel(dataclasses.replace(base.params, id=3, k1=cal.k1, k2=cal.k2))
+    read = geo.cameras[0]
+    ours = CameraModel(read.camera_params())
+    assert (ours.cx, ours.cy) == (512.0, 384.0)  # the image's centre in either way of counting
     field_mm, _ = _image_points(ours)
-    off = np.hypot(*(_ssl_vision_pixels(cal, field_mm) - ours.project(field_mm / 1000.0)).T)
-    assert off.max() < max_px, (distortion, cal.k1, cal.k2, off.max())
+    off = np.hypot(*(_ssl_vision_pixels(cal, field_mm) + PIXEL_ORIGIN - ours.project(field_mm / 1000.0)).T)
+    assert off.max() < max_px, (distortion, read.k1, read.k2, off.max())
     if distortion <= 0.0:
-        assert (cal.k1, cal.k2) == (0.0, 0.0)
-
-
-def test_a_tracker_packet_with_a_robot_of_no_team_keeps_the_rest() -> None:
-    """The league's RobotId may say team UNKNOWN (0): that robot is left out and counted, the
-    packet's other robots and ball read as sent (it was refused whole)."""
-    m = tw_pb.TrackerWrapperPacket(uuid="u", source_name="autoref")
-    f = m.tracked_frame
-    f.frame_number, f.timestamp = 9, EPOCH.to_unix(2.5)
-    for rid, team in ((1, trk_pb.BLUE), (4, trk_pb.UNKNOWN), (2, trk_pb.YELLOW)):
-        f.robots.add(robot_id=trk_pb.RobotId(id=rid, team=team), pos=trk_pb.Vector2(x=rid, y=0.5), orientation=0.25)
-    f.balls.add(pos=trk_pb.Vector3(x=1.0, y=-1.0, z=0.0))
-    got = read_tracker(m.SerializeToString(), EPOCH)
-    assert got.unknown_team == 1 and got.world is not None and got.world.t == 2.5
-    assert [(r.team, r.id, r.x) for r in got.world.robots] == [("blue", 1, 1.0), ("yellow", 2, 2.0)]
-    assert got.world.ball is not None and (got.world.ball.x, got.world.ball.y) == (1.0, -1.0)
-
-
-def test_detections_without_id_or_orientation_are_left_out_and_counted(udp_port: int) -> None:
-    """SSL-Vision's robot_id and orientation are optional: a robot without either is not read as id
-    0 or heading 0; it is left out, counted by reason in the receiving stage's summary."""
-    w = wrap_pb.SSL_WrapperPacket()
-    d = w.detection
-    d.frame_number, d.t_capture, d.t_sent, d.camera_id = 5, EPOCH.to_unix(1.0), EPOCH.to_unix(1.004), 6
-    d.robots_blue.add(confidence=0.9, robot_id=3, x=100.0, y=200.0, orientation=1.5, pixel_x=1.0, pixel_y=2.0)
-    d.robots_blue.add(confidence=0.9, x=300.0, y=200.0, orientation=0.5, pixel_x=1.0, pixel_y=2.0)  # no id
-    d.robots_yellow.add(confidence=0.9, robot_id=0, x=-100.0, y=0.0, pixel_x=1.0, pixel_y=2.0)  # no orientation
-    d.robots_yellow.add(confidence=0.8, robot_id=7, x=-500.0, y=0.0, orientation=-1.0, pixel_x=1.0, pixel_y=2.0)
-    got = read_wrapper(w.SerializeToString(), EPOCH)
-    assert got.robots_left_out == {"no id": 1, "no orientation": 1} and got.detection is not None
-    assert [(r.team, r.id, r.theta) for r in got.detection.robots] == [("blue", 3, 1.5), ("yellow", 7, -1.0)]
-    queue = DatagramQueue()
-    stage = VisionInStage(load_settings().protocols, [], lockstep=False, receiver=queue, epoch=EPOCH)
-    queue.push(w.SerializeToString())
-    published: list[tuple[str, Any]] = []
-    stage.on_message("clock", Tick(0), lambda topic, m: published.append((topic, m)))
-    figures: list[Any] = []
-    stage.summarize(lambda _t, s: figures.append(s.figures))
-    assert [t for t, _ in published] == ["ssl/vision/6"]  # camera 6: not in any config of ours, taken
-    assert figures[0]["robots_left_out"] == {"no id": 1, "no orientation": 1}
+        assert (read.k1, read.k2) == (0.0, 0.0)
 
 
 # Answers recorded on this machine to a RobotControl for blue robot 0 (local velocity; then a global

@@ -99,6 +99,8 @@ def test_detections_and_geometry_cross_loopback_unchanged(udp_port: int) -> None
     assert det.t_sent == pytest.approx(DET.t_sent, abs=1e-6)  # through Unix time: to the microsecond
     sent = SSL_WrapperPacket.FromString(det_data).detection  # Unix time on the wire, the match's in the camera's
     assert (sent.t_capture, sent.t_sent, sent.t_capture_camera) == (EPOCH.epoch_s + 0.7, EPOCH.epoch_s + 0.702, 0.7)
+    # SSL-Vision counts pixels from the centre of the top-left pixel, we from its corner
+    assert (sent.balls[0].pixel_x, sent.balls[0].pixel_y, sent.robots_blue[0].pixel_x) == (100.0, 199.75, 9.5)
     other, _ = decode_wrapper(det_data, EPOCH)  # anyone's packet: Unix time less the epoch
     assert (other.t_capture, other.t_sent) == pytest.approx((0.7, 0.702), abs=1e-6)
     assert det.robots[1].x == pytest.approx(-1.0, abs=1e-6) and det.balls[0].sigma_m == pytest.approx(0.004)

@@ -10,6 +10,8 @@ field origin in the camera frame, so a point's camera coordinates are R(q) p + t
 barrel distortion (our lens model's k1 < 0), none at all for a value <= 0; our (k1, k2) go out as
 the nearest such value over the image and come back as the (k1, k2) nearest to it
 (:func:`cmdragons.camera.ssl_vision_distortion`). The league's layout has no second coefficient.
+Pixels (principal points, detections' pixel_x and pixel_y) are SSL-Vision's on the wire
+(:data:`PIXEL_ORIGIN`).
 """
 
 from __future__ import annotations
@@ -42,6 +44,9 @@ __all__ = ["CameraCalibration", "FieldArc", "FieldLine", "VisionGeometry", "deco
            "settings_on_geometry"]  # fmt: skip
 
 MM = wire.MM
+# SSL-Vision's pixel coordinates count from the centre of the top-left pixel (its regions' centroids
+# are means of column and row indices), ours from that pixel's corner: ours = SSL-Vision's + 0.5
+PIXEL_ORIGIN = 0.5
 
 # our field's straight markings (Field.line_segments' order) by the league's names
 _LINE_NAMES = ("BottomTouchLine", "TopTouchLine", "LeftGoalLine", "RightGoalLine", "HalfwayLine", "CenterLine",
@@ -130,7 +135,8 @@ def _calibration(cam: CameraModel) -> Any:
     t = -r_field_to_cam @ cam.center * MM
     c = cam.center * MM
     return geo_pb.SSL_GeometryCameraCalibration(
-        camera_id=cam.id, focal_length=cam.f, principal_point_x=cam.cx, principal_point_y=cam.cy,
+        camera_id=cam.id, focal_length=cam.f, principal_point_x=cam.cx - PIXEL_ORIGIN,
+        principal_point_y=cam.cy - PIXEL_ORIGIN,
         distortion=ssl_vision_distortion(cam.params),
         q0=q[0], q1=q[1], q2=q[2], q3=q[3], tx=t[0], ty=t[1], tz=t[2], derived_camera_world_tx=c[0],
         derived_camera_world_ty=c[1], derived_camera_world_tz=c[2], pixel_image_width=cam.width,
@@ -172,6 +178,8 @@ def detection_packet(det: DetectionFrame, epoch: UnixEpoch | None = None) -> byt
     g.detection.CopyFrom(wire.to_proto(det))
     d = g.detection
     d.t_capture, d.t_sent, d.t_capture_camera = e.to_unix(det.t_capture), e.to_unix(det.t_sent), det.t_capture
+    for row in (*d.balls, *d.robots_blue, *d.robots_yellow):
+        row.pixel_x, row.pixel_y = row.pixel_x - PIXEL_ORIGIN, row.pixel_y - PIXEL_ORIGIN
     return g.SerializeToString(deterministic=True)  # type: ignore[no-any-return]
 
 
@@ -194,7 +202,7 @@ def geometry_of(m: Any) -> VisionGeometry:
 def _calibration_of(c: Any) -> CameraCalibration:
     """One SSL_GeometryCameraCalibration (metres); the image's size, when not sent, taken as twice
     the principal point's for fitting our lens terms."""
-    pp = (c.principal_point_x, c.principal_point_y)
+    pp = (c.principal_point_x + PIXEL_ORIGIN, c.principal_point_y + PIXEL_ORIGIN)
     size = (c.pixel_image_width, c.pixel_image_height)
     fit_size = size if min(size) > 0 else (round(2.0 * pp[0]), round(2.0 * pp[1]))
     k1, k2 = from_ssl_vision_distortion(c.distortion, c.focal_length, pp, fit_size) if c.focal_length > 0 and \
@@ -256,6 +264,8 @@ def read_wrapper(data: bytes, epoch: UnixEpoch | None = None, camera_clock: bool
         e = run_epoch() if epoch is None else epoch
         m = g.detection
         left_out = _keep_whole_robots(m)
+        for row in (*m.balls, *m.robots_blue, *m.robots_yellow):
+            row.pixel_x, row.pixel_y = row.pixel_x + PIXEL_ORIGIN, row.pixel_y + PIXEL_ORIGIN
         t = m.t_capture_camera if camera_clock and m.HasField("t_capture_camera") else e.to_match(m.t_capture)
         det = dataclasses.replace(wire.from_proto(m), t_capture=t, t_sent=e.to_match(m.t_sent))
     geo = geometry_of(g.geometry) if g.HasField("geometry") else None

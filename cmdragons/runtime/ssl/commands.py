@@ -116,14 +116,19 @@ def read_robot_control(data: bytes, team: Team, headings: Mapping[int, float],
     return ReadCommands(tuple(out), tuple(errors))
 
 
-def robot_control_response(team: Team, ids: list[int], errors: list[str]) -> bytes:
-    """The ``RobotControlResponse`` a simulator answers a ``RobotControl`` with."""
+def robot_control_response(team: Team, ids: list[int], errors: list[str],
+                           contact: Mapping[int, bool] | None = None) -> bytes:  # fmt: skip
+    """The ``RobotControlResponse`` a simulator answers a ``RobotControl`` with; ``contact``: robot
+    id -> the ball at its dribbler (``dribbler_ball_contact``; left out for a robot not in it)."""
     m = sim_pb.RobotControlResponse()
     for e in errors:
         m.errors.add(code="unsupported", unsupported_capability=sim_pb.SIMULATOR_CAPABILITY_MOVE_WHEEL_VELOCITY,
                      message=e)  # fmt: skip
     for i in ids:
-        m.feedback.add().id.CopyFrom(trk_pb.RobotId(id=i, team=_TEAM_PB[team]))
+        fb = m.feedback.add()
+        fb.id.CopyFrom(trk_pb.RobotId(id=i, team=_TEAM_PB[team]))
+        if contact is not None and i in contact:
+            fb.dribbler_ball_contact = contact[i]
     return m.SerializeToString(deterministic=True)  # type: ignore[no-any-return]
 
 

@@ -10,7 +10,7 @@ from typing import Literal
 
 from cmdragons.config import Validated, setting
 
-__all__ = ["GrsimParams", "MulticastParams", "ProtocolParams", "SimulationParams"]
+__all__ = ["GrsimParams", "MulticastParams", "ProtocolParams", "ServeParams", "SimulationParams"]
 
 CommandsTo = Literal["none", "grsim", "simulation"]
 
@@ -89,6 +89,13 @@ class SimulationParams(Validated):
 
 
 @dataclass(frozen=True)
+class ServeParams(Validated):
+    """``cmdragons sim --serve``: our simulator alone as a league simulator."""
+
+    vision_noise: bool = True  # its SSL-Vision detections carry the tracker's measurement noise (false: exact)
+
+
+@dataclass(frozen=True)
 class ProtocolParams(Validated):
     interface: str = _LOOPBACK  # every multicast socket sends and joins on this interface's address
     network: bool = False  # allow an interface and unicast peers off loopback (a real field's network)
@@ -103,6 +110,7 @@ class ProtocolParams(Validated):
     referee: RefereeStreamParams = RefereeStreamParams()
     grsim: GrsimParams = GrsimParams()
     simulation: SimulationParams = SimulationParams()
+    serve: ServeParams = ServeParams()
 
     def __post_init__(self) -> None:
         super().__post_init__()

@@ -170,7 +170,7 @@ def test_robot_control_moves_a_robot_and_the_silent_team_stands(team: str) -> No
         for _ in range(60):  # a second at 1 m/s forward: the robot faces +y
             response = sim_pb.RobotControlResponse()
             response.ParseFromString(srv.send(_control(1, forward=1.0), port))
-            assert [f.id.id for f in response.feedback] == [1] and list(response.errors) == []
+            assert [f.id for f in response.feedback] == [1] and list(response.errors) == []
         moved = srv.robot(team, 1)
         assert moved.y - start.y > 0.6 and abs(moved.x - start.x) < 0.05
         assert (moved.vx, moved.vy) == pytest.approx((0.0, 1.0), abs=0.05)
@@ -200,7 +200,7 @@ def test_the_feedback_says_which_robot_has_the_ball_at_its_dribbler() -> None:
             v = m.robot_commands.add(id=rid, dribbler_speed=5000.0).move_command.local_velocity
             v.forward = v.left = v.angular = 0.0
         response.ParseFromString(srv.send(m.SerializeToString(), sim.blue_port))
-        contact = {f.id.id: f.dribbler_ball_contact for f in response.feedback}
+        contact = {f.id: f.dribbler_ball_contact for f in response.feedback}
         assert contact == {0: True, 3: False}
 
 

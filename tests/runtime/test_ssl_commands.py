@@ -27,9 +27,13 @@ from cmdragons.runtime.proto import ssl_tracked_pb2 as trk_pb
 from cmdragons.runtime.proto.generate import PROTO_DIR, ROOT
 from cmdragons.runtime.settings import load_settings
 from cmdragons.runtime.ssl.commands import (
+    UNSUPPORTED,
+    Feedback,
+    SimError,
     grsim_packet,
     local_velocity,
     read_robot_control,
+    read_robot_control_response,
     read_simulator_command,
     robot_control_packet,
     robot_control_response,
@@ -147,9 +151,11 @@ def test_every_message_sent_decodes_with_protoc() -> None:
     tp = msg.Teleport(0.0, (("yellow", 2, -1.0, 1.0, -2.0),), (0.25, 0.75))
     out = _protoc("ssl_simulator.proto", "SimulatorCommand", simulator_command_packet(tp))
     assert "teleport_ball" in out and "x: 0.25" in out and "team: YELLOW" in out and "present: true" in out
-    out = _protoc("ssl_simulator.proto", "RobotControlResponse", robot_control_response("yellow", [3], ["robot 4: no"]))
-    assert "unsupported_capability: SIMULATOR_CAPABILITY_MOVE_WHEEL_VELOCITY" in out and "team: YELLOW" in out
-    out = _protoc("ssl_simulator.proto", "SimulatorResponse", simulator_response(["config: not here"]))
+    out = _protoc("ssl_simulator.proto", "RobotControlResponse",
+                  robot_control_response([Feedback(3)], [SimError(UNSUPPORTED, "robot 4: no")]))  # fmt: skip
+    assert "message: \"robot 4: no\"" in out and "feedback {\n  id: 3\n}" in out
+    out = _protoc("ssl_simulator.proto", "SimulatorResponse",
+                  simulator_response([SimError(UNSUPPORTED, "config: not here")]))  # fmt: skip
     assert "message: \"config: not here\"" in out
 
 
@@ -259,9 +265,8 @@ def test_a_team_outside_drives_its_robot_in_our_simulator_over_udp(kind: str) ->
             client.send_to(m.SerializeToString(), ("127.0.0.1", ports["yellow"]))
             match.step()
             while (got := client.receive()) is not None:
-                resp = sim_pb.RobotControlResponse()
-                resp.ParseFromString(got[0])
-                assert [f.id.id for f in resp.feedback] == [1] and not resp.errors
+                resp = read_robot_control_response(got[0])
+                assert [f.id for f in resp.feedback] == [1] and not resp.errors and not resp.earlier_layout
                 answers += 1
         summary = match.summary()
     finally:

@@ -25,8 +25,6 @@ import uuid
 from collections.abc import Sequence
 from typing import Any, Protocol, TextIO
 
-from google.protobuf.message import DecodeError
-
 from cmdragons.geometry import LeagueParams, Team
 from cmdragons.messages import (
     DetectionFrame,
@@ -41,10 +39,13 @@ from cmdragons.messages import (
     WorldState,
 )
 from cmdragons.runtime.bus import BaseStage, Publish
-from cmdragons.runtime.proto import ssl_simulator_pb2 as sim_pb
 from cmdragons.runtime.ssl.commands import (
+    UNSUPPORTED,
+    Feedback,
+    SimError,
     grsim_packet,
     read_robot_control,
+    read_robot_control_response,
     read_simulator_command,
     robot_control_packet,
     robot_control_response,
@@ -235,9 +236,11 @@ class RefereeOutStage(SocketStage):
 
 class RefereeInStage(SocketStage):
     """A game controller's Referee packets from multicast -> ``referee/gc`` game states, on every
-    clock tick each packet that came since. On
-    ``world_topic`` it watches the ball: once a kickoff's or penalty's restart is taken (the ball
-    ``moved_m`` from the designated position), play is normal."""
+    clock tick each packet that came since. On ``world_topic`` it watches the ball: once a
+    kickoff's or penalty's restart is taken (the ball moved ``moved_m``, the rules' ball-in-play
+    distance, from its spot), play is normal. The spot is the designated position of the packet
+    that started it, or (a game controller clears the designated position at NORMAL_START) of the
+    prepare command before it, or else where the ball was first seen after the normal start."""
 
     @staticmethod
     def declare(params: ProtocolParams, world_topic: str, moved_m: float = 0.0) -> Contract:
@@ -253,8 +256,9 @@ class RefereeInStage(SocketStage):
         self.moved_m = moved_m
         self.reader = RefereeReader()
         self.drops = DropLog(f"referee {r.group}:{r.port}", params.drop_report_interval_s, err)
-        self.received = 0
+        self.received = self.restarts_taken = 0
         self._last: bytes | None = None
+        self._spot: tuple[float, float] | None = None  # where the restart under way was set (field, m)
 
     def on_message(self, topic: str, message: Any, publish: Publish) -> None:
         if topic == "clock":
@@ -262,10 +266,14 @@ class RefereeInStage(SocketStage):
                 self._take(data, publish)
             return
         g, b = self.reader.last, message.ball
-        taking = g is not None and g.command.prepared and g.ready and g.placement is not None
-        if taking and b is not None and self._last is not None and g is not None and g.placement is not None \
-                and math.hypot(b.x - g.placement[0], b.y - g.placement[1]) > self.moved_m:  # fmt: skip
+        if g is None or not (g.command.prepared and g.ready) or b is None or self._last is None:
+            return
+        if self._spot is None:
+            self._spot = (b.x, b.y)
+        elif math.hypot(b.x - self._spot[0], b.y - self._spot[1]) > self.moved_m:
             self.reader.ball_moved()
+            self.restarts_taken += 1
+            self._spot = None
             publish("referee/gc", self.reader.read(self._last))
 
     def _take(self, data: bytes, publish: Publish) -> None:
@@ -276,11 +284,16 @@ class RefereeInStage(SocketStage):
             self.drops.drop("undecodable", f"{len(data)} bytes, {exc}")
             return
         self._last = data
+        if not game.command.prepared:
+            self._spot = None
+        elif game.placement is not None:  # the prepare's spot, or the start's when it says one
+            self._spot = game.placement
         publish("referee/gc", game)
 
     def summarize(self, publish: Publish) -> None:
         publish(f"summary/{self.name}", StageSummary(self.name, {
-            "packets": self.received, "dropped": dict(sorted(self.drops.counts.items()))}))  # fmt: skip
+            "packets": self.received, "restarts_taken": self.restarts_taken,
+            "dropped": dict(sorted(self.drops.counts.items()))}))  # fmt: skip
 
     def close(self) -> None:
         self.receiver.close()
@@ -338,7 +351,7 @@ class CommandsOutStage(SocketStage):
         self.chip_angle_rad = chip_angle_rad
         self.full_rpm = sim.dribbler_full_rpm
         self.headings: dict[int, float] = {}
-        self.sent = self.teleports = self.answers = self.answer_errors = 0
+        self.sent = self.teleports = self.answers = self.answer_errors = self.answers_earlier_layout = 0
         self.drops = DropLog(f"{self.to} answers", params.drop_report_interval_s, err)
 
     def on_message(self, topic: str, message: Any, publish: Publish) -> None:
@@ -360,19 +373,20 @@ class CommandsOutStage(SocketStage):
         """The simulation protocol answers each packet (grSim does not): count them and their errors."""
         while (got := self.endpoint.receive()) is not None:
             data, _peer = got
-            answer = sim_pb.RobotControlResponse()
             try:
-                answer.ParseFromString(data)
-            except DecodeError as exc:
+                answer = read_robot_control_response(data)
+            except MessageError as exc:
                 self.drops.drop("undecodable", f"{len(data)} bytes, {exc}")
                 continue
             self.answers += 1
             self.answer_errors += len(answer.errors)
+            self.answers_earlier_layout += answer.earlier_layout
 
     def summarize(self, publish: Publish) -> None:
         publish(f"summary/{self.name}", StageSummary(self.name, {
             "to": self.to, "packets": self.sent, "teleports": self.teleports, "answers": self.answers,
-            "answer_errors": self.answer_errors, "dropped": dict(sorted(self.drops.counts.items()))}))  # fmt: skip
+            "answer_errors": self.answer_errors, "answers_earlier_layout": self.answers_earlier_layout,
+            "dropped": dict(sorted(self.drops.counts.items()))}))  # fmt: skip
 
     def close(self) -> None:
         self.endpoint.close()
@@ -466,8 +480,9 @@ class SimulationInStage(SocketStage):
         self.packets += 1
         for _, why in read.errors:
             self._refuse(why)
-        self.robots[team].send_to(robot_control_response(team, [c.id for c in read.commands],
-                                                         [why for _, why in read.errors], contact), peer)  # fmt: skip
+        feedback = [Feedback(c.id, contact.get(c.id)) for c in read.commands]
+        self.robots[team].send_to(robot_control_response(feedback, [SimError(UNSUPPORTED, why)
+                                                                    for _, why in read.errors]), peer)  # fmt: skip
         return read.commands
 
     def _teleport(self, got: tuple[bytes, tuple[str, int]], gt: GroundTruth,
@@ -483,7 +498,7 @@ class SimulationInStage(SocketStage):
         if tp is not None:
             self.teleports += 1
             publish("teleport", tp)
-        self.control.send_to(simulator_response(refused), peer)
+        self.control.send_to(simulator_response([SimError(UNSUPPORTED, why) for why in refused]), peer)
 
     def _refuse(self, why: str) -> None:
         key = why.split(":")[0]

@@ -5,8 +5,11 @@ The detection inside the packet is the wire's own mapping (:func:`cmdragons.runt
 of a DetectionFrame is the league's SSL_DetectionFrame already); this module adds the wrapper and
 the geometry. Camera calibrations follow SSL-Vision's convention: the quaternion (q0, q1, q2 the
 vector part, q3 the scalar) rotates field coordinates into the camera frame and (tx, ty, tz) is the
-field origin in the camera frame, so a point's camera coordinates are R(q) p + t (mm). Our
-``distortion`` is the camera model's first radial coefficient on normalised image coordinates.
+field origin in the camera frame, so a point's camera coordinates are R(q) p + t (mm). The
+``distortion`` is SSL-Vision's: r_u = r_d (1 + distortion r_d^2) on normalised radii, positive for
+barrel distortion (our lens model's k1 < 0), none at all for a value <= 0; our (k1, k2) go out as
+the nearest such value over the image and come back as the (k1, k2) nearest to it
+(:func:`cmdragons.camera.ssl_vision_distortion`). The league's layout has no second coefficient.
 """
 
 from __future__ import annotations
@@ -18,7 +21,7 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from cmdragons.camera import CameraModel
+from cmdragons.camera import CameraModel, from_ssl_vision_distortion, ssl_vision_distortion
 from cmdragons.geometry import BallShape, Field
 from cmdragons.messages import DetectionFrame
 from cmdragons.runtime import wire
@@ -59,11 +62,13 @@ class CameraCalibration:
     camera_id: int
     focal_px: float
     principal_point_px: tuple[float, float]
-    distortion: float
+    distortion: float  # SSL-Vision's (see the module)
     quaternion: tuple[float, float, float, float]  # q0, q1, q2 (vector), q3 (scalar): field -> camera
     translation_m: tuple[float, float, float]  # the field origin in the camera frame
     position_m: tuple[float, float, float]  # the camera in the field frame
-    resolution_px: tuple[int, int]
+    resolution_px: tuple[int, int]  # (0, 0): not sent
+    k1: float = 0.0  # our lens model's radial terms nearest to ``distortion`` over the image
+    k2: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -100,7 +105,8 @@ def _calibration(cam: CameraModel) -> Any:
     t = -r_field_to_cam @ cam.center * MM
     c = cam.center * MM
     return geo_pb.SSL_GeometryCameraCalibration(
-        camera_id=cam.id, focal_length=cam.f, principal_point_x=cam.cx, principal_point_y=cam.cy, distortion=cam.k1,
+        camera_id=cam.id, focal_length=cam.f, principal_point_x=cam.cx, principal_point_y=cam.cy,
+        distortion=ssl_vision_distortion(cam.params),
         q0=q[0], q1=q[1], q2=q[2], q3=q[3], tx=t[0], ty=t[1], tz=t[2], derived_camera_world_tx=c[0],
         derived_camera_world_ty=c[1], derived_camera_world_tz=c[2], pixel_image_width=cam.width,
         pixel_image_height=cam.height)  # fmt: skip
@@ -146,16 +152,25 @@ def geometry_of(m: Any) -> VisionGeometry:
                   for s in f.field_lines)  # fmt: skip
     arcs = tuple(FieldArc(a.name, (a.center.x / MM, a.center.y / MM), a.radius / MM, a.a1, a.a2, a.thickness / MM)
                  for a in f.field_arcs)  # fmt: skip
-    cams = tuple(CameraCalibration(
-        c.camera_id, c.focal_length, (c.principal_point_x, c.principal_point_y), c.distortion,
-        (c.q0, c.q1, c.q2, c.q3), (c.tx / MM, c.ty / MM, c.tz / MM),
-        _camera_position(c), (c.pixel_image_width, c.pixel_image_height)) for c in m.calib)  # fmt: skip
+    cams = tuple(_calibration_of(c) for c in m.calib)
     s = m.models.straight_two_phase if m.models.HasField("straight_two_phase") else None
     return VisionGeometry(
         f.field_length / MM, f.field_width / MM, f.goal_width / MM, f.goal_depth / MM, f.boundary_width / MM,
         f.penalty_area_depth / MM, f.penalty_area_width / MM, f.center_circle_radius / MM, f.line_thickness / MM,
         f.goal_height / MM, f.ball_radius / MM, f.max_robot_radius / MM, lines, arcs, cams,
         -s.acc_slide if s else math.nan, -s.acc_roll if s else math.nan, s.k_switch if s else math.nan)  # fmt: skip
+
+
+def _calibration_of(c: Any) -> CameraCalibration:
+    """One SSL_GeometryCameraCalibration (metres); the image's size, when not sent, taken as twice
+    the principal point's for fitting our lens terms."""
+    pp = (c.principal_point_x, c.principal_point_y)
+    size = (c.pixel_image_width, c.pixel_image_height)
+    fit_size = size if min(size) > 0 else (round(2.0 * pp[0]), round(2.0 * pp[1]))
+    k1, k2 = from_ssl_vision_distortion(c.distortion, c.focal_length, pp, fit_size) if c.focal_length > 0 and \
+        min(fit_size) > 0 else (0.0, 0.0)  # fmt: skip
+    return CameraCalibration(c.camera_id, c.focal_length, pp, c.distortion, (c.q0, c.q1, c.q2, c.q3),
+                             (c.tx / MM, c.ty / MM, c.tz / MM), _camera_position(c), size, k1, k2)  # fmt: skip
 
 
 def _camera_position(c: Any) -> tuple[float, float, float]:

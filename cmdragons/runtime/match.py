@@ -51,6 +51,7 @@ from cmdragons.team import Brain
 from cmdragons.tracking import Tracker
 from sim.params import SimParams
 from sim.referee import Referee
+from sim.restarts import park
 from sim.simulator import Simulator, robot_keys
 from strategy.simple import SimpleTeam
 
@@ -186,7 +187,8 @@ def scripted_wiring(sim: Simulator, script: ScriptedPlay, recorder: RecordingWri
 def served_wiring(settings: Settings, sim: Simulator, seed: int) -> list[Entry]:
     """The table of ``cmdragons sim --serve``: our simulator alone as a league simulator. Both
     teams' robots take the simulation protocol (``RobotControl`` on each team's port, teleports on
-    the control port; a team that sends nothing has its robots stand), the field is seen as
+    the control port, a robot taken off the field parked out of view; a team that sends nothing has
+    its robots stand), the field is seen as
     SSL-Vision packets from every camera of the division (detections made from the truth, with the
     geometry now and then), and the simulator's referee judges on the truth and speaks the league's
     Referee packets. ``sim``: built without rendering and without its own referee; ``seed``: the
@@ -201,6 +203,8 @@ def served_wiring(settings: Settings, sim: Simulator, seed: int) -> list[Entry]:
     keys = robot_keys(league, settings.sim)
     sigmas = _measurement_sigmas(settings) if p.serve.vision_noise else (0.0, 0.0, 0.0)
     touch_m = settings.sim.kicker.touch_tolerance_m
+    pitch = settings.field_geometry()  # a robot taken off the field waits where the referee parks robots sent off
+    parked = {key: park(pitch, i, key[0], settings.sim.referee.park_distance_m) for i, key in enumerate(keys)}
     return [
         Entry(SimStage.declare([]), "sim", lambda: SimStage(sim, TEAMS)),
         Entry(RefereeStage.contract, "sim",
@@ -208,7 +212,7 @@ def served_wiring(settings: Settings, sim: Simulator, seed: int) -> list[Entry]:
         Entry(CameraTruthStage.declare(ids), "sim",
               functools.partial(CameraTruthStage, models, league.robot.height_m, sigmas, seed)),
         Entry(SimulationInStage.declare(p, TEAMS), "", functools.partial(SimulationInStage, p, TEAMS, 0.0, league,
-                                                                           touch_m)),
+                                                                           touch_m, parked)),
         Entry(VisionOutStage.declare(p, ids, geometry), "", functools.partial(VisionOutStage, p, ids, geometry)),
         Entry(RefereeOutStage.contract, "", functools.partial(RefereeOutStage, p)),
     ]  # fmt: skip

@@ -150,10 +150,20 @@ def test_teleports_place_the_ball_and_robots_in_the_served_vision() -> None:
             seen = [r for f in frames.values() for r in f.robots if (r.team, r.id) == (team, rid)]
             assert seen and all((r.x, r.y) == pytest.approx((x, y), abs=MM) for r in seen)
             assert all(abs(math.remainder(r.theta - theta, 2 * math.pi)) < 1e-3 for r in seen)
-        # present: false takes a robot off the field: refused with the reason, the robot stays
+        # present: false takes a robot off the field (out of every camera's view), present: true brings it back
         answer.ParseFromString(srv.send(_teleport(None, ((BLUE, 2, 0.0, 0.0, 0.0),), present=False), sim.control_port))
-        assert len(answer.errors) == 1 and "taken off" in answer.errors[0].message
-        assert (srv.robot("blue", 2).x, srv.robot("blue", 2).y) == pytest.approx((-0.5, 2.5), abs=1e-3)
+        assert list(answer.errors) == []
+        srv.tick(2)
+        off = srv.robot("blue", 2)
+        assert abs(off.y) > s.field_geometry().boundary_half_width
+        frames, _ = srv.seen()
+        assert not [r for f in frames.values() for r in f.robots if (r.team, r.id) == ("blue", 2)]
+        srv.send(_teleport(None, ((BLUE, 2, 0.5, 2.5, 0.0),)), sim.control_port)
+        srv.tick(2)
+        frames, _ = srv.seen()
+        assert [(r.x, r.y) for f in frames.values() for r in f.robots if (r.team, r.id) == ("blue", 2)] and all(
+            (r.x, r.y) == pytest.approx((0.5, 2.5), abs=MM) for f in frames.values() for r in f.robots
+            if (r.team, r.id) == ("blue", 2))  # fmt: skip
 
 
 @pytest.mark.parametrize("team", ["blue", "yellow"])

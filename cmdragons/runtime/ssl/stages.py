@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 import time
 import uuid
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any, Protocol, TextIO
 
 from cmdragons.geometry import LeagueParams, Team
@@ -401,8 +401,10 @@ class SimulationInStage(SocketStage):
     keeps pace with a team that answers every frame). A team that sent nothing this frame has no
     commands for it (its robots stop by their own command timeout). Local velocities turn into the
     field frame by the robot's true heading. Each packet is answered (RobotControlResponse, with each
-    robot's ball contact when ``league`` is given, within ``touch_m`` of its front; SimulatorResponse);
-    garbage and a packet cut short are counted and dropped with a line on stderr."""
+    robot's ball contact when ``league`` is given, within ``touch_m`` of its front; SimulatorResponse).
+    A robot taken off the field (``present: false``) goes to its spot in ``parked``, out of the
+    cameras' view (refused without). Garbage and a packet cut short are counted and dropped with a
+    line on stderr."""
 
     @staticmethod
     def declare(params: ProtocolParams, teams: Team | Sequence[Team]) -> Contract:
@@ -413,6 +415,7 @@ class SimulationInStage(SocketStage):
 
     def __init__(self, params: ProtocolParams, teams: Team | Sequence[Team], wait_s: float | None = None,
                  league: LeagueParams | None = None, touch_m: float = 0.0,
+                 parked: Mapping[tuple[Team, int], tuple[float, float]] | None = None,
                  err: TextIO | None = None) -> None:  # fmt: skip
         sim = params.simulation
         self.contract = self.declare(params, teams)
@@ -427,7 +430,7 @@ class SimulationInStage(SocketStage):
                 endpoint.close()
             raise
         self.wait_s = sim.wait_s if wait_s is None else wait_s
-        self.league, self.touch_m = league, touch_m
+        self.league, self.touch_m, self.parked = league, touch_m, parked
         self.full_rpm = sim.dribbler_full_rpm
         ports = "/".join(str(sim.port(t)) for t in self.teams)
         self.drops = DropLog(f"simulation protocol {sim.address}:{ports}/{sim.control_port}",
@@ -489,7 +492,7 @@ class SimulationInStage(SocketStage):
                   where: dict[tuple[Team, int], tuple[float, float, float]], publish: Publish) -> None:  # fmt: skip
         data, peer = got
         try:
-            tp, refused = read_simulator_command(data, gt.t, where, (gt.ball.x, gt.ball.y))
+            tp, refused = read_simulator_command(data, gt.t, where, (gt.ball.x, gt.ball.y), self.parked)
         except MessageError as exc:
             self.drops.drop("undecodable", f"{len(data)} bytes from {peer[0]}:{peer[1]}, {exc}")
             return

@@ -13,6 +13,8 @@ import sys
 import time
 from typing import Any
 
+import numpy as np
+
 from cmdragons.runtime.interrupt import Interrupt
 
 __all__ = ["cmd_serve", "refused_options"]
@@ -76,6 +78,7 @@ def cmd_serve(args: argparse.Namespace, stop: Interrupt) -> int:
         print(_listening(settings, [m.id for m in models]), flush=True)
         bus.start()
         late = [0]
+        frame_ms: list[float] = []  # each frame's work (the wall time it took, the wait for it left out)
         wall0 = time.monotonic()
         due = [wall0]  # when the next frame is due (wall clock)
 
@@ -89,7 +92,9 @@ def cmd_serve(args: argparse.Namespace, stop: Interrupt) -> int:
                 late[0] += 1
                 due[0] = time.monotonic()
             due[0] += 1.0 / fps
+            t0 = time.perf_counter()
             bus.tick(i)
+            frame_ms.append((time.perf_counter() - t0) * 1e3)
 
         with progress_bar(not args.no_progress, counts=args.seconds is not None) as progress, stop.soft():
             task = progress.add_task("sim --serve", total=n_frames if args.seconds is not None else None, info="")
@@ -102,7 +107,7 @@ def cmd_serve(args: argparse.Namespace, stop: Interrupt) -> int:
             log.close()
     with stop.shield():
         bus.summarize()
-        return _finish(args, stop, folder, summaries.figures, wall, late[0], len(models))
+        return _finish(args, stop, folder, summaries.figures, wall, late[0], frame_ms, len(models))
 
 
 def _listening(settings: Any, camera_ids: list[int]) -> str:
@@ -116,13 +121,15 @@ def _listening(settings: Any, camera_ids: list[int]) -> str:
 
 
 def _finish(args: argparse.Namespace, stop: Interrupt, folder: Any, f: dict[str, Any], wall: float, late: int,
-            cameras: int) -> int:  # fmt: skip
+            frame_ms: list[float], cameras: int) -> int:  # fmt: skip
     """summary.json and the line that sums the run up."""
     sim, referee = f["sim"], f["referee"]
     seconds = float(sim["seconds"])
     summary = {
         "score": referee["score"], "seconds": seconds, "wall_seconds": round(wall, 3), "frames": sim["frames"],
-        "frames_late": late, "cameras": cameras, "interrupted": stop.requested, "kicks": referee["kicks"],
+        "frames_late": late, "frame_ms": {"median": float(np.median(frame_ms)),
+                                          "p95": float(np.percentile(frame_ms, 95))} if frame_ms else None,
+        "cameras": cameras, "interrupted": stop.requested, "kicks": referee["kicks"],
         "balls_out": referee["balls_out"], "command_faults": sim["command_faults"],
         "rules": {k: referee[k] for k in ("rules", "game_stage", "fouls", "cards", "placements")},
         "protocols": {k: v for k, v in f.items() if k.startswith("ssl/")},

@@ -16,7 +16,7 @@ import pytest
 
 from cmdragons import messages as msg
 from cmdragons.runtime.bus import Bus
-from cmdragons.runtime.match import build, served_wiring
+from cmdragons.runtime.match import CLOCK, build, served_wiring
 from cmdragons.runtime.proto import ssl_simulation_control_pb2 as ctl_pb
 from cmdragons.runtime.proto import ssl_simulator_pb2 as sim_pb
 from cmdragons.runtime.proto import ssl_tracked_pb2 as trk_pb
@@ -25,6 +25,7 @@ from cmdragons.runtime.ssl.stages import RefereeOutStage, SimulationInStage, Vis
 from cmdragons.runtime.ssl.udp import MulticastReceiver, UdpEndpoint
 from cmdragons.runtime.ssl.vision import VisionGeometry, decode_wrapper
 from cmdragons.runtime.stages import Tap
+from cmdragons.runtime.topics import topic_matches
 from sim.simulator import Simulator
 from tests.runtime.conftest import free_udp_ports
 
@@ -232,6 +233,28 @@ def test_every_camera_of_the_division_is_served_with_its_geometry(division: str)
     # every robot on the field is seen by some camera
     seen = {(r.team, r.id) for f in frames.values() for r in f.robots}
     assert seen == {(r.team, r.id) for r in srv.truth[-1].robots}
+
+
+def test_the_served_stages_publish_what_they_declare() -> None:
+    """Every topic published on the served bus is declared by a row of the table with its message
+    type, and every topic the rows declare for each frame is published (with a client sending)."""
+    s = _settings()
+    sim = s.protocols.simulation
+    seen: list[tuple[str, object]] = []
+    with served(s) as srv:
+        srv.bus.add(Tap("every", ("*",), lambda t, m: seen.append((t, m))))
+        srv.send(_teleport((1.0, 1.0)), sim.control_port)
+        for _ in range(5):
+            srv.send(_control(1, forward=0.5), sim.yellow_port)
+        srv.bus.summarize()
+        declared = [p for st in srv.stages for p in st.contract.writes] + list(CLOCK)
+    for topic, m in seen:
+        ports = [p for p in declared if topic_matches(p.topic, topic)]
+        assert ports and type(m) is ports[0].type, topic
+    published = {t for t, _ in seen}
+    for p in declared:
+        if not p.sometimes:
+            assert any(topic_matches(p.topic, t) for t in published), p.topic
 
 
 def test_the_served_sockets_stay_on_this_machine() -> None:

@@ -96,9 +96,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="simulated seconds (default 10; with --serve: until interrupted)")
     p.add_argument("--serve", action="store_true",
                    help="run alone in real time and speak what grSim speaks: SSL-Vision packets with the geometry "
-                   "(224.5.23.2:10006, every camera of the division), the simulation protocol for both teams "
-                   "(SimulatorCommand on 127.0.0.1:10300, RobotControl on 10301 blue and 10302 yellow) and Referee "
-                   "packets from its own referee (224.5.23.1:10003); all on loopback (configs/protocols.yaml)")
+                   "(224.5.23.2:10020 as grSim's, every camera of the division), the simulation protocol for both "
+                   "teams (SimulatorCommand on 127.0.0.1:10300, RobotControl on 10301 blue and 10302 yellow) and "
+                   "Referee packets from its own referee (224.5.23.1:10003); all on loopback (configs/protocols.yaml)")
     p.add_argument("--division", choices=("A", "B"), default=None, help="field and team size (default: config)")
     p.add_argument("--record", action="store_true", help="write camera frames, cameras.yaml and truth.jsonl")
     p.add_argument("--format", choices=("h264", "ffv1", "png"), default=None,

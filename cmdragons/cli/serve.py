@@ -115,7 +115,7 @@ def _listening(settings: Any, camera_ids: list[int]) -> str:
     p = settings.protocols
     s = p.simulation
     return (f"sim --serve: Division {settings.field.division}, cameras {', '.join(map(str, camera_ids))}: SSL-Vision "
-            f"on {p.vision.group}:{p.vision.port}, Referee on {p.referee.group}:{p.referee.port} (interface "
+            f"on {p.vision.group}:{p.simulation.vision_port}, Referee on {p.referee.group}:{p.referee.port} (interface "
             f"{p.interface}, ttl {p.ttl}); simulation protocol on {s.address}: control {s.control_port}, blue "
             f"{s.blue_port}, yellow {s.yellow_port}")  # fmt: skip
 

@@ -197,6 +197,8 @@ def served_wiring(settings: Settings, sim: Simulator, seed: int) -> list[Entry]:
     from cmdragons.runtime.ssl.vision import geometry_packet
 
     p, league = settings.protocols, settings.field
+    # its vision where a simulation-protocol simulator sends it (grSim's and the ER-Force simulator's port)
+    p = dataclasses.replace(p, vision=dataclasses.replace(p.vision, port=p.simulation.vision_port))
     models = settings.camera_models()
     ids = [m.id for m in models]
     geometry = geometry_packet(settings.field_geometry(), models)

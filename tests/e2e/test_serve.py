@@ -34,7 +34,7 @@ AIM_Y_M = 0.42  # into the goal beside the keeper standing on its centre
 @pytest.mark.slow
 def test_a_two_process_match_scores_and_restarts(tmp_path: Path) -> None:
     vision_port, referee_port, control, blue, yellow = free_udp_ports(5)
-    sets = [f"protocols.vision.port={vision_port}", f"protocols.referee.port={referee_port}",
+    sets = [f"protocols.simulation.vision_port={vision_port}", f"protocols.referee.port={referee_port}",
             f"protocols.simulation.control_port={control}", f"protocols.simulation.blue_port={blue}",
             f"protocols.simulation.yellow_port={yellow}"]  # fmt: skip
     p = load_settings(None, sets).protocols

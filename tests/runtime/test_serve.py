@@ -36,7 +36,7 @@ def _settings(division: str = "B", *extra: str) -> Settings:
     """Served on ports of their own (tests that run at once never hear each other), no vision noise,
     the basic rules (the referee leaves the client's placements alone)."""
     vision, referee, control, blue, yellow = free_udp_ports(5)
-    return load_settings(None, [f"field.division={division}", f"protocols.vision.port={vision}",
+    return load_settings(None, [f"field.division={division}", f"protocols.simulation.vision_port={vision}",
                                 f"protocols.referee.port={referee}", f"protocols.simulation.control_port={control}",
                                 f"protocols.simulation.blue_port={blue}",
                                 f"protocols.simulation.yellow_port={yellow}", "protocols.serve.vision_noise=false",
@@ -87,7 +87,7 @@ class Served:
 def served(settings: Settings) -> Iterator[Served]:
     sim = Simulator(settings.field, settings.camera_models(), settings.sim, seed=1, render=False, referee=False)
     p = settings.protocols
-    vision = MulticastReceiver(p.vision.group, p.vision.port, p.interface, p.receive_buffer_bytes)
+    vision = MulticastReceiver(p.vision.group, p.simulation.vision_port, p.interface, p.receive_buffer_bytes)
     truth: list[msg.GroundTruth] = []
     stages = build(served_wiring(settings, sim, 1), [Tap("truth", ("truth",), lambda _t, m: truth.append(m))])
     bus = Bus()
@@ -270,5 +270,9 @@ def test_the_served_sockets_stay_on_this_machine() -> None:
         sim_in = stages[SimulationInStage]
         for endpoint in (sim_in.control, *sim_in.robots.values()):
             assert endpoint.sock.getsockname()[0] == "127.0.0.1"
+        assert stages[VisionOutStage].sender.address == ("224.5.23.2", s.protocols.simulation.vision_port)
     p = load_settings().protocols
     assert (p.interface, p.ttl, p.network, p.simulation.address) == ("127.0.0.1", 0, False, "127.0.0.1")
+    # where grSim and the ER-Force simulator speak: vision on 10020, commands and teleports on 10301/10302/10300
+    assert (p.simulation.vision_port, p.simulation.control_port, p.simulation.blue_port,
+            p.simulation.yellow_port, p.referee.port) == (10020, 10300, 10301, 10302, 10003)  # fmt: skip

@@ -82,6 +82,7 @@ class SimulationParams(Validated):
     yellow_port: int = setting(10302, lo=1, hi=65535)
     dribbler_full_rpm: float = setting(10000.0, lo=1.0, hi=1e6)  # dribbler_speed (rpm) that is our full power (1)
     wait_s: float = setting(0.05, lo=0.0, hi=60.0)  # our simulator: a frame without a new RobotControl waits this long
+    vision_port: int = setting(10020, lo=1, hi=65535)  # play --simulator sim-protocol: the simulator's SSL-Vision
 
     def port(self, team: str) -> int:
         """The RobotControl port of ``team``."""

@@ -10,7 +10,7 @@ from typing import Literal
 
 from cmdragons.config import Validated, setting
 
-__all__ = ["GrsimParams", "MulticastParams", "ProtocolParams", "SimulationParams"]
+__all__ = ["GrsimParams", "MulticastParams", "ProtocolParams", "ServeParams", "SimulationParams"]
 
 CommandsTo = Literal["none", "grsim", "simulation"]
 
@@ -82,10 +82,18 @@ class SimulationParams(Validated):
     yellow_port: int = setting(10302, lo=1, hi=65535)
     dribbler_full_rpm: float = setting(10000.0, lo=1.0, hi=1e6)  # dribbler_speed (rpm) that is our full power (1)
     wait_s: float = setting(0.05, lo=0.0, hi=60.0)  # our simulator: a frame without a new RobotControl waits this long
+    vision_port: int = setting(10020, lo=1, hi=65535)  # play --simulator sim-protocol: the simulator's SSL-Vision
 
     def port(self, team: str) -> int:
         """The RobotControl port of ``team``."""
         return self.blue_port if team == "blue" else self.yellow_port
+
+
+@dataclass(frozen=True)
+class ServeParams(Validated):
+    """``cmdragons sim --serve``: our simulator alone as a league simulator."""
+
+    vision_noise: bool = True  # its SSL-Vision detections carry the tracker's measurement noise (false: exact)
 
 
 @dataclass(frozen=True)
@@ -103,6 +111,7 @@ class ProtocolParams(Validated):
     referee: RefereeStreamParams = RefereeStreamParams()
     grsim: GrsimParams = GrsimParams()
     simulation: SimulationParams = SimulationParams()
+    serve: ServeParams = ServeParams()
 
     def __post_init__(self) -> None:
         super().__post_init__()

@@ -5,6 +5,7 @@ loopback UDP and teleports the ball, and bad packets are counted and dropped wit
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import math
 import shutil
@@ -26,6 +27,7 @@ from cmdragons.runtime.proto import ssl_simulator_pb2 as sim_pb
 from cmdragons.runtime.proto import ssl_tracked_pb2 as trk_pb
 from cmdragons.runtime.proto.generate import PROTO_DIR, ROOT
 from cmdragons.runtime.settings import load_settings
+from cmdragons.runtime.ssl.clock import UnixEpoch
 from cmdragons.runtime.ssl.commands import (
     UNSUPPORTED,
     Feedback,
@@ -141,8 +143,9 @@ def test_simulator_command_round_trips() -> None:
 
 @pytest.mark.skipif(shutil.which("protoc") is None, reason=NO_PROTOC)
 def test_every_message_sent_decodes_with_protoc() -> None:
-    out = _protoc("ssl_tracker_wrapper.proto", "TrackerWrapperPacket", tracker_packet(WORLD, "u-1", "cmdragons"))
-    for line in ("uuid: \"u-1\"", "frame_number: 77", "timestamp: 1.25", "team: YELLOW", "id: 15"):
+    data = tracker_packet(WORLD, "u-1", "cmdragons", UnixEpoch(1_764_000_000))
+    out = _protoc("ssl_tracker_wrapper.proto", "TrackerWrapperPacket", data)
+    for line in ("uuid: \"u-1\"", "frame_number: 77", "timestamp: 1764000001.25", "team: YELLOW", "id: 15"):
         assert line in out, (line, out)
     out = _protoc("grsim.proto", "grSim_Packet", grsim_packet(COMMANDS, HEADINGS, CHIP))
     assert "isteamyellow: false" in out and "veltangent:" in out and "spinner: true" in out and "id: 4" in out
@@ -178,7 +181,9 @@ def test_a_match_multicasts_its_world_states_as_tracker_packets(udp_port: int) -
         match.close()
         rx.close()
     assert len(got) == len(worlds) == 12 and len({u for u, _, _ in got}) == 1
-    assert [w for _, _, w in got] == worlds  # world states on the bus are already in their wire form
+    back = [w for _, _, w in got]  # world states on the bus are already in their wire form; times via Unix time
+    assert [dataclasses.replace(w, t=want.t) for w, want in zip(back, worlds, strict=True)] == worlds
+    assert [w.t for w in back] == pytest.approx([w.t for w in worlds], abs=1e-6)
     assert summary["protocols"]["ssl/tracker_out/blue"]["packets"] == 12
 
 

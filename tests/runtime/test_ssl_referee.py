@@ -16,6 +16,7 @@ from cmdragons.runtime.match import Match
 from cmdragons.runtime.proto import ssl_referee_pb2 as ref_pb
 from cmdragons.runtime.proto.generate import PROTO_DIR, ROOT
 from cmdragons.runtime.settings import load_settings
+from cmdragons.runtime.ssl.clock import UnixEpoch
 from cmdragons.runtime.ssl.referee import RefereeReader, referee_packet, referee_proto
 from cmdragons.runtime.ssl.stages import RefereeInStage
 from cmdragons.runtime.ssl.udp import DatagramQueue
@@ -63,11 +64,14 @@ def test_our_referees_states_round_trip(g: msg.GameState) -> None:
 
 
 def test_the_leagues_fields_say_what_the_state_says() -> None:
-    m = referee_proto(FULL, "field A", ("cmdragons", "them"))
+    m = referee_proto(FULL, "field A", ("cmdragons", "them"), UnixEpoch(1_764_000_000))
     assert m.command == R.BALL_PLACEMENT_BLUE and m.next_command == R.DIRECT_FREE_BLUE
     assert m.stage == R.NORMAL_SECOND_HALF and m.stage_time_left == 187_250_000
     assert (m.designated_position.x, m.designated_position.y) == (-2000.0, 1500.0)
-    assert m.blue_team_on_positive_half is False and m.packet_timestamp == 41_500_000
+    # the packet's and the command's times in Unix microseconds, as the game controller's
+    assert m.packet_timestamp == 1_764_000_041_500_000 and m.command_timestamp == 1_764_000_040_000_000
+    assert RefereeReader(UnixEpoch(1_764_000_000)).read(m).t == 41.5
+    assert m.blue_team_on_positive_half is False
     assert (m.blue.name, m.blue.score, m.blue.goalkeeper, m.blue.foul_counter) == ("cmdragons", 1, 1, 2)
     assert list(m.yellow.yellow_card_times) == [75_500_000, 3_250_000] and m.yellow.timeout_time == 120_000_000
     assert m.source_identifier == "field A" and not m.HasField("ball_in_play")

@@ -12,9 +12,12 @@
 ``ssl/vision_in`` runs free (on every ``clock`` tick it publishes what came since) when the packets
 come from outside; fed by our own ``ssl/vision_out`` in the same match it runs in lock-step: on each
 ``ssl/vision/sent`` it waits (up to ``vision.wait_s``) until that frame's packet from every camera
-came, so the match plays the same as on the in-process path. Garbage, a packet cut short, a camera
-not in the config and a packet already seen are counted and dropped with a line on stderr (by every
-receiving stage: garbage and cut packets for the simulation protocol and the referee too).
+came, so the match plays the same as on the in-process path. Every camera id is taken (published
+on ``ssl/vision/<id>``, whoever reads it: grSim sends four cameras, a Division A field may have
+eight); garbage, a packet cut short and a packet already seen are counted and dropped with a line
+on stderr (by every receiving stage: garbage and cut packets for the simulation protocol and the
+referee too); robot detections without id or orientation are left out and counted. Times on the
+wire are Unix time, match time here (:mod:`cmdragons.runtime.ssl.clock`).
 """
 
 from __future__ import annotations
@@ -52,11 +55,12 @@ from cmdragons.runtime.ssl.commands import (
     simulator_command_packet,
     simulator_response,
 )
+from cmdragons.runtime.ssl.clock import UnixEpoch, run_epoch
 from cmdragons.runtime.ssl.params import ProtocolParams
 from cmdragons.runtime.ssl.referee import RefereeReader, referee_packet
 from cmdragons.runtime.ssl.tracker import tracker_packet
 from cmdragons.runtime.ssl.udp import DropLog, MulticastReceiver, MulticastSender, UdpEndpoint
-from cmdragons.runtime.ssl.vision import VisionGeometry, decode_wrapper, detection_packet
+from cmdragons.runtime.ssl.vision import VisionGeometry, detection_packet, read_wrapper
 from cmdragons.runtime.topics import Contract, Port, summary_port
 from sim.world import ball_at_front
 
@@ -100,8 +104,9 @@ class VisionOutStage(SocketStage):
                         (Port("ssl/vision/sent", Tick), summary_port("ssl/vision_out")))
 
     def __init__(self, params: ProtocolParams, camera_ids: Sequence[int], geometry: bytes,
-                 topics: Sequence[str] | None = None) -> None:  # fmt: skip
+                 topics: Sequence[str] | None = None, epoch: UnixEpoch | None = None) -> None:  # fmt: skip
         v = params.vision
+        self.epoch = run_epoch() if epoch is None else epoch
         self.contract = self.declare(params, camera_ids, geometry, topics)
         self.camera_ids = tuple(camera_ids)
         self.sender = MulticastSender(v.group, v.port, params.interface, params.ttl)
@@ -125,7 +130,7 @@ class VisionOutStage(SocketStage):
             self.sender.send(self.geometry)
             self.geometry_packets += 1
             self._next_geometry = det.t_capture + self.interval_s
-        self.sender.send(detection_packet(det))
+        self.sender.send(detection_packet(det, self.epoch))
         self._sent.add(det.camera_id)
         if self._sent >= set(self.camera_ids):
             publish("ssl/vision/sent", Tick(det.frame_number))
@@ -143,17 +148,25 @@ class VisionOutStage(SocketStage):
 
 class VisionInStage(SocketStage):
     """SSL-Vision packets from multicast -> ``ssl/vision/<camera id>`` detections (metres), the
-    latest geometry kept. ``lockstep``: fed by our own sender in this match (see the module)."""
+    latest geometry kept. ``lockstep``: fed by our own sender in this match (see the module).
+    Times: the packets' less ``epoch``; by default our sender's in lock-step, else the first
+    packet's second (a sender's clock from 0, grSim's, is taken as it is)."""
 
     @staticmethod
     def declare(params: ProtocolParams, camera_ids: Sequence[int], lockstep: bool) -> Contract:
+        any_camera = () if lockstep else (Port("ssl/vision/*", DetectionFrame),)  # from outside: any camera id
         return Contract("ssl/vision_in", (Port("ssl/vision/sent" if lockstep else "clock", Tick),),
-                        (*(Port(f"ssl/vision/{c}", DetectionFrame) for c in sorted(camera_ids)),
+                        (*(Port(f"ssl/vision/{c}", DetectionFrame) for c in sorted(camera_ids)), *any_camera,
                          summary_port("ssl/vision_in")))  # fmt: skip
 
     def __init__(self, params: ProtocolParams, camera_ids: Sequence[int], lockstep: bool,
-                 err: TextIO | None = None, receiver: Receiver | None = None) -> None:  # fmt: skip
+                 err: TextIO | None = None, receiver: Receiver | None = None, epoch: UnixEpoch | None = None,
+                 camera_clock: bool | None = None) -> None:  # fmt: skip
         v = params.vision
+        # lock-step: our own sender's epoch; from outside: given, or the first packet's (a sender's clock
+        # from 0, grSim's, stays as it is; Unix time becomes match time from that packet's second)
+        self.epoch: UnixEpoch | None = run_epoch() if epoch is None and lockstep else epoch
+        self.camera_clock = lockstep if camera_clock is None else camera_clock  # our own packets: exact times
         self.receiver: Receiver = receiver if receiver is not None else MulticastReceiver(
             v.group, v.port, params.interface, params.receive_buffer_bytes, params.max_datagram_bytes)  # fmt: skip
         self.camera_ids = frozenset(camera_ids)
@@ -163,6 +176,8 @@ class VisionInStage(SocketStage):
         self.drops = DropLog(f"ssl-vision {v.group}:{v.port}", params.drop_report_interval_s, err)
         self.geometry: VisionGeometry | None = None
         self.received = self.detections = self.geometry_packets = self.late = 0
+        self.robots_left_out: dict[str, int] = {}  # robot detections without id or orientation, by reason
+        self.cameras_seen: set[int] = set()  # any camera id is taken (grSim sends four, a big field eight)
         self._last: dict[int, int] = {}  # camera -> the last frame number published
 
     def on_message(self, topic: str, message: Any, publish: Publish) -> None:
@@ -182,19 +197,22 @@ class VisionInStage(SocketStage):
     def _take(self, data: bytes, publish: Publish) -> None:
         self.received += 1
         try:
-            det, geo = decode_wrapper(data)
+            if self.epoch is None:
+                first = read_wrapper(data, UnixEpoch(0)).detection
+                self.epoch = None if first is None else UnixEpoch.of_first(first.t_capture)
+            got = read_wrapper(data, self.epoch or UnixEpoch(0), camera_clock=self.camera_clock)
         except MessageError as exc:
             self.drops.drop("undecodable", f"{len(data)} bytes, {exc}")
             return
+        det, geo = got.detection, got.geometry
+        for why, n in got.robots_left_out.items():
+            self.robots_left_out[why] = self.robots_left_out.get(why, 0) + n
         if geo is not None:
             self.geometry = geo
             self.geometry_packets += 1
         if det is None:
             return
-        if det.camera_id not in self.camera_ids:
-            self.drops.drop("unknown camera", f"camera {det.camera_id} is not in the config "
-                            f"({', '.join(map(str, sorted(self.camera_ids)))})")  # fmt: skip
-            return
+        self.cameras_seen.add(det.camera_id)
         last = self._last.get(det.camera_id, -1)
         if det.frame_number <= last:
             self.drops.drop("duplicate", f"camera {det.camera_id} frame {det.frame_number} after frame {last}")
@@ -208,6 +226,8 @@ class VisionInStage(SocketStage):
         publish(f"summary/{self.name}", StageSummary(self.name, {
             "packets": self.received, "detections": self.detections, "geometry_packets": self.geometry_packets,
             "dropped": dict(sorted(self.drops.counts.items())), "frames_late": self.late,
+            "robots_left_out": dict(sorted(self.robots_left_out.items())),
+            "cameras_seen": sorted(self.cameras_seen),
             "field_m": None if g is None else [g.field_length_m, g.field_width_m]}))  # fmt: skip
 
     def close(self) -> None:
@@ -219,13 +239,14 @@ class RefereeOutStage(SocketStage):
 
     contract = Contract("ssl/referee_out", (Port("referee", GameState),), (summary_port("ssl/referee_out"),))
 
-    def __init__(self, params: ProtocolParams) -> None:
+    def __init__(self, params: ProtocolParams, epoch: UnixEpoch | None = None) -> None:
         r = params.referee
         self.sender = MulticastSender(r.group, r.port, params.interface, params.ttl)
         self.source = r.source_identifier
+        self.epoch = run_epoch() if epoch is None else epoch
 
     def on_message(self, topic: str, message: Any, publish: Publish) -> None:
-        self.sender.send(referee_packet(message, self.source))
+        self.sender.send(referee_packet(message, self.source, epoch=self.epoch))
 
     def summarize(self, publish: Publish) -> None:
         publish(f"summary/{self.name}", StageSummary(self.name, {"packets": self.sender.sent}))
@@ -240,21 +261,22 @@ class RefereeInStage(SocketStage):
     kickoff's or penalty's restart is taken (the ball moved ``moved_m``, the rules' ball-in-play
     distance, from its spot), play is normal. The spot is the designated position of the packet
     that started it, or (a game controller clears the designated position at NORMAL_START) of the
-    prepare command before it, or else where the ball was first seen after the normal start."""
+    prepare command before it, or else where the ball was first seen after the normal start. Times:
+    the packets' Unix times less ``epoch``, by default their first packet's second."""
 
     @staticmethod
     def declare(params: ProtocolParams, world_topic: str, moved_m: float = 0.0) -> Contract:
         return Contract("ssl/referee_in", (Port("clock", Tick), Port(world_topic, WorldState)),
                         (Port("referee/gc", GameState), summary_port("ssl/referee_in")))
 
-    def __init__(self, params: ProtocolParams, world_topic: str, moved_m: float,
-                 err: TextIO | None = None, receiver: Receiver | None = None) -> None:  # fmt: skip
+    def __init__(self, params: ProtocolParams, world_topic: str, moved_m: float, err: TextIO | None = None,
+                 receiver: Receiver | None = None, epoch: UnixEpoch | None = None) -> None:  # fmt: skip
         r = params.referee
         self.receiver: Receiver = receiver if receiver is not None else MulticastReceiver(
             r.group, r.port, params.interface, params.receive_buffer_bytes, params.max_datagram_bytes)  # fmt: skip
         self.contract = self.declare(params, world_topic)
         self.moved_m = moved_m
-        self.reader = RefereeReader()
+        self.reader = RefereeReader(epoch) if epoch is not None else None  # None: the first packet's epoch
         self.drops = DropLog(f"referee {r.group}:{r.port}", params.drop_report_interval_s, err)
         self.received = self.restarts_taken = 0
         self._last: bytes | None = None
@@ -265,8 +287,8 @@ class RefereeInStage(SocketStage):
             for data in self.receiver.drain():
                 self._take(data, publish)
             return
-        g, b = self.reader.last, message.ball
-        if g is None or not (g.command.prepared and g.ready) or b is None or self._last is None:
+        g, b = (None if self.reader is None else self.reader.last), message.ball
+        if self.reader is None or g is None or not (g.command.prepared and g.ready) or b is None or self._last is None:
             return
         if self._spot is None:
             self._spot = (b.x, b.y)
@@ -279,6 +301,9 @@ class RefereeInStage(SocketStage):
     def _take(self, data: bytes, publish: Publish) -> None:
         self.received += 1
         try:
+            if self.reader is None:
+                first = RefereeReader(UnixEpoch(0)).read(data)
+                self.reader = RefereeReader(UnixEpoch.of_first(first.t))
             game = self.reader.read(data)
         except MessageError as exc:
             self.drops.drop("undecodable", f"{len(data)} bytes, {exc}")
@@ -308,15 +333,16 @@ class TrackerOutStage(SocketStage):
         name = f"ssl/tracker_out/{team}"
         return Contract(name, (Port(f"world/{team}", WorldState),), (summary_port(name),))
 
-    def __init__(self, params: ProtocolParams, team: Team) -> None:
+    def __init__(self, params: ProtocolParams, team: Team, epoch: UnixEpoch | None = None) -> None:
         t = params.tracker
+        self.epoch = run_epoch() if epoch is None else epoch
         self.contract = self.declare(params, team)
         self.sender = MulticastSender(t.group, t.port, params.interface, params.ttl)
         self.uuid = str(uuid.uuid4())
         self.source = t.source_name
 
     def on_message(self, topic: str, message: Any, publish: Publish) -> None:
-        self.sender.send(tracker_packet(message, self.uuid, self.source))
+        self.sender.send(tracker_packet(message, self.uuid, self.source, self.epoch))
 
     def summarize(self, publish: Publish) -> None:
         publish(f"summary/{self.name}", StageSummary(self.name, {"packets": self.sender.sent,

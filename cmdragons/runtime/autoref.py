@@ -93,9 +93,13 @@ def autoref_rows(settings: Settings, detection_topics: Sequence[str], keys: Sequ
     taken in this order each frame) and the referee on it, for the match's robots ``keys`` (team,
     id). It drives the match (writes ``referee``, ``referee/events``, and ``teleport`` with
     ``sim.referee.place_by: teleport``), or with ``passive`` only watches (the same under
-    ``autoref/``). Both run on the ``referee`` node."""
+    ``autoref/``). Both run on the ``referee`` node. With ``protocols.referee.source:
+    game_controller`` a real game controller referees (its packets through
+    :class:`~cmdragons.runtime.ssl.stages.RefereeInStage`) and a driving autoref has no rows."""
     from cmdragons.runtime.match import Entry
 
+    if settings.protocols.referee.source == "game_controller" and not passive:
+        return []
     prefix = PASSIVE if passive else ""
     teleports = settings.sim.referee.place_by == "teleport"
     topics = tuple(detection_topics)

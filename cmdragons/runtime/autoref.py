@@ -78,9 +78,11 @@ class AutorefStage(BaseStage):
 
 
 def _tracker(settings: Settings, detection_topics: Sequence[str]) -> TrackerStage:
-    # the estimate at the capture time: a referee judges what was, not what will be
+    # the estimate at the capture time: a referee judges what was, not what will be; our simulator's
+    # cameras capture together, SSL-Vision's packets each at their own time (as our team's tracker takes them)
     tracker = Tracker(dataclasses.replace(settings.tracker, latency_s=0.0))
-    return TrackerStage("autoref", tracker, detection_topics, take_commands=False, synchronized=True)
+    synchronized = settings.protocols.perception != "ssl_vision"
+    return TrackerStage("autoref", tracker, detection_topics, take_commands=False, synchronized=synchronized)
 
 
 def _autoref(settings: Settings, keys: Sequence[tuple[Team, int]], prefix: str, teleports: bool) -> AutorefStage:

@@ -28,43 +28,21 @@ configuration is right, nothing changes.
 
 from __future__ import annotations
 
-import enum
 import math
 from collections import deque
-from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, Literal, Self
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
 
 from cmdragons.config import Validated, derived, setting
+from cmdragons.messages import Fact, FactEstimate, PhysicsFacts
 
-__all__ = ["Fact", "FactEstimate", "PhysicsEstimator", "PhysicsFacts", "PhysicsFactsParams", "fit_acceleration"]
+__all__ = ["PhysicsEstimator", "PhysicsFactsParams", "fit_acceleration"]
 
 Array = NDArray[np.float64]
 
-
-class Fact(enum.StrEnum):
-    """A physical fact the tracker measures, named as in ``learn``."""
-
-    BALL_ROLL = "ball_roll"
-    BALL_SLIDE = "ball_slide"
-    ROBOT_ACCEL = "robot_accel"
-    ROBOT_BRAKE = "robot_brake"
-
-    @property
-    def source(self) -> str:
-        """The configuration key the fact is configured at (field.yaml), as derived fields name it."""
-        return _SOURCES[self]
-
-
-_SOURCES = {
-    Fact.BALL_ROLL: "field.ball.acc_roll_m_s2",
-    Fact.BALL_SLIDE: "field.ball.acc_slide_m_s2",
-    Fact.ROBOT_ACCEL: "field.robot.max_accel_m_s2",
-    Fact.ROBOT_BRAKE: "field.robot.max_brake_m_s2",
-}
 
 FactName = Literal["ball_roll", "ball_slide", "robot_accel", "robot_brake"]
 
@@ -104,65 +82,6 @@ class PhysicsFactsParams(Validated):
     def configured(self, fact: Fact) -> float:
         return {Fact.BALL_ROLL: self.acc_roll_m_s2, Fact.BALL_SLIDE: self.acc_slide_m_s2,
                 Fact.ROBOT_ACCEL: self.max_accel_m_s2, Fact.ROBOT_BRAKE: self.max_brake_m_s2}[fact]  # fmt: skip
-
-
-@dataclass(frozen=True)
-class FactEstimate:
-    """One fact as measured so far (m/s²): the median of ``samples`` windows, their spread as a
-    standard deviation, and whether it is confident and used."""
-
-    fact: Fact
-    value_m_s2: float
-    configured_m_s2: float
-    samples: int
-    spread_m_s2: float
-    confident: bool
-    used: bool
-
-    def to_dict(self) -> dict[str, Any]:
-        return {"fact": self.fact.value, "value_m_s2": _num(self.value_m_s2), "configured_m_s2": self.configured_m_s2,
-                "samples": self.samples, "spread_m_s2": _num(self.spread_m_s2), "confident": self.confident,
-                "used": self.used}  # fmt: skip
-
-    @classmethod
-    def from_dict(cls, d: Mapping[str, Any]) -> Self:
-        def f(key: str) -> float:
-            v = d.get(key)
-            return math.nan if v is None else float(v)
-
-        return cls(Fact(d["fact"]), f("value_m_s2"), f("configured_m_s2"), int(d["samples"]), f("spread_m_s2"),
-                   bool(d["confident"]), bool(d["used"]))  # fmt: skip
-
-
-def _num(x: float) -> float | None:
-    return x if math.isfinite(x) else None
-
-
-@dataclass(frozen=True)
-class PhysicsFacts:
-    """What the tracker learnt of the physics by time ``t`` (s): one estimate per fact."""
-
-    t: float
-    estimates: tuple[FactEstimate, ...] = ()
-
-    def in_use(self) -> dict[str, float]:
-        """The used facts' values by the configuration key they replace (``field.ball.acc_roll_m_s2``)."""
-        return {e.fact.source: e.value_m_s2 for e in self.estimates if e.used}
-
-    def estimate(self, fact: Fact) -> FactEstimate | None:
-        return next((e for e in self.estimates if e.fact == fact), None)
-
-    def to_dict(self) -> dict[str, Any]:
-        return {"t": self.t, "estimates": [e.to_dict() for e in self.estimates]}
-
-    @classmethod
-    def from_dict(cls, d: Mapping[str, Any]) -> Self:
-        return cls(float(d["t"]), tuple(FactEstimate.from_dict(e) for e in d.get("estimates", ())))
-
-    def summary(self) -> dict[str, Any]:
-        """The summary's figures: per fact its estimate (without the fact's name, which is the key)."""
-        return {e.fact.value: {k: round(v, 4) if isinstance(v, float) else v for k, v in e.to_dict().items()
-                               if k != "fact"} for e in self.estimates}  # fmt: skip
 
 
 def fit_acceleration(t: Array, xy: Array) -> tuple[Array, Array, Array, float]:

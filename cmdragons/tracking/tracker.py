@@ -26,10 +26,10 @@ import numpy as np
 
 from cmdragons.config import Validated, derived, override_derived, setting
 from cmdragons.geometry import Team
-from cmdragons.messages import BallState, DetectionFrame, RobotCommand, RobotState, WorldState
+from cmdragons.messages import BallState, DetectionFrame, PhysicsFacts, RobotCommand, RobotState, WorldState
 from cmdragons.tracking import filters
 from cmdragons.tracking.filters import BallFilter, BallModelParams, RobotFilter, RobotModelParams
-from cmdragons.tracking.physics import PhysicsEstimator, PhysicsFacts, PhysicsFactsParams
+from cmdragons.tracking.physics import PhysicsEstimator, PhysicsFactsParams
 
 __all__ = ["Tracker", "TrackerParams", "TrackerStats"]
 

@@ -12,9 +12,9 @@ import pytest
 
 from cmdragons.config import override_derived
 from cmdragons.geometry import LeagueParams
-from cmdragons.messages import RobotCommand
+from cmdragons.messages import Fact, PhysicsFacts, RobotCommand
 from cmdragons.tracking import Tracker, TrackerParams
-from cmdragons.tracking.physics import Fact, PhysicsFacts, fit_acceleration
+from cmdragons.tracking.physics import fit_acceleration
 from sim.world import BallParams, DribblerParams, KickerParams, PhysicsParams, RobotParams, World
 from tests.tracking.test_tracker import detect, params
 

@@ -254,8 +254,8 @@ class TrackerStage(BaseStage):
     """One team's tracker: steps once every detection topic it reads has delivered the frame (a
     newer frame first closes the one in progress with what came), and takes its team's commands as
     the robots' control input (``take_commands``; not when the robots seen are driven by someone
-    else, as in a real match's log). The physics facts it measured go to the brain whenever those in
-    use change (``physics/<team>``), and into its summary.
+    else, as in a real match's log). The physics facts it measured go to the brain whenever the tracker
+    hands on those in use (``physics/<team>``), and into its summary.
 
     ``synchronized``: the cameras of a frame share its capture time (the simulator's cameras), so
     each camera's detections are taken as they come, in the order of ``detection_topics``, and the
@@ -284,7 +284,7 @@ class TrackerStage(BaseStage):
         self._taken = 0  # synchronized: how many of the frame's topics, in order, the tracker took
         self._t_frame = -math.inf  # the newest capture time of the frame in progress
         self._t_capture: dict[int, float] = {}
-        self._in_use: dict[str, float] = {}  # the physics facts in use last handed on
+        self._handed = tracker.handed  # the physics facts the brain was handed last
 
     def on_message(self, topic: str, message: Any, publish: Publish) -> None:
         if isinstance(message, TeamCommands):
@@ -316,10 +316,9 @@ class TrackerStage(BaseStage):
         self._pending, self._taken = {}, 0
         self._t_capture = {self._frame: self._t_frame}
         self._t_frame = -math.inf
-        facts = self.tracker.physics
-        if facts.in_use() != self._in_use:
-            self._in_use = facts.in_use()
-            publish(f"physics/{self.team}", facts)
+        if self.tracker.handed is not self._handed:
+            self._handed = self.tracker.handed
+            publish(f"physics/{self.team}", self._handed)
         publish(f"world/{self.team}", WorldState(world.t, world.ball, world.robots, self._frame))
 
     def summarize(self, publish: Publish) -> None:

@@ -54,16 +54,17 @@ class PhysicsFactsParams(Validated):
     measure: bool = setting(True)  # measure at all
     # the facts whose measured value may replace the configured one
     learn: tuple[FactName, ...] = setting(("ball_roll", "robot_accel", "robot_brake"))
-    min_samples: int = setting(20, lo=1, hi=100000)  # windows before a fact can be confident
+    min_samples: int = setting(10, lo=1, hi=100000)  # windows before a fact can be confident
     max_relative_error: float = setting(0.05, lo=0.0, hi=1.0)  # the median's standard error, of the median
     use_margin: float = setting(0.15, lo=0.0, hi=10.0)  # used only this share off the configured value
+    retune_change: float = setting(0.05, lo=0.0, hi=10.0)  # a used value handed on again: moved by this share
     update_period_s: float = setting(1.0, lo=0.0, hi=600.0)  # the facts are summed up this often
     samples_kept: int = setting(400, lo=1, hi=1000000)  # the newest windows per fact
     max_gap_s: float = setting(0.1, lo=0.0, hi=10.0)  # detections further apart break a window
     # the ball
-    clear_m: float = setting(0.3, lo=0.0, hi=5.0)  # no robot centre this near the ball: it runs free
-    after_touch_s: float = setting(1.0, lo=0.0, hi=60.0)  # free this long since a touch or kick: rolling
-    window_s: float = setting(0.5, lo=0.01, hi=10.0)  # a rolling window's length
+    clear_m: float = setting(0.2, lo=0.0, hi=5.0)  # no robot centre this near the ball: it runs free
+    after_touch_s: float = setting(0.8, lo=0.0, hi=60.0)  # free this long since a touch or kick: rolling
+    window_s: float = setting(0.4, lo=0.01, hi=10.0)  # a rolling window's length
     min_speed_m_s: float = setting(0.3, lo=0.0, hi=20.0)  # the ball at least this fast all through it
     max_residual_m: float = setting(0.01, lo=0.0, hi=1.0)  # the fit's RMS residual: more is a bounce
     slide_clear_m: float = setting(0.15, lo=0.0, hi=5.0)  # a kicked ball this far from the robots ...

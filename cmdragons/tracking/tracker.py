@@ -108,7 +108,8 @@ class Tracker:
         self.p = params
         self.configured = params  # what the configuration says; :attr:`p` with the physics facts in use
         self.estimator = PhysicsEstimator(params.physics) if params.physics.measure else None
-        self.physics = PhysicsFacts(-math.inf)
+        self.physics = PhysicsFacts(-math.inf)  # the facts as measured last
+        self.handed = self.physics  # the facts whose values in use the tracker's models (and the brain) took last
         self.robots: dict[tuple[Team, int], _RobotTrack] = {}
         self.balls: list[_BallTrack] = []
         self.stats = TrackerStats()
@@ -255,9 +256,13 @@ class Tracker:
             est.robot(key, t, det.x, det.y, (vx, vy), None if cmd is None else (cmd[0], cmd[1]))
 
     def _learn(self, facts: PhysicsFacts) -> None:
-        """The facts of now; the ball and robot models take those in use (new filters get them)."""
-        if facts.in_use() != self.physics.in_use():
-            self.p = override_derived(self.configured, facts.in_use())
+        """The facts of now; when those in use changed (another set, or a value moved by more than
+        ``retune_change``) they are handed on: the ball and robot models take them (new filters get them)."""
+        new, old = facts.in_use(), self.handed.in_use()
+        change = self.p.physics.retune_change
+        if new.keys() != old.keys() or any(abs(v - old[k]) > change * abs(old[k]) for k, v in new.items()):
+            self.handed = facts
+            self.p = override_derived(self.configured, new)
             self.p = dataclasses.replace(self.p, physics=self.configured.physics)
         self.physics = facts
 

@@ -12,7 +12,7 @@ import pytest
 
 from cmdragons.config import override_derived
 from cmdragons.geometry import LeagueParams
-from cmdragons.messages import Fact, PhysicsFacts, RobotCommand
+from cmdragons.messages import DetectionFrame, Fact, PhysicsFacts, RobotCommand
 from cmdragons.tracking import Tracker, TrackerParams
 from cmdragons.tracking.physics import fit_acceleration
 from sim.world import BallParams, DribblerParams, KickerParams, PhysicsParams, RobotParams, World
@@ -68,7 +68,9 @@ def test_rolling_deceleration_is_learnt_within_ten_percent(acc_roll: float) -> N
     assert est.configured_m_s2 == configured
     # used only where it differs from the configuration: our own simulator's ball changes nothing
     assert est.used == (acc_roll != configured)
-    assert tracker.p.ball.acc_roll_m_s2 == (est.value_m_s2 if est.used else configured)
+    handed = tracker.handed.in_use().get(Fact.BALL_ROLL.source)  # the value the tracker's ball model took
+    assert tracker.p.ball.acc_roll_m_s2 == (handed if est.used else configured)
+    assert handed is None or handed == pytest.approx(acc_roll, rel=0.10)
 
 
 @pytest.mark.parametrize("brake", [6.0, 4.0])  # configured; about grSim's
@@ -120,3 +122,22 @@ def test_facts_round_trip_and_the_keys_they_replace() -> None:
     # the one object a consumer overrides its configured facts with: here the tracker's robot model
     tuned = override_derived(TrackerParams(), {Fact.ROBOT_ACCEL.source: 1.5})
     assert tuned.robot.max_accel_m_s2 == 1.5 and tuned.ball == TrackerParams().ball
+
+
+def test_a_used_value_is_handed_on_again_only_when_it_moved_enough() -> None:
+    tracker = Tracker(params(sigma=SIGMA))
+    samples = tracker.estimator.samples[Fact.ROBOT_BRAKE]  # type: ignore[union-attr]
+    change = tracker.p.physics.retune_change
+
+    def at(t: float, brake: float) -> PhysicsFacts:
+        samples.clear()
+        samples.extend([brake] * 40)
+        tracker.step([DetectionFrame(0, int(t), t, t)])
+        return tracker.handed
+
+    first = at(0.0, 4.0)
+    assert first.in_use() == {Fact.ROBOT_BRAKE.source: 4.0} and tracker.p.robot == tracker.configured.robot
+    assert at(2.0, 4.0 * (1 + 0.5 * change)) is first  # a small drift: the models keep what they took
+    moved = at(4.0, 4.0 * (1 + 2 * change))
+    assert moved is not first and moved.in_use()[Fact.ROBOT_BRAKE.source] == pytest.approx(4.0 * (1 + 2 * change))
+    assert at(6.0, 6.0).in_use() == {}  # back at the configured value: nothing in use

@@ -14,9 +14,9 @@ metres and seconds:
   clear of the robots (shots: their slide lasts that long; slow passes mix in some rolling);
 * each robot's reachable acceleration and braking from our own robots' detections while the
   command in force asks for a velocity change the robot cannot make at once (more than
-  ``saturated_m_s`` from the velocity tracked): the robot then gives all it can, and the fitted
-  acceleration's magnitude is its limit. Braking as our simulator's motors tell it: the change
-  points against the motion and the commanded speed is lower.
+  ``saturated_m_s`` from the velocity tracked) and no other robot is within ``robot_clear_m``: the
+  robot then gives all it can, and the fitted acceleration's magnitude is its limit. Braking as our
+  simulator's motors tell it: the change points against the motion and the commanded speed is lower.
 
 Each fact is the median of its windows (robust to the odd push or bounce), its spread the
 median absolute deviation scaled to a standard deviation; it is *confident* after ``min_samples``
@@ -74,6 +74,7 @@ class PhysicsFactsParams(Validated):
     robot_window_s: float = setting(0.15, lo=0.01, hi=10.0)
     saturated_m_s: float = setting(0.3, lo=0.0, hi=10.0)  # commanded velocity this far off the tracked one
     robot_max_residual_m: float = setting(0.01, lo=0.0, hi=1.0)
+    robot_clear_m: float = setting(0.3, lo=0.0, hi=5.0)  # no other robot centre this near (it could push or block)
     # what is configured: field.yaml, configured once
     acc_roll_m_s2: float = derived("field.ball.acc_roll_m_s2", 0.26, lo=0.0, hi=10.0)
     acc_slide_m_s2: float = derived("field.ball.acc_slide_m_s2", 3.0, lo=0.0, hi=50.0)

@@ -241,10 +241,11 @@ class Tracker:
         t = self.t
         est = self.estimator
         assert est is not None
+        keys = list(self.robots)
+        xy = np.array([track.filter.kf.x[:2] for track in self.robots.values()]).reshape(-1, 2)
         ball = self.best_ball()
         if ball is not None and ball.last_seen == t:
-            near = min((math.hypot(ball.z[0] - tr.filter.kf.x[0], ball.z[1] - tr.filter.kf.x[1])
-                        for tr in self.robots.values()), default=math.inf)  # fmt: skip
+            near = float(np.hypot(*(xy - ball.z).T).min()) if len(xy) else math.inf
             est.ball(t, ball.z[0], ball.z[1], near, ball.kicked)
         for det in frame.robots:
             key = (det.team, det.id)
@@ -252,6 +253,10 @@ class Tracker:
             if key not in self._commands or track is None or track.last_seen != t or not math.isfinite(det.x):
                 continue
             cmd = self._command_at(key, t)
+            others = np.hypot(*(xy - (det.x, det.y)).T)
+            others[keys.index(key)] = math.inf
+            if cmd is not None and len(others) and others.min() < est.p.robot_clear_m:
+                cmd = None  # another robot this near may push or block it: not its own acceleration
             vx, vy = track.filter.kf.x[3:5].tolist()
             est.robot(key, t, det.x, det.y, (vx, vy), None if cmd is None else (cmd[0], cmd[1]))
 

@@ -42,6 +42,7 @@ __all__ = [
     "default_config_dir",
     "derived",
     "load_yaml",
+    "override_derived",
     "parse",
     "resolve_derived",
     "sections",
@@ -134,8 +135,18 @@ def sections(known: typing.Callable[[], Mapping[str, type]]) -> Any:
 def resolve_derived(obj: T, lookup: typing.Callable[[str], Any]) -> T:
     """``obj`` with every :func:`derived` field (in nested dataclasses and mappings too) set to
     ``lookup(source)``."""
+    return _replace_derived(obj, lambda source, _value: lookup(source))
+
+
+def override_derived(obj: T, values: Mapping[str, Any]) -> T:
+    """``obj`` with the :func:`derived` fields whose source ``values`` names (``field.ball.acc_roll_m_s2``)
+    set to its value, the others as they are: facts measured at run time in place of the configured ones."""
+    return _replace_derived(obj, lambda source, value: values.get(source, value))
+
+
+def _replace_derived(obj: T, new_value: typing.Callable[[str, Any], Any]) -> T:
     if isinstance(obj, Mapping):
-        return type(obj)({k: resolve_derived(v, lookup) for k, v in obj.items()})  # type: ignore[call-arg]
+        return type(obj)({k: _replace_derived(v, new_value) for k, v in obj.items()})  # type: ignore[call-arg]
     if not (dataclasses.is_dataclass(obj) and not isinstance(obj, type)):
         return obj
     changes: dict[str, Any] = {}
@@ -144,7 +155,7 @@ def resolve_derived(obj: T, lookup: typing.Callable[[str], Any]) -> T:
             continue
         value = getattr(obj, f.name)
         source = f.metadata.get("source")
-        new = lookup(source) if source is not None else resolve_derived(value, lookup)
+        new = new_value(source, value) if source is not None else _replace_derived(value, new_value)
         if new is not value:
             changes[f.name] = new
     return dataclasses.replace(obj, **changes) if changes else obj

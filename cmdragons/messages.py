@@ -30,6 +30,8 @@ __all__ = [
     "Contact",
     "DetectionFrame",
     "Event",
+    "Fact",
+    "FactEstimate",
     "GameEvent",
     "GameEvents",
     "GameStage",
@@ -41,6 +43,7 @@ __all__ = [
     "MessageError",
     "RefereeCommand",
     "NodeControl",
+    "PhysicsFacts",
     "RobotCommand",
     "RobotDetection",
     "RobotReport",
@@ -880,6 +883,86 @@ class Timing:
             return cls(str(d["stage"]), int(d["frame_number"]), {str(k): float(v) for k, v in d["ms"].items()})
         except (KeyError, TypeError, ValueError, AttributeError) as exc:
             raise MessageError(f"bad timing: {exc!r}") from None
+
+
+# --- physics facts -----------------------------------------------------------------------------
+
+
+class Fact(StrEnum):
+    """A physical fact the tracker measures, named as in ``learn``."""
+
+    BALL_ROLL = "ball_roll"
+    BALL_SLIDE = "ball_slide"
+    ROBOT_ACCEL = "robot_accel"
+    ROBOT_BRAKE = "robot_brake"
+
+    @property
+    def source(self) -> str:
+        """The configuration key the fact is configured at (field.yaml), as derived fields name it."""
+        return _SOURCES[self]
+
+
+_SOURCES = {
+    Fact.BALL_ROLL: "field.ball.acc_roll_m_s2",
+    Fact.BALL_SLIDE: "field.ball.acc_slide_m_s2",
+    Fact.ROBOT_ACCEL: "field.robot.max_accel_m_s2",
+    Fact.ROBOT_BRAKE: "field.robot.max_brake_m_s2",
+}
+
+
+@dataclass(frozen=True)
+class FactEstimate:
+    """One fact as measured so far (m/s²): the median of ``samples`` windows, their spread as a
+    standard deviation, and whether it is confident and used."""
+
+    fact: Fact
+    value_m_s2: float
+    configured_m_s2: float
+    samples: int
+    spread_m_s2: float
+    confident: bool
+    used: bool
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"fact": self.fact.value, "value_m_s2": _num(self.value_m_s2), "configured_m_s2": self.configured_m_s2,
+                "samples": self.samples, "spread_m_s2": _num(self.spread_m_s2), "confident": self.confident,
+                "used": self.used}  # fmt: skip
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Self:
+        def f(key: str) -> float:
+            v = d.get(key)
+            return math.nan if v is None else float(v)
+
+        return cls(Fact(d["fact"]), f("value_m_s2"), f("configured_m_s2"), int(d["samples"]), f("spread_m_s2"),
+                   bool(d["confident"]), bool(d["used"]))  # fmt: skip
+
+
+@dataclass(frozen=True)
+class PhysicsFacts:
+    """What the tracker learnt of the physics by time ``t`` (s): one estimate per fact."""
+
+    t: float
+    estimates: tuple[FactEstimate, ...] = ()
+
+    def in_use(self) -> dict[str, float]:
+        """The used facts' values by the configuration key they replace (``field.ball.acc_roll_m_s2``)."""
+        return {e.fact.source: e.value_m_s2 for e in self.estimates if e.used}
+
+    def estimate(self, fact: Fact) -> FactEstimate | None:
+        return next((e for e in self.estimates if e.fact == fact), None)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"t": self.t, "estimates": [e.to_dict() for e in self.estimates]}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Self:
+        return cls(float(d["t"]), tuple(FactEstimate.from_dict(e) for e in d.get("estimates", ())))
+
+    def summary(self) -> dict[str, Any]:
+        """The summary's figures: per fact its estimate (without the fact's name, which is the key)."""
+        return {e.fact.value: {k: round(v, 4) if isinstance(v, float) else v for k, v in e.to_dict().items()
+                               if k != "fact"} for e in self.estimates}  # fmt: skip
 
 
 @dataclass(frozen=True)

@@ -7,6 +7,11 @@ it may not enter; its local navigator (``team.navigator``: trajectory following 
 turns path and world into this frame's command; the Dynamics Safety Search makes the whole team's
 commands safe together (ch. 5). The brain knows neither which planner nor which navigator runs.
 
+The ball model and the robots' limits are field.yaml's until the tracker has measured them off
+(:meth:`Brain.use_physics`): then the measured values replace the configured ones in every part
+that reads them, through the settings the brain holds (``settings``; ``configured`` keeps what the
+configuration says).
+
 Each frame turns the world's robots into arrays once and builds one collision world; each robot's
 queries see it without the robot itself (and without the ball or its own defense area where its
 intent allows). A frame's result is one value (:class:`BrainOutput`): the commands and what viewers
@@ -26,10 +31,18 @@ from typing import TYPE_CHECKING, Any, Literal, Protocol
 import numpy as np
 from numpy.typing import NDArray
 
-from cmdragons.config import FrozenMap, Validated, sections, setting
+from cmdragons.config import FrozenMap, Validated, override_derived, sections, setting
 from cmdragons.control.motion import predict_braking
 from cmdragons.geometry import Team
-from cmdragons.messages import GameState, KickPurpose, RefereeCommand, RobotCommand, RobotState, WorldState
+from cmdragons.messages import (
+    GameState,
+    KickPurpose,
+    PhysicsFacts,
+    RefereeCommand,
+    RobotCommand,
+    RobotState,
+    WorldState,
+)
 from cmdragons.navigation import NAVIGATORS, Arrival, Navigator, config_sections, make_navigator
 from cmdragons.planning import (
     CollisionWorld,
@@ -59,6 +72,10 @@ __all__ = ["Brain", "BrainOutput", "BrainParams", "RobotPlan", "RobotPlanStatus"
 # which defense areas a robot must keep out of: both, or only the one at x of the sign given
 _DEFENSE_SIDES: tuple[tuple[str, bool | Literal[-1, 1]], ...] = (("both", True), ("+x", 1), ("-x", -1),
                                                                   ("none", False))
+
+# the concerns of a team's settings whose derived fields (the ball model, the robots' limits) the
+# measured physics facts replace
+_TUNED = ("planner", "control", "safety", "strategy", "team")
 
 
 @dataclass(frozen=True)
@@ -179,16 +196,16 @@ class Brain:
 
     def __init__(self, team: Team, settings: TeamSettings, params: TeamParams | None = None) -> None:
         self.team = team
-        self.settings = settings
+        self.configured = settings  # what the configuration says
+        self.settings = settings  # ... with the physics facts in use (:meth:`use_physics`)
+        self._physics: dict[str, float] = {}
         self.params = params or settings.team
         self.field = settings.field_geometry()
         self.radius = settings.field.robot.radius_m
         self.strategy = Strategy(team, self.field, settings.strategy)
         self.planners: dict[int, Planner] = {}
         self.navigators: dict[int, Navigator] = {}
-        static = field_world(self.field, defense_areas=False)
-        stream = 0 if team == "blue" else 1
-        self.safety: Safety = make_safety(settings.safety, settings.control, self.radius, static, stream=stream)
+        self.safety: Safety = self._safety()
         self.times: dict[str, float] = {}  # each part's ms, the frame in progress
         self.plans: dict[int, RobotPlan] = {}  # robot id -> its plan, the frame in progress
         self.braking: dict[int, np.ndarray] = {}  # robot id -> (k, 2) the braking path DSS checked last frame
@@ -202,6 +219,27 @@ class Brain:
                            for row in every])
             for key, side in _DEFENSE_SIDES
         }  # fmt: skip
+
+    def _safety(self) -> Safety:
+        static = field_world(self.field, defense_areas=False)
+        stream = 0 if self.team == "blue" else 1
+        return make_safety(self.settings.safety, self.settings.control, self.radius, static, stream=stream)
+
+    def use_physics(self, facts: PhysicsFacts) -> None:
+        """The physics facts our tracker measured: those in use (confident and off the configuration)
+        replace field.yaml's ball model and robot limits wherever the brain reads them (pass speeds,
+        kicks and intercepts, the navigators' profiles, the safety search); the others stay as
+        configured. Strategy keeps its state; navigators and the safety search start afresh."""
+        values = facts.in_use()
+        if values == self._physics:
+            return
+        self._physics = values
+        base: Any = self.configured
+        self.settings = dataclasses.replace(base, **{name: override_derived(getattr(base, name), values)
+                                                     for name in _TUNED})  # fmt: skip
+        self.strategy.retune(self.settings.strategy)
+        self.safety = self._safety()
+        self.navigators.clear()
 
     def _planner(self, rid: int) -> Planner:
         planner = self.planners.get(rid)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
@@ -28,6 +29,20 @@ class SimParams(Validated):
     referee: RefereeParams = RefereeParams()
     script: ScriptParams = ScriptParams()
     render: RenderParams = RenderParams()
+    # the simulated world off field.yaml's facts, to watch the team measure them (another simulator's
+    # ball, slower robots); 0 keeps field.yaml's. The team still believes field.yaml until it measured
+    world_ball_acc_roll_m_s2: float = setting(0.0, lo=0.0, hi=10.0)  # the ball's rolling deceleration
+    world_robot_max_brake_m_s2: float = setting(0.0, lo=0.0, hi=50.0)  # the robots' braking
+
+    def world_robot(self) -> RobotParams:
+        """The simulated robots: :attr:`robot` with ``world_robot_max_brake_m_s2`` where set."""
+        b = self.world_robot_max_brake_m_s2
+        return dataclasses.replace(self.robot, max_brake_m_s2=b) if b > 0.0 else self.robot
+
+    def world_ball(self) -> BallParams:
+        """The simulated ball: :attr:`ball` with ``world_ball_acc_roll_m_s2`` where set."""
+        a = self.world_ball_acc_roll_m_s2
+        return dataclasses.replace(self.ball, acc_roll_m_s2=a) if a > 0.0 else self.ball
 
     def __post_init__(self) -> None:
         super().__post_init__()

@@ -60,8 +60,8 @@ class Simulator:
         self.league, self.params = league, params
         self.seed = params.seed if seed is None else seed
         counts = robot_counts(league, params)
-        self.world = World(league, params.physics, params.robot, params.ball, params.kicker, params.dribbler,
-                           robots_per_team=counts)  # fmt: skip
+        self.world = World(league, params.physics, params.world_robot(), params.world_ball(), params.kicker,
+                           params.dribbler, robots_per_team=counts)  # fmt: skip
         self.world.blue_defends = -1 if params.referee.blue_defends == "negative_x" else 1
         self.referee: Referee | None = None
         if referee:

@@ -127,6 +127,12 @@ class Strategy:
         self._taker: int | None = None  # the kicker of our kickoff or free kick under way
         self._barred: int | None = None  # our restart's taker, until another robot touched the ball
 
+    def retune(self, params: StrategyParams) -> None:
+        """Decide with ``params`` from now on (the ball model as measured in play: pass speeds, kicks,
+        intercepts), keeping what is kept from frame to frame (roles, the pass under way, placements)."""
+        self.p = params
+        self.attacker.skills = params.skills
+
     def own_sign(self, game: GameState) -> float:
         """-1 when we defend the goal at negative x, else +1."""
         return own_goal_sign(self.team, game)

@@ -5,6 +5,7 @@ control, safety, navigation and the team checks its ranges."""
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Callable
 from pathlib import Path
 
@@ -12,7 +13,16 @@ import numpy as np
 import pytest
 
 from cmdragons.control import MotionParams, PathParams, TrapezoidParams
-from cmdragons.messages import BallState, GameState, RobotCommand, RobotState, WorldState
+from cmdragons.messages import (
+    BallState,
+    Fact,
+    FactEstimate,
+    GameState,
+    PhysicsFacts,
+    RobotCommand,
+    RobotState,
+    WorldState,
+)
 from cmdragons.navigation import DynamicWindowParams, TrajectoryParams
 from cmdragons.planning import (
     CollisionParams,
@@ -27,6 +37,7 @@ from cmdragons.planning.errt import SmoothingParams
 from cmdragons.runtime.settings import load_settings
 from cmdragons.safety import DSSParams, SafetyParams
 from cmdragons.team import Brain, BrainParams, TeamParams
+from strategy.skills import pass_speed
 
 SETTINGS = load_settings(Path(__file__).resolve().parents[1] / "configs")
 BALL = BallState(2.0, 1.0, 0.0, 0.0)
@@ -169,3 +180,54 @@ def test_every_planner_status_is_a_robot_plan_status_of_the_same_value() -> None
     for status in PlanStatus:
         assert RobotPlanStatus.planned(status).value == status.value
     assert {s.value for s in RobotPlanStatus} - {s.value for s in PlanStatus} == {"halt", "direct", "escape"}
+
+
+def _facts(*used: tuple[Fact, float]) -> PhysicsFacts:
+    return PhysicsFacts(5.0, tuple(FactEstimate(f, v, 0.0, 40, 0.01, True, True) for f, v in used))
+
+
+def test_a_learnt_braking_replaces_the_configured_one_in_control_and_safety() -> None:
+    brain = Brain("blue", SETTINGS)
+    brain.use_physics(PhysicsFacts(1.0))  # nothing in use: the configuration as it is
+    assert brain.settings is SETTINGS
+    brain.use_physics(_facts((Fact.ROBOT_BRAKE, 4.0)))
+    assert brain.settings.control.motion.max_brake_m_s2 == 4.0
+    assert brain.configured.control.motion.max_brake_m_s2 == SETTINGS.control.motion.max_brake_m_s2
+    assert brain.settings.control.motion.max_accel_m_s2 == SETTINGS.control.motion.max_accel_m_s2
+    game = GameState(0.0)
+    brain.step(world(0.0, RobotState("blue", 0, -1.0, 0.0, 0.0), RobotState("blue", 1, 0.0, 0.0, 0.0, 1.2, 0.0)),
+               game)  # fmt: skip
+    (rest,) = brain._lost_robots(world(2.0, RobotState("blue", 0, -1.0, 0.0, 0.0)))
+    assert rest.x == pytest.approx(1.2**2 / (2 * 4.0))  # a lost robot brakes as measured
+
+
+def _arrival(kick_m_s: float, distance_m: float, acc_roll_m_s2: float) -> float:
+    """The speed (m/s) a ball kicked at ``kick_m_s`` has after ``distance_m`` in our simulator with its
+    rolling deceleration set to ``acc_roll_m_s2``; 0 when it stops short."""
+    from cmdragons.geometry import LeagueParams
+    from sim.world import BallParams, DribblerParams, KickerParams, PhysicsParams, RobotParams, World
+
+    w = World(LeagueParams(), PhysicsParams(), RobotParams(), BallParams(acc_roll_m_s2=acc_roll_m_s2), KickerParams(),
+              DribblerParams(), robots_per_team={"blue": 0, "yellow": 0})  # fmt: skip
+    w.place_ball(-2.0, 0.0, vx=kick_m_s)
+    for _ in range(60 * 20):
+        snap = w.snapshot()
+        if snap.ball[0] >= -2.0 + distance_m:
+            return float(math.hypot(snap.ball[3], snap.ball[4]))
+        w.step_frame()
+    return 0.0
+
+
+def test_the_pass_model_takes_the_ball_deceleration_learnt_in_a_slower_simulator() -> None:
+    from tests.tracking.test_physics import rolled_balls
+
+    learnt = rolled_balls(0.70).physics  # the tracker's view of a simulator whose ball rolls out at 0.70 m/s²
+    brain = Brain("blue", SETTINGS)
+    brain.use_physics(learnt)
+    skills = brain.settings.strategy.skills
+    assert skills.acc_roll_m_s2 == pytest.approx(0.70, rel=0.10)
+    assert brain.strategy.p.skills == skills
+    want = skills.pass_arrival_m_s
+    # a 3 m pass kicked as the learnt model says arrives about as meant; as the configured one says, too slow
+    assert _arrival(pass_speed(3.0, skills), 3.0, 0.70) == pytest.approx(want, abs=0.15)
+    assert _arrival(pass_speed(3.0, SETTINGS.strategy.skills), 3.0, 0.70) < want - 0.3

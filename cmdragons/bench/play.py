@@ -30,6 +30,8 @@ from cmdragons.runtime.topics import Contract, Port
 __all__ = ["SHOOTOUT_KICKS", "run"]
 
 SHOOTOUT_KICKS = 10  # penalty kicks each way in the bench's shootout (the issue's measure)
+GRSIM_BALL_ROLL_M_S2 = 0.70  # grSim's ball decelerates so while rolling (measured against its own vision)
+GRSIM_ROBOT_BRAKE_M_S2 = 4.0  # ... and its robots brake at about this
 _SHOOTOUT_HALF_S = 1.0  # the halves before the shootout: as short as the rules' figures allow
 
 
@@ -111,7 +113,32 @@ def _match_row(settings: Settings, seed: int, seconds: float, opponent: str) -> 
         "vision_median_ms": c["vision"]["median"],
         "frame_median_ms": c["frame"]["median"],
         "realtime_factor": s["seconds"] / wall,
+        **_learnt(s),
     }
+
+
+def _learnt(summary: dict[str, Any]) -> dict[str, Any]:
+    """What our tracker measured of the ball and our robots, against the configured values (m/s²)."""
+    out: dict[str, Any] = {}
+    for name, e in summary.get("physics", {}).items():
+        if name in ("ball_roll", "robot_brake"):
+            out[f"{name}_learnt_m_s2"] = e["value_m_s2"]
+            out[f"{name}_configured_m_s2"] = e["configured_m_s2"]
+            out[f"{name}_windows"] = e["samples"]
+            out[f"{name}_used"] = e["used"]
+    return out
+
+
+def _other_world_row(settings: Settings, seed: int, seconds: float, opponent: str, roll_m_s2: float,
+                     brake_m_s2: float) -> dict[str, Any]:  # fmt: skip
+    """A match in our simulator made another simulator's world (its ball rolling out at ``roll_m_s2``,
+    its robots braking at ``brake_m_s2``; grSim's by default) while our team believes field.yaml:
+    what the tracker learns, and how the team plays once it uses it."""
+    world = dataclasses.replace(settings.sim, world_ball_acc_roll_m_s2=roll_m_s2, world_robot_max_brake_m_s2=brake_m_s2)
+    row = _match_row(dataclasses.replace(settings, sim=world), seed, seconds, opponent)
+    row["name"] = f"other_world_roll_{roll_m_s2:g}_brake_{brake_m_s2:g}_seed_{seed}"
+    row["world_ball_roll_m_s2"], row["world_robot_brake_m_s2"] = roll_m_s2, brake_m_s2
+    return row
 
 
 def _kinds_text(kinds: dict[str, int]) -> str:
@@ -179,6 +206,10 @@ def run(settings: Settings, quick: bool, opponent: str | None = None, matches: i
                                                                     if r["placement_median_s"] is not None]) else None,
         "realtime_factor": float(np.median([r["realtime_factor"] for r in rows])),
     })  # fmt: skip
+    print("bench play: a match in grSim's physics (ball 0.70 m/s², braking 4 m/s²) ...", file=sys.stderr, flush=True)
+    other = _other_world_row(rules, seeds[0], seconds, opponent, GRSIM_BALL_ROLL_M_S2, GRSIM_ROBOT_BRAKE_M_S2)
+    other.pop("_kinds")
+    rows.append(other)
     if opponent == "self":
         return rows
     kicks = (3 if quick else SHOOTOUT_KICKS) if shootout is None else shootout

@@ -471,6 +471,8 @@ def _finish_play(folder: Path, run: RunData, summary: dict[str, Any], args: argp
     rules = summary.get("rules")
     if rules is not None and rules["rules"] == "full":
         print("play: " + _rules_line(rules))
+    if summary.get("physics"):
+        print("play: " + physics_line(summary["physics"]))
     for w in warnings:
         print(f"play: warning: {w}")
     if stop.requested:
@@ -479,6 +481,22 @@ def _finish_play(folder: Path, run: RunData, summary: dict[str, Any], args: argp
     files = ["run.mcap", "summary.json"] + (["match.mp4"] if args.video and (folder / "match.mp4").exists() else [])
     files += [report.name] if report is not None else []
     print(f"play: {', '.join(files)} -> {folder}")
+
+
+_FACT_WORDS = {"ball_roll": "ball rolls", "ball_slide": "slides", "robot_accel": "robots accelerate",
+               "robot_brake": "brake"}
+
+
+def physics_line(physics: dict[str, Any]) -> str:
+    """What the tracker measured, each fact against its configured value (m/s²), and which are in use."""
+    parts = []
+    for name, e in physics.items():
+        if not e["samples"]:
+            continue
+        state = "in use" if e["used"] else "confident" if e["confident"] else "unsure"
+        parts.append(f"{_FACT_WORDS.get(name, name)} {e['value_m_s2']:.2f} (configured {e['configured_m_s2']:g}, "
+                     f"{_plural(e['samples'], 'window')}, {state})")  # fmt: skip
+    return "physics measured (m/s²): " + ("; ".join(parts) if parts else "nothing yet")
 
 
 def _rules_line(rules: dict[str, Any]) -> str:

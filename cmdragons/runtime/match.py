@@ -411,6 +411,8 @@ def match_summary(f: dict[str, Any], stage_ms: dict[str, list[float]], seed: int
     """summary.json's figures from every stage's summary (``f``: stage name -> figures) and the
     per-frame stage times (ms) the runtime measured."""
     sim, referee, stats = f["sim"], f["referee"], f[f"stats/{OURS}"]
+    tracker = dict(f[f"tracker/{OURS}"])
+    physics = tracker.pop("physics", None)  # what our tracker measured of the ball and robots
     open_pairs = [{a[0], b[0]} for a, b in sim["open_contacts"]]
     cycle = {k: {"median": float(np.median(v)), "p95": float(np.percentile(v, 95))}
              for k, v in stage_ms.items() if v}  # fmt: skip
@@ -430,7 +432,8 @@ def match_summary(f: dict[str, Any], stage_ms: dict[str, list[float]], seed: int
         "kicks": referee["kicks"],
         "balls_out": referee["balls_out"],
         "command_faults": sim["command_faults"],
-        "tracker": f[f"tracker/{OURS}"],
+        "tracker": tracker,
+        **({"physics": physics} if physics is not None else {}),
         "rules": {k: referee[k] for k in ("rules", "game_stage", "fouls", "cards", "placements", "penalties",
                                            "shootout")},
         **({"opponent_team": _their_figures(f, open_pairs)} if opponent == "self" else {}),

@@ -29,6 +29,7 @@ from cmdragons.messages import (
     GroundTruth,
     Kick,
     KickPurpose,
+    PhysicsFacts,
     RefereeCommand,
     RobotCommand,
     RobotDetection,
@@ -291,7 +292,8 @@ class TrackerStage(BaseStage):
     """One team's tracker: steps once every detection topic it reads has delivered the frame (a
     newer frame first closes the one in progress with what came), and takes its team's commands as
     the robots' control input (``take_commands``; not when the robots seen are driven by someone
-    else, as in a real match's log).
+    else, as in a real match's log). The physics facts it measured go to the brain whenever the tracker
+    hands on those in use (``physics/<team>``), and into its summary.
 
     ``synchronized``: the cameras of a frame share its capture time (the simulator's cameras), so
     each camera's detections are taken as they come, in the order of ``detection_topics``, and the
@@ -309,7 +311,8 @@ class TrackerStage(BaseStage):
         name = f"tracker/{team}"
         return Contract(name, (*(Port(t, DetectionFrame) for t in detection_topics),
                                *((Port(f"commands/{team}", TeamCommands),) if take_commands else ())),
-                        (Port(f"world/{team}", WorldState), summary_port(name)))  # fmt: skip
+                        (Port(f"physics/{team}", PhysicsFacts, sometimes=True), Port(f"world/{team}", WorldState),
+                         summary_port(name)))  # fmt: skip
 
     def __init__(self, team: Team | Literal["autoref"], tracker: Tracker, detection_topics: Sequence[str],
                  take_commands: bool = True, synchronized: bool = False) -> None:  # fmt: skip
@@ -323,6 +326,7 @@ class TrackerStage(BaseStage):
         self._taken = 0  # synchronized: how many of the frame's topics, in order, the tracker took
         self._t_frame = -math.inf  # the newest capture time of the frame in progress
         self._t_capture: dict[int, float] = {}
+        self._handed = tracker.handed  # the physics facts the brain was handed last
 
     def on_message(self, topic: str, message: Any, publish: Publish) -> None:
         if isinstance(message, TeamCommands):
@@ -354,10 +358,16 @@ class TrackerStage(BaseStage):
         self._pending, self._taken = {}, 0
         self._t_capture = {self._frame: self._t_frame}
         self._t_frame = -math.inf
+        if self.tracker.handed is not self._handed:
+            self._handed = self.tracker.handed
+            publish(f"physics/{self.team}", self._handed)
         publish(f"world/{self.team}", WorldState(world.t, world.ball, world.robots, self._frame))
 
     def summarize(self, publish: Publish) -> None:
-        publish(f"summary/{self.name}", StageSummary(self.name, self.tracker.stats.as_dict()))
+        figures: dict[str, Any] = dict(self.tracker.stats.as_dict())
+        if self.tracker.estimator is not None:
+            figures["physics"] = self.tracker.physics.summary()
+        publish(f"summary/{self.name}", StageSummary(self.name, figures))
 
 
 class _PlayingStage(BaseStage, ABC):
@@ -388,11 +398,13 @@ class _PlayingStage(BaseStage, ABC):
 
 class TeamStage(_PlayingStage):
     """One team's brain: world state and game state -> that frame's commands, its report and its
-    parts' times, all from the brain's output of the frame."""
+    parts' times, all from the brain's output of the frame; the physics facts its tracker measured
+    tune it when they come."""
 
     @staticmethod
     def declare(team: Team, referee_topic: str = "referee") -> Contract:
-        return Contract(f"team/{team}", (Port(f"world/{team}", WorldState), Port(referee_topic, GameState)),
+        return Contract(f"team/{team}", (Port(f"world/{team}", WorldState), Port(referee_topic, GameState),
+                                         Port(f"physics/{team}", PhysicsFacts, sometimes=True)),
                         (Port(f"commands/{team}", TeamCommands), Port(f"report/{team}", TeamReport),
                          Port(f"timing/{team}", Timing)))  # fmt: skip
 
@@ -400,6 +412,12 @@ class TeamStage(_PlayingStage):
         super().__init__(self.declare(team, referee_topic), team, referee_topic)
         self.brain = brain
         self._out: BrainOutput | None = None
+
+    def on_message(self, topic: str, message: Any, publish: Publish) -> None:
+        if isinstance(message, PhysicsFacts):
+            self.brain.use_physics(message)
+            return
+        super().on_message(topic, message, publish)
 
     def play(self, message: Any) -> tuple[WorldState, list[RobotCommand]]:
         self._out = self.brain.step(message, self.game)

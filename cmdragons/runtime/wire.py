@@ -38,6 +38,8 @@ from cmdragons.messages import (
     Contact,
     DetectionFrame,
     Event,
+    Fact,
+    FactEstimate,
     GameEvent,
     GameEvents,
     GameStage,
@@ -47,6 +49,7 @@ from cmdragons.messages import (
     Kick,
     MessageError,
     NodeControl,
+    PhysicsFacts,
     RefereeCommand,
     RobotCommand,
     RobotDetection,
@@ -432,6 +435,29 @@ def _timing_from(m: Any) -> Timing:
     return Timing(m.stage, m.frame_number, dict(sorted(m.ms.items())))
 
 
+def _physics_to(p: PhysicsFacts) -> Any:
+    def fact(e: FactEstimate) -> Any:
+        out = pb.PhysicsFact(fact=e.fact.value, configured=e.configured_m_s2, samples=e.samples, confident=e.confident,
+                             used=e.used)  # fmt: skip
+        if math.isfinite(e.value_m_s2):
+            out.value = e.value_m_s2
+        if math.isfinite(e.spread_m_s2):
+            out.spread = e.spread_m_s2
+        return out
+
+    return pb.PhysicsFacts(t=p.t, facts=[fact(e) for e in p.estimates])
+
+
+def _physics_from(m: Any) -> PhysicsFacts:
+    try:
+        return PhysicsFacts(m.t, tuple(
+            FactEstimate(Fact(f.fact), f.value if f.HasField("value") else math.nan, f.configured, f.samples,
+                         f.spread if f.HasField("spread") else math.nan, f.confident, f.used)
+            for f in m.facts))  # fmt: skip
+    except ValueError as exc:
+        raise MessageError(f"bad physics facts: {exc}") from None
+
+
 def _summary_to(s: StageSummary) -> Any:
     return pb.StageSummary(stage=s.stage, figures_json=json.dumps(s.figures, separators=(",", ":")))
 
@@ -470,6 +496,7 @@ CODECS: dict[type[Any], Codec] = {c.message: c for c in (
     Codec(TeamReport, pb.TeamReport, _report_to, _report_from),
     Codec(Timing, pb.Timing, _timing_to, _timing_from),
     Codec(StageSummary, pb.StageSummary, _summary_to, _summary_from),
+    Codec(PhysicsFacts, pb.PhysicsFacts, _physics_to, _physics_from),
     Codec(NodeControl, pb.NodeControl, lambda c: pb.NodeControl(node=c.node, command=c.command),
           lambda m: NodeControl(m.node, m.command)),
 )}  # fmt: skip

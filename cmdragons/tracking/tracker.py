@@ -16,6 +16,7 @@ estimate at the capture time instead (``step(frames, ahead_s=0.0)``).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections import deque
 from collections.abc import Iterable, Sequence
@@ -23,11 +24,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from cmdragons.config import Validated, derived, setting
+from cmdragons.config import Validated, derived, override_derived, setting
 from cmdragons.geometry import Team
-from cmdragons.messages import BallState, DetectionFrame, RobotCommand, RobotState, WorldState
+from cmdragons.messages import BallState, DetectionFrame, PhysicsFacts, RobotCommand, RobotState, WorldState
 from cmdragons.tracking import filters
 from cmdragons.tracking.filters import BallFilter, BallModelParams, RobotFilter, RobotModelParams
+from cmdragons.tracking.physics import PhysicsEstimator, PhysicsFactsParams
 
 __all__ = ["Tracker", "TrackerParams", "TrackerStats"]
 
@@ -58,6 +60,7 @@ class TrackerParams(Validated):
     robot_reinit_spread_m: float = setting(0.05, lo=0.0, hi=5.0)  # ... within this of each other
     robot_confirm_detections: int = setting(3, lo=1, hi=100)
     robot_timeout_s: float = setting(1.0, lo=0.0, hi=60.0)
+    physics: PhysicsFactsParams = PhysicsFactsParams()  # the ball's deceleration and the robots' reach, measured
 
 
 @dataclass
@@ -93,13 +96,20 @@ class _BallTrack:
     last_seen: float = 0.0
     holder: tuple[Team, int] | None = None  # the robot whose mouth hides the ball from the cameras
     held_since: float = math.nan
+    z: tuple[float, float] = (math.nan, math.nan)  # the last detection taken
+    kicked: bool = False  # ... and whether it looked like a kick or bounce
 
 
 class Tracker:
-    """Detections of every camera in, one :class:`WorldState` per frame out."""
+    """Detections of every camera in, one :class:`WorldState` per frame out; beside them, the physics
+    facts measured so far (:attr:`physics`)."""
 
     def __init__(self, params: TrackerParams) -> None:
         self.p = params
+        self.configured = params  # what the configuration says; :attr:`p` with the physics facts in use
+        self.estimator = PhysicsEstimator(params.physics) if params.physics.measure else None
+        self.physics = PhysicsFacts(-math.inf)  # the facts as measured last
+        self.handed = self.physics  # the facts whose values in use the tracker's models (and the brain) took last
         self.robots: dict[tuple[Team, int], _RobotTrack] = {}
         self.balls: list[_BallTrack] = []
         self.stats = TrackerStats()
@@ -160,6 +170,8 @@ class Tracker:
         """Close the set of frames taken since the last call (tracks no camera saw miss, held balls
         move with their holder, old tracks go) and return the world state, as :meth:`step` does."""
         self.stats.frames += 1
+        if self.estimator is not None and self.t - self.physics.t >= self.p.physics.update_period_s:
+            self._learn(self.estimator.facts(self.t))
         for track in self.robots.values():
             if track.last_seen != self.t:
                 track.filter.miss()
@@ -220,6 +232,44 @@ class Tracker:
             else:
                 balls.append((np.array([bd.x, bd.y]), bd.sigma_m))
         self._take_balls(balls, t)
+        if self.estimator is not None:
+            self._measure(frame)
+
+    # --- physics facts ------------------------------------------------------------------------
+    def _measure(self, frame: DetectionFrame) -> None:
+        """This frame's detections of the tracked ball and of our commanded robots to the estimator."""
+        t = self.t
+        est = self.estimator
+        assert est is not None
+        keys = list(self.robots)
+        xy = np.array([track.filter.kf.x[:2] for track in self.robots.values()]).reshape(-1, 2)
+        ball = self.best_ball()
+        if ball is not None and ball.last_seen == t:
+            near = float(np.hypot(*(xy - ball.z).T).min()) if len(xy) else math.inf
+            est.ball(t, ball.z[0], ball.z[1], near, ball.kicked)
+        for det in frame.robots:
+            key = (det.team, det.id)
+            track = self.robots.get(key)
+            if key not in self._commands or track is None or track.last_seen != t or not math.isfinite(det.x):
+                continue
+            cmd = self._command_at(key, t)
+            others = np.hypot(*(xy - (det.x, det.y)).T)
+            others[keys.index(key)] = math.inf
+            if cmd is not None and len(others) and others.min() < est.p.robot_clear_m:
+                cmd = None  # another robot this near may push or block it: not its own acceleration
+            vx, vy = track.filter.kf.x[3:5].tolist()
+            est.robot(key, t, det.x, det.y, (vx, vy), None if cmd is None else (cmd[0], cmd[1]))
+
+    def _learn(self, facts: PhysicsFacts) -> None:
+        """The facts of now; when those in use changed (another set, or a value moved by more than
+        ``retune_change``) they are handed on: the ball and robot models take them (new filters get them)."""
+        new, old = facts.in_use(), self.handed.in_use()
+        change = self.p.physics.retune_change
+        if new.keys() != old.keys() or any(abs(v - old[k]) > change * abs(old[k]) for k, v in new.items()):
+            self.handed = facts
+            self.p = override_derived(self.configured, new)
+            self.p = dataclasses.replace(self.p, physics=self.configured.physics)
+        self.physics = facts
 
     # --- robots -------------------------------------------------------------------------------
     def _take_robot(self, key: tuple[Team, int], z: tuple[float, float, float], t: float) -> None:
@@ -268,13 +318,16 @@ class Tracker:
             used_dets.add(j)
             track = self.balls[i]
             z, sigma = detections[j]
-            if track.filter.update(z, nis, sigma):
+            track.kicked = track.filter.update(z, nis, sigma)
+            if track.kicked:
                 self.stats.ball_kicks += 1
+            track.z = (float(z[0]), float(z[1]))
             track.hits += 1
             track.last_seen = t
         for j, (z, _) in enumerate(detections):
             if j not in used_dets:
-                self.balls.append(_BallTrack(BallFilter(self.p.ball, z[0], z[1], t), born=t, last_seen=t))
+                new = BallFilter(self.p.ball, z[0], z[1], t)
+                self.balls.append(_BallTrack(new, born=t, last_seen=t, z=(float(z[0]), float(z[1]))))
         if len(self.balls) > self.p.ball_hypotheses:
             self.balls.sort(key=self._ball_rank, reverse=True)
             del self.balls[self.p.ball_hypotheses :]

@@ -54,6 +54,8 @@ EXACT: list[Any] = [
     msg.Timing("team/blue", 3, {"plan": 1.5, "safety": 0.25}),
     msg.StageSummary("referee", {"score": {"blue": 1, "yellow": 0}, "kicks": 3, "ratio": 0.5}),
     msg.NodeControl("team", "ready"),
+    msg.PhysicsFacts(12.5, (msg.FactEstimate(msg.Fact.BALL_ROLL, 0.7, 0.26, 45, 0.02, True, True),
+                            msg.FactEstimate(msg.Fact.BALL_SLIDE, math.nan, 3.0, 0, math.nan, False, False))),
     msg.CameraFrame(0, 3, 0.05, np.arange(4 * 5 * 3, dtype=np.uint8).reshape(4, 5, 3)),
 ]  # fmt: skip
 REPORT = msg.TeamReport(

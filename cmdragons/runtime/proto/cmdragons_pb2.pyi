@@ -406,6 +406,32 @@ class StageSummary(_message.Message):
     figures_json: str
     def __init__(self, stage: _Optional[str] = ..., figures_json: _Optional[str] = ...) -> None: ...
 
+class PhysicsFact(_message.Message):
+    __slots__ = ("fact", "value", "configured", "samples", "spread", "confident", "used")
+    FACT_FIELD_NUMBER: _ClassVar[int]
+    VALUE_FIELD_NUMBER: _ClassVar[int]
+    CONFIGURED_FIELD_NUMBER: _ClassVar[int]
+    SAMPLES_FIELD_NUMBER: _ClassVar[int]
+    SPREAD_FIELD_NUMBER: _ClassVar[int]
+    CONFIDENT_FIELD_NUMBER: _ClassVar[int]
+    USED_FIELD_NUMBER: _ClassVar[int]
+    fact: str
+    value: float
+    configured: float
+    samples: int
+    spread: float
+    confident: bool
+    used: bool
+    def __init__(self, fact: _Optional[str] = ..., value: _Optional[float] = ..., configured: _Optional[float] = ..., samples: _Optional[int] = ..., spread: _Optional[float] = ..., confident: _Optional[bool] = ..., used: _Optional[bool] = ...) -> None: ...
+
+class PhysicsFacts(_message.Message):
+    __slots__ = ("t", "facts")
+    T_FIELD_NUMBER: _ClassVar[int]
+    FACTS_FIELD_NUMBER: _ClassVar[int]
+    t: float
+    facts: _containers.RepeatedCompositeFieldContainer[PhysicsFact]
+    def __init__(self, t: _Optional[float] = ..., facts: _Optional[_Iterable[_Union[PhysicsFact, _Mapping]]] = ...) -> None: ...
+
 class NodeControl(_message.Message):
     __slots__ = ("node", "command")
     NODE_FIELD_NUMBER: _ClassVar[int]

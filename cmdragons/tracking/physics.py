@@ -1,0 +1,234 @@
+"""Physics facts measured from what the team sees: the ball's deceleration and the robots' reach.
+
+The configured ball model and robot limits (field.yaml ``ball`` and ``robot``) are what our own
+simulator does; another simulator or a real field differs (grSim's ball rolls out at 0.70 m/s²,
+its robots brake at about 4 m/s²). The tracker measures them from raw detections, field frame,
+metres and seconds:
+
+* the ball's rolling deceleration from free-rolling balls: detections of the tracked ball with no
+  robot within ``clear_m`` since ``after_touch_s`` (the slide after a kick or touch is over), in
+  consecutive windows of ``window_s``; each window's quadratic fit of position over time gives
+  one deceleration (the acceleration against the direction of travel), kept when the fit is tight
+  (no bounce) and the ball still rolls at its end;
+* the ball's sliding deceleration likewise, from the first ``slide_window_s`` a kicked ball runs
+  clear of the robots (shots: their slide lasts that long; slow passes mix in some rolling);
+* each robot's reachable acceleration and braking from our own robots' detections while the
+  command in force asks for a velocity change the robot cannot make at once (more than
+  ``saturated_m_s`` from the velocity tracked) and no other robot is within ``robot_clear_m``: the
+  robot then gives all it can, and the fitted acceleration's magnitude is its limit. Braking as our
+  simulator's motors tell it: the change points against the motion and the commanded speed is lower.
+
+Each fact is the median of its windows (robust to the odd push or bounce), its spread the
+median absolute deviation scaled to a standard deviation; it is *confident* after ``min_samples``
+windows with the median's standard error within ``max_relative_error`` of it, and *used* (handed to
+planning, passing, the kick model and safety instead of the configured value) only when also
+allowed by ``learn`` and off the configured value by more than ``use_margin``: where the
+configuration is right, nothing changes.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from cmdragons.config import Validated, derived, setting
+from cmdragons.messages import Fact, FactEstimate, PhysicsFacts
+
+__all__ = ["PhysicsEstimator", "PhysicsFactsParams", "fit_acceleration"]
+
+Array = NDArray[np.float64]
+
+
+FactName = Literal["ball_roll", "ball_slide", "robot_accel", "robot_brake"]
+
+
+@dataclass(frozen=True)
+class PhysicsFactsParams(Validated):
+    """configs/tracker.yaml ``physics``."""
+
+    measure: bool = setting(True)  # measure at all
+    # the facts whose measured value may replace the configured one
+    learn: tuple[FactName, ...] = setting(("ball_roll", "robot_accel", "robot_brake"))
+    min_samples: int = setting(10, lo=1, hi=100000)  # windows before a fact can be confident
+    max_relative_error: float = setting(0.05, lo=0.0, hi=1.0)  # the median's standard error, of the median
+    use_margin: float = setting(0.15, lo=0.0, hi=10.0)  # used only this share off the configured value
+    retune_change: float = setting(0.05, lo=0.0, hi=10.0)  # a used value handed on again: moved by this share
+    update_period_s: float = setting(1.0, lo=0.0, hi=600.0)  # the facts are summed up this often
+    samples_kept: int = setting(400, lo=1, hi=1000000)  # the newest windows per fact
+    max_gap_s: float = setting(0.1, lo=0.0, hi=10.0)  # detections further apart break a window
+    # the ball
+    clear_m: float = setting(0.2, lo=0.0, hi=5.0)  # no robot centre this near the ball: it runs free
+    after_touch_s: float = setting(0.8, lo=0.0, hi=60.0)  # free this long since a touch or kick: rolling
+    window_s: float = setting(0.4, lo=0.01, hi=10.0)  # a rolling window's length
+    min_speed_m_s: float = setting(0.3, lo=0.0, hi=20.0)  # the ball at least this fast all through it
+    max_residual_m: float = setting(0.01, lo=0.0, hi=1.0)  # the fit's RMS residual: more is a bounce
+    slide_clear_m: float = setting(0.15, lo=0.0, hi=5.0)  # a kicked ball this far from the robots ...
+    slide_within_s: float = setting(0.15, lo=0.0, hi=5.0)  # ... this soon after the kick starts a slide window
+    slide_window_s: float = setting(0.1, lo=0.01, hi=5.0)
+    # our robots
+    robot_window_s: float = setting(0.15, lo=0.01, hi=10.0)
+    saturated_m_s: float = setting(0.3, lo=0.0, hi=10.0)  # commanded velocity this far off the tracked one
+    robot_max_residual_m: float = setting(0.01, lo=0.0, hi=1.0)
+    robot_clear_m: float = setting(0.3, lo=0.0, hi=5.0)  # no other robot centre this near (it could push or block)
+    # what is configured: field.yaml, configured once
+    acc_roll_m_s2: float = derived("field.ball.acc_roll_m_s2", 0.26, lo=0.0, hi=10.0)
+    acc_slide_m_s2: float = derived("field.ball.acc_slide_m_s2", 3.0, lo=0.0, hi=50.0)
+    max_accel_m_s2: float = derived("field.robot.max_accel_m_s2", 3.0, lo=0.0, hi=50.0)
+    max_brake_m_s2: float = derived("field.robot.max_brake_m_s2", 6.0, lo=0.0, hi=50.0)
+
+    def configured(self, fact: Fact) -> float:
+        return {Fact.BALL_ROLL: self.acc_roll_m_s2, Fact.BALL_SLIDE: self.acc_slide_m_s2,
+                Fact.ROBOT_ACCEL: self.max_accel_m_s2, Fact.ROBOT_BRAKE: self.max_brake_m_s2}[fact]  # fmt: skip
+
+
+def fit_acceleration(t: Array, xy: Array) -> tuple[Array, Array, Array, float]:
+    """Least-squares quadratic fit of positions ``xy`` (n, 2) m over times ``t`` (n,) s: the
+    acceleration (2,) m/s², the velocity at the first and at the last time (2,) m/s each, and the
+    fit's RMS residual (m)."""
+    t0 = t[0]
+    tau = t - t0
+    coef = np.polynomial.polynomial.polyfit(tau, xy, 2)  # (3, 2): constant, linear, quadratic terms
+    fitted = coef[0] + np.outer(tau, coef[1]) + np.outer(tau * tau, coef[2])
+    rms = float(np.sqrt(np.mean(np.sum((xy - fitted) ** 2, axis=1))))
+    accel = 2.0 * coef[2]
+    return accel, coef[1].copy(), coef[1] + accel * tau[-1], rms
+
+
+class _Window:
+    """Detections (t, x, y) gathered for one fit."""
+
+    def __init__(self) -> None:
+        self.t: list[float] = []
+        self.xy: list[tuple[float, float]] = []
+
+    def add(self, t: float, x: float, y: float, max_gap_s: float) -> None:
+        if self.t and (t - self.t[-1] > max_gap_s or t <= self.t[-1]):
+            if t <= self.t[-1]:
+                return  # a second camera's view of the same instant
+            self.clear()
+        self.t.append(t)
+        self.xy.append((x, y))
+
+    def span(self) -> float:
+        return self.t[-1] - self.t[0] if self.t else 0.0
+
+    def clear(self) -> None:
+        self.t.clear()
+        self.xy.clear()
+
+    def arrays(self) -> tuple[Array, Array]:
+        return np.asarray(self.t, dtype=np.float64), np.asarray(self.xy, dtype=np.float64)
+
+
+class _RobotRun(_Window):
+    def __init__(self) -> None:
+        super().__init__()
+        self.braking: bool | None = None
+
+
+class PhysicsEstimator:
+    """Collects deceleration and acceleration windows frame by frame and sums them up (see the
+    module docstring)."""
+
+    def __init__(self, params: PhysicsFactsParams) -> None:
+        self.p = params
+        self.samples: dict[Fact, deque[float]] = {f: deque(maxlen=params.samples_kept) for f in Fact}
+        self._roll = _Window()
+        self._slide = _Window()
+        self._touched = -math.inf  # a robot near the ball or a kick, last
+        self._kicked = -math.inf
+        self._slide_done = True
+        self._robots: dict[Any, _RobotRun] = {}
+
+    # --- the ball -----------------------------------------------------------------------------------------
+    def ball(self, t: float, x: float, y: float, robot_m: float, kicked: bool) -> None:
+        """A detection of the tracked ball at ``t``; ``robot_m``: the nearest robot centre's distance,
+        ``kicked``: the tracker took it as a kick or bounce."""
+        p = self.p
+        if kicked:
+            self._kicked, self._slide_done = t, False
+            self._slide.clear()
+        if kicked or robot_m < p.clear_m:
+            self._touched = t
+            self._roll.clear()
+        if not self._slide_done:
+            if t - self._kicked > p.slide_within_s and not self._slide.t:
+                self._slide_done = True
+            elif robot_m >= p.slide_clear_m:
+                self._slide.add(t, x, y, p.max_gap_s)
+                if self._slide.span() >= p.slide_window_s:
+                    self._ball_sample(Fact.BALL_SLIDE, self._slide)
+                    self._slide_done = True
+            elif self._slide.t:
+                self._slide_done = True  # back at a robot before the window was full
+        if t - self._touched >= p.after_touch_s:
+            self._roll.add(t, x, y, p.max_gap_s)
+            if self._roll.span() >= p.window_s:
+                self._ball_sample(Fact.BALL_ROLL, self._roll)
+
+    def _ball_sample(self, fact: Fact, window: _Window) -> None:
+        t, xy = window.arrays()
+        window.clear()
+        if len(t) < 4:
+            return
+        accel, v0, v1, rms = fit_acceleration(t, xy)
+        speed0, speed1 = float(np.hypot(*v0)), float(np.hypot(*v1))
+        if rms > self.p.max_residual_m or min(speed0, speed1) < self.p.min_speed_m_s:
+            return
+        heading = (v0 + v1) / max(float(np.hypot(*(v0 + v1))), 1e-9)
+        self.samples[fact].append(-float(accel @ heading))
+
+    # --- our robots ---------------------------------------------------------------------------------------
+    def robot(self, key: Any, t: float, x: float, y: float, velocity: tuple[float, float],
+              command: tuple[float, float] | None) -> None:  # fmt: skip
+        """A detection of our robot ``key`` at ``t``, its tracked ``velocity`` and the velocity its
+        command in force asks (None: no command of ours)."""
+        run = self._robots.setdefault(key, _RobotRun())
+        braking = None
+        if command is not None:
+            vx, vy = velocity
+            dvx, dvy = command[0] - vx, command[1] - vy
+            if math.hypot(dvx, dvy) > self.p.saturated_m_s:
+                braking = dvx * vx + dvy * vy < 0.0 and math.hypot(*command) < math.hypot(vx, vy)
+        if braking is None or braking != run.braking:
+            run.clear()
+            run.braking = braking
+            if braking is None:
+                return
+        run.add(t, x, y, self.p.max_gap_s)
+        if run.span() >= self.p.robot_window_s:
+            times, xy = run.arrays()
+            run.clear()
+            if len(times) >= 4:
+                accel, _, _, rms = fit_acceleration(times, xy)
+                if rms <= self.p.robot_max_residual_m:
+                    self.samples[Fact.ROBOT_BRAKE if braking else Fact.ROBOT_ACCEL].append(float(np.hypot(*accel)))
+
+    def forget_robot(self, key: Any) -> None:
+        self._robots.pop(key, None)
+
+    # --- summing up ---------------------------------------------------------------------------------------
+    def facts(self, t: float) -> PhysicsFacts:
+        p = self.p
+        learn = {Fact(name) for name in p.learn}
+        out = []
+        for fact in Fact:
+            values = np.asarray(self.samples[fact], dtype=np.float64)
+            configured = p.configured(fact)
+            n = len(values)
+            if n == 0:
+                out.append(FactEstimate(fact, math.nan, configured, 0, math.nan, False, False))
+                continue
+            median = float(np.median(values))
+            spread = 1.4826 * float(np.median(np.abs(values - median)))
+            # the median's standard error: sqrt(pi / 2) times the mean's
+            error = 1.2533 * spread / math.sqrt(n)
+            confident = n >= p.min_samples and median > 0.0 and error <= p.max_relative_error * median
+            used = confident and fact in learn and abs(median - configured) > p.use_margin * configured
+            out.append(FactEstimate(fact, median, configured, n, spread, confident, used))
+        return PhysicsFacts(t, tuple(out))

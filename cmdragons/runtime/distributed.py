@@ -5,7 +5,7 @@ Nodes (``cmdragons node ROLE``) and the stages of :func:`~cmdragons.runtime.matc
     sim       the simulator and its cameras, and the match's clock (below)
     vision    vision per camera (or the truth perception of ``--perception truth``)
     team      our tracker, our brain, our statistics and the brain's timings
-    opponent  the simple team on the truth, or the copy of our team with its own tracker
+    opponent  a built-in team on the truth (simple, defend), or the copy of our team with its own tracker
     referee   the referee
     log       run.mcap: every topic and Foxglove's scene
 
@@ -44,6 +44,7 @@ from typing import Any, TextIO
 from cmdragons.messages import NodeControl
 from cmdragons.runtime.bus import Bus, Stage, run_frames
 from cmdragons.runtime.match import (
+    BUILT_IN,
     Entry,
     Match,
     Opponent,
@@ -121,7 +122,7 @@ def _hold_cpu_latency(us: int) -> str | None:
 def node_roles(opponent: Opponent, log: bool, vision_with_sim: bool = False) -> list[str]:
     """The nodes a match needs (no opponent node against nobody or a team outside; the log node
     when logging; no vision node when vision runs in the sim node)."""
-    return [r for r in ROLES if (r != "opponent" or opponent in ("simple", "self")) and (r != "log" or log)
+    return [r for r in ROLES if (r != "opponent" or opponent in (*BUILT_IN, "self")) and (r != "log" or log)
             and (r != "vision" or not vision_with_sim)]  # fmt: skip
 
 
@@ -174,14 +175,14 @@ def rehearse(spec: MatchSpec, role: str) -> None:
     the node says it is ready, so a free-running match does not start with its teams a second
     behind. Trackers and brains play ``runtime.rehearsal_frames`` frames (their first plans come a
     few frames in), the simulator and vision two (their kernels load on the first); the referee,
-    the logger and the simple opponent need none. Throwaway: its own simulator, vision, trackers
+    the logger and the built-in opponents need none. Throwaway: its own simulator, vision, trackers
     and brains, nothing published."""
     frames = spec.settings.runtime.rehearsal_frames
     if frames == 0 or role in ("referee", "log") or (role == "opponent" and spec.opponent != "self"):
-        return  # (the simple opponent's first frame costs what its others do)
+        return  # (a built-in opponent's first frame costs what its others do)
     settings = spec.settings
     if role in ("team", "opponent"):  # trackers and brains on the truth: the same work as on detections
-        opponent: Opponent = spec.opponent if spec.opponent in ("simple", "self") else "none"
+        opponent: Opponent = spec.opponent if spec.opponent in (*BUILT_IN, "self") else "none"
         match = Match(settings, opponent, "truth", seed=spec.seed,
                       opponent_settings=spec.opponent_settings if opponent == "self" else None)  # fmt: skip
         run_frames(lambda _i: match.step(), frames)

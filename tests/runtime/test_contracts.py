@@ -23,7 +23,7 @@ SETTINGS = load_settings()
 ROOT = Path(__file__).resolve().parents[2]
 
 
-@pytest.mark.parametrize(("opponent", "perception"), [("simple", "truth"), ("self", "vision")])
+@pytest.mark.parametrize(("opponent", "perception"), [("simple", "truth"), ("defend", "truth"), ("self", "vision")])
 def test_every_topic_published_is_declared_and_every_declared_one_is_published(opponent: str,
                                                                                 perception: str) -> None:  # fmt: skip
     seen: dict[str, set[type]] = {}

@@ -2,12 +2,12 @@
 limits, and defends. A sparring partner that makes passes and shots earn their way, not a team.
 
 Roles in priority order (:class:`~strategy.roles.RoleAssigner`, appendix B.5 of Bruce 2006): the
-lowest id keeps goal (blocking, or clearing a ball at rest in its area: :func:`strategy.defense.goalie`);
-the attacker, the robot that meets the ball soonest (:func:`strategy.skills.intercept`), shoots
-at the widest gap of the goal mouth (:func:`strategy.evaluation.best_shot`) or, without one, kicks
-the ball along the most open lane toward the goal, to come to rest ``advance_m`` on; the blocker
-stands on the ball's line to its goal, ``block_distance_m`` in front of the ball, where a shot
-must pass; the markers stand in the
+configured goalie (``strategy.roles.goalie_id``) keeps goal (blocking, or clearing a ball at rest
+in its area: :func:`strategy.defense.goalie`); the attacker, the robot that meets the ball soonest
+(:func:`strategy.skills.intercept`), shoots at the widest gap of the goal mouth
+(:func:`strategy.evaluation.best_shot`) or, without one, kicks the ball along the most open lane
+toward the goal, to come to rest ``advance_m`` on; the blocker stands on the ball's line to its
+goal, ``block_distance_m`` in front of the ball, where a shot must pass; the markers stand in the
 passing lanes of the opponents most dangerous to its goal (nearest to it first), on the line from
 each receiver to the ball, ``mark_gap_m`` from the receiver; the robots left over defend the edge
 of the defense area (:func:`strategy.skills.defend`). A marker keeps its receiver from frame to
@@ -236,21 +236,31 @@ class DefendTeam:
         self._barred = self._double_touch_bar(game, own, opp, ball)
         by_id = {r.id: r for r in own}
         stopped = game.command in (RefereeCommand.STOP, RefereeCommand.BALL_PLACEMENT)
-        intents, attacker = self._normal(by_id, own[0].id, opp, ball, own_sign, restart and game.ready,
+        goalie_id = self._goalie(own)
+        intents, attacker = self._normal(by_id, goalie_id, opp, ball, own_sign, restart and game.ready,
                                          self.p.mark_gap_stopped_m if stopped else None)  # fmt: skip
         self._taker = attacker if restart and game.ready else None
         gs, radius = self.sp.game_states, self.sp.robot_radius_m
         if game.command == RefereeCommand.BALL_PLACEMENT and game.placement is not None:
             intents = keep_off_line(intents, (ball.x, ball.y), game.placement, f, gs, radius)
             if ours:
-                placer = min(own[1:] or own, key=lambda r: math.hypot(r.x - ball.x, r.y - ball.y))
+                players = [r for r in own if r.id != goalie_id] or own
+                placer = min(players, key=lambda r: math.hypot(r.x - ball.x, r.y - ball.y))
                 intents[placer.id], self._placing = place_ball(placer, ball, game.placement, self.sp.skills, gs,
                                                                world.t, self._placing)  # fmt: skip
             return intents
         if game.command == RefereeCommand.PENALTY:
-            return self._penalty(intents, own, opp, ball, game, ours, own_sign)
+            return self._penalty(intents, own, goalie_id, opp, ball, game, ours, own_sign)
         kicker = attacker if restart and game.ready else None
         return restart_rules(intents, game, ours, ball, f, own_sign, gs, radius, kicker)
+
+    def _goalie(self, own: Sequence[RobotState]) -> int | None:
+        """Its keeper: the configured goalie (``strategy.roles.goalie_id``, the id the referee knows
+        as the keeper) while it is on the field, else none; with -1, its lowest id."""
+        gid = self.sp.roles.goalie_id
+        if gid < 0:
+            return own[0].id
+        return gid if any(r.id == gid for r in own) else None
 
     def _steer(self, r: RobotState, it: Intent, on: Sequence[RobotState]) -> RobotCommand:
         """Plain steering toward ``it`` at our robots' limits (slow enough to stop on the target at
@@ -278,7 +288,7 @@ class DefendTeam:
             return None
         return barred
 
-    def _normal(self, own: Mapping[int, RobotState], goalie_id: int, opp: Sequence[RobotState], ball: BallState,
+    def _normal(self, own: Mapping[int, RobotState], goalie_id: int | None, opp: Sequence[RobotState], ball: BallState,
                 own_sign: float, set_piece: bool, mark_gap_m: float | None) -> tuple[dict[int, Intent], int | None]:
         """Normal play: every robot's intent and the attacker's id (``set_piece``: its kick is a
         restart's; ``mark_gap_m``: the markers' gap, default ``mark_gap_m``)."""
@@ -291,15 +301,16 @@ class DefendTeam:
         costs = {rid: math.hypot(m.x - own[rid].x, m.y - own[rid].y) for rid, m in meet.items()}
         if self._barred in costs:  # its restart's kicker plays the ball again only when nobody else can
             costs[self._barred] = math.inf
-        field_players = len(own) - 1
+        field_players = len(own) - (goalie_id is not None)
         n_blockers = min(p.blockers, max(field_players - 1, 0))
         n_markers = min(len(marks), max(field_players - 1 - n_blockers, 0))
         n_defenders = max(field_players - 1 - n_blockers - n_markers, 0)  # the rest
         slots = defender_slots(DefenseParams(defenders=n_defenders,
                                              defender_spacing_m=sp.defense.defender_spacing_m)) if n_defenders else []
         defenders = {Role(RoleKind.DEFENDER, k): defend(ball, f, own_sign, s, sp.skills) for k, s in enumerate(slots)}
-        objectives = [Objective(GOALIE, own_sign * f.half_length, 0.0, fixed_robot=goalie_id),
-                      Objective(ATTACKER, ball.x, ball.y, costs=costs)]
+        keeps = goalie_id is not None
+        objectives = [Objective(GOALIE, own_sign * f.half_length, 0.0, fixed_robot=goalie_id)] if keeps else []
+        objectives.append(Objective(ATTACKER, ball.x, ball.y, costs=costs))
         objectives += [Objective(Role(RoleKind.BLOCKER, k), block.x, block.y) for k in range(n_blockers)]
         objectives += [Objective(role, it.x, it.y) for role, it in list(marks.items())[:n_markers]]
         objectives += [Objective(role, it.x, it.y) for role, it in defenders.items()]
@@ -357,23 +368,27 @@ class DefendTeam:
             return set_kick(robot, meet, target, speed, sp.skills)
         return kick_to(robot, meet, target, speed, sp.skills)
 
-    def _penalty(self, intents: dict[int, Intent], own: list[RobotState], opp: Sequence[RobotState],
-                 ball: BallState, game: GameState, ours: bool, own_sign: float) -> dict[int, Intent]:  # fmt: skip
+    def _penalty(self, intents: dict[int, Intent], own: list[RobotState], goalie_id: int | None,
+                 opp: Sequence[RobotState], ball: BallState, game: GameState, ours: bool,
+                 own_sign: float) -> dict[int, Intent]:  # fmt: skip
         """A penalty: its taker plays it from the normal start, everyone else behind the ball;
         theirs, its keeper on the line until the normal start, then out at the ball once it is in
         play."""
         f, sp, gs = self.field, self.sp, self.sp.game_states
-        keeper = own[0]
         if ours:
             attack = -own_sign
-            taker = min(own[1:] or own, key=lambda r: math.hypot(r.x - ball.x, r.y - ball.y))
+            players = [r for r in own if r.id != goalie_id] or own
+            taker = min(players, key=lambda r: math.hypot(r.x - ball.x, r.y - ball.y))
             their_keeper = min(opp, key=lambda r: abs(r.x - attack * f.half_length) + abs(r.y), default=None)
             out = behind_ball({k: v for k, v in intents.items() if k != taker.id}, ball, attack, f, gs,
                               sp.robot_radius_m)  # fmt: skip
             out[taker.id] = penalty_shot(taker, ball, attack, their_keeper, f, sp.skills, gs, game.ready)
             return out
-        out = behind_ball({k: v for k, v in intents.items() if k != keeper.id}, ball, own_sign, f, gs,
+        out = behind_ball({k: v for k, v in intents.items() if k != goalie_id}, ball, own_sign, f, gs,
                           sp.robot_radius_m)  # fmt: skip
+        keeper = next((r for r in own if r.id == goalie_id), None)
+        if keeper is None:
+            return out
         if not game.ready:
             out[keeper.id] = keeper_on_line(ball, f, own_sign, sp.skills, gs)
         else:

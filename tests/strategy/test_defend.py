@@ -75,14 +75,17 @@ def test_a_blocker_stands_on_the_shots_line_to_the_goal(ball_xy: tuple[float, fl
     assert nearest == pytest.approx(P.block_distance_m, abs=0.01)
 
 
+@pytest.mark.parametrize("keeper", [True, False])  # False: its goalie sent off, nobody keeps goal
 @pytest.mark.parametrize("ball_xy", [(4.0, 0.5), (-4.0, -0.5), (3.6, 0.9)])
-def test_no_field_player_is_sent_into_a_defense_area(ball_xy: tuple[float, float]) -> None:
+def test_no_field_player_is_sent_into_a_defense_area(ball_xy: tuple[float, float], keeper: bool) -> None:
     ball = BallState(*ball_xy, 0.0, 0.0)
     blue = [RobotState("blue", 0, -4.3, 0.0, 0.0), RobotState("blue", 1, ball_xy[0] - 0.2, ball_xy[1], 0.0),
             RobotState("blue", 2, 4.0, -0.6, 0.0), RobotState("blue", 3, 3.8, 0.9, 0.0)]  # fmt: skip
-    intents = team().intents(WorldState(0.0, ball, (*blue, *yellow_line_up())), GAME)
+    yellow = yellow_line_up() if keeper else yellow_line_up()[1:]
+    intents = team().intents(WorldState(0.0, ball, (*blue, *yellow)), GAME)
+    assert sorted(intents) == [r.id for r in yellow]
     for rid, it in intents.items():
-        if rid != 0:
+        if rid != SETTINGS.strategy.roles.goalie_id:
             assert FIELD.in_defense_area(it.x, it.y, R) == 0, (rid, it)
 
 

@@ -55,6 +55,7 @@ from cmdragons.planning import (
     make_termination,
 )
 from cmdragons.safety import Safety, make_safety
+from strategy.defend import DefendTeamParams
 from strategy.plays import Strategy
 from strategy.simple import SimpleTeamParams
 from strategy.skills import Intent
@@ -93,7 +94,7 @@ class BrainParams(Validated):
 
 @dataclass(frozen=True)
 class TeamParams(Validated):
-    """configs/team.yaml: our brain, its navigator, and the built-in simple opponent. Beside them sit
+    """configs/team.yaml: our brain, its navigator, and the built-in opponents. Beside them sit
     the registered navigators' config sections (each navigator declares the ones it reads:
     cmdragons/navigation/registry.py); they are parsed and checked with the file, and the navigator
     reads its own when it is built."""
@@ -102,6 +103,7 @@ class TeamParams(Validated):
     navigator_sections: FrozenMap[str, Any] = sections(config_sections)  # section name -> its navigator's params
     brain: BrainParams = BrainParams()
     simple_opponent: SimpleTeamParams = SimpleTeamParams()
+    defend_opponent: DefendTeamParams = DefendTeamParams()
 
     def with_section(self, name: str, params: Any) -> TeamParams:
         """These params with navigator section ``name`` replaced by ``params``."""

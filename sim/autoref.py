@@ -33,7 +33,6 @@ from cmdragons.messages import (
     GroundTruth,
     Kick,
     RefereeCommand,
-    RobotState,
     RobotTruth,
     Teleport,
     WorldState,

@@ -79,7 +79,7 @@ class Referee:
     rules also the stages, fouls, cards, placements and penalties."""
 
     def __init__(self, field: Field, robot_keys: Sequence[tuple[Team, int]], params: RefereeParams,
-                 margins: TrackMargins = TrackMargins(), leave_s: float = 0.0) -> None:  # fmt: skip
+                 margins: TrackMargins | None = None, leave_s: float = 0.0) -> None:  # fmt: skip
         """``margins`` and ``leave_s``: what judging tracked robots allows (the auto-referee on
         vision): the foul watch's margins, and how long a robot sent off may still be seen on the
         field before its team has too many robots (on the truth it leaves at once)."""
@@ -102,7 +102,7 @@ class Referee:
         self.full = params.enabled and params.rules == "full"
         self.rules = params.figures
         self.game = GameController(self.rules, halves=self.full)
-        self.watch = FoulWatch(field, self.rules, margins)
+        self.watch = FoulWatch(field, self.rules, margins if margins is not None else TrackMargins())
         self.leave_s = leave_s
         self._sent_off_t: dict[Team, float] = {}  # per team: when the referee last sent one of its robots off
         self._too_many: set[Team] = set()  # teams called for too many robots, not down to what they may have since

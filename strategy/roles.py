@@ -38,6 +38,8 @@ class RoleKind(enum.Enum):
     RECEIVER = "receiver"  # of a pass decided or under way
     DEFENDER = "defender"  # on the edge of our defense area
     SUPPORTER = "supporter"  # at a receiving point of the pass evaluation
+    MARKER = "marker"  # in an opponent's passing lane (its index: the opponent's id)
+    BLOCKER = "blocker"  # on the ball's line to our goal, in front of the ball
 
 
 @dataclass(frozen=True)

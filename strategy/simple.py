@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from typing import Protocol
 
 import numpy as np
 
@@ -33,7 +34,7 @@ from strategy.game_states import (
 from strategy.plays import StrategyParams
 from strategy.skills import Intent, goalie_block, kick_to
 
-__all__ = ["SimpleTeam", "SimpleTeamParams", "steer"]
+__all__ = ["SimpleTeam", "SimpleTeamParams", "Steering", "steer"]
 
 
 @dataclass(frozen=True)
@@ -50,7 +51,20 @@ class SimpleTeamParams(Validated):
     shape_spacing_m: float = setting(1.2, lo=0.0, hi=5.0)  # ... this far apart across the field
 
 
-def steer(team: Team, rid: int, x: float, y: float, theta: float, it: Intent, p: SimpleTeamParams) -> RobotCommand:
+class Steering(Protocol):
+    """What :func:`steer` reads of a team's parameters."""
+
+    @property
+    def max_speed_m_s(self) -> float: ...
+    @property
+    def position_gain_1_s(self) -> float: ...  # speed per metre of position error
+    @property
+    def heading_gain_1_s(self) -> float: ...
+    @property
+    def max_omega_rad_s(self) -> float: ...
+
+
+def steer(team: Team, rid: int, x: float, y: float, theta: float, it: Intent, p: Steering) -> RobotCommand:
     """Proportional steering toward an intent, field frame; no obstacle avoidance."""
     dx, dy = it.x - x, it.y - y
     d = math.hypot(dx, dy)

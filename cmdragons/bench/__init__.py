@@ -54,7 +54,7 @@ ABOUT: dict[str, str] = {
     "planning": "the planners and collision queries on seeded small-size scenes",
     "safety": "the dynamics safety search in the simulator (Bruce 2006 5.6.1): collisions with and without",
     "tracking": "the tracker on the rendered cameras through vision, against the truth",
-    "play": "seeded full-rules matches against the simple opponent (--opponent self), and the brain's cycle",
+    "play": "seeded full-rules matches against the simple, the defending and our own team, and the brain's cycle",
     "vision": "detection quality against truth (noise, light, video, 1920x1200) and time beside OpenCV",
     "grid": "the grid planners on Moving AI maps beside their peers (--maps DIR)",
     "robox": "Philippsen's Robox stack (E*, elastic band, dynamic window) beside ERRT and DSS",

@@ -1,15 +1,21 @@
-"""``cmdragons bench play``: seeded matches against the simple opponent under the league's full rules,
-our team seeing through the cameras; and the brain's cycle for 11 v 11 in division A.
+"""``cmdragons bench play``: seeded matches against the built-in opponents under the league's full
+rules, our team seeing through the cameras; the two built-in teams against each other; and the
+brain's cycle for 11 v 11 in division A.
 
 A match is two halves of the rules' duration (5 minutes each; the half-time break, in which nothing
-moves, is not simulated), the sides changed between them. Rows per match (goals for and against,
-shots, passes, own collisions (apart: those where an opponent touched one of the two, pushing it into
-the other), fouls and cards per team, our placements tried and succeeded, stage
-times), a totals row (matches won, drawn, lost; pass completion; own collisions; our fouls by kind,
-per match; placements succeeded and their median time), and the brain's cycle time (tracker to
-commands) for 6 and 11 robots; a penalty shootout of ``SHOOTOUT_KICKS`` kicks each way (ours against their
-keeper, theirs against ours: scored and saved), played as a shootout after two halves of a second.
-``--quick`` plays two matches of two 30 s halves and a shootout of 3 kicks each.
+moves, is not simulated), the sides changed between them. Rows per match against each opponent
+(the simple team; the defending team; ``self``, our team in the other colour) (goals for and
+against, shots, passes, own collisions (apart: those where an opponent touched one of the two,
+pushing it into the other), fouls and cards per team, our placements tried and succeeded, stage
+times), a totals row per opponent (matches won, drawn, lost; pass completion; own collisions; our
+fouls by kind, per match; placements succeeded and their median time); the defending team against
+the simple team on the true state, the same halves, once in each colour (goals, fouls and cards of
+each; neither team nor the simulator draws anything at random on the true state, so more seeds
+would replay these two matches) and their totals row; the brain's cycle
+time (tracker to commands) for 6 and 11 robots; a penalty shootout of ``SHOOTOUT_KICKS`` kicks
+each way (ours against their keeper, theirs against ours: scored and saved), played as a shootout
+after two halves of a second. ``--quick`` plays two matches of two 30 s halves against simple and
+against defend (no self-play), the two built-in teams' two, and a shootout of 3 kicks each.
 """
 
 from __future__ import annotations
@@ -22,12 +28,17 @@ from typing import Any
 import numpy as np
 
 from cmdragons.messages import GameStage, GameState
-from cmdragons.runtime.bus import BaseStage, Publish, run_frames
-from cmdragons.runtime.match import Match
+from cmdragons.runtime.bus import BaseStage, Bus, Publish, run_frames
+from cmdragons.runtime.match import BuiltIn, Match, built_in_wiring
+from cmdragons.runtime.match import build as build_stages
 from cmdragons.runtime.settings import Settings
+from cmdragons.runtime.stages import SummaryCollector
 from cmdragons.runtime.topics import Contract, Port
+from sim.simulator import Simulator
 
-__all__ = ["SHOOTOUT_KICKS", "run"]
+__all__ = ["OPPONENTS", "SHOOTOUT_KICKS", "run"]
+
+OPPONENTS = ("simple", "defend", "self")  # whom our team plays in the suite, in this order
 
 SHOOTOUT_KICKS = 10  # penalty kicks each way in the bench's shootout (the issue's measure)
 GRSIM_BALL_ROLL_M_S2 = 0.70  # grSim's ball decelerates so while rolling (measured against its own vision)
@@ -78,6 +89,11 @@ def _shootout_row(settings: Settings, kicks: int, seed: int) -> dict[str, Any]:
             "realtime_factor": s["seconds"] / wall}
 
 
+def _suffix(opponent: str) -> str:
+    """Row names against the simple team as they always were; against another, its name appended."""
+    return "" if opponent == "simple" else f"_{opponent}"
+
+
 def _match_row(settings: Settings, seed: int, seconds: float, opponent: str) -> dict[str, Any]:
     wall = time.perf_counter()
     m = Match(settings, opponent, "vision", seed=seed)  # type: ignore[arg-type]
@@ -88,7 +104,7 @@ def _match_row(settings: Settings, seed: int, seconds: float, opponent: str) -> 
     ours, theirs = rules["fouls"]["blue"], rules["fouls"]["yellow"]
     placed = rules["placements"]["blue"]
     return {
-        "name": f"match_seed_{seed}",
+        "name": f"match_seed_{seed}{_suffix(opponent)}",
         "goals_for": s["score"]["blue"],
         "goals_against": s["score"]["yellow"],
         "shots": s["shots"],
@@ -168,31 +184,65 @@ def _brain_cycle(settings: Settings, division: str, seconds: float) -> dict[str,
             "tracker_median_ms": float(np.median(tracker))}  # fmt: skip
 
 
-def run(settings: Settings, quick: bool, opponent: str | None = None, matches: int | None = None,
-        half: float | None = None, shootout: int | None = None) -> list[dict[str, Any]]:
-    """The suite's rows. ``opponent``: "simple" (default) or "self" (our team in the other colour:
-    the matches and their fouls only); ``matches``, ``half``: how many and how long (seconds);
-    ``shootout``: the shootout's kicks each way (default ``SHOOTOUT_KICKS``, quick 3; 0: none)."""
-    opponent = opponent or "simple"
-    seeds = list(range(1, (matches or (2 if quick else 10)) + 1))
-    half = half or (30.0 if quick else settings.sim.referee.figures.half_s)
-    seconds = 2.0 * half
-    rules = _halves(settings, half)
-    rows = []
-    for k, seed in enumerate(seeds):
-        print(f"bench play: match {k + 1} of {len(seeds)} (seed {seed}, 2 x {half:g} s, against {opponent}) ...",
-              file=sys.stderr, flush=True)  # fmt: skip
-        rows.append(_match_row(rules, seed, seconds, opponent))
+def _built_in_match(settings: Settings, blue: BuiltIn, yellow: BuiltIn, seed: int,
+                    seconds: float) -> tuple[dict[str, Any], float]:  # fmt: skip
+    """One match of two built-in teams on the true state: the referee's figures and the simulated
+    seconds per wall-clock second."""
+    sim = Simulator(settings.field, settings.camera_models(), settings.sim, seed=seed, render=False, referee=False)
+    summaries = SummaryCollector()
+    bus = Bus()
+    for stage in build_stages(built_in_wiring(settings, blue, yellow, lambda: sim), [summaries]):
+        bus.add(stage)
+    wall = time.perf_counter()
+    bus.start()
+    run_frames(bus.tick, max(1, round(seconds * settings.sim.physics.frame_rate_hz)))
+    wall = time.perf_counter() - wall
+    bus.summarize()
+    return summaries.figures["referee"], summaries.figures["sim"]["seconds"] / wall
+
+
+def _duel_row(settings: Settings, seed: int, seconds: float) -> dict[str, Any]:
+    """The defending team against the simple team: yellow on odd seeds, blue on even ones (the
+    seed picks nothing else: both play on the true state, which the simulator keeps free of noise)."""
+    defend, simple = ("yellow", "blue") if seed % 2 else ("blue", "yellow")
+    colours: dict[str, BuiltIn] = {defend: "defend", simple: "simple"}
+    ref, speed = _built_in_match(settings, colours["blue"], colours["yellow"], seed, seconds)
+    return {"name": f"defend_vs_simple_seed_{seed}", "defend_plays": defend,
+            "goals_defend": ref["score"][defend], "goals_simple": ref["score"][simple],
+            "fouls_defend": ref["fouls"][defend]["total"], "fouls_simple": ref["fouls"][simple]["total"],
+            "fouls_defend_by_kind": _kinds_text({k: v for k, v in ref["fouls"][defend].items() if k != "total"}),
+            "cards_defend": ref["cards"][defend]["yellow"] + ref["cards"][defend]["red"],
+            "cards_simple": ref["cards"][simple]["yellow"] + ref["cards"][simple]["red"],
+            "realtime_factor": speed}  # fmt: skip
+
+
+def _duel_total(rows: list[dict[str, Any]], seconds: float) -> dict[str, Any]:
+    won = sum(r["goals_defend"] > r["goals_simple"] for r in rows)
+    lost = sum(r["goals_defend"] < r["goals_simple"] for r in rows)
+    n = len(rows)
+    return {"name": f"total_defend_vs_simple_{n}_matches_{seconds:.0f}s", "won_defend": won,
+            "drawn": n - won - lost, "lost_defend": lost,
+            "goals_defend": sum(r["goals_defend"] for r in rows), "goals_simple": sum(r["goals_simple"] for r in rows),
+            "fouls_defend_per_match": sum(r["fouls_defend"] for r in rows) / n,
+            "fouls_simple_per_match": sum(r["fouls_simple"] for r in rows) / n,
+            "cards_defend": sum(r["cards_defend"] for r in rows), "cards_simple": sum(r["cards_simple"] for r in rows),
+            "realtime_factor": float(np.median([r["realtime_factor"] for r in rows]))}  # fmt: skip
+
+
+def _total(rows: list[dict[str, Any]], seconds: float, opponent: str) -> dict[str, Any]:
+    """The totals row of the matches ``rows`` against ``opponent`` (each row's kinds of fouls taken out)."""
     won = sum(r["goals_for"] > r["goals_against"] for r in rows)
     tried_placing = sum(r["placements_tried"] for r in rows)
     placed = sum(r["placements_succeeded"] for r in rows)
     lost = sum(r["goals_for"] < r["goals_against"] for r in rows)
     tried = sum(r["passes_tried"] for r in rows)
-    rows.append({
-        "name": f"total_{len(rows)}_matches_{seconds:.0f}s",
+    return {
+        "name": f"total_{len(rows)}_matches_{seconds:.0f}s{_suffix(opponent)}", "opponent": opponent,
         "won": won, "drawn": len(rows) - won - lost, "lost": lost,
         "goals_for": sum(r["goals_for"] for r in rows), "goals_against": sum(r["goals_against"] for r in rows),
+        "passes_tried": tried, "passes_completed": sum(r["passes_completed"] for r in rows),
         "pass_completion": sum(r["passes_completed"] for r in rows) / tried if tried else float("nan"),
+        "shots": sum(r["shots"] for r in rows),
         "own_collisions": sum(r["own_collisions"] for r in rows),
         "own_collisions_pushed": sum(r["own_collisions_pushed"] for r in rows),
         "fouls_ours_per_match": sum(r["fouls_ours"] for r in rows) / len(rows),
@@ -205,12 +255,43 @@ def run(settings: Settings, quick: bool, opponent: str | None = None, matches: i
         "placement_median_of_matches_s": float(np.median(times)) if (times := [r["placement_median_s"] for r in rows
                                                                     if r["placement_median_s"] is not None]) else None,
         "realtime_factor": float(np.median([r["realtime_factor"] for r in rows])),
-    })  # fmt: skip
-    print("bench play: a match in grSim's physics (ball 0.70 m/s², braking 4 m/s²) ...", file=sys.stderr, flush=True)
-    other = _other_world_row(rules, seeds[0], seconds, opponent, GRSIM_BALL_ROLL_M_S2, GRSIM_ROBOT_BRAKE_M_S2)
-    other.pop("_kinds")
-    rows.append(other)
-    if opponent == "self":
+    }  # fmt: skip
+
+
+def run(settings: Settings, quick: bool, opponent: str | None = None, matches: int | None = None,
+        half: float | None = None, shootout: int | None = None) -> list[dict[str, Any]]:
+    """The suite's rows. ``opponent``: one of :data:`OPPONENTS` alone (default: each of them, but
+    self-play only without ``quick``); the defending team's matches against the simple team come
+    with the matches against the defending team, the shootout and the brain's cycle with those
+    against the simple team. ``matches``, ``half``: how many and how long (seconds); ``shootout``:
+    the shootout's kicks each way (default ``SHOOTOUT_KICKS``, quick 3; 0: none)."""
+    opponents = [opponent] if opponent else [o for o in OPPONENTS if not (quick and o == "self")]
+    seeds = list(range(1, (matches or (2 if quick else 10)) + 1))
+    half = half or (30.0 if quick else settings.sim.referee.figures.half_s)
+    seconds = 2.0 * half
+    rules = _halves(settings, half)
+    rows: list[dict[str, Any]] = []
+    for opp in opponents:
+        played = []
+        for k, seed in enumerate(seeds):
+            print(f"bench play: match {k + 1} of {len(seeds)} (seed {seed}, 2 x {half:g} s, against {opp}) ...",
+                  file=sys.stderr, flush=True)  # fmt: skip
+            played.append(_match_row(rules, seed, seconds, opp))
+        rows += [*played, _total(played, seconds, opp)]
+        if opp == "defend":
+            duels = []
+            for k, seed in enumerate(seeds[:2]):  # (deterministic: one match in each colour is all there is)
+                print(f"bench play: defend against simple {k + 1} of {len(seeds[:2])} (2 x {half:g} s) ...",
+                      file=sys.stderr, flush=True)  # fmt: skip
+                duels.append(_duel_row(rules, seed, seconds))
+            rows += [*duels, _duel_total(duels, seconds)]
+    if "simple" in opponents:  # and one more against the simple team in grSim's physics
+        print("bench play: a match in grSim's physics (ball 0.70 m/s², braking 4 m/s²) ...", file=sys.stderr,
+              flush=True)  # fmt: skip
+        other = _other_world_row(rules, seeds[0], seconds, "simple", GRSIM_BALL_ROLL_M_S2, GRSIM_ROBOT_BRAKE_M_S2)
+        other.pop("_kinds")
+        rows.append(other)
+    if "simple" not in opponents:
         return rows
     kicks = (3 if quick else SHOOTOUT_KICKS) if shootout is None else shootout
     if kicks:

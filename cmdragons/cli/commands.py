@@ -114,8 +114,11 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("play", help="play a match in the simulator; our team sees only the camera images")
     _common(p, "strategy.kicking.shoot_value=0.1")
-    p.add_argument("--opponent", choices=("simple", "self", "none", "outside", "simulation"), default="simple",
-                   help="the built-in simple team (on the true state), a copy of our team, nobody, (with "
+    p.add_argument("--opponent", choices=("simple", "defend", "self", "none", "outside", "simulation"),
+                   default="simple",
+                   help="the built-in simple team (on the true state), the built-in defending team (on the true "
+                   "state, at our robots' limits: marks receivers in their passing lanes, blocks shots; configs/"
+                   "team.yaml defend_opponent), a copy of our team, nobody, (with "
                    "--distributed) a team outside on commands/yellow (examples/outside_team.py), or a team outside "
                    "over the league's simulation protocol (RobotControl to 127.0.0.1:10302, SimulatorCommand to "
                    "10300; it sees SSL-Vision packets on 224.5.23.2:10006 and Referee packets on 224.5.23.1:10003)")
@@ -176,8 +179,9 @@ def build_parser() -> argparse.ArgumentParser:
                    "(default ../shared/benchdata/moving_ai)")
     p.add_argument("--figures", metavar="DIR", default=None,
                    help="navigation: the folder of the PNGs of each method's paths (default logs/bench-navigation)")
-    p.add_argument("--opponent", choices=("simple", "self"), default=None,
-                   help="play: the opponent (default simple; self: our team in the other colour, for the foul counts)")
+    p.add_argument("--opponent", choices=("simple", "defend", "self"), default=None,
+                   help="play: only this opponent (default: simple, defend (with defend against simple on the "
+                   "true state) and self, our team in the other colour; --quick: simple and defend)")
     p.add_argument("--matches", metavar="N", type=_count, default=None,
                    help="play: this many seeded matches (default 10, --quick 2)")
     p.add_argument("--half", metavar="S", type=_positive, default=None,

@@ -20,7 +20,7 @@ __all__ = ["add_parsers", "cmd_log", "cmd_node", "cmd_replay", "play_distributed
 
 
 def _match_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--opponent", choices=("simple", "self", "none", "outside"), default="simple",
+    p.add_argument("--opponent", choices=("simple", "defend", "self", "none", "outside"), default="simple",
                    help="as cmdragons play: every node of a match must be given the same")  # fmt: skip
     p.add_argument("--perception", choices=("vision", "truth"), default="vision", help="as cmdragons play")
     p.add_argument("--seed", type=int, default=None, help="override sim.seed (every node the same)")

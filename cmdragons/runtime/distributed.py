@@ -5,7 +5,7 @@ Nodes (``cmdragons node ROLE``) and the stages of :func:`~cmdragons.runtime.matc
     sim       the simulator and its cameras, and the match's clock (below)
     vision    vision per camera (or the truth perception of ``--perception truth``)
     team      our tracker, our brain, our statistics and the brain's timings
-    opponent  the simple team on the truth, or the copy of our team with its own tracker
+    opponent  a built-in team on the truth (simple, defend), or the copy of our team with its own tracker
     referee   the referee
     log       run.mcap: every topic and Foxglove's scene
 
@@ -44,6 +44,7 @@ from typing import TYPE_CHECKING, Any, TextIO
 from cmdragons.messages import DetectionFrame, NodeControl
 from cmdragons.runtime.bus import Bus, Stage, run_frames
 from cmdragons.runtime.match import (
+    BUILT_IN,
     OURS,
     THEIRS,
     Entry,
@@ -126,7 +127,7 @@ def _hold_cpu_latency(us: int) -> str | None:
 def node_roles(opponent: Opponent, log: bool, vision_with_sim: bool = False) -> list[str]:
     """The nodes a match needs (no opponent node against nobody or a team outside; the log node
     when logging; no vision node when vision runs in the sim node)."""
-    return [r for r in ROLES if (r != "opponent" or opponent in ("simple", "self")) and (r != "log" or log)
+    return [r for r in ROLES if (r != "opponent" or opponent in (*BUILT_IN, "self")) and (r != "log" or log)
             and (r != "vision" or not vision_with_sim)]  # fmt: skip
 
 
@@ -180,10 +181,10 @@ def rehearse(spec: MatchSpec, role: str) -> None:
     behind. The team's (and a copy's) tracker and brain play ``runtime.rehearsal_frames`` frames of
     a scene made up from the field alone (:func:`rehearsal_scene`: no simulator; their first plans
     come a few frames in); the simulator and vision two (their kernels load on the first); the
-    referee, the logger and the simple opponent need none. Throwaway: nothing published."""
+    referee, the logger and the built-in opponents need none. Throwaway: nothing published."""
     frames = spec.settings.runtime.rehearsal_frames
     if frames == 0 or role in ("referee", "log") or (role == "opponent" and spec.opponent != "self"):
-        return  # (the simple opponent's first frame costs what its others do)
+        return  # (a built-in opponent's first frame costs what its others do)
     settings = spec.settings
     if role in ("team", "opponent"):
         from cmdragons.messages import GameState

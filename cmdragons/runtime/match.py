@@ -3,8 +3,9 @@
 Per camera frame the clock ticks; the simulator renders every camera; our team sees only those
 images, through vision (one stage per camera) and its tracker; the brain decides; once every
 playing team's commands are in, the simulator steps and the referee judges the frame. The opponent
-is the built-in simple team (playing on the true state), a copy of our team (its own tracker on the
-same detections, its own brain), or nobody.
+is a built-in team playing on the true state (the simple team, or the defending team that marks
+receivers and blocks shots), a copy of our team (its own tracker on the same detections, its own
+brain), or nobody. :func:`built_in_wiring` plays two built-in teams against each other.
 
 ``perception = "truth"`` replaces the camera images by detections made from the simulator's truth
 plus vision-like noise, drawn per team: for working on strategy, planning and control without
@@ -32,11 +33,12 @@ from cmdragons.messages import Tick
 from cmdragons.runtime.bus import Bus, Stage, Transport, run_frames
 from cmdragons.runtime.settings import Settings
 from cmdragons.runtime.stages import (
+    BuiltInOpponentStage,
+    BuiltInTeam,
     CameraTruthStage,
     RecorderStage,
     RefereeStage,
     ScriptStage,
-    SimpleOpponentStage,
     SimStage,
     StatsStage,
     SummaryCollector,
@@ -56,10 +58,13 @@ if TYPE_CHECKING:
     from sim.script import ScriptedPlay
     from sim.simulator import Simulator
 
-__all__ = ["CLOCK", "OURS", "THEIRS", "Entry", "Match", "Opponent", "Perception", "build", "match_sim_params",
-           "match_summary", "scripted_wiring", "served_wiring", "summary_stages", "timing_keys", "wiring"]
+__all__ = ["BUILT_IN", "CLOCK", "OURS", "THEIRS", "BuiltIn", "Entry", "Match", "Opponent", "Perception", "build",
+           "built_in_team", "built_in_wiring", "match_sim_params", "match_summary", "scripted_wiring",
+           "served_wiring", "summary_stages", "timing_keys", "wiring"]
 
-Opponent = Literal["simple", "self", "none", "outside", "simulation"]
+Opponent = Literal["simple", "defend", "self", "none", "outside", "simulation"]
+BuiltIn = Literal["simple", "defend"]
+BUILT_IN: tuple[BuiltIn, ...] = ("simple", "defend")  # the opponents the runtime plays itself, on the truth
 Perception = Literal["vision", "truth"]
 OURS: Team = "blue"
 THEIRS: Team = "yellow"
@@ -148,9 +153,9 @@ def wiring(settings: Settings, opponent: Opponent, perception: Perception, seed:
                     Entry(TeamStage.declare(team, referee_topic), node,
                           functools.partial(_team_stage, team, own, referee_topic))]
     entries += _ssl_out_stages(settings)
-    if opponent == "simple":
-        entries.append(Entry(SimpleOpponentStage.declare(THEIRS), "opponent",
-                             functools.partial(_simple_opponent_stage, settings)))  # fmt: skip
+    if opponent in BUILT_IN:
+        entries.append(Entry(BuiltInOpponentStage.declare(THEIRS), "opponent",
+                             functools.partial(_built_in_stage, opponent, THEIRS, settings)))  # fmt: skip
     pass_timeout_s = settings.strategy.pass_timeout_s
     entries += [Entry(StatsStage.declare(OURS), "team", lambda: StatsStage(OURS, pass_timeout_s)),
                 Entry(TimingStage.contract, "team", TimingStage)]  # fmt: skip
@@ -166,11 +171,34 @@ def _referee_stage(settings: Settings, keys: list[tuple[Team, int]]) -> Stage:
     return RefereeStage(Referee(settings.field_geometry(), keys, settings.sim.referee))
 
 
-def _simple_opponent_stage(settings: Settings) -> Stage:
-    from strategy.simple import SimpleTeam  # (only the opponent's node loads it)
+def built_in_team(kind: BuiltIn, team: Team, settings: Settings) -> BuiltInTeam:
+    """A built-in team of ``kind`` playing ``team``: its own section of configs/team.yaml
+    (``simple_opponent``, ``defend_opponent``) and the strategy's parts (only the opponent's node
+    loads them)."""
+    if kind == "defend":
+        from strategy.defend import DefendTeam
 
-    simple = SimpleTeam(THEIRS, settings.field_geometry(), settings.team.simple_opponent, settings.strategy)
-    return SimpleOpponentStage(THEIRS, simple)
+        return DefendTeam(team, settings.field_geometry(), settings.team.defend_opponent, settings.strategy)
+    from strategy.simple import SimpleTeam
+
+    return SimpleTeam(team, settings.field_geometry(), settings.team.simple_opponent, settings.strategy)
+
+
+def _built_in_stage(kind: BuiltIn, team: Team, settings: Settings) -> Stage:
+    return BuiltInOpponentStage(team, built_in_team(kind, team, settings))
+
+
+def built_in_wiring(settings: Settings, blue: BuiltIn, yellow: BuiltIn, sim: Callable[[], Simulator]) -> list[Entry]:
+    """The table of a match between two built-in teams on the true state (no cameras, no brain):
+    the simulator, the referee and both teams; ``sim`` builds (or gives) the simulator."""
+    keys = robot_keys(settings.field, settings.sim)
+    sides: tuple[tuple[Team, BuiltIn], ...] = (("blue", blue), ("yellow", yellow))
+    return [
+        Entry(SimStage.declare([]), "sim", lambda: SimStage(sim(), list(TEAMS))),
+        Entry(RefereeStage.contract, "referee", functools.partial(_referee_stage, settings, keys)),
+        *(Entry(BuiltInOpponentStage.declare(team), "opponent",
+                functools.partial(_built_in_stage, kind, team, settings)) for team, kind in sides),
+    ]  # fmt: skip
 
 
 def _tracker_stage(team: Team, own: Settings, topics: Sequence[str], synchronized: bool) -> Stage:

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Any, Literal, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -55,7 +55,6 @@ if TYPE_CHECKING:
     from sim.script import ScriptedPlay
     from sim.simulator import Simulator
     from sim.world import World
-    from strategy.simple import SimpleTeam
 
 __all__ = [
     "CameraTruthStage",
@@ -63,8 +62,9 @@ __all__ = [
     "RecorderStage",
     "RefereeStage",
     "ScriptStage",
+    "BuiltInOpponentStage",
+    "BuiltInTeam",
     "SimStage",
-    "SimpleOpponentStage",
     "StatsStage",
     "SummaryCollector",
     "Tap",
@@ -446,21 +446,28 @@ def _points(a: Any) -> NDArray[np.float64]:
     return np.asarray(a, dtype=np.float64).reshape(-1, 2)
 
 
-class SimpleOpponentStage(_PlayingStage):
-    """The built-in simple team: plays on the true state, plain steering."""
+class BuiltInTeam(Protocol):
+    """A built-in opponent (:class:`strategy.simple.SimpleTeam`, :class:`strategy.defend.DefendTeam`):
+    one frame's commands of its robots from the true state and the referee's word."""
+
+    def commands(self, world: WorldState, game: GameState) -> list[RobotCommand]: ...
+
+
+class BuiltInOpponentStage(_PlayingStage):
+    """A built-in opponent: plays on the true state (the simple team, the defending team)."""
 
     @staticmethod
     def declare(team: Team) -> Contract:
         return Contract(f"opponent/{team}", (Port("truth", GroundTruth), Port("referee", GameState)),
                         (Port(f"commands/{team}", TeamCommands),))
 
-    def __init__(self, team: Team, simple: SimpleTeam) -> None:
+    def __init__(self, team: Team, plays: BuiltInTeam) -> None:
         super().__init__(self.declare(team), team)
-        self.simple = simple
+        self.plays = plays
 
     def play(self, message: Any) -> tuple[WorldState, list[RobotCommand]]:
         world = message.world()
-        return world, self.simple.commands(world, self.game)
+        return world, self.plays.commands(world, self.game)
 
 
 class RefereeStage(BaseStage):

@@ -135,5 +135,5 @@ def test_the_team_config_lists_every_section_in_its_yaml_order() -> None:
     from cmdragons.config import to_plain
 
     plain = to_plain(TeamParams())
-    assert list(plain)[0] == "navigator" and list(plain)[-2:] == ["brain", "simple_opponent"]
-    assert set(plain) == {"navigator", "brain", "simple_opponent", *config_sections()}
+    assert list(plain)[0] == "navigator" and list(plain)[-3:] == ["brain", "simple_opponent", "defend_opponent"]
+    assert set(plain) == {"navigator", "brain", "simple_opponent", "defend_opponent", *config_sections()}

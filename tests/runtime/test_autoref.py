@@ -9,10 +9,10 @@ import dataclasses
 import pytest
 
 from cmdragons.bench.autoref import WINDOW_S, Call, match_calls, rows, watch
+from cmdragons.messages import Teleport
 from cmdragons.runtime.autoref import PASSIVE, WORLD, autoref_rows
 from cmdragons.runtime.match import CLOCK, match_sim_params, wiring
 from cmdragons.runtime.settings import load_settings
-from cmdragons.messages import Teleport
 from cmdragons.runtime.topics import Port, check_wiring
 from sim.simulator import robot_keys
 

@@ -12,10 +12,11 @@ import pytest
 
 from cmdragons import messages as msg
 from cmdragons.messages import DetectionFrame, Tick, WorldState
+from cmdragons.runtime.bus import Bus
 from cmdragons.runtime.distributed import MatchSpec
-from cmdragons.runtime.match import CLOCK, Match
+from cmdragons.runtime.match import CLOCK, Match, build, built_in_wiring
 from cmdragons.runtime.settings import load_settings
-from cmdragons.runtime.stages import Tap
+from cmdragons.runtime.stages import SummaryCollector, Tap
 from cmdragons.runtime.topics import Contract, Port, WiringError, check_wiring, topic_matches
 from sim.simulator import Simulator
 
@@ -23,7 +24,7 @@ SETTINGS = load_settings()
 ROOT = Path(__file__).resolve().parents[2]
 
 
-@pytest.mark.parametrize(("opponent", "perception"), [("simple", "truth"), ("self", "vision")])
+@pytest.mark.parametrize(("opponent", "perception"), [("simple", "truth"), ("defend", "truth"), ("self", "vision")])
 def test_every_topic_published_is_declared_and_every_declared_one_is_published(opponent: str,
                                                                                 perception: str) -> None:  # fmt: skip
     seen: dict[str, set[type]] = {}
@@ -37,6 +38,28 @@ def test_every_topic_published_is_declared_and_every_declared_one_is_published(o
         assert types == {ports[0].type}, f"{topic}: published {types}, declared {ports[0].type}"
     for p in declared:
         assert p.sometimes or any(topic_matches(p.topic, t) for t in seen), f"{p.topic} declared but never published"
+
+
+def test_two_built_in_teams_play_each_other_on_their_declared_topics() -> None:
+    seen: dict[str, set[type]] = {}
+    tap = Tap("every", ("*",), lambda topic, m: seen.setdefault(topic, set()).add(type(m)))
+    summaries = SummaryCollector()
+    sim = Simulator(SETTINGS.field, SETTINGS.camera_models(), SETTINGS.sim, seed=1, render=False, referee=False)
+    stages = build(built_in_wiring(SETTINGS, "simple", "defend", lambda: sim), [tap, summaries])
+    bus = Bus()
+    for stage in stages:
+        bus.add(stage)
+    bus.start()
+    frames = 120
+    for i in range(frames):
+        bus.tick(i)
+    bus.summarize()
+    declared = [p for s in stages for p in s.contract.writes] + list(CLOCK)
+    for topic, types in seen.items():
+        ports = [p for p in declared if topic_matches(p.topic, topic)]
+        assert ports and types == {ports[0].type}, topic
+    assert {"commands/blue", "commands/yellow", "truth", "events", "referee"} <= set(seen)
+    assert summaries.figures["sim"]["seconds"] == pytest.approx(frames / SETTINGS.sim.physics.frame_rate_hz)
 
 
 def test_a_topic_read_that_nobody_writes_is_refused_naming_the_reader_and_the_topic() -> None:

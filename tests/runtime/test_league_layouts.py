@@ -23,7 +23,7 @@ from cmdragons.runtime.proto import ssl_tracked_pb2 as trk_pb
 from cmdragons.runtime.proto import ssl_tracker_wrapper_pb2 as tw_pb
 from cmdragons.runtime.proto import ssl_wrapper_pb2 as wrap_pb
 from cmdragons.runtime.settings import load_settings
-
+from cmdragons.runtime.ssl.clock import UnixEpoch
 from cmdragons.runtime.ssl.commands import (
     UNSUPPORTED,
     Feedback,
@@ -33,7 +33,6 @@ from cmdragons.runtime.ssl.commands import (
     robot_control_response,
     simulator_response,
 )
-from cmdragons.runtime.ssl.clock import UnixEpoch
 from cmdragons.runtime.ssl.stages import VisionInStage
 from cmdragons.runtime.ssl.tracker import read_tracker
 from cmdragons.runtime.ssl.udp import DatagramQueue
@@ -268,7 +267,7 @@ def test_a_live_receiver_takes_a_senders_clock_from_its_first_packet() -> None:
             first_t, 0  # fmt: skip
         queue.push(w.SerializeToString())
         got: list[Any] = []
-        stage.on_message("clock", Tick(0), lambda _t, d: got.append(d))
+        stage.on_message("clock", Tick(0), lambda _t, d, got=got: got.append(d))
         assert got[0].t_capture == pytest.approx(want, abs=1e-6)
 
 

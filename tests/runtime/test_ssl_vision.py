@@ -23,11 +23,11 @@ from cmdragons.config import ConfigError
 from cmdragons.runtime import wire
 from cmdragons.runtime.match import Match
 from cmdragons.runtime.proto.generate import PROTO_DIR, ROOT
+from cmdragons.runtime.proto.ssl_wrapper_pb2 import SSL_WrapperPacket
 from cmdragons.runtime.settings import load_settings
+from cmdragons.runtime.ssl.clock import UnixEpoch
 from cmdragons.runtime.ssl.params import ProtocolParams
 from cmdragons.runtime.ssl.stages import VisionInStage, close_sockets
-from cmdragons.runtime.proto.ssl_wrapper_pb2 import SSL_WrapperPacket
-from cmdragons.runtime.ssl.clock import UnixEpoch
 from cmdragons.runtime.ssl.udp import MulticastReceiver, MulticastSender
 from cmdragons.runtime.ssl.vision import decode_wrapper, detection_packet, geometry_packet
 from cmdragons.runtime.stages import Tap

@@ -34,7 +34,7 @@ LEAGUE = LeagueParams()
 FRONT = LEAGUE.robot.front_distance_m + LEAGUE.ball.radius_m  # a ball at a robot's front: its centre this far ahead
 
 
-def scene(params: RefereeParams = RefereeParams()) -> tuple[World, Referee, AutoRef]:
+def scene(params: RefereeParams | None = None) -> tuple[World, Referee, AutoRef]:
     """Robots parked apart along the bottom touch line, the ball at rest mid-field; both referees in
     normal play."""
     w = World(LEAGUE, PhysicsParams(), RobotParams(command_latency_s=0.0), BallParams(), KickerParams(),
@@ -42,6 +42,7 @@ def scene(params: RefereeParams = RefereeParams()) -> tuple[World, Referee, Auto
     for i, (team, rid) in enumerate(w.robot_keys()):
         w.place_robot(team, rid, -3.5 + 1.0 * i, -2.6, 0.0)
     w.place_ball(0.0, 1.5)
+    params = params if params is not None else RefereeParams()
     ref = Referee(w.field, w.robot_keys(), params)
     auto = AutoRef(w.field, w.robot_keys(), params)
     for r in (ref, auto.referee):

@@ -27,10 +27,10 @@ from cmdragons.messages import MessageError
 from cmdragons.runtime.bus import Bus, Stage
 from cmdragons.runtime.match import Entry, build
 from cmdragons.runtime.settings import Settings
+from cmdragons.runtime.ssl.clock import UnixEpoch
 from cmdragons.runtime.ssl.logfile import LogReader, MessageType
 from cmdragons.runtime.ssl.stages import RefereeInStage, VisionInStage
 from cmdragons.runtime.ssl.udp import DatagramQueue
-from cmdragons.runtime.ssl.clock import UnixEpoch
 from cmdragons.runtime.ssl.vision import VisionGeometry, decode_wrapper, settings_on_geometry
 from cmdragons.runtime.stages import SummaryCollector, TeamStage, TrackerStage
 

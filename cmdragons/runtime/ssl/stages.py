@@ -42,6 +42,7 @@ from cmdragons.messages import (
     WorldState,
 )
 from cmdragons.runtime.bus import BaseStage, Publish
+from cmdragons.runtime.ssl.clock import UnixEpoch, run_epoch
 from cmdragons.runtime.ssl.commands import (
     UNSUPPORTED,
     Feedback,
@@ -55,7 +56,6 @@ from cmdragons.runtime.ssl.commands import (
     simulator_command_packet,
     simulator_response,
 )
-from cmdragons.runtime.ssl.clock import UnixEpoch, run_epoch
 from cmdragons.runtime.ssl.params import ProtocolParams
 from cmdragons.runtime.ssl.referee import RefereeReader, referee_packet
 from cmdragons.runtime.ssl.tracker import tracker_packet

@@ -106,11 +106,22 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("play", help="play a match in the simulator; our team sees only the camera images")
     _common(p, "strategy.kicking.shoot_value=0.1")
-    p.add_argument("--opponent", choices=("simple", "self", "none", "outside", "simulation"), default="simple",
-                   help="the built-in simple team (on the true state), a copy of our team, nobody, (with "
+    p.add_argument("--simulator", choices=("own", "grsim", "sim-protocol"), default="own",
+                   help="own: our simulator, embedded (default); grsim: an outside grSim (its vision on "
+                   "224.5.23.2:10020, grSim packets to 127.0.0.1:20011); sim-protocol: an outside simulator over the "
+                   "league's simulation protocol (grSim, the ER-Force simulator, cmdragons sim --serve: RobotControl "
+                   "to 127.0.0.1:10301/10302, teleports to 10300, its vision on protocols.simulation.vision_port). "
+                   "Outside, we see its SSL-Vision packets, play on the field its geometry gives, and --seconds is "
+                   "its vision's time")
+    p.add_argument("--team", choices=("blue", "yellow"), default="blue",
+                   help="with --simulator grsim|sim-protocol: the colour our team plays (default blue)")
+    p.add_argument("--opponent", choices=("simple", "self", "none", "outside", "simulation"), default=None,
+                   help="the built-in simple team (on the true state; the default), a copy of our team, nobody, (with "
                    "--distributed) a team outside on commands/yellow (examples/outside_team.py), or a team outside "
                    "over the league's simulation protocol (RobotControl to 127.0.0.1:10302, SimulatorCommand to "
-                   "10300; it sees SSL-Vision packets on 224.5.23.2:10006 and Referee packets on 224.5.23.1:10003)")
+                   "10300; it sees SSL-Vision packets on 224.5.23.2:10006 and Referee packets on 224.5.23.1:10003). "
+                   "In an outside simulator: none (the default: the other side's robots idle) or self (both colours "
+                   "ours)")
     p.add_argument("--opponent-set", metavar="KEY=VALUE", action="append", default=[],
                    help="with --opponent self: override one value of the copy's own config, on top of --config "
                    "and --set (its brain and tracker: planner, control, safety, tracker, strategy, team), "
@@ -121,7 +132,7 @@ def build_parser() -> argparse.ArgumentParser:
                    "penalties, halves); basic: goals, balls out and restarts placed by the referee "
                    "(default: sim.referee.rules, full)")
     p.add_argument("--division", choices=("A", "B"), default=None, help="field and team size (default: config)")
-    p.add_argument("--perception", choices=("vision", "truth"), default="vision",
+    p.add_argument("--perception", choices=("vision", "truth"), default=None,
                    help="vision: our team sees the rendered images (default); truth: noisy true detections")
     p.add_argument("--video", action="store_true", help="write match.mp4 (H.264): a top-down view of the match")
     p.add_argument("--view", choices=("field", "cameras"), default="field",
@@ -200,6 +211,17 @@ def main(argv: Sequence[str] | None = None) -> int:
                 return _cmd_sim(args, stop)
             if args.command == "bench":
                 return _cmd_bench(args)
+            if args.command == "play" and args.simulator != "own":
+                from cmdragons.cli.outside import play_outside
+
+                return play_outside(args, stop, _compile_kernels)
+            if args.command == "play":
+                if args.team != "blue":
+                    print("cmdragons play: --team is for an outside simulator: in ours, our team plays blue",
+                          file=sys.stderr)  # fmt: skip
+                    return 2
+                args.opponent = args.opponent or "simple"
+                args.perception = args.perception or "vision"
             if args.command == "play" and args.distributed and args.opponent == "simulation":
                 print("cmdragons play: --opponent simulation plays in the embedded match: leave out --distributed",
                       file=sys.stderr)  # fmt: skip

@@ -211,6 +211,11 @@ def test_a_match_sends_our_commands_to_a_league_simulator(to: str) -> None:
         match.close()
         peer.close()
         control.close()
+    if to == "grsim":  # grSim hears the last commands again on each vision frame, before the frame's own
+        chip = settings.sim.kicker.chip_angle_rad
+        assert packets[1::2] == [grsim_packet(tc, {r.id: r.theta for r in w.robots if r.team == "blue"}, chip)
+                                 for tc, w in zip(sent[:-1], worlds[1:], strict=True)]  # (in the robots' new headings)
+        packets = packets[0::2]
     assert len(packets) == len(sent) == 10
     for data, tc, world in zip(packets, sent, worlds, strict=True):
         headings = {r.id: r.theta for r in world.robots if r.team == "blue"}

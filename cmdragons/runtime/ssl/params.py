@@ -10,7 +10,7 @@ from typing import Literal
 
 from cmdragons.config import Validated, setting
 
-__all__ = ["GrsimParams", "MulticastParams", "ProtocolParams", "SimulationParams"]
+__all__ = ["GrsimParams", "MulticastParams", "OutsideParams", "ProtocolParams", "SimulationParams"]
 
 CommandsTo = Literal["none", "grsim", "simulation"]
 
@@ -82,10 +82,20 @@ class SimulationParams(Validated):
     yellow_port: int = setting(10302, lo=1, hi=65535)
     dribbler_full_rpm: float = setting(10000.0, lo=1.0, hi=1e6)  # dribbler_speed (rpm) that is our full power (1)
     wait_s: float = setting(0.05, lo=0.0, hi=60.0)  # our simulator: a frame without a new RobotControl waits this long
+    vision_port: int = setting(10020, lo=1, hi=65535)  # play --simulator sim-protocol: the simulator's SSL-Vision
 
     def port(self, team: str) -> int:
         """The RobotControl port of ``team``."""
         return self.blue_port if team == "blue" else self.yellow_port
+
+
+@dataclass(frozen=True)
+class OutsideParams(Validated):
+    """A match in an outside simulator (``play --simulator grsim|sim-protocol``)."""
+
+    geometry_timeout_s: float = setting(10.0, lo=0.1, hi=600.0)  # before the match: its geometry must come by then
+    learn_s: float = setting(0.5, lo=0.0, hi=60.0)  # before the match: its cameras are those heard this long
+    frame_wait_s: float = setting(2.0, lo=0.01, hi=600.0)  # no vision for this long ends the match
 
 
 @dataclass(frozen=True)
@@ -103,6 +113,7 @@ class ProtocolParams(Validated):
     referee: RefereeStreamParams = RefereeStreamParams()
     grsim: GrsimParams = GrsimParams()
     simulation: SimulationParams = SimulationParams()
+    outside: OutsideParams = OutsideParams()
 
     def __post_init__(self) -> None:
         super().__post_init__()

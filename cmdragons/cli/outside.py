@@ -55,6 +55,7 @@ def play_outside(args: argparse.Namespace, stop: Interrupt, compile_kernels: Cal
     from cmdragons.runtime.settings import load_settings
     from cmdragons.runtime.ssl.udp import MulticastReceiver
     from cmdragons.runtime.stages import LoggerStage, Tap
+    from cmdragons.runtime.warmup import warm_team
 
     why = _refused(args)
     if why is not None:
@@ -92,10 +93,10 @@ def play_outside(args: argparse.Namespace, stop: Interrupt, compile_kernels: Cal
         report = ReportStage(ours, positions=f"world/{ours}")
         extra: list[Stage] = [LoggerStage(log), scene, report,
                               Tap("progress", ("referee",), lambda _topic, g: game.__setitem__(0, g))]  # fmt: skip
-        if args.video:
+        if args.video:  # drawn from the log once the match is over: the match is in real time
             video = MatchVideoStage(folder / "match.mp4", "field", ours, [], geometry, settings.field.robot.radius_m,
                                     settings.field.robot.height_m, settings.sim.physics.frame_rate_hz)  # fmt: skip
-            extra.append(video)
+        warm_team(settings)
         match = OutsideMatch(settings, kind, teams, heard, receiver, extra)
         match.skip_stale()  # what came while the team was built is gone by now
         started = time.time()
@@ -121,8 +122,8 @@ def play_outside(args: argparse.Namespace, stop: Interrupt, compile_kernels: Cal
                 receiver.close()
             if log is not None:
                 log.close()
-            if video is not None:
-                video.close()
+            if video is not None and log is not None:
+                _draw(video, folder / "run.mcap", ours)
     with stop.shield():
         summary["interrupted"] = stop.requested
         summary["started_utc"] = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime(started))
@@ -132,6 +133,17 @@ def play_outside(args: argparse.Namespace, stop: Interrupt, compile_kernels: Cal
             summary["field_differs"] = line
         _finish(folder, report.collector.result(), summary, args, (geometry.half_length, geometry.half_width))
     return stop.exit_code
+
+
+def _draw(video: Any, log: Any, ours: str) -> None:
+    """The match video from the match's log (its topics in the order the match wrote them)."""
+    from cmdragons.runtime.log import read_log
+
+    try:
+        for topic, _t, message in read_log(log, {f"/{t}" for t in video.inputs if "*" not in t}):
+            video.on_message(topic[1:], message, lambda *_: None)
+    finally:
+        video.close()
 
 
 def _finish(folder: Any, run: Any, summary: dict[str, Any], args: argparse.Namespace,

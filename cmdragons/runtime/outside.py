@@ -332,8 +332,13 @@ class OutsideMatch:
         frame_ms = (time.perf_counter() - t0) * 1e3
         self.frames += 1
         times = self.bus.take_times()
-        for name, keys in _timings(self.teams[0], self.teams).items():
+        timings = _timings(self.teams[0], self.teams)
+        for name, keys in timings.items():
             self.stage_ms.setdefault(name, []).append(sum(times.get(k, 0.0) for k in keys))
+        # the rest: the log, the viewers, the summaries
+        known = {k for keys in timings.values() for k in keys} | {"timing"}
+        rest = sum(times.get(s.name, 0.0) for s in self.bus.stages if s.name not in known)
+        self.stage_ms.setdefault("log_and_viewers", []).append(rest)
         self.stage_ms.setdefault("frame", []).append(frame_ms)
         return True
 

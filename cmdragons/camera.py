@@ -32,10 +32,12 @@ __all__ = [
     "CamerasParams",
     "RecordingParams",
     "cameras_from_config",
+    "from_ssl_vision_distortion",
     "opencv_extrinsics",
     "params_from_opencv",
     "scaled_to",
     "smallest_ball_px",
+    "ssl_vision_distortion",
 ]
 
 
@@ -275,6 +277,43 @@ def params_from_opencv(rvec: NDArray[np.float64], tvec: NDArray[np.float64], bas
         yaw_rad=math.remainder(yaw, 2.0 * math.pi), tilt_x_rad=math.atan2(m[2, 1], m[1, 1]),
         tilt_y_rad=math.atan2(m[0, 2], m[0, 0]),
     )  # fmt: skip
+
+
+def _image_radii(focal_px: float, principal_point_px: tuple[float, float],
+                 resolution_px: tuple[int, int]) -> NDArray[np.float64]:  # fmt: skip
+    """Distorted normalised radii of a grid of points over the whole image (the weights a lens
+    model is fitted with: every part of the image as much as it covers)."""
+    u = np.linspace(0.0, resolution_px[0], 33) - principal_point_px[0]
+    v = np.linspace(0.0, resolution_px[1], 25) - principal_point_px[1]
+    uu, vv = np.meshgrid(u, v)
+    r: NDArray[np.float64] = np.hypot(uu, vv).ravel() / focal_px
+    return r[r > 0.0]
+
+
+def ssl_vision_distortion(params: CameraParams) -> float:
+    """The ``distortion`` of SSL-Vision's camera model nearest to our lens (k1, k2) over the image.
+
+    SSL-Vision relates the undistorted normalised radius r_u and the distorted one r_d by
+    r_u = r_d (1 + d r_d^2): a positive d is barrel distortion (our k1 < 0), and a d <= 0 means no
+    distortion at all there (a pincushion lens has no value: 0 is sent). d is the least-squares fit
+    over the image (to first order d = -k1)."""
+    rd = _image_radii(params.focal_px, params.principal_point_px, params.resolution_px)
+    ru = np.hypot(*CameraModel(params).undistort(np.stack([rd, np.zeros_like(rd)], axis=-1)).T)
+    d = float(np.sum(rd**3 * (ru - rd)) / np.sum(rd**6))
+    return max(d, 0.0)
+
+
+def from_ssl_vision_distortion(distortion: float, focal_px: float, principal_point_px: tuple[float, float],
+                               resolution_px: tuple[int, int]) -> tuple[float, float]:  # fmt: skip
+    """Our (k1, k2) nearest, over the image, to SSL-Vision's ``distortion`` (see
+    :func:`ssl_vision_distortion`): the least-squares fit of r_d = r_u (1 + k1 r_u^2 + k2 r_u^4) to
+    SSL-Vision's r_u = r_d (1 + d r_d^2); (0, 0) for d <= 0, SSL-Vision's "no distortion"."""
+    if not distortion > 0.0:
+        return 0.0, 0.0
+    rd = _image_radii(focal_px, principal_point_px, resolution_px)
+    ru = rd * (1.0 + distortion * rd * rd)
+    (k1, k2), *_ = np.linalg.lstsq(np.stack([ru**3, ru**5], axis=-1), rd - ru, rcond=None)
+    return float(k1), float(k2)
 
 
 def _auto_camera(cam_id: int, center: tuple[float, float], half: tuple[float, float], lay: AutoLayout,

@@ -87,6 +87,7 @@ def add_parsers(sub: Any, common: Callable[[argparse.ArgumentParser, str], None]
     p.add_argument("path", metavar="LOG", help="a run's run.mcap or a league log (.log, .log.gz)")
     p.add_argument("out", metavar="OUT", nargs="?", default=None,
                    help="convert: the file to write (a league log from an MCAP log, an MCAP log from a league log)")
+    common(p, "cameras.auto.k1=-0.02")  # convert to a league log: the geometry packets' field and cameras
 
 
 def _spec(args: argparse.Namespace) -> Any:
@@ -217,6 +218,7 @@ def play_distributed(args: argparse.Namespace, stop: Interrupt) -> int:
 def _league_log(args: argparse.Namespace, path: Path) -> int:
     """``log info`` of a league log (records per type, time span) and ``log convert`` both ways."""
     from cmdragons.runtime.log import LogError
+    from cmdragons.runtime.settings import load_settings
     from cmdragons.runtime.ssl.convert import is_league_log, league_to_mcap, mcap_to_league
     from cmdragons.runtime.ssl.logfile import LogFileError, LogReader, MessageType
 
@@ -231,8 +233,9 @@ def _league_log(args: argparse.Namespace, path: Path) -> int:
                 if cut is not None:
                     print(f"cmdragons log: warning: {cut}", file=sys.stderr)
             else:
-                n = mcap_to_league(path, args.out)
-                print(f"log convert: {path} -> {args.out}: {n} records (SSL-Vision and Referee packets)")
+                n = mcap_to_league(path, args.out, load_settings(args.config, args.set))
+                print(f"log convert: {path} -> {args.out}: {n} records (SSL-Vision packets with geometry, "
+                      "Referee packets)")
             return 0
         reader = LogReader(path)
         kinds: dict[str, int] = {}
@@ -379,7 +382,8 @@ def _replay_league(args: argparse.Namespace, path: Path, stop: Interrupt) -> int
     tracker = result.figures.get(f"tracker/{args.team}", {})
     summary = {"log": str(path), "team": args.team, "own": args.own, "records": result.records,
                "cameras": result.cameras, "seconds": round(span, 3), "truncated": result.truncated,
-               "interrupted": result.interrupted, "vision": vision,
+               "interrupted": result.interrupted, "field_m": list(result.field_m), "field_from": result.field_from,
+               "vision": vision,
                "referee": result.figures.get("ssl/referee_in", {}), "tracker": tracker}  # fmt: skip
     (folder / "summary.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
     dropped = vision.get("dropped", {})

@@ -34,7 +34,6 @@ from typing import Any
 
 import numpy as np
 
-from cmdragons.config import ConfigError
 from cmdragons.geometry import Team
 from cmdragons.messages import GameState, MessageError, WorldState
 from cmdragons.runtime.bus import Bus, Stage, Transport
@@ -48,7 +47,7 @@ from cmdragons.runtime.ssl.stages import (
     VisionInStage,
     close_sockets,
 )
-from cmdragons.runtime.ssl.vision import VisionGeometry, decode_wrapper
+from cmdragons.runtime.ssl.vision import VisionGeometry, decode_wrapper, field_dims_of
 from cmdragons.runtime.stages import SummaryCollector, Tap, TeamStage, TimingStage, TrackerStage
 from cmdragons.runtime.topics import Port
 
@@ -179,32 +178,27 @@ def listen(receiver: Any, timeout_s: float, learn_s: float, where: str,
     return Heard(geometry, tuple(sorted(seen)), packets)
 
 
-# a field.yaml key and the geometry's value for it (m); a zero means the simulator left it out
-def _sent_dims(g: VisionGeometry) -> dict[str, float]:
-    return {"length_m": g.field_length_m, "width_m": g.field_width_m, "boundary_width_m": g.boundary_width_m,
-            "goal_width_m": g.goal_width_m, "goal_depth_m": g.goal_depth_m, "defense_depth_m": g.penalty_area_depth_m,
-            "defense_width_m": g.penalty_area_width_m, "center_circle_radius_m": g.center_circle_radius_m,
-            "line_width_m": g.line_thickness_m}  # fmt: skip
-
-
+# the sizes a geometry packet gives, compared with field.yaml's (m)
+_COMPARED = ("length_m", "width_m", "boundary_width_m", "goal_width_m", "goal_depth_m", "defense_depth_m",
+             "defense_width_m", "center_circle_radius_m", "line_width_m", "goal_height_m")  # fmt: skip
 _SAME_M = 0.0015  # sent in whole millimetres: a difference below this is rounding
 
 
 def field_settings(settings: Settings, geometry: VisionGeometry) -> tuple[Settings, str | None]:
     """The settings on the simulator's field: the division whose length is nearest the sent one,
-    its dimensions those the geometry gives (what it leaves out, field.yaml's); and one line that
-    says how the field differs from field.yaml's division in force (None: it does not)."""
+    sized as the geometry's field (:func:`~cmdragons.runtime.ssl.vision.field_dims_of`: what it
+    leaves out, field.yaml's); and one line that says how the field differs from field.yaml's
+    division in force (None: it does not)."""
     league = settings.field
-    sent = {k: v for k, v in _sent_dims(geometry).items() if v > 0.0}
     division = min(league.divisions, key=lambda d: abs(league.divisions[d].length_m - geometry.field_length_m))
     try:
-        dims = dataclasses.replace(league.divisions[division], **sent)  # type: ignore[arg-type]
-        new = dataclasses.replace(league, division=division, divisions={**league.divisions, division: dims})
-    except (ValueError, ConfigError) as exc:
-        raise OutsideError(f"the simulator's field cannot be played on: {exc}") from None
+        dims = field_dims_of(geometry, league.divisions[division])
+    except MessageError as exc:
+        raise OutsideError(str(exc)) from None
+    new = dataclasses.replace(league, division=division, divisions={**league.divisions, division: dims})
     ours = league.dims
-    diffs = [f"{k.removesuffix('_m')} {v:.3f} m (field.yaml {getattr(ours, k):.3f})" for k, v in sent.items()
-             if abs(getattr(ours, k) - v) >= _SAME_M]  # fmt: skip
+    diffs = [f"{k.removesuffix('_m')} {getattr(dims, k):.3f} m (field.yaml {getattr(ours, k):.3f})" for k in _COMPARED
+             if abs(getattr(ours, k) - getattr(dims, k)) >= _SAME_M]  # fmt: skip
     if division != league.division:
         diffs.insert(0, f"division {division} (field.yaml {league.division})")
     line = None

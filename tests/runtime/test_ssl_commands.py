@@ -5,6 +5,7 @@ loopback UDP and teleports the ball, and bad packets are counted and dropped wit
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import math
 import shutil
@@ -26,10 +27,15 @@ from cmdragons.runtime.proto import ssl_simulator_pb2 as sim_pb
 from cmdragons.runtime.proto import ssl_tracked_pb2 as trk_pb
 from cmdragons.runtime.proto.generate import PROTO_DIR, ROOT
 from cmdragons.runtime.settings import load_settings
+from cmdragons.runtime.ssl.clock import UnixEpoch
 from cmdragons.runtime.ssl.commands import (
+    UNSUPPORTED,
+    Feedback,
+    SimError,
     grsim_packet,
     local_velocity,
     read_robot_control,
+    read_robot_control_response,
     read_simulator_command,
     robot_control_packet,
     robot_control_response,
@@ -148,8 +154,9 @@ def test_simulator_command_round_trips() -> None:
 
 @pytest.mark.skipif(shutil.which("protoc") is None, reason=NO_PROTOC)
 def test_every_message_sent_decodes_with_protoc() -> None:
-    out = _protoc("ssl_tracker_wrapper.proto", "TrackerWrapperPacket", tracker_packet(WORLD, "u-1", "cmdragons"))
-    for line in ("uuid: \"u-1\"", "frame_number: 77", "timestamp: 1.25", "team: YELLOW", "id: 15"):
+    data = tracker_packet(WORLD, "u-1", "cmdragons", UnixEpoch(1_764_000_000))
+    out = _protoc("ssl_tracker_wrapper.proto", "TrackerWrapperPacket", data)
+    for line in ("uuid: \"u-1\"", "frame_number: 77", "timestamp: 1764000001.25", "team: YELLOW", "id: 15"):
         assert line in out, (line, out)
     out = _protoc("grsim.proto", "grSim_Packet", grsim_packet(COMMANDS, HEADINGS, CHIP))
     assert "isteamyellow: false" in out and "veltangent:" in out and "spinner: true" in out and "id: 4" in out
@@ -158,9 +165,11 @@ def test_every_message_sent_decodes_with_protoc() -> None:
     tp = msg.Teleport(0.0, (("yellow", 2, -1.0, 1.0, -2.0),), (0.25, 0.75))
     out = _protoc("ssl_simulator.proto", "SimulatorCommand", simulator_command_packet(tp))
     assert "teleport_ball" in out and "x: 0.25" in out and "team: YELLOW" in out and "present: true" in out
-    out = _protoc("ssl_simulator.proto", "RobotControlResponse", robot_control_response("yellow", [3], ["robot 4: no"]))
-    assert "unsupported_capability: SIMULATOR_CAPABILITY_MOVE_WHEEL_VELOCITY" in out and "team: YELLOW" in out
-    out = _protoc("ssl_simulator.proto", "SimulatorResponse", simulator_response(["config: not here"]))
+    out = _protoc("ssl_simulator.proto", "RobotControlResponse",
+                  robot_control_response([Feedback(3)], [SimError(UNSUPPORTED, "robot 4: no")]))  # fmt: skip
+    assert "message: \"robot 4: no\"" in out and "feedback {\n  id: 3\n}" in out
+    out = _protoc("ssl_simulator.proto", "SimulatorResponse",
+                  simulator_response([SimError(UNSUPPORTED, "config: not here")]))  # fmt: skip
     assert "message: \"config: not here\"" in out
 
 
@@ -183,7 +192,9 @@ def test_a_match_multicasts_its_world_states_as_tracker_packets(udp_port: int) -
         match.close()
         rx.close()
     assert len(got) == len(worlds) == 12 and len({u for u, _, _ in got}) == 1
-    assert [w for _, _, w in got] == worlds  # world states on the bus are already in their wire form
+    back = [w for _, _, w in got]  # world states on the bus are already in their wire form; times via Unix time
+    assert [dataclasses.replace(w, t=want.t) for w, want in zip(back, worlds, strict=True)] == worlds
+    assert [w.t for w in back] == pytest.approx([w.t for w in worlds], abs=1e-6)
     assert summary["protocols"]["ssl/tracker_out/blue"]["packets"] == 12
 
 
@@ -275,9 +286,8 @@ def test_a_team_outside_drives_its_robot_in_our_simulator_over_udp(kind: str) ->
             client.send_to(m.SerializeToString(), ("127.0.0.1", ports["yellow"]))
             match.step()
             while (got := client.receive()) is not None:
-                resp = sim_pb.RobotControlResponse()
-                resp.ParseFromString(got[0])
-                assert [f.id.id for f in resp.feedback] == [1] and not resp.errors
+                resp = read_robot_control_response(got[0])
+                assert [f.id for f in resp.feedback] == [1] and not resp.errors and not resp.earlier_layout
                 answers += 1
         summary = match.summary()
     finally:

@@ -4,6 +4,7 @@ match's MCAP log to a league log and back with the same detections and game stat
 
 from __future__ import annotations
 
+import dataclasses
 import gzip
 import struct
 from pathlib import Path
@@ -16,7 +17,7 @@ from cmdragons.runtime import wire
 from cmdragons.runtime.log import read_log
 from cmdragons.runtime.ssl.logfile import LogFileError, LogReader, LogRecord, MessageType, write_log
 from cmdragons.runtime.ssl.referee import referee_packet
-from cmdragons.runtime.ssl.vision import detection_packet
+from cmdragons.runtime.ssl.vision import decode_wrapper, detection_packet
 
 RECORDS = [LogRecord(1_700_000_000_000_000_000 + i * 16_666_667, MessageType.VISION_2014,
                      detection_packet(msg.DetectionFrame(i % 2, i, i / 60, i / 60))) for i in range(6)]  # fmt: skip
@@ -89,7 +90,16 @@ def test_convert_a_match_log_to_a_league_log_and_back(tmp_path: Path, capsys: py
     key = [(round(t, 9), m.camera_id, m.frame_number) for t, m in ours]
     assert sorted(key) == sorted((round(t, 9), m.camera_id, m.frame_number) for t, m in theirs)
     by = {(m.camera_id, m.frame_number): m for _, m in theirs}
-    assert all(by[(m.camera_id, m.frame_number)] == wire.canonical(m) for _, m in ours)
+    # the same detections, their times to the microsecond (they crossed as Unix time)
+    for _, m in ours:
+        back_m, want = by[(m.camera_id, m.frame_number)], wire.canonical(m)
+        assert dataclasses.replace(back_m, t_capture=want.t_capture, t_sent=want.t_sent) == want
+        assert (back_m.t_capture, back_m.t_sent) == pytest.approx((want.t_capture, want.t_sent), abs=1e-6)
+    assert "geometry 1," in out  # SSL-Vision's geometry packet, once a second of log time
+    first = next(r for r in LogReader(league) if r.type == MessageType.VISION_2014)  # before any detections
+    _, geo = decode_wrapper(first.payload)
+    assert geo is not None and (geo.field_length_m, geo.field_width_m) == (9.0, 6.0) and len(geo.cameras) == 2
+    assert first.receive_time_ns > 1_700_000_000 * 10**9  # Unix time in the league's log
     games = [m for topic, _, m in read_log(mcap) if topic == "/referee"]
     back_games = [m for topic, _, m in read_log(back) if topic == "/referee/gc"]
     assert [(g.command, g.for_team, g.ready, g.score_blue) for g in games] == \

@@ -16,7 +16,10 @@ from cmdragons.runtime.match import Match
 from cmdragons.runtime.proto import ssl_referee_pb2 as ref_pb
 from cmdragons.runtime.proto.generate import PROTO_DIR, ROOT
 from cmdragons.runtime.settings import load_settings
+from cmdragons.runtime.ssl.clock import UnixEpoch
 from cmdragons.runtime.ssl.referee import RefereeReader, referee_packet, referee_proto
+from cmdragons.runtime.ssl.stages import RefereeInStage
+from cmdragons.runtime.ssl.udp import DatagramQueue
 from cmdragons.runtime.stages import Tap
 
 R = ref_pb.Referee
@@ -61,11 +64,14 @@ def test_our_referees_states_round_trip(g: msg.GameState) -> None:
 
 
 def test_the_leagues_fields_say_what_the_state_says() -> None:
-    m = referee_proto(FULL, "field A", ("cmdragons", "them"))
+    m = referee_proto(FULL, "field A", ("cmdragons", "them"), UnixEpoch(1_764_000_000))
     assert m.command == R.BALL_PLACEMENT_BLUE and m.next_command == R.DIRECT_FREE_BLUE
     assert m.stage == R.NORMAL_SECOND_HALF and m.stage_time_left == 187_250_000
     assert (m.designated_position.x, m.designated_position.y) == (-2000.0, 1500.0)
-    assert m.blue_team_on_positive_half is False and m.packet_timestamp == 41_500_000
+    # the packet's and the command's times in Unix microseconds, as the game controller's
+    assert m.packet_timestamp == 1_764_000_041_500_000 and m.command_timestamp == 1_764_000_040_000_000
+    assert RefereeReader(UnixEpoch(1_764_000_000)).read(m).t == 41.5
+    assert m.blue_team_on_positive_half is False
     assert (m.blue.name, m.blue.score, m.blue.goalkeeper, m.blue.foul_counter) == ("cmdragons", 1, 1, 2)
     assert list(m.yellow.yellow_card_times) == [75_500_000, 3_250_000] and m.yellow.timeout_time == 120_000_000
     assert m.source_identifier == "field A" and not m.HasField("ball_in_play")
@@ -100,6 +106,34 @@ def test_a_game_controllers_sequence_reads_as_our_commands() -> None:
     assert (r.read(_gc(R.NORMAL_START, 6, 11.0)).command, r.read(_gc(R.STOP, 7, 12.0)).command) == ("penalty", "stop")
     # a normal start after a stop: normal play
     assert r.read(_gc(R.NORMAL_START, 8, 13.0)).command == msg.RefereeCommand.NORMAL
+
+
+def _ball_at(x: float, y: float) -> msg.WorldState:
+    return msg.WorldState(0.0, msg.BallState(x, y, 0.0, 0.0, True), ())
+
+
+@pytest.mark.parametrize("prepare_at", [(0.0, 0.0), None], ids=["prepare-says-the-spot", "no-spot-at-all"])
+def test_a_game_controllers_normal_start_without_designated_position_ends_when_the_ball_moves(
+        prepare_at: tuple[float, float] | None) -> None:  # fmt: skip
+    """A game controller clears designated_position at NORMAL_START: the kickoff still ends by the
+    ball moving the rules' ball-in-play distance (0.05 m) from its spot, and not before."""
+    queue = DatagramQueue()
+    stage = RefereeInStage(load_settings().protocols, "world/blue", 0.05, receiver=queue)
+    states: list[msg.GameState] = []
+    spot = {} if prepare_at is None else {"designated_position": R.Point(x=prepare_at[0], y=prepare_at[1])}
+    queue.push(_gc(R.PREPARE_KICKOFF_BLUE, 2, 2.0, **spot))
+    queue.push(_gc(R.NORMAL_START, 3, 3.0))  # no designated position, no ball_in_play: the league's fields
+    stage.on_message("clock", msg.Tick(0), lambda _t, g: states.append(g))
+    assert [(g.command, g.ready, g.placement) for g in states] == [
+        ("kickoff", False, prepare_at), ("kickoff", True, None)]  # fmt: skip
+    for x in (0.0, 0.02, 0.049):  # the ball resting on the mark, nudged less than 0.05 m
+        stage.on_message("world/blue", _ball_at(x, 0.0), lambda _t, g: states.append(g))
+    assert len(states) == 2
+    stage.on_message("world/blue", _ball_at(0.04, 0.035), lambda _t, g: states.append(g))  # 0.053 m away
+    assert len(states) == 3 and states[-1].command == msg.RefereeCommand.NORMAL and stage.restarts_taken == 1
+    queue.push(_gc(R.NORMAL_START, 3, 3.1))  # the start repeated: play stays normal
+    stage.on_message("clock", msg.Tick(1), lambda _t, g: states.append(g))
+    assert states[-1].command == msg.RefereeCommand.NORMAL
 
 
 @pytest.mark.parametrize("data", [b"\x08", b"garbage\xff\xff", _gc(R.HALT, 1, 1.0)[:-3]])

@@ -14,11 +14,13 @@ import pytest
 from cmdragons import messages as msg
 from cmdragons.cli import main
 from cmdragons.runtime.log import read_log
+from cmdragons.runtime.proto import ssl_wrapper_pb2 as wrap_pb
 from cmdragons.runtime.settings import load_settings
+from cmdragons.runtime.ssl.clock import UnixEpoch
 from cmdragons.runtime.ssl.logfile import LogRecord, MessageType, write_log
 from cmdragons.runtime.ssl.referee import referee_packet
 from cmdragons.runtime.ssl.replay import replay_league_log
-from cmdragons.runtime.ssl.vision import detection_packet
+from cmdragons.runtime.ssl.vision import decode_wrapper, detection_packet, geometry_packet, settings_on_geometry
 from cmdragons.runtime.stages import Tap
 
 
@@ -78,20 +80,22 @@ def test_a_league_replay_refuses_the_zenoh_options_in_one_line(
 
 @pytest.mark.slow
 def test_a_real_matchs_log_is_tracked_to_its_truth(tmp_path: Path) -> None:
-    t0 = 1_700_000_000.0  # Unix time, as SSL-Vision stamps its frames
+    t0 = UnixEpoch(1_700_000_000)  # Unix time, as SSL-Vision and the game controller stamp their packets
     counters = {0: 1000, 1: 52000, 2: 7, 3: 999_999}  # each camera counts its own frames
     records = []
     for k in range(240):  # 4 s: a blue robot crossing at 0.5 m/s, seen by four cameras in turn
         for cam in range(4):
             counters[cam] += 1
-            t = t0 + k / 60 + cam * 0.002
-            robot = msg.RobotDetection("blue", 2, -1.0 + 0.5 * (t - t0), 0.3, 0.0, 0.9, (0.0, 0.0))
+            t = 0.2 + k / 60 + cam * 0.002
+            robot = msg.RobotDetection("blue", 2, -1.0 + 0.5 * t, 0.3, 0.0, 0.9, (0.0, 0.0))
             det = msg.DetectionFrame(cam, counters[cam], t, t + 0.004, (msg.BallDetection(1.0, 0.0, 0.9, (0.0, 0.0)),),
                                      (robot,))  # fmt: skip
-            records.append(LogRecord(round((t + 0.005) * 1e9), MessageType.VISION_2014, detection_packet(det)))
+            packet = wrap_pb.SSL_WrapperPacket.FromString(detection_packet(det, t0))
+            packet.detection.ClearField("t_capture_camera")  # SSL-Vision's cameras have clocks of their own
+            records.append(LogRecord(t0.to_unix_ns(t + 0.005), MessageType.VISION_2014, packet.SerializeToString()))
         if k % 6 == 0:
-            game = referee_packet(msg.GameState(t0 + k / 60, "stop"))
-            records.append(LogRecord(round((t0 + k / 60) * 1e9), MessageType.REFBOX_2013, game))
+            game = referee_packet(msg.GameState(0.2 + k / 60, "stop"), epoch=t0)
+            records.append(LogRecord(t0.to_unix_ns(0.2 + k / 60), MessageType.REFBOX_2013, game))
     write_log(tmp_path / "real.log", records)
     worlds: list[msg.WorldState] = []
     games: list[msg.GameState] = []
@@ -103,8 +107,10 @@ def test_a_real_matchs_log_is_tracked_to_its_truth(tmp_path: Path) -> None:
     assert len(games) == 40 and all(g.command == msg.RefereeCommand.STOP for g in games)
     w = worlds[-1]
     r = next(r for r in w.robots if r.team == "blue" and r.id == 2)
-    # the truth at the world state's time (the tracker predicts ahead by its latency): 5 mm, 0.01 m/s
-    assert (r.x, r.y) == pytest.approx((-1.0 + 0.5 * (w.t - t0), 0.3), abs=0.005)
+    # the truth at the world state's time (the tracker predicts ahead by its latency): 5 mm, 0.01 m/s;
+    # the log's times are match time from its first second
+    assert (r.x, r.y) == pytest.approx((-1.0 + 0.5 * w.t, 0.3), abs=0.005) and 3.5 < w.t < 4.5
+    assert games[0].t == pytest.approx(0.2, abs=1e-6)
     assert (r.vx, r.vy) == pytest.approx((0.5, 0.0), abs=0.01)
 
 
@@ -131,3 +137,31 @@ def test_a_league_replay_is_a_table_of_declared_stages_checked_when_built(tmp_pa
     with pytest.raises(WiringError, match=r"'viewer' reads topic 'world/yellow'"):
         replay_league_log(tmp_path / "one.log", settings, extra=(Viewer(),))
     assert replay_league_log(tmp_path / "one.log", settings).records == {"VISION_2014": 1}
+
+
+def test_a_replay_plays_on_the_logs_geometry(tmp_path: Path) -> None:
+    """A league log whose geometry packets say 12 x 9 m (Division A) replays on that field though
+    our config is Division B (9 x 6 m); a log without geometry plays on the config's field."""
+    division_a = load_settings(None, ["field.division=A"])
+    epoch = UnixEpoch(1_764_000_000)
+    geometry = geometry_packet(division_a.field_geometry(), division_a.camera_models())
+    records = [LogRecord(epoch.to_unix_ns(0.0), MessageType.VISION_2014, geometry)]
+    for k in range(30):  # a robot standing at x = 5.5 m: inside the 12 m field, past the 9 m field's boundary
+        det = msg.DetectionFrame(0, k, k / 60, k / 60, (), (msg.RobotDetection("blue", 1, 5.5, 0.0, 0.0, 0.9,
+                                                                                (0.0, 0.0)),))  # fmt: skip
+        records.append(LogRecord(epoch.to_unix_ns(k / 60), MessageType.VISION_2014, detection_packet(det, epoch)))
+    write_log(tmp_path / "a.log", records)
+    write_log(tmp_path / "none.log", records[1:])
+    worlds: list[msg.WorldState] = []
+    config = load_settings()
+    assert (config.field.dims.length_m, config.field.dims.width_m) == (9.0, 6.0)
+    result = replay_league_log(tmp_path / "a.log", config, extra=(Tap("w", ("world/blue",), lambda _t, w:
+                                                                       worlds.append(w)),))  # fmt: skip
+    assert (result.field_m, result.field_from) == ((12.0, 9.0), "log")
+    assert worlds and worlds[-1].robots[0].x == pytest.approx(5.5, abs=0.01)
+    plain = replay_league_log(tmp_path / "none.log", config)
+    assert (plain.field_m, plain.field_from) == ((9.0, 6.0), "config")
+    dims = settings_on_geometry(config, decode_wrapper(geometry)[1]).field.dims  # type: ignore[arg-type]
+    a = division_a.field.dims
+    assert (dims.length_m, dims.width_m, dims.goal_width_m, dims.defense_width_m, dims.defense_depth_m) == \
+        (a.length_m, a.width_m, a.goal_width_m, a.defense_width_m, a.defense_depth_m)  # fmt: skip

@@ -5,6 +5,7 @@ one (the wire loses nothing that matters). Every socket is pinned to 127.0.0.1 w
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import math
 import shutil
@@ -25,6 +26,8 @@ from cmdragons.runtime.proto.generate import PROTO_DIR, ROOT
 from cmdragons.runtime.settings import load_settings
 from cmdragons.runtime.ssl.params import ProtocolParams
 from cmdragons.runtime.ssl.stages import VisionInStage, close_sockets
+from cmdragons.runtime.proto.ssl_wrapper_pb2 import SSL_WrapperPacket
+from cmdragons.runtime.ssl.clock import UnixEpoch
 from cmdragons.runtime.ssl.udp import MulticastReceiver, MulticastSender
 from cmdragons.runtime.ssl.vision import decode_wrapper, detection_packet, geometry_packet
 from cmdragons.runtime.stages import Tap
@@ -35,6 +38,15 @@ DET = msg.DetectionFrame(
     (msg.RobotDetection("blue", 3, 1.0, 2.0, 0.5, 0.99, (10.0, 20.0)),
      msg.RobotDetection("yellow", 15, -1.0, -2.0, -3.0, 0.5, (30.0, 40.0))),
 )  # fmt: skip
+
+
+EPOCH = UnixEpoch(1_764_000_000)  # a Unix time of 2025, in whole seconds
+
+
+def _same(a: msg.DetectionFrame, b: msg.DetectionFrame) -> bool:
+    """The same detections, times to the microsecond (they crossed the wire as Unix time)."""
+    return dataclasses.replace(a, t_capture=b.t_capture, t_sent=b.t_sent) == b and \
+        abs(a.t_capture - b.t_capture) < 1e-6 and abs(a.t_sent - b.t_sent) < 1e-6  # fmt: skip
 
 
 def _params(port: int, **extra: Any) -> ProtocolParams:
@@ -76,14 +88,21 @@ def test_detections_and_geometry_cross_loopback_unchanged(udp_port: int) -> None
     try:
         cams = settings.camera_models()
         tx.send(geometry_packet(settings.field_geometry(), cams))
-        tx.send(detection_packet(DET))
+        tx.send(detection_packet(DET, EPOCH))
         geo_data, det_data = rx.receive(2.0), rx.receive(2.0)
     finally:
         tx.close()
         rx.close()
     assert geo_data is not None and det_data is not None
-    det, none = decode_wrapper(det_data)
-    assert none is None and det == wire.canonical(DET)  # what the in-process bus delivers, to the bit
+    det, none = decode_wrapper(det_data, EPOCH, camera_clock=True)  # our own packet: the camera clock's time
+    assert none is None and det == dataclasses.replace(wire.canonical(DET), t_sent=det.t_sent)  # to the bit
+    assert det.t_sent == pytest.approx(DET.t_sent, abs=1e-6)  # through Unix time: to the microsecond
+    sent = SSL_WrapperPacket.FromString(det_data).detection  # Unix time on the wire, the match's in the camera's
+    assert (sent.t_capture, sent.t_sent, sent.t_capture_camera) == (EPOCH.epoch_s + 0.7, EPOCH.epoch_s + 0.702, 0.7)
+    # SSL-Vision counts pixels from the centre of the top-left pixel, we from its corner
+    assert (sent.balls[0].pixel_x, sent.balls[0].pixel_y, sent.robots_blue[0].pixel_x) == (100.0, 199.75, 9.5)
+    other, _ = decode_wrapper(det_data, EPOCH)  # anyone's packet: Unix time less the epoch
+    assert (other.t_capture, other.t_sent) == pytest.approx((0.7, 0.702), abs=1e-6)
     assert det.robots[1].x == pytest.approx(-1.0, abs=1e-6) and det.balls[0].sigma_m == pytest.approx(0.004)
     _, geo = decode_wrapper(geo_data)
     assert geo is not None
@@ -138,11 +157,11 @@ def test_bad_packets_are_counted_and_dropped_with_a_line(udp_port: int) -> None:
     finally:
         close_sockets([rx])
         tx.close()
-    assert [t for t, _ in got] == ["ssl/vision/1"] and got[0][1] == wire.canonical(DET)
-    assert rx.drops.counts == {"undecodable": 2, "unknown camera": 1, "duplicate": 2}
+    # camera 7 is not in the config: taken all the same (a field of eight cameras, grSim's four)
+    assert [t for t, _ in got] == ["ssl/vision/7", "ssl/vision/1"] and _same(got[1][1], wire.canonical(DET))
+    assert rx.drops.counts == {"undecodable": 2, "duplicate": 2} and rx.cameras_seen == {1, 7}
     lines = err.getvalue().splitlines()
-    assert len(lines) == 5 and "camera 7 is not in the config (0, 1)" in lines[2]
-    assert "duplicate: camera 1 frame 42 after frame 42" in lines[3]
+    assert len(lines) == 4 and "duplicate: camera 1 frame 42 after frame 42" in lines[2]
 
 
 def _worlds(settings_overrides: list[str], seconds: float) -> tuple[list[msg.WorldState], dict[str, Any]]:

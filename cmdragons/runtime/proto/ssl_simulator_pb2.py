@@ -26,15 +26,15 @@ from cmdragons.runtime.proto import ssl_tracked_pb2 as cmdragons_dot_runtime_dot
 from cmdragons.runtime.proto import ssl_geometry_pb2 as cmdragons_dot_runtime_dot_proto_dot_ssl__geometry__pb2
 
 
-DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n+cmdragons/runtime/proto/ssl_simulator.proto\x12\x10\x63mdragons.league\x1a)cmdragons/runtime/proto/ssl_tracked.proto\x1a*cmdragons/runtime/proto/ssl_geometry.proto\"\xa1\x01\n\x0cTeleportBall\x12\t\n\x01x\x18\x01 \x01(\x02\x12\t\n\x01y\x18\x02 \x01(\x02\x12\t\n\x01z\x18\x03 \x01(\x02\x12\n\n\x02vx\x18\x04 \x01(\x02\x12\n\n\x02vy\x18\x05 \x01(\x02\x12\n\n\x02vz\x18\x06 \x01(\x02\x12\x1e\n\x0fteleport_safely\x18\x07 \x01(\x08:\x05\x66\x61lse\x12\x13\n\x04roll\x18\x08 \x01(\x08:\x05\x66\x61lse\x12\x17\n\x08\x62y_force\x18\t \x01(\x08:\x05\x66\x61lse\"\xb8\x01\n\rTeleportRobot\x12%\n\x02id\x18\x01 \x02(\x0b\x32\x19.cmdragons.league.RobotId\x12\t\n\x01x\x18\x02 \x01(\x02\x12\t\n\x01y\x18\x03 \x01(\x02\x12\x13\n\x0borientation\x18\x04 \x01(\x02\x12\x0b\n\x03v_x\x18\x05 \x01(\x02\x12\x0b\n\x03v_y\x18\x06 \x01(\x02\x12\x11\n\tv_angular\x18\x07 \x01(\x02\x12\x0f\n\x07present\x18\x08 \x01(\x08\x12\x17\n\x08\x62y_force\x18\t \x01(\x08:\x05\x66\x61lse\"\x9c\x01\n\x10SimulatorControl\x12\x35\n\rteleport_ball\x18\x01 \x01(\x0b\x32\x1e.cmdragons.league.TeleportBall\x12\x37\n\x0eteleport_robot\x18\x02 \x03(\x0b\x32\x1f.cmdragons.league.TeleportRobot\x12\x18\n\x10simulation_speed\x18\x03 \x01(\x02\"\\\n\x0fSimulatorConfig\x12\x34\n\x08geometry\x18\x01 \x01(\x0b\x32\".cmdragons.league.SSL_GeometryData\x12\x13\n\x0bvision_port\x18\x04 \x01(\r\"z\n\x10SimulatorCommand\x12\x33\n\x07\x63ontrol\x18\x01 \x01(\x0b\x32\".cmdragons.league.SimulatorControl\x12\x31\n\x06\x63onfig\x18\x02 \x01(\x0b\x32!.cmdragons.league.SimulatorConfig\"v\n\x0eSimulatorError\x12\x0c\n\x04\x63ode\x18\x01 \x01(\t\x12\x45\n\x16unsupported_capability\x18\x02 \x01(\x0e\x32%.cmdragons.league.SimulatorCapability\x12\x0f\n\x07message\x18\x03 \x01(\t\"E\n\x11SimulatorResponse\x12\x30\n\x06\x65rrors\x18\x01 \x03(\x0b\x32 .cmdragons.league.SimulatorError\"U\n\rRobotFeedback\x12%\n\x02id\x18\x01 \x02(\x0b\x32\x19.cmdragons.league.RobotId\x12\x1d\n\x15\x64ribbler_ball_contact\x18\x02 \x01(\x08\"{\n\x14RobotControlResponse\x12\x30\n\x06\x65rrors\x18\x01 \x03(\x0b\x32 .cmdragons.league.SimulatorError\x12\x31\n\x08\x66\x65\x65\x64\x62\x61\x63k\x18\x02 \x03(\x0b\x32\x1f.cmdragons.league.RobotFeedback*\xc2\x01\n\x13SimulatorCapability\x12 \n\x1cSIMULATOR_CAPABILITY_UNKNOWN\x10\x01\x12,\n(SIMULATOR_CAPABILITY_MOVE_WHEEL_VELOCITY\x10\x02\x12,\n(SIMULATOR_CAPABILITY_MOVE_LOCAL_VELOCITY\x10\x03\x12-\n)SIMULATOR_CAPABILITY_MOVE_GLOBAL_VELOCITY\x10\x04')
+DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n+cmdragons/runtime/proto/ssl_simulator.proto\x12\x10\x63mdragons.league\x1a)cmdragons/runtime/proto/ssl_tracked.proto\x1a*cmdragons/runtime/proto/ssl_geometry.proto\"\xa1\x01\n\x0cTeleportBall\x12\t\n\x01x\x18\x01 \x01(\x02\x12\t\n\x01y\x18\x02 \x01(\x02\x12\t\n\x01z\x18\x03 \x01(\x02\x12\n\n\x02vx\x18\x04 \x01(\x02\x12\n\n\x02vy\x18\x05 \x01(\x02\x12\n\n\x02vz\x18\x06 \x01(\x02\x12\x1e\n\x0fteleport_safely\x18\x07 \x01(\x08:\x05\x66\x61lse\x12\x13\n\x04roll\x18\x08 \x01(\x08:\x05\x66\x61lse\x12\x17\n\x08\x62y_force\x18\t \x01(\x08:\x05\x66\x61lse\"\xb8\x01\n\rTeleportRobot\x12%\n\x02id\x18\x01 \x02(\x0b\x32\x19.cmdragons.league.RobotId\x12\t\n\x01x\x18\x02 \x01(\x02\x12\t\n\x01y\x18\x03 \x01(\x02\x12\x13\n\x0borientation\x18\x04 \x01(\x02\x12\x0b\n\x03v_x\x18\x05 \x01(\x02\x12\x0b\n\x03v_y\x18\x06 \x01(\x02\x12\x11\n\tv_angular\x18\x07 \x01(\x02\x12\x0f\n\x07present\x18\x08 \x01(\x08\x12\x17\n\x08\x62y_force\x18\t \x01(\x08:\x05\x66\x61lse\"\x9c\x01\n\x10SimulatorControl\x12\x35\n\rteleport_ball\x18\x01 \x01(\x0b\x32\x1e.cmdragons.league.TeleportBall\x12\x37\n\x0eteleport_robot\x18\x02 \x03(\x0b\x32\x1f.cmdragons.league.TeleportRobot\x12\x18\n\x10simulation_speed\x18\x03 \x01(\x02\"\\\n\x0fSimulatorConfig\x12\x34\n\x08geometry\x18\x01 \x01(\x0b\x32\".cmdragons.league.SSL_GeometryData\x12\x13\n\x0bvision_port\x18\x04 \x01(\r\"z\n\x10SimulatorCommand\x12\x33\n\x07\x63ontrol\x18\x01 \x01(\x0b\x32\".cmdragons.league.SimulatorControl\x12\x31\n\x06\x63onfig\x18\x02 \x01(\x0b\x32!.cmdragons.league.SimulatorConfig\"/\n\x0eSimulatorError\x12\x0c\n\x04\x63ode\x18\x01 \x01(\t\x12\x0f\n\x07message\x18\x02 \x01(\t\"E\n\x11SimulatorResponse\x12\x30\n\x06\x65rrors\x18\x01 \x03(\x0b\x32 .cmdragons.league.SimulatorError\":\n\rRobotFeedback\x12\n\n\x02id\x18\x01 \x02(\r\x12\x1d\n\x15\x64ribbler_ball_contact\x18\x02 \x01(\x08\"{\n\x14RobotControlResponse\x12\x30\n\x06\x65rrors\x18\x01 \x03(\x0b\x32 .cmdragons.league.SimulatorError\x12\x31\n\x08\x66\x65\x65\x64\x62\x61\x63k\x18\x02 \x03(\x0b\x32\x1f.cmdragons.league.RobotFeedback\"}\n\x15\x45\x61rlierSimulatorError\x12\x0c\n\x04\x63ode\x18\x01 \x01(\t\x12\x45\n\x16unsupported_capability\x18\x02 \x01(\x0e\x32%.cmdragons.league.SimulatorCapability\x12\x0f\n\x07message\x18\x03 \x01(\t\"\\\n\x14\x45\x61rlierRobotFeedback\x12%\n\x02id\x18\x01 \x02(\x0b\x32\x19.cmdragons.league.RobotId\x12\x1d\n\x15\x64ribbler_ball_contact\x18\x02 \x01(\x08*\xc2\x01\n\x13SimulatorCapability\x12 \n\x1cSIMULATOR_CAPABILITY_UNKNOWN\x10\x01\x12,\n(SIMULATOR_CAPABILITY_MOVE_WHEEL_VELOCITY\x10\x02\x12,\n(SIMULATOR_CAPABILITY_MOVE_LOCAL_VELOCITY\x10\x03\x12-\n)SIMULATOR_CAPABILITY_MOVE_GLOBAL_VELOCITY\x10\x04')
 
 _globals = globals()
 _builder.BuildMessageAndEnumDescriptors(DESCRIPTOR, _globals)
 _builder.BuildTopDescriptorsAndMessages(DESCRIPTOR, 'cmdragons.runtime.proto.ssl_simulator_pb2', _globals)
 if not _descriptor._USE_C_DESCRIPTORS:
   DESCRIPTOR._loaded_options = None
-  _globals['_SIMULATORCAPABILITY']._serialized_start=1284
-  _globals['_SIMULATORCAPABILITY']._serialized_end=1478
+  _globals['_SIMULATORCAPABILITY']._serialized_start=1407
+  _globals['_SIMULATORCAPABILITY']._serialized_end=1601
   _globals['_TELEPORTBALL']._serialized_start=153
   _globals['_TELEPORTBALL']._serialized_end=314
   _globals['_TELEPORTROBOT']._serialized_start=317
@@ -46,11 +46,15 @@ if not _descriptor._USE_C_DESCRIPTORS:
   _globals['_SIMULATORCOMMAND']._serialized_start=756
   _globals['_SIMULATORCOMMAND']._serialized_end=878
   _globals['_SIMULATORERROR']._serialized_start=880
-  _globals['_SIMULATORERROR']._serialized_end=998
-  _globals['_SIMULATORRESPONSE']._serialized_start=1000
-  _globals['_SIMULATORRESPONSE']._serialized_end=1069
-  _globals['_ROBOTFEEDBACK']._serialized_start=1071
-  _globals['_ROBOTFEEDBACK']._serialized_end=1156
-  _globals['_ROBOTCONTROLRESPONSE']._serialized_start=1158
-  _globals['_ROBOTCONTROLRESPONSE']._serialized_end=1281
+  _globals['_SIMULATORERROR']._serialized_end=927
+  _globals['_SIMULATORRESPONSE']._serialized_start=929
+  _globals['_SIMULATORRESPONSE']._serialized_end=998
+  _globals['_ROBOTFEEDBACK']._serialized_start=1000
+  _globals['_ROBOTFEEDBACK']._serialized_end=1058
+  _globals['_ROBOTCONTROLRESPONSE']._serialized_start=1060
+  _globals['_ROBOTCONTROLRESPONSE']._serialized_end=1183
+  _globals['_EARLIERSIMULATORERROR']._serialized_start=1185
+  _globals['_EARLIERSIMULATORERROR']._serialized_end=1310
+  _globals['_EARLIERROBOTFEEDBACK']._serialized_start=1312
+  _globals['_EARLIERROBOTFEEDBACK']._serialized_end=1404
 # @@protoc_insertion_point(module_scope)

@@ -91,14 +91,12 @@ class SimulatorCommand(_message.Message):
     def __init__(self, control: _Optional[_Union[SimulatorControl, _Mapping]] = ..., config: _Optional[_Union[SimulatorConfig, _Mapping]] = ...) -> None: ...
 
 class SimulatorError(_message.Message):
-    __slots__ = ("code", "unsupported_capability", "message")
+    __slots__ = ("code", "message")
     CODE_FIELD_NUMBER: _ClassVar[int]
-    UNSUPPORTED_CAPABILITY_FIELD_NUMBER: _ClassVar[int]
     MESSAGE_FIELD_NUMBER: _ClassVar[int]
     code: str
-    unsupported_capability: SimulatorCapability
     message: str
-    def __init__(self, code: _Optional[str] = ..., unsupported_capability: _Optional[_Union[SimulatorCapability, str]] = ..., message: _Optional[str] = ...) -> None: ...
+    def __init__(self, code: _Optional[str] = ..., message: _Optional[str] = ...) -> None: ...
 
 class SimulatorResponse(_message.Message):
     __slots__ = ("errors",)
@@ -110,9 +108,9 @@ class RobotFeedback(_message.Message):
     __slots__ = ("id", "dribbler_ball_contact")
     ID_FIELD_NUMBER: _ClassVar[int]
     DRIBBLER_BALL_CONTACT_FIELD_NUMBER: _ClassVar[int]
-    id: _ssl_tracked_pb2.RobotId
+    id: int
     dribbler_ball_contact: bool
-    def __init__(self, id: _Optional[_Union[_ssl_tracked_pb2.RobotId, _Mapping]] = ..., dribbler_ball_contact: _Optional[bool] = ...) -> None: ...
+    def __init__(self, id: _Optional[int] = ..., dribbler_ball_contact: _Optional[bool] = ...) -> None: ...
 
 class RobotControlResponse(_message.Message):
     __slots__ = ("errors", "feedback")
@@ -121,3 +119,21 @@ class RobotControlResponse(_message.Message):
     errors: _containers.RepeatedCompositeFieldContainer[SimulatorError]
     feedback: _containers.RepeatedCompositeFieldContainer[RobotFeedback]
     def __init__(self, errors: _Optional[_Iterable[_Union[SimulatorError, _Mapping]]] = ..., feedback: _Optional[_Iterable[_Union[RobotFeedback, _Mapping]]] = ...) -> None: ...
+
+class EarlierSimulatorError(_message.Message):
+    __slots__ = ("code", "unsupported_capability", "message")
+    CODE_FIELD_NUMBER: _ClassVar[int]
+    UNSUPPORTED_CAPABILITY_FIELD_NUMBER: _ClassVar[int]
+    MESSAGE_FIELD_NUMBER: _ClassVar[int]
+    code: str
+    unsupported_capability: SimulatorCapability
+    message: str
+    def __init__(self, code: _Optional[str] = ..., unsupported_capability: _Optional[_Union[SimulatorCapability, str]] = ..., message: _Optional[str] = ...) -> None: ...
+
+class EarlierRobotFeedback(_message.Message):
+    __slots__ = ("id", "dribbler_ball_contact")
+    ID_FIELD_NUMBER: _ClassVar[int]
+    DRIBBLER_BALL_CONTACT_FIELD_NUMBER: _ClassVar[int]
+    id: _ssl_tracked_pb2.RobotId
+    dribbler_ball_contact: bool
+    def __init__(self, id: _Optional[_Union[_ssl_tracked_pb2.RobotId, _Mapping]] = ..., dribbler_ball_contact: _Optional[bool] = ...) -> None: ...

@@ -13,18 +13,22 @@ A chip is our robots' own chip elevation (``sim.kicker.chip_angle_rad``).
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
+
+from google.protobuf.message import DecodeError
 
 from cmdragons.geometry import Team
-from cmdragons.messages import RobotCommand, TeamCommands, Teleport
+from cmdragons.messages import MessageError, RobotCommand, TeamCommands, Teleport
 from cmdragons.runtime import wire
 from cmdragons.runtime.proto import grsim_pb2 as grsim_pb
 from cmdragons.runtime.proto import ssl_simulation_control_pb2 as ctl_pb
 from cmdragons.runtime.proto import ssl_simulator_pb2 as sim_pb
 from cmdragons.runtime.proto import ssl_tracked_pb2 as trk_pb
 
-__all__ = ["ReadCommands", "grsim_packet", "local_velocity", "read_robot_control", "read_simulator_command",
+__all__ = ["UNSUPPORTED", "ControlAnswer", "Feedback", "ReadCommands", "SimError", "grsim_packet", "local_velocity",
+           "read_robot_control", "read_robot_control_response", "read_simulator_command", "read_simulator_response",
            "robot_control_packet", "robot_control_response", "simulator_command_packet", "simulator_response",
            "to_field"]  # fmt: skip
 
@@ -116,15 +120,101 @@ def read_robot_control(data: bytes, team: Team, headings: Mapping[int, float],
     return ReadCommands(tuple(out), tuple(errors))
 
 
-def robot_control_response(team: Team, ids: list[int], errors: list[str]) -> bytes:
-    """The ``RobotControlResponse`` a simulator answers a ``RobotControl`` with."""
+@dataclass(frozen=True)
+class Feedback:
+    """One robot's feedback in a ``RobotControlResponse``: its id (the team is the port's) and
+    whether its dribbler touches the ball (None: the simulator did not say)."""
+
+    id: int
+    ball_contact: bool | None = None
+
+
+@dataclass(frozen=True)
+class SimError:
+    """One ``SimulatorError``: the simulator's code for it and a text for a person."""
+
+    code: str
+    message: str
+
+
+@dataclass(frozen=True)
+class ControlAnswer:
+    """What a ``RobotControlResponse`` said. ``earlier_layout``: some entry came in the layout
+    before 2021-01-27 (a RobotId as the feedback's id, the error's text in field 3); ``unnamed``:
+    feedback entries that named no robot in either layout (left out)."""
+
+    feedback: tuple[Feedback, ...]
+    errors: tuple[SimError, ...]
+    earlier_layout: bool = False
+    unnamed: int = 0
+
+
+UNSUPPORTED = "UNSUPPORTED"  # our code for a request this simulator does not carry out
+
+
+def robot_control_response(feedback: Sequence[Feedback], errors: Sequence[SimError] = ()) -> bytes:
+    """The ``RobotControlResponse`` a simulator answers a ``RobotControl`` with, in the league's
+    current layout: each robot's ``RobotFeedback`` by its plain id, each error's text in field 2."""
     m = sim_pb.RobotControlResponse()
     for e in errors:
-        m.errors.add(code="unsupported", unsupported_capability=sim_pb.SIMULATOR_CAPABILITY_MOVE_WHEEL_VELOCITY,
-                     message=e)  # fmt: skip
-    for i in ids:
-        m.feedback.add().id.CopyFrom(trk_pb.RobotId(id=i, team=_TEAM_PB[team]))
+        m.errors.add(code=e.code, message=e.message)
+    for f in feedback:
+        r = m.feedback.add(id=f.id)
+        if f.ball_contact is not None:
+            r.dribbler_ball_contact = f.ball_contact
     return m.SerializeToString(deterministic=True)  # type: ignore[no-any-return]
+
+
+def _parse_partial(proto_type: Any, data: bytes) -> Any:
+    """``data`` as a ``proto_type`` with its required fields not checked (an entry of the other
+    layout lacks them: its fields of the other wire type are kept aside as unknown ones)."""
+    m = proto_type()
+    try:
+        m.ParseFromString(data)
+    except DecodeError as exc:
+        raise MessageError(f"not a {proto_type.DESCRIPTOR.name}: {exc}") from None
+    return m
+
+
+def _error_of(e: Any) -> tuple[SimError, bool]:
+    """A ``SimulatorError`` of either layout, and whether it was the earlier one."""
+    if e.HasField("message"):
+        return SimError(e.code, e.message), False
+    earlier = _parse_partial(sim_pb.EarlierSimulatorError, e.SerializePartialToString())
+    if not (earlier.HasField("message") or earlier.HasField("unsupported_capability")):
+        return SimError(e.code, ""), False
+    text = earlier.message
+    if earlier.HasField("unsupported_capability"):
+        capability = sim_pb.SimulatorCapability.Name(earlier.unsupported_capability)
+        text = f"{text} ({capability})" if text else capability
+    return SimError(earlier.code, text), True
+
+
+def read_robot_control_response(data: bytes) -> ControlAnswer:
+    """A ``RobotControlResponse``'s bytes in the league's current layout or the earlier one (both
+    read, entry by entry: a field of the other wire type tells them apart); :class:`MessageError`
+    for bytes that are not one."""
+    m = _parse_partial(sim_pb.RobotControlResponse, data)
+    feedback: list[Feedback] = []
+    errors: list[SimError] = []
+    earlier = False
+    unnamed = 0
+    for f in m.feedback:
+        contact = f.dribbler_ball_contact if f.HasField("dribbler_ball_contact") else None
+        if f.HasField("id"):
+            feedback.append(Feedback(f.id, contact))
+            continue
+        old = _parse_partial(sim_pb.EarlierRobotFeedback, f.SerializePartialToString())
+        if old.HasField("id") and old.id.HasField("id"):
+            feedback.append(Feedback(old.id.id, contact))
+            earlier = True
+        else:
+            unnamed += 1
+    for e in m.errors:
+        err, was_earlier = _error_of(e)
+        errors.append(err)
+        earlier = earlier or was_earlier
+    return ControlAnswer(tuple(feedback), tuple(errors), earlier, unnamed)
 
 
 def simulator_command_packet(tp: Teleport) -> bytes:
@@ -179,9 +269,14 @@ def read_simulator_command(data: bytes, t: float, where: Mapping[tuple[Team, int
     return Teleport(t, tuple(robots), ball_at), unsupported
 
 
-def simulator_response(errors: list[str]) -> bytes:
-    """The ``SimulatorResponse`` a simulator answers a ``SimulatorCommand`` with."""
+def simulator_response(errors: Sequence[SimError]) -> bytes:
+    """The ``SimulatorResponse`` a simulator answers a ``SimulatorCommand`` with (current layout)."""
     m = sim_pb.SimulatorResponse()
     for e in errors:
-        m.errors.add(code="unsupported", message=e)
+        m.errors.add(code=e.code, message=e.message)
     return m.SerializeToString(deterministic=True)  # type: ignore[no-any-return]
+
+
+def read_simulator_response(data: bytes) -> tuple[SimError, ...]:
+    """A ``SimulatorResponse``'s errors, in either layout (as :func:`read_robot_control_response`)."""
+    return tuple(_error_of(e)[0] for e in _parse_partial(sim_pb.SimulatorResponse, data).errors)

@@ -1,7 +1,8 @@
 """The game controller's Referee message <-> our :class:`GameState`: the one place that maps them.
 
-Times go as microseconds (the packet's and the command's since the epoch: our clock's seconds
-there), the designated position as millimetres. Our commands name the team apart; the league's
+Times go as microseconds: the packet's and the command's in Unix time, as the game controller sends
+them (our match time and a :class:`~cmdragons.runtime.ssl.clock.UnixEpoch`), durations as they
+are; the designated position as millimetres. Our commands name the team apart; the league's
 carry it (``DIRECT_FREE_BLUE``). A kickoff or penalty whose normal start is given is
 ``NORMAL_START`` after its ``PREPARE_...``: our referee adds which restart it starts (field 101) and
 whether it judges the ball in play already (field 100); from a game controller, which sends neither,
@@ -20,6 +21,7 @@ from google.protobuf.message import DecodeError
 from cmdragons.geometry import Team
 from cmdragons.messages import GameStage, GameState, MessageError, RefereeCommand, TeamInfo
 from cmdragons.runtime.proto import ssl_referee_pb2 as ref_pb
+from cmdragons.runtime.ssl.clock import UnixEpoch, run_epoch
 
 __all__ = ["RefereeReader", "referee_packet", "referee_proto"]
 
@@ -81,13 +83,16 @@ def _team_from(m: Any) -> TeamInfo:
                     m.max_allowed_bots if m.HasField("max_allowed_bots") else d.max_robots)  # fmt: skip
 
 
-def referee_proto(g: GameState, source: str = "cmdragons", names: tuple[str, str] = ("blue", "yellow")) -> Any:
-    """The league's Referee message of our game state (``names``: the blue and yellow teams')."""
+def referee_proto(g: GameState, source: str = "cmdragons", names: tuple[str, str] = ("blue", "yellow"),
+                  epoch: UnixEpoch | None = None) -> Any:  # fmt: skip
+    """The league's Referee message of our game state (``names``: the blue and yellow teams'), its
+    times in Unix time (``epoch``, by default the run's)."""
+    e = run_epoch() if epoch is None else epoch
     ready_start = g.command in _PREPARED and g.ready
     code = R.NORMAL_START if ready_start else _command_code(g.command, g.for_team)
-    m = R(packet_timestamp=_us(g.t), stage=_STAGE_TO[g.stage], command=code, command_counter=g.command_counter,
-          command_timestamp=_us(g.command_t), blue_team_on_positive_half=not g.blue_defends_negative_x,
-          source_identifier=source)  # fmt: skip
+    m = R(packet_timestamp=e.to_unix_us(g.t), stage=_STAGE_TO[g.stage], command=code,
+          command_counter=g.command_counter, command_timestamp=e.to_unix_us(g.command_t),
+          blue_team_on_positive_half=not g.blue_defends_negative_x, source_identifier=source)  # fmt: skip
     _team_to(g.blue_team, g.score_blue, names[0], m.blue)
     _team_to(g.yellow_team, g.score_yellow, names[1], m.yellow)
     if math.isfinite(g.stage_time_left_s):
@@ -105,16 +110,20 @@ def referee_proto(g: GameState, source: str = "cmdragons", names: tuple[str, str
     return m
 
 
-def referee_packet(g: GameState, source: str = "cmdragons", names: tuple[str, str] = ("blue", "yellow")) -> bytes:
+def referee_packet(g: GameState, source: str = "cmdragons", names: tuple[str, str] = ("blue", "yellow"),
+                   epoch: UnixEpoch | None = None) -> bytes:  # fmt: skip
     """:func:`referee_proto`'s bytes."""
-    return referee_proto(g, source, names).SerializeToString(deterministic=True)  # type: ignore[no-any-return]
+    m = referee_proto(g, source, names, epoch)
+    return m.SerializeToString(deterministic=True)  # type: ignore[no-any-return]
 
 
 class RefereeReader:
-    """Referee messages -> game states, remembering the last prepare command (what a normal start
-    starts) and whether the ball has moved since."""
+    """Referee messages -> game states (in match time: the packets' Unix times less ``epoch``, by
+    default the run's), remembering the last prepare command (what a normal start starts) and
+    whether the ball has moved since."""
 
-    def __init__(self) -> None:
+    def __init__(self, epoch: UnixEpoch | None = None) -> None:
+        self.epoch = run_epoch() if epoch is None else epoch
         self._prepared: tuple[RefereeCommand, Team] | None = None  # kickoff or penalty and its team
         self._in_play = False
         self.last: GameState | None = None
@@ -162,10 +171,11 @@ class RefereeReader:
             nxt = _FROM_LEAGUE[m.next_command]
         p = m.designated_position
         self.last = GameState(
-            m.packet_timestamp / US, command, team, m.blue.score, m.yellow.score, not m.blue_team_on_positive_half,
+            self.epoch.from_unix_us(m.packet_timestamp), command, team, m.blue.score, m.yellow.score,
+            not m.blue_team_on_positive_half,
             (p.x / MM, p.y / MM) if m.HasField("designated_position") else None, ready, _STAGE_FROM[m.stage],
             m.stage_time_left / US if m.HasField("stage_time_left") else math.inf, m.command_counter,
-            m.command_timestamp / US,
+            self.epoch.from_unix_us(m.command_timestamp),
             m.current_action_time_remaining / US if m.HasField("current_action_time_remaining") else math.inf,
             nxt[0], nxt[1], _team_from(m.blue), _team_from(m.yellow))  # fmt: skip
         return self.last

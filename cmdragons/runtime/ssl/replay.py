@@ -7,7 +7,8 @@ same way), and each Referee packet to the same game-controller stage
 (:class:`~cmdragons.runtime.ssl.stages.RefereeInStage`, ``referee/gc``). Our tracker steps once
 every camera in the log has delivered a frame (a newer frame closes the one in progress: cameras
 with counters of their own step it one by one), and our brain plays on its world states and the
-game controller's word, as fast as they come (the log's own times stay in the messages). The
+game controller's word, as fast as they come, on the field of the log's geometry packets (the
+config's when it has none); the log's Unix times are match time from its first record's second. The
 brain's commands go nowhere but the run's log, and into the tracker (as the robots' control
 input) only for a log of our own match (``own``). Tracker packets, the 2010 vision format and
 unknown record types are counted and left out. A log cut off mid-record replays up to its last
@@ -29,10 +30,11 @@ from cmdragons.runtime.settings import Settings
 from cmdragons.runtime.ssl.logfile import LogReader, MessageType
 from cmdragons.runtime.ssl.stages import RefereeInStage, VisionInStage
 from cmdragons.runtime.ssl.udp import DatagramQueue
-from cmdragons.runtime.ssl.vision import decode_wrapper
+from cmdragons.runtime.ssl.clock import UnixEpoch
+from cmdragons.runtime.ssl.vision import VisionGeometry, decode_wrapper, settings_on_geometry
 from cmdragons.runtime.stages import SummaryCollector, TeamStage, TrackerStage
 
-__all__ = ["LeagueReplay", "camera_ids", "league_replay_wiring", "replay_league_log"]
+__all__ = ["LeagueReplay", "LogScan", "camera_ids", "league_replay_wiring", "replay_league_log", "scan_log"]
 
 
 @dataclass
@@ -46,37 +48,60 @@ class LeagueReplay:
     last_ns: int | None = None
     interrupted: bool = False
     figures: dict[str, Any] = field(default_factory=dict)
+    field_m: tuple[float, float] = (0.0, 0.0)  # the field played on: length, width
+    field_from: str = "config"  # "log": its geometry packets; "config (why)": the log's geometry refused
 
 
-def camera_ids(path: str | Path) -> list[int]:
-    """The camera ids of a league log's detection packets (undecodable packets passed over)."""
+@dataclass(frozen=True)
+class LogScan:
+    """What a league log holds before it is played: its cameras, its first geometry packet's
+    contents (None: none), and the epoch of its times (its first record's whole second)."""
+
+    cameras: list[int]
+    geometry: VisionGeometry | None
+    epoch: UnixEpoch
+
+
+def scan_log(path: str | Path) -> LogScan:
+    """One pass over a league log's SSL-Vision records (undecodable packets passed over)."""
     ids: set[int] = set()
+    geometry: VisionGeometry | None = None
+    first_ns: int | None = None
     for r in LogReader(path):
+        first_ns = r.receive_time_ns if first_ns is None else first_ns
         if r.type == MessageType.VISION_2014:
             try:
-                det, _ = decode_wrapper(r.payload)
+                det, geo = decode_wrapper(r.payload)
             except MessageError:
                 continue
             if det is not None:
                 ids.add(det.camera_id)
-    return sorted(ids)
+            if geometry is None and geo is not None:
+                geometry = geo
+    return LogScan(sorted(ids), geometry, UnixEpoch.of_first(0.0 if first_ns is None else first_ns / 1e9))
+
+
+def camera_ids(path: str | Path) -> list[int]:
+    """The camera ids of a league log's detection packets (undecodable packets passed over)."""
+    return scan_log(path).cameras
 
 
 def league_replay_wiring(settings: Settings, team: Team, cameras: Sequence[int], own: bool, vision: DatagramQueue,
-                         referee: DatagramQueue) -> list[Entry]:  # fmt: skip
+                         referee: DatagramQueue, epoch: UnixEpoch | None = None) -> list[Entry]:  # fmt: skip
     """The table of a league log's replay: the log's SSL-Vision packets (``cameras``) and Referee
     packets, fed from the queues ``vision`` and ``referee``, into the receiving stages that read
-    them from the network; ``team``'s tracker on them (taking the brain's commands for a log of
-    our own match, ``own``) and its brain on the game controller's word."""
+    them from the network (their Unix times less ``epoch``, by default the run's; a log of our own
+    match, ``own``, gives its capture times in match time exactly); ``team``'s tracker on them
+    (taking the brain's commands for ``own``) and its brain on the game controller's word."""
     p = settings.protocols
     world_topic = f"world/{team}"
     topics = [f"ssl/vision/{c}" for c in cameras]
     moved_m = settings.sim.referee.figures.ball_in_play_m
     return [
         Entry(VisionInStage.declare(p, cameras, False), "",
-              lambda: VisionInStage(p, cameras, lockstep=False, receiver=vision)),
+              lambda: VisionInStage(p, cameras, lockstep=False, receiver=vision, epoch=epoch, camera_clock=own)),
         Entry(RefereeInStage.declare(p, world_topic), "",
-              lambda: RefereeInStage(p, world_topic, moved_m, receiver=referee)),
+              lambda: RefereeInStage(p, world_topic, moved_m, receiver=referee, epoch=epoch)),
         Entry(TrackerStage.declare(team, topics, own), "",
               lambda: TrackerStage(team, _tracker(settings), topics, take_commands=own)),
         Entry(TeamStage.declare(team, "referee/gc"), "", lambda: TeamStage(team, _brain(team, settings), "referee/gc")),
@@ -90,13 +115,23 @@ def replay_league_log(path: str | Path, settings: Settings, team: Team = "blue",
     more stages on the bus (a logger). ``own``: the log is of a match our team played (with these
     settings): the tracker takes the brain's commands as the robots' control input, as it did in
     the match; else it follows the robots by their detections alone (a real match's robots did not
-    follow our brain). ``on_record(receive_time_ns, n)`` after each record."""
-    out = LeagueReplay(cameras=camera_ids(path))
+    follow our brain). The field is the log's (its first geometry packet's), else the config's.
+    ``on_record(receive_time_ns, n)`` after each record."""
+    scan = scan_log(path)
+    out = LeagueReplay(cameras=scan.cameras)
+    if scan.geometry is not None:
+        try:
+            settings = settings_on_geometry(settings, scan.geometry)
+            out.field_from = "log"
+        except MessageError as exc:
+            out.field_from = f"config ({exc})"
+    d = settings.field.dims
+    out.field_m = (d.length_m, d.width_m)
     vision_q, referee_q = DatagramQueue(), DatagramQueue()
     summaries = SummaryCollector()
     bus = Bus()
-    for stage in build(league_replay_wiring(settings, team, out.cameras, own, vision_q, referee_q),
-                       [*extra, summaries]):  # fmt: skip
+    table = league_replay_wiring(settings, team, out.cameras, own, vision_q, referee_q, scan.epoch)
+    for stage in build(table, [*extra, summaries]):
         bus.add(stage)
     bus.start()
     reader = LogReader(path)

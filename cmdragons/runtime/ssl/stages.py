@@ -12,9 +12,12 @@
 ``ssl/vision_in`` runs free (on every ``clock`` tick it publishes what came since) when the packets
 come from outside; fed by our own ``ssl/vision_out`` in the same match it runs in lock-step: on each
 ``ssl/vision/sent`` it waits (up to ``vision.wait_s``) until that frame's packet from every camera
-came, so the match plays the same as on the in-process path. Garbage, a packet cut short, a camera
-not in the config and a packet already seen are counted and dropped with a line on stderr (by every
-receiving stage: garbage and cut packets for the simulation protocol and the referee too).
+came, so the match plays the same as on the in-process path. Every camera id is taken (published
+on ``ssl/vision/<id>``, whoever reads it: grSim sends four cameras, a Division A field may have
+eight); garbage, a packet cut short and a packet already seen are counted and dropped with a line
+on stderr (by every receiving stage: garbage and cut packets for the simulation protocol and the
+referee too); robot detections without id or orientation are left out and counted. Times on the
+wire are Unix time, match time here (:mod:`cmdragons.runtime.ssl.clock`).
 """
 
 from __future__ import annotations
@@ -24,8 +27,6 @@ import time
 import uuid
 from collections.abc import Sequence
 from typing import Any, Protocol, TextIO
-
-from google.protobuf.message import DecodeError
 
 from cmdragons.geometry import Team
 from cmdragons.messages import (
@@ -41,21 +42,25 @@ from cmdragons.messages import (
     WorldState,
 )
 from cmdragons.runtime.bus import BaseStage, Publish
-from cmdragons.runtime.proto import ssl_simulator_pb2 as sim_pb
 from cmdragons.runtime.ssl.commands import (
+    UNSUPPORTED,
+    Feedback,
+    SimError,
     grsim_packet,
     read_robot_control,
+    read_robot_control_response,
     read_simulator_command,
     robot_control_packet,
     robot_control_response,
     simulator_command_packet,
     simulator_response,
 )
+from cmdragons.runtime.ssl.clock import UnixEpoch, run_epoch
 from cmdragons.runtime.ssl.params import ProtocolParams
 from cmdragons.runtime.ssl.referee import RefereeReader, referee_packet
 from cmdragons.runtime.ssl.tracker import tracker_packet
 from cmdragons.runtime.ssl.udp import DropLog, MulticastReceiver, MulticastSender, UdpEndpoint
-from cmdragons.runtime.ssl.vision import VisionGeometry, decode_wrapper, detection_packet
+from cmdragons.runtime.ssl.vision import VisionGeometry, detection_packet, read_wrapper
 from cmdragons.runtime.topics import Contract, Port, summary_port
 
 __all__ = ["CommandsOutStage", "RefereeInStage", "RefereeOutStage", "SimulationInStage", "SocketStage",
@@ -98,8 +103,9 @@ class VisionOutStage(SocketStage):
                         (Port("ssl/vision/sent", Tick), summary_port("ssl/vision_out")))
 
     def __init__(self, params: ProtocolParams, camera_ids: Sequence[int], geometry: bytes,
-                 topics: Sequence[str] | None = None) -> None:  # fmt: skip
+                 topics: Sequence[str] | None = None, epoch: UnixEpoch | None = None) -> None:  # fmt: skip
         v = params.vision
+        self.epoch = run_epoch() if epoch is None else epoch
         self.contract = self.declare(params, camera_ids, geometry, topics)
         self.camera_ids = tuple(camera_ids)
         self.sender = MulticastSender(v.group, v.port, params.interface, params.ttl)
@@ -123,7 +129,7 @@ class VisionOutStage(SocketStage):
             self.sender.send(self.geometry)
             self.geometry_packets += 1
             self._next_geometry = det.t_capture + self.interval_s
-        self.sender.send(detection_packet(det))
+        self.sender.send(detection_packet(det, self.epoch))
         self._sent.add(det.camera_id)
         if self._sent >= set(self.camera_ids):
             publish("ssl/vision/sent", Tick(det.frame_number))
@@ -145,13 +151,17 @@ class VisionInStage(SocketStage):
 
     @staticmethod
     def declare(params: ProtocolParams, camera_ids: Sequence[int], lockstep: bool) -> Contract:
+        any_camera = () if lockstep else (Port("ssl/vision/*", DetectionFrame),)  # from outside: any camera id
         return Contract("ssl/vision_in", (Port("ssl/vision/sent" if lockstep else "clock", Tick),),
-                        (*(Port(f"ssl/vision/{c}", DetectionFrame) for c in sorted(camera_ids)),
+                        (*(Port(f"ssl/vision/{c}", DetectionFrame) for c in sorted(camera_ids)), *any_camera,
                          summary_port("ssl/vision_in")))  # fmt: skip
 
     def __init__(self, params: ProtocolParams, camera_ids: Sequence[int], lockstep: bool,
-                 err: TextIO | None = None, receiver: Receiver | None = None) -> None:  # fmt: skip
+                 err: TextIO | None = None, receiver: Receiver | None = None, epoch: UnixEpoch | None = None,
+                 camera_clock: bool | None = None) -> None:  # fmt: skip
         v = params.vision
+        self.epoch = run_epoch() if epoch is None else epoch
+        self.camera_clock = lockstep if camera_clock is None else camera_clock  # our own packets: exact times
         self.receiver: Receiver = receiver if receiver is not None else MulticastReceiver(
             v.group, v.port, params.interface, params.receive_buffer_bytes, params.max_datagram_bytes)  # fmt: skip
         self.camera_ids = frozenset(camera_ids)
@@ -161,6 +171,8 @@ class VisionInStage(SocketStage):
         self.drops = DropLog(f"ssl-vision {v.group}:{v.port}", params.drop_report_interval_s, err)
         self.geometry: VisionGeometry | None = None
         self.received = self.detections = self.geometry_packets = self.late = 0
+        self.robots_left_out: dict[str, int] = {}  # robot detections without id or orientation, by reason
+        self.cameras_seen: set[int] = set()  # any camera id is taken (grSim sends four, a big field eight)
         self._last: dict[int, int] = {}  # camera -> the last frame number published
 
     def on_message(self, topic: str, message: Any, publish: Publish) -> None:
@@ -180,19 +192,19 @@ class VisionInStage(SocketStage):
     def _take(self, data: bytes, publish: Publish) -> None:
         self.received += 1
         try:
-            det, geo = decode_wrapper(data)
+            got = read_wrapper(data, self.epoch, camera_clock=self.camera_clock)
         except MessageError as exc:
             self.drops.drop("undecodable", f"{len(data)} bytes, {exc}")
             return
+        det, geo = got.detection, got.geometry
+        for why, n in got.robots_left_out.items():
+            self.robots_left_out[why] = self.robots_left_out.get(why, 0) + n
         if geo is not None:
             self.geometry = geo
             self.geometry_packets += 1
         if det is None:
             return
-        if det.camera_id not in self.camera_ids:
-            self.drops.drop("unknown camera", f"camera {det.camera_id} is not in the config "
-                            f"({', '.join(map(str, sorted(self.camera_ids)))})")  # fmt: skip
-            return
+        self.cameras_seen.add(det.camera_id)
         last = self._last.get(det.camera_id, -1)
         if det.frame_number <= last:
             self.drops.drop("duplicate", f"camera {det.camera_id} frame {det.frame_number} after frame {last}")
@@ -206,6 +218,8 @@ class VisionInStage(SocketStage):
         publish(f"summary/{self.name}", StageSummary(self.name, {
             "packets": self.received, "detections": self.detections, "geometry_packets": self.geometry_packets,
             "dropped": dict(sorted(self.drops.counts.items())), "frames_late": self.late,
+            "robots_left_out": dict(sorted(self.robots_left_out.items())),
+            "cameras_seen": sorted(self.cameras_seen),
             "field_m": None if g is None else [g.field_length_m, g.field_width_m]}))  # fmt: skip
 
     def close(self) -> None:
@@ -217,13 +231,14 @@ class RefereeOutStage(SocketStage):
 
     contract = Contract("ssl/referee_out", (Port("referee", GameState),), (summary_port("ssl/referee_out"),))
 
-    def __init__(self, params: ProtocolParams) -> None:
+    def __init__(self, params: ProtocolParams, epoch: UnixEpoch | None = None) -> None:
         r = params.referee
         self.sender = MulticastSender(r.group, r.port, params.interface, params.ttl)
         self.source = r.source_identifier
+        self.epoch = run_epoch() if epoch is None else epoch
 
     def on_message(self, topic: str, message: Any, publish: Publish) -> None:
-        self.sender.send(referee_packet(message, self.source))
+        self.sender.send(referee_packet(message, self.source, epoch=self.epoch))
 
     def summarize(self, publish: Publish) -> None:
         publish(f"summary/{self.name}", StageSummary(self.name, {"packets": self.sender.sent}))
@@ -234,26 +249,29 @@ class RefereeOutStage(SocketStage):
 
 class RefereeInStage(SocketStage):
     """A game controller's Referee packets from multicast -> ``referee/gc`` game states, on every
-    clock tick each packet that came since. On
-    ``world_topic`` it watches the ball: once a kickoff's or penalty's restart is taken (the ball
-    ``moved_m`` from the designated position), play is normal."""
+    clock tick each packet that came since. On ``world_topic`` it watches the ball: once a
+    kickoff's or penalty's restart is taken (the ball moved ``moved_m``, the rules' ball-in-play
+    distance, from its spot), play is normal. The spot is the designated position of the packet
+    that started it, or (a game controller clears the designated position at NORMAL_START) of the
+    prepare command before it, or else where the ball was first seen after the normal start."""
 
     @staticmethod
     def declare(params: ProtocolParams, world_topic: str, moved_m: float = 0.0) -> Contract:
         return Contract("ssl/referee_in", (Port("clock", Tick), Port(world_topic, WorldState)),
                         (Port("referee/gc", GameState), summary_port("ssl/referee_in")))
 
-    def __init__(self, params: ProtocolParams, world_topic: str, moved_m: float,
-                 err: TextIO | None = None, receiver: Receiver | None = None) -> None:  # fmt: skip
+    def __init__(self, params: ProtocolParams, world_topic: str, moved_m: float, err: TextIO | None = None,
+                 receiver: Receiver | None = None, epoch: UnixEpoch | None = None) -> None:  # fmt: skip
         r = params.referee
         self.receiver: Receiver = receiver if receiver is not None else MulticastReceiver(
             r.group, r.port, params.interface, params.receive_buffer_bytes, params.max_datagram_bytes)  # fmt: skip
         self.contract = self.declare(params, world_topic)
         self.moved_m = moved_m
-        self.reader = RefereeReader()
+        self.reader = RefereeReader(epoch)
         self.drops = DropLog(f"referee {r.group}:{r.port}", params.drop_report_interval_s, err)
-        self.received = 0
+        self.received = self.restarts_taken = 0
         self._last: bytes | None = None
+        self._spot: tuple[float, float] | None = None  # where the restart under way was set (field, m)
 
     def on_message(self, topic: str, message: Any, publish: Publish) -> None:
         if topic == "clock":
@@ -261,10 +279,14 @@ class RefereeInStage(SocketStage):
                 self._take(data, publish)
             return
         g, b = self.reader.last, message.ball
-        taking = g is not None and g.command.prepared and g.ready and g.placement is not None
-        if taking and b is not None and self._last is not None and g is not None and g.placement is not None \
-                and math.hypot(b.x - g.placement[0], b.y - g.placement[1]) > self.moved_m:  # fmt: skip
+        if g is None or not (g.command.prepared and g.ready) or b is None or self._last is None:
+            return
+        if self._spot is None:
+            self._spot = (b.x, b.y)
+        elif math.hypot(b.x - self._spot[0], b.y - self._spot[1]) > self.moved_m:
             self.reader.ball_moved()
+            self.restarts_taken += 1
+            self._spot = None
             publish("referee/gc", self.reader.read(self._last))
 
     def _take(self, data: bytes, publish: Publish) -> None:
@@ -275,11 +297,16 @@ class RefereeInStage(SocketStage):
             self.drops.drop("undecodable", f"{len(data)} bytes, {exc}")
             return
         self._last = data
+        if not game.command.prepared:
+            self._spot = None
+        elif game.placement is not None:  # the prepare's spot, or the start's when it says one
+            self._spot = game.placement
         publish("referee/gc", game)
 
     def summarize(self, publish: Publish) -> None:
         publish(f"summary/{self.name}", StageSummary(self.name, {
-            "packets": self.received, "dropped": dict(sorted(self.drops.counts.items()))}))  # fmt: skip
+            "packets": self.received, "restarts_taken": self.restarts_taken,
+            "dropped": dict(sorted(self.drops.counts.items()))}))  # fmt: skip
 
     def close(self) -> None:
         self.receiver.close()
@@ -294,15 +321,16 @@ class TrackerOutStage(SocketStage):
         name = f"ssl/tracker_out/{team}"
         return Contract(name, (Port(f"world/{team}", WorldState),), (summary_port(name),))
 
-    def __init__(self, params: ProtocolParams, team: Team) -> None:
+    def __init__(self, params: ProtocolParams, team: Team, epoch: UnixEpoch | None = None) -> None:
         t = params.tracker
+        self.epoch = run_epoch() if epoch is None else epoch
         self.contract = self.declare(params, team)
         self.sender = MulticastSender(t.group, t.port, params.interface, params.ttl)
         self.uuid = str(uuid.uuid4())
         self.source = t.source_name
 
     def on_message(self, topic: str, message: Any, publish: Publish) -> None:
-        self.sender.send(tracker_packet(message, self.uuid, self.source))
+        self.sender.send(tracker_packet(message, self.uuid, self.source, self.epoch))
 
     def summarize(self, publish: Publish) -> None:
         publish(f"summary/{self.name}", StageSummary(self.name, {"packets": self.sender.sent,
@@ -342,7 +370,8 @@ class CommandsOutStage(SocketStage):
         self.chip_angle_rad = chip_angle_rad
         self.full_rpm = sim.dribbler_full_rpm
         self.headings: dict[int, float] = {}
-        self.sent = self.teleports = self.answers = self.answer_errors = self.resent = 0
+        self.sent = self.teleports = self.answers = self.answer_errors = self.answers_earlier_layout = 0
+        self.resent = 0
         self._last: TeamCommands | None = None  # grSim: the latest commands, resent each vision frame
         self.drops = DropLog(f"{self.to} answers", params.drop_report_interval_s, err)
 
@@ -369,19 +398,20 @@ class CommandsOutStage(SocketStage):
         """The simulation protocol answers each packet (grSim does not): count them and their errors."""
         while (got := self.endpoint.receive()) is not None:
             data, _peer = got
-            answer = sim_pb.RobotControlResponse()
             try:
-                answer.ParseFromString(data)
-            except DecodeError as exc:
+                answer = read_robot_control_response(data)
+            except MessageError as exc:
                 self.drops.drop("undecodable", f"{len(data)} bytes, {exc}")
                 continue
             self.answers += 1
             self.answer_errors += len(answer.errors)
+            self.answers_earlier_layout += answer.earlier_layout
 
     def summarize(self, publish: Publish) -> None:
         publish(f"summary/{self.name}", StageSummary(self.name, {
             "to": self.to, "packets": self.sent, "resent": self.resent, "teleports": self.teleports,
             "answers": self.answers, "answer_errors": self.answer_errors,
+            "answers_earlier_layout": self.answers_earlier_layout,
             "dropped": dict(sorted(self.drops.counts.items()))}))  # fmt: skip
 
     def close(self) -> None:
@@ -444,8 +474,8 @@ class SimulationInStage(SocketStage):
         self.packets += 1
         for _, why in read.errors:
             self._refuse(why)
-        self.robots.send_to(robot_control_response(self.team, [c.id for c in read.commands],
-                                                   [why for _, why in read.errors]), peer)  # fmt: skip
+        self.robots.send_to(robot_control_response([Feedback(c.id) for c in read.commands],
+                                                   [SimError(UNSUPPORTED, why) for _, why in read.errors]), peer)
         return read.commands
 
     def _teleport(self, got: tuple[bytes, tuple[str, int]], gt: GroundTruth,
@@ -461,7 +491,7 @@ class SimulationInStage(SocketStage):
         if tp is not None:
             self.teleports += 1
             publish("teleport", tp)
-        self.control.send_to(simulator_response(refused), peer)
+        self.control.send_to(simulator_response([SimError(UNSUPPORTED, why) for why in refused]), peer)
 
     def _refuse(self, why: str) -> None:
         key = why.split(":")[0]

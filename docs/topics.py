@@ -5,7 +5,8 @@
 
 Each topic, its message, the stages that write it and those that read it, over the set-ups of a
 match: the embedded match on vision and on truth, with the simple opponent, a copy of our team and
-a team outside over the simulation protocol, with every league protocol on and off.
+a team outside over the simulation protocol, with every league protocol on and off; and our
+simulator served alone (``cmdragons sim --serve``).
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from cmdragons.runtime.match import CLOCK, Opponent, Perception, wiring
+from cmdragons.runtime.match import CLOCK, Opponent, Perception, served_wiring, wiring
 from cmdragons.runtime.settings import load_settings
 from cmdragons.runtime.topics import Contract, topic_table
 
@@ -33,6 +34,7 @@ def contracts() -> list[Contract]:
         for opponent, perception in SETUPS:
             table = wiring(settings, opponent, perception, 0, lambda: None)  # type: ignore[arg-type, return-value]
             out += [e.contract for e in table]
+    out += [e.contract for e in served_wiring(load_settings(), None, 0)]  # type: ignore[arg-type]
     return out
 
 

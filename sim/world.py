@@ -45,6 +45,7 @@ __all__ = [
     "PhysicsParams",
     "RobotParams",
     "World",
+    "ball_at_front",
 ]
 
 # collision types
@@ -154,6 +155,19 @@ class _BallState:
     vz: float = 0.0
     last_touch: Team | None = None
     touches: set[int] = field(default_factory=set)  # robots in contact this substep
+
+
+def ball_at_front(league: LeagueParams, dx: float, dy: float, theta: float,
+                  slack_m: float) -> tuple[bool, float, float]:  # fmt: skip
+    """Is a ball ``(dx, dy)`` m from a robot's centre (field frame) against the flat front of the
+    robot heading ``theta`` (rad), within ``slack_m`` of touching it? Returns (touching, x, y), the
+    ball in the robot's frame: what the kicker's light barrier and the dribbler feel."""
+    c, s = math.cos(theta), math.sin(theta)
+    x, y = c * dx + s * dy, -s * dx + c * dy
+    shape = league.robot
+    front = shape.front_distance_m + league.ball.radius_m
+    touching = front - 0.01 <= x <= front + slack_m and abs(y) <= shape.mouth_half_width_m
+    return touching, x, y
 
 
 class World:
@@ -421,12 +435,7 @@ class World:
     def _in_mouth(self, r: _Robot, slack: float) -> tuple[bool, float, float]:
         """Is the ball against robot r's flat front? Returns (touching, x, y) in the robot frame."""
         rel = self.ball_body.position - r.body.position
-        c, s = math.cos(r.body.angle), math.sin(r.body.angle)
-        x, y = c * rel.x + s * rel.y, -s * rel.x + c * rel.y
-        shape = self.league.robot
-        front = shape.front_distance_m + self.league.ball.radius_m
-        touching = front - 0.01 <= x <= front + slack and abs(y) <= shape.mouth_half_width_m
-        return touching, x, y
+        return ball_at_front(self.league, rel.x, rel.y, r.body.angle, slack)
 
     def _kick(self) -> None:
         """An armed kicker fires when the ball is at the front face (within the tolerance, as the

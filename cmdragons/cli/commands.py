@@ -89,9 +89,17 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"cmdragons {version('cmdragons')}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    p = sub.add_parser("sim", help="run the simulator with scripted motion; record camera frames and truth")
+    p = sub.add_parser("sim", help="run the simulator with scripted motion; record camera frames and truth; or "
+                       "(--serve) serve it to teams as a league simulator")  # fmt: skip
     _common(p, "sim.physics.substeps=8")
-    p.add_argument("--seconds", type=_positive, default=10.0, help="simulated seconds (default 10)")
+    p.add_argument("--seconds", type=_positive, default=None,
+                   help="simulated seconds (default 10; with --serve: until interrupted)")
+    p.add_argument("--serve", action="store_true",
+                   help="run alone in real time and speak what grSim speaks: SSL-Vision packets with the geometry "
+                   "(224.5.23.2:10020 as grSim's, every camera of the division), the simulation protocol for both "
+                   "teams (SimulatorCommand on 127.0.0.1:10300, RobotControl on 10301 blue and 10302 yellow) and "
+                   "Referee packets from its own referee (224.5.23.1:10003); all on loopback (configs/protocols.yaml)")
+    p.add_argument("--division", choices=("A", "B"), default=None, help="field and team size (default: config)")
     p.add_argument("--record", action="store_true", help="write camera frames, cameras.yaml and truth.jsonl")
     p.add_argument("--format", choices=("h264", "ffv1", "png"), default=None,
                    help="recorded frames: H.264 .mp4, lossless FFV1 .mkv or lossless PNG "
@@ -207,6 +215,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         return exc.code if isinstance(exc.code, int) else 2
     with Interrupt() as stop:
         try:
+            if args.command == "sim" and args.serve:
+                from cmdragons.cli.serve import cmd_serve
+
+                return cmd_serve(args, stop)
             if args.command == "sim":
                 return _cmd_sim(args, stop)
             if args.command == "bench":
@@ -267,7 +279,8 @@ def _cmd_sim(args: argparse.Namespace, stop: Interrupt) -> int:
     from sim.script import ScriptedPlay
     from sim.simulator import Simulator
 
-    settings = load_settings(args.config, args.set)
+    settings = load_settings(args.config, [*args.set, *([f"field.division={args.division}"] if args.division else [])])
+    seconds = 10.0 if args.seconds is None else args.seconds
     if args.snapshot:
         if Path(args.snapshot).suffix.lower() not in (".png", ".jpg", ".jpeg"):
             raise OutputError(f"--snapshot {args.snapshot}: not an image file name; give one ending in .png")
@@ -277,7 +290,7 @@ def _cmd_sim(args: argparse.Namespace, stop: Interrupt) -> int:
     sim = Simulator(settings.field, models, settings.sim, seed=args.seed)
     script = ScriptedPlay(settings.field_geometry(), settings.field.robot.radius_m, settings.sim.script, sim.rng)
     fps = settings.sim.physics.frame_rate_hz
-    n_frames = max(1, round(args.seconds * fps))
+    n_frames = max(1, round(seconds * fps))
     rec = settings.cameras.recording
     rec = dataclasses.replace(rec, codec=args.format or rec.codec, crf=rec.crf if args.crf is None else args.crf)
     recorder = RecordingWriter(folder, models, fps, rec) if args.record else None

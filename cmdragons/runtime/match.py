@@ -32,6 +32,7 @@ from cmdragons.messages import Tick
 from cmdragons.runtime.bus import Bus, Stage, Transport, run_frames
 from cmdragons.runtime.settings import Settings
 from cmdragons.runtime.stages import (
+    CameraTruthStage,
     RecorderStage,
     RefereeStage,
     ScriptStage,
@@ -50,6 +51,7 @@ from cmdragons.team import Brain
 from cmdragons.tracking import Tracker
 from sim.params import SimParams
 from sim.referee import Referee
+from sim.restarts import park
 from sim.simulator import Simulator, robot_keys
 from strategy.simple import SimpleTeam
 
@@ -58,7 +60,7 @@ if TYPE_CHECKING:
     from sim.script import ScriptedPlay
 
 __all__ = ["CLOCK", "OURS", "THEIRS", "Entry", "Match", "Opponent", "Perception", "build", "match_sim_params",
-           "match_summary", "scripted_wiring", "summary_stages", "timing_keys", "wiring"]
+           "match_summary", "scripted_wiring", "served_wiring", "summary_stages", "timing_keys", "wiring"]
 
 Opponent = Literal["simple", "self", "none", "outside", "simulation"]
 Perception = Literal["vision", "truth"]
@@ -180,6 +182,48 @@ def scripted_wiring(sim: Simulator, script: ScriptedPlay, recorder: RecordingWri
     return [Entry(SimStage.declare(ids, referee=True), "sim", lambda: SimStage(sim, TEAMS)),
             Entry(ScriptStage.contract, "sim", lambda: ScriptStage(script, sim.world)),
             Entry(RecorderStage.declare(ids), "sim", lambda: RecorderStage(recorder, ids))]  # fmt: skip
+
+
+def served_wiring(settings: Settings, sim: Simulator, seed: int) -> list[Entry]:
+    """The table of ``cmdragons sim --serve``: our simulator alone as a league simulator. Both
+    teams' robots take the simulation protocol (``RobotControl`` on each team's port, teleports on
+    the control port, a robot taken off the field parked out of view; a team that sends nothing has
+    its robots stand), the field is seen as
+    SSL-Vision packets from every camera of the division (detections made from the truth, with the
+    geometry now and then), and the simulator's referee judges on the truth and speaks the league's
+    Referee packets. ``sim``: built without rendering and without its own referee; ``seed``: the
+    vision noise's."""
+    from cmdragons.runtime.ssl.stages import RefereeOutStage, SimulationInStage, VisionOutStage
+    from cmdragons.runtime.ssl.vision import geometry_packet
+
+    p, league = settings.protocols, settings.field
+    # its vision where a simulation-protocol simulator sends it (grSim's and the ER-Force simulator's port)
+    p = dataclasses.replace(p, vision=dataclasses.replace(p.vision, port=p.simulation.vision_port))
+    models = settings.camera_models()
+    ids = [m.id for m in models]
+    geometry = geometry_packet(settings.field_geometry(), models)
+    keys = robot_keys(league, settings.sim)
+    sigmas = _measurement_sigmas(settings) if p.serve.vision_noise else (0.0, 0.0, 0.0)
+    touch_m = settings.sim.kicker.touch_tolerance_m
+    pitch = settings.field_geometry()  # a robot taken off the field waits where the referee parks robots sent off
+    parked = {key: park(pitch, i, key[0], settings.sim.referee.park_distance_m) for i, key in enumerate(keys)}
+    return [
+        Entry(SimStage.declare([]), "sim", lambda: SimStage(sim, TEAMS)),
+        Entry(RefereeStage.contract, "sim",
+              lambda: RefereeStage(Referee(settings.field_geometry(), keys, settings.sim.referee))),
+        Entry(CameraTruthStage.declare(ids), "sim",
+              functools.partial(CameraTruthStage, models, league.robot.height_m, sigmas, seed)),
+        Entry(SimulationInStage.declare(p, TEAMS), "", functools.partial(SimulationInStage, p, TEAMS, 0.0, league,
+                                                                           touch_m, parked)),
+        Entry(VisionOutStage.declare(p, ids, geometry), "", functools.partial(VisionOutStage, p, ids, geometry)),
+        Entry(RefereeOutStage.contract, "", functools.partial(RefereeOutStage, p)),
+    ]  # fmt: skip
+
+
+def _measurement_sigmas(settings: Settings) -> tuple[float, float, float]:
+    """The noise vision measures (ball m, robot m, robot rad): the tracker's measurement model."""
+    t = settings.tracker
+    return t.ball.measurement_sigma_m, t.robot.measurement_sigma_m, t.robot.measurement_sigma_rad
 
 
 def _protocol(cls: Any, *args: Any) -> Entry:

@@ -17,7 +17,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from cmdragons.geometry import TEAMS, Team
+from cmdragons.camera import CameraModel
+from cmdragons.geometry import TEAMS, Team, wrap_angle
 from cmdragons.messages import (
     BallDetection,
     CameraFrame,
@@ -56,6 +57,7 @@ if TYPE_CHECKING:
     from sim.world import World
 
 __all__ = [
+    "CameraTruthStage",
     "LoggerStage",
     "RecorderStage",
     "RefereeStage",
@@ -247,6 +249,42 @@ class TruthPerceptionStage(BaseStage):
         robots = tuple(RobotDetection(r.team, r.id, r.x + n(0, sxy), r.y + n(0, sxy), r.theta + n(0, sth), 1.0,
                                       (0.0, 0.0)) for r in gt.robots)  # fmt: skip
         publish(self.topic, DetectionFrame(0, gt.frame_number, gt.t, gt.t, ball, robots))
+
+
+class CameraTruthStage(BaseStage):
+    """The served simulator's vision (``cmdragons sim --serve``), as grSim's: each camera's
+    detections made from the truth, without rendering: the ball where its centre projects into the
+    camera's image, each robot where the centre of its top does (so an object in the strip two
+    cameras share is seen by both, as on a real field), with its pixel there. ``sigmas`` (ball m,
+    robot m, robot rad): vision-like noise, drawn per camera (all zero: the exact truth)."""
+
+    @staticmethod
+    def declare(camera_ids: Sequence[int]) -> Contract:
+        return Contract("vision/truth", (Port("truth", GroundTruth),),
+                        tuple(Port(f"detections/{c}", DetectionFrame) for c in camera_ids))
+
+    def __init__(self, cameras: Sequence[CameraModel], robot_height_m: float, sigmas: tuple[float, float, float],
+                 seed: int) -> None:  # fmt: skip
+        self.cameras = tuple(cameras)
+        self.contract = self.declare([m.id for m in self.cameras])
+        self.robot_height_m = robot_height_m
+        self.sigma_ball, self.sigma_xy, self.sigma_theta = sigmas
+        self.rng = np.random.default_rng(seed)
+
+    def on_message(self, topic: str, message: Any, publish: Publish) -> None:
+        gt: GroundTruth = message
+        b = gt.ball
+        points = np.array([[b.x, b.y, b.z], *([r.x, r.y, self.robot_height_m] for r in gt.robots)])
+        n, sb, sxy, sth = self.rng.normal, self.sigma_ball, self.sigma_xy, self.sigma_theta
+        for m in self.cameras:
+            px = m.project(points)
+            seen = m.in_image(px)
+            balls = (BallDetection(b.x + n(0, sb), b.y + n(0, sb), 1.0, (float(px[0, 0]), float(px[0, 1]))),) \
+                if seen[0] else ()  # fmt: skip
+            robots = tuple(RobotDetection(r.team, r.id, r.x + n(0, sxy), r.y + n(0, sxy),
+                                          wrap_angle(r.theta + n(0, sth)), 1.0, (float(p[0]), float(p[1])))
+                           for r, p, s in zip(gt.robots, px[1:], seen[1:], strict=True) if s)  # fmt: skip
+            publish(f"detections/{m.id}", DetectionFrame(m.id, gt.frame_number, gt.t, gt.t, balls, robots))
 
 
 class TrackerStage(BaseStage):

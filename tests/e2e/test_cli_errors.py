@@ -4,6 +4,7 @@ no traceback, and nothing already done lost (checks that can fail late run befor
 from __future__ import annotations
 
 import json
+import socket
 from pathlib import Path
 
 import pytest
@@ -48,6 +49,9 @@ CASES = [
     (["bench", "sim", "--quick", "--json", "/proc/rows.json"], ["--json", "/proc/rows.json", "not writable"]),
     (["sim", "--snapshot", "{file}/last.png", "--out", "{tmp}/s"], ["--snapshot", "a_file is a file"]),
     (["sim", "--snapshot", "{tmp}/last.txt", "--out", "{tmp}/s"], ["--snapshot", "ending in .png"]),
+    (["sim", "--serve", "--record", "--out", "{tmp}/s"], ["--serve", "--record", "cannot be used"]),
+    (["sim", "--serve", "--division", "C"], ["--division", "invalid choice", "'A', 'B'"]),
+    (["sim", "--serve", "--set", "protocols.simulation.address=10.1.2.3"], ["simulation.address", "network: true"]),
     (["play", "--set", "sim.physics.substeps=[1"], ["sim.physics.substeps", "not valid YAML", "[1, 2]"]),
     (["play", "--set", "sim.render.noise_sigma=0"], ["render.noise_sigma", "did you mean noise_sigma_grey?"]),
     (["play", "--set", "nosuch.key=1"], ["unknown concern"]),
@@ -71,6 +75,19 @@ def test_bad_input_one_line_exit_2(argv: list[str], words: list[str], tmp_path: 
     for w in words:
         assert w in line, line
     assert "cmdragons bench" not in out  # no table: the bench never ran
+
+
+def test_a_served_port_in_use_is_one_line_and_nothing_written(tmp_path: Path,
+                                                              capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as held:
+        held.bind(("127.0.0.1", 0))
+        port = held.getsockname()[1]
+        code, _, err = run(["sim", "--serve", "--seconds", "0.1", "--out", str(tmp_path / "s"), "--no-progress",
+                            "--set", f"protocols.simulation.control_port={port}"], capsys)  # fmt: skip
+    assert code == 2
+    line = one_line(err)
+    assert "cannot open its sockets" in line and str(port) in line and "--set protocols.simulation" in line
+    assert not (tmp_path / "s").exists()
 
 
 def test_snapshot_checked_before_the_run(tmp_path: Path, a_file: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -83,3 +83,27 @@ def test_sim_record_interrupted_keeps_the_camera_videos(tmp_path: Path) -> None:
         assert abs(video_frames(out / f"camera_{cam}.mp4") - summary["frames"]) <= 1
     assert mcap_messages(out / "run.mcap") > summary["frames"]
     assert stdout.strip().splitlines()[-1].endswith(str(out))
+
+
+@pytest.mark.slow
+def test_the_served_simulator_runs_until_interrupted_and_keeps_everything(tmp_path: Path) -> None:
+    from tests.runtime.conftest import free_udp_ports
+
+    out = tmp_path / "served"
+    vision, referee, control, blue, yellow = free_udp_ports(5)
+    child = start(["sim", "--serve", "--no-progress", "--out", str(out),
+                   "--set", f"protocols.simulation.vision_port={vision}", "--set", f"protocols.referee.port={referee}",
+                   "--set", f"protocols.simulation.control_port={control}",
+                   "--set", f"protocols.simulation.blue_port={blue}",
+                   "--set", f"protocols.simulation.yellow_port={yellow}"])  # fmt: skip
+    wait_for_frames(out / "run.mcap", child)
+    child.send_signal(signal.SIGINT)
+    stdout, stderr = child.communicate(timeout=300)
+    assert child.returncode == 128 + signal.SIGINT, stderr
+    assert "Traceback" not in stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["interrupted"] is True and summary["seconds"] > 0
+    assert summary["frames"] == round(summary["seconds"] * 60)
+    assert mcap_messages(out / "run.mcap") > 0
+    last = stdout.strip().splitlines()[-1]
+    assert "score blue 0:0 yellow" in last and "interrupted by SIGINT" in last and str(out) in last

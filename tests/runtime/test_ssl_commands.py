@@ -47,6 +47,7 @@ from cmdragons.runtime.ssl.stages import SimulationInStage, TrackerOutStage, clo
 from cmdragons.runtime.ssl.tracker import decode_tracker, tracker_packet
 from cmdragons.runtime.ssl.udp import MulticastReceiver, UdpEndpoint
 from cmdragons.runtime.stages import Tap
+from tests.runtime.conftest import free_udp_ports
 
 NO_PROTOC = "Debian's protoc (apt-get install protobuf-compiler) is the independent decoder"
 F32 = 1e-6  # the wire's 32-bit floats, relative
@@ -60,18 +61,6 @@ COMMANDS = msg.TeamCommands("blue", 77, 1.25, (
     msg.RobotCommand("blue", 4, -0.3, 0.7, -1.0, 3.0, True, 0.5)))  # fmt: skip
 HEADINGS = {3: 0.5, 4: -2.0}
 CHIP = math.radians(45.0)
-
-
-def _ports(n: int) -> list[int]:
-    """``n`` UDP ports free on loopback now (held open together so they differ)."""
-    socks = [socket.socket(socket.AF_INET, socket.SOCK_DGRAM) for _ in range(n)]
-    try:
-        for s in socks:
-            s.bind(("127.0.0.1", 0))
-        return [int(s.getsockname()[1]) for s in socks]
-    finally:
-        for s in socks:
-            s.close()
 
 
 def _protoc(schema: str, message: str, data: bytes) -> str:
@@ -252,7 +241,7 @@ def test_a_match_sends_our_commands_to_a_league_simulator(to: str) -> None:
 
 
 def _outside_match(**extra: Any) -> tuple[Match, list[msg.GroundTruth], dict[str, int]]:
-    control, yellow = _ports(2)
+    control, yellow = free_udp_ports(2)
     settings = load_settings(None, [f"protocols.simulation.control_port={control}",
                                     f"protocols.simulation.yellow_port={yellow}", "protocols.simulation.wait_s=0",
                                     *(f"protocols.{k}={v}" for k, v in extra.items())])  # fmt: skip
@@ -327,7 +316,7 @@ def test_a_teleport_over_the_control_port_puts_the_ball_where_asked() -> None:
 
 
 def test_garbage_and_cut_packets_to_our_simulator_are_counted_and_dropped() -> None:
-    control, yellow = _ports(2)
+    control, yellow = free_udp_ports(2)
     settings = load_settings(None, [f"protocols.simulation.control_port={control}",
                                     f"protocols.simulation.yellow_port={yellow}", "protocols.simulation.wait_s=0"])
     err = io.StringIO()
@@ -361,7 +350,7 @@ def test_the_example_client_plays_yellow_in_our_simulator_over_the_leagues_proto
     from pathlib import Path
 
     root = Path(__file__).resolve().parents[2]
-    control, yellow = _ports(2)
+    control, yellow = free_udp_ports(2)
     settings = load_settings(None, [f"protocols.vision.port={udp_port}", f"protocols.simulation.control_port={control}",
                                     f"protocols.simulation.yellow_port={yellow}", "protocols.simulation.wait_s=1.0"])
     client = subprocess.Popen([sys.executable, str(root / "examples" / "simulation_team.py"), "--vision-port",
@@ -395,7 +384,7 @@ def test_the_example_client_plays_yellow_in_our_simulator_over_the_leagues_proto
 def test_garbage_answers_to_our_commands_are_counted_and_dropped() -> None:
     from cmdragons.runtime.ssl.stages import CommandsOutStage
 
-    sim_port, control = _ports(2)
+    sim_port, control = free_udp_ports(2)
     settings = load_settings(None, ["protocols.commands_to=simulation", f"protocols.simulation.blue_port={sim_port}",
                                     f"protocols.simulation.control_port={control}"])  # fmt: skip
     err = io.StringIO()

@@ -231,11 +231,14 @@ def simulator_command_packet(tp: Teleport) -> bytes:
 
 
 def read_simulator_command(data: bytes, t: float, where: Mapping[tuple[Team, int], tuple[float, float, float]],
-                           ball: tuple[float, float]) -> tuple[Teleport | None, list[str]]:  # fmt: skip
+                           ball: tuple[float, float],
+                           parked: Mapping[tuple[Team, int], tuple[float, float]] | None = None,
+                           ) -> tuple[Teleport | None, list[str]]:  # fmt: skip
     """A ``SimulatorCommand``'s teleports as our :class:`Teleport` at time ``t`` (a coordinate left
     out keeps the object's own: ``where`` (team, id) -> (x, y, theta) and ``ball`` now), and one
-    line per request not carried out (velocities, removing robots, configuration);
-    :class:`MessageError` for bytes that are not one."""
+    line per request not carried out (velocities, removing robots without ``parked``,
+    configuration); :class:`MessageError` for bytes that are not one. ``parked``: (team, id) -> where
+    a robot taken off the field (``present: false``) waits, out of the cameras' view."""
     m = wire.parse(sim_pb.SimulatorCommand, data)
     unsupported: list[str] = []
     if m.HasField("config"):
@@ -251,7 +254,10 @@ def read_simulator_command(data: bytes, t: float, where: Mapping[tuple[Team, int
             unsupported.append(f"teleport_robot {r.id.id} of team code {r.id.team}: no such robot here")
             continue
         if r.HasField("present") and not r.present:
-            unsupported.append(f"teleport_robot {team} {r.id.id}: robots are not taken off the field here")
+            if parked is None or key not in parked:
+                unsupported.append(f"teleport_robot {team} {r.id.id}: robots are not taken off the field here")
+            else:
+                robots.append((key[0], key[1], *parked[key], 0.0))
             continue
         x0, y0, th0 = where[key]
         robots.append((key[0], key[1], r.x if r.HasField("x") else x0, r.y if r.HasField("y") else y0,

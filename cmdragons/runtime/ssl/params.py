@@ -10,7 +10,8 @@ from typing import Literal
 
 from cmdragons.config import Validated, setting
 
-__all__ = ["GrsimParams", "MulticastParams", "OutsideParams", "ProtocolParams", "SimulationParams"]
+__all__ = ["GrsimParams", "MulticastParams", "OutsideParams", "ProtocolParams", "ServeParams",
+           "SimulationParams"]
 
 CommandsTo = Literal["none", "grsim", "simulation"]
 
@@ -99,6 +100,13 @@ class OutsideParams(Validated):
 
 
 @dataclass(frozen=True)
+class ServeParams(Validated):
+    """``cmdragons sim --serve``: our simulator alone as a league simulator."""
+
+    vision_noise: bool = True  # its SSL-Vision detections carry the tracker's measurement noise (false: exact)
+
+
+@dataclass(frozen=True)
 class ProtocolParams(Validated):
     interface: str = _LOOPBACK  # every multicast socket sends and joins on this interface's address
     network: bool = False  # allow an interface and unicast peers off loopback (a real field's network)
@@ -114,6 +122,7 @@ class ProtocolParams(Validated):
     grsim: GrsimParams = GrsimParams()
     simulation: SimulationParams = SimulationParams()
     outside: OutsideParams = OutsideParams()
+    serve: ServeParams = ServeParams()
 
     def __post_init__(self) -> None:
         super().__post_init__()

@@ -25,10 +25,10 @@ from __future__ import annotations
 import math
 import time
 import uuid
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any, Protocol, TextIO
 
-from cmdragons.geometry import Team
+from cmdragons.geometry import LeagueParams, Team
 from cmdragons.messages import (
     DetectionFrame,
     GameState,
@@ -62,6 +62,7 @@ from cmdragons.runtime.ssl.tracker import tracker_packet
 from cmdragons.runtime.ssl.udp import DropLog, MulticastReceiver, MulticastSender, UdpEndpoint
 from cmdragons.runtime.ssl.vision import VisionGeometry, detection_packet, read_wrapper
 from cmdragons.runtime.topics import Contract, Port, summary_port
+from sim.world import ball_at_front
 
 __all__ = ["CommandsOutStage", "RefereeInStage", "RefereeOutStage", "SimulationInStage", "SocketStage",
            "TrackerOutStage", "VisionInStage", "VisionOutStage", "close_sockets"]  # fmt: skip
@@ -419,29 +420,47 @@ class CommandsOutStage(SocketStage):
 
 
 class SimulationInStage(SocketStage):
-    """Our simulator as a simulation-protocol simulator for ``team``: ``RobotControl`` on the team's
-    port (loopback) becomes that team's commands, ``SimulatorCommand`` teleports on the control
-    port become teleports. On each captured frame (``truth``) it takes what came since; a frame
-    with no new RobotControl waits up to ``simulation.wait_s`` for one (the match keeps pace with a
-    team that answers every frame). Local velocities turn into the field frame by the robot's true
-    heading. Each packet is answered (RobotControlResponse, SimulatorResponse); garbage and a
-    packet cut short are counted and dropped with a line on stderr."""
+    """Our simulator as a simulation-protocol simulator for ``teams`` (one, or both when it is
+    served alone): ``RobotControl`` on each team's port (loopback) becomes that team's commands,
+    ``SimulatorCommand`` teleports on the control port become teleports. On each captured frame
+    (``truth``) it takes what came since; a frame with no new RobotControl waits up to ``wait_s``
+    (default ``simulation.wait_s``; 0 for a simulator running on its own clock) for one (the match
+    keeps pace with a team that answers every frame). A team that sent nothing this frame has no
+    commands for it (its robots stop by their own command timeout). Local velocities turn into the
+    field frame by the robot's true heading. Each packet is answered (RobotControlResponse, with each
+    robot's ball contact when ``league`` is given, within ``touch_m`` of its front; SimulatorResponse).
+    A robot taken off the field (``present: false``) goes to its spot in ``parked``, out of the
+    cameras' view (refused without). Garbage and a packet cut short are counted and dropped with a
+    line on stderr."""
 
     @staticmethod
-    def declare(params: ProtocolParams, team: Team) -> Contract:
-        name = f"ssl/simulation_in/{team}"
-        return Contract(name, (Port("truth", GroundTruth),), (Port(f"commands/{team}", TeamCommands),
+    def declare(params: ProtocolParams, teams: Team | Sequence[Team]) -> Contract:
+        ts = _teams(teams)
+        name = f"ssl/simulation_in/{ts[0]}" if len(ts) == 1 else "ssl/simulation_in"
+        return Contract(name, (Port("truth", GroundTruth),), (*(Port(f"commands/{t}", TeamCommands) for t in ts),
                         Port("teleport", Teleport), summary_port(name)))  # fmt: skip
 
-    def __init__(self, params: ProtocolParams, team: Team, err: TextIO | None = None) -> None:
+    def __init__(self, params: ProtocolParams, teams: Team | Sequence[Team], wait_s: float | None = None,
+                 league: LeagueParams | None = None, touch_m: float = 0.0,
+                 parked: Mapping[tuple[Team, int], tuple[float, float]] | None = None,
+                 err: TextIO | None = None) -> None:  # fmt: skip
         sim = params.simulation
-        self.contract = self.declare(params, team)
-        self.team = team
-        self.robots = UdpEndpoint(sim.address, sim.port(team), params.max_datagram_bytes)
-        self.control = UdpEndpoint(sim.address, sim.control_port, params.max_datagram_bytes)
-        self.wait_s = sim.wait_s
+        self.contract = self.declare(params, teams)
+        self.teams = _teams(teams)
+        self.robots: dict[Team, UdpEndpoint] = {}
+        try:  # a port another program holds: what was opened is closed again
+            for t in self.teams:
+                self.robots[t] = UdpEndpoint(sim.address, sim.port(t), params.max_datagram_bytes)
+            self.control = UdpEndpoint(sim.address, sim.control_port, params.max_datagram_bytes)
+        except OSError:
+            for endpoint in self.robots.values():
+                endpoint.close()
+            raise
+        self.wait_s = sim.wait_s if wait_s is None else wait_s
+        self.league, self.touch_m, self.parked = league, touch_m, parked
         self.full_rpm = sim.dribbler_full_rpm
-        self.drops = DropLog(f"simulation protocol {sim.address}:{sim.port(team)}/{sim.control_port}",
+        ports = "/".join(str(sim.port(t)) for t in self.teams)
+        self.drops = DropLog(f"simulation protocol {sim.address}:{ports}/{sim.control_port}",
                              params.drop_report_interval_s, err)  # fmt: skip
         self.packets = self.teleports = self.frames_waited_out = 0
         self.refused: dict[str, int] = {}
@@ -451,38 +470,56 @@ class SimulationInStage(SocketStage):
         where = {(r.team, r.id): (r.x, r.y, r.theta) for r in gt.robots}
         while (got := self.control.receive()) is not None:
             self._teleport(got, gt, where, publish)
-        headings = {r.id: r.theta for r in gt.robots if r.team == self.team}
+        for team in self.teams:
+            commands = self._team_commands(team, gt)
+            publish(f"commands/{team}", TeamCommands(team, gt.frame_number, gt.t, commands))
+
+    def _team_commands(self, team: Team, gt: GroundTruth) -> tuple[RobotCommand, ...]:
+        """The newest command of each of ``team``'s robots that came since the last frame."""
+        endpoint = self.robots[team]
+        headings = {r.id: r.theta for r in gt.robots if r.team == team}
+        contact = self._contact(team, gt)
         latest: dict[int, RobotCommand] = {}
-        got = self.robots.receive()
+        got = endpoint.receive()
         if got is None and self.wait_s > 0:
-            got = self.robots.receive(self.wait_s)
+            got = endpoint.receive(self.wait_s)
             self.frames_waited_out += got is None
         while got is not None:
-            for c in self._commands(got, headings):
+            for c in self._commands(team, got, headings, contact):
                 latest[c.id] = c
-            got = self.robots.receive()
-        publish(f"commands/{self.team}", TeamCommands(self.team, gt.frame_number, gt.t,
-                                                      tuple(latest[i] for i in sorted(latest))))  # fmt: skip
+            got = endpoint.receive()
+        return tuple(latest[i] for i in sorted(latest))
 
-    def _commands(self, got: tuple[bytes, tuple[str, int]], headings: dict[int, float]) -> tuple[RobotCommand, ...]:
+    def _contact(self, team: Team, gt: GroundTruth) -> dict[int, bool]:
+        """Each of ``team``'s robots: is the ball at its dribbler (none known without ``league``)?"""
+        if self.league is None:
+            return {}
+        b = gt.ball
+        on_ground = b.z <= self.league.ball.radius_m + 1e-6
+        return {r.id: on_ground and ball_at_front(self.league, b.x - r.x, b.y - r.y, r.theta, self.touch_m)[0]
+                for r in gt.robots if r.team == team}  # fmt: skip
+
+    def _commands(self, team: Team, got: tuple[bytes, tuple[str, int]], headings: dict[int, float],
+                  contact: dict[int, bool]) -> tuple[RobotCommand, ...]:  # fmt: skip
         data, peer = got
         try:
-            read = read_robot_control(data, self.team, headings, self.full_rpm)
+            read = read_robot_control(data, team, headings, self.full_rpm)
         except MessageError as exc:
             self.drops.drop("undecodable", f"{len(data)} bytes from {peer[0]}:{peer[1]}, {exc}")
             return ()
         self.packets += 1
         for _, why in read.errors:
             self._refuse(why)
-        self.robots.send_to(robot_control_response([Feedback(c.id) for c in read.commands],
-                                                   [SimError(UNSUPPORTED, why) for _, why in read.errors]), peer)
+        feedback = [Feedback(c.id, contact.get(c.id)) for c in read.commands]
+        self.robots[team].send_to(robot_control_response(feedback, [SimError(UNSUPPORTED, why)
+                                                                    for _, why in read.errors]), peer)  # fmt: skip
         return read.commands
 
     def _teleport(self, got: tuple[bytes, tuple[str, int]], gt: GroundTruth,
                   where: dict[tuple[Team, int], tuple[float, float, float]], publish: Publish) -> None:  # fmt: skip
         data, peer = got
         try:
-            tp, refused = read_simulator_command(data, gt.t, where, (gt.ball.x, gt.ball.y))
+            tp, refused = read_simulator_command(data, gt.t, where, (gt.ball.x, gt.ball.y), self.parked)
         except MessageError as exc:
             self.drops.drop("undecodable", f"{len(data)} bytes from {peer[0]}:{peer[1]}, {exc}")
             return
@@ -504,5 +541,11 @@ class SimulationInStage(SocketStage):
             "dropped": dict(sorted(self.drops.counts.items()))}))  # fmt: skip
 
     def close(self) -> None:
-        self.robots.close()
+        for endpoint in self.robots.values():
+            endpoint.close()
         self.control.close()
+
+
+def _teams(teams: Team | Sequence[Team]) -> tuple[Team, ...]:
+    """One team or several, as a tuple in the order given."""
+    return (teams,) if isinstance(teams, str) else tuple(teams)

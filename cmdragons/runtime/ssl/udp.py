@@ -118,7 +118,11 @@ class UdpEndpoint:
 
     def __init__(self, address: str, port: int = 0, max_bytes: int = 65507) -> None:
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
-        self.sock.bind((address, port))
+        try:
+            self.sock.bind((address, port))
+        except OSError:  # (a port another program holds) the socket is not left open
+            self.sock.close()
+            raise
         self.sock.setblocking(False)
         self.max_bytes = max_bytes
         self.port = self.sock.getsockname()[1]

@@ -2,15 +2,18 @@
 each camera's newest frame, the cameras and the field are learnt from the simulator's packets,
 the set-up is a checked table, grSim's commands go again each vision frame, and our team plays
 yellow in a simulator it reaches only through the league's protocols (our own embedded match
-serving the simulation protocol, in a thread): its tracked robots where the simulator's truth has
-them. Every socket on 127.0.0.1, TTL 0, on ports free at the time."""
+served by ``cmdragons sim --serve`` in another process): its tracked robots where the served
+truth has them. Every socket on 127.0.0.1, TTL 0, on ports free at the time."""
 
 from __future__ import annotations
 
 import itertools
+import json
 import math
-import socket
-import threading
+import signal
+import subprocess
+import sys
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -18,12 +21,11 @@ import pytest
 
 from cmdragons import messages as msg
 from cmdragons.geometry import Field
-from cmdragons.runtime.match import Match
+from cmdragons.runtime.log import read_log
 from cmdragons.runtime.outside import (
     NO_REFEREE,
     FrameGate,
     OutsideError,
-    OutsideMatch,
     SimulatorKind,
     field_settings,
     listen,
@@ -33,11 +35,11 @@ from cmdragons.runtime.outside import (
 from cmdragons.runtime.proto import grsim_pb2 as grsim_pb
 from cmdragons.runtime.settings import load_settings
 from cmdragons.runtime.ssl.stages import CommandsOutStage
-from cmdragons.runtime.ssl.udp import DatagramQueue, MulticastReceiver, UdpEndpoint
+from cmdragons.runtime.ssl.udp import DatagramQueue, UdpEndpoint
 from cmdragons.runtime.ssl.vision import decode_wrapper, geometry_packet
 from cmdragons.runtime.ssl.vision import detection_packet as packet
-from cmdragons.runtime.stages import Tap
 from cmdragons.runtime.topics import check_wiring
+from tests.runtime.conftest import free_udp_ports
 
 
 def _det(camera: int, frame: int) -> bytes:
@@ -144,16 +146,6 @@ def test_the_set_up_is_a_checked_table_without_our_simulator(kind: SimulatorKind
     assert p.vision.port == 10020 and p.commands_to == ("grsim" if kind is SimulatorKind.GRSIM else "simulation")
 
 
-def _free_ports(n: int) -> list[int]:
-    socks = [socket.socket(socket.AF_INET, socket.SOCK_DGRAM) for _ in range(n)]
-    for s in socks:
-        s.bind(("127.0.0.1", 0))
-    ports = [int(s.getsockname()[1]) for s in socks]
-    for s in socks:
-        s.close()
-    return ports
-
-
 def test_grsim_hears_the_last_commands_again_on_each_vision_frame(udp_port: int) -> None:
     settings = load_settings(None, [f"protocols.grsim.port={udp_port}"])
     p = vision_params(settings.protocols, SimulatorKind.GRSIM)
@@ -180,67 +172,55 @@ def test_grsim_hears_the_last_commands_again_on_each_vision_frame(udp_port: int)
         grsim.close()
 
 
+def _cmdragons(*args: str | Path) -> list[str]:
+    return [sys.executable, "-m", "cmdragons.cli", *map(str, args)]
+
+
 @pytest.mark.slow
-def test_our_team_plays_yellow_in_a_simulator_it_reaches_only_by_the_leagues_protocols() -> None:
-    vision, control, blue, yellow = _free_ports(4)
-    overrides = [f"protocols.vision.port={vision}", f"protocols.simulation.vision_port={vision}",
-                 f"protocols.simulation.control_port={control}", f"protocols.simulation.blue_port={blue}",
-                 f"protocols.simulation.yellow_port={yellow}", "protocols.outside.frame_wait_s=1.0",
-                 "protocols.outside.learn_s=0.3", "protocols.simulation.wait_s=0.2"]  # fmt: skip
-    settings = load_settings(None, overrides)
-    # the outside simulator: our own match serving yellow over the simulation protocol, its vision
-    # as SSL-Vision packets (noisy truth, one camera)
-    served = Match(settings, "simulation", "truth", seed=5)
-    truths: list[msg.GroundTruth] = []
-    served.bus.add(Tap("truths", ("truth",), lambda _t, m: truths.append(m)))
-    worlds: list[msg.WorldState] = []
-    errors: list[BaseException] = []
-    done = threading.Event()
-    summary: dict[str, Any] = {}
-
-    def ours() -> None:
-        p = vision_params(settings.protocols, SimulatorKind.SIM_PROTOCOL)
-        receiver = MulticastReceiver(p.vision.group, p.vision.port, p.interface, p.receive_buffer_bytes)
-        try:
-            heard = listen(receiver, 20.0, settings.protocols.outside.learn_s, "test")
-            played, line = field_settings(settings, heard.geometry)
-            assert line is None
-            match = OutsideMatch(played, SimulatorKind.SIM_PROTOCOL, ["yellow"], heard, receiver,
-                                 [Tap("worlds", ("world/yellow",), lambda _t, m: worlds.append(m))])  # fmt: skip
-            try:
-                match.skip_stale()
-                summary.update(match.run(60.0, done.is_set))
-            finally:
-                match.close()
-        except BaseException as exc:  # noqa: BLE001 (handed to the test's thread)
-            errors.append(exc)
-        finally:
-            done.set()
-
-    thread = threading.Thread(target=ours)
-    thread.start()
+def test_two_processes_play_our_team_in_the_served_simulator_as_in_any_league_simulator(tmp_path: Path) -> None:
+    """``sim --serve`` in one process, ``play --simulator sim-protocol`` in another: our team (blue,
+    on the served referee's word) sees the served field where the served truth has it and plays
+    the ball."""
+    vision, referee, control, blue, yellow = free_udp_ports(5)
+    sets = [f"protocols.simulation.vision_port={vision}", f"protocols.referee.port={referee}",
+            f"protocols.simulation.control_port={control}", f"protocols.simulation.blue_port={blue}",
+            f"protocols.simulation.yellow_port={yellow}", "protocols.referee.source=game_controller"]  # fmt: skip
+    flags = [x for k in sets for x in ("--set", k)]
+    served = subprocess.Popen(_cmdragons("sim", "--serve", "--seconds", 120, "--no-progress", "--seed", 3,
+                                         "--out", tmp_path / "served", *flags),
+                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)  # fmt: skip
     try:
-        for _ in range(900):  # 15 s of the served match
-            if done.is_set():
-                break
-            served.step()
+        ours = subprocess.run(_cmdragons("play", "--simulator", "sim-protocol", "--seconds", 12, "--no-progress",
+                                         "--out", tmp_path / "ours", *flags),
+                              capture_output=True, text=True, timeout=240)  # fmt: skip
     finally:
-        done.set()
-        thread.join(60.0)
-        served.close()
-    assert not errors, errors
-    assert summary["frames"] > 200 and summary["cameras"] == [0]
-    # our tracker saw yellow where the served simulator's truth had it (at the tracked time: the
-    # tracker hands on its state predicted to the time the commands act)
-    times = np.array([g.t for g in truths])
-    err = []
-    for w in worlds[30:]:
-        g = truths[int(np.argmin(np.abs(times - w.t)))]
-        true = {r.id: (r.x, r.y) for r in g.robots if r.team == "yellow"}
-        err += [math.hypot(r.x - true[r.id][0], r.y - true[r.id][1]) for r in w.robots
-                if r.team == "yellow" and r.id in true]  # fmt: skip
-    assert len(err) > 1000 and float(np.percentile(err, 95)) < 0.08
-    # and it played: yellow's robots went for the ball in the served simulator
-    near = [min(math.hypot(r.x - g.ball.x, r.y - g.ball.y) for r in g.robots if r.team == "yellow") for g in truths]
-    assert min(near[len(near) // 3 :]) < 0.15
-    assert summary["protocols"]["ssl/commands_out/yellow"]["answers"] > 100
+        served.send_signal(signal.SIGINT)
+        served_out, _ = served.communicate(timeout=60)
+    assert ours.returncode == 0, ours.stderr + ours.stdout
+    assert served.returncode == 130, served_out  # (stopped by SIGINT, its output written)
+    summary = json.loads((tmp_path / "ours" / "summary.json").read_text())
+    assert summary["seconds"] >= 12.0 and summary["cameras"] == [0, 1] and summary["simulator"] == "sim-protocol"
+    assert summary["protocols"]["ssl/commands_out/blue"]["answers"] > 100
+    assert summary["protocols"]["ssl/referee_in"]["packets"] > 100  # the served referee's word, followed
+    # our tracker against the served truth, frame by frame (its state is predicted to when the
+    # commands act: compared with the truth that many frames on)
+    truth = {m.frame_number: m for _topic, _t, m in read_log(tmp_path / "served" / "run.mcap", {"/truth"})}
+    ahead = round(load_settings().tracker.latency_s * load_settings().sim.physics.frame_rate_hz)
+    err: list[float] = []
+    for _topic, _t, w in read_log(tmp_path / "ours" / "run.mcap", {"/world/blue"}):
+        g = truth.get(w.frame_number + ahead)
+        if g is None:
+            continue
+        true = {(r.team, r.id): (r.x, r.y) for r in g.robots}
+        err += [math.hypot(r.x - true[r.team, r.id][0], r.y - true[r.team, r.id][1]) for r in w.robots
+                if r.visible and (r.team, r.id) in true]  # fmt: skip
+    assert len(err) > 3000 and float(np.percentile(err, 95)) < 0.08
+    # blue went for the ball and played it
+    frames = sorted(truth)
+    first, last = truth[frames[0]], truth[frames[-1]]
+    ball_path = sum(math.hypot(truth[b].ball.x - truth[a].ball.x, truth[b].ball.y - truth[a].ball.y)
+                    for a, b in itertools.pairwise(frames))  # fmt: skip
+    start = {r.id: (r.x, r.y) for r in first.robots if r.team == "blue"}
+    moved = max(math.hypot(r.x - start[r.id][0], r.y - start[r.id][1]) for r in last.robots
+                if r.team == "blue" and r.id in start)  # fmt: skip
+    assert ball_path > 1.0 and moved > 0.5

@@ -291,7 +291,8 @@ class OutsideMatch:
         outside = NO_REFEREE if settings.protocols.referee.source != "game_controller" else CLOCK
         for stage in build(table, [*extra, watch, self._summaries], outside=outside):
             self.bus.add(stage)
-        self.frames = 0
+        self.frames = 0  # the frame loop's turns (each when vision came)
+        self.worlds = 0  # our (first) team's world states: the simulator's vision frames we played on
         self.stage_ms: dict[str, list[float]] = {}
         self.bus.start()
 
@@ -304,6 +305,7 @@ class OutsideMatch:
     def _world(self, _topic: str, world: WorldState) -> None:
         self.t0 = world.t if self.t0 is None else self.t0
         self.t = world.t
+        self.worlds += 1
 
     @property
     def frames_behind(self) -> int:
@@ -376,7 +378,8 @@ def outside_summary(f: dict[str, Any], stage_ms: dict[str, list[float]], match: 
         "simulator": match.kind.value,
         "teams": list(match.teams),
         "seconds": round(match.seconds, 3),
-        "frames": match.frames,
+        "frames": match.worlds,
+        "loop_turns": match.frames,
         "frames_behind": match.frames_behind,
         "frames_waited_out": match.frames_waited_out,
         "cameras": list(match.heard.cameras),

@@ -19,6 +19,7 @@ import numpy as np
 
 from cmdragons.geometry import TEAMS, Team
 from cmdragons.messages import GameStage, GameState, RefereeCommand, TeamInfo
+from sim.restarts import RestartKind
 from sim.rules import RulesParams
 
 __all__ = [
@@ -227,11 +228,13 @@ class Cards:
 
 @dataclass
 class Placement:
-    """A ball placement under way: by ``team`` to ``target`` (field frame, m) since ``t_start`` (s)."""
+    """A ball placement under way: by ``team`` to ``target`` (field frame, m) since ``t_start`` (s),
+    for the restart ``then``."""
 
     team: Team
     target: tuple[float, float]
     t_start: float
+    then: RestartKind = RestartKind.PLACED_FREE_KICK  # the restart once the ball is placed
 
 
 @dataclass

@@ -24,6 +24,7 @@ the other team.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from typing import Literal
 
@@ -66,7 +67,7 @@ from sim.restarts import (
     penalty_mark,
     restart_of_call,
 )
-from sim.rules import FOUL_RESTARTS, FoulWatch, HeldBall, NoProgress, Situation, penalty_set, placed
+from sim.rules import FOUL_RESTARTS, FoulWatch, HeldBall, NoProgress, Situation, TrackMargins, penalty_set, placed
 
 __all__ = ["Referee"]
 
@@ -77,7 +78,11 @@ class Referee:
     """Keeps the score and the game state; restarts play by asking for teleports; with the full
     rules also the stages, fouls, cards, placements and penalties."""
 
-    def __init__(self, field: Field, robot_keys: Sequence[tuple[Team, int]], params: RefereeParams) -> None:
+    def __init__(self, field: Field, robot_keys: Sequence[tuple[Team, int]], params: RefereeParams,
+                 margins: TrackMargins = TrackMargins(), leave_s: float = 0.0) -> None:  # fmt: skip
+        """``margins`` and ``leave_s``: what judging tracked robots allows (the auto-referee on
+        vision): the foul watch's margins, and how long a robot sent off may still be seen on the
+        field before its team has too many robots (on the truth it leaves at once)."""
         self.field = field
         self.robot_keys = list(robot_keys)
         self.params = params
@@ -97,12 +102,16 @@ class Referee:
         self.full = params.enabled and params.rules == "full"
         self.rules = params.figures
         self.game = GameController(self.rules, halves=self.full)
-        self.watch = FoulWatch(field, self.rules)
+        self.watch = FoulWatch(field, self.rules, margins)
+        self.leave_s = leave_s
+        self._sent_off_t: dict[Team, float] = {}  # per team: when the referee last sent one of its robots off
+        self._too_many: set[Team] = set()  # teams called for too many robots, not down to what they may have since
         self.calls = Calls()
         self.cards = Cards(self.rules)
         self.tally = Tally()
         self._last_t = 0.0
-        self.moves = Moves(field, robot_keys, params.formations, params.park_distance_m)
+        self.moves = Moves(field, robot_keys, params.formations, params.park_distance_m,
+                           teleports=params.place_by == "teleport")  # fmt: skip
         self._truth: GroundTruth | None = None  # the last true state seen (where the robots stand)
 
     # --- commands ---------------------------------------------------------------------------
@@ -228,14 +237,19 @@ class Referee:
                        ball_xy: tuple[float, float]) -> None:  # fmt: skip
         """The restart due now: the ball (and robots) where it wants them, its command given."""
         t = self.t
+        by_robots = not self.moves.teleports
         if kind is RestartKind.FORCE_START or team is None:  # after no progress: where the ball lies, for both
             self._set(RefereeCommand.FORCE_START, None)
-        elif kind is RestartKind.KICKOFF and self.params.place_robots_on_goal:
+        elif by_robots and kind in (RestartKind.KICKOFF, RestartKind.PENALTY) \
+                and self.game.stage != GameStage.PENALTY_SHOOTOUT:  # fmt: skip
+            self._set(RefereeCommand.BALL_PLACEMENT, team)  # the kicking team puts the ball on its spot
+            self.game.placement = Placement(team, spot, t, kind.placed)
+        elif kind is RestartKind.KICKOFF and self.params.place_robots_on_goal and not by_robots:
             self.moves.append(self.kickoff_setup(team))
         elif kind is RestartKind.FREE_KICK and self.full and self._can_place(team):
             self._set(RefereeCommand.BALL_PLACEMENT, team)
             self.game.placement = Placement(team, spot, t)
-        elif kind is RestartKind.PENALTY:
+        elif kind in (RestartKind.PENALTY, RestartKind.PLACED_PENALTY):
             if self.game.stage == GameStage.PENALTY_SHOOTOUT:
                 self.moves.shootout_kick(self.t, self.cards.off, self.rules.keepers, team, spot,
                                          self._attack_sign(team), self.rules.penalty_behind_m)  # fmt: skip
@@ -246,8 +260,8 @@ class Referee:
             self.game.penalty = Penalty(team, t, spot)
             kicks = self.tally.shootout if self.game.stage == GameStage.PENALTY_SHOOTOUT else self.tally.penalties
             kicks[team]["taken"] += 1
-        else:
-            placed = kind is RestartKind.PLACED_FREE_KICK
+        else:  # with no teleports a free kick whose ball nobody may place is taken where the ball lies
+            placed = kind in (RestartKind.PLACED_FREE_KICK, RestartKind.PLACED_KICKOFF) or by_robots
             if not placed:
                 self.moves.add(self.t, ball=spot)
             self._set(kind.command, team)
@@ -335,6 +349,7 @@ class Referee:
     def _send_off(self, key: Key, red: bool) -> None:
         self.cards.off[key] = red
         self.moves.send_off(self.t, key)
+        self._sent_off_t[key[0]] = self.t
 
     def _follow_cards(self, dt: float, truth: GroundTruth) -> None:
         """Cards run while the game is not halted; a robot whose card ran out comes back at the
@@ -357,13 +372,18 @@ class Referee:
             allowed = self.cards.max_robots(team, self.robot_keys)
             extra = len(on) - allowed
             if extra <= 0:
+                self._too_many.discard(team)
                 continue
+            if team in self._too_many or self.t - self._sent_off_t.get(team, -math.inf) < self.leave_s:
+                continue  # called already (until the team is down to what it may have), or leaving now
+            self._too_many.add(team)
             ids = sorted((r.id for r in on), key=lambda rid: ((team, rid) not in self.cards.off, -rid))[:extra]
             self._call(GameEvent(self.t, "too_many_robots", team, ids[0], float(len(on)), float(allowed),
                                  "robots"))  # fmt: skip
             self._foul(team, None)
             for rid in ids:  # off (its card's robot back for good, any other until the end)
                 self.moves.send_off(self.t, (team, rid))
+            self._sent_off_t[team] = self.t
 
     # --- placement, penalty, stages ----------------------------------------------------------
     def _follow_placement(self, truth: GroundTruth) -> None:
@@ -378,13 +398,22 @@ class Referee:
         if done:
             self.tally.placed(pl.team, took)
             self._call(GameEvent(self.t, "placement_succeeded", pl.team, None, took, r.placement_time_s, "s"))
-            self._award(RestartKind.PLACED_FREE_KICK, pl.team, pl.target)
+            self._award(pl.then, pl.team, pl.target)
+        elif took > r.placement_time_s and pl.then is not RestartKind.PLACED_FREE_KICK:
+            # (no teleports) a kickoff or penalty whose ball its team did not place: taken where the ball lies
+            self.tally.failed(pl.team)
+            self._call(GameEvent(self.t, "placement_failed", pl.team, None, off, r.placement_tolerance_m, "m",
+                                 pl.then.command, pl.team))  # fmt: skip
+            self._award(pl.then, pl.team, (truth.ball.x, truth.ball.y))
         elif took > r.placement_time_s:
             self.tally.failed(pl.team)
             self._call(GameEvent(self.t, "placement_failed", pl.team, None, off, r.placement_tolerance_m, "m",
                                  RefereeCommand.FREE_KICK, other(pl.team)))  # fmt: skip
-            self.moves.add(self.t, ball=pl.target)  # the referee places it
-            self._award(RestartKind.PLACED_FREE_KICK, other(pl.team), pl.target)
+            if self.moves.teleports:
+                self.moves.add(self.t, ball=pl.target)  # the referee places it
+                self._award(RestartKind.PLACED_FREE_KICK, other(pl.team), pl.target)
+            else:  # the other team's free kick, placed by it if it may
+                self._award(RestartKind.FREE_KICK, other(pl.team), pl.target)
 
     def _follow_penalty(self, truth: GroundTruth) -> None:
         pen = self.game.penalty
@@ -436,7 +465,10 @@ class Referee:
             self.blue_sign = -1 if self.blue_sign > 0 else 1
             self._restart = None
             self.game.clear_special()
-            self.moves.append(self.kickoff_setup("yellow"))
+            if self.moves.teleports:
+                self.moves.append(self.kickoff_setup("yellow"))
+            else:  # the ball placed on the centre spot by the kicking team first
+                self._award(RestartKind.KICKOFF, "yellow", (0.0, 0.0))
         elif stage is GameStage.PENALTY_SHOOTOUT:
             self._shootout_teams()
             self._call(GameEvent(self.t, f"stage_{self.game.stage}"))

@@ -1,5 +1,7 @@
 """configs/sim.yaml's ``referee``: how the simulator's referee runs (which rules, the restarts' delays
-and timeouts, the kickoff formations) and the league's figures it judges by (:class:`sim.rules.RulesParams`)."""
+and timeouts, the kickoff formations), the league's figures it judges by (:class:`sim.rules.RulesParams`)
+and what it allows for tracks' noise when it judges vision's world as an auto-referee
+(:class:`AutorefParams`)."""
 
 from __future__ import annotations
 
@@ -8,9 +10,9 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 from cmdragons.config import Validated, setting
-from sim.rules import RulesParams
+from sim.rules import RulesParams, TrackMargins
 
-__all__ = ["RefereeParams"]
+__all__ = ["AutorefParams", "RefereeParams"]
 
 _Pose = tuple[float, float, float]
 _DEFAULT_FORMATIONS: dict[Literal["A", "B"], tuple[_Pose, ...]] = {
@@ -23,11 +25,30 @@ _DEFAULT_FORMATIONS: dict[Literal["A", "B"], tuple[_Pose, ...]] = {
 
 
 @dataclass(frozen=True)
+class AutorefParams(Validated):
+    """configs/sim.yaml ``referee.autoref``: the referee judging the tracked world (no truth): how it
+    tells a touch of the ball from the ball's track and what it allows for the tracks' noise."""
+
+    # a touch (the kick detector): the ball's tracked velocity changing by more than this from one frame
+    # to the next ...
+    kick_speed_change_m_s: float = setting(0.8, lo=0.05, hi=20.0)
+    kick_reach_m: float = setting(0.05, lo=0.0, hi=1.0)  # ... a robot's body this near the ball ...
+    kick_memory_s: float = setting(0.1, lo=0.0, hi=2.0)  # ... at some moment of the last this long
+    margins: TrackMargins = TrackMargins(touch_release_m=0.01, contact_release_m=0.0, distance_m=0.05, speed_m_s=0.1,
+                                        fast_ball_frames=2)
+    leave_s: float = setting(2.0, lo=0.0, hi=60.0)  # a robot sent off may be seen on the field this long
+
+
+@dataclass(frozen=True)
 class RefereeParams(Validated):
     enabled: bool = True  # off: no restarts, the ball bounces off the boundary walls
     rules: Literal["full", "basic"] = "full"  # full: the league's game controller and auto-referee
     blue_defends: Literal["negative_x", "positive_x"] = "negative_x"
     restart_delay_s: float = setting(1.0, lo=0.0, hi=30.0)  # goal or out -> ball placed
+    # who puts the ball where a restart wants it: the referee by teleport (the kickoffs, penalties and
+    # balls the teams failed to place; a free kick is the taking team's placement first, with the full
+    # rules), or only ever the teams' ball placement (robots: no teleport at all)
+    place_by: Literal["teleport", "robots"] = "teleport"
     place_robots_on_goal: bool = True  # put both teams in their kickoff formation after a goal
     free_kick_distance_m: float = setting(0.2, lo=0.0, hi=2.0)  # from the lines and defense areas
     restart_timeout_s: float = setting(10.0, lo=0.1, hi=600.0)  # a restart not taken by then: play on
@@ -40,3 +61,4 @@ class RefereeParams(Validated):
     )
     figures: RulesParams = RulesParams()  # the league's figures for the full rules
     park_distance_m: float = setting(3.0, lo=0.5, hi=50.0)  # robots sent off wait this far outside the boundary
+    autoref: AutorefParams = AutorefParams()  # judging the tracked world (an outside simulator, vision)

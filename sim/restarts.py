@@ -49,6 +49,8 @@ class RestartKind(enum.Enum):
     KICKOFF = "kickoff"  # the ball on the centre spot (and, if configured, both teams in formation)
     FREE_KICK = "free_kick"  # the taking team places the ball if it may, else the referee puts it there
     PLACED_FREE_KICK = "placed_free_kick"  # the ball placed already: the free kick where it lies
+    PLACED_KICKOFF = "placed_kickoff"  # the ball placed on the centre spot by the kicking team (no teleport)
+    PLACED_PENALTY = "placed_penalty"  # the ball placed on the mark by the kicking team (no teleport)
     REFEREE_FREE_KICK = "referee_free_kick"  # the referee puts the ball on the spot (a free kick by hand)
     PENALTY = "penalty"  # the ball on the mark
     FORCE_START = "force_start"  # for both teams, where the ball lies (after no progress)
@@ -58,12 +60,19 @@ class RestartKind(enum.Enum):
         """The command this restart gives once the ball is in place."""
         return _COMMANDS[self]
 
+    @property
+    def placed(self) -> RestartKind:
+        """This restart once the taking team has placed the ball for it."""
+        return _PLACED.get(self, RestartKind.PLACED_FREE_KICK)
+
 
 _COMMANDS = {
     RestartKind.KICKOFF: RefereeCommand.KICKOFF, RestartKind.FREE_KICK: RefereeCommand.FREE_KICK,
     RestartKind.PLACED_FREE_KICK: RefereeCommand.FREE_KICK, RestartKind.REFEREE_FREE_KICK: RefereeCommand.FREE_KICK,
     RestartKind.PENALTY: RefereeCommand.PENALTY, RestartKind.FORCE_START: RefereeCommand.FORCE_START,
+    RestartKind.PLACED_KICKOFF: RefereeCommand.KICKOFF, RestartKind.PLACED_PENALTY: RefereeCommand.PENALTY,
 }  # fmt: skip
+_PLACED = {RestartKind.KICKOFF: RestartKind.PLACED_KICKOFF, RestartKind.PENALTY: RestartKind.PLACED_PENALTY}
 
 
 @dataclass(frozen=True)
@@ -204,18 +213,22 @@ class Moves:
     ball put down, for a shootout kick."""
 
     def __init__(self, pitch: Field, keys: Sequence[Key], formations: Mapping[Literal["A", "B"], Sequence[Pose]],
-                 park_distance_m: float) -> None:  # fmt: skip
+                 park_distance_m: float, teleports: bool = True) -> None:  # fmt: skip
+        """``teleports``: False when nothing may be placed by teleport (the teams place the ball, the
+        robot handlers move the robots): every move asked for is left out."""
         self.field = pitch
+        self.teleports = teleports
         self.keys = list(keys)
         self.formations = formations
         self.park_distance_m = park_distance_m
         self.pending: list[Teleport] = []
 
     def add(self, t: float, robots: Sequence[Move] = (), ball: tuple[float, float] | None = None) -> None:
-        self.pending.append(Teleport(t, tuple(robots), ball))
+        self.append(Teleport(t, tuple(robots), ball))
 
     def append(self, teleport: Teleport) -> None:
-        self.pending.append(teleport)
+        if self.teleports:
+            self.pending.append(teleport)
 
     def moving(self) -> set[Key]:
         """The robots placed this frame so far."""

@@ -18,7 +18,8 @@ from cmdragons.geometry import Field, Team
 from cmdragons.messages import GameEvent, GroundTruth, RefereeCommand, RobotTruth
 from sim.restarts import other
 
-__all__ = ["FOUL_RESTARTS", "FoulWatch", "HeldBall", "NoProgress", "RulesParams", "Situation", "penalty_set", "placed"]
+__all__ = ["FOUL_RESTARTS", "FoulWatch", "HeldBall", "NoProgress", "RulesParams", "Situation", "TrackMargins",
+           "penalty_set", "placed"]
 
 Key = tuple[Team, int]
 
@@ -72,6 +73,23 @@ class RulesParams(Validated):
 
 
 @dataclass(frozen=True)
+class TrackMargins(Validated):
+    """What a watch on tracked positions allows for their noise (configs/sim.yaml referee.autoref;
+    none on the simulator's truth): a touch or a contact, once begun, lasts until the ball or the
+    robots are this much farther apart than where it began, so a track's jitter at the edge does not
+    end and start it again (a double touch, a second crash that never happened)."""
+
+    touch_release_m: float = setting(0.0, lo=0.0, hi=0.5)
+    contact_release_m: float = setting(0.0, lo=0.0, hi=0.5)
+    # a distance foul (at a stop, at the other team's free kick) only this far inside the rule's distance,
+    # a speed foul at a stop only this much over the rule's speed: the benefit of the tracks' doubt
+    distance_m: float = setting(0.0, lo=0.0, hi=0.5)
+    speed_m_s: float = setting(0.0, lo=0.0, hi=2.0)
+    # the ball too fast in this many frames in a row (a track's velocity overshoots for a frame after a kick)
+    fast_ball_frames: int = setting(1, lo=1, hi=100)
+
+
+@dataclass(frozen=True)
 class Situation:
     """What the checks need of the game controller this frame."""
 
@@ -103,10 +121,10 @@ def _team_sign(team: Team, blue_sign: int) -> int:
 
 
 class FoulWatch:
-    """Frame-by-frame foul detection on the true state."""
+    """Frame-by-frame foul detection on the true state (or, with ``margins``, on tracks)."""
 
-    def __init__(self, pitch: Field, params: RulesParams) -> None:
-        self.field, self.p = pitch, params
+    def __init__(self, pitch: Field, params: RulesParams, margins: TrackMargins = TrackMargins()) -> None:
+        self.field, self.p, self.margins = pitch, params, margins
         self.robot_r = pitch.league.robot.radius_m
         self.ball_r = pitch.league.ball.radius_m
         self.touching: dict[Key, _Touch] = {}
@@ -118,6 +136,7 @@ class FoulWatch:
         self._restart_kicker: Key | None = None  # a restart's kicker until another robot touched the ball
         self._kicker_left = False  # ... and whether it let go of the ball since
         self._fast_ball_called = False
+        self._fast_frames = 0  # frames in a row the ball was too fast
 
     def kicked(self, kicker: Key) -> None:
         """The simulator's kicker fired: a touch, however short (a kick can leave before a frame shows it)."""
@@ -161,8 +180,9 @@ class FoulWatch:
         margin, the ball on the ground); returns those that started touching it this frame."""
         b = gt.ball
         reach = self.robot_r + self.ball_r + self.p.touch_margin_m
+        release = self.margins.touch_release_m
         now = {(r.team, r.id) for r in robots if b.z < 2.0 * self.ball_r + 0.05
-               and math.hypot(r.x - b.x, r.y - b.y) < reach}  # fmt: skip
+               and math.hypot(r.x - b.x, r.y - b.y) < reach + (release if (r.team, r.id) in self.touching else 0.0)}
         new = [k for k in sorted(now) if k not in self.touching]
         for k in list(self.touching):
             if k not in now:
@@ -207,7 +227,7 @@ class FoulWatch:
                 d = math.hypot(dx, dy)
                 ka, kb = (a.team, a.id), (b.team, b.id)
                 pair = (ka, kb)
-                if d >= touch or d < 1e-9:
+                if d >= touch + (self.margins.contact_release_m if pair in self._contacts else 0.0) or d < 1e-9:
                     continue
                 seen.add(pair)
                 n = (dx / d, dy / d)
@@ -247,7 +267,8 @@ class FoulWatch:
         """Ball speed over ``ball_speed_limit_m_s``: the last robot to touch it is at fault (once a touch)."""
         b = gt.ball
         speed = math.sqrt(b.vx * b.vx + b.vy * b.vy + b.vz * b.vz)
-        if speed <= self.p.ball_speed_limit_m_s or self._fast_ball_called or self.last_touch is None:
+        self._fast_frames = self._fast_frames + 1 if speed > self.p.ball_speed_limit_m_s else 0
+        if self._fast_frames < self.margins.fast_ball_frames or self._fast_ball_called or self.last_touch is None:
             return []
         self._fast_ball_called = True
         return [self._event(gt.t, "ball_too_fast", self.last_touch, speed, self.p.ball_speed_limit_m_s, "m/s")]
@@ -319,10 +340,10 @@ class FoulWatch:
         for r in robots:
             k = (r.team, r.id)
             speed = math.hypot(r.vx, r.vy)
-            if speed > self.p.stop_speed_m_s and self._once("stop_speed", k):
+            if speed > self.p.stop_speed_m_s + self.margins.speed_m_s and self._once("stop_speed", k):
                 out.append(self._event(gt.t, "stop_speed", k, speed, self.p.stop_speed_m_s, "m/s"))
             gap = self._gap(r, gt)
-            if gap < self.p.stop_distance_m and self._once("stop_distance", k):
+            if gap < self.p.stop_distance_m - self.margins.distance_m and self._once("stop_distance", k):
                 out.append(self._event(gt.t, "stop_distance", k, gap, self.p.stop_distance_m, "m"))
         return out
 
@@ -334,7 +355,7 @@ class FoulWatch:
             if r.team != defending:
                 continue
             gap = self._gap(r, gt)
-            if gap < self.p.kick_point_distance_m and self._once("kick_point_distance", k):
+            if gap < self.p.kick_point_distance_m - self.margins.distance_m and self._once("kick_point_distance", k):
                 out.append(self._event(gt.t, "kick_point_distance", k, gap, self.p.kick_point_distance_m, "m"))
         return out
 

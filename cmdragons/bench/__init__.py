@@ -46,6 +46,7 @@ SUITES: dict[str, Suite] = {
     "goalie": _lazy("cmdragons.bench.goalie"),
     "runtime": _lazy("cmdragons.bench.runtime"),
     "protocols": _lazy("cmdragons.bench.protocols"),
+    "autoref": _lazy("cmdragons.bench.autoref"),
 }
 # what each suite measures, one line each (``cmdragons bench -h``)
 ABOUT: dict[str, str] = {
@@ -62,6 +63,7 @@ ABOUT: dict[str, str] = {
     "goalie": "what the goalie's escape/evade reflex is worth on seeded shots",
     "runtime": "the distributed runtime on zenoh against the embedded one",
     "protocols": "the league's packets through loopback: size, encode and decode time, none lost",
+    "autoref": "the auto-referee on vision against the referee on the truth: calls both made, calls of its own",
 }
 # the options each suite takes
 OPTIONS: dict[str, tuple[str, ...]] = {"grid": ("maps",), "navigation": ("figures",),

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -298,16 +298,20 @@ class TrackerStage(BaseStage):
     frame is closed when the last comes: the same work in the same order as taking them together,
     but done while the other cameras are still being seen (in another process, the tracker works on
     the first camera while vision works on the second). Otherwise a frame's detections wait for
-    one another and are taken in capture-time order."""
+    one another and are taken in capture-time order.
+
+    ``team`` names its topics (``world/<team>``); a tracker of no team (the auto-referee's,
+    ``autoref``) takes no commands."""
 
     @staticmethod
-    def declare(team: Team, detection_topics: Sequence[str], take_commands: bool = True) -> Contract:
+    def declare(team: Team | Literal["autoref"], detection_topics: Sequence[str],
+                take_commands: bool = True) -> Contract:  # fmt: skip
         name = f"tracker/{team}"
         return Contract(name, (*(Port(t, DetectionFrame) for t in detection_topics),
                                *((Port(f"commands/{team}", TeamCommands),) if take_commands else ())),
                         (Port(f"world/{team}", WorldState), summary_port(name)))  # fmt: skip
 
-    def __init__(self, team: Team, tracker: Tracker, detection_topics: Sequence[str],
+    def __init__(self, team: Team | Literal["autoref"], tracker: Tracker, detection_topics: Sequence[str],
                  take_commands: bool = True, synchronized: bool = False) -> None:  # fmt: skip
         self.contract = self.declare(team, detection_topics, take_commands)
         self.team = team

@@ -35,24 +35,25 @@ from typing import Any
 import numpy as np
 
 from cmdragons.geometry import Team
-from cmdragons.messages import GameState, MessageError, WorldState
+from cmdragons.messages import MessageError, WorldState
+from cmdragons.runtime.autoref import autoref_rows
 from cmdragons.runtime.bus import Bus, Stage, Transport
-from cmdragons.runtime.match import CLOCK, Entry, build
+from cmdragons.runtime.match import Entry, build
 from cmdragons.runtime.settings import Settings
 from cmdragons.runtime.ssl.params import CommandsTo, ProtocolParams
 from cmdragons.runtime.ssl.stages import (
     CommandsOutStage,
     RefereeInStage,
+    RefereeOutStage,
     TrackerOutStage,
     VisionInStage,
     close_sockets,
 )
 from cmdragons.runtime.ssl.vision import VisionGeometry, decode_wrapper, field_dims_of
 from cmdragons.runtime.stages import SummaryCollector, Tap, TeamStage, TimingStage, TrackerStage
-from cmdragons.runtime.topics import Port
 
-__all__ = ["Heard", "OutsideError", "OutsideMatch", "SimulatorKind", "field_settings", "listen", "outside_wiring",
-           "outside_summary"]  # fmt: skip
+__all__ = ["FrameGate", "Heard", "OutsideError", "OutsideMatch", "SimulatorKind", "field_settings", "listen",
+           "outside_summary", "outside_wiring", "vision_params"]  # fmt: skip
 
 
 class SimulatorKind(enum.Enum):
@@ -130,11 +131,12 @@ class FrameGate:
 @dataclass(frozen=True)
 class Heard:
     """What the simulator's vision said before the match: its geometry, its cameras (those whose
-    detections came) and the packets heard."""
+    detections came), the packets heard and the robots seen."""
 
     geometry: VisionGeometry
     cameras: tuple[int, ...]
     packets: int
+    robots: tuple[tuple[Team, int], ...] = ()  # (team, id) of every robot seen
 
     @property
     def uncalibrated(self) -> tuple[int, ...]:
@@ -144,16 +146,18 @@ class Heard:
 
 def listen(receiver: Any, timeout_s: float, learn_s: float, where: str,
            clock: Callable[[], float] = time.monotonic) -> Heard:  # fmt: skip
-    """Read the simulator's SSL-Vision packets until its geometry and a detection came and
-    ``learn_s`` passed (the cameras it sends from); :class:`OutsideError` naming ``where`` when they
-    have not within ``timeout_s``."""
+    """Read the simulator's SSL-Vision packets until its geometry came and ``learn_s`` passed since
+    its first detection (the cameras it sends from are those heard by then); :class:`OutsideError`
+    naming ``where`` when neither came within ``timeout_s``."""
     t0 = clock()
     geometry: VisionGeometry | None = None
     seen: set[int] = set()
+    robots: set[tuple[Team, int]] = set()
     packets = undecodable = 0
+    t_first: float | None = None  # when the first detection came
     while True:
         now = clock()
-        if geometry is not None and seen and now - t0 >= learn_s:
+        if geometry is not None and t_first is not None and now - t_first >= learn_s:
             break
         if now - t0 >= timeout_s:
             lacks = " and ".join(w for w, got in (("a geometry", geometry), ("a detection", seen)) if not got)
@@ -173,9 +177,11 @@ def listen(receiver: Any, timeout_s: float, learn_s: float, where: str,
         if geo is not None:
             geometry = geo
         if det is not None:
+            t_first = clock() if t_first is None else t_first
             seen.add(det.camera_id)
+            robots.update((r.team, r.id) for r in det.robots)
     assert geometry is not None
-    return Heard(geometry, tuple(sorted(seen)), packets)
+    return Heard(geometry, tuple(sorted(seen)), packets, tuple(sorted(robots)))
 
 
 # the sizes a geometry packet gives, compared with field.yaml's (m)
@@ -209,17 +215,17 @@ def field_settings(settings: Settings, geometry: VisionGeometry) -> tuple[Settin
 
 
 def outside_wiring(settings: Settings, kind: SimulatorKind, teams: Sequence[Team], cameras: Sequence[int],
-                   receiver: Any) -> list[Entry]:  # fmt: skip
+                   receiver: Any, robots: Sequence[tuple[Team, int]]) -> list[Entry]:  # fmt: skip
     """The table of a match in an outside simulator: the simulator's SSL-Vision packets (``cameras``,
     read from ``receiver``) into each of our ``teams``' tracker and brain, their commands out to
-    the simulator (``kind``). The referee: a game controller's packets with
-    ``protocols.referee.source: game_controller``; else none yet, and the teams play on as in
-    normal play (see :data:`NO_REFEREE`)."""
+    the simulator (``kind``; the referee's teleports through the first team's stage). The referee:
+    ours on the tracked world (the autoref, for the match's ``robots``), or a game controller's
+    packets with ``protocols.referee.source: game_controller``."""
     p = vision_params(settings.protocols, kind)
     topics = [f"ssl/vision/{c}" for c in cameras]
     entries = [Entry(VisionInStage.declare(p, cameras, False), "",
                      lambda: VisionInStage(p, cameras, lockstep=False, receiver=receiver))]  # fmt: skip
-    referee, referee_topic, teleports = _referee(settings, p, teams[0])
+    referee, referee_topic, teleports = _referee(settings, p, teams[0], topics, robots)
     entries += referee
     chip = settings.sim.kicker.chip_angle_rad
     for k, team in enumerate(teams):
@@ -237,19 +243,20 @@ def outside_wiring(settings: Settings, kind: SimulatorKind, teams: Sequence[Team
     return entries
 
 
-def _referee(settings: Settings, p: ProtocolParams, ours: Team) -> tuple[list[Entry], str, bool]:
+def _referee(settings: Settings, p: ProtocolParams, ours: Team, topics: Sequence[str],
+             robots: Sequence[tuple[Team, int]]) -> tuple[list[Entry], str, bool]:  # fmt: skip
     """The referee's rows, the topic of its word and whether it teleports: a game controller's
-    packets (``protocols.referee.source: game_controller``), else none yet."""
+    packets (``protocols.referee.source: game_controller``), else our referee on the tracked world
+    (the autoref: its own tracker on every camera's packets ``topics``, judging the match's
+    ``robots``), with its Referee packets out when ``protocols.referee.send``."""
     if p.referee.source == "game_controller":
         world_topic, moved_m = f"world/{ours}", settings.sim.referee.figures.ball_in_play_m
         return [Entry(RefereeInStage.declare(p, world_topic), "",
                       lambda: RefereeInStage(p, world_topic, moved_m))], "referee/gc", False  # fmt: skip
-    return [], "referee", False
-
-
-# what comes from outside the table: the runtime's clock, and the referee's word while no
-# referee of ours judges the outside simulator's game (the teams then play on in normal play)
-NO_REFEREE = (*CLOCK, Port("referee", GameState))
+    rows = autoref_rows(settings, topics, robots)
+    if p.referee.send:
+        rows.append(Entry(RefereeOutStage.contract, "", functools.partial(RefereeOutStage, p)))
+    return rows, "referee", settings.sim.referee.place_by == "teleport"
 
 
 def _tracker(team: Team, settings: Settings, topics: Sequence[str]) -> Stage:
@@ -285,11 +292,10 @@ class OutsideMatch:
         self.t0: float | None = None  # the first world state's capture time (s, the simulator's clock)
         self.t = math.nan  # the newest
         self.frames_waited_out = 0  # frames whose vision did not come within the wait
-        table = outside_wiring(settings, kind, teams, heard.cameras, self.gate)
+        table = outside_wiring(settings, kind, teams, heard.cameras, self.gate, heard.robots)
         self.table = table
         watch = Tap("outside/clock", (f"world/{teams[0]}",), self._world)
-        outside = NO_REFEREE if settings.protocols.referee.source != "game_controller" else CLOCK
-        for stage in build(table, [*extra, watch, self._summaries], outside=outside):
+        for stage in build(table, [*extra, watch, self._summaries]):
             self.bus.add(stage)
         self.frames = 0  # the frame loop's turns (each when vision came)
         self.worlds = 0  # our (first) team's world states: the simulator's vision frames we played on

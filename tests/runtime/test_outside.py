@@ -22,8 +22,8 @@ import pytest
 from cmdragons import messages as msg
 from cmdragons.geometry import Field
 from cmdragons.runtime.log import read_log
+from cmdragons.runtime.match import CLOCK
 from cmdragons.runtime.outside import (
-    NO_REFEREE,
     FrameGate,
     OutsideError,
     SimulatorKind,
@@ -87,6 +87,7 @@ def test_listening_learns_the_cameras_that_send_and_the_geometry() -> None:
     settings = load_settings()
     geometry = geometry_packet(settings.field_geometry(), settings.camera_models())  # calibrates cameras 0 and 1
     heard = listen(_queue(_det(3, 1), _det(7, 1), geometry, _det(3, 2)), 5.0, 0.1, "here", _clock(0.01))
+    assert heard.robots == ()
     assert heard.cameras == (3, 7)
     assert heard.geometry.field_length_m == pytest.approx(9.0)
     assert heard.packets == 4
@@ -134,10 +135,15 @@ def test_the_field_is_the_simulators_and_a_difference_is_one_line() -> None:
 @pytest.mark.parametrize("teams", [["blue"], ["yellow"], ["blue", "yellow"]])
 def test_the_set_up_is_a_checked_table_without_our_simulator(kind: SimulatorKind, teams: list[Any]) -> None:
     settings = load_settings()
-    table = outside_wiring(settings, kind, teams, [0, 1, 2, 3], DatagramQueue())
-    check_wiring([e.contract for e in table], NO_REFEREE)
+    robots = [(t, i) for t in ("blue", "yellow") for i in range(6)]
+    table = outside_wiring(settings, kind, teams, [0, 1, 2, 3], DatagramQueue(), robots)
+    check_wiring([e.contract for e in table], CLOCK)
     names = {e.contract.name for e in table}
-    assert not names & {"sim", "referee"} and not any(n.startswith(("vision/", "perception/")) for n in names)
+    assert "sim" not in names and not any(n.startswith(("vision/", "perception/")) for n in names)
+    # refereed by our referee on its own tracked world of every camera, its teleports sent by one team's stage
+    assert {"tracker/autoref", "autoref"} <= names
+    takes = [e.contract.name for e in table if "teleport" in e.contract.inputs]
+    assert takes == [f"ssl/commands_out/{teams[0]}"]
     for team in teams:
         assert {f"tracker/{team}", f"team/{team}", f"ssl/commands_out/{team}"} <= names
     tracker = next(e.contract for e in table if e.contract.name == f"tracker/{teams[0]}")
@@ -214,7 +220,7 @@ def test_two_processes_play_our_team_in_the_served_simulator_as_in_any_league_si
         true = {(r.team, r.id): (r.x, r.y) for r in g.robots}
         err += [math.hypot(r.x - true[r.team, r.id][0], r.y - true[r.team, r.id][1]) for r in w.robots
                 if r.visible and (r.team, r.id) in true]  # fmt: skip
-    assert len(err) > 3000 and float(np.percentile(err, 95)) < 0.08
+    assert len(err) > 1000 and float(np.percentile(err, 95)) < 0.08
     # blue went for the ball and played it
     frames = sorted(truth)
     first, last = truth[frames[0]], truth[frames[-1]]

@@ -95,7 +95,7 @@ class OutsideParams(Validated):
     """A match in an outside simulator (``play --simulator grsim|sim-protocol``)."""
 
     geometry_timeout_s: float = setting(10.0, lo=0.1, hi=600.0)  # before the match: its geometry must come by then
-    learn_s: float = setting(0.5, lo=0.0, hi=60.0)  # before the match: its cameras are those heard this long
+    learn_s: float = setting(0.5, lo=0.0, hi=60.0)  # its cameras: those heard this long from the first detection on
     frame_wait_s: float = setting(2.0, lo=0.01, hi=600.0)  # no vision for this long ends the match
 
 

@@ -346,9 +346,9 @@ class CommandsOutStage(SocketStage):
     or the simulation protocol (``RobotControl`` to the team's port); our referee's teleports as
     ``SimulatorCommand`` to the simulation protocol's control port (grSim takes them there too;
     ``teleports``: this team's stage sends them, one of a match's does). Velocities go in each
-    robot's frame by its heading in our tracker's latest world state. grSim stops a robot whose last packet is older than one of its frames: on each world
-    state (a vision frame) the last packet goes again, with the new headings, before the frame's
-    own commands come. The simulators' answers are read and counted."""
+    robot's frame by its heading in our tracker's latest world state. grSim stops a robot whose last
+    packet is older than one of its frames: on each world state (a vision frame) the last packet
+    goes again, with the new headings, before the frame's own commands come. The simulators' answers are read and counted."""
 
     @staticmethod
     def declare(params: ProtocolParams, team: Team, chip_angle_rad: float = 0.0, teleports: bool = True) -> Contract:

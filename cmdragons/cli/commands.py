@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Any, NoReturn
 
 import numpy as np
 
+from cmdragons.cli.lines import plural, rules_line
 from cmdragons.cli.progress import compile_bar, progress_bar, run_shown, starting
 from cmdragons.cli.runtime import add_parsers as add_runtime_parsers
 from cmdragons.cli.runtime import cmd_log, cmd_node, cmd_replay, play_distributed
@@ -339,10 +340,10 @@ def _finish_sim(args: argparse.Namespace, stop: Interrupt, sim: Any, models: Seq
     score = summary["score"]
     print(
         f"sim: {sim.t:.1f} s simulated in {wall:.1f} s ({summary['realtime_factor']}x real time), "
-        f"{_plural(summary['frames'], 'frame')} x {_plural(len(models), 'camera')}, score blue "
-        f"{score['blue']}:{score['yellow']} yellow, {_plural(summary['kicks'], 'kick')}, "
-        f"{_plural(summary['balls_out'], 'ball')} out, {_plural(summary['robot_contacts']['count'], 'robot contact')}, "
-        f"{_plural(faults, 'command fault')}"
+        f"{plural(summary['frames'], 'frame')} x {plural(len(models), 'camera')}, score blue "
+        f"{score['blue']}:{score['yellow']} yellow, {plural(summary['kicks'], 'kick')}, "
+        f"{plural(summary['balls_out'], 'ball')} out, {plural(summary['robot_contacts']['count'], 'robot contact')}, "
+        f"{plural(faults, 'command fault')}"
     )
     code = stop.exit_code
     if args.snapshot and images and not cv2.imwrite(args.snapshot, tile_cameras(images, models)):
@@ -350,7 +351,7 @@ def _finish_sim(args: argparse.Namespace, stop: Interrupt, sim: Any, models: Seq
               file=sys.stderr)  # fmt: skip
         code = code or 1
     if stop.requested:
-        print(f"sim: interrupted by {stop.signal} after {_plural(summary['frames'], 'frame')} of {n_frames}: "
+        print(f"sim: interrupted by {stop.signal} after {plural(summary['frames'], 'frame')} of {n_frames}: "
               "the output so far is closed and readable, summary.json says \"interrupted\": true")  # fmt: skip
     print(f"sim: output -> {folder}")
     return code
@@ -461,10 +462,6 @@ def _utc(t: float) -> str:
     return dt.datetime.fromtimestamp(t, dt.UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
 
 
-def _plural(n: int, word: str, many: str | None = None) -> str:
-    return f"{n} {word if n == 1 else (many or word + 's')}"
-
-
 def _finish_play(folder: Path, run: RunData, summary: dict[str, Any], args: argparse.Namespace, stop: Interrupt,
                  half_size_m: tuple[float, float]) -> None:  # fmt: skip
     """summary.json (with its warnings), the match report of ``run`` and the summary lines; the last
@@ -486,13 +483,13 @@ def _finish_play(folder: Path, run: RunData, summary: dict[str, Any], args: argp
     print(
         f"play: {played} against {args.opponent} ({args.perception}) in {summary['wall_seconds']:.1f} s "
         f"({rtf}x real time{compile_note}): blue (us) {score['blue']}:{score['yellow']} yellow (them); ours: "
-        f"{_plural(summary['shots'], 'shot')}, passes {passes['completed']}/{passes['tried']} completed, "
-        f"{_plural(coll['own'], 'own collision')}{_pushed(coll)}; brain {brain:.2f} ms median"
+        f"{plural(summary['shots'], 'shot')}, passes {passes['completed']}/{passes['tried']} completed, "
+        f"{plural(coll['own'], 'own collision')}{_pushed(coll)}; brain {brain:.2f} ms median"
         + _their_line(summary)
     )
     rules = summary.get("rules")
     if rules is not None and rules["rules"] == "full":
-        print("play: " + _rules_line(rules))
+        print("play: " + rules_line(rules))
     for w in warnings:
         print(f"play: warning: {w}")
     if stop.requested:
@@ -501,23 +498,6 @@ def _finish_play(folder: Path, run: RunData, summary: dict[str, Any], args: argp
     files = ["run.mcap", "summary.json"] + (["match.mp4"] if args.video and (folder / "match.mp4").exists() else [])
     files += [report.name] if report is not None else []
     print(f"play: {', '.join(files)} -> {folder}")
-
-
-def _rules_line(rules: dict[str, Any]) -> str:
-    """The referee's calls per team: fouls by kind, cards, placements tried and succeeded."""
-    parts = []
-    for team, who in (("blue", "us"), ("yellow", "them")):
-        fouls = rules["fouls"][team]
-        kinds = ", ".join(f"{k.replace('_', ' ')} {n}" for k, n in fouls.items() if k != "total")
-        cards, placed = rules["cards"][team], rules["placements"][team]
-        median = f", median {placed['median_s']:.1f} s" if placed["median_s"] is not None else ""
-        cut = f", {placed['cut_short']} cut short" if placed.get("cut_short") else ""
-        shot = rules.get("shootout", {}).get(team, {})
-        shootout = f", shootout {shot['scored']}/{shot['taken']}" if shot.get("taken") else ""
-        parts.append(f"{team} ({who}) {_plural(fouls['total'], 'foul')}{f' ({kinds})' if kinds else ''}, "
-                     f"cards {cards['yellow']} yellow {cards['red']} red, placements {placed['succeeded']}/"
-                     f"{placed['tried']}{median}{cut}{shootout}")  # fmt: skip
-    return "rules: " + "; ".join(parts)
 
 
 def _pushed(collisions: dict[str, int]) -> str:
@@ -532,7 +512,7 @@ def _their_line(summary: dict[str, Any]) -> str:
     if them is None:
         return ""
     brain = summary["cycle_ms"].get("opponent_brain", {}).get("median", float("nan"))
-    return (f"; theirs: {_plural(them['shots'], 'shot')}, {_plural(them['collisions']['own'], 'own collision')}"
+    return (f"; theirs: {plural(them['shots'], 'shot')}, {plural(them['collisions']['own'], 'own collision')}"
             f"{_pushed(them['collisions'])}, "
             f"brain {brain:.2f} ms median")  # fmt: skip
 

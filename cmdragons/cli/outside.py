@@ -11,6 +11,7 @@ import time
 from collections.abc import Callable
 from typing import Any
 
+from cmdragons.cli.lines import plural, rules_line
 from cmdragons.cli.progress import progress_bar
 from cmdragons.runtime.interrupt import Interrupt
 
@@ -163,6 +164,12 @@ def _finish(folder: Any, run: Any, summary: dict[str, Any], args: argparse.Names
           f"came while we were busy; brain {brain.get('median', float('nan')):.2f} ms median, "
           f"{brain.get('p95', float('nan')):.2f} ms p95; cameras {cams}; field {length:g} x {width:g} m "
           f"(division {summary['division']})")  # fmt: skip
+    if "score" in summary:  # refereed by ours on the tracked world
+        score = summary["score"]
+        print(f"play: refereed on our tracked world: blue {score['blue']}:{score['yellow']} yellow, "
+              f"{plural(summary['balls_out'], 'ball')} out, {plural(summary['kicks'], 'kick')} seen")  # fmt: skip
+        if summary["rules"].get("rules") == "full":
+            print("play: " + rules_line(summary["rules"], args.team))
     for w in summary["warnings"]:
         print(f"play: warning: {w}")
     files = ["run.mcap", "summary.json"] + (["match.mp4"] if args.video and (folder / "match.mp4").exists() else [])

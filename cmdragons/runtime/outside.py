@@ -40,6 +40,7 @@ from cmdragons.runtime.autoref import autoref_rows
 from cmdragons.runtime.bus import Bus, Stage, Transport
 from cmdragons.runtime.match import Entry, build
 from cmdragons.runtime.settings import Settings
+from cmdragons.runtime.ssl.clock import UnixEpoch
 from cmdragons.runtime.ssl.params import CommandsTo, ProtocolParams
 from cmdragons.runtime.ssl.stages import (
     CommandsOutStage,
@@ -137,6 +138,7 @@ class Heard:
     cameras: tuple[int, ...]
     packets: int
     robots: tuple[tuple[Team, int], ...] = ()  # (team, id) of every robot seen
+    epoch: UnixEpoch = UnixEpoch()  # the simulator's clock -> match time (grSim's counts from 0, others' Unix)
 
     @property
     def uncalibrated(self) -> tuple[int, ...]:
@@ -155,6 +157,7 @@ def listen(receiver: Any, timeout_s: float, learn_s: float, where: str,
     robots: set[tuple[Team, int]] = set()
     packets = undecodable = 0
     t_first: float | None = None  # when the first detection came
+    epoch = UnixEpoch()
     while True:
         now = clock()
         if geometry is not None and t_first is not None and now - t_first >= learn_s:
@@ -170,18 +173,19 @@ def listen(receiver: Any, timeout_s: float, learn_s: float, where: str,
             continue
         packets += 1
         try:
-            det, geo = decode_wrapper(data)
+            det, geo = decode_wrapper(data, UnixEpoch(0))  # (the sender's own times)
         except MessageError:
             undecodable += 1
             continue
         if geo is not None:
             geometry = geo
         if det is not None:
-            t_first = clock() if t_first is None else t_first
+            if t_first is None:
+                t_first, epoch = clock(), UnixEpoch.of_first(det.t_capture)
             seen.add(det.camera_id)
             robots.update((r.team, r.id) for r in det.robots)
     assert geometry is not None
-    return Heard(geometry, tuple(sorted(seen)), packets, tuple(sorted(robots)))
+    return Heard(geometry, tuple(sorted(seen)), packets, tuple(sorted(robots)), epoch)
 
 
 # the sizes a geometry packet gives, compared with field.yaml's (m)
@@ -215,7 +219,8 @@ def field_settings(settings: Settings, geometry: VisionGeometry) -> tuple[Settin
 
 
 def outside_wiring(settings: Settings, kind: SimulatorKind, teams: Sequence[Team], cameras: Sequence[int],
-                   receiver: Any, robots: Sequence[tuple[Team, int]]) -> list[Entry]:  # fmt: skip
+                   receiver: Any, robots: Sequence[tuple[Team, int]],
+                   epoch: UnixEpoch | None = None) -> list[Entry]:  # fmt: skip
     """The table of a match in an outside simulator: the simulator's SSL-Vision packets (``cameras``,
     read from ``receiver``) into each of our ``teams``' tracker and brain, their commands out to
     the simulator (``kind``; the referee's teleports through the first team's stage). The referee:
@@ -224,7 +229,7 @@ def outside_wiring(settings: Settings, kind: SimulatorKind, teams: Sequence[Team
     p = vision_params(settings.protocols, kind)
     topics = [f"ssl/vision/{c}" for c in cameras]
     entries = [Entry(VisionInStage.declare(p, cameras, False), "",
-                     lambda: VisionInStage(p, cameras, lockstep=False, receiver=receiver))]  # fmt: skip
+                     lambda: VisionInStage(p, cameras, lockstep=False, receiver=receiver, epoch=epoch))]  # fmt: skip
     referee, referee_topic, teleports = _referee(settings, p, teams[0], topics, robots)
     entries += referee
     chip = settings.sim.kicker.chip_angle_rad
@@ -292,7 +297,7 @@ class OutsideMatch:
         self.t0: float | None = None  # the first world state's capture time (s, the simulator's clock)
         self.t = math.nan  # the newest
         self.frames_waited_out = 0  # frames whose vision did not come within the wait
-        table = outside_wiring(settings, kind, teams, heard.cameras, self.gate, heard.robots)
+        table = outside_wiring(settings, kind, teams, heard.cameras, self.gate, heard.robots, heard.epoch)
         self.table = table
         watch = Tap("outside/clock", (f"world/{teams[0]}",), self._world)
         for stage in build(table, [*extra, watch, self._summaries]):
@@ -380,7 +385,11 @@ def outside_summary(f: dict[str, Any], stage_ms: dict[str, list[float]], match: 
     cycle.update(f.get("timing", {}).get(f"team/{ours}", {}))
     vision = f.get("ssl/vision_in", {})
     g = match.heard.geometry
+    referee = f.get("autoref", {})  # our referee on the tracked world (none: a game controller's word)
     return {
+        **({"score": referee["score"], "balls_out": referee["balls_out"], "kicks": referee["kicks_seen"],
+            "rules": {k: referee[k] for k in ("rules", "game_stage", "fouls", "cards", "placements", "penalties",
+                                              "shootout") if k in referee}} if referee else {}),  # fmt: skip
         "simulator": match.kind.value,
         "teams": list(match.teams),
         "seconds": round(match.seconds, 3),

@@ -34,6 +34,7 @@ from cmdragons.runtime.outside import (
 )
 from cmdragons.runtime.proto import grsim_pb2 as grsim_pb
 from cmdragons.runtime.settings import load_settings
+from cmdragons.runtime.ssl.clock import UnixEpoch, run_epoch
 from cmdragons.runtime.ssl.stages import CommandsOutStage
 from cmdragons.runtime.ssl.udp import DatagramQueue, UdpEndpoint
 from cmdragons.runtime.ssl.vision import decode_wrapper, geometry_packet
@@ -42,8 +43,12 @@ from cmdragons.runtime.topics import check_wiring
 from tests.runtime.conftest import free_udp_ports
 
 
-def _det(camera: int, frame: int) -> bytes:
-    return packet(msg.DetectionFrame(camera, frame, frame / 60, frame / 60, (), ()))
+FROM_ZERO = UnixEpoch(0)  # a sender whose clock counts from 0 (grSim's simulation time)
+
+
+def _det(camera: int, frame: int, epoch: UnixEpoch | None = FROM_ZERO) -> bytes:
+    """A camera's empty frame, its times on a clock from 0 (grSim's) or (``epoch`` None) Unix time."""
+    return packet(msg.DetectionFrame(camera, frame, 10.0 + frame / 60, 10.0 + frame / 60, (), ()), epoch)
 
 
 def _queue(*items: bytes) -> DatagramQueue:
@@ -87,7 +92,10 @@ def test_listening_learns_the_cameras_that_send_and_the_geometry() -> None:
     settings = load_settings()
     geometry = geometry_packet(settings.field_geometry(), settings.camera_models())  # calibrates cameras 0 and 1
     heard = listen(_queue(_det(3, 1), _det(7, 1), geometry, _det(3, 2)), 5.0, 0.1, "here", _clock(0.01))
-    assert heard.robots == () and heard.epoch.epoch_s == 0  # a clock from 0, as grSim's, is match time
+    assert heard.robots == () and heard.epoch == UnixEpoch(0)  # a clock from 0, as grSim's, is match time
+    # Unix time: match time from the first packet's whole second on
+    unix = listen(_queue(geometry, _det(3, 1, None)), 5.0, 0.1, "here", _clock(0.01)).epoch
+    assert unix == UnixEpoch(run_epoch().epoch_s + 10)
     assert heard.cameras == (3, 7)
     assert heard.geometry.field_length_m == pytest.approx(9.0)
     assert heard.packets == 4

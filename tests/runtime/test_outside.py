@@ -42,7 +42,6 @@ from cmdragons.runtime.ssl.vision import detection_packet as packet
 from cmdragons.runtime.topics import check_wiring
 from tests.runtime.conftest import free_udp_ports
 
-
 FROM_ZERO = UnixEpoch(0)  # a sender whose clock counts from 0 (grSim's simulation time)
 
 

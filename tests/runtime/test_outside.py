@@ -10,6 +10,8 @@ from __future__ import annotations
 import itertools
 import json
 import math
+import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -237,3 +239,32 @@ def test_two_processes_play_our_team_in_the_served_simulator_as_in_any_league_si
     moved = max(math.hypot(r.x - start[r.id][0], r.y - start[r.id][1]) for r in last.robots
                 if r.team == "blue" and r.id in start)  # fmt: skip
     assert ball_path > 1.0 and moved > 0.5
+
+
+def _grsim_netns() -> str | None:
+    """The script that runs grSim and a command beside it in a network namespace of their own
+    (grSim multicasts with no pinned interface: never run it outside one): ``GRSIM_NETNS``, else
+    ``grsim-netns.sh`` on PATH; None when there is none or no grSim for it (``GRSIM``)."""
+    script = os.environ.get("GRSIM_NETNS") or shutil.which("grsim-netns.sh")
+    grsim = os.environ.get("GRSIM", "/opt/grsim/bin/grSim")
+    return script if script and os.access(script, os.X_OK) and os.access(grsim, os.X_OK) else None
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(_grsim_netns() is None, reason="no grSim: set GRSIM_NETNS to a script that runs grSim in a "
+                    "network namespace of its own with a command beside it (and GRSIM to its binary)")  # fmt: skip
+def test_our_team_plays_in_grsim(tmp_path: Path) -> None:
+    """grSim's Division B: four cameras learnt, its field played on, our team refereed by our
+    autoref on the tracked world moves the ball."""
+    script = _grsim_netns()
+    assert script is not None
+    done = subprocess.run([script, "--division", "B", *_cmdragons("play", "--simulator", "grsim", "--seconds", 20,
+                                                                   "--no-progress", "--out", tmp_path / "ours")],
+                          capture_output=True, text=True, timeout=300)  # fmt: skip
+    assert done.returncode == 0, done.stderr + done.stdout
+    summary = json.loads((tmp_path / "ours" / "summary.json").read_text())
+    assert summary["cameras"] == [0, 1, 2, 3] and summary["field_m"] == [9.0, 6.0] and summary["division"] == "B"
+    assert summary["seconds"] >= 20.0 and summary["frames"] > 300
+    balls = [(w.ball.x, w.ball.y) for _topic, _t, w in read_log(tmp_path / "ours" / "run.mcap", {"/world/blue"})
+             if w.ball is not None]  # fmt: skip
+    assert sum(math.dist(a, b) for a, b in itertools.pairwise(balls)) > 1.0

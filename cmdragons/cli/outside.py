@@ -158,8 +158,8 @@ def _finish(folder: Any, run: Any, summary: dict[str, Any], args: argparse.Names
     brain = summary["cycle_ms"].get("brain", {})
     cams = ", ".join(map(str, summary["cameras"]))
     length, width = summary["field_m"]
-    print(f"play: {summary['seconds']:.1f} s in {args.simulator} ({' and '.join(summary['teams'])} ours, the other "
-          f"side {'ours too' if len(summary['teams']) > 1 else 'idle'}) in {summary['wall_seconds']:.1f} s "
+    sides = "both colours ours" if len(summary["teams"]) > 1 else f"{summary['teams'][0]} ours, the other side idle"
+    print(f"play: {summary['seconds']:.1f} s in {args.simulator} ({sides}) in {summary['wall_seconds']:.1f} s "
           f"({summary['realtime_factor']}x real time): {summary['frames']} frames, {summary['frames_behind']} "
           f"came while we were busy; brain {brain.get('median', float('nan')):.2f} ms median, "
           f"{brain.get('p95', float('nan')):.2f} ms p95; cameras {cams}; field {length:g} x {width:g} m "

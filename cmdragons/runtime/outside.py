@@ -370,10 +370,13 @@ class OutsideMatch:
 
 def _timings(ours: Team, teams: Sequence[Team]) -> dict[str, tuple[str, ...]]:
     """The per-frame timings of the summary (bus timing keys summed into each): our perception
-    (the vision packets received), our tracker, our brain, and the commands sent."""
+    (the vision packets received), our tracker, our brain, the commands sent, the referee (the
+    autoref's tracker and rules) and, in self-play, the other colour's tracker and brain."""
+    others = [t for t in teams if t != ours]
     return {"vision": ("ssl/vision_in",), "tracker": (f"tracker/{ours}",), "brain": (f"team/{ours}",),
-            "commands": tuple(f"ssl/commands_out/{t}" for t in teams),
-            **({"opponent_brain": tuple(f"team/{t}" for t in teams if t != ours)} if len(teams) > 1 else {})}
+            "commands": tuple(f"ssl/commands_out/{t}" for t in teams), "referee": ("tracker/autoref", "autoref"),
+            **({"opponent_tracker": tuple(f"tracker/{t}" for t in others),
+                "opponent_brain": tuple(f"team/{t}" for t in others)} if others else {})}  # fmt: skip
 
 
 def outside_summary(f: dict[str, Any], stage_ms: dict[str, list[float]], match: OutsideMatch) -> dict[str, Any]:

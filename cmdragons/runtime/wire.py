@@ -492,6 +492,7 @@ TOPICS: tuple[tuple[str, type[Any]], ...] = (
     ("perception/*", DetectionFrame),
     ("ssl/vision/sent", Tick),  # our SSL-Vision packets of a frame are out
     ("ssl/vision/*", DetectionFrame),  # detections that came as SSL-Vision packets
+    ("world/autoref", WorldState),  # the autoref's own tracked world (an outside simulator's referee)
     ("world/*", WorldState),
     ("commands/*", TeamCommands),
     ("report/*", TeamReport),

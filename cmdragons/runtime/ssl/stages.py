@@ -148,7 +148,9 @@ class VisionOutStage(SocketStage):
 
 class VisionInStage(SocketStage):
     """SSL-Vision packets from multicast -> ``ssl/vision/<camera id>`` detections (metres), the
-    latest geometry kept. ``lockstep``: fed by our own sender in this match (see the module)."""
+    latest geometry kept. ``lockstep``: fed by our own sender in this match (see the module).
+    Times: the packets' less ``epoch``; by default our sender's in lock-step, else the first
+    packet's second (a sender's clock from 0, grSim's, is taken as it is)."""
 
     @staticmethod
     def declare(params: ProtocolParams, camera_ids: Sequence[int], lockstep: bool) -> Contract:
@@ -161,7 +163,9 @@ class VisionInStage(SocketStage):
                  err: TextIO | None = None, receiver: Receiver | None = None, epoch: UnixEpoch | None = None,
                  camera_clock: bool | None = None) -> None:  # fmt: skip
         v = params.vision
-        self.epoch = run_epoch() if epoch is None else epoch
+        # lock-step: our own sender's epoch; from outside: given, or the first packet's (a sender's clock
+        # from 0, grSim's, stays as it is; Unix time becomes match time from that packet's second)
+        self.epoch: UnixEpoch | None = run_epoch() if epoch is None and lockstep else epoch
         self.camera_clock = lockstep if camera_clock is None else camera_clock  # our own packets: exact times
         self.receiver: Receiver = receiver if receiver is not None else MulticastReceiver(
             v.group, v.port, params.interface, params.receive_buffer_bytes, params.max_datagram_bytes)  # fmt: skip
@@ -193,7 +197,10 @@ class VisionInStage(SocketStage):
     def _take(self, data: bytes, publish: Publish) -> None:
         self.received += 1
         try:
-            got = read_wrapper(data, self.epoch, camera_clock=self.camera_clock)
+            if self.epoch is None:
+                first = read_wrapper(data, UnixEpoch(0)).detection
+                self.epoch = None if first is None else UnixEpoch.of_first(first.t_capture)
+            got = read_wrapper(data, self.epoch or UnixEpoch(0), camera_clock=self.camera_clock)
         except MessageError as exc:
             self.drops.drop("undecodable", f"{len(data)} bytes, {exc}")
             return
@@ -254,7 +261,8 @@ class RefereeInStage(SocketStage):
     kickoff's or penalty's restart is taken (the ball moved ``moved_m``, the rules' ball-in-play
     distance, from its spot), play is normal. The spot is the designated position of the packet
     that started it, or (a game controller clears the designated position at NORMAL_START) of the
-    prepare command before it, or else where the ball was first seen after the normal start."""
+    prepare command before it, or else where the ball was first seen after the normal start. Times:
+    the packets' Unix times less ``epoch``, by default their first packet's second."""
 
     @staticmethod
     def declare(params: ProtocolParams, world_topic: str, moved_m: float = 0.0) -> Contract:
@@ -268,7 +276,7 @@ class RefereeInStage(SocketStage):
             r.group, r.port, params.interface, params.receive_buffer_bytes, params.max_datagram_bytes)  # fmt: skip
         self.contract = self.declare(params, world_topic)
         self.moved_m = moved_m
-        self.reader = RefereeReader(epoch)
+        self.reader = RefereeReader(epoch) if epoch is not None else None  # None: the first packet's epoch
         self.drops = DropLog(f"referee {r.group}:{r.port}", params.drop_report_interval_s, err)
         self.received = self.restarts_taken = 0
         self._last: bytes | None = None
@@ -279,8 +287,8 @@ class RefereeInStage(SocketStage):
             for data in self.receiver.drain():
                 self._take(data, publish)
             return
-        g, b = self.reader.last, message.ball
-        if g is None or not (g.command.prepared and g.ready) or b is None or self._last is None:
+        g, b = (None if self.reader is None else self.reader.last), message.ball
+        if self.reader is None or g is None or not (g.command.prepared and g.ready) or b is None or self._last is None:
             return
         if self._spot is None:
             self._spot = (b.x, b.y)
@@ -293,6 +301,9 @@ class RefereeInStage(SocketStage):
     def _take(self, data: bytes, publish: Publish) -> None:
         self.received += 1
         try:
+            if self.reader is None:
+                first = RefereeReader(UnixEpoch(0)).read(data)
+                self.reader = RefereeReader(UnixEpoch.of_first(first.t))
             game = self.reader.read(data)
         except MessageError as exc:
             self.drops.drop("undecodable", f"{len(data)} bytes, {exc}")

@@ -153,6 +153,8 @@ class AutoRef:
             self._ball = (world.ball.x, world.ball.y)
         events: list[Event] = []
         kick = self.kicks.see(world)
+        if kick is not None and (kick.team, kick.id) == r.watch.last_touch:
+            kick = None  # the last toucher's own touch seen late (the track's velocity lags the kick): no new one
         if kick is not None:
             events.append(kick)
         last = r.watch.last_touch if kick is None else (kick.team, kick.id)

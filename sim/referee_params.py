@@ -62,3 +62,8 @@ class RefereeParams(Validated):
     figures: RulesParams = RulesParams()  # the league's figures for the full rules
     park_distance_m: float = setting(3.0, lo=0.5, hi=50.0)  # robots sent off wait this far outside the boundary
     autoref: AutorefParams = AutorefParams()  # judging the tracked world (an outside simulator, vision)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.place_by == "robots" and self.enabled and self.rules != "full":
+            raise ValueError("place_by: robots needs rules: full (the teams' ball placement is one of the full rules)")

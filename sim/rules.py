@@ -137,9 +137,14 @@ class FoulWatch:
         self._kicker_left = False  # ... and whether it let go of the ball since
         self._fast_ball_called = False
         self._fast_frames = 0  # frames in a row the ball was too fast
+        self._kicked: list[Key] = []  # new touches by a kick since the last frame judged
 
     def kicked(self, kicker: Key) -> None:
-        """The simulator's kicker fired: a touch, however short (a kick can leave before a frame shows it)."""
+        """The simulator's kicker fired: a touch, however short (a kick can leave before a frame shows it);
+        a new one (the robot not touching the ball already) counts as the frame's new touch for the
+        double touch and the defense areas, as one seen by distance does."""
+        if kicker not in self.touching:
+            self._kicked.append(kicker)
         self.touching.setdefault(kicker, _Touch((math.nan, math.nan), called=True))
         self.last_touch = kicker
         self._fast_ball_called = False
@@ -193,7 +198,9 @@ class FoulWatch:
             self.touching[k] = _Touch((b.x, b.y))
             self.last_touch = k
             self._fast_ball_called = False
-        return new
+        on = {(r.team, r.id) for r in robots}
+        kicked, self._kicked = self._kicked, []
+        return new + [k for k in kicked if k not in new and k in on]
 
     def _event(self, t: float, kind: str, key: Key | None, value: float, limit: float, unit: str) -> GameEvent:
         restart = FOUL_RESTARTS[kind]

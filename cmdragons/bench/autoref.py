@@ -146,7 +146,4 @@ def run(settings: Settings, quick: bool) -> list[dict[str, Any]]:
         offset = seed * (seconds + 10.0 * WINDOW_S)
         truth += [dataclasses.replace(c, t=c.t + offset) for c in t]
         seen += [dataclasses.replace(c, t=c.t + offset) for c in s]
-    out = rows(truth, seen)
-    for r in out:
-        r["name"] = f"{r['name']} ({len(seeds)}x{seconds:.0f}s, {WINDOW_S:.1f}s window)"
-    return out
+    return rows(truth, seen)

@@ -78,9 +78,11 @@ class AutorefStage(BaseStage):
 
 
 def _tracker(settings: Settings, detection_topics: Sequence[str]) -> TrackerStage:
-    # the estimate at the capture time: a referee judges what was, not what will be
+    # the estimate at the capture time: a referee judges what was, not what will be; our simulator's
+    # cameras capture together, SSL-Vision's packets each at their own time (as our team's tracker takes them)
     tracker = Tracker(dataclasses.replace(settings.tracker, latency_s=0.0))
-    return TrackerStage("autoref", tracker, detection_topics, take_commands=False, synchronized=True)
+    synchronized = settings.protocols.perception != "ssl_vision"
+    return TrackerStage("autoref", tracker, detection_topics, take_commands=False, synchronized=synchronized)
 
 
 def _autoref(settings: Settings, keys: Sequence[tuple[Team, int]], prefix: str, teleports: bool) -> AutorefStage:
@@ -93,9 +95,13 @@ def autoref_rows(settings: Settings, detection_topics: Sequence[str], keys: Sequ
     taken in this order each frame) and the referee on it, for the match's robots ``keys`` (team,
     id). It drives the match (writes ``referee``, ``referee/events``, and ``teleport`` with
     ``sim.referee.place_by: teleport``), or with ``passive`` only watches (the same under
-    ``autoref/``). Both run on the ``referee`` node."""
+    ``autoref/``). Both run on the ``referee`` node. With ``protocols.referee.source:
+    game_controller`` a real game controller referees (its packets through
+    :class:`~cmdragons.runtime.ssl.stages.RefereeInStage`) and a driving autoref has no rows."""
     from cmdragons.runtime.match import Entry
 
+    if settings.protocols.referee.source == "game_controller" and not passive:
+        return []
     prefix = PASSIVE if passive else ""
     teleports = settings.sim.referee.place_by == "teleport"
     topics = tuple(detection_topics)

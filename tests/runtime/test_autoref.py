@@ -42,6 +42,13 @@ def test_the_autoref_rows_fit_a_match_table(passive: bool, place_by: str, writte
     assert {t for t in _table(passive, place_by) if not t.startswith("summary/")} == written
 
 
+def test_a_game_controller_referees_in_place_of_the_autoref() -> None:
+    s = load_settings(overrides=["protocols.referee.source=game_controller"])
+    keys = robot_keys(s.field, match_sim_params(s, "simple"))
+    assert autoref_rows(s, ["detections/0"], keys) == []
+    assert len(autoref_rows(s, ["detections/0"], keys, passive=True)) == 2  # watching still
+
+
 def test_calls_pair_by_kind_team_and_window() -> None:
     truth = [Call(1.0, "goal", "blue"), Call(5.0, "crash", "yellow"), Call(9.0, "ball_out", "blue")]
     seen = [Call(1.1, "goal", "blue"), Call(5.0, "crash", "blue"), Call(9.0 + WINDOW_S + 0.1, "ball_out", "blue"),

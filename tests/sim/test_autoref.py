@@ -223,3 +223,8 @@ def test_the_kick_detector_ignores_a_ball_put_elsewhere() -> None:
     assert d.see(WorldState(1 / 60, BallState(FRONT, 0.0, 0.0, 0.0), (robot,))) is None  # put at the robot
     kick = d.see(WorldState(2 / 60, BallState(FRONT + 0.03, 0.0, 2.0, 0.0), (robot,)))  # then kicked by it
     assert kick is not None and (kick.team, kick.id) == ("blue", 1)
+
+
+def test_placing_by_robots_needs_the_full_rules() -> None:
+    with pytest.raises(ValueError, match="place_by"):
+        RefereeParams(rules="basic", place_by="robots")

@@ -15,7 +15,9 @@ import sys
 from pathlib import Path
 
 from cmdragons.runtime.match import CLOCK, Opponent, Perception, served_wiring, wiring
+from cmdragons.runtime.outside import SimulatorKind, outside_wiring
 from cmdragons.runtime.settings import load_settings
+from cmdragons.runtime.ssl.udp import DatagramQueue
 from cmdragons.runtime.topics import Contract, topic_table
 
 DOC = Path(__file__).resolve().parent / "architecture.md"
@@ -35,6 +37,11 @@ def contracts() -> list[Contract]:
             table = wiring(settings, opponent, perception, 0, lambda: None)  # type: ignore[arg-type, return-value]
             out += [e.contract for e in table]
     out += [e.contract for e in served_wiring(load_settings(), None, 0)]  # type: ignore[arg-type]
+    # our team in an outside simulator, both colours (grSim's four cameras, its teleports on the
+    # simulation protocol's port)
+    robots = [(t, i) for t in ("blue", "yellow") for i in range(6)]
+    out += [e.contract for e in outside_wiring(load_settings(), SimulatorKind.GRSIM, ["blue", "yellow"], [0, 1, 2, 3],
+                                               DatagramQueue(), robots)]  # fmt: skip
     return out
 
 

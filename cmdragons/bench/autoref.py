@@ -27,9 +27,9 @@ from cmdragons.runtime.bus import BaseStage, Publish
 from cmdragons.runtime.match import Match, match_sim_params
 from cmdragons.runtime.settings import Settings
 from cmdragons.runtime.topics import Contract, Port
+from sim.params import robot_keys
 from sim.restarts import ball_out_taker
 from sim.rules import FOUL_RESTARTS
-from sim.simulator import robot_keys
 
 __all__ = ["WINDOW_S", "CallLog", "Call", "match_calls", "run"]
 

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Any, NoReturn
 
 import numpy as np
 
+from cmdragons.cli.lines import plural, rules_line
 from cmdragons.cli.progress import compile_bar, progress_bar, run_shown, starting
 from cmdragons.cli.runtime import add_parsers as add_runtime_parsers
 from cmdragons.cli.runtime import cmd_log, cmd_node, cmd_replay, play_distributed
@@ -114,14 +115,24 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("play", help="play a match in the simulator; our team sees only the camera images")
     _common(p, "strategy.kicking.shoot_value=0.1")
-    p.add_argument("--opponent", choices=("simple", "defend", "self", "none", "outside", "simulation"),
-                   default="simple",
-                   help="the built-in simple team (on the true state), the built-in defending team (on the true "
-                   "state, at our robots' limits: marks receivers in their passing lanes, blocks shots; configs/"
-                   "team.yaml defend_opponent), a copy of our team, nobody, (with "
+    p.add_argument("--simulator", choices=("own", "grsim", "sim-protocol"), default="own",
+                   help="own: our simulator, embedded (default); grsim: an outside grSim (its vision on "
+                   "224.5.23.2:10020, grSim packets to 127.0.0.1:20011); sim-protocol: an outside simulator over the "
+                   "league's simulation protocol (grSim, the ER-Force simulator, cmdragons sim --serve: RobotControl "
+                   "to 127.0.0.1:10301/10302, teleports to 10300, its vision on protocols.simulation.vision_port). "
+                   "Outside, we see its SSL-Vision packets, play on the field its geometry gives, and --seconds is "
+                   "its vision's time")
+    p.add_argument("--team", choices=("blue", "yellow"), default="blue",
+                   help="with --simulator grsim|sim-protocol: the colour our team plays (default blue)")
+    p.add_argument("--opponent", choices=("simple", "defend", "self", "none", "outside", "simulation"), default=None,
+                   help="the built-in simple team (on the true state; the default), the built-in defending team (on "
+                   "the true state, at our robots' limits: marks receivers in their passing lanes, blocks shots; "
+                   "configs/team.yaml defend_opponent), a copy of our team, nobody, (with "
                    "--distributed) a team outside on commands/yellow (examples/outside_team.py), or a team outside "
                    "over the league's simulation protocol (RobotControl to 127.0.0.1:10302, SimulatorCommand to "
-                   "10300; it sees SSL-Vision packets on 224.5.23.2:10006 and Referee packets on 224.5.23.1:10003)")
+                   "10300; it sees SSL-Vision packets on 224.5.23.2:10006 and Referee packets on 224.5.23.1:10003). "
+                   "In an outside simulator: none (the default: the other side's robots idle) or self (both colours "
+                   "ours)")
     p.add_argument("--opponent-set", metavar="KEY=VALUE", action="append", default=[],
                    help="with --opponent self: override one value of the copy's own config, on top of --config "
                    "and --set (its brain and tracker: planner, control, safety, tracker, strategy, team), "
@@ -132,7 +143,7 @@ def build_parser() -> argparse.ArgumentParser:
                    "penalties, halves); basic: goals, balls out and restarts placed by the referee "
                    "(default: sim.referee.rules, full)")
     p.add_argument("--division", choices=("A", "B"), default=None, help="field and team size (default: config)")
-    p.add_argument("--perception", choices=("vision", "truth"), default="vision",
+    p.add_argument("--perception", choices=("vision", "truth"), default=None,
                    help="vision: our team sees the rendered images (default); truth: noisy true detections")
     p.add_argument("--video", action="store_true", help="write match.mp4 (H.264): a top-down view of the match")
     p.add_argument("--view", choices=("field", "cameras"), default="field",
@@ -216,6 +227,17 @@ def main(argv: Sequence[str] | None = None) -> int:
                 return _cmd_sim(args, stop)
             if args.command == "bench":
                 return _cmd_bench(args)
+            if args.command == "play" and args.simulator != "own":
+                from cmdragons.cli.outside import play_outside
+
+                return play_outside(args, stop, _compile_kernels)
+            if args.command == "play":
+                if args.team != "blue":
+                    print("cmdragons play: --team is for an outside simulator: in ours, our team plays blue",
+                          file=sys.stderr)  # fmt: skip
+                    return 2
+                args.opponent = args.opponent or "simple"
+                args.perception = args.perception or "vision"
             if args.command == "play" and args.distributed and args.opponent == "simulation":
                 print("cmdragons play: --opponent simulation plays in the embedded match: leave out --distributed",
                       file=sys.stderr)  # fmt: skip
@@ -321,10 +343,10 @@ def _finish_sim(args: argparse.Namespace, stop: Interrupt, sim: Any, models: Seq
     score = summary["score"]
     print(
         f"sim: {sim.t:.1f} s simulated in {wall:.1f} s ({summary['realtime_factor']}x real time), "
-        f"{_plural(summary['frames'], 'frame')} x {_plural(len(models), 'camera')}, score blue "
-        f"{score['blue']}:{score['yellow']} yellow, {_plural(summary['kicks'], 'kick')}, "
-        f"{_plural(summary['balls_out'], 'ball')} out, {_plural(summary['robot_contacts']['count'], 'robot contact')}, "
-        f"{_plural(faults, 'command fault')}"
+        f"{plural(summary['frames'], 'frame')} x {plural(len(models), 'camera')}, score blue "
+        f"{score['blue']}:{score['yellow']} yellow, {plural(summary['kicks'], 'kick')}, "
+        f"{plural(summary['balls_out'], 'ball')} out, {plural(summary['robot_contacts']['count'], 'robot contact')}, "
+        f"{plural(faults, 'command fault')}"
     )
     code = stop.exit_code
     if args.snapshot and images and not cv2.imwrite(args.snapshot, tile_cameras(images, models)):
@@ -332,7 +354,7 @@ def _finish_sim(args: argparse.Namespace, stop: Interrupt, sim: Any, models: Seq
               file=sys.stderr)  # fmt: skip
         code = code or 1
     if stop.requested:
-        print(f"sim: interrupted by {stop.signal} after {_plural(summary['frames'], 'frame')} of {n_frames}: "
+        print(f"sim: interrupted by {stop.signal} after {plural(summary['frames'], 'frame')} of {n_frames}: "
               "the output so far is closed and readable, summary.json says \"interrupted\": true")  # fmt: skip
     print(f"sim: output -> {folder}")
     return code
@@ -443,10 +465,6 @@ def _utc(t: float) -> str:
     return dt.datetime.fromtimestamp(t, dt.UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
 
 
-def _plural(n: int, word: str, many: str | None = None) -> str:
-    return f"{n} {word if n == 1 else (many or word + 's')}"
-
-
 def _finish_play(folder: Path, run: RunData, summary: dict[str, Any], args: argparse.Namespace, stop: Interrupt,
                  half_size_m: tuple[float, float]) -> None:  # fmt: skip
     """summary.json (with its warnings), the match report of ``run`` and the summary lines; the last
@@ -468,13 +486,13 @@ def _finish_play(folder: Path, run: RunData, summary: dict[str, Any], args: argp
     print(
         f"play: {played} against {args.opponent} ({args.perception}) in {summary['wall_seconds']:.1f} s "
         f"({rtf}x real time{compile_note}): blue (us) {score['blue']}:{score['yellow']} yellow (them); ours: "
-        f"{_plural(summary['shots'], 'shot')}, passes {passes['completed']}/{passes['tried']} completed, "
-        f"{_plural(coll['own'], 'own collision')}{_pushed(coll)}; brain {brain:.2f} ms median"
+        f"{plural(summary['shots'], 'shot')}, passes {passes['completed']}/{passes['tried']} completed, "
+        f"{plural(coll['own'], 'own collision')}{_pushed(coll)}; brain {brain:.2f} ms median"
         + _their_line(summary)
     )
     rules = summary.get("rules")
     if rules is not None and rules["rules"] == "full":
-        print("play: " + _rules_line(rules))
+        print("play: " + rules_line(rules))
     if summary.get("physics"):
         print("play: " + physics_line(summary["physics"]))
     for w in warnings:
@@ -499,25 +517,8 @@ def physics_line(physics: dict[str, Any]) -> str:
             continue
         state = "in use" if e["used"] else "confident" if e["confident"] else "unsure"
         parts.append(f"{_FACT_WORDS.get(name, name)} {e['value_m_s2']:.2f} (configured {e['configured_m_s2']:g}, "
-                     f"{_plural(e['samples'], 'window')}, {state})")  # fmt: skip
+                     f"{plural(e['samples'], 'window')}, {state})")  # fmt: skip
     return "physics measured (m/s²): " + ("; ".join(parts) if parts else "nothing yet")
-
-
-def _rules_line(rules: dict[str, Any]) -> str:
-    """The referee's calls per team: fouls by kind, cards, placements tried and succeeded."""
-    parts = []
-    for team, who in (("blue", "us"), ("yellow", "them")):
-        fouls = rules["fouls"][team]
-        kinds = ", ".join(f"{k.replace('_', ' ')} {n}" for k, n in fouls.items() if k != "total")
-        cards, placed = rules["cards"][team], rules["placements"][team]
-        median = f", median {placed['median_s']:.1f} s" if placed["median_s"] is not None else ""
-        cut = f", {placed['cut_short']} cut short" if placed.get("cut_short") else ""
-        shot = rules.get("shootout", {}).get(team, {})
-        shootout = f", shootout {shot['scored']}/{shot['taken']}" if shot.get("taken") else ""
-        parts.append(f"{team} ({who}) {_plural(fouls['total'], 'foul')}{f' ({kinds})' if kinds else ''}, "
-                     f"cards {cards['yellow']} yellow {cards['red']} red, placements {placed['succeeded']}/"
-                     f"{placed['tried']}{median}{cut}{shootout}")  # fmt: skip
-    return "rules: " + "; ".join(parts)
 
 
 def _pushed(collisions: dict[str, int]) -> str:
@@ -532,7 +533,7 @@ def _their_line(summary: dict[str, Any]) -> str:
     if them is None:
         return ""
     brain = summary["cycle_ms"].get("opponent_brain", {}).get("median", float("nan"))
-    return (f"; theirs: {_plural(them['shots'], 'shot')}, {_plural(them['collisions']['own'], 'own collision')}"
+    return (f"; theirs: {plural(them['shots'], 'shot')}, {plural(them['collisions']['own'], 'own collision')}"
             f"{_pushed(them['collisions'])}, "
             f"brain {brain:.2f} ms median")  # fmt: skip
 

@@ -52,11 +52,15 @@ class RunData:
 
 class RunCollector:
     """Gathers a :class:`RunData` from the bus's messages as they come: a play's own stage
-    (:class:`ReportStage`) or a log read back (:func:`load_run`). ``topics``: what it reads."""
+    (:class:`ReportStage`) or a log read back (:func:`load_run`). ``topics``: what it reads.
+    ``positions``: the topic the ball's and robots' positions come from: the simulator's truth, or
+    (a simulator of someone else's, which tells us no truth) our tracked world."""
 
-    def __init__(self, ours: str = "blue") -> None:
+    def __init__(self, ours: str = "blue", positions: str = "truth") -> None:
         self.ours = ours
-        self.topics = ("truth", f"world/{ours}", f"report/{ours}", "referee", "events")
+        self.positions = positions
+        self.topics = tuple(dict.fromkeys((positions, "truth", f"world/{ours}", f"report/{ours}", "referee",
+                                           "events")))  # fmt: skip
         self._run = RunData(ours=ours)
         self._times: list[float] = []
         self._balls: list[tuple[float, float]] = []
@@ -70,7 +74,7 @@ class RunCollector:
     def take(self, topic: str, message: Any) -> None:
         """One message of ``topic`` (one of :attr:`topics`, without the log's leading slash)."""
         run = self._run
-        if topic == "truth":
+        if topic == self.positions and message.ball is not None:
             t, b = message.t, message.ball
             self._times.append(t)
             self._balls.append((b.x, b.y))
@@ -81,7 +85,7 @@ class RunCollector:
                 if dist < near:
                     near, holder = dist, r.team
             run.possession.append(holder)
-        elif topic == f"world/{self.ours}":
+        if topic == f"world/{self.ours}":
             self._world_frames += 1
             if message.ball is not None:
                 self._ball_tracked += 1
@@ -123,8 +127,8 @@ class ReportStage(BaseStage):
     """The match report's data gathered as the match runs (a subscriber: what :func:`load_run`
     would read back from the log, without reading it)."""
 
-    def __init__(self, ours: str = "blue") -> None:
-        self.collector = RunCollector(ours)
+    def __init__(self, ours: str = "blue", positions: str = "truth") -> None:
+        self.collector = RunCollector(ours, positions)
         self.contract = Contract("report", tuple(Port(t, ANY) for t in self.collector.topics))
 
     def on_message(self, topic: str, message: Any, publish: Publish) -> None:

@@ -33,7 +33,7 @@ from typing import TYPE_CHECKING, Any, TextIO
 if TYPE_CHECKING:
     from cmdragons.runtime.settings import Settings
 
-__all__ = ["CompileWatch", "cold_kernels", "warm_up", "warm_up_parts"]
+__all__ = ["CompileWatch", "cold_kernels", "warm_team", "warm_up", "warm_up_parts"]
 
 # the top-level kernels of a play, by module: if any has no cache index, the run compiles
 _PLAY_KERNELS: dict[str, tuple[str, ...]] = {
@@ -253,6 +253,17 @@ def _child(part: str, settings: Settings, out: TextIO) -> None:
             _warm_planner(settings)
         else:
             _warm_motion(settings)
+
+
+def warm_team(settings: Settings) -> None:
+    """Load into this process (compiling what has no cache) what our team's tracker and brain call
+    on their first frames: for a match in real time (an outside simulator's), whose first frames
+    would otherwise wait on it."""
+    from cmdragons.tracking.filters import kalman
+
+    kalman()
+    _warm_planner(settings)
+    _warm_motion(settings)
 
 
 def _warm_motion(settings: Any) -> None:

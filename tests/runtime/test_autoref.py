@@ -14,7 +14,7 @@ from cmdragons.runtime.autoref import PASSIVE, WORLD, autoref_rows
 from cmdragons.runtime.match import CLOCK, match_sim_params, wiring
 from cmdragons.runtime.settings import load_settings
 from cmdragons.runtime.topics import Port, check_wiring
-from sim.simulator import robot_keys
+from sim.params import robot_keys
 
 
 def _table(passive: bool, place_by: str = "teleport") -> list[str]:

@@ -211,6 +211,11 @@ def test_a_match_sends_our_commands_to_a_league_simulator(to: str) -> None:
         match.close()
         peer.close()
         control.close()
+    if to == "grsim":  # grSim hears the last commands again on each vision frame, before the frame's own
+        chip = settings.sim.kicker.chip_angle_rad
+        assert packets[1::2] == [grsim_packet(tc, {r.id: r.theta for r in w.robots if r.team == "blue"}, chip)
+                                 for tc, w in zip(sent[:-1], worlds[1:], strict=True)]  # (in the robots' new headings)
+        packets = packets[0::2]
     assert len(packets) == len(sent) == 10
     for data, tc, world in zip(packets, sent, worlds, strict=True):
         headings = {r.id: r.theta for r in world.robots if r.team == "blue"}
@@ -227,12 +232,12 @@ def test_a_match_sends_our_commands_to_a_league_simulator(to: str) -> None:
             assert r[1:] == pytest.approx((c.vx, c.vy, c.omega), abs=1e-5)
     figures = summary["protocols"]["ssl/commands_out/blue"]
     assert figures["packets"] == 10 and figures["to"] == to
-    # the simulation protocol also gets our referee's kickoff formation as a SimulatorCommand
-    assert (len(teleports) >= 1) == (to == "simulation")
-    if to == "simulation":
-        cmd = sim_pb.SimulatorCommand()
-        cmd.ParseFromString(teleports[0])
-        assert len(cmd.control.teleport_robot) > 0
+    # the simulator also gets our referee's kickoff formation as a SimulatorCommand (grSim takes it
+    # on the simulation protocol's control port too)
+    assert len(teleports) >= 1
+    cmd = sim_pb.SimulatorCommand()
+    cmd.ParseFromString(teleports[0])
+    assert len(cmd.control.teleport_robot) > 0
 
 
 def _outside_match(**extra: Any) -> tuple[Match, list[msg.GroundTruth], dict[str, int]]:

@@ -10,7 +10,8 @@ from typing import Literal
 
 from cmdragons.config import Validated, setting
 
-__all__ = ["GrsimParams", "MulticastParams", "ProtocolParams", "ServeParams", "SimulationParams"]
+__all__ = ["GrsimParams", "MulticastParams", "OutsideParams", "ProtocolParams", "ServeParams",
+           "SimulationParams"]
 
 CommandsTo = Literal["none", "grsim", "simulation"]
 
@@ -90,6 +91,15 @@ class SimulationParams(Validated):
 
 
 @dataclass(frozen=True)
+class OutsideParams(Validated):
+    """A match in an outside simulator (``play --simulator grsim|sim-protocol``)."""
+
+    geometry_timeout_s: float = setting(10.0, lo=0.1, hi=600.0)  # before the match: its geometry must come by then
+    learn_s: float = setting(0.5, lo=0.0, hi=60.0)  # its cameras: those heard this long from the first detection on
+    frame_wait_s: float = setting(2.0, lo=0.01, hi=600.0)  # no vision for this long ends the match
+
+
+@dataclass(frozen=True)
 class ServeParams(Validated):
     """``cmdragons sim --serve``: our simulator alone as a league simulator."""
 
@@ -111,6 +121,7 @@ class ProtocolParams(Validated):
     referee: RefereeStreamParams = RefereeStreamParams()
     grsim: GrsimParams = GrsimParams()
     simulation: SimulationParams = SimulationParams()
+    outside: OutsideParams = OutsideParams()
     serve: ServeParams = ServeParams()
 
     def __post_init__(self) -> None:

@@ -354,19 +354,24 @@ class TrackerOutStage(SocketStage):
 
 class CommandsOutStage(SocketStage):
     """Our team's commands to a league simulator: grSim (``grSim_Packet`` to ``grsim.address:port``)
-    or the simulation protocol (``RobotControl`` to the team's port, our referee's teleports as
-    ``SimulatorCommand`` to the control port). Velocities go in each robot's frame by its heading in
-    our tracker's latest world state. The simulators' answers are read and counted."""
+    or the simulation protocol (``RobotControl`` to the team's port); our referee's teleports as
+    ``SimulatorCommand`` to the simulation protocol's control port (grSim takes them there too;
+    ``teleports``: this team's stage sends them, one of a match's does). Velocities go in each
+    robot's frame by its heading in our tracker's latest world state. grSim stops a robot whose last
+    packet is older than one of its frames: on each world state (a vision frame) the last packet
+    goes again, with the new headings, before the frame's own commands come. The simulators' answers are read and counted."""
 
     @staticmethod
-    def declare(params: ProtocolParams, team: Team, chip_angle_rad: float = 0.0) -> Contract:
+    def declare(params: ProtocolParams, team: Team, chip_angle_rad: float = 0.0, teleports: bool = True) -> Contract:
         name = f"ssl/commands_out/{team}"
+        takes = params.commands_to != "none" and teleports  # (grSim takes them on the simulation protocol's port too)
         return Contract(name, (Port(f"world/{team}", WorldState), Port(f"commands/{team}", TeamCommands),
-                               *((Port("teleport", Teleport),) if params.commands_to == "simulation" else ())),
+                               *((Port("teleport", Teleport),) if takes else ())),
                         (summary_port(name),))  # fmt: skip
 
-    def __init__(self, params: ProtocolParams, team: Team, chip_angle_rad: float, err: TextIO | None = None) -> None:
-        self.contract = self.declare(params, team)
+    def __init__(self, params: ProtocolParams, team: Team, chip_angle_rad: float, err: TextIO | None = None,
+                 teleports: bool = True) -> None:  # fmt: skip
+        self.contract = self.declare(params, team, chip_angle_rad, teleports)
         self.team = team
         self.to = params.commands_to
         sim = params.simulation
@@ -378,6 +383,8 @@ class CommandsOutStage(SocketStage):
         self.full_rpm = sim.dribbler_full_rpm
         self.headings: dict[int, float] = {}
         self.sent = self.teleports = self.answers = self.answer_errors = self.answers_earlier_layout = 0
+        self.resent = 0
+        self._last: TeamCommands | None = None  # grSim: the latest commands, resent each vision frame
         self.drops = DropLog(f"{self.to} answers", params.drop_report_interval_s, err)
 
     def on_message(self, topic: str, message: Any, publish: Publish) -> None:
@@ -387,12 +394,16 @@ class CommandsOutStage(SocketStage):
         elif isinstance(message, TeamCommands):
             if self.to == "grsim":
                 data = grsim_packet(message, self.headings, self.chip_angle_rad)
+                self._last = message
             else:
                 data = robot_control_packet(message, self.headings, self.chip_angle_rad, self.full_rpm)
             self.endpoint.send_to(data, self.peer)
             self.sent += 1
         else:
             self.headings = {r.id: r.theta for r in message.robots if r.team == self.team}
+            if self._last is not None:
+                self.endpoint.send_to(grsim_packet(self._last, self.headings, self.chip_angle_rad), self.peer)
+                self.resent += 1
         self._read_answers()
 
     def _read_answers(self) -> None:
@@ -410,8 +421,9 @@ class CommandsOutStage(SocketStage):
 
     def summarize(self, publish: Publish) -> None:
         publish(f"summary/{self.name}", StageSummary(self.name, {
-            "to": self.to, "packets": self.sent, "teleports": self.teleports, "answers": self.answers,
-            "answer_errors": self.answer_errors, "answers_earlier_layout": self.answers_earlier_layout,
+            "to": self.to, "packets": self.sent, "resent": self.resent, "teleports": self.teleports,
+            "answers": self.answers, "answer_errors": self.answer_errors,
+            "answers_earlier_layout": self.answers_earlier_layout,
             "dropped": dict(sorted(self.drops.counts.items()))}))  # fmt: skip
 
     def close(self) -> None:

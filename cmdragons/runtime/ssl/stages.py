@@ -359,7 +359,8 @@ class CommandsOutStage(SocketStage):
     ``teleports``: this team's stage sends them, one of a match's does). Velocities go in each
     robot's frame by its heading in our tracker's latest world state. grSim stops a robot whose last
     packet is older than one of its frames: on each world state (a vision frame) the last packet
-    goes again, with the new headings, before the frame's own commands come. The simulators' answers are read and counted."""
+    goes again, with the new headings, before the frame's own commands come. The simulators'
+    answers are read and counted."""
 
     @staticmethod
     def declare(params: ProtocolParams, team: Team, chip_angle_rad: float = 0.0, teleports: bool = True) -> Contract:

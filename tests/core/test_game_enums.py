@@ -23,7 +23,7 @@ from cmdragons.runtime.ssl.referee import RefereeReader, referee_proto
 
 
 def _wire(m: GameState | GameEvents | TeamReport, topic: str) -> object:
-    return wire.decode(topic, wire.encode(m))
+    return wire.decode(wire.schema(m), wire.encode(m))
 
 
 @pytest.mark.parametrize("command", list(RefereeCommand))

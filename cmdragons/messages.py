@@ -46,6 +46,7 @@ __all__ = [
     "PhysicsFacts",
     "RobotCommand",
     "RobotDetection",
+    "PassReport",
     "RobotReport",
     "RobotState",
     "RobotTruth",
@@ -824,12 +825,37 @@ class RobotReport:
                    _points(d.get("braking", ())))  # fmt: skip
 
 
+@dataclass(frozen=True)
+class PassReport:
+    """The team's pass of a frame, as its strategy follows it: who passes to whom, the point the
+    receiver takes the ball at (field frame, m), the one-touch aim there (None: the receiver traps
+    the ball) and whether the ball is under way."""
+
+    passer: int
+    receiver: int
+    target: tuple[float, float]
+    shoot_at: tuple[float, float] | None = None
+    kicked: bool = False
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"passer": self.passer, "receiver": self.receiver, "target": list(self.target),
+                "shoot_at": None if self.shoot_at is None else list(self.shoot_at), "kicked": self.kicked}  # fmt: skip
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Self:
+        x, y = d["target"]
+        aim = d.get("shoot_at")
+        return cls(int(d["passer"]), int(d["receiver"]), (float(x), float(y)),
+                   None if aim is None else (float(aim[0]), float(aim[1])), bool(d.get("kicked", False)))  # fmt: skip
+
+
 @dataclass(frozen=True, eq=False)
 class TeamReport:
     """One team's brain in one frame, for statistics, overlays and logs: per robot what it did, each
     robot's last action as the strategy decided it (what its kick is for), and the pass evaluation's
     receiving points (n, 2) and values (n,) when it was redone this frame (empty in the frames
-    between: the last one holds). Wall-clock times go on a topic of their own (:class:`Timing`)."""
+    between: the last one holds), and the pass planned or under way (None: none). Wall-clock times
+    go on a topic of their own (:class:`Timing`)."""
 
     team: Team
     frame_number: int
@@ -838,6 +864,7 @@ class TeamReport:
     actions: Mapping[int, KickPurpose] = field(default_factory=dict)
     pass_points: NDArray[np.float64] = field(default_factory=_no_points)
     pass_values: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    passing: PassReport | None = None
 
     def __post_init__(self) -> None:  # the JSONL and protobuf forms come as their values
         actions = {rid: _member(KickPurpose, a, "a robot's action") for rid, a in self.actions.items()}
@@ -851,7 +878,8 @@ class TeamReport:
                 "robots": [r.to_dict() for r in self.robots],
                 "actions": {str(k): v for k, v in self.actions.items()},
                 "pass_points": np.asarray(self.pass_points).tolist(),
-                "pass_values": np.asarray(self.pass_values).tolist()}  # fmt: skip
+                "pass_values": np.asarray(self.pass_values).tolist(),
+                "passing": None if self.passing is None else self.passing.to_dict()}  # fmt: skip
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> Self:
@@ -860,7 +888,8 @@ class TeamReport:
                        tuple(RobotReport.from_dict(r) for r in d.get("robots", ())),
                        {int(k): KickPurpose(str(v)) for k, v in d.get("actions", {}).items()},
                        _points(d.get("pass_points", ())),
-                       np.asarray(d.get("pass_values", ()), dtype=np.float64))  # fmt: skip
+                       np.asarray(d.get("pass_values", ()), dtype=np.float64),
+                       None if d.get("passing") is None else PassReport.from_dict(d["passing"]))  # fmt: skip
         except (KeyError, TypeError, ValueError) as exc:
             raise MessageError(f"bad team report: {exc!r}") from None
 

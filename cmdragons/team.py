@@ -37,6 +37,7 @@ from cmdragons.geometry import Team
 from cmdragons.messages import (
     GameState,
     KickPurpose,
+    PassReport,
     PhysicsFacts,
     RefereeCommand,
     RobotCommand,
@@ -151,8 +152,9 @@ class BrainOutput:
     # the pass evaluation over the candidate grid, points (n, 2) m and values (n,): only on the
     # frames it was redone
     pass_heat: tuple[NDArray[np.float64], NDArray[np.float64]] | None
-    last_actions: Mapping[int, KickPurpose]  # robot id -> what its last kick was for ("shot", "pass", "clear")
+    last_actions: Mapping[int, KickPurpose]  # robot id -> what its armed kick is for ("shot", "pass", "clear")
     times_ms: Mapping[str, float]  # each part's wall-clock time this frame (strategy, planning_control, safety, brain)
+    passing: PassReport | None = None  # the pass planned or under way
 
 
 @dataclass(frozen=True, eq=False)
@@ -267,10 +269,12 @@ class Brain:
         safe = self.drive(world, intents, game)
         self.times["brain"] = (time.perf_counter() - t0) * 1e3
         ours = {r.id for r in world.robots if r.team == self.team}
-        actions = {rid: a for rid, a in self.strategy.last_action.items() if rid in ours}
+        # what a kick is for, of the robots whose kicker is armed (a robot's kick as another role's is not)
+        actions = {rid: a for rid, a in self.strategy.last_action.items()
+                   if rid in ours and rid in intents and intents[rid].kick_speed > 0.0}  # fmt: skip
         return BrainOutput(tuple(safe), dict(sorted(self.plans.items())), dict(self.braking),
                            self.strategy.pass_heat if self.strategy.pass_heat_redone else None, actions,
-                           dict(self.times))  # fmt: skip
+                           dict(self.times), self.strategy.pass_report)  # fmt: skip
 
     def drive(self, world: WorldState, intents: Mapping[int, Intent], game: GameState) -> list[RobotCommand]:
         """Everything after strategy: each robot's planner and navigator toward its intent, then team

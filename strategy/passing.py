@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from cmdragons.config import Validated, setting
 from cmdragons.messages import BallState, RobotState
 
-__all__ = ["Pass", "PassPlay", "PassPlayParams"]
+__all__ = ["Pass", "PassPlay", "PassPlayParams", "PassRecordParams"]
 
 
 @dataclass(frozen=True)
@@ -26,6 +26,20 @@ class PassPlayParams(Validated):
     kicked_cos: float = setting(0.8, lo=-1.0, hi=1.0)  # ... heading at least this straight at it (cosine)
     dead_speed_m_s: float = setting(0.2, lo=0.0, hi=10.0)  # a kicked ball slower than this has died: over
     received_m: float = setting(0.3, lo=0.0, hi=3.0)  # the ball this near the receiver, off its way: received
+
+
+@dataclass(frozen=True)
+class PassRecordParams(Validated):
+    """How a pass is judged after the fact (the match statistics' pass record, from the true state)."""
+
+    touch_m: float = setting(0.01, lo=0.0, hi=0.5)  # a robot's body this near the ball's touches it
+    control_s: float = setting(0.3, lo=0.01, hi=5.0)  # after a team-mate's touch: kicked on or held within this ...
+    hold_m: float = setting(0.15, lo=0.05, hi=1.0)  # ... held: the ball's centre this near the robot's
+    at_target_m: float = setting(0.15, lo=0.01, hi=2.0)  # the receiver's centre this near the target: there
+    past_m: float = setting(0.5, lo=0.0, hi=5.0)  # the ball this far past the target, untouched: missed
+    dead_m_s: float = setting(0.2, lo=0.0, hi=5.0)  # the ball slower than this, untouched: over
+    horizon_s: float = setting(4.0, lo=0.1, hi=30.0)  # the opponents' interception predicted this far ahead ...
+    step_s: float = setting(0.02, lo=0.001, hi=1.0)  # ... in steps of this
 
 
 @dataclass(frozen=True)

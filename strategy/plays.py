@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, Team
-from cmdragons.messages import BallState, GameState, RefereeCommand, RobotState, WorldState
+from cmdragons.messages import BallState, GameState, PassReport, RefereeCommand, RobotState, WorldState
 from strategy.defense import DefenseParams, defender_slots, goalie
 from strategy.evaluation import PassParams
 from strategy.game_states import (
@@ -39,7 +39,7 @@ from strategy.game_states import (
     restart_rules,
 )
 from strategy.kicking import Attacker, KickParams, KickPurpose
-from strategy.passing import PassPlay, PassPlayParams
+from strategy.passing import PassPlay, PassPlayParams, PassRecordParams
 from strategy.roles import Objective, Role, RoleAssigner, RoleKind, RoleParams
 from strategy.skills import Intent, SkillParams, defend, intercept, mark, receive
 from strategy.support import Supporters, SupportParams
@@ -62,6 +62,7 @@ class StrategyParams(Validated):
     defense: DefenseParams = DefenseParams()
     kicking: KickParams = KickParams()
     pass_play: PassPlayParams = PassPlayParams()
+    pass_record: PassRecordParams = PassRecordParams()  # the match statistics' judge of each pass
     support: SupportParams = SupportParams()
     game_states: GameStateParams = GameStateParams()
     ball_room_m: float = setting(0.35, lo=0.0, hi=3.0)  # team-mates leave the ball handler this much room
@@ -147,6 +148,14 @@ class Strategy:
         points, values = ev.points.view(), ev.values.view()
         points.flags.writeable = values.flags.writeable = False
         return points, values
+
+    @property
+    def pass_report(self) -> PassReport | None:
+        """The pass planned or under way after the last :meth:`decide` (None: none)."""
+        ps = self.passes.current
+        if ps is None:
+            return None
+        return PassReport(ps.passer, ps.receiver, ps.point, ps.shoot_at, ps.kicked)
 
     @property
     def pass_heat_redone(self) -> bool:
@@ -300,6 +309,8 @@ class Strategy:
                 assert passing is not None
                 out[rid] = receive(r, ball, passing.point, p.skills, passing.shoot_at,
                                    p.skills.max_kick_m_s if passing.shoot_at else 0.0)  # fmt: skip
+                if passing.shoot_at is not None:
+                    self.last_action[rid] = KickPurpose.SHOT  # the one-touch shot at the goal
             elif role.kind is RoleKind.DEFENDER:
                 out[rid] = defenders[role]
             else:

@@ -16,6 +16,7 @@ import numpy as np
 from cmdragons.config import Validated, derived, setting
 from cmdragons.geometry import Field, wrap_angle
 from cmdragons.messages import BallState, RobotState
+from strategy.ballmodel import BallModel
 from strategy.onetouch import aim_heading
 
 __all__ = [
@@ -87,6 +88,11 @@ class SkillParams(Validated):
     goalie_shot_vx_m_s: float = setting(0.2, lo=0.0, hi=10.0)  # ... coming at our goal line this fast: met on its line
     goalie_shade: float = setting(0.5, lo=0.0, hi=1.0)  # else the goalie stands at this share of the ball's y
     mark_max_share: float = setting(0.5, lo=0.0, hi=1.0)  # a marker at most this share of the way to our goal
+
+    @property
+    def ball_model(self) -> BallModel:
+        """The ball's two-phase model every prediction of a kicked ball's run reads."""
+        return BallModel(self.acc_slide_m_s2, self.acc_roll_m_s2, self.slide_to_roll_fraction)
 
     @property
     def contact_m(self) -> float:
@@ -207,11 +213,7 @@ def dribble(robot: RobotState, ball: BallState, target: tuple[float, float], p: 
 
 def speed_after(speed: float, distance: float, p: SkillParams) -> float:
     """Ball speed after rolling ``distance`` from a kick at ``speed`` (0 if it stops before)."""
-    v_roll = p.slide_to_roll_fraction * speed
-    slide = (speed**2 - v_roll**2) / (2 * max(p.acc_slide_m_s2, 1e-9))
-    if distance <= slide:
-        return math.sqrt(max(speed**2 - 2 * p.acc_slide_m_s2 * distance, 0.0))
-    return math.sqrt(max(v_roll**2 - 2 * p.acc_roll_m_s2 * (distance - slide), 0.0))
+    return p.ball_model.speed_after(speed, distance)
 
 
 def pass_speed(distance: float, p: SkillParams, arrival_m_s: float | None = None,

@@ -31,6 +31,7 @@ from cmdragons.camera import CameraModel
 from cmdragons.geometry import TEAMS, Team
 from cmdragons.messages import Tick
 from cmdragons.runtime.bus import Bus, Stage, Transport, run_frames
+from cmdragons.runtime.pass_record import PassRecorder
 from cmdragons.runtime.settings import Settings
 from cmdragons.runtime.stages import (
     BuiltInOpponentStage,
@@ -156,12 +157,11 @@ def wiring(settings: Settings, opponent: Opponent, perception: Perception, seed:
     if opponent in BUILT_IN:
         entries.append(Entry(BuiltInOpponentStage.declare(THEIRS), "opponent",
                              functools.partial(_built_in_stage, opponent, THEIRS, settings)))  # fmt: skip
-    pass_timeout_s = settings.strategy.pass_timeout_s
-    entries += [Entry(StatsStage.declare(OURS), "team", lambda: StatsStage(OURS, pass_timeout_s)),
+    entries += [Entry(StatsStage.declare(OURS), "team", functools.partial(_stats_stage, OURS, settings)),
                 Entry(TimingStage.contract, "team", TimingStage)]  # fmt: skip
     if opponent == "self":  # the copy of our team: its own figures too
-        theirs_s = (opponent_settings or settings).strategy.pass_timeout_s
-        entries.append(Entry(StatsStage.declare(THEIRS), "opponent", lambda: StatsStage(THEIRS, theirs_s)))
+        entries.append(Entry(StatsStage.declare(THEIRS), "opponent",
+                             functools.partial(_stats_stage, THEIRS, opponent_settings or settings)))  # fmt: skip
     return entries
 
 
@@ -199,6 +199,10 @@ def built_in_wiring(settings: Settings, blue: BuiltIn, yellow: BuiltIn, sim: Cal
         *(Entry(BuiltInOpponentStage.declare(team), "opponent",
                 functools.partial(_built_in_stage, kind, team, settings)) for team, kind in sides),
     ]  # fmt: skip
+
+
+def _stats_stage(team: Team, own: Settings) -> Stage:
+    return StatsStage(team, PassRecorder.of(team, own))
 
 
 def _tracker_stage(team: Team, own: Settings, topics: Sequence[str], synchronized: bool) -> Stage:
@@ -449,6 +453,7 @@ def match_summary(f: dict[str, Any], stage_ms: dict[str, list[float]], seed: int
         "score": referee["score"],
         "shots": stats["shots"],
         "passes": stats["passes"],
+        "kickoff_to_shot_s": stats["kickoff_to_shot_s"],
         "collisions": {"own": stats["collisions"]["own"] + sum(p == {OURS} for p in open_pairs),
                        "own_pushed": stats["collisions"]["own_pushed"],
                        "opponent": stats["collisions"]["opponent"] + sum(p == {OURS, THEIRS} for p in open_pairs)},

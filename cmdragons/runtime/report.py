@@ -191,6 +191,46 @@ def pyplot() -> Any:
     return plt
 
 
+# how each pass ended (cmdragons/runtime/pass_record.py), and its colour in the report
+PASS_END_COLOURS = {"received": "tab:green", "too_fast": "tab:olive", "intercepted": "tab:red", "out": "tab:gray",
+                    "stopped": "0.6", "late": "tab:orange", "missed": "tab:purple", "too_slow": "tab:brown",
+                    "reassigned": "tab:pink", "timeout": "tab:cyan"}  # fmt: skip
+
+
+def _draw_passes(ax_map: Any, ax_time: Any, run: RunData, passes: dict[str, Any], field_axes: Any) -> None:
+    """Each pass from where it was kicked to its target, coloured by how it ended; beside it each
+    pass's ball arrival at the target against its receiver's and the closest opponent's predicted
+    interception (s after the kick)."""
+    records = passes.get("list", [])
+    kicks = {round(float(e["t"]), 4): (e["x"], e["y"]) for e in run.kicks if "x" in e}
+    ends = passes.get("ends", {})
+    field_axes(ax_map, "Our passes, kick to target, by how they ended")
+    seen: set[str] = set()
+    for r in records:
+        start, target, end = kicks.get(round(float(r["t_kick"]), 4)), r.get("target"), r.get("end")
+        colour = PASS_END_COLOURS.get(str(end), "black")
+        label = None if end in seen else f"{end} ({ends.get(str(end), 0)})"
+        seen.add(str(end))
+        if start is not None and target is not None:
+            ax_map.annotate("", xy=target, xytext=start, arrowprops={"arrowstyle": "->", "color": colour, "lw": 1.5})
+            ax_map.scatter([start[0]], [start[1]], color=colour, s=15, label=label)
+        elif start is not None:
+            ax_map.scatter([start[0]], [start[1]], color=colour, marker="x", s=40, label=label)
+    if seen:
+        ax_map.legend(loc="upper left", fontsize=8)
+    ax_time.set_title("Per pass: ball at target (o), receiver there (^),\nclosest opponent's predicted "
+                      "interception (x)", fontsize=10)  # fmt: skip
+    for k, r in enumerate(records):
+        colour = PASS_END_COLOURS.get(str(r.get("end")), "black")
+        for key, marker in (("ball_s", "o"), ("receiver_s", "^"), ("opponent_s", "x")):
+            if r.get(key) is not None:
+                ax_time.scatter([r[key]], [k], marker=marker, color=colour, s=40)
+        ax_time.text(0.0, k + 0.25, f"{r.get('end')} {r.get('speed_m_s', float('nan')):.1f} m/s", fontsize=7)
+    ax_time.set_xlabel("s after the kick")
+    ax_time.set_ylabel("pass")
+    ax_time.set_ylim(-0.5, max(len(records), 1) - 0.5 + 0.5)
+
+
 def write_report(run: RunData, summary: dict[str, Any], path: str | Path,
                  half_size_m: tuple[float, float] = (4.5, 3.0)) -> Path:  # fmt: skip
     """The one-page match report PNG (see the module docstring) of a field of ``half_size_m``
@@ -200,8 +240,8 @@ def write_report(run: RunData, summary: dict[str, Any], path: str | Path,
     plt = pyplot()
 
     path = Path(path)
-    fig = plt.figure(figsize=(14, 10), dpi=100)
-    grid = fig.add_gridspec(3, 2, height_ratios=[1.25, 0.6, 1.0])
+    fig = plt.figure(figsize=(14, 14), dpi=100)
+    grid = fig.add_gridspec(4, 2, height_ratios=[1.25, 1.25, 0.6, 1.0])
     score = summary.get("score", {})
     fig.suptitle(f"Match report: blue (us) {score.get('blue', 0)} : {score.get('yellow', 0)} yellow (them), "
                  f"{summary.get('seconds', 0):.0f} s against {summary.get('opponent')} "
@@ -245,8 +285,11 @@ def write_report(run: RunData, summary: dict[str, Any], path: str | Path,
     if len(run.ball):
         ax.plot(run.ball[:, 0], run.ball[:, 1], lw=0.6, color="black", alpha=0.6)
 
+    _draw_passes(fig.add_subplot(grid[1, 0]), fig.add_subplot(grid[1, 1]), run, summary.get("passes", {}),
+                 field_axes)  # fmt: skip
+
     # possession and passes over time
-    ax = fig.add_subplot(grid[1, :])
+    ax = fig.add_subplot(grid[2, :])
     ax.set_title("Possession over time (robot within 0.15 m of the ball) and our kicks", fontsize=11)
     if run.frames:
         code = np.array([1.0 if p == run.ours else (-1.0 if p is not None else 0.0) for p in run.possession])
@@ -267,7 +310,7 @@ def write_report(run: RunData, summary: dict[str, Any], path: str | Path,
     ax.legend(loc="upper right", fontsize=8, ncol=5)
 
     # timings
-    ax = fig.add_subplot(grid[2, :])
+    ax = fig.add_subplot(grid[3, :])
     cycle = summary.get("cycle_ms", {})
     names = [n for n in ("render", "vision", "tracker", "brain", "strategy", "planning_control", "safety",
                          "physics_and_opponent", "frame") if n in cycle]  # fmt: skip

@@ -45,6 +45,7 @@ from cmdragons.messages import (
 )
 from cmdragons.runtime.bus import BaseStage, Publish
 from cmdragons.runtime.log import RunLog
+from cmdragons.runtime.pass_record import PassRecorder
 from cmdragons.runtime.topics import ANY, Contract, Port, summary_port, topic_matches
 from cmdragons.team import Brain, BrainOutput
 from cmdragons.tracking import Tracker
@@ -438,7 +439,7 @@ def _report(team: Team, world: WorldState, out: BrainOutput) -> TeamReport:
         for rid, p in out.plans.items()
     )  # fmt: skip
     points, values = out.pass_heat if out.pass_heat is not None else (_points(()), np.zeros(0))
-    return TeamReport(team, world.frame_number, world.t, robots, dict(out.last_actions), points, values)
+    return TeamReport(team, world.frame_number, world.t, robots, dict(out.last_actions), points, values, out.passing)
 
 
 def _points(a: Any) -> NDArray[np.float64]:
@@ -508,9 +509,10 @@ class RefereeStage(BaseStage):
 
 class StatsStage(BaseStage):
     """One team's match statistics from the bus: shots and passes (kicks with the action the
-    strategy had decided), passes completed (a team-mate holds the ball next), collisions among
-    own robots (apart: those where an opponent touched one of the two, pushing it into the other)
-    and with opponents."""
+    strategy had decided), each pass's record (:mod:`cmdragons.runtime.pass_record`: its plan, kick,
+    timing and how it ended), the time from each kickoff to our first shot after it, collisions
+    among own robots (apart: those where an opponent touched one of the two, pushing it into the
+    other) and with opponents."""
 
     @staticmethod
     def declare(team: Team) -> Contract:
@@ -518,27 +520,38 @@ class StatsStage(BaseStage):
                                           Port(f"report/{team}", TeamReport), Port("events", SimEvents)),
                         (summary_port(f"stats/{team}"),))  # fmt: skip
 
-    def __init__(self, team: Team, pass_timeout_s: float, hold_m: float = 0.15) -> None:
+    def __init__(self, team: Team, passes: PassRecorder) -> None:
         self.contract = self.declare(team)
         self.team = team
-        self.pass_timeout_s = pass_timeout_s
-        self.hold_m = hold_m  # a robot whose centre is this near the ball holds it
-        self.shots = self.passes_tried = self.passes_completed = 0
+        self.passes = passes
+        self.shots = 0
         self.own_collisions = self.own_pushed = self.opponent_collisions = 0
-        self.pending_pass: tuple[float, int] | None = None  # (time kicked, passer id)
+        self.kickoff_to_shot_s: list[float | None] = []  # per kickoff: to our first shot (None: none before the next)
+        self._kickoff_t: float | None = None  # the kickoff's normal start, our shot after it not yet taken
         self._truth: GroundTruth | None = None
         self._game = GameState(0.0)
-        self._actions: dict[int, str] = {}
+        self._actions: dict[int, KickPurpose] = {}
 
     def on_message(self, topic: str, message: Any, publish: Publish) -> None:
         if topic == "truth":
             self._truth = message
+            self.passes.truth(message)
         elif topic == "referee":
-            self._game = message
+            self._referee(message)
         elif isinstance(message, TeamReport):
             self._actions = dict(message.actions)
+            self.passes.report(message)
         elif isinstance(message, SimEvents):
             self._count(message)
+
+    def _referee(self, game: GameState) -> None:
+        started = game.command == RefereeCommand.KICKOFF and game.ready
+        if started and not (self._game.command == RefereeCommand.KICKOFF and self._game.ready):
+            if self._kickoff_t is not None:
+                self.kickoff_to_shot_s.append(None)
+            self._kickoff_t = game.t
+        self._game = game
+        self.passes.referee(game)
 
     def _count(self, ev: SimEvents) -> None:
         for e in ev.events:
@@ -546,9 +559,10 @@ class StatsStage(BaseStage):
                 action = self._actions.get(e.id)
                 if action is KickPurpose.SHOT:
                     self.shots += 1
-                elif action is KickPurpose.PASS:
-                    self.passes_tried += 1
-                    self.pending_pass = (e.t, e.id)
+                    if self._kickoff_t is not None:
+                        self.kickoff_to_shot_s.append(e.t - self._kickoff_t)
+                        self._kickoff_t = None
+                self.passes.kick(e, action, self._truth)
             elif isinstance(e, Contact):
                 teams = {e.a[0], e.b[0]}
                 if teams == {self.team} and e.pushed_by is not None:
@@ -557,20 +571,15 @@ class StatsStage(BaseStage):
                     self.own_collisions += 1
                 elif self.team in teams:
                     self.opponent_collisions += 1
-        if self.pending_pass is not None and self._truth is not None:
-            t_kick, passer = self.pending_pass
-            gt = self._truth
-            holders = [r for r in gt.robots if math.hypot(r.x - gt.ball.x, r.y - gt.ball.y) < self.hold_m]
-            if gt.t - t_kick > self.pass_timeout_s or self._game.command != RefereeCommand.NORMAL:
-                self.pending_pass = None
-            elif gt.t - t_kick > 0.2 and holders:
-                if any(r.team == self.team and r.id != passer for r in holders):
-                    self.passes_completed += 1
-                self.pending_pass = None
 
     def summarize(self, publish: Publish) -> None:
+        shots = [s for s in self.kickoff_to_shot_s if s is not None]
         publish(f"summary/{self.name}", StageSummary(self.name, {
-            "shots": self.shots, "passes": {"tried": self.passes_tried, "completed": self.passes_completed},
+            "shots": self.shots, "passes": self.passes.summary(),
+            "kickoff_to_shot_s": {"kickoffs": len(self.kickoff_to_shot_s) + (self._kickoff_t is not None),
+                                  "with_shot": len(shots),
+                                  "median": round(float(np.median(shots)), 3) if shots else None,
+                                  "each": [None if s is None else round(s, 3) for s in self.kickoff_to_shot_s]},
             "collisions": {"own": self.own_collisions, "own_pushed": self.own_pushed,
                            "opponent": self.opponent_collisions},
         }))  # fmt: skip

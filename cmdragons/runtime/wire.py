@@ -49,6 +49,7 @@ from cmdragons.messages import (
     Kick,
     MessageError,
     NodeControl,
+    PassReport,
     PhysicsFacts,
     RefereeCommand,
     RobotCommand,
@@ -415,6 +416,12 @@ def _report_to(r: TeamReport) -> Any:
             _command_to(rr.command, rm.command)
     for rid, action in r.actions.items():
         m.actions.add(id=rid, action=action)
+    ps = r.passing
+    if ps is not None:
+        m.passing.passer, m.passing.receiver, m.passing.kicked = ps.passer, ps.receiver, ps.kicked
+        m.passing.target_x, m.passing.target_y = ps.target
+        if ps.shoot_at is not None:
+            m.passing.shoot_x, m.passing.shoot_y = ps.shoot_at
     return m
 
 
@@ -423,8 +430,13 @@ def _report_from(m: Any) -> TeamReport:
     robots = tuple(RobotReport(r.id, r.status, (r.target_x, r.target_y, r.target_theta), _pairs(r.path),
                                _command_from(r.command, team) if r.HasField("command") else None, _pairs(r.braking))
                    for r in m.robots)  # fmt: skip
+    passing = None
+    if m.HasField("passing"):
+        ps = m.passing
+        aim = (ps.shoot_x, ps.shoot_y) if ps.HasField("shoot_x") else None
+        passing = PassReport(ps.passer, ps.receiver, (ps.target_x, ps.target_y), aim, ps.kicked)
     return TeamReport(team, m.frame_number, m.t, robots, {a.id: a.action for a in m.actions}, _pairs(m.pass_points),
-                      np.asarray(m.pass_values, dtype=np.float64))  # fmt: skip
+                      np.asarray(m.pass_values, dtype=np.float64), passing)  # fmt: skip
 
 
 def _timing_to(t: Timing) -> Any:

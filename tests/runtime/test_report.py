@@ -89,12 +89,15 @@ def test_report_png_is_one_page(tmp_path: Path) -> None:
     write_log(tmp_path / "run.mcap", 120, ball_visible_every=1, robot_1_visible=True)
     summary = json.loads(json.dumps({
         "score": {"blue": 1, "yellow": 0}, "seconds": 2.0, "opponent": "simple", "perception": "vision", "seed": 1,
-        "passes": {"tried": 1, "completed": 0}, "realtime_factor": 1.2, "compile_seconds": 0.0,
+        "passes": {"tried": 1, "completed": 0, "ends": {"late": 1},
+                   "list": [{"t_kick": 0.5, "passer": 1, "receiver": 2, "target": [1.0, 1.0], "speed_m_s": 2.0,
+                             "ball_s": 0.6, "receiver_s": None, "opponent_s": 0.9, "end": "late"}]},
+        "realtime_factor": 1.2, "compile_seconds": 0.0,
         "cycle_ms": {"vision": {"median": 1.5, "p95": 2.0}, "brain": {"median": 2.0, "p95": 4.0}},
     }))  # fmt: skip
     path = write_report(load_run(tmp_path / "run.mcap"), summary, tmp_path / "report.png")
     img = cv2.imread(str(path))
-    assert img is not None and img.shape == (1000, 1400, 3)
+    assert img is not None and img.shape == (1400, 1400, 3)
 
 
 @pytest.mark.slow

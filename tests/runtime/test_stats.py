@@ -5,11 +5,13 @@ from __future__ import annotations
 from typing import Any
 
 from cmdragons.messages import Contact, SimEvents
+from cmdragons.runtime.pass_record import PassRecorder
+from cmdragons.runtime.settings import load_settings
 from cmdragons.runtime.stages import StatsStage
 
 
 def test_own_collisions_are_told_from_those_an_opponent_pushed_into() -> None:
-    stats = StatsStage("blue", pass_timeout_s=2.0)
+    stats = StatsStage("blue", PassRecorder.of("blue", load_settings()))
     events = (
         Contact(1.0, 0.1, ("blue", 1), ("blue", 2), 0.001, 0.4),  # ours drove into each other
         Contact(2.0, 0.1, ("blue", 1), ("blue", 3), 0.001, 0.6, pushed_by=("yellow", 4)),  # pushed

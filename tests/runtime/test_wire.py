@@ -64,7 +64,9 @@ REPORT = msg.TeamReport(
                      msg.RobotCommand("blue", 0, 0.5, 0.25, 1.0), np.array([[0.0, 0.0], [0.1, 0.05]])),
      msg.RobotReport(1, "halt", (0.0, 0.0, 0.0))),
     {0: msg.KickPurpose.PASS, 1: msg.KickPurpose.WAIT}, np.array([[1.0, 1.0], [2.0, -1.0]]), np.array([0.25, 0.75]),
+    msg.PassReport(0, 1, (2.0, -1.0), (4.5, 0.25), kicked=True),
 )  # fmt: skip
+REPORT_TRAP = msg.TeamReport("blue", 5, 0.08, passing=msg.PassReport(1, 0, (1.0, 1.0)))  # no one-touch aim
 
 
 def _close(a: Any, b: Any, rel: float) -> None:
@@ -92,7 +94,7 @@ def test_exact_messages_round_trip_equal(m: Any) -> None:
     assert _back(m) == m
 
 
-@pytest.mark.parametrize("m", [DET, WORLD, COMMANDS, REPORT], ids=lambda m: type(m).__name__)
+@pytest.mark.parametrize("m", [DET, WORLD, COMMANDS, REPORT, REPORT_TRAP], ids=lambda m: type(m).__name__)
 def test_float32_messages_round_trip_to_a_millionth_and_are_stable(m: Any) -> None:
     back = _back(m)
     _close(m.to_dict(), back.to_dict(), rel=1e-6)

@@ -363,8 +363,26 @@ class RobotAction(_message.Message):
     action: str
     def __init__(self, id: _Optional[int] = ..., action: _Optional[str] = ...) -> None: ...
 
+class PassReport(_message.Message):
+    __slots__ = ("passer", "receiver", "target_x", "target_y", "shoot_x", "shoot_y", "kicked")
+    PASSER_FIELD_NUMBER: _ClassVar[int]
+    RECEIVER_FIELD_NUMBER: _ClassVar[int]
+    TARGET_X_FIELD_NUMBER: _ClassVar[int]
+    TARGET_Y_FIELD_NUMBER: _ClassVar[int]
+    SHOOT_X_FIELD_NUMBER: _ClassVar[int]
+    SHOOT_Y_FIELD_NUMBER: _ClassVar[int]
+    KICKED_FIELD_NUMBER: _ClassVar[int]
+    passer: int
+    receiver: int
+    target_x: float
+    target_y: float
+    shoot_x: float
+    shoot_y: float
+    kicked: bool
+    def __init__(self, passer: _Optional[int] = ..., receiver: _Optional[int] = ..., target_x: _Optional[float] = ..., target_y: _Optional[float] = ..., shoot_x: _Optional[float] = ..., shoot_y: _Optional[float] = ..., kicked: _Optional[bool] = ...) -> None: ...
+
 class TeamReport(_message.Message):
-    __slots__ = ("team", "frame_number", "t", "robots", "actions", "pass_points", "pass_values")
+    __slots__ = ("team", "frame_number", "t", "robots", "actions", "pass_points", "pass_values", "passing")
     TEAM_FIELD_NUMBER: _ClassVar[int]
     FRAME_NUMBER_FIELD_NUMBER: _ClassVar[int]
     T_FIELD_NUMBER: _ClassVar[int]
@@ -372,6 +390,7 @@ class TeamReport(_message.Message):
     ACTIONS_FIELD_NUMBER: _ClassVar[int]
     PASS_POINTS_FIELD_NUMBER: _ClassVar[int]
     PASS_VALUES_FIELD_NUMBER: _ClassVar[int]
+    PASSING_FIELD_NUMBER: _ClassVar[int]
     team: _ssl_tracked_pb2.Team
     frame_number: int
     t: float
@@ -379,7 +398,8 @@ class TeamReport(_message.Message):
     actions: _containers.RepeatedCompositeFieldContainer[RobotAction]
     pass_points: _containers.RepeatedScalarFieldContainer[float]
     pass_values: _containers.RepeatedScalarFieldContainer[float]
-    def __init__(self, team: _Optional[_Union[_ssl_tracked_pb2.Team, str]] = ..., frame_number: _Optional[int] = ..., t: _Optional[float] = ..., robots: _Optional[_Iterable[_Union[RobotReport, _Mapping]]] = ..., actions: _Optional[_Iterable[_Union[RobotAction, _Mapping]]] = ..., pass_points: _Optional[_Iterable[float]] = ..., pass_values: _Optional[_Iterable[float]] = ...) -> None: ...
+    passing: PassReport
+    def __init__(self, team: _Optional[_Union[_ssl_tracked_pb2.Team, str]] = ..., frame_number: _Optional[int] = ..., t: _Optional[float] = ..., robots: _Optional[_Iterable[_Union[RobotReport, _Mapping]]] = ..., actions: _Optional[_Iterable[_Union[RobotAction, _Mapping]]] = ..., pass_points: _Optional[_Iterable[float]] = ..., pass_values: _Optional[_Iterable[float]] = ..., passing: _Optional[_Union[PassReport, _Mapping]] = ...) -> None: ...
 
 class Timing(_message.Message):
     __slots__ = ("stage", "frame_number", "ms")

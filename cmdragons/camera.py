@@ -134,7 +134,7 @@ class RealisticParams(Validated):
     h264_crf: int = setting(23, lo=0, hi=51)
     floor_bgr: tuple[int, int, int] = setting((70, 110, 150), lo=0, hi=255)  # wooden floor past the boundary
     clutter: int = setting(6, lo=0, hi=100)  # orange-ish things lying on the floor (boxes, a cone, a tan ball)
-    hidden_dot: tuple[int, int, int] = (0, 2, 1)  # (team 0 blue / 1 yellow, id, dot 0..3) taped over; id < 0: none
+    hidden_dot: tuple[int, int, int] = (0, 2, 2)  # (team 0 blue / 1 yellow, id, dot 0..3) taped over; id < 0: none
 
 
 @dataclass(frozen=True)

@@ -81,7 +81,7 @@ def test_hidden_dot_and_floor_clutter() -> None:
     r = renderer(2, look)
     img = r.render(snap(0.0, ROBOTS))[0]
     model = r.model
-    # the taped-over dot (blue 2, dot 1) is as dark as the cover; another dot of it is bright
+    # the taped-over dot is as dark as the cover; the others are bright
     x, y, th = ROBOTS[0][2:5]
     c, s = np.cos(th), np.sin(th)
     dots = LEAGUE.pattern.dot_positions_m
@@ -90,7 +90,9 @@ def test_hidden_dot_and_floor_clutter() -> None:
         dx, dy = dots[k]
         px = model.project_xy(np.array([x + c * dx - s * dy, y + s * dx + c * dy]), LEAGUE.robot.height_m)
         lumas.append(float(np.mean(img[int(px[1]), int(px[0])])))
-    hidden = lumas.pop(1)
+    team, rid, dot = look.hidden_dot
+    assert ROBOTS[0][:2] == (team, rid)
+    hidden = lumas.pop(dot)
     assert hidden < 70.0 and min(lumas) > hidden + 60.0, (hidden, lumas)  # the cover: about 45 here
     # past the boundary: the wooden floor, and orange-ish things on it (red above blue by far)
     f = Field(LEAGUE)

@@ -9,7 +9,8 @@ first condition's first frame (from a rough start: the height and the rectangle 
 its colours learnt by ``tune --auto`` from that condition's first seconds; then each condition is
 scored against the truth with that camera and those colours, unchanged, and again with colours
 learnt on the condition's own first seconds. A lab's vision.yaml knows its covers: three dots of
-four read, ``patterns.ids_in_play`` the ids on the field.
+four read, ``patterns.ids_in_play`` the ids on the field; the classes follow the light
+(``light.follow``).
 
 Calibration row: the line fit's reported error beside its error against the true line centres,
 the pose error, and the wrong fields and the wrong frame size refused.
@@ -35,12 +36,12 @@ from cmdragons.messages import GroundTruth
 from cmdragons.runtime.settings import Settings
 from sim.script import ScriptedPlay
 from sim.simulator import Simulator
-from vision.field_lines import CalibrationRefused, LineCalibration, calibrate_from_lines, field_samples, rough_start
+from vision.field_lines import CalibrationRefused, LineCalibration, calibrate_from_lines, rough_start, true_error_px
 from vision.pipeline import VisionParams, VisionPipeline
 from vision.score import Score
 from vision.tune import auto_samples, learn_boxes
 
-__all__ = ["CONDITIONS", "LAB_BALL_RADIUS_M", "LAB_LINE_WIDTH_M", "REALDATA", "lab_rows", "true_error_px"]
+__all__ = ["CONDITIONS", "LAB_BALL_RADIUS_M", "LAB_LINE_WIDTH_M", "REALDATA", "lab_rows"]
 
 Row = dict[str, Any]
 
@@ -62,15 +63,16 @@ CONDITIONS: dict[str, dict[str, Any]] = {
 
 def _lab_settings(settings: Settings) -> Settings:
     """The settings with the realistic camera over a lab's field.yaml (its ball and tape), and a
-    lab's vision.yaml: three dots of four read among the ids on the field."""
+    lab's vision.yaml: three dots of four read among the ids on the field, classes following the light."""
     league = settings.field
     dims = dataclasses.replace(league.dims, line_width_m=LAB_LINE_WIDTH_M)
     league = dataclasses.replace(league, divisions={**league.divisions, league.division: dims},
                                  ball=dataclasses.replace(league.ball, radius_m=LAB_BALL_RADIUS_M))  # fmt: skip
     ids = tuple(range(dims.robots_per_team))
     pat = dataclasses.replace(settings.vision.patterns, min_dots=3, ids_in_play=ids)
+    light = dataclasses.replace(settings.vision.light, follow=True)
     return dataclasses.replace(settings, field=league, cameras=dataclasses.replace(settings.cameras, preset="realistic"),
-                               vision=dataclasses.replace(settings.vision, patterns=pat))  # fmt: skip
+                               vision=dataclasses.replace(settings.vision, patterns=pat, light=light))  # fmt: skip
 
 
 def _frames(settings: Settings, look: RealisticParams, n: int) -> Iterator[tuple[NDArray[np.uint8], GroundTruth]]:
@@ -101,19 +103,6 @@ def _colours(settings: Settings, images: Sequence[NDArray[np.uint8]], model: Cam
     boxes, _ = learn_boxes({names[r]: v for r, v in rep.samples.items()}, rep.background,
                            {names[r]: v for r, v in rep.light.items()}, vis.colours, vis.colour_space)  # fmt: skip
     return dataclasses.replace(vis, colours=boxes)
-
-
-def true_error_px(got: CameraParams, true: CameraParams, league: LeagueParams) -> float:
-    """RMS normal distance (px) between the fitted and the true projections of the field's line
-    centres in view: a line fit's error against the true centres."""
-    pts, tan, _ = field_samples(league, 0.01)
-    a, b = CameraModel(got), CameraModel(true)
-    pa, pb = a.project(pts), b.project(pts)
-    ahead = b.project(pts + np.concatenate([tan * 0.01, np.zeros((len(tan), 1))], axis=1))
-    d = ahead - pb
-    nrm = np.stack([-d[:, 1], d[:, 0]], axis=1) / np.linalg.norm(d, axis=1, keepdims=True)
-    view = b.in_image(np.nan_to_num(pb, nan=-1.0), margin=2.0)
-    return float(np.sqrt(np.mean(np.sum((pa[view] - pb[view]) * nrm[view], axis=1) ** 2)))
 
 
 def _pose_errors(got: CameraParams, true: CameraParams) -> tuple[float, float]:

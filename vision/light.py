@@ -9,7 +9,8 @@ afterwards every confident robot's markers and every confident ball measure, in 
 in, the gain that brings them back to those colours, and the cell's gain moves toward it by
 ``rate`` a frame; a cell with nothing seen this frame moves, at half that rate, toward the gain
 the whole frame measured (light that changes everywhere at once). A marker whose colour is far
-off its role's (a dot taped over, glare) teaches nothing.
+off its role's (a dot taped over, glare) teaches nothing. The gains are updated every
+``every_frames`` frames: light drifts over seconds, and a frame's update costs a few milliseconds.
 """
 
 from __future__ import annotations
@@ -38,6 +39,7 @@ class LightParams(Validated):
     min_confidence: float = setting(0.7, lo=0.0, hi=1.0)  # detections at least this confident teach
     max_change: float = setting(2.0, lo=1.0, hi=8.0)  # a gain stays within [1 / this, this]; a marker
     #   further than this from its role's colour in a channel teaches nothing
+    every_frames: int = setting(6, lo=1, hi=1000)  # the gains are updated every this many frames (light drifts slowly)
 
 
 class LightFollower:
@@ -53,9 +55,13 @@ class LightFollower:
         self.pattern = pat
         self.dots = np.array(pat.dot_positions_m, dtype=np.float64).reshape(-1, 2)
         depth = camera.center[2] - league.robot.height_m
-        self.dot_px = 0.6 * pat.id_dot_diameter_m / 2 * camera.f / depth  # sampled within this of a dot's centre
-        self.centre_px = 0.6 * pat.center_dot_diameter_m / 2 * camera.f / depth
-        self.ball_px = 0.5 * league.ball.radius_m * camera.f / camera.center[2]
+        # every marker sampled within 0.6 of an id dot's radius (at least the pixel and its 4 neighbours)
+        r = max(1.0, 0.6 * pat.id_dot_diameter_m / 2 * camera.f / depth)
+        k = int(math.ceil(r))
+        dv, du = np.mgrid[-k : k + 1, -k : k + 1]
+        keep = du**2 + dv**2 <= r * r
+        self.offsets = np.stack([du[keep], dv[keep]], axis=1).astype(np.int64)  # (n, 2) (du, dv)
+        self.frames = 0
 
     def cell(self, pixel: tuple[float, float]) -> tuple[int, int]:
         """(row, column) of the cell holding ``pixel`` (u, v)."""
@@ -70,42 +76,48 @@ class LightFollower:
         return out
 
     def observe(self, image: NDArray[np.uint8], robots: list[RobotDetection],
-                balls: list[BallDetection]) -> NDArray[np.float64]:  # fmt: skip
-        """Update the gains from this frame's confident detections; returns them (rows, columns, 3)."""
+                balls: list[BallDetection]) -> NDArray[np.float64] | None:  # fmt: skip
+        """Update the gains from this frame's confident detections, every ``every_frames``-th frame;
+        returns them (rows, columns, 3) when they were updated, else None."""
         p = self.params
-        seen: list[tuple[str, tuple[float, float], NDArray[np.float64]]] = []  # role, pixel, mean BGR
+        self.frames += 1
+        if (self.frames - 1) % p.every_frames:
+            return None
+        roles: list[str] = []
+        pixels: list[NDArray[np.float64]] = []
         for r in robots:
             if r.confidence < p.min_confidence:
                 continue
-            z = self.heights[r.team]
-            seen.append((r.team, r.pixel, self._mean(image, r.pixel, self.centre_px)))
             c, s = math.cos(r.theta), math.sin(r.theta)
-            pink = self.pattern.dot_is_pink(r.id)
-            for (dx, dy), is_pink in zip(self.dots, pink, strict=True):
-                px = self.camera.project_xy(np.array([r.x + c * dx - s * dy, r.y + s * dx + c * dy]), z)
-                if np.all(np.isfinite(px)):
-                    pixel = (float(px[0]), float(px[1]))
-                    seen.append(("pink" if is_pink else "green", pixel, self._mean(image, pixel, self.dot_px)))
+            xy = np.array([r.x, r.y]) + self.dots @ np.array([[c, s], [-s, c]])
+            pixels += [np.array(r.pixel, dtype=np.float64)[None], self.camera.project_xy(xy, self.heights[r.team])]
+            roles += [r.team, *("pink" if pink else "green" for pink in self.pattern.dot_is_pink(r.id))]
         for b in balls:
             if b.confidence >= p.min_confidence:
-                seen.append(("ball", b.pixel, self._mean(image, b.pixel, self.ball_px)))
+                pixels.append(np.array(b.pixel, dtype=np.float64)[None])
+                roles.append("ball")
+        if not roles:
+            return None
+        means = self._means(image, np.concatenate(pixels))
         ny, nx = self.gains.shape[:2]
         num, den = np.zeros((ny, nx, 3)), np.zeros((ny, nx, 3))
-        for role, pixel, bgr in seen:
+        px_all = np.concatenate(pixels)
+        for role, pixel, bgr in zip(roles, px_all, means, strict=True):
             if not np.all(np.isfinite(bgr)):
                 continue
+            where = (float(pixel[0]), float(pixel[1]))
             ref = self.reference.get(role)
-            cell = self.cell(pixel)
             if ref is None:
-                self.reference[role] = self.corrected(bgr, pixel)
+                self.reference[role] = self.corrected(bgr, where)
                 continue
             ratio = ref / np.maximum(bgr, 1.0)
             if np.any(ratio > p.max_change) or np.any(ratio < 1.0 / p.max_change):
                 continue  # a dot taped over, glare: not the marker's colour
+            cell = self.cell(where)
             num[cell] += ref
             den[cell] += np.maximum(bgr, 1.0)
         if not den.any():
-            return self.gains
+            return None
         seen_cells = den[..., 0] > 0.0
         measured = np.where(seen_cells[..., None], num / np.where(den > 0.0, den, 1.0), self.gains)
         whole = num.sum(axis=(0, 1)) / den.sum(axis=(0, 1))
@@ -114,16 +126,14 @@ class LightFollower:
         self.gains = np.clip(self.gains, 1.0 / p.max_change, p.max_change)
         return self.gains
 
-    @staticmethod
-    def _mean(image: NDArray[np.uint8], pixel: tuple[float, float], r_px: float) -> NDArray[np.float64]:
-        """Mean BGR of the pixels within ``r_px`` (at least 1) of ``pixel``; NaN off the image."""
-        r = max(1.0, r_px)
+    def _means(self, image: NDArray[np.uint8], pixels: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Mean BGR (n, 3) of the pixels within the id dots' inner radius of each of ``pixels``
+        (n, 2) (u, v); NaN where that reaches off the image."""
         h, w = image.shape[:2]
-        i0, i1 = int(pixel[1] - r), int(pixel[1] + r) + 1
-        j0, j1 = int(pixel[0] - r), int(pixel[0] + r) + 1
-        if not (0 <= i0 and i1 <= h and 0 <= j0 and j1 <= w):
-            return np.full(3, np.nan)
-        v, u = np.mgrid[i0:i1, j0:j1] + 0.5
-        inside = (u - pixel[0]) ** 2 + (v - pixel[1]) ** 2 <= r * r
-        out: NDArray[np.float64] = image[i0:i1, j0:j1][inside].astype(np.float64).mean(axis=0)
+        i = np.floor(pixels[:, 1]).astype(np.int64)[:, None] + self.offsets[None, :, 1]
+        j = np.floor(pixels[:, 0]).astype(np.int64)[:, None] + self.offsets[None, :, 0]
+        ok = np.all((i >= 0) & (i < h) & (j >= 0) & (j < w), axis=1)
+        out = np.full((len(pixels), 3), np.nan)
+        if ok.any():
+            out[ok] = image[i[ok], j[ok]].astype(np.float64).mean(axis=1)
         return out

@@ -162,7 +162,8 @@ class VisionPipeline:
         robots = [r for r in robots if self.in_field(r.x, r.y)]
         if self.light is not None:
             gains = self.light.observe(image, robots, balls)
-            self.segmenter.set_light(gains, self.camera.width, self.camera.height)
+            if gains is not None:
+                self.segmenter.set_light(gains, self.camera.width, self.camera.height)
         # no wall clock here: the frame is "sent" at its capture time (latency is the runtime's)
         return DetectionFrame(self.camera.id, frame_number, t_capture, t_capture, tuple(balls),
                               tuple(sorted(robots, key=lambda r: (r.team, r.id))))  # fmt: skip

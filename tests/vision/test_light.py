@@ -58,7 +58,7 @@ def scene(cameras: list[CameraModel]) -> tuple[CameraModel, NDArray[np.uint8]]:
 
 def test_classes_follow_a_lighting_change(scene: tuple[CameraModel, NDArray[np.uint8]]) -> None:
     model, image = scene
-    following = dataclasses.replace(VisionParams(), light=LightParams(follow=True, grid=(4, 3), rate=0.2))
+    following = dataclasses.replace(VisionParams(), light=LightParams(follow=True, grid=(4, 3), rate=0.2, every_frames=1))
     got = run(following, model, image, 40)
     assert got == [len(ROBOTS)] * 40
     still = run(VisionParams(), model, image, 40)

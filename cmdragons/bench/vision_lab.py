@@ -114,10 +114,12 @@ def _pose_errors(got: CameraParams, true: CameraParams) -> tuple[float, float]:
 
 def _refused(image: NDArray[np.uint8], league: LeagueParams, height_m: float) -> tuple[int, int]:
     """(refused, tried): the line fit on ``image`` with a field 12% too long, one 12% too wide,
-    one without its centre circle, and on the frame cut to another aspect ratio."""
+    one whose centre circle is 20% too big, and on the frame cut to another aspect ratio. (A
+    field.yaml that leaves out a line the image shows, its centre circle say, is no wrong field:
+    the fit to the lines it names is right, and taken.)"""
     dims = league.dims
     wrong = [dataclasses.replace(dims, length_m=dims.length_m * 1.12), dataclasses.replace(dims, width_m=dims.width_m * 1.12),
-             dataclasses.replace(dims, center_circle=False)]  # fmt: skip
+             dataclasses.replace(dims, center_circle_radius_m=dims.center_circle_radius_m * 1.2)]  # fmt: skip
     refused = 0
     h, w = image.shape[:2]
     for d in wrong:

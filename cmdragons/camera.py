@@ -30,6 +30,7 @@ __all__ = [
     "CameraModel",
     "CameraParams",
     "CamerasParams",
+    "RealisticParams",
     "RecordingParams",
     "cameras_from_config",
     "from_ssl_vision_distortion",
@@ -101,6 +102,44 @@ class RecordingParams(Validated):
 
 
 @dataclass(frozen=True)
+class RealisticParams(Validated):
+    """configs/cameras.yaml ``realistic``: what a lab's camera adds to the simulator's clean render
+    when ``preset: realistic`` (:mod:`sim.render`, ``CameraLook``). Colours BGR grey levels, SI units.
+
+    The lab's own facts -- its ball's size, its tape's width -- are field.yaml's (``ball.radius_m``,
+    ``dims.line_width_m``): the preset draws what field.yaml says, as vision reads it."""
+
+    k1: float = setting(-0.2, lo=-0.5, hi=0.5)  # strong barrel distortion, in place of auto.k1 and k2
+    k2: float = setting(0.04, lo=-0.5, hi=0.5)
+    resolution_px: tuple[int, int] = (1920, 1200)  # in place of auto.resolution_px
+    view_margin_m: float = setting(0.6, lo=0.0, hi=5.0)  # seen past the field lines, in place of auto's margins
+    vignetting_fraction: float = setting(0.35, lo=0.0, hi=0.9)  # light lost at the image corners (cos^4 falloff)
+    lamps: tuple[int, int] = (3, 2)  # ceiling lamps in a grid over the field, along x and y
+    lamp_height_m: float = setting(3.0, lo=0.5, hi=20.0)  # above the carpet; lower: rounder pools of light
+    lamp_level: float = setting(1.0, lo=0.0, hi=3.0)  # the lamps' light against the plain render's
+    lamp_bgr: tuple[float, float, float] = setting((0.85, 1.0, 1.12), lo=0.0, hi=2.0)  # warm-white tint per channel
+    lamp_drift_fraction: float = setting(0.15, lo=0.0, hi=0.9)  # each lamp's brightness wanders this much ...
+    lamp_drift_period_s: float = setting(40.0, lo=1.0, hi=10000.0)  # ... over about this long (each its own phase)
+    daylight_level: float = setting(0.3, lo=0.0, hi=3.0)  # window light from +y, strongest at that touch line
+    daylight_bgr: tuple[float, float, float] = setting((1.15, 1.0, 0.88), lo=0.0, hi=2.0)  # bluish
+    daylight_drift_fraction: float = setting(0.3, lo=0.0, hi=0.9)  # clouds: daylight wanders this much
+    daylight_drift_period_s: float = setting(25.0, lo=1.0, hi=10000.0)
+    exposure_target_grey: float = setting(90.0, lo=10.0, hi=240.0)  # auto exposure: mean luma it steers to
+    exposure_rate: float = setting(0.15, lo=0.0, hi=1.0)  # share of the error corrected per frame (0: fixed)
+    saturation: float = setting(0.75, lo=0.0, hi=1.0)  # colours pulled toward grey (1: as rendered)
+    bayer: bool = True  # an RGGB sensor: one channel per pixel, the others interpolated (OpenCV demosaicing)
+    specular_grey: float = setting(90.0, lo=0.0, hi=255.0)  # glare on a robot's cover at its peak, under full light
+    specular_radius_m: float = setting(0.015, lo=0.001, hi=0.1)  # its Gaussian's sigma on the cover
+    specular_reach_m: float = setting(0.15, lo=0.01, hi=2.0)  # how far off a lamp's mirror point a cover still glares
+    codec: Literal["none", "jpeg", "h264"] = "jpeg"  # what the camera delivers: raw, JPEG (MJPEG) or H.264
+    jpeg_quality: int = setting(85, lo=1, hi=100)
+    h264_crf: int = setting(23, lo=0, hi=51)
+    floor_bgr: tuple[int, int, int] = setting((70, 110, 150), lo=0, hi=255)  # wooden floor past the boundary
+    clutter: int = setting(6, lo=0, hi=100)  # orange-ish things lying on the floor (boxes, a cone, a tan ball)
+    hidden_dot: tuple[int, int, int] = (0, 2, 2)  # (team 0 blue / 1 yellow, id, dot 0..3) taped over; id < 0: none
+
+
+@dataclass(frozen=True)
 class CamerasParams(Validated):
     """configs/cameras.yaml."""
 
@@ -108,6 +147,12 @@ class CamerasParams(Validated):
     auto: AutoLayout = AutoLayout()
     cameras: tuple[CameraParams, ...] = ()
     recording: RecordingParams = RecordingParams()
+    preset: Literal["plain", "realistic"] = "plain"  # the simulated camera: the clean render, or a lab's
+    realistic: RealisticParams = RealisticParams()
+
+    def look(self) -> RealisticParams | None:
+        """The realistic camera's parameters when that preset is chosen, else None (the clean render)."""
+        return self.realistic if self.preset == "realistic" else None
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -386,6 +431,10 @@ def cameras_from_config(params: CamerasParams, league: LeagueParams) -> list[Cam
     if params.layout == "list":
         return [CameraModel(p) for p in params.cameras]
     lay = params.auto
+    if params.preset == "realistic":
+        r = params.realistic
+        lay = dataclasses.replace(lay, k1=r.k1, k2=r.k2, resolution_px=r.resolution_px, margin_x_m=r.view_margin_m,
+                                  margin_y_m=r.view_margin_m)  # fmt: skip
     if lay.grid != "auto":
         return _grid_cameras(lay.grid, lay, league)
     for grid in _GRIDS:

@@ -13,20 +13,25 @@ all in one numba pass (:mod:`sim._kernels`).
 
 from __future__ import annotations
 
+import math
 import sys
 from dataclasses import dataclass
+from fractions import Fraction
+from typing import Any
 
+import cv2
 import numba
 import numpy as np
 from numpy.typing import NDArray
 
-from cmdragons.camera import CameraModel
+from cmdragons.camera import CameraModel, RealisticParams
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, LeagueParams
 from sim import _kernels as kern
+from cmdragons.videoio import bgr_to_i420, i420_to_bgr
 from sim.snapshot import Snapshot
 
-__all__ = ["CameraRenderer", "CameraTruth", "RenderParams"]
+__all__ = ["CameraLook", "CameraRenderer", "CameraTruth", "Lighting", "RenderParams"]
 
 BGR = tuple[int, int, int]
 
@@ -84,9 +89,13 @@ class CameraRenderer:
     generator seeded by ``seed`` and the camera id, and the key picks every row's values from a
     pool of Gaussian noise and flips their signs (:mod:`sim._kernels`, sensor noise). The same
     seed and snapshots give identical bytes.
+
+    ``lighting`` (a lab's light, one for all cameras of a match): the frames are a lab camera's
+    (:class:`CameraLook`, cameras.yaml ``preset: realistic``), not the clean render's.
     """
 
-    def __init__(self, model: CameraModel, league: LeagueParams, params: RenderParams, seed: int) -> None:
+    def __init__(self, model: CameraModel, league: LeagueParams, params: RenderParams, seed: int,
+                 lighting: Lighting | None = None) -> None:  # fmt: skip
         self.model, self.league, self.params = model, league, params
         self.field = Field(league)
         self.rng = np.random.default_rng([seed, model.id])
@@ -98,6 +107,10 @@ class CameraRenderer:
         ground = model.center[:2] + model.center[2] * self.rays.astype(np.float64)
         self.gain = _lighting_gain(model, ground, self.field.dims.length_m, params)
         self.background = _static_background(model, self.field, params, self.rays, self.foot, self.gain)
+        self.look: CameraLook | None = None
+        if lighting is not None:
+            self.look = CameraLook(model, league, lighting.params, lighting, self.rays, seed)
+            self.background = self.look.floor(self.background, self.rays, self.gain, self.field)
 
         robot, pattern = league.robot, league.pattern
         self.cam = kern.camera_vector(model)
@@ -139,6 +152,8 @@ class CameraRenderer:
             out = np.empty((self.model.height, self.model.width, 3), dtype=np.uint8)
         truth = self.render_into(snapshot, out)
         self._last_image = out
+        if self.look is not None:
+            return self.look.apply(out, snapshot, self.gain, self.params.cover_bgr), truth
         return out, truth
 
     def render_into(self, snapshot: Snapshot, out: NDArray[np.uint8]) -> CameraTruth:
@@ -325,3 +340,257 @@ def _draw_goal(model: CameraModel, boxes: list[tuple[float, float, float, float]
     wall = np.where(sub_hit[..., None], face_gain[sub_face][..., None] * goal, img[ii, jj][:, None, None, :])
     img[ii, jj] = wall.mean(axis=(1, 2))
     return img
+
+
+# --- a lab's camera: cameras.yaml ``preset: realistic`` ------------------------------------------------
+
+_LIGHT_STEP_PX = 8  # the light is smooth: computed on every 8th pixel and interpolated
+_CLUTTER_BGR = ((30, 105, 235), (55, 125, 205), (35, 80, 215), (20, 95, 250), (80, 140, 200))  # orange-ish, tan
+
+
+class Lighting:
+    """The lab's light over the field, one for all cameras of a match: ``lamps`` in a grid under the
+    ceiling, each a pool of light (a point source's irradiance on the carpet, brightest straight
+    below it) whose brightness wanders slowly with its own period and phase, and daylight through a
+    window along the +y touch line, wandering with the clouds. Phases from ``seed``."""
+
+    def __init__(self, league: LeagueParams, params: RealisticParams, seed: int) -> None:
+        self.params, self.seed = params, seed
+        f = Field(league)
+        rng = np.random.default_rng([seed, 0x11647])
+        nx, ny = params.lamps
+        xs = (np.arange(nx) + 0.5) / nx * 2.0 * f.half_length - f.half_length
+        ys = (np.arange(ny) + 0.5) / ny * 2.0 * f.half_width - f.half_width
+        self.lamps_xy = np.array([(x, y) for x in xs for y in ys], dtype=np.float64).reshape(-1, 2)
+        k = len(self.lamps_xy)
+        self.periods_s = params.lamp_drift_period_s * rng.uniform(0.7, 1.3, k)
+        self.phases = rng.uniform(0.0, 2.0 * np.pi, k)
+        self.day_phase = float(rng.uniform(0.0, 2.0 * np.pi))
+        self.half_width = f.boundary_half_width
+        # the lamps' pools, scaled so that their sum's mean over the field is 1
+        g = np.stack(np.meshgrid(np.linspace(-f.half_length, f.half_length, 25),
+                                 np.linspace(-f.half_width, f.half_width, 17)), -1).reshape(-1, 2)  # fmt: skip
+        self.scale = 1.0 / max(float(np.mean(self.pools(g).sum(axis=1))), 1e-9)
+
+    def pools(self, ground: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Each lamp's irradiance at ground points (..., 2), 1 straight below it: (..., lamps)."""
+        h = self.params.lamp_height_m
+        d2 = ((ground[..., None, :] - self.lamps_xy) ** 2).sum(axis=-1)
+        out: NDArray[np.float64] = h**3 / (d2 + h * h) ** 1.5
+        return out
+
+    def weights(self, t: float) -> tuple[NDArray[np.float64], float]:
+        """Each lamp's brightness and the daylight's at time ``t`` (s), against their nominal levels."""
+        p = self.params
+        lamps = p.lamp_level * (1.0 + p.lamp_drift_fraction * np.sin(2.0 * np.pi * t / self.periods_s + self.phases))
+        day = p.daylight_level * (1.0 + p.daylight_drift_fraction
+                                  * math.sin(2.0 * math.pi * t / p.daylight_drift_period_s + self.day_phase))  # fmt: skip
+        return lamps * self.scale, day
+
+    def daylight(self, ground: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The window light's share at ground points (..., 2): 1 at the +y boundary, 0.25 at the -y."""
+        out: NDArray[np.float64] = 0.25 + 0.75 * np.clip((ground[..., 1] / self.half_width + 1.0) / 2.0, 0.0, 1.0)
+        return out
+
+
+class CameraLook:
+    """What a lab's camera makes of the clean render (``RealisticParams``), deterministic per seed:
+    the floor past the field with orange-ish clutter (into the static scene), a cover with one dot
+    taped over, the lamps' and daylight's light with cos^4 vignetting, glare on the covers under
+    the lamps, auto exposure, desaturation, an RGGB sensor demosaiced, and the camera's
+    compression (JPEG or H.264). Geometry (the strong barrel distortion) is the camera model's."""
+
+    def __init__(self, model: CameraModel, league: LeagueParams, params: RealisticParams, lighting: Lighting,
+                 rays: NDArray[np.float32], seed: int) -> None:  # fmt: skip
+        self.model, self.league, self.params, self.lighting = model, league, params, lighting
+        self.seed = seed
+        h, w = model.height, model.width
+        s = _LIGHT_STEP_PX
+        self.small_ground = model.center[:2] + model.center[2] * rays[::s, ::s].astype(np.float64)
+        self.small_pools = lighting.pools(self.small_ground)  # (hs, ws, lamps)
+        self.small_day = lighting.daylight(self.small_ground)
+        # cos^4 vignetting, as strong at the farthest corner as asked
+        r2 = (rays[::s, ::s].astype(np.float64) ** 2).sum(axis=-1)  # tan^2 of the angle off the vertical
+        c4 = 1.0 / (1.0 + r2) ** 2
+        c4_min = float(c4.min())
+        power = math.log(1.0 - params.vignetting_fraction) / math.log(c4_min) if c4_min < 1.0 else 0.0
+        self.small_vignette = c4**power
+        self.size = (w, h)
+        self.exposure: float | None = None
+        y = np.array([0.114, 0.587, 0.299], dtype=np.float32)
+        sat = np.float32(params.saturation)
+        self.desaturate = (sat * np.eye(3, dtype=np.float32) + (1 - sat) * np.outer(np.ones(3, np.float32), y))
+        self._h264: _H264 | None = None
+        if params.codec == "h264":
+            self._h264 = _H264(w, h, params.h264_crf)
+        pat, robot = league.pattern, league.robot
+        self.top_m = robot.height_m
+        # mirror points of the lamps on the robots' tops, seen from this camera
+        hc, hl = model.center[2] - self.top_m, params.lamp_height_m - self.top_m
+        self.mirror_xy = model.center[:2] + (lighting.lamps_xy - model.center[:2]) * hc / max(hc + hl, 1e-6)
+        self.dot_radius_m = pat.id_dot_diameter_m / 2.0
+        self.dots = np.array(pat.dot_positions_m, dtype=np.float64).reshape(-1, 2)
+        self.robot_radius_m = robot.radius_m
+
+    # the static scene --------------------------------------------------------------------------
+    def floor(self, background: NDArray[np.uint8], rays: NDArray[np.float32], gain: NDArray[np.float32],
+              field: Field) -> NDArray[np.uint8]:  # fmt: skip
+        """``background`` with the floor past the boundary: wooden planks along x, and ``clutter``
+        orange-ish things (boxes and discs, placed by the seed) lying on it."""
+        p = self.params
+        ground = self.model.center[:2] + self.model.center[2] * rays.astype(np.float64)
+        gx, gy = ground[..., 0], ground[..., 1]
+        hx, hy = field.boundary_half_length, field.boundary_half_width
+        outside = (np.abs(gx) > hx) | (np.abs(gy) > hy)
+        if not outside.any():
+            return background
+        plank = 0.92 + 0.08 * np.sin(gy / 0.15 * np.pi) ** 2 + 0.03 * np.sin(gx * 7.0 + 3.0 * np.sin(gy * 5.0))
+        img = np.array(p.floor_bgr, dtype=np.float64) * plank[..., None]
+        rng = np.random.default_rng([self.lighting.seed, 0xF1002])  # one floor for all cameras
+        reach = p.view_margin_m + 0.5
+        placed = 0
+        while placed < p.clutter:
+            x, y = rng.uniform(-hx - reach, hx + reach), rng.uniform(-hy - reach, hy + reach)
+            size = rng.uniform(0.04, 0.25)
+            colour = np.array(_CLUTTER_BGR[int(rng.integers(len(_CLUTTER_BGR)))], dtype=np.float64)
+            if abs(x) <= hx + size and abs(y) <= hy + size:
+                continue  # on the floor, not on the carpet
+            placed += 1
+            if rng.uniform() < 0.5:  # a disc (a tan ball, a cone seen from above)
+                shape = np.hypot(gx - x, gy - y) <= size / 2.0
+            else:  # a box, turned
+                a = rng.uniform(0.0, np.pi)
+                u = (gx - x) * math.cos(a) + (gy - y) * math.sin(a)
+                v = -(gx - x) * math.sin(a) + (gy - y) * math.cos(a)
+                shape = (np.abs(u) <= size / 2.0) & (np.abs(v) <= size / 3.0)
+            img[shape] = colour
+        img *= gain[..., None]
+        out = background.copy()
+        out[outside] = np.clip(np.floor(img[outside] + 0.5), 0, 255).astype(np.uint8)
+        return out
+
+    # per frame --------------------------------------------------------------------------------
+    def apply(self, image: NDArray[np.uint8], snapshot: Snapshot, gain: NDArray[np.float32],
+              cover_bgr: BGR) -> NDArray[np.uint8]:  # fmt: skip
+        """The camera's frame of the clean render ``image`` (not written) at ``snapshot``."""
+        p = self.params
+        img = image.copy()
+        robots = np.asarray(snapshot.robots, dtype=np.float64).reshape(-1, 8)
+        self._hide_dot(img, robots, gain, cover_bgr)
+        lamps, day = self.lighting.weights(snapshot.t)
+        small = self.small_pools @ lamps
+        light = (small[..., None] * np.array(p.lamp_bgr) + (day * self.small_day)[..., None] * np.array(p.daylight_bgr))
+        light *= self.small_vignette[..., None]
+        w, h = self.size
+        full = cv2.resize(light.astype(np.float32), (w, h), interpolation=cv2.INTER_LINEAR)
+        f = img.astype(np.float32)
+        f *= full
+        self._glare(f, robots, lamps)
+        if self.exposure is None:  # the camera starts settled on its first scene
+            self.exposure = p.exposure_target_grey / max(self._luma(f), 1.0)
+        f *= np.float32(self.exposure)
+        f = cv2.transform(f, self.desaturate)
+        out = np.clip(f + 0.5, 0, 255).astype(np.uint8)
+        if p.exposure_rate > 0.0:
+            self.exposure *= (p.exposure_target_grey / max(self._luma(out), 1.0)) ** p.exposure_rate
+        if p.bayer:
+            out = _demosaic(out)
+        if p.codec == "jpeg":
+            ok, buf = cv2.imencode(".jpg", out, [cv2.IMWRITE_JPEG_QUALITY, p.jpeg_quality])
+            out = np.asarray(cv2.imdecode(buf, cv2.IMREAD_COLOR), dtype=np.uint8)
+        elif self._h264 is not None:
+            out = self._h264(out)
+        return out
+
+    @staticmethod
+    def _luma(img: NDArray[Any]) -> float:
+        sub = img[::4, ::4].astype(np.float64)
+        return float(np.mean(0.114 * sub[..., 0] + 0.587 * sub[..., 1] + 0.299 * sub[..., 2]))
+
+    def _hide_dot(self, img: NDArray[np.uint8], robots: NDArray[np.float64], gain: NDArray[np.float32],
+                  cover_bgr: BGR) -> None:  # fmt: skip
+        team, rid, dot = self.params.hidden_dot
+        if rid < 0 or not 0 <= dot < len(self.dots):
+            return
+        for r in robots[(robots[:, 0] == team) & (robots[:, 1] == rid)]:
+            c, s = math.cos(r[4]), math.sin(r[4])
+            dx, dy = self.dots[dot]
+            xy = np.array([r[2] + c * dx - s * dy, r[3] + s * dx + c * dy])
+            px = self.model.project_xy(xy, self.top_m)
+            if not np.all(np.isfinite(px)) or not self.model.in_image(px[None], margin=0.0)[0]:
+                continue
+            rad = 1.15 * self.dot_radius_m * self.model.pixels_per_metre((float(xy[0]), float(xy[1])), self.top_m)
+            g = float(gain[min(int(px[1]), self.model.height - 1), min(int(px[0]), self.model.width - 1)])
+            colour = tuple(int(round(v * g)) for v in cover_bgr)
+            sh = 4  # sub-pixel centre: cv2 draws in 1/16 px
+            cv2.circle(img, (int(round(px[0] * 2**sh - 0.5 * 2**sh)), int(round(px[1] * 2**sh - 0.5 * 2**sh))),
+                       int(round(rad * 2**sh)), colour, -1, cv2.LINE_AA, sh)  # fmt: skip
+
+    def _glare(self, f: NDArray[np.float32], robots: NDArray[np.float64], lamps: NDArray[np.float64]) -> None:
+        """Glare on each cover near a lamp's mirror point: a Gaussian spot on the cover's side
+        toward that point, as bright as the lamp and the cover's distance from the point allow."""
+        p = self.params
+        if p.specular_grey <= 0.0 or not len(robots):
+            return
+        level = lamps / max(float(lamps.mean()), 1e-9) if lamps.size else lamps
+        rad = self.robot_radius_m
+        for r in robots:
+            for k, m in enumerate(self.mirror_xy):
+                d = float(np.hypot(*(m - r[2:4])))
+                amp = p.specular_grey * level[k] * math.exp(-0.5 * (max(0.0, d - rad) / p.specular_reach_m) ** 2)
+                if amp < 4.0:
+                    continue
+                spot = r[2:4] + (m - r[2:4]) * min(1.0, 0.55 * rad / max(d, 1e-9))
+                px = self.model.project_xy(spot, self.top_m)
+                if not np.all(np.isfinite(px)):
+                    continue
+                sig = p.specular_radius_m * self.model.pixels_per_metre((float(spot[0]), float(spot[1])), self.top_m)
+                half = int(3.0 * sig) + 1
+                i0, i1 = max(0, int(px[1]) - half), min(f.shape[0], int(px[1]) + half + 1)
+                j0, j1 = max(0, int(px[0]) - half), min(f.shape[1], int(px[0]) + half + 1)
+                if i0 >= i1 or j0 >= j1:
+                    continue
+                vv, uu = np.mgrid[i0:i1, j0:j1] + 0.5
+                spot_img = amp * np.exp(-0.5 * ((uu - px[0]) ** 2 + (vv - px[1]) ** 2) / (sig * sig))
+                f[i0:i1, j0:j1] += spot_img[..., None].astype(np.float32)
+
+
+def _demosaic(image: NDArray[np.uint8]) -> NDArray[np.uint8]:
+    """``image`` as an RGGB sensor sees it (one channel per pixel: R G on even rows, G B on odd)
+    and OpenCV's demosaicing makes of it."""
+    h, w = image.shape[:2]
+    raw = np.empty((h, w), np.uint8)
+    raw[0::2, 0::2] = image[0::2, 0::2, 2]
+    raw[0::2, 1::2] = image[0::2, 1::2, 1]
+    raw[1::2, 0::2] = image[1::2, 0::2, 1]
+    raw[1::2, 1::2] = image[1::2, 1::2, 0]
+    out: NDArray[np.uint8] = cv2.cvtColor(raw, cv2.COLOR_BayerBG2BGR)  # OpenCV names the layout by its second row
+    return out
+
+
+class _H264:
+    """Frames through an H.264 encoder and decoder in memory, one frame in, the same frame out
+    (x264 without look-ahead or B-frames, on one thread: the same bytes every run)."""
+
+    def __init__(self, width: int, height: int, crf: int) -> None:
+        import av
+
+        self.enc: Any = av.CodecContext.create("libx264", "w")
+        self.enc.width, self.enc.height, self.enc.pix_fmt = width, height, "yuv420p"
+        self.enc.time_base = Fraction(1, 60)
+        self.enc.options = {"crf": str(crf), "preset": "veryfast", "tune": "zerolatency", "threads": "1"}
+        self.dec: Any = av.CodecContext.create("h264", "r")
+        self.dec.thread_count = 1
+        self.n = 0
+        self.h, self.w = height, width
+        self._av = av
+
+    def __call__(self, image: NDArray[np.uint8]) -> NDArray[np.uint8]:
+        frame = self._av.VideoFrame.from_ndarray(bgr_to_i420(image), format="yuv420p")
+        frame.pts = self.n
+        self.n += 1
+        out = image
+        for packet in self.enc.encode(frame):
+            for decoded in self.dec.decode(packet):
+                out = i420_to_bgr(decoded.to_ndarray(), self.h, self.w)
+        return out

@@ -14,12 +14,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from cmdragons.camera import CameraModel
+from cmdragons.camera import CameraModel, RealisticParams
 from cmdragons.geometry import TEAMS, LeagueParams, Team
 from cmdragons.messages import BallOut, Contact, GameState, Goal, GroundTruth, Kick, RobotCommand, Teleport
 from sim.params import SimParams, robot_counts
 from sim.referee import Referee
-from sim.render import CameraRenderer
+from sim.render import CameraRenderer, Lighting
 from sim.world import World
 
 __all__ = ["Frame", "Simulator", "referee_summary"]
@@ -54,9 +54,11 @@ class Simulator:
         seed: int | None = None,
         render: bool = True,
         referee: bool = True,
+        look: RealisticParams | None = None,
     ) -> None:
         """``referee``: judge the game here (``cmdragons sim``); off, the referee is a stage of its own
-        that sends teleports (:meth:`teleport`)."""
+        that sends teleports (:meth:`teleport`). ``look``: the cameras are a lab's (cameras.yaml
+        ``preset: realistic``, :meth:`CamerasParams.look`), under one light seeded by the match's seed."""
         self.league, self.params = league, params
         self.seed = params.seed if seed is None else seed
         counts = robot_counts(league, params)
@@ -72,8 +74,9 @@ class Simulator:
         self.cameras = list(cameras)
         seeds = np.random.SeedSequence(self.seed).spawn(len(self.cameras) + 1)
         self.rng = np.random.default_rng(seeds[0])  # for scripted play and anything else of the sim
+        lighting = None if look is None else Lighting(league, look, self.seed)
         self.renderers = (
-            [CameraRenderer(m, league, params.render, seed=int(s.generate_state(1)[0]))
+            [CameraRenderer(m, league, params.render, seed=int(s.generate_state(1)[0]), lighting=lighting)
              for m, s in zip(self.cameras, seeds[1:], strict=True)]
             if render else []
         )  # fmt: skip

@@ -149,7 +149,8 @@ def _classify_row(lut: np.ndarray, c0: np.ndarray, c1: np.ndarray, c2: np.ndarra
 
 @numba.njit(cache=True, nogil=True)
 def classify(image: np.ndarray, yuv: bool, lut: np.ndarray, screen: np.ndarray, bits: np.ndarray,
-             runs: np.ndarray, counts: np.ndarray, row0: int, row1: int) -> None:  # fmt: skip
+             runs: np.ndarray, counts: np.ndarray, gains: np.ndarray, row_cell: np.ndarray, row0: int,
+             row1: int) -> None:  # fmt: skip
     """Classification (thesis A.1.3) and run-length encoding in one pass over rows [row0, row1) of
     the image.
 
@@ -167,6 +168,10 @@ def classify(image: np.ndarray, yuv: bool, lut: np.ndarray, screen: np.ndarray, 
     runs: pixels of no class make no runs; a row with more runs than ``runs.shape[1]`` keeps the
     first.
 
+    The light per cell of a grid over the image: when ``gains`` (R, W * 3) int32 has rows, each
+    byte of row ``i`` is first scaled by ``gains[row_cell[i]]`` (x 256, rounded, saturated at 255),
+    the row of cells holding it (:meth:`vision.cmvision.Segmenter.set_light`); no rows: the image as it is.
+
     Serial, without the GIL: the caller may run bands of rows on threads at once (rows are
     independent; :class:`vision.cmvision.Segmenter` does for large images). numba's own parallel
     loop costs seconds more to compile and, on a 2-core machine shared with other jobs, ran no
@@ -183,14 +188,23 @@ def classify(image: np.ndarray, yuv: bool, lut: np.ndarray, screen: np.ndarray, 
         hit[j] = 0
     row = np.empty(w, np.uint32)
     no_runs = np.empty((0, 3), np.int32)
+    lit = gains.shape[0] > 0
+    scaled = np.empty(w * 3, np.uint8)
+    half, top, eight = np.int32(128), np.int32(255), np.int32(8)
     for i in range(row0, row1):
         out = bits[i] if keep_bits else row
         if keep_bits:
             out[:] = 0
+        src = flat[i]
+        if lit:
+            g = gains[row_cell[i]]
+            for q in range(w * 3):
+                scaled[q] = np.uint8(min(np.int32(np.int32(np.int32(src[q]) * g[q] + half) >> eight), top))
+            src = scaled
         if yuv:
-            _yuv_row(flat[i], c0, c1, c2)
+            _yuv_row(src, c0, c1, c2)
         else:
-            _bgr_row(flat[i], c0, c1, c2)
+            _bgr_row(src, c0, c1, c2)
         n = 0
         if _screen_row(c0, c1, c2, screen, hit):
             n = _classify_row(lut, c0, c1, c2, hit, out, runs[i] if encode else no_runs)

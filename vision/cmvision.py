@@ -167,9 +167,18 @@ def _screen_boxes(classes: Sequence[ColourClass]) -> NDArray[np.uint8]:
 
 
 def classify_reference(
-    image: NDArray[np.uint8], classes: Sequence[ColourClass], space: ColourSpace
+    image: NDArray[np.uint8], classes: Sequence[ColourClass], space: ColourSpace,
+    gains: NDArray[np.float64] | None = None,
 ) -> NDArray[np.uint32]:
-    """Per pixel, the bit set of classes whose box holds it, by a direct threshold test."""
+    """Per pixel, the bit set of classes whose box holds it, by a direct threshold test; with
+    ``gains`` (rows of cells, columns of cells, 3), each pixel's BGR first scaled by its cell's
+    (x 256 fixed point, rounded, saturated), cells splitting the image evenly."""
+    if gains is not None:
+        h, w = image.shape[:2]
+        ny, nx = gains.shape[:2]
+        g = np.round(np.clip(gains, 0.0, 8.0) * 256.0).astype(np.int64)
+        per_px = g[np.minimum(np.arange(h) * ny // h, ny - 1)][:, np.minimum(np.arange(w) * nx // w, nx - 1)]
+        image = np.minimum((image.astype(np.int64) * per_px + 128) >> 8, 255).astype(np.uint8)
     c = convert_colour(image, space)
     out = np.zeros(image.shape[:2], dtype=np.uint32)
     for k, cc in enumerate(classes):
@@ -239,6 +248,21 @@ class Segmenter:
         self._no_runs = np.zeros((0, 1, 3), dtype=np.int32)  # "keep no runs" for the kernel
         self._no_bits = np.zeros((0, 1), dtype=np.uint32)
         self._pool: ThreadPoolExecutor | None = None  # the bands' threads for large images, made on first use
+        self._gains: NDArray[np.int32] = np.zeros((0, 0), dtype=np.int32)  # the light per cell: none
+        self._row_cell: NDArray[np.int64] = np.zeros(0, dtype=np.int64)
+
+    def set_light(self, gains: NDArray[np.float64] | None, width: int, height: int) -> None:
+        """Colour gains per cell of a grid over images of ``width`` x ``height``: ``gains`` (rows of
+        cells, columns of cells, 3) per BGR channel, each pixel's channels scaled by its cell's before
+        it is classified (:func:`vision._kernels.classify`); None: none. Cells split the image evenly."""
+        if gains is None:
+            self._gains, self._row_cell = np.zeros((0, 0), dtype=np.int32), np.zeros(0, dtype=np.int64)
+            return
+        ny, nx = gains.shape[:2]
+        col_cell = np.minimum(np.arange(width) * nx // width, nx - 1)
+        self._row_cell = np.minimum(np.arange(height) * ny // height, ny - 1).astype(np.int64)
+        fixed = np.round(np.clip(gains, 0.0, 8.0) * 256.0).astype(np.int32)  # (ny, nx, 3), x 256
+        self._gains = np.ascontiguousarray(fixed[:, col_cell, :].reshape(ny, width * 3))
 
     def index(self, name: str) -> int:
         return self.names.index(name)
@@ -247,7 +271,7 @@ class Segmenter:
         """Per pixel, the bit set of classes (bit k: class k) whose box holds it."""
         out = np.empty(image.shape[:2], dtype=np.uint32)
         kern.classify(np.ascontiguousarray(image), self.space == "yuv", self.lut, self._screen, out, self._no_runs,
-                      self._counts, 0, image.shape[0])  # fmt: skip
+                      self._counts, self._gains, self._row_cell, 0, image.shape[0])  # fmt: skip
         return out
 
     def runs(self, image: NDArray[np.uint8]) -> tuple[NDArray[np.int32], NDArray[np.int64]]:
@@ -263,14 +287,16 @@ class Segmenter:
             if self._pool is None:
                 self._pool = ThreadPoolExecutor(threads - 1, thread_name_prefix="cmvision")
             bands = np.linspace(0, h, threads + 1).astype(int).tolist()
-            args = (image, yuv, self.lut, self._screen, self._no_bits, self._runs, self._counts)
+            args = (image, yuv, self.lut, self._screen, self._no_bits, self._runs, self._counts, self._gains,
+                    self._row_cell)  # fmt: skip
             done = [self._pool.submit(kern.classify, *args, a, b) for a, b in zip(bands[1:-1], bands[2:], strict=True)]
             # the first band in this thread
             kern.classify(*args, 0, bands[1])
             for job in done:
                 job.result()
         else:
-            kern.classify(image, yuv, self.lut, self._screen, self._no_bits, self._runs, self._counts, 0, h)
+            kern.classify(image, yuv, self.lut, self._screen, self._no_bits, self._runs, self._counts, self._gains,
+                          self._row_cell, 0, h)  # fmt: skip
         return self._runs, self._counts
 
     def regions(self, image: NDArray[np.uint8], merge: bool = True) -> Regions:

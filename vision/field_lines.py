@@ -57,6 +57,7 @@ __all__ = [
     "field_samples",
     "line_strength",
     "rough_start",
+    "true_error_px",
 ]
 
 F64 = NDArray[np.float64]
@@ -535,3 +536,16 @@ def draw_field(image: NDArray[np.uint8], params: CameraParams, league: LeaguePar
         cv2.putText(out, f"{rms:.2f} px", (int(at[0]) + 6, int(at[1]) - 6), cv2.FONT_HERSHEY_SIMPLEX, 0.45,
                     (255, 255, 255), 1, cv2.LINE_AA)  # fmt: skip
     return out
+
+
+def true_error_px(got: CameraParams, true: CameraParams, league: LeagueParams) -> float:
+    """RMS normal distance (px) between the fitted and the true projections of the field's line
+    centres in view: a line fit's error against the true centres."""
+    pts, tan, _ = field_samples(league, 0.01)
+    a, b = CameraModel(got), CameraModel(true)
+    pa, pb = a.project(pts), b.project(pts)
+    ahead = b.project(pts + np.concatenate([tan * 0.01, np.zeros((len(tan), 1))], axis=1))
+    d = ahead - pb
+    nrm = np.stack([-d[:, 1], d[:, 0]], axis=1) / np.linalg.norm(d, axis=1, keepdims=True)
+    view = b.in_image(np.nan_to_num(pb, nan=-1.0), margin=2.0)
+    return float(np.sqrt(np.mean(np.sum((pa[view] - pb[view]) * nrm[view], axis=1) ** 2)))

@@ -29,6 +29,7 @@ from vision.cmvision import (
     SplitRule,
     convert_colour,
 )
+from vision.light import LightFollower, LightParams
 from vision.patterns import BallParams, PatternMatcher, PatternParams, RegionGeometry, detect_ball
 
 __all__ = ["ColourRoles", "VisionParams", "VisionPipeline", "default_colours"]
@@ -71,6 +72,7 @@ class VisionParams(Validated):
     regions: RegionParams = RegionParams()
     patterns: PatternParams = PatternParams()
     ball: BallParams = BallParams()
+    light: LightParams = LightParams()  # colour classes that follow the light, per cell of a grid
     # height of the pattern plane per team, m; a team left out: the robot height of configs/field.yaml
     robot_height_m: Mapping[Team, float] = field(default_factory=dict)
     # the field mask: a detection further than this past the field lines is dropped (m; null: the
@@ -122,6 +124,9 @@ class VisionPipeline:
         # half extents of the field mask (inf: none)
         self.mask_half_m = (f.half_length + margin, f.half_width + margin) if margin >= 0.0 else (math.inf, math.inf)
         self.last_regions: Regions | None = None
+        self.light: LightFollower | None = None
+        if params.light.follow:
+            self.light = LightFollower(params.light, league, camera, self.heights)
 
     def _smallest_pixel_area(self) -> float:
         """The smallest field area of one pixel per metre of descent squared over the image (where
@@ -155,6 +160,10 @@ class VisionPipeline:
         balls = detect_ball(geo, image, self.classes["ball"], self.league.ball.radius_m, robots, self.heights,
                             self.pattern_radius_m * 0.8, self.params.ball, self.in_field)  # fmt: skip
         robots = [r for r in robots if self.in_field(r.x, r.y)]
+        if self.light is not None:
+            gains = self.light.observe(image, robots, balls)
+            if gains is not None:
+                self.segmenter.set_light(gains, self.camera.width, self.camera.height)
         # no wall clock here: the frame is "sent" at its capture time (latency is the runtime's)
         return DetectionFrame(self.camera.id, frame_number, t_capture, t_capture, tuple(balls),
                               tuple(sorted(robots, key=lambda r: (r.team, r.id))))  # fmt: skip
@@ -176,7 +185,13 @@ class VisionPipeline:
             return None
         v, u = np.mgrid[i0:i1, j0:j1] + 0.5
         inside = (u - pixel[0]) ** 2 + (v - pixel[1]) ** 2 <= r * r
-        mean = convert_colour(image[i0:i1, j0:j1][inside][None], self.params.colour_space)[0].mean(axis=0)
+        if self.light is None:
+            mean = convert_colour(image[i0:i1, j0:j1][inside][None], self.params.colour_space)[0].mean(axis=0)
+        else:  # as the classes see it, its cell's gains applied
+            bgr = self.light.corrected(image[i0:i1, j0:j1][inside].astype(np.float64).mean(axis=0),
+                                       (float(pixel[0]), float(pixel[1])))  # fmt: skip
+            mean = convert_colour(np.clip(np.round(bgr), 0, 255).astype(np.uint8)[None, None],
+                                  self.params.colour_space)[0, 0].astype(np.float64)  # fmt: skip
         reach = []
         for role in ("pink", "green"):
             box = self.params.colours[getattr(self.params.roles, role)]

@@ -35,6 +35,7 @@ __all__ = [
     "AutoTuneReport",
     "Label",
     "auto_samples",
+    "learn_boxes",
     "boxes_from_samples",
     "keep_apart",
     "overlaps",
@@ -224,6 +225,12 @@ def _blobs(image: NDArray[np.uint8], model: CameraModel, league: LeagueParams,
     contrast = np.sqrt((0.5 * d[..., 0]) ** 2 + d[..., 1] ** 2 + d[..., 2] ** 2)
     sat = np.hypot(yuv[..., 1] - 128.0, yuv[..., 2] - 128.0)
     coloured = inside & (contrast > p.min_contrast) & (sat > p.min_saturation)
+    depth = float(model.center[2]) - league.robot.height_m
+    if league.pattern.id_dot_diameter_m / 2.0 * model.f / depth >= 2.0:
+        # id dots 4 px across or more: a 3x3 cross opening drops the colour fringes one or two pixels
+        # wide that a Bayer sensor's demosaicing leaves along the white lines (they would join a ball on a line)
+        cross = cv2.getStructuringElement(cv2.MORPH_CROSS, (3, 3))
+        coloured = cv2.morphologyEx(coloured.astype(np.uint8), cv2.MORPH_OPEN, cross).astype(bool)
     n, labels, stats, cents = cv2.connectedComponentsWithStats(coloured.astype(np.uint8), connectivity=8)
     blobs = []
     sums = np.zeros((n, 3))
@@ -269,7 +276,9 @@ def auto_samples(images: Sequence[NDArray[np.uint8]], model: CameraModel, league
     distance around it is a robot; its centre dot samples the team colour (blue when its U is
     above grey's, yellow below), its id dots pink (V above grey's) or green. A round blob of the
     ball's size (field.yaml's ball radius) that is no pattern's, orange (U below and V above
-    grey's), samples the ball. Each blob is sampled within ``inner_fraction`` of its expected
+    grey's, V's excess at least 0.4 of U's shortfall: not a yellow marker), not on a robot's top
+    (a marker blob with an id dot round it), samples the ball: of those in a frame, the one most
+    saturated and round. Each blob is sampled within ``inner_fraction`` of its expected
     radius, in the colour space ``space``."""
     p = params or AutoTuneParams()
     pat, h = league.pattern, league.robot.height_m
@@ -295,11 +304,14 @@ def auto_samples(images: Sequence[NDArray[np.uint8]], model: CameraModel, league
         is_centre = (area >= lo_a * math.pi * (r_centre * ppm) ** 2) & (area <= hi_a * math.pi * (r_centre * ppm) ** 2)
         is_id = (area >= lo_a * math.pi * (r_id * ppm) ** 2) & (area <= hi_a * math.pi * (r_id * ppm) ** 2)
         used = np.zeros(len(blobs), bool)
+        robot_tops: list[NDArray[np.float64]] = []
 
         for k in np.flatnonzero(is_centre):
             dist = np.hypot(*(ground - ground[k]).T)
             ring = np.flatnonzero(is_id & (np.abs(dist - dot_dist) <= p.dot_distance_tolerance_m) & ~used)
             ring = ring[ring != k]
+            if len(ring) >= 1:
+                robot_tops.append(ground[k])  # a marker with id dots round it: no ball, pattern or not
             if not 3 <= len(ring) <= 4:
                 continue
             used[k] = True
@@ -310,16 +322,29 @@ def auto_samples(images: Sequence[NDArray[np.uint8]], model: CameraModel, league
             for j in ring:
                 _take(samples, lit, "pink" if blobs[j].colour[2] > 128.0 else "green", blobs[j],
                       max(1.0, p.inner_fraction * r_id * ppm[j]), labels, conv, light_img)
-        for k in np.flatnonzero(~used):
+        tops = np.array(robot_tops).reshape(-1, 2)
+        on_robot = np.zeros(len(blobs), bool)
+        if len(tops):
+            on_robot = np.min(np.hypot(ground[:, None, 0] - tops[:, 0], ground[:, None, 1] - tops[:, 1]), axis=1) \
+                <= league.robot.radius_m
+        best_ball: tuple[float, int] | None = None  # saturation times fill, blob
+        for k in np.flatnonzero(~used & ~on_robot):
             b = blobs[k]
             g = model.unproject(b.pixel, r_ball)
             expect = math.pi * (r_ball * model.pixels_per_metre((float(g[0]), float(g[1])), r_ball)) ** 2
-            orange = b.colour[1] < 128.0 and b.colour[2] > 140.0
+            # orange: U below grey's, V well above it and red enough against U not to be yellow (a team
+            # marker of no pattern found, of about the lab ball's size)
+            orange = b.colour[1] < 128.0 and b.colour[2] > 140.0 and b.colour[2] - 128.0 >= 0.4 * (128.0 - b.colour[1])
             ys, xs = np.nonzero(labels == b.label)
             fill = b.area / max(1.0, float((np.ptp(xs) + 1) * (np.ptp(ys) + 1)))
             if orange and lo_a * expect <= b.area <= hi_a * expect and fill >= 0.5:
-                n_balls += 1
-                _take(samples, lit, "ball", b, max(1.0, p.inner_fraction * r_ball * ppm[k]), labels, conv, light_img)
+                sat = math.hypot(b.colour[1] - 128.0, b.colour[2] - 128.0)
+                if best_ball is None or sat * fill > best_ball[0]:
+                    best_ball = (sat * fill, k)
+        if best_ball is not None:  # one ball a frame, the most saturated and round: glare and clutter are paler
+            k = best_ball[1]
+            n_balls += 1
+            _take(samples, lit, "ball", blobs[k], max(1.0, p.inner_fraction * r_ball * ppm[k]), labels, conv, light_img)
     back_all = {k: np.concatenate(v) for k, v in background.items()}
     y = back_all["carpet"][:, 0].astype(np.float64)
     dark, bright = (float(np.percentile(y, q)) for q in (0.5, 99.5))
@@ -415,3 +440,23 @@ def keep_apart(boxes: dict[str, ColourClass], samples: Mapping[str, NDArray[np.i
             out[name] = ColourClass(lo=(int(lo[0]), int(lo[1]), int(lo[2])), hi=(int(hi[0]), int(hi[1]), int(hi[2])),
                                     min_area_px=box.min_area_px)  # fmt: skip
     return out
+
+
+def learn_boxes(samples: Samples, background: Mapping[str, NDArray[np.int32]], light: Mapping[str, tuple[float, float]],
+                current: Mapping[str, ColourClass], space: ColourSpace, margin: int = 16,
+                max_overlap: float | None = None) -> tuple[dict[str, ColourClass], list[str]]:  # fmt: skip
+    """The colour boxes from samples per colour name (and, learnt automatically, the background's
+    samples and the light each box must reach): each sampled colour's box
+    (:func:`boxes_from_samples`, widened by :func:`widen_for_light`), the others as ``current``
+    has them, all cut apart where they overlap (:func:`keep_apart`). Returns the boxes and the
+    warnings, one line each: where boxes overlapped, and where they still do after the cut."""
+    share = AutoTuneParams().max_overlap if max_overlap is None else max_overlap
+    learnt = boxes_from_samples(samples, margin=margin)
+    boxes = {**current, **{n: widen_for_light(b, light[n], space) if n in light else b for n, b in learnt.items()}}
+    pooled = {**{n: np.concatenate(p) for n, p in samples.items()}, **background}
+    warnings = [f"{part:.0%} of the {what} samples fall in {other}'s box (lo {list(boxes[other].lo)} hi "
+                f"{list(boxes[other].hi)}): the boxes are cut apart" for what, other, part in overlaps(boxes, pooled, share)]
+    boxes = keep_apart(boxes, pooled, set(boxes), share, space)
+    warnings += [f"still {part:.0%} of the {what} samples in {other}'s box: those pixels are misread; label more or "
+                 "other spots" for what, other, part in overlaps(boxes, pooled, share)]  # fmt: skip
+    return boxes, warnings

@@ -21,6 +21,9 @@ high       6.0          0.25          0.15        4 ms
 says they sit (:func:`vision.score.ball_height_bias_m`); the default level's value, added to
 ``ball.blob_height_above_centre_m`` in configs/vision.yaml, calibrates vision to the renderer.
 
+Then a lab's camera (:mod:`cmdragons.bench.vision_lab`): the realistic preset under four lighting
+conditions and the real lab frame, each calibrated and coloured automatically.
+
 Baseline: ``cv2.cvtColor`` to YUV, then per colour class one ``cv2.inRange`` and one
 ``cv2.connectedComponentsWithStats`` -- the segmentation alone, with no pattern matching.
 """
@@ -105,9 +108,10 @@ def _quality(name: str, settings: Settings, models: list[CameraModel], score: Sc
     return row
 
 
-def run(settings: Settings, quick: bool, frames: int | None = None) -> list[Row]:
+def run(settings: Settings, quick: bool, frames: int | None = None, lab: bool = True) -> list[Row]:
     """Quality rows per level, per compressed input and at 1920x1200, then timing rows; ``frames``
-    per input (default 40 quick, 300 full; 1920x1200: a quarter of that)."""
+    per input (default 40 quick, 300 full; 1920x1200: a quarter of that); then, with ``lab``, a
+    lab's camera (:func:`cmdragons.bench.vision_lab.lab_rows`)."""
     frames = frames or (40 if quick else 300)
     models = settings.camera_models()
     rows: list[Row] = []
@@ -161,6 +165,10 @@ def run(settings: Settings, quick: bool, frames: int | None = None) -> list[Row]
     rows += _timing(settings, {m.id: VisionPipeline(settings.vision, settings.field, m) for m in models}, samples,
                     reps)  # fmt: skip
     rows += _timing(settings, big_pipes, big_samples, reps)
+    if lab:
+        from cmdragons.bench.vision_lab import lab_rows  # a lab's camera: the realistic preset, the real frame
+
+        rows += lab_rows(settings, quick)
     return rows
 
 

@@ -291,7 +291,7 @@ def _cmd_sim(args: argparse.Namespace, stop: Interrupt) -> int:
         check_writable_file(args.snapshot, "--snapshot")
     folder = run_folder("sim", args.out, overwrite=args.overwrite)
     models = settings.camera_models()
-    sim = Simulator(settings.field, models, settings.sim, seed=args.seed)
+    sim = Simulator(settings.field, models, settings.sim, seed=args.seed, look=settings.cameras.look())
     script = ScriptedPlay(settings.field_geometry(), settings.field.robot.radius_m, settings.sim.script, sim.rng)
     fps = settings.sim.physics.frame_rate_hz
     n_frames = max(1, round(seconds * fps))

@@ -221,16 +221,7 @@ def _check_cameras(data: dict[str, Any], path: Path) -> None:
 
 
 def _tune(args: argparse.Namespace, settings: object) -> int:
-    from vision.tune import (
-        AutoTuneParams,
-        boxes_from_samples,
-        keep_apart,
-        overlaps,
-        read_labels,
-        samples_from_labels,
-        samples_from_truth,
-        widen_for_light,
-    )
+    from vision.tune import learn_boxes, read_labels, samples_from_labels, samples_from_truth
 
     vis = settings.vision  # type: ignore[attr-defined]
     first = Path(args.images[0])
@@ -255,18 +246,9 @@ def _tune(args: argparse.Namespace, settings: object) -> int:
                 raise ValueError(f"{name}: cannot be read as an image")
             images.append(np.asarray(img, dtype=np.uint8))
         samples = samples_from_labels(images, read_labels(args.labels), vis.colour_space)
-    learnt = boxes_from_samples(samples, margin=args.margin)
-    boxes = {**vis.colours, **{n: widen_for_light(b, light[n], vis.colour_space) if n in light else b
-                               for n, b in learnt.items()}}  # fmt: skip
-    pooled = {**{n: np.concatenate(p) for n, p in samples.items()}, **background}
-    share = AutoTuneParams().max_overlap
-    for what, other, part in overlaps(boxes, pooled, share):
-        print(f"tune: warning: {part:.0%} of the {what} samples fall in {other}'s box (lo {list(boxes[other].lo)} hi "
-              f"{list(boxes[other].hi)}): the boxes are cut apart", file=sys.stderr)  # fmt: skip
-    boxes = keep_apart(boxes, pooled, set(boxes), share, vis.colour_space)
-    for what, other, part in overlaps(boxes, pooled, share):
-        print(f"tune: warning: still {part:.0%} of the {what} samples in {other}'s box: those pixels are misread; "
-              "label more or other spots", file=sys.stderr)  # fmt: skip
+    boxes, warnings = learn_boxes(samples, background, light, vis.colours, vis.colour_space, args.margin)
+    for line in warnings:
+        print(f"tune: warning: {line}", file=sys.stderr)
     changed = {n for n, b in boxes.items() if n in samples or b != vis.colours.get(n)}
     source = settings.config_dir / "vision.yaml"  # type: ignore[attr-defined]
     out = Path(args.out) if args.out else source

@@ -385,7 +385,8 @@ class Match:
         from sim.simulator import Simulator  # (a distributed node that runs no simulator never loads it)
 
         self.sim = Simulator(settings.field, settings.camera_models(), match_sim_params(settings, opponent), seed=seed,
-                             render=render or perception == "vision", referee=False)  # fmt: skip
+                             render=render or perception == "vision", referee=False,
+                             look=settings.cameras.look())  # fmt: skip
         self.seed = self.sim.seed
         self.cameras = list(self.sim.cameras)
         self.bus = Bus(transport)

@@ -252,3 +252,23 @@ def test_merge_kernel_equals_reference_among_many_specks(seed: int, gap: float, 
     alive = kern.merge_regions(got, gap, density)
     assert len(ref) < len(stats), "the case merges"
     np.testing.assert_array_equal(got[alive], ref)  # the same merges in the same order: the same sums
+
+
+@pytest.mark.parametrize("space", ["yuv", "bgr"])
+def test_light_per_cell_equals_the_numpy_reference(space: str) -> None:
+    """Gains per cell of a 3 x 4 grid (some saturating, some darkening) applied before the boxes:
+    the kernel's classification and runs equal the reference's exactly; no gains: the image as it is."""
+    image = every_colour(5)
+    h, w = image.shape[:2]
+    gains = np.random.default_rng(4).uniform(0.5, 1.6, (3, 4, 3))
+    classes = wide_classes()
+    seg = Segmenter(classes, space, RegionParams())  # type: ignore[arg-type]
+    seg.set_light(gains, w, h)
+    bits = classify_reference(image, list(classes.values()), space, gains)  # type: ignore[arg-type]
+    np.testing.assert_array_equal(seg.classify(image), bits)
+    runs, counts = seg.runs(image)
+    got = [[tuple(int(x) for x in runs[i, k]) for k in range(counts[i])] for i in range(h)]
+    assert got == runs_reference(bits)
+    assert not np.array_equal(bits, classify_reference(image, list(classes.values()), space))  # type: ignore[arg-type]
+    seg.set_light(None, w, h)
+    np.testing.assert_array_equal(seg.classify(image), classify_reference(image, list(classes.values()), space))  # type: ignore[arg-type]

@@ -18,7 +18,7 @@ from cmdragons.camera import CameraModel, CameraParams, CamerasParams, cameras_f
 from cmdragons.cli import main
 from cmdragons.geometry import FieldDims, LeagueParams
 from sim.render import CameraRenderer, RenderParams
-from vision.field_lines import CalibrationRefused, LineFitParams, calibrate_from_lines, field_samples, rough_start
+from vision.field_lines import CalibrationRefused, LineFitParams, calibrate_from_lines, rough_start, true_error_px
 
 from .conftest import LEAGUE, render, snapshot
 
@@ -131,19 +131,6 @@ LAB = FieldDims(length_m=5.54, width_m=3.77, boundary_width_m=0.3, goal_width_m=
 
 def _league(dims: FieldDims) -> LeagueParams:
     return dataclasses.replace(LEAGUE, divisions={"B": dims, "A": LEAGUE.divisions["A"]})
-
-
-def true_error_px(got: CameraParams, true: CameraParams, league: LeagueParams) -> float:
-    """RMS normal distance (px) between the fitted and the true projections of the field's line
-    centres in view: the fit's error against the true centres."""
-    pts, tan, _ = field_samples(league, 0.01)
-    a, b = CameraModel(got), CameraModel(true)
-    pa, pb = a.project(pts), b.project(pts)
-    ahead = b.project(pts + np.concatenate([tan * 0.01, np.zeros((len(tan), 1))], axis=1))
-    d = ahead - pb
-    nrm = np.stack([-d[:, 1], d[:, 0]], axis=1) / np.linalg.norm(d, axis=1, keepdims=True)
-    view = b.in_image(np.nan_to_num(pb, nan=-1.0), margin=2.0)
-    return float(np.sqrt(np.mean(np.sum((pa[view] - pb[view]) * nrm[view], axis=1) ** 2)))
 
 
 @pytest.fixture(scope="module")

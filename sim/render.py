@@ -27,8 +27,8 @@ from numpy.typing import NDArray
 from cmdragons.camera import CameraModel, RealisticParams
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, LeagueParams
-from sim import _kernels as kern
 from cmdragons.videoio import bgr_to_i420, i420_to_bgr
+from sim import _kernels as kern
 from sim.snapshot import Snapshot
 
 __all__ = ["CameraLook", "CameraRenderer", "CameraTruth", "Lighting", "RenderParams"]

@@ -65,9 +65,9 @@ def i420_to_bgr(planes: np.ndarray, to_bgr: np.ndarray, out: np.ndarray) -> None
             a00, a01, a10, a11 = (1.0 - fy) * (1.0 - fx), (1.0 - fy) * fx, fy * (1.0 - fx), fy * fx
             k00, k01, k10, k11 = i0 * wc + j0, i0 * wc + j1, i1 * wc + j0, i1 * wc + j1
             cb = (a00 * planes[u_at + k00] + a01 * planes[u_at + k01] + a10 * planes[u_at + k10]
-                  + a11 * planes[u_at + k11])  # fmt: skip
+                  + a11 * planes[u_at + k11])
             cr = (a00 * planes[v_at + k00] + a01 * planes[v_at + k01] + a10 * planes[v_at + k10]
-                  + a11 * planes[v_at + k11])  # fmt: skip
+                  + a11 * planes[v_at + k11])
             y = float(planes[i * w + j])
             for ch in range(3):
                 out[i, j, ch] = _u8(to_bgr[ch, 0] * y + to_bgr[ch, 1] * cb + to_bgr[ch, 2] * cr + to_bgr[ch, 3])

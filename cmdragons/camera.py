@@ -283,7 +283,7 @@ def scaled_to(params: CameraParams, width: int, height: int) -> CameraParams | N
         return None
     cx, cy = params.principal_point_px
     return dataclasses.replace(params, resolution_px=(width, height), focal_px=params.focal_px * math.sqrt(sx * sy),
-                               principal_point_px=(cx * sx, cy * sy))  # fmt: skip
+                               principal_point_px=(cx * sx, cy * sy))
 
 
 def opencv_extrinsics(model: CameraModel) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -321,11 +321,11 @@ def params_from_opencv(rvec: NDArray[np.float64], tvec: NDArray[np.float64], bas
         base, position_m=(float(center[0]), float(center[1]), float(center[2])),
         yaw_rad=math.remainder(yaw, 2.0 * math.pi), tilt_x_rad=math.atan2(m[2, 1], m[1, 1]),
         tilt_y_rad=math.atan2(m[0, 2], m[0, 0]),
-    )  # fmt: skip
+    )
 
 
 def _image_radii(focal_px: float, principal_point_px: tuple[float, float],
-                 resolution_px: tuple[int, int]) -> NDArray[np.float64]:  # fmt: skip
+                 resolution_px: tuple[int, int]) -> NDArray[np.float64]:
     """Distorted normalised radii of a grid of points over the whole image (the weights a lens
     model is fitted with: every part of the image as much as it covers)."""
     u = np.linspace(0.0, resolution_px[0], 33) - principal_point_px[0]
@@ -349,7 +349,7 @@ def ssl_vision_distortion(params: CameraParams) -> float:
 
 
 def from_ssl_vision_distortion(distortion: float, focal_px: float, principal_point_px: tuple[float, float],
-                               resolution_px: tuple[int, int]) -> tuple[float, float]:  # fmt: skip
+                               resolution_px: tuple[int, int]) -> tuple[float, float]:
     """Our (k1, k2) nearest, over the image, to SSL-Vision's ``distortion`` (see
     :func:`ssl_vision_distortion`): the least-squares fit of r_d = r_u (1 + k1 r_u^2 + k2 r_u^4) to
     SSL-Vision's r_u = r_d (1 + d r_d^2); (0, 0) for d <= 0, SSL-Vision's "no distortion"."""
@@ -362,7 +362,7 @@ def from_ssl_vision_distortion(distortion: float, focal_px: float, principal_poi
 
 
 def _auto_camera(cam_id: int, center: tuple[float, float], half: tuple[float, float], lay: AutoLayout,
-                 robot_height: float) -> CameraParams:  # fmt: skip
+                 robot_height: float) -> CameraParams:
     w, h = lay.resolution_px
     long_axis = lay.long_axis if lay.long_axis != "auto" else ("x" if half[0] >= half[1] else "y")
     yaw = 0.0 if long_axis == "x" else -math.pi / 2.0
@@ -383,7 +383,7 @@ def _auto_camera(cam_id: int, center: tuple[float, float], half: tuple[float, fl
     return CameraParams(
         id=cam_id, position_m=(center[0], center[1], lay.height_m), yaw_rad=yaw, focal_px=lo,
         principal_point_px=(w / 2.0, h / 2.0), k1=lay.k1, k2=lay.k2, resolution_px=(w, h),
-    )  # fmt: skip
+    )
 
 
 def _grid_cameras(grid: tuple[int, int], lay: AutoLayout, league: LeagueParams) -> list[CameraModel]:
@@ -434,7 +434,7 @@ def cameras_from_config(params: CamerasParams, league: LeagueParams) -> list[Cam
     if params.preset == "realistic":
         r = params.realistic
         lay = dataclasses.replace(lay, k1=r.k1, k2=r.k2, resolution_px=r.resolution_px, margin_x_m=r.view_margin_m,
-                                  margin_y_m=r.view_margin_m)  # fmt: skip
+                                  margin_y_m=r.view_margin_m)
     if lay.grid != "auto":
         return _grid_cameras(lay.grid, lay, league)
     for grid in _GRIDS:

@@ -129,7 +129,7 @@ def sections(known: typing.Callable[[], Mapping[str, type]]) -> Any:
         return FrozenMap({name: tp() for name, tp in known().items()})
 
     return dataclasses.field(default_factory=defaults, metadata={"sections": known, "lo": None, "hi": None,
-                                                                 "choices": None})  # fmt: skip
+                                                                 "choices": None})
 
 
 def resolve_derived(obj: T, lookup: typing.Callable[[str], Any]) -> T:
@@ -211,7 +211,7 @@ def apply_override(raw: dict[str, dict[str, Any]], assignment: str) -> None:
     except yaml.YAMLError as exc:
         problem = getattr(exc, "problem", None) or type(exc).__name__
         raise ConfigError(origin, path, f"value {text!r} is not valid YAML ({problem}); write a number, true/false, "
-                                        "a word, or a list such as [1, 2]") from None  # fmt: skip
+                                        "a word, or a list such as [1, 2]") from None
     node: Any = raw[concern]
     for i, key in enumerate(parts[1:-1], start=1):
         if isinstance(node, list):
@@ -363,7 +363,7 @@ def _convert_dataclass(cls: type, value: Any, file: str, key: str) -> Any:
         sub = _join(key, name)
         if f is plugins:
             kwargs[name] = FrozenMap({s: _convert(tp, value[s], file, _join(key, s)) if s in value else tp()
-                                      for s, tp in known.items()})  # fmt: skip
+                                      for s, tp in known.items()})
             continue
         if name not in value:
             if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:

@@ -136,7 +136,7 @@ _DEFAULT_DOTS = ((0.035, 0.054772), (0.035, -0.054772), (-0.054772, 0.035), (-0.
 _DEFAULT_IDS = (
     "PPGP", "GPGP", "GGGP", "PGGP", "PPPG", "GPPG", "GGPG", "PGPG",
     "GGGG", "PPPP", "PPGG", "GGPP", "GPGG", "GPPP", "PGGG", "PGPP",
-)  # fmt: skip
+)
 
 
 @dataclass(frozen=True)
@@ -179,7 +179,7 @@ class LeagueParams(Validated):
                 robots_per_team=11,
             ),
         }
-    )  # fmt: skip
+    )
     robot: RobotShape = RobotShape()
     ball: BallShape = BallShape()
     pattern: PatternGeometry = PatternGeometry()

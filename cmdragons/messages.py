@@ -178,7 +178,7 @@ class DetectionFrame:
                     RobotDetection(_team(r["team"]), int(r["id"]), _f(r, "x"), _f(r, "y"), _f(r, "theta"),
                                    _f(r, "confidence", 1.0), _pixel(r.get("pixel")))
                     for r in d.get("robots", ())
-                ),  # fmt: skip
+                ),
             )
         except (KeyError, TypeError, AttributeError) as exc:
             raise MessageError(f"bad detection frame: {exc!r}") from None
@@ -242,12 +242,12 @@ class WorldState:
         try:
             b = d.get("ball")
             ball = None if b is None else BallState(_f(b, "x"), _f(b, "y"), _f(b, "vx", 0.0), _f(b, "vy", 0.0),
-                                                     bool(b.get("visible", True)))  # fmt: skip
+                                                     bool(b.get("visible", True)))
             robots = tuple(
                 RobotState(_team(r["team"]), int(r["id"]), _f(r, "x"), _f(r, "y"), _f(r, "theta"),
                            _f(r, "vx", 0.0), _f(r, "vy", 0.0), _f(r, "omega", 0.0), bool(r.get("visible", True)))
                 for r in d.get("robots", ())
-            )  # fmt: skip
+            )
             return cls(_f(d, "t"), ball, robots, int(d.get("frame_number", 0)))
         except (KeyError, TypeError, AttributeError) as exc:
             raise MessageError(f"bad world state: {exc!r}") from None
@@ -273,13 +273,13 @@ class RobotCommand:
     def to_dict(self) -> dict[str, Any]:
         return {"team": self.team, "id": self.id, "vx": _num(self.vx), "vy": _num(self.vy),
                 "omega": _num(self.omega), "kick_speed": _num(self.kick_speed), "chip": self.chip,
-                "dribbler": _num(self.dribbler)}  # fmt: skip
+                "dribbler": _num(self.dribbler)}
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> Self:
         try:
             return cls(_team(d["team"]), int(d["id"]), _f(d, "vx", 0.0), _f(d, "vy", 0.0), _f(d, "omega", 0.0),
-                       _f(d, "kick_speed", 0.0), bool(d.get("chip", False)), _f(d, "dribbler", 0.0))  # fmt: skip
+                       _f(d, "kick_speed", 0.0), bool(d.get("chip", False)), _f(d, "dribbler", 0.0))
         except (KeyError, TypeError, AttributeError) as exc:
             raise MessageError(f"bad robot command: {exc!r}") from None
 
@@ -328,7 +328,7 @@ class GroundTruth:
         b = self.ball
         return WorldState(self.t, BallState(b.x, b.y, b.vx, b.vy), tuple(
             RobotState(r.team, r.id, r.x, r.y, r.theta, r.vx, r.vy, r.omega) for r in self.robots),
-            self.frame_number)  # fmt: skip
+            self.frame_number)
 
     def to_dict(self) -> dict[str, Any]:
         b = self.ball
@@ -338,7 +338,7 @@ class GroundTruth:
         robots = []
         for r in self.robots:
             rd: dict[str, Any] = {"team": r.team, "id": r.id, "x": r.x, "y": r.y, "theta": r.theta, "vx": r.vx,
-                                  "vy": r.vy, "omega": r.omega}  # fmt: skip
+                                  "vy": r.vy, "omega": r.omega}
             if r.pixels:
                 rd["cameras"] = {str(k): {"pixel": [u, v]} for k, (u, v) in r.pixels.items()}
             robots.append(rd)
@@ -352,13 +352,13 @@ class GroundTruth:
                 _f(b, "x"), _f(b, "y"), _f(b, "z", 0.0), _f(b, "vx", 0.0), _f(b, "vy", 0.0), _f(b, "vz", 0.0),
                 {int(k): (*_pixel(c["pixel"]), float(c.get("visible_fraction", 1.0)))
                  for k, c in b.get("cameras", {}).items()},
-            )  # fmt: skip
+            )
             robots = tuple(
                 RobotTruth(_team(r["team"]), int(r["id"]), _f(r, "x"), _f(r, "y"), _f(r, "theta"),
                            _f(r, "vx", 0.0), _f(r, "vy", 0.0), _f(r, "omega", 0.0),
                            {int(k): _pixel(c["pixel"]) for k, c in r.get("cameras", {}).items()})
                 for r in d.get("robots", ())
-            )  # fmt: skip
+            )
             return cls(int(d["frame_number"]), _f(d, "t"), ball, robots)
         except (KeyError, TypeError, AttributeError, ValueError) as exc:
             raise MessageError(f"bad ground truth: {exc!r}") from None
@@ -453,7 +453,7 @@ class TeamInfo:
                 "yellow_card_times": list(self.yellow_card_times_s), "fouls": self.fouls,
                 "goalkeeper": self.goalkeeper, "timeouts": self.timeouts, "timeout_time": self.timeout_time_s,
                 "placement_failures": self.placement_failures, "can_place_ball": self.can_place_ball,
-                "max_robots": self.max_robots}  # fmt: skip
+                "max_robots": self.max_robots}
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> Self:
@@ -461,7 +461,7 @@ class TeamInfo:
                    tuple(float(v) for v in d.get("yellow_card_times", ())), int(d.get("fouls", 0)),
                    int(d.get("goalkeeper", 0)), int(d.get("timeouts", 4)), _f(d, "timeout_time", 300.0),
                    int(d.get("placement_failures", 0)), bool(d.get("can_place_ball", True)),
-                   int(d.get("max_robots", 11)))  # fmt: skip
+                   int(d.get("max_robots", 11)))
 
 
 @dataclass(frozen=True)
@@ -509,7 +509,7 @@ class GameState:
                 "command_counter": self.command_counter, "command_t": self.command_t,
                 "action_time_left": _finite(self.action_time_left_s), "next_command": self.next_command,
                 "next_for_team": self.next_for_team,
-                "teams": {"blue": self.blue_team.to_dict(), "yellow": self.yellow_team.to_dict()}}  # fmt: skip
+                "teams": {"blue": self.blue_team.to_dict(), "yellow": self.yellow_team.to_dict()}}
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> Self:
@@ -529,7 +529,7 @@ class GameState:
                 float(d.get("command_t", 0.0)), math.inf if action_left is None else float(action_left),
                 d.get("next_command"), None if nxt is None else _team(nxt),
                 TeamInfo.from_dict(teams.get("blue", {})), TeamInfo.from_dict(teams.get("yellow", {})),
-            )  # fmt: skip
+            )
         except (KeyError, TypeError, AttributeError, ValueError, IndexError) as exc:
             raise MessageError(f"bad game state: {exc!r}") from None
 
@@ -560,7 +560,7 @@ class GameEvent:
     def to_dict(self) -> dict[str, Any]:
         return {"t": self.t, "kind": self.kind, "team": self.team, "robot": self.robot, "value": _num(self.value),
                 "limit": _num(self.limit), "unit": self.unit, "restart": self.restart or "",
-                "for_team": self.for_team}  # fmt: skip
+                "for_team": self.for_team}
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> Self:
@@ -569,7 +569,7 @@ class GameEvent:
             return cls(_f(d, "t"), str(d["kind"]), None if team is None else _team(team),
                        None if robot is None else int(robot), _f(d, "value", math.nan), _f(d, "limit", math.nan),
                        str(d.get("unit", "")), RefereeCommand(str(d["restart"])) if d.get("restart") else None,
-                       None if for_team is None else _team(for_team))  # fmt: skip
+                       None if for_team is None else _team(for_team))
         except (KeyError, TypeError, ValueError) as exc:
             raise MessageError(f"bad game event: {exc!r}") from None
 
@@ -672,14 +672,14 @@ class SimEvents:
 
     def to_dict(self) -> dict[str, Any]:
         return {"frame_number": self.frame_number, "t": self.t, "ball": list(self.ball_xy),
-                "events": [_event_dict(e) for e in self.events]}  # fmt: skip
+                "events": [_event_dict(e) for e in self.events]}
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> Self:
         try:
             bx, by = d["ball"]
             return cls(int(d["frame_number"]), _f(d, "t"), (float(bx), float(by)),
-                       tuple(_event_from_dict(e) for e in d.get("events", ())))  # fmt: skip
+                       tuple(_event_from_dict(e) for e in d.get("events", ())))
         except (KeyError, TypeError, ValueError) as exc:
             raise MessageError(f"bad simulator events: {exc!r}") from None
 
@@ -696,7 +696,7 @@ class Teleport:
     def to_dict(self) -> dict[str, Any]:
         return {"t": self.t, "robots": [{"team": t, "id": i, "x": x, "y": y, "theta": th}
                                         for t, i, x, y, th in self.robots],
-                "ball": None if self.ball is None else list(self.ball)}  # fmt: skip
+                "ball": None if self.ball is None else list(self.ball)}
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> Self:
@@ -704,7 +704,7 @@ class Teleport:
             ball = d.get("ball")
             return cls(_f(d, "t"), tuple((_team(r["team"]), int(r["id"]), _f(r, "x"), _f(r, "y"), _f(r, "theta"))
                                          for r in d.get("robots", ())),
-                       None if ball is None else (float(ball[0]), float(ball[1])))  # fmt: skip
+                       None if ball is None else (float(ball[0]), float(ball[1])))
         except (KeyError, TypeError, ValueError, IndexError) as exc:
             raise MessageError(f"bad teleport: {exc!r}") from None
 
@@ -724,7 +724,7 @@ class CameraFrame:
     def __eq__(self, other: object) -> bool:
         return (isinstance(other, CameraFrame) and (self.camera_id, self.frame_number, self.t_capture)
                 == (other.camera_id, other.frame_number, other.t_capture)
-                and np.array_equal(self.image, other.image))  # fmt: skip
+                and np.array_equal(self.image, other.image))
 
     __hash__ = None  # type: ignore[assignment]
 
@@ -733,7 +733,7 @@ class CameraFrame:
         h, w = self.image.shape[:2]
         return {"camera_id": self.camera_id, "frame_number": self.frame_number, "t_capture": self.t_capture,
                 "width": w, "height": h, "encoding": "bgr8",
-                "data": base64.b64encode(np.ascontiguousarray(self.image).tobytes()).decode("ascii")}  # fmt: skip
+                "data": base64.b64encode(np.ascontiguousarray(self.image).tobytes()).decode("ascii")}
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> Self:
@@ -778,13 +778,13 @@ class TeamCommands:
 
     def to_dict(self) -> dict[str, Any]:
         return {"team": self.team, "frame_number": self.frame_number, "t": self.t,
-                "commands": [c.to_dict() for c in self.commands]}  # fmt: skip
+                "commands": [c.to_dict() for c in self.commands]}
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> Self:
         try:
             return cls(_team(d["team"]), int(d["frame_number"]), _f(d, "t"),
-                       tuple(RobotCommand.from_dict(c) for c in d.get("commands", ())))  # fmt: skip
+                       tuple(RobotCommand.from_dict(c) for c in d.get("commands", ())))
         except (KeyError, TypeError, ValueError) as exc:
             raise MessageError(f"bad team commands: {exc!r}") from None
 
@@ -814,7 +814,7 @@ class RobotReport:
     def to_dict(self) -> dict[str, Any]:
         return {"id": self.id, "status": self.status, "target": list(self.target),
                 "path": np.asarray(self.path).tolist(), "braking": np.asarray(self.braking).tolist(),
-                "command": None if self.command is None else self.command.to_dict()}  # fmt: skip
+                "command": None if self.command is None else self.command.to_dict()}
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> Self:
@@ -822,7 +822,7 @@ class RobotReport:
         x, y, th = d["target"]
         return cls(int(d["id"]), str(d.get("status", "")), (float(x), float(y), float(th)),
                    _points(d.get("path", ())), None if c is None else RobotCommand.from_dict(c),
-                   _points(d.get("braking", ())))  # fmt: skip
+                   _points(d.get("braking", ())))
 
 
 @dataclass(frozen=True)
@@ -839,14 +839,14 @@ class PassReport:
 
     def to_dict(self) -> dict[str, Any]:
         return {"passer": self.passer, "receiver": self.receiver, "target": list(self.target),
-                "shoot_at": None if self.shoot_at is None else list(self.shoot_at), "kicked": self.kicked}  # fmt: skip
+                "shoot_at": None if self.shoot_at is None else list(self.shoot_at), "kicked": self.kicked}
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> Self:
         x, y = d["target"]
         aim = d.get("shoot_at")
         return cls(int(d["passer"]), int(d["receiver"]), (float(x), float(y)),
-                   None if aim is None else (float(aim[0]), float(aim[1])), bool(d.get("kicked", False)))  # fmt: skip
+                   None if aim is None else (float(aim[0]), float(aim[1])), bool(d.get("kicked", False)))
 
 
 @dataclass(frozen=True, eq=False)
@@ -879,7 +879,7 @@ class TeamReport:
                 "actions": {str(k): v for k, v in self.actions.items()},
                 "pass_points": np.asarray(self.pass_points).tolist(),
                 "pass_values": np.asarray(self.pass_values).tolist(),
-                "passing": None if self.passing is None else self.passing.to_dict()}  # fmt: skip
+                "passing": None if self.passing is None else self.passing.to_dict()}
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> Self:
@@ -889,7 +889,7 @@ class TeamReport:
                        {int(k): KickPurpose(str(v)) for k, v in d.get("actions", {}).items()},
                        _points(d.get("pass_points", ())),
                        np.asarray(d.get("pass_values", ()), dtype=np.float64),
-                       None if d.get("passing") is None else PassReport.from_dict(d["passing"]))  # fmt: skip
+                       None if d.get("passing") is None else PassReport.from_dict(d["passing"]))
         except (KeyError, TypeError, ValueError) as exc:
             raise MessageError(f"bad team report: {exc!r}") from None
 
@@ -955,7 +955,7 @@ class FactEstimate:
     def to_dict(self) -> dict[str, Any]:
         return {"fact": self.fact.value, "value_m_s2": _num(self.value_m_s2), "configured_m_s2": self.configured_m_s2,
                 "samples": self.samples, "spread_m_s2": _num(self.spread_m_s2), "confident": self.confident,
-                "used": self.used}  # fmt: skip
+                "used": self.used}
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> Self:
@@ -964,7 +964,7 @@ class FactEstimate:
             return math.nan if v is None else float(v)
 
         return cls(Fact(d["fact"]), f("value_m_s2"), f("configured_m_s2"), int(d["samples"]), f("spread_m_s2"),
-                   bool(d["confident"]), bool(d["used"]))  # fmt: skip
+                   bool(d["confident"]), bool(d["used"]))
 
 
 @dataclass(frozen=True)
@@ -991,7 +991,7 @@ class PhysicsFacts:
     def summary(self) -> dict[str, Any]:
         """The summary's figures: per fact its estimate (without the fact's name, which is the key)."""
         return {e.fact.value: {k: round(v, 4) if isinstance(v, float) else v for k, v in e.to_dict().items()
-                               if k != "fact"} for e in self.estimates}  # fmt: skip
+                               if k != "fact"} for e in self.estimates}
 
 
 @dataclass(frozen=True)

@@ -50,7 +50,7 @@ class RecordingWriter:
     """Writes frames of every camera and their truth into ``folder``, encoded as ``params`` says."""
 
     def __init__(self, folder: str | Path, cameras: Sequence[CameraModel], fps: float,
-                 params: RecordingParams | None = None) -> None:  # fmt: skip
+                 params: RecordingParams | None = None) -> None:
         self.folder = Path(folder)
         self.folder.mkdir(parents=True, exist_ok=True)
         params = params or RecordingParams()
@@ -79,7 +79,7 @@ class RecordingWriter:
                 h, w = image.shape[:2]
                 try:
                     video = VideoWriter(self.folder / f"camera_{cam}{SUFFIX[codec]}", w, h, self.fps, codec,
-                                        self.params.crf if codec == "h264" else None)  # fmt: skip
+                                        self.params.crf if codec == "h264" else None)
                 except VideoError as exc:
                     raise RecordingError(str(exc)) from None
                 self._videos[cam] = video

@@ -222,7 +222,7 @@ class Brain:
             key: np.array([any(np.array_equal(row, b) for b in field_world(self.field, defense_areas=side).boxes)
                            for row in every])
             for key, side in _DEFENSE_SIDES
-        }  # fmt: skip
+        }
 
     def _safety(self) -> Safety:
         static = field_world(self.field, defense_areas=False)
@@ -240,7 +240,7 @@ class Brain:
         self._physics = values
         base: Any = self.configured
         self.settings = dataclasses.replace(base, **{name: override_derived(getattr(base, name), values)
-                                                     for name in _TUNED})  # fmt: skip
+                                                     for name in _TUNED})
         self.strategy.retune(self.settings.strategy)
         self.safety = self._safety()
         self.navigators.clear()
@@ -256,7 +256,7 @@ class Brain:
         if nav is None:
             nav = self.navigators[rid] = make_navigator(self.params.navigator, self.params.navigator_sections,
                                                         self.settings.control, self.radius,
-                                                        self.settings.planner.collision)  # fmt: skip
+                                                        self.settings.planner.collision)
         return nav
 
     def step(self, world: WorldState, game: GameState) -> BrainOutput:
@@ -271,10 +271,10 @@ class Brain:
         ours = {r.id for r in world.robots if r.team == self.team}
         # what a kick is for, of the robots whose kicker is armed (a robot's kick as another role's is not)
         actions = {rid: a for rid, a in self.strategy.last_action.items()
-                   if rid in ours and rid in intents and intents[rid].kick_speed > 0.0}  # fmt: skip
+                   if rid in ours and rid in intents and intents[rid].kick_speed > 0.0}
         return BrainOutput(tuple(safe), dict(sorted(self.plans.items())), dict(self.braking),
                            self.strategy.pass_heat if self.strategy.pass_heat_redone else None, actions,
-                           dict(self.times), self.strategy.pass_report)  # fmt: skip
+                           dict(self.times), self.strategy.pass_report)
 
     def drive(self, world: WorldState, intents: Mapping[int, Intent], game: GameState) -> list[RobotCommand]:
         """Everything after strategy: each robot's planner and navigator toward its intent, then team
@@ -315,7 +315,7 @@ class Brain:
         ball = None
         if world.ball is not None:
             ball = np.array([[world.ball.x, world.ball.y,
-                              self.settings.field.ball.radius_m + self._ball_clearance(game)]])  # fmt: skip
+                              self.settings.field.ball.radius_m + self._ball_clearance(game)]])
         circles = np.column_stack([xy, np.full(len(xy), self.radius)])
         if ball is not None:
             circles, vel_all = np.vstack([circles, ball]), np.vstack([vel, np.zeros((1, 2))])
@@ -363,7 +363,7 @@ class Brain:
         stops = [RobotCommand(self.team, r.id) for r in lost]
         ids = [r.id for r in frame.robots if r.team == self.team] + [r.id for r in lost]
         states = np.vstack([np.hstack([frame.xy[frame.own], frame.vel[frame.own]]),
-                            np.array([(r.x, r.y, r.vx, r.vy) for r in lost]).reshape(-1, 4)])  # fmt: skip
+                            np.array([(r.x, r.y, r.vx, r.vy) for r in lost]).reshape(-1, 4)])
         opponents = np.hstack([frame.xy[~frame.own], frame.vel[~frame.own]])
         by_id = {c.id: c for c in commands + stops}
         asked = np.array([(by_id[i].vx, by_id[i].vy) if i in by_id else (0.0, 0.0) for i in ids]).reshape(-1, 2)
@@ -374,7 +374,7 @@ class Brain:
         for c in commands + stops:
             v = safe_v.get(c.id)
             out.append(c if v is None else RobotCommand(c.team, c.id, float(v[0]), float(v[1]), c.omega, c.kick_speed,
-                                                        c.chip, c.dribbler))  # fmt: skip
+                                                        c.chip, c.dribbler))
         return out
 
     def _ball_escape(self, frame: Frame, start: tuple[float, float], it: Intent) -> tuple[float, float] | None:

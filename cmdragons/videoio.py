@@ -30,6 +30,7 @@ import cmdragons._kernels as kern
 __all__ = [
     "CODECS",
     "Codec",
+    "H264RoundTrip",
     "VideoError",
     "VideoWriter",
     "bgr_to_i420",
@@ -56,7 +57,7 @@ class VideoWriter:
     in 4:2:0. A context manager; :meth:`close` flushes the encoder and finishes the file."""
 
     def __init__(self, path: str | Path, width: int, height: int, fps: float, codec: Codec = "h264",
-                 crf: int | None = None) -> None:  # fmt: skip
+                 crf: int | None = None) -> None:
         self.path = Path(path)
         if codec not in _ENCODERS:
             raise VideoError(f"{self.path}: unknown codec {codec!r}; choose one of {', '.join(CODECS)}")
@@ -99,7 +100,7 @@ class VideoWriter:
             raise VideoError(f"{self.path}: written after close")
         if image.shape != (self.height, self.width, 3) or image.dtype != np.uint8:
             raise VideoError(f"{self.path}: frame {self.frames} is {image.dtype} {image.shape}, "
-                             f"expected uint8 ({self.height}, {self.width}, 3)")  # fmt: skip
+                             f"expected uint8 ({self.height}, {self.width}, 3)")
         if self.codec == "h264":
             frame = av.VideoFrame.from_ndarray(bgr_to_i420(image), format="yuv420p")
         else:
@@ -127,7 +128,7 @@ class VideoWriter:
         return self
 
     def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
-                 tb: TracebackType | None) -> None:  # fmt: skip
+                 tb: TracebackType | None) -> None:
         self.close()
 
 
@@ -141,14 +142,14 @@ def video_info(path: str | Path) -> dict[str, Any]:
             s = c.streams.video[0]
             rate = s.average_rate or s.guessed_rate
             return {"codec": s.codec_context.name, "pix_fmt": s.codec_context.pix_fmt, "width": s.width,
-                    "height": s.height, "fps": float(rate) if rate else None, "frames": int(s.frames)}  # fmt: skip
+                    "height": s.height, "fps": float(rate) if rate else None, "frames": int(s.frames)}
     except av.FFmpegError as exc:
         raise VideoError(f"{path}: cannot be opened as a video ({exc})") from None
 
 
 # BT.601 in the limited range (Y 16..235, Cb and Cr 16..240), rows Y, Cb, Cr over (B, G, R, 1)
 _TO_YUV = np.array([[24.966, 128.553, 65.481, 16.0 * 255.0], [112.0, -74.203, -37.797, 128.0 * 255.0],
-                    [-18.214, -93.786, 112.0, 128.0 * 255.0]], dtype=np.float64) / 255.0  # fmt: skip
+                    [-18.214, -93.786, 112.0, 128.0 * 255.0]], dtype=np.float64) / 255.0
 # and back: rows B, G, R over (Y, Cb, Cr, 1)
 _TO_BGR = np.linalg.inv(np.vstack([_TO_YUV, [0.0, 0.0, 0.0, 1.0]]))[:3]
 
@@ -188,7 +189,7 @@ def bgr_to_i420_reference(image: NDArray[np.uint8]) -> NDArray[np.uint8]:
     left = np.concatenate([pair[:, :1], pair[:, 1:-1:2]], axis=1)  # column 2j - 1, 0 at the edge
     site = 0.25 * left + 0.5 * pair[:, 0::2] + 0.25 * pair[:, 1::2]
     return np.concatenate([y.ravel(), _u8(site @ _TO_YUV[1]).ravel(), _u8(site @ _TO_YUV[2]).ravel()]).reshape(
-        h * 3 // 2, w)  # fmt: skip
+        h * 3 // 2, w)
 
 
 def i420_to_bgr_reference(planes: NDArray[np.uint8], h: int, w: int) -> NDArray[np.uint8]:
@@ -257,6 +258,31 @@ def read_video(path: str | Path) -> Iterator[tuple[int, NDArray[np.uint8]]]:
             raise VideoError(f"{path}: frame {k} cannot be decoded ({exc}); read frames 0 to {k - 1}") from None
         if stated and k < stated - (0 if exact else 1):
             raise VideoError(f"{path}: ends at frame {k} of the {stated} it states (truncated?); "
-                             f"read frames 0 to {k - 1}")  # fmt: skip
+                             f"read frames 0 to {k - 1}")
     finally:
         container.close()
+
+
+class H264RoundTrip:
+    """Frames through an H.264 encoder and decoder in memory, one frame in, the same frame out
+    (x264 without look-ahead or B-frames, on one thread: the same bytes every run)."""
+
+    def __init__(self, width: int, height: int, crf: int) -> None:
+        self.enc: Any = av.CodecContext.create("libx264", "w")
+        self.enc.width, self.enc.height, self.enc.pix_fmt = width, height, "yuv420p"
+        self.enc.time_base = Fraction(1, 60)
+        self.enc.options = {"crf": str(crf), "preset": "veryfast", "tune": "zerolatency", "threads": "1"}
+        self.dec: Any = av.CodecContext.create("h264", "r")
+        self.dec.thread_count = 1
+        self.n = 0
+        self.h, self.w = height, width
+
+    def __call__(self, image: NDArray[np.uint8]) -> NDArray[np.uint8]:
+        frame = av.VideoFrame.from_ndarray(bgr_to_i420(image), format="yuv420p")
+        frame.pts = self.n
+        self.n += 1
+        out = image
+        for packet in self.enc.encode(frame):
+            for decoded in self.dec.decode(packet):
+                out = i420_to_bgr(decoded.to_ndarray(), self.h, self.w)
+        return out

@@ -66,7 +66,7 @@ def full_tables(results: list[dict[str, Any]] | None = None) -> str:
         parts += [f"### `{data['command']}`", "",
                   f"At commit `{data['commit']}`, {data['date']}, on a {data['machine']} "
                   f"(`docs/results/{data['file']}`).", "",
-                  "| name | " + " | ".join(metrics) + " |", "|---" * (len(metrics) + 1) + "|"]  # fmt: skip
+                  "| name | " + " | ".join(metrics) + " |", "|---" * (len(metrics) + 1) + "|"]
         for row in data["rows"]:
             parts.append(f"| {row['name']} | " + " | ".join(_number(row.get(m, "")) for m in metrics) + " |")
         parts.append("")
@@ -104,7 +104,7 @@ def main(argv: list[str]) -> int:
     if argv[0] == "--check":
         if new != text:
             print(f"{path}: the results table is not the one docs/results/*.json give: "
-                  f"run python docs/results.py --write {path}", file=sys.stderr)  # fmt: skip
+                  f"run python docs/results.py --write {path}", file=sys.stderr)
             return 1
         return 0
     path.write_text(new, encoding="utf-8")

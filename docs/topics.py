@@ -41,7 +41,7 @@ def contracts() -> list[Contract]:
     # simulation protocol's port)
     robots = [(t, i) for t in ("blue", "yellow") for i in range(6)]
     out += [e.contract for e in outside_wiring(load_settings(), SimulatorKind.GRSIM, ["blue", "yellow"], [0, 1, 2, 3],
-                                               DatagramQueue(), robots)]  # fmt: skip
+                                               DatagramQueue(), robots)]
     return out
 
 

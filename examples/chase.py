@@ -13,7 +13,7 @@ def see(seen: dict[str | int, tuple[float, float]], frame: ssl_detection_pb2.SSL
 
 
 def chase(out: ssl_simulation_control_pb2.RobotControl, seen: dict[str | int, tuple[float, float]],
-          speed: float) -> None:  # fmt: skip
+          speed: float) -> None:
     """Add to ``out`` a global velocity (m/s) at the ball for every robot seen, slower near it."""
     bx, by = seen.get("ball", (0.0, 0.0))
     for robot_id, (x, y) in seen.items():

@@ -25,7 +25,7 @@ signal.signal(signal.SIGINT, signal.default_int_handler)  # Ctrl-C stops it, eve
 # a client of the router only: no listening socket, no multicast scouting (zenoh's defaults would
 # listen on every interface and scout by multicast)
 config = {"mode": "client", "connect": {"endpoints": [args.router]}, "listen": {"endpoints": []},
-          "scouting": {"multicast": {"enabled": False}, "gossip": {"enabled": False}}}  # fmt: skip
+          "scouting": {"multicast": {"enabled": False}, "gossip": {"enabled": False}}}
 seen: dict[str | int, tuple[float, float]] = {}  # the latest position of the ball and each robot, any camera (mm)
 answered = -1  # the last camera frame answered
 
@@ -38,7 +38,7 @@ def on_detections(sample: zenoh.Sample) -> None:
         return
     answered = frame.frame_number
     out = ssl_simulation_control_pb2.RobotControl(team=ssl_tracked_pb2.YELLOW, frame_number=frame.frame_number,
-                                                  t=frame.t_capture)  # fmt: skip
+                                                  t=frame.t_capture)
     chase(out, seen, args.speed)
     session.put(f"cmdragons/{args.field}/commands/yellow", out.SerializeToString())
 
@@ -52,7 +52,7 @@ while session is None:  # the match may not be there yet
         time.sleep(1)
 with session:
     subscribers = [session.declare_subscriber(f"cmdragons/{args.field}/{key}", on_detections)
-                   for key in ("detections/**", "perception/yellow")]  # fmt: skip
+                   for key in ("detections/**", "perception/yellow")]
     print(f"outside team: yellow on cmdragons/{args.field} via {args.router}; Ctrl-C to stop", flush=True)
     try:
         while True:

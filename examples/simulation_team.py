@@ -36,7 +36,7 @@ robots.setblocking(False)
 seen: dict[str | int, tuple[float, float]] = {}  # the latest position of the ball and each robot (mm)
 answered = -1  # the last camera frame answered
 print(f"simulation team: yellow, vision {args.group}:{args.vision_port}, commands to 127.0.0.1:{args.port}; "
-      "Ctrl-C to stop", flush=True)  # fmt: skip
+      "Ctrl-C to stop", flush=True)
 try:
     while True:
         packet = ssl_wrapper_pb2.SSL_WrapperPacket.FromString(vision.recv(65536))

@@ -126,7 +126,7 @@ def project_points(cam: NDArray[np.float64], pts: NDArray[np.float64]) -> NDArra
 
 @njit(cache=True)
 def _bbox(cam: NDArray[np.float64], x: float, y: float, ext: float, z0: float, z1: float,
-          out: NDArray[np.int32]) -> None:  # fmt: skip
+          out: NDArray[np.int32]) -> None:
     """Pixel rows/columns [i0, i1) x [j0, j1) holding the projection of the axis-aligned box
     ``[x-ext, x+ext] x [y-ext, y+ext] x [z0, z1]``, clipped to the image; (0, 0, 0, 0) if empty."""
     umin, umax, vmin, vmax = math.inf, -math.inf, math.inf, -math.inf
@@ -166,7 +166,7 @@ def _plan_objects_kernel(
     rob_samples: NDArray[np.float64], rob_k: NDArray[np.int64], rob_bbox: NDArray[np.int32],
     rob_colors: NDArray[np.float32], rob_truth: NDArray[np.float64], ball_samples: NDArray[np.float64],
     ball_bbox: NDArray[np.int32], ball_truth: NDArray[np.float64],
-) -> int:  # fmt: skip
+) -> int:
     r, h = shape[SHAPE_ROBOT_RADIUS], shape[SHAPE_ROBOT_HEIGHT]
     f, cz = cam[CAM_FOCAL], cam[CAM_CENTER + 2]
     w_img, h_img = cam[CAM_WIDTH], cam[CAM_HEIGHT]
@@ -248,7 +248,7 @@ def plan_objects(
     plan: ObjectPlan, robots: NDArray[np.float64], ball: NDArray[np.float64], cam: NDArray[np.float64],
     shape: NDArray[np.float64], pink: NDArray[np.bool_], dots: NDArray[np.float64],
     palette: NDArray[np.float32], exposure_s: float, blur_step_px: float,
-) -> None:  # fmt: skip
+) -> None:
     """Fill ``plan`` for the snapshot's robots (n, 8: team, id, x, y, theta, vx, vy, omega) and
     ball (6: x, y, z, vx, vy, vz), field frame, SI units. The plan must hold n robots.
 
@@ -263,7 +263,7 @@ def plan_objects(
         robots, ball, cam, shape, pink, dots, palette, exposure_s, plan.max_samples, blur_step_px,
         plan.rob_samples[:n], plan.rob_k[:n], plan.rob_bbox[:n], plan.rob_colors[:n], plan.rob_truth[:n],
         plan.ball_samples, plan.ball_bbox, plan.ball_truth,
-    )  # fmt: skip
+    )
 
 
 # --- per-pixel shading ---------------------------------------------------------------------------
@@ -323,7 +323,7 @@ def _coverage(sd: float, pix: float) -> float:
 @njit(cache=True, fastmath=True, inline="always")
 def _body_coverage(samples: NDArray[np.float64], k: int, n: int, shape: NDArray[np.float64],
                    ax_w: float, ay_w: float, bx_w: float, by_w: float, z_a: float, z_b: float,
-                   cam_z: float, foot: float) -> float:  # fmt: skip
+                   cam_z: float, foot: float) -> float:
     """Coverage of robot k's body (averaged over its n blur samples) along the part of a pixel's
     ray between heights z_a > z_b, whose field points are A_w and B_w: the ray passes through the
     body's vertical prism there when the segment A -> B meets the top outline."""
@@ -357,7 +357,7 @@ def _body_coverage(samples: NDArray[np.float64], k: int, n: int, shape: NDArray[
 @njit(cache=True, fastmath=True, inline="always")
 def _top_colour(samples: NDArray[np.float64], k: int, n: int, shape: NDArray[np.float64], dots: NDArray[np.float64],
                 colors: NDArray[np.float32], cover: NDArray[np.float32], qx_w: float, qy_w: float,
-                pix: float, acc: NDArray[np.float64]) -> float:  # fmt: skip
+                pix: float, acc: NDArray[np.float64]) -> float:
     """Premultiplied colour of robot k's top (cover with its pattern) at the field point Q_w on
     the plane of the top, averaged over the blur samples, into ``acc``; returns the coverage.
     Squared distances reject what a shape's coverage ramp cannot reach before any square root."""
@@ -402,7 +402,7 @@ def _top_colour(samples: NDArray[np.float64], k: int, n: int, shape: NDArray[np.
 
 @njit(cache=True, fastmath=True, inline="always")
 def _ball_sample(cam: NDArray[np.float64], rdx: float, rdy: float, foot: float, bx: float, by: float,
-                 bz: float, rb: float, ambient: float) -> tuple[float, float, float]:  # fmt: skip
+                 bz: float, rb: float, ambient: float) -> tuple[float, float, float]:
     """Ray (dx, dy, -1) from the optical centre against the ball sphere at B: (coverage, shade,
     height of the visible surface point). Off the silhouette the nearest point of the ray stands
     in for the hit, so the anti-aliased rim still gets a height and a shade."""
@@ -480,7 +480,7 @@ def _noise_row(nz: NDArray[np.int8], pool: NDArray[np.int8], key: np.uint64, row
 
 @njit(cache=True, fastmath=True, inline="always")
 def _write_span(o: NDArray[np.uint8], scratch: NDArray[np.float32], nz: NDArray[np.int8], noise_on: bool,
-                q0: int, q1: int) -> None:  # fmt: skip
+                q0: int, q1: int) -> None:
     for q in range(q0, q1):
         v = int(scratch[q] + 0.5)  # colours are never negative: truncation rounds
         if noise_on:
@@ -496,7 +496,7 @@ def _render_frame_kernel(
     rob_samples: NDArray[np.float64], rob_k: NDArray[np.int64], rob_bbox: NDArray[np.int32],
     rob_colors: NDArray[np.float32], ball_samples: NDArray[np.float64], ball_k: int,
     ball_bbox: NDArray[np.int32], row_ball: NDArray[np.float64], n_chunks: int,
-) -> None:  # fmt: skip
+) -> None:
     h_img, w3 = out2.shape
     n_rob = rob_k.shape[0]
     cx, cy, cz = cam[CAM_CENTER], cam[CAM_CENTER + 1], cam[CAM_CENTER + 2]
@@ -543,7 +543,7 @@ def _render_frame_kernel(
                 for j in range(rob_bbox[k, 2], rob_bbox[k, 3]):
                     rdx, rdy, fp = rays[i, j, 0], rays[i, j, 1], foot[i, j]
                     al = _body_coverage(rob_samples, k, rob_k[k], shape, cx + (cz - h) * rdx, cy + (cz - h) * rdy,
-                                        cx + cz * rdx, cy + cz * rdy, h, 0.0, cz, fp)  # fmt: skip
+                                        cx + cz * rdx, cy + cz * rdy, h, 0.0, cz, fp)
                     if al > 0.0:
                         g = gain[i, j]
                         for c in range(3):
@@ -554,7 +554,7 @@ def _render_frame_kernel(
                 for j in range(rob_bbox[k, 2], rob_bbox[k, 3]):
                     rdx, rdy = rays[i, j, 0], rays[i, j, 1]
                     al = _top_colour(rob_samples, k, rob_k[k], shape, dots, rob_colors, cover,
-                                     cx + (cz - h) * rdx, cy + (cz - h) * rdy, (cz - h) * foot[i, j], acc)  # fmt: skip
+                                     cx + (cz - h) * rdx, cy + (cz - h) * rdy, (cz - h) * foot[i, j], acc)
                     if al > 0.0:
                         g = gain[i, j]
                         for c in range(3):
@@ -568,7 +568,7 @@ def _render_frame_kernel(
                     a_sum, c_sum, sil = 0.0, 0.0, 0.0
                     for m in range(ball_k):
                         al, shade, z_hit = _ball_sample(cam, rdx, rdy, fp, ball_samples[m, 0], ball_samples[m, 1],
-                                                        ball_samples[m, 2], rb, ambient)  # fmt: skip
+                                                        ball_samples[m, 2], rb, ambient)
                         if al <= 0.0:
                             continue
                         sil += al
@@ -581,7 +581,7 @@ def _render_frame_kernel(
                                 if rob_bbox[k, 2] <= j < rob_bbox[k, 3]:
                                     occ = _body_coverage(rob_samples, k, rob_k[k], shape, cx + (cz - h) * rdx,
                                                          cy + (cz - h) * rdy, cx + (cz - zb) * rdx,
-                                                         cy + (cz - zb) * rdy, h, zb, cz, fp)  # fmt: skip
+                                                         cy + (cz - zb) * rdy, h, zb, cz, fp)
                                     vis *= 1.0 - occ
                         a_sum += al * vis
                         c_sum += al * vis * shade
@@ -609,7 +609,7 @@ def render_frame(
     rays: NDArray[np.float32], foot: NDArray[np.float32], gain: NDArray[np.float32], cam: NDArray[np.float64],
     shape: NDArray[np.float64], dots: NDArray[np.float64], palette: NDArray[np.float32], plan: ObjectPlan,
     row_ball: NDArray[np.float64], n_chunks: int = 2,
-) -> tuple[float, float]:  # fmt: skip
+) -> tuple[float, float]:
     """Compose one frame into ``out`` (H, W, 3 BGR uint8): the static ``background``, the planned
     robots (sides, then tops) and ball, lighting ``gain`` on object colours, then sensor noise
     drawn from ``pool`` (:func:`noise_pool`) by the frame's ``noise_key`` (0 .. 2**64 - 1) and
@@ -627,7 +627,7 @@ def render_frame(
         np.uint64(noise_key if noise_key is not None else 0), noise_on,
         rays, foot, gain, cam, shape, dots, palette, plan.rob_samples[:n], plan.rob_k[:n], plan.rob_bbox[:n],
         plan.rob_colors[:n], plan.ball_samples, plan.ball_k, plan.ball_bbox, row_ball, n_chunks,
-    )  # fmt: skip
+    )
     return _ball_rows_sum(row_ball, int(plan.ball_bbox[0]), int(plan.ball_bbox[1]))
 
 
@@ -678,7 +678,7 @@ def plan_objects_reference(
     model: CameraModel, robots: NDArray[np.float64], ball: NDArray[np.float64], shape: NDArray[np.float64],
     pink: NDArray[np.bool_], palette: NDArray[np.float32], exposure_s: float, max_samples: int,
     blur_step_px: float,
-) -> ObjectPlan:  # fmt: skip
+) -> ObjectPlan:
     """:func:`plan_objects` computed with ``CameraModel.project``, robot by robot."""
     r, h, rb = shape[SHAPE_ROBOT_RADIUS], shape[SHAPE_ROBOT_HEIGHT], shape[SHAPE_BALL_RADIUS]
 
@@ -736,7 +736,7 @@ def _shape_sd_np(x: NDArray[np.float64], y: NDArray[np.float64], r: float, front
 
 def _segment_sd_np(ax: NDArray[np.float64], ay: NDArray[np.float64], bx: NDArray[np.float64],
                    by: NDArray[np.float64], r: float, front: float,
-                   ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:  # fmt: skip
+                   ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Vectorised :func:`_segment_sd` (the same candidate points of t)."""
     dx, dy = bx - ax, by - ay
     dd = dx * dx + dy * dy
@@ -758,7 +758,7 @@ def _segment_sd_np(ax: NDArray[np.float64], ay: NDArray[np.float64], bx: NDArray
 
 def _body_coverage_np(samples: NDArray[np.float64], shape: NDArray[np.float64], a_w: NDArray[np.float64],
                       b_w: NDArray[np.float64], z_a: float, z_b: NDArray[np.float64] | float, cam_z: float,
-                      foot: NDArray[np.float64]) -> NDArray[np.float64]:  # fmt: skip
+                      foot: NDArray[np.float64]) -> NDArray[np.float64]:
     r, front = shape[SHAPE_ROBOT_RADIUS], shape[SHAPE_ROBOT_FRONT]
     acc = np.zeros(foot.shape)
     for px, py, co, si in samples:
@@ -777,7 +777,7 @@ def render_frame_reference(
     background: NDArray[np.uint8], pool: NDArray[np.int8], noise_key: int | None, rays: NDArray[np.float32],
     foot: NDArray[np.float32], gain: NDArray[np.float32], cam: NDArray[np.float64], shape: NDArray[np.float64],
     dots: NDArray[np.float64], palette: NDArray[np.float32], plan: ObjectPlan,
-) -> tuple[NDArray[np.uint8], float, float]:  # fmt: skip
+) -> tuple[NDArray[np.uint8], float, float]:
     """:func:`render_frame` object by object over whole boxes: (image, ball visible, silhouette)."""
     cx, cy, cz = cam[:3]
     r, h, front = shape[SHAPE_ROBOT_RADIUS], shape[SHAPE_ROBOT_HEIGHT], shape[SHAPE_ROBOT_FRONT]
@@ -798,7 +798,7 @@ def render_frame_reference(
         sl = region(tuple(box))
         samples = plan.rob_samples[k, : plan.rob_k[k]]
         al = _body_coverage_np(samples, shape, plane_points(sl, h), plane_points(sl, 0.0), h, 0.0, cz,
-                               foot[sl].astype(np.float64))[..., None]  # fmt: skip
+                               foot[sl].astype(np.float64))[..., None]
         clean[sl] = clean[sl] + al * (palette[PAL_SIDE] * gain[sl][..., None] - clean[sl])
     for k, box in enumerate(rob_bbox):
         sl = region(tuple(box))

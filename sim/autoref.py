@@ -53,7 +53,7 @@ def observed(world: WorldState, ball_xy: tuple[float, float]) -> GroundTruth:
     b = world.ball
     ball = BallTruth(b.x, b.y, 0.0, b.vx, b.vy) if b is not None else BallTruth(*ball_xy, 0.0, 0.0, 0.0)
     robots = tuple(RobotTruth(r.team, r.id, r.x, r.y, r.theta, r.vx, r.vy, r.omega) for r in world.robots
-                   if r.visible)  # fmt: skip
+                   if r.visible)
     return GroundTruth(world.frame_number, world.t, ball, robots)
 
 
@@ -107,7 +107,7 @@ class KickDetector:
             self._recent.clear()
             return None
         gaps = {(r.team, r.id): math.hypot(r.x - b.x, r.y - b.y) - self.robot_r - self.ball_r
-                for r in world.robots if r.visible}  # fmt: skip
+                for r in world.robots if r.visible}
         last, self._last = self._last, (t, b.x, b.y, b.vx, b.vy)
         self._recent.append((t, gaps))
         while self._recent and t - self._recent[0][0] > self.p.kick_memory_s:
@@ -166,11 +166,11 @@ class AutoRef:
             scorer = next((team for team in r.score if r.score[team] > score[team]), None)
             if scorer is not None:
                 r.calls.call(GameEvent(world.t, "goal", scorer, None, float(r.score[scorer]), math.nan, "goals",
-                                       RefereeCommand.KICKOFF, other(scorer)))  # fmt: skip
+                                       RefereeCommand.KICKOFF, other(scorer)))
         elif isinstance(crossing, BallOut) and r.balls_out > outs:
             taker = ball_out_taker(crossing.last_touch, crossing.x, sign)
             r.calls.call(GameEvent(world.t, "ball_out", crossing.last_touch, None if last is None else last[1],
-                                   restart=RefereeCommand.FREE_KICK, for_team=taker))  # fmt: skip
+                                   restart=RefereeCommand.FREE_KICK, for_team=taker))
         return teleport
 
     @property

@@ -96,7 +96,7 @@ class GameController:
 
     def state(self, t: float, score: Mapping[Team, int], blue_sign: float, spot: tuple[float, float] | None,
               kick_left_s: float, upcoming: tuple[RefereeCommand | None, Team | None],
-              teams: Mapping[Team, TeamInfo]) -> GameState:  # fmt: skip
+              teams: Mapping[Team, TeamInfo]) -> GameState:
         """The game state at ``t`` as the league's game controller sends it: the ball's designated
         position the placement's target or the penalty mark under way, else ``spot`` (the restart's);
         ``upcoming`` the next command and its team; ``blue_sign`` -1 while blue defends the goal at -x."""
@@ -112,7 +112,7 @@ class GameController:
             stage_time_left_s=self.stage_end - t, command_counter=self.counter, command_t=self.command_t,
             action_time_left_s=self.action_left(t, kick_left_s), next_command=nxt, next_for_team=nxt_team,
             blue_team=teams["blue"], yellow_team=teams["yellow"],
-        )  # fmt: skip
+        )
 
     def stage_over(self, t: float) -> bool:
         return t >= self.stage_end
@@ -297,4 +297,4 @@ def team_info(team: Team, cards: Cards, tally: Tally, keys: Sequence[Key], full:
         timeout_time_s=r.timeout_total_s, placement_failures=tally.placement_failures[team],
         can_place_ball=full and tally.may_place(team, r.placement_failures_max),
         max_robots=cards.max_robots(team, keys),
-    )  # fmt: skip
+    )

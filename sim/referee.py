@@ -79,7 +79,7 @@ class Referee:
     rules also the stages, fouls, cards, placements and penalties."""
 
     def __init__(self, field: Field, robot_keys: Sequence[tuple[Team, int]], params: RefereeParams,
-                 margins: TrackMargins | None = None, leave_s: float = 0.0) -> None:  # fmt: skip
+                 margins: TrackMargins | None = None, leave_s: float = 0.0) -> None:
         """``margins`` and ``leave_s``: what judging tracked robots allows (the auto-referee on
         vision): the foul watch's margins, and how long a robot sent off may still be seen on the
         field before its team has too many robots (on the truth it leaves at once)."""
@@ -111,7 +111,7 @@ class Referee:
         self.tally = Tally()
         self._last_t = 0.0
         self.moves = Moves(field, robot_keys, params.formations, params.park_distance_m,
-                           teleports=params.place_by == "teleport")  # fmt: skip
+                           teleports=params.place_by == "teleport")
         self._truth: GroundTruth | None = None  # the last true state seen (where the robots stand)
 
     # --- commands ---------------------------------------------------------------------------
@@ -161,7 +161,7 @@ class Referee:
 
     # --- one frame --------------------------------------------------------------------------
     def observe(self, t: float, events: Sequence[Event], ball_xy: tuple[float, float],
-                truth: GroundTruth | None = None) -> Teleport | None:  # fmt: skip
+                truth: GroundTruth | None = None) -> Teleport | None:
         """Take one frame's events at time ``t`` with the ball at ``ball_xy`` (field frame, m) and,
         for the full rules, the true state ``truth`` the auto-referee judges; returns what a restart
         due now wants placed, or None."""
@@ -234,14 +234,14 @@ class Referee:
             self._restart_ball = None
 
     def _start_restart(self, kind: RestartKind, team: Team | None, spot: tuple[float, float],
-                       ball_xy: tuple[float, float]) -> None:  # fmt: skip
+                       ball_xy: tuple[float, float]) -> None:
         """The restart due now: the ball (and robots) where it wants them, its command given."""
         t = self.t
         by_robots = not self.moves.teleports
         if kind is RestartKind.FORCE_START or team is None:  # after no progress: where the ball lies, for both
             self._set(RefereeCommand.FORCE_START, None)
         elif by_robots and kind in (RestartKind.KICKOFF, RestartKind.PENALTY) \
-                and self.game.stage != GameStage.PENALTY_SHOOTOUT:  # fmt: skip
+                and self.game.stage != GameStage.PENALTY_SHOOTOUT:
             self._set(RefereeCommand.BALL_PLACEMENT, team)  # the kicking team puts the ball on its spot
             self.game.placement = Placement(team, spot, t, kind.placed)
         elif kind is RestartKind.KICKOFF and self.params.place_robots_on_goal and not by_robots:
@@ -252,7 +252,7 @@ class Referee:
         elif kind in (RestartKind.PENALTY, RestartKind.PLACED_PENALTY):
             if self.game.stage == GameStage.PENALTY_SHOOTOUT:
                 self.moves.shootout_kick(self.t, self.cards.off, self.rules.keepers, team, spot,
-                                         self._attack_sign(team), self.rules.penalty_behind_m)  # fmt: skip
+                                         self._attack_sign(team), self.rules.penalty_behind_m)
             else:
                 self._clear_spot(spot, self._attack_sign(team))
             self.moves.add(self.t, ball=spot)
@@ -368,7 +368,7 @@ class Referee:
         leaving = self.moves.moving()  # sent off this frame
         for team in TEAMS:
             on = [r for r in truth.robots if r.team == team and (team, r.id) not in leaving
-                  and self.field.in_field(r.x, r.y, -self.field.dims.boundary_width_m)]  # fmt: skip
+                  and self.field.in_field(r.x, r.y, -self.field.dims.boundary_width_m)]
             allowed = self.cards.max_robots(team, self.robot_keys)
             extra = len(on) - allowed
             if extra <= 0:
@@ -379,7 +379,7 @@ class Referee:
             self._too_many.add(team)
             ids = sorted((r.id for r in on), key=lambda rid: ((team, rid) not in self.cards.off, -rid))[:extra]
             self._call(GameEvent(self.t, "too_many_robots", team, ids[0], float(len(on)), float(allowed),
-                                 "robots"))  # fmt: skip
+                                 "robots"))
             self._foul(team, None)
             for rid in ids:  # off (its card's robot back for good, any other until the end)
                 self.moves.send_off(self.t, (team, rid))
@@ -403,12 +403,12 @@ class Referee:
             # (no teleports) a kickoff or penalty whose ball its team did not place: taken where the ball lies
             self.tally.failed(pl.team)
             self._call(GameEvent(self.t, "placement_failed", pl.team, None, off, r.placement_tolerance_m, "m",
-                                 pl.then.command, pl.team))  # fmt: skip
+                                 pl.then.command, pl.team))
             self._award(pl.then, pl.team, (truth.ball.x, truth.ball.y))
         elif took > r.placement_time_s:
             self.tally.failed(pl.team)
             self._call(GameEvent(self.t, "placement_failed", pl.team, None, off, r.placement_tolerance_m, "m",
-                                 RefereeCommand.FREE_KICK, other(pl.team)))  # fmt: skip
+                                 RefereeCommand.FREE_KICK, other(pl.team)))
             if self.moves.teleports:
                 self.moves.add(self.t, ball=pl.target)  # the referee places it
                 self._award(RestartKind.PLACED_FREE_KICK, other(pl.team), pl.target)
@@ -437,7 +437,7 @@ class Referee:
             shootout = self.game.stage == GameStage.PENALTY_SHOOTOUT
             self._call(GameEvent(self.t, "penalty_over", pen.team, None, took, self.rules.penalty_time_s, "s",
                                  None if shootout else RefereeCommand.FREE_KICK,
-                                 None if shootout else other(pen.team)))  # fmt: skip
+                                 None if shootout else other(pen.team)))
             if shootout:
                 self._next_shootout_kick()
             else:
@@ -508,7 +508,7 @@ class Referee:
             if self.full:
                 self._call(GameEvent(t, "keeper_held_ball", holder, self.rules.keepers.get(holder),
                                      self.params.keeper_held_ball_s, self.params.keeper_held_ball_s, "s",
-                                     RefereeCommand.FREE_KICK, taker))  # fmt: skip
+                                     RefereeCommand.FREE_KICK, taker))
                 self._foul(holder, self.rules.keepers.get(holder))
             self._award(RestartKind.FREE_KICK, taker, spot)
 
@@ -518,7 +518,7 @@ class Referee:
         away): a stop, then a force start where it lies."""
         if self._no_progress.stuck(t, ball_xy, self.full and self.game.command.running and self._restart is None):
             self._call(GameEvent(t, "no_progress", None, None, self.params.no_progress_s, self.params.no_progress_s,
-                                 "s", RefereeCommand.FORCE_START))  # fmt: skip
+                                 "s", RefereeCommand.FORCE_START))
             self._set(RefereeCommand.STOP, None)
             self._restart = Restart(t + self.params.restart_delay_s, RestartKind.FORCE_START, None, ball_xy)
 

@@ -16,7 +16,6 @@ from __future__ import annotations
 import math
 import sys
 from dataclasses import dataclass
-from fractions import Fraction
 from typing import Any
 
 import cv2
@@ -27,7 +26,7 @@ from numpy.typing import NDArray
 from cmdragons.camera import CameraModel, RealisticParams
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, LeagueParams
-from cmdragons.videoio import bgr_to_i420, i420_to_bgr
+from cmdragons.videoio import H264RoundTrip
 from sim import _kernels as kern
 from sim.snapshot import Snapshot
 
@@ -95,7 +94,7 @@ class CameraRenderer:
     """
 
     def __init__(self, model: CameraModel, league: LeagueParams, params: RenderParams, seed: int,
-                 lighting: Lighting | None = None) -> None:  # fmt: skip
+                 lighting: Lighting | None = None) -> None:
         self.model, self.league, self.params = model, league, params
         self.field = Field(league)
         self.rng = np.random.default_rng([seed, model.id])
@@ -166,17 +165,17 @@ class CameraRenderer:
         if robots.shape[0] > plan.capacity:
             plan = self._plan = kern.ObjectPlan(robots.shape[0], self.params.max_blur_samples, len(self.dots))
         kern.plan_objects(plan, robots, ball, self.cam, self.shape, self.pink, self.dots, self.palette,
-                          self.params.exposure_s, self.params.blur_step_px)  # fmt: skip
+                          self.params.exposure_s, self.params.blur_step_px)
         noise_key = None
         if self.params.noise_sigma_grey > 0.0:
             noise_key = int(self.rng.integers(2**64, dtype=np.uint64))
         vis, sil = kern.render_frame(out, self.background, self.noise, noise_key, self.rays, self.foot, self.gain,
                                      self.cam, self.shape, self.dots, self.palette, plan, self._row_ball,
-                                     self._n_chunks)  # fmt: skip
+                                     self._n_chunks)
         return self._truth(snapshot, robots, plan, vis, sil)
 
     def _truth(self, snapshot: Snapshot, robots: NDArray[np.float64], plan: kern.ObjectPlan, vis: float,
-               sil: float) -> CameraTruth:  # fmt: skip
+               sil: float) -> CameraTruth:
         bt = plan.ball_truth
         ball = None
         if bt[2] > 0.0:
@@ -202,7 +201,7 @@ def _footprints(rays: NDArray[np.float32]) -> NDArray[np.float32]:
 
 
 def _lighting_gain(model: CameraModel, ground: NDArray[np.float64], field_length_m: float,
-                   params: RenderParams) -> NDArray[np.float32]:  # fmt: skip
+                   params: RenderParams) -> NDArray[np.float32]:
     """Per-pixel light gain: vignetting (quadratic in the distance from the principal point,
     ``1 - vignetting`` at the farthest corner) times a linear gradient along the field's x
     (``1 +- gradient/2`` at the goal lines)."""
@@ -222,7 +221,7 @@ def _coverage(sd: NDArray[np.float64], pix: NDArray[np.float64]) -> NDArray[np.f
 
 
 def _segment_distance(px: NDArray[np.float64], py: NDArray[np.float64], a: tuple[float, float],
-                      b: tuple[float, float]) -> NDArray[np.float64]:  # fmt: skip
+                      b: tuple[float, float]) -> NDArray[np.float64]:
     ax, ay = a
     dx, dy = b[0] - ax, b[1] - ay
     t = np.clip(((px - ax) * dx + (py - ay) * dy) / max(dx * dx + dy * dy, 1e-18), 0.0, 1.0)
@@ -230,7 +229,7 @@ def _segment_distance(px: NDArray[np.float64], py: NDArray[np.float64], a: tuple
 
 
 def _goal_hits(center: NDArray[np.float64], d: NDArray[np.float64], boxes: list[tuple[float, float, float, float]],
-               height_m: float) -> tuple[NDArray[np.bool_], NDArray[np.int64]]:  # fmt: skip
+               height_m: float) -> tuple[NDArray[np.bool_], NDArray[np.int64]]:
     """Rays ``center + t (dx, dy, -1)`` against vertical boxes (x0, y0, x1, y1) of ``height_m``:
     hit mask and the face the nearest hit enters (0 top, 1 an x face, 2 a y face)."""
     best_t = np.full(d.shape[:-1], np.inf)
@@ -254,7 +253,7 @@ def _goal_hits(center: NDArray[np.float64], d: NDArray[np.float64], boxes: list[
 
 
 def _static_background(model: CameraModel, field: Field, params: RenderParams, rays: NDArray[np.float32],
-                       foot: NDArray[np.float32], gain: NDArray[np.float32]) -> NDArray[np.uint8]:  # fmt: skip
+                       foot: NDArray[np.float32], gain: NDArray[np.float32]) -> NDArray[np.uint8]:
     """The field without robots and ball, lit: carpet, painted lines (anti-aliased by coverage),
     the boundary, and the goals as 3D walls seen with parallax (supersampled at their edges)."""
     d = rays.astype(np.float64)
@@ -290,11 +289,11 @@ def _static_background(model: CameraModel, field: Field, params: RenderParams, r
     for side in (1.0, -1.0):
         boxes = field.goal_walls(side)
         corners = np.array([(x, y, z) for x0, y0, x1, y1 in boxes for x in (x0, x1) for y in (y0, y1)
-                            for z in (0.0, gh)])  # fmt: skip
+                            for z in (0.0, gh)])
         win = _window(model, corners)
         if win is not None:
             img[win] = _draw_goal(model, boxes, gh, d[win], img[win], win, params.static_supersampling,
-                                  face_gain, goal)  # fmt: skip
+                                  face_gain, goal)
 
     img *= gain[..., None]
     return np.clip(np.floor(img + 0.5), 0, 255).astype(np.uint8)
@@ -319,7 +318,7 @@ def _window(model: CameraModel, points: NDArray[np.float64], margin_px: int = 3)
 
 def _draw_goal(model: CameraModel, boxes: list[tuple[float, float, float, float]], height_m: float,
                d: NDArray[np.float64], img: NDArray[np.float64], win: tuple[slice, slice], s: int,
-               face_gain: NDArray[np.float64], goal: NDArray[np.float64]) -> NDArray[np.float64]:  # fmt: skip
+               face_gain: NDArray[np.float64], goal: NDArray[np.float64]) -> NDArray[np.float64]:
     """One goal's walls over the window ``img`` (rays ``d``): pixels near a wall are
     supersampled s x s, since the walls are only a few pixels thick in the image."""
     img = img.copy()
@@ -369,7 +368,7 @@ class Lighting:
         self.half_width = f.boundary_half_width
         # the lamps' pools, scaled so that their sum's mean over the field is 1
         g = np.stack(np.meshgrid(np.linspace(-f.half_length, f.half_length, 25),
-                                 np.linspace(-f.half_width, f.half_width, 17)), -1).reshape(-1, 2)  # fmt: skip
+                                 np.linspace(-f.half_width, f.half_width, 17)), -1).reshape(-1, 2)
         self.scale = 1.0 / max(float(np.mean(self.pools(g).sum(axis=1))), 1e-9)
 
     def pools(self, ground: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -384,7 +383,7 @@ class Lighting:
         p = self.params
         lamps = p.lamp_level * (1.0 + p.lamp_drift_fraction * np.sin(2.0 * np.pi * t / self.periods_s + self.phases))
         day = p.daylight_level * (1.0 + p.daylight_drift_fraction
-                                  * math.sin(2.0 * math.pi * t / p.daylight_drift_period_s + self.day_phase))  # fmt: skip
+                                  * math.sin(2.0 * math.pi * t / p.daylight_drift_period_s + self.day_phase))
         return lamps * self.scale, day
 
     def daylight(self, ground: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -401,7 +400,7 @@ class CameraLook:
     compression (JPEG or H.264). Geometry (the strong barrel distortion) is the camera model's."""
 
     def __init__(self, model: CameraModel, league: LeagueParams, params: RealisticParams, lighting: Lighting,
-                 rays: NDArray[np.float32], seed: int) -> None:  # fmt: skip
+                 rays: NDArray[np.float32], seed: int) -> None:
         self.model, self.league, self.params, self.lighting = model, league, params, lighting
         self.seed = seed
         h, w = model.height, model.width
@@ -420,9 +419,9 @@ class CameraLook:
         y = np.array([0.114, 0.587, 0.299], dtype=np.float32)
         sat = np.float32(params.saturation)
         self.desaturate = (sat * np.eye(3, dtype=np.float32) + (1 - sat) * np.outer(np.ones(3, np.float32), y))
-        self._h264: _H264 | None = None
+        self._h264: H264RoundTrip | None = None
         if params.codec == "h264":
-            self._h264 = _H264(w, h, params.h264_crf)
+            self._h264 = H264RoundTrip(w, h, params.h264_crf)
         pat, robot = league.pattern, league.robot
         self.top_m = robot.height_m
         # mirror points of the lamps on the robots' tops, seen from this camera
@@ -434,7 +433,7 @@ class CameraLook:
 
     # the static scene --------------------------------------------------------------------------
     def floor(self, background: NDArray[np.uint8], rays: NDArray[np.float32], gain: NDArray[np.float32],
-              field: Field) -> NDArray[np.uint8]:  # fmt: skip
+              field: Field) -> NDArray[np.uint8]:
         """``background`` with the floor past the boundary: wooden planks along x, and ``clutter``
         orange-ish things (boxes and discs, placed by the seed) lying on it."""
         p = self.params
@@ -471,7 +470,7 @@ class CameraLook:
 
     # per frame --------------------------------------------------------------------------------
     def apply(self, image: NDArray[np.uint8], snapshot: Snapshot, gain: NDArray[np.float32],
-              cover_bgr: BGR) -> NDArray[np.uint8]:  # fmt: skip
+              cover_bgr: BGR) -> NDArray[np.uint8]:
         """The camera's frame of the clean render ``image`` (not written) at ``snapshot``."""
         p = self.params
         img = image.copy()
@@ -508,7 +507,7 @@ class CameraLook:
         return float(np.mean(0.114 * sub[..., 0] + 0.587 * sub[..., 1] + 0.299 * sub[..., 2]))
 
     def _hide_dot(self, img: NDArray[np.uint8], robots: NDArray[np.float64], gain: NDArray[np.float32],
-                  cover_bgr: BGR) -> None:  # fmt: skip
+                  cover_bgr: BGR) -> None:
         team, rid, dot = self.params.hidden_dot
         if rid < 0 or not 0 <= dot < len(self.dots):
             return
@@ -524,7 +523,7 @@ class CameraLook:
             colour = tuple(int(round(v * g)) for v in cover_bgr)
             sh = 4  # sub-pixel centre: cv2 draws in 1/16 px
             cv2.circle(img, (int(round(px[0] * 2**sh - 0.5 * 2**sh)), int(round(px[1] * 2**sh - 0.5 * 2**sh))),
-                       int(round(rad * 2**sh)), colour, -1, cv2.LINE_AA, sh)  # fmt: skip
+                       int(round(rad * 2**sh)), colour, -1, cv2.LINE_AA, sh)
 
     def _glare(self, f: NDArray[np.float32], robots: NDArray[np.float64], lamps: NDArray[np.float64]) -> None:
         """Glare on each cover near a lamp's mirror point: a Gaussian spot on the cover's side
@@ -566,31 +565,3 @@ def _demosaic(image: NDArray[np.uint8]) -> NDArray[np.uint8]:
     raw[1::2, 1::2] = image[1::2, 1::2, 0]
     out: NDArray[np.uint8] = cv2.cvtColor(raw, cv2.COLOR_BayerBG2BGR)  # OpenCV names the layout by its second row
     return out
-
-
-class _H264:
-    """Frames through an H.264 encoder and decoder in memory, one frame in, the same frame out
-    (x264 without look-ahead or B-frames, on one thread: the same bytes every run)."""
-
-    def __init__(self, width: int, height: int, crf: int) -> None:
-        import av
-
-        self.enc: Any = av.CodecContext.create("libx264", "w")
-        self.enc.width, self.enc.height, self.enc.pix_fmt = width, height, "yuv420p"
-        self.enc.time_base = Fraction(1, 60)
-        self.enc.options = {"crf": str(crf), "preset": "veryfast", "tune": "zerolatency", "threads": "1"}
-        self.dec: Any = av.CodecContext.create("h264", "r")
-        self.dec.thread_count = 1
-        self.n = 0
-        self.h, self.w = height, width
-        self._av = av
-
-    def __call__(self, image: NDArray[np.uint8]) -> NDArray[np.uint8]:
-        frame = self._av.VideoFrame.from_ndarray(bgr_to_i420(image), format="yuv420p")
-        frame.pts = self.n
-        self.n += 1
-        out = image
-        for packet in self.enc.encode(frame):
-            for decoded in self.dec.decode(packet):
-                out = i420_to_bgr(decoded.to_ndarray(), self.h, self.w)
-        return out

@@ -71,7 +71,7 @@ _COMMANDS = {
     RestartKind.PLACED_FREE_KICK: RefereeCommand.FREE_KICK, RestartKind.REFEREE_FREE_KICK: RefereeCommand.FREE_KICK,
     RestartKind.PENALTY: RefereeCommand.PENALTY, RestartKind.FORCE_START: RefereeCommand.FORCE_START,
     RestartKind.PLACED_KICKOFF: RefereeCommand.KICKOFF, RestartKind.PLACED_PENALTY: RefereeCommand.PENALTY,
-}  # fmt: skip
+}
 _PLACED = {RestartKind.KICKOFF: RestartKind.PLACED_KICKOFF, RestartKind.PENALTY: RestartKind.PLACED_PENALTY}
 
 
@@ -168,7 +168,7 @@ def entry_spot(pitch: Field, robots: Sequence[RobotTruth], team: Team, blue_sign
 
 
 def aside(robots: Sequence[RobotTruth], spot: tuple[float, float], clear_m: float, attack: float,
-          off: Collection[Key]) -> list[Move]:  # fmt: skip
+          off: Collection[Key]) -> list[Move]:
     """The robots nearer ``spot`` than ``clear_m`` (those ``off`` the field aside) moved out to that
     distance, straight away from it (toward -``attack`` along x when on it), so the ball put there
     is not put into a robot."""
@@ -185,7 +185,7 @@ def aside(robots: Sequence[RobotTruth], spot: tuple[float, float], clear_m: floa
 
 def shootout_poses(pitch: Field, keys: Sequence[Key], off: Collection[Key], keepers: Mapping[Team, int],
                    team: Team, mark: tuple[float, float], attack: float, behind_m: float,
-                   parked: Mapping[Key, tuple[float, float]]) -> list[Move]:  # fmt: skip
+                   parked: Mapping[Key, tuple[float, float]]) -> list[Move]:
     """A shootout kick by ``team`` at ``mark`` (the rules: only the kicker and the other team's
     keeper may move; the robot handlers take the others off): its field player ``behind_m`` behind
     the mark facing the goal it attacks (``attack``: +1.0 for +x), the other keeper on its goal
@@ -213,7 +213,7 @@ class Moves:
     ball put down, for a shootout kick."""
 
     def __init__(self, pitch: Field, keys: Sequence[Key], formations: Mapping[Literal["A", "B"], Sequence[Pose]],
-                 park_distance_m: float, teleports: bool = True) -> None:  # fmt: skip
+                 park_distance_m: float, teleports: bool = True) -> None:
         """``teleports``: False when nothing may be placed by teleport (the teams place the ball, the
         robot handlers move the robots): every move asked for is left out."""
         self.field = pitch
@@ -262,7 +262,7 @@ class Moves:
             ids = [rid for t_, rid in self.keys if t_ == team]
             poses = self.formation(team, blue_sign)
             robots += [(team, rid, x, y, th) for rid, (x, y, th) in zip(ids, poses, strict=False)
-                       if (team, rid) not in off]  # fmt: skip
+                       if (team, rid) not in off]
         return Teleport(t, tuple(robots), (0.0, 0.0))
 
     def park(self, key: Key) -> tuple[float, float]:
@@ -274,14 +274,14 @@ class Moves:
         self.add(t, [(key[0], key[1], x, y, 0.0)])
 
     def clear_spot(self, t: float, robots: Sequence[RobotTruth], spot: tuple[float, float], clear_m: float,
-                   attack: float, off: Collection[Key]) -> None:  # fmt: skip
+                   attack: float, off: Collection[Key]) -> None:
         """The ``robots`` nearer ``spot`` than ``clear_m`` moved aside first (:func:`aside`)."""
         moved = aside(robots, spot, clear_m, attack, off)
         if moved:
             self.add(t, moved)
 
     def shootout_kick(self, t: float, off: Collection[Key], keepers: Mapping[Team, int], team: Team,
-                      mark: tuple[float, float], attack: float, behind_m: float) -> None:  # fmt: skip
+                      mark: tuple[float, float], attack: float, behind_m: float) -> None:
         """The rules: during a shootout attempt only the kicker and the other team's keeper may move
         (the others must not interfere; robots may be substituted between attempts). The robot
         handlers take the kicking team's keeper and the other team's field player off (where robots

@@ -30,7 +30,7 @@ FOUL_RESTARTS: dict[str, RefereeCommand | None] = {
     "attacker_in_defense_area": _FREE, "defender_in_defense_area": _PENALTY, "double_touch": _FREE,
     "stop_speed": None, "stop_distance": None, "kick_point_distance": None, "keeper_held_ball": _FREE,
     "boundary_crossing": _FREE, "too_many_robots": None,
-}  # fmt: skip
+}
 
 
 @dataclass(frozen=True)
@@ -174,7 +174,7 @@ class FoulWatch:
         if s.command == RefereeCommand.STOP and gt.t - s.since >= self.p.stop_grace_s:
             out += self._stop(gt, robots)
         if s.command.kick_restart and s.for_team is not None and not s.in_play \
-                and gt.t - s.since >= self.p.kick_point_grace_s:  # fmt: skip
+                and gt.t - s.since >= self.p.kick_point_grace_s:
             out += self._kick_point(gt, robots, other(s.for_team))
         self._prev = {(r.team, r.id): r for r in robots}
         return out
@@ -206,7 +206,7 @@ class FoulWatch:
         restart = FOUL_RESTARTS[kind]
         team = None if key is None else key[0]
         return GameEvent(t, kind, team, None if key is None else key[1], value, limit, unit, restart,
-                         other(team) if restart is not None and team is not None else None)  # fmt: skip
+                         other(team) if restart is not None and team is not None else None)
 
     def _once(self, kind: str, key: Key) -> bool:
         """True the first time ``kind`` is called on ``key`` since the command changed."""
@@ -249,10 +249,10 @@ class FoulWatch:
                         va, vb = math.hypot(pa.vx, pa.vy), math.hypot(pb.vx, pb.vy)
                         if abs(va - vb) < self.p.crash_drawn_m_s:
                             out += [self._event(gt.t, "crash_drawn", k, closing, self.p.crash_speed_m_s, "m/s")
-                                    for k in (ka, kb)]  # fmt: skip
+                                    for k in (ka, kb)]
                         else:
                             out.append(self._event(gt.t, "crash", ka if va > vb else kb, closing,
-                                                   self.p.crash_speed_m_s, "m/s"))  # fmt: skip
+                                                   self.p.crash_speed_m_s, "m/s"))
                     continue
                 if c.pushed:
                     continue
@@ -292,7 +292,7 @@ class FoulWatch:
         return out
 
     def _area_touches(self, gt: GroundTruth, robots: list[RobotTruth], new: list[Key],
-                      s: Situation) -> list[GameEvent]:  # fmt: skip
+                      s: Situation) -> list[GameEvent]:
         """A robot that starts touching the ball inside the opponent's defense area (the ball in
         it); a robot other than the keeper touching it with its centre inside its own."""
         out = []
@@ -306,7 +306,7 @@ class FoulWatch:
             elif k[1] != self.p.keepers.get(k[0], -1) and self.field.in_defense_area(r.x, r.y) == own:
                 depth = self.field.half_length - abs(r.x)
                 out.append(self._event(gt.t, "defender_in_defense_area", k, depth, self.field.dims.defense_depth_m,
-                                       "m from the goal line"))  # fmt: skip
+                                       "m from the goal line"))
         return out
 
     def _double_touch(self, gt: GroundTruth, new: list[Key]) -> list[GameEvent]:
@@ -411,7 +411,7 @@ class NoProgress:
 
 
 def placed(gt: GroundTruth, team: Team, target: tuple[float, float], pitch: Field,
-           p: RulesParams) -> tuple[float, bool]:  # fmt: skip
+           p: RulesParams) -> tuple[float, bool]:
     """Ball placement by ``team``: how far the ball is off ``target`` (m), and whether the
     placement succeeded: the ball within ``placement_tolerance_m`` of it, at rest (slower than
     ``placement_rest_m_s``), the team's robots ``placement_clear_m`` clear of it."""
@@ -423,7 +423,7 @@ def placed(gt: GroundTruth, team: Team, target: tuple[float, float], pitch: Fiel
 
 
 def penalty_set(gt: GroundTruth, team: Team, mark: tuple[float, float], attack: float, pitch: Field,
-                p: RulesParams, off: Collection[Key]) -> bool:  # fmt: skip
+                p: RulesParams, off: Collection[Key]) -> bool:
     """A penalty by ``team`` at ``mark`` (``attack``: +1.0 toward +x) is ready for its normal start:
     every robot on the field (those ``off`` aside) but the kicker (the team's nearest to the mark)
     and the other keeper ``penalty_behind_m`` behind the ball, that keeper on its goal line."""

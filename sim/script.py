@@ -47,10 +47,10 @@ class ScriptedPlay:
     def _random_point(self) -> tuple[float, float]:
         m = self.params.field_margin_m
         return (float(self.rng.uniform(-self.field.half_length + m, self.field.half_length - m)),
-                float(self.rng.uniform(-self.field.half_width + m, self.field.half_width - m)))  # fmt: skip
+                float(self.rng.uniform(-self.field.half_width + m, self.field.half_width - m)))
 
     def _drive_to(self, key: tuple[int, int], row: np.ndarray, x: float, y: float, theta: float,
-                  speed: float) -> RobotCommand:  # fmt: skip
+                  speed: float) -> RobotCommand:
         dx, dy = x - row[2], y - row[3]
         dist = math.hypot(dx, dy)
         v = min(speed, self.params.position_gain_1_s * dist)

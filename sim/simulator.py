@@ -63,7 +63,7 @@ class Simulator:
         self.seed = params.seed if seed is None else seed
         counts = robot_counts(league, params)
         self.world = World(league, params.physics, params.world_robot(), params.world_ball(), params.kicker,
-                           params.dribbler, robots_per_team=counts)  # fmt: skip
+                           params.dribbler, robots_per_team=counts)
         self.world.blue_defends = -1 if params.referee.blue_defends == "negative_x" else 1
         self.referee: Referee | None = None
         if referee:
@@ -79,7 +79,7 @@ class Simulator:
             [CameraRenderer(m, league, params.render, seed=int(s.generate_state(1)[0]), lighting=lighting)
              for m, s in zip(self.cameras, seeds[1:], strict=True)]
             if render else []
-        )  # fmt: skip
+        )
         self.times = StageTimes()
 
     @property

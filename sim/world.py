@@ -120,7 +120,7 @@ class CommandFaults:
 
     def as_dict(self) -> dict[str, int]:
         return {"non_finite": self.non_finite, "clamped": self.clamped, "unknown_robot": self.unknown_robot,
-                "timed_out": self.timed_out}  # fmt: skip
+                "timed_out": self.timed_out}
 
 
 @dataclass
@@ -158,7 +158,7 @@ class _BallState:
 
 
 def ball_at_front(league: LeagueParams, dx: float, dy: float, theta: float,
-                  slack_m: float) -> tuple[bool, float, float]:  # fmt: skip
+                  slack_m: float) -> tuple[bool, float, float]:
     """Is a ball ``(dx, dy)`` m from a robot's centre (field frame) against the flat front of the
     robot heading ``theta`` (rad), within ``slack_m`` of touching it? Returns (touching, x, y), the
     ball in the robot's frame: what the kicker's light barrier and the dribbler feel."""
@@ -587,7 +587,7 @@ class World:
         ra, rb = self.robots[key[0]], self.robots[key[1]]
         pusher = None if track.pushed_by is None else self.robots[track.pushed_by]
         return Contact(track.t_start, self.t - track.t_start, (ra.team, ra.id), (rb.team, rb.id), track.max_depth,
-                       track.relative_speed, None if pusher is None else (pusher.team, pusher.id))  # fmt: skip
+                       track.relative_speed, None if pusher is None else (pusher.team, pusher.id))
 
     def open_contacts(self) -> list[Contact]:
         """Contacts still going on now, as if they ended now (for a run's summary)."""

@@ -15,7 +15,7 @@ from cmdragons.angles import wrap_angle
 
 @njit(cache=True)
 def goal_samples_free(points: np.ndarray, ys: np.ndarray, gx: float, obstacles: np.ndarray,
-                      radius: float) -> np.ndarray:  # fmt: skip
+                      radius: float) -> np.ndarray:
     """Per point (N, 2) and goal-line sample (x = gx, y = ys[k]): whether no obstacle (M, 2) of
     ``radius`` shadows it, an obstacle nearer than the sample and farther than ``radius`` (the
     shooter itself) whose angular half-width covers the sample's direction."""

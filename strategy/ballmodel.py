@@ -106,7 +106,7 @@ class BallModel:
 def robot_limits(robot: RobotShape) -> Limits:
     """The league robot's driving limits, as motion control names them."""
     return Limits(robot.max_speed_m_s, robot.max_accel_m_s2, robot.max_brake_m_s2, robot.max_omega_rad_s,
-                  robot.max_alpha_rad_s2)  # fmt: skip
+                  robot.max_alpha_rad_s2)
 
 
 def reach_times(xy: Array, vel: Array, points: Array, reach_m: float, limits: Limits, latency_s: float) -> Array:
@@ -134,7 +134,7 @@ def reach_times(xy: Array, vel: Array, points: Array, reach_m: float, limits: Li
 
 def interception_times(xy: Array, vel: Array, ball: tuple[float, float], ball_vel: tuple[float, float],
                        model: BallModel, limits: Limits, latency_s: float, reach_m: float, horizon_s: float,
-                       step_s: float) -> tuple[Array, Array]:  # fmt: skip
+                       step_s: float) -> tuple[Array, Array]:
     """The earliest time (s) each robot ((M, 2) rows) can be at the ball running from ``ball`` with
     ``ball_vel`` (the model's run, sampled every ``step_s`` up to ``horizon_s``; a ball that stops
     before is met where it lies, its stop time or the robot's arrival there, whichever is later), and
@@ -152,7 +152,7 @@ def interception_times(xy: Array, vel: Array, ball: tuple[float, float], ball_ve
     if len(xy) == 0:
         return np.zeros(0), np.zeros((0, 2))
     reach = reach_times(np.asarray(xy, dtype=np.float64), np.asarray(vel, dtype=np.float64), pts, reach_m, limits,
-                        latency_s)  # fmt: skip
+                        latency_s)
     ok = reach <= ts[None, :]
     first = np.argmax(ok, axis=1)
     found = ok[np.arange(len(xy)), first]

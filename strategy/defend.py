@@ -97,7 +97,7 @@ class DefendTeamParams(Validated):
 
 
 def threats(opponents: Sequence[RobotState], ball: BallState, pitch: Field, own_sign: float,
-            p: DefendTeamParams) -> list[RobotState]:  # fmt: skip
+            p: DefendTeamParams) -> list[RobotState]:
     """The opponents to mark, most dangerous first (nearest our goal's centre): all but the one
     playing the ball (the nearest to it, within ``on_ball_m``) and those in their own defense area
     (their keeper)."""
@@ -115,7 +115,7 @@ def _legal(x: float, y: float, pitch: Field, radius: float, p: DefendTeamParams)
 
 
 def mark_point(receiver: RobotState, ball: BallState, pitch: Field, radius: float, p: DefendTeamParams,
-               gap_m: float | None = None) -> Intent:  # fmt: skip
+               gap_m: float | None = None) -> Intent:
     """A marker in the passing lane: on the line from ``receiver`` to the ball, ``gap_m`` (default
     ``mark_gap_m``) from the receiver (at most ``mark_lane_share`` of the way), facing the ball; off
     the defense areas."""
@@ -140,7 +140,7 @@ def block_point(ball: BallState, pitch: Field, own_sign: float, radius: float, p
 
 
 def detour(start: tuple[float, float], goal: tuple[float, float], centre: tuple[float, float], radius: float,
-           share: float) -> tuple[float, float]:  # fmt: skip
+           share: float) -> tuple[float, float]:
     """Where to head from ``start`` for ``goal`` without crossing the circle of ``radius`` round
     ``centre``: ``goal`` when the straight way keeps out of it, else a point on the circle of
     ``share`` times the radius, round from ``start``'s side toward ``goal``'s by at most the angle
@@ -166,7 +166,7 @@ def detour(start: tuple[float, float], goal: tuple[float, float], centre: tuple[
 
 
 def keep_off_robots(cmd: RobotCommand, robot: RobotState, others: Sequence[RobotState], radius: float,
-                    p: DefendTeamParams) -> RobotCommand:  # fmt: skip
+                    p: DefendTeamParams) -> RobotCommand:
     """``cmd`` with its velocity toward each robot within ``near_gap_m`` (body to body) cut to
     ``closing_m_s`` times the share of that gap still open (nothing at touching: following a robot
     that backs off while touching it is pushing), less the other's speed toward it; it is only ever
@@ -238,7 +238,7 @@ class DefendTeam:
         stopped = game.command in (RefereeCommand.STOP, RefereeCommand.BALL_PLACEMENT)
         goalie_id = self._goalie(own)
         intents, attacker = self._normal(by_id, goalie_id, opp, ball, own_sign, restart and game.ready,
-                                         self.p.mark_gap_stopped_m if stopped else None)  # fmt: skip
+                                         self.p.mark_gap_stopped_m if stopped else None)
         self._taker = attacker if restart and game.ready else None
         gs, radius = self.sp.game_states, self.sp.robot_radius_m
         if game.command == RefereeCommand.BALL_PLACEMENT and game.placement is not None:
@@ -247,7 +247,7 @@ class DefendTeam:
                 players = [r for r in own if r.id != goalie_id] or own
                 placer = min(players, key=lambda r: math.hypot(r.x - ball.x, r.y - ball.y))
                 intents[placer.id], self._placing = place_ball(placer, ball, game.placement, self.sp.skills, gs,
-                                                               world.t, self._placing)  # fmt: skip
+                                                               world.t, self._placing)
             return intents
         if game.command == RefereeCommand.PENALTY:
             return self._penalty(intents, own, goalie_id, opp, ball, game, ours, own_sign)
@@ -274,7 +274,7 @@ class DefendTeam:
         return keep_off_robots(cmd, r, others, self.sp.robot_radius_m, p)
 
     def _double_touch_bar(self, game: GameState, own: Sequence[RobotState], opp: Sequence[RobotState],
-                          ball: BallState) -> int | None:  # fmt: skip
+                          ball: BallState) -> int | None:
         """The robot that may not touch the ball now: its restart's kicker, from the normal start
         after the restart until another robot comes within touching reach of the ball."""
         barred = self._barred
@@ -295,7 +295,7 @@ class DefendTeam:
         p, sp, f = self.p, self.sp, self.field
         radius = sp.robot_radius_m
         marks = {Role(RoleKind.MARKER, r.id): mark_point(r, ball, f, radius, p, mark_gap_m)
-                 for r in threats(opp, ball, f, own_sign, p)}  # fmt: skip
+                 for r in threats(opp, ball, f, own_sign, p)}
         block = block_point(ball, f, own_sign, radius, p)
         meet = {rid: intercept(r, ball, sp.skills, f) for rid, r in own.items()}
         costs = {rid: math.hypot(m.x - own[rid].x, m.y - own[rid].y) for rid, m in meet.items()}
@@ -333,11 +333,11 @@ class DefendTeam:
         barred = self._barred
         if barred is not None and barred in out and barred != attacker:  # it must not meet the ball it kicked
             out[barred] = off_ball_line(own[barred], replace(out[barred], kick_speed=0.0), ball, f, radius,
-                                        sp.barred_near_m, sp.barred_clear_m, sp.barred_rolling_m_s)  # fmt: skip
+                                        sp.barred_near_m, sp.barred_clear_m, sp.barred_rolling_m_s)
         return out, attacker
 
     def _attack(self, robot: RobotState, meet: BallState, opp: Sequence[RobotState], own_sign: float,
-                set_piece: bool) -> Intent:  # fmt: skip
+                set_piece: bool) -> Intent:
         """The attacker: a shot at the widest gap of the goal mouth from within ``shot_range_m``, else
         the ball along the most open lane toward the goal; a ball in either defense area waited for
         outside it; a restart's kick lined up first."""
@@ -359,7 +359,7 @@ class DefendTeam:
             toward = math.atan2(goal[1] - meet.y, goal[0] - meet.x)
             angle, _ = clearest_direction(at, toward, others, sp.obstacle_radius_m, kp.clear_reach_m,
                                           kp.clear_spread_rad, kp.clear_samples, kp.clear_lane_cap_rad,
-                                          kp.clear_turn_cost)  # fmt: skip
+                                          kp.clear_turn_cost)
             target = (meet.x + p.advance_m * math.cos(angle), meet.y + p.advance_m * math.sin(angle))
             lim_x, lim_y = f.half_length - p.advance_margin_m, f.half_width - p.advance_margin_m
             target = (min(max(target[0], -lim_x), lim_x), min(max(target[1], -lim_y), lim_y))
@@ -370,7 +370,7 @@ class DefendTeam:
 
     def _penalty(self, intents: dict[int, Intent], own: list[RobotState], goalie_id: int | None,
                  opp: Sequence[RobotState], ball: BallState, game: GameState, ours: bool,
-                 own_sign: float) -> dict[int, Intent]:  # fmt: skip
+                 own_sign: float) -> dict[int, Intent]:
         """A penalty: its taker plays it from the normal start, everyone else behind the ball;
         theirs, its keeper on the line until the normal start, then out at the ball once it is in
         play."""
@@ -381,11 +381,11 @@ class DefendTeam:
             taker = min(players, key=lambda r: math.hypot(r.x - ball.x, r.y - ball.y))
             their_keeper = min(opp, key=lambda r: abs(r.x - attack * f.half_length) + abs(r.y), default=None)
             out = behind_ball({k: v for k, v in intents.items() if k != taker.id}, ball, attack, f, gs,
-                              sp.robot_radius_m)  # fmt: skip
+                              sp.robot_radius_m)
             out[taker.id] = penalty_shot(taker, ball, attack, their_keeper, f, sp.skills, gs, game.ready)
             return out
         out = behind_ball({k: v for k, v in intents.items() if k != goalie_id}, ball, own_sign, f, gs,
-                          sp.robot_radius_m)  # fmt: skip
+                          sp.robot_radius_m)
         keeper = next((r for r in own if r.id == goalie_id), None)
         if keeper is None:
             return out

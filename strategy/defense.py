@@ -48,11 +48,11 @@ def clear_target(ball: BallState, pitch: Field, own_sign: float, p: DefenseParam
     """Where the goalie clears the ball to: up the field in their half, out on the ball's side (away
     from the middle)."""
     return (-own_sign * pitch.half_length * p.clear_depth_share,
-            math.copysign(pitch.half_width * p.clear_width_share, ball.y or 1.0))  # fmt: skip
+            math.copysign(pitch.half_width * p.clear_width_share, ball.y or 1.0))
 
 
 def goalie(robot: RobotState, ball: BallState, pitch: Field, own_sign: float, p: DefenseParams,
-           skills: SkillParams) -> tuple[Intent, bool]:  # fmt: skip
+           skills: SkillParams) -> tuple[Intent, bool]:
     """The goalie's intent, and whether it clears the ball (a kick) rather than blocks."""
     if ball_to_clear(ball, pitch, own_sign, p):
         intent = kick_to(robot, ball, clear_target(ball, pitch, own_sign, p), p.clear_kick_m_s, skills)
@@ -64,7 +64,7 @@ def goalie(robot: RobotState, ball: BallState, pitch: Field, own_sign: float, p:
 
 
 def goalie_reflex(intent: Intent, robot: RobotState, ball: BallState, pitch: Field, own_sign: float,
-                  p: DefenseParams, skills: SkillParams) -> Intent:  # fmt: skip
+                  p: DefenseParams, skills: SkillParams) -> Intent:
     """The escape/evade reflex (seed 003 §5.1) turned round for the goalie: while the ball runs at
     our goal line, blocking's point moves along the goalie's line toward the ball's path by
     ``goalie_reflex_gain_s`` times the part along the line of the fused vector at the goalie (the

@@ -99,7 +99,7 @@ def lane_open_angle(origin: Array, targets: Array, obstacles: Array, radius: flo
 
 
 def goal_samples_free_reference(points: Array, ys: Array, gx: float, obstacles: Array,
-                                radius: float) -> NDArray[np.bool_]:  # fmt: skip
+                                radius: float) -> NDArray[np.bool_]:
     """The plain-numpy reference of :func:`strategy._kernels.goal_samples_free`."""
     dx = gx - points[:, 0:1]
     dy = ys[None, :] - points[:, 1:2]
@@ -115,7 +115,7 @@ def goal_samples_free_reference(points: Array, ys: Array, gx: float, obstacles: 
 
 
 def open_goal_angle(points: Array, field: Field, goal_sign: float, obstacles: Array, radius: float, samples: int,
-                    post_margin_m: float) -> tuple[Array, Array]:  # fmt: skip
+                    post_margin_m: float) -> tuple[Array, Array]:
     """Open angle of the goal at x = goal_sign * half_length from each point (N,), and the y on the
     goal line to aim at (aim points reach up to ``post_margin_m`` from the posts). A free run of the
     mouth between two shadows (or the whole mouth) is aimed at its centre and counts its width; a
@@ -132,7 +132,7 @@ def open_goal_angle(points: Array, field: Field, goal_sign: float, obstacles: Ar
     free: NDArray[np.bool_] = np.ones(theta.shape, dtype=bool)
     if len(obstacles):
         free = goal_samples_free(np.ascontiguousarray(points, dtype=np.float64), ys, float(gx),
-                                 np.ascontiguousarray(obstacles, dtype=np.float64), float(radius))  # fmt: skip
+                                 np.ascontiguousarray(obstacles, dtype=np.float64), float(radius))
     # the longest run of free samples per point, and the free runs from each post
     n, k = free.shape
     best_len, best_end, lead, trail = free_runs(free)
@@ -154,10 +154,10 @@ def open_goal_angle(points: Array, field: Field, goal_sign: float, obstacles: Ar
 
 
 def best_shot(ball: Array, field: Field, goal_sign: float, obstacles: Array, radius: float,
-              params: PassParams) -> tuple[float, tuple[float, float], float]:  # fmt: skip
+              params: PassParams) -> tuple[float, tuple[float, float], float]:
     """(open angle rad, aim point on the goal line, value 0..1) of a shot from ``ball``."""
     width, aim = open_goal_angle(ball[None, :], field, goal_sign, obstacles, radius, params.goal_samples,
-                                 params.post_margin_m)  # fmt: skip
+                                 params.post_margin_m)
     target = (goal_sign * field.half_length, float(aim[0]))
     d = math.hypot(target[0] - ball[0], target[1] - ball[1])
     value = min(1.0, float(width[0]) / params.shot_open_angle_rad) * math.exp(-d / params.shot_distance_scale_m)
@@ -196,7 +196,7 @@ def candidate_grid(field: Field, params: PassParams) -> Array:
 
 
 def pass_values(ball: Array, points: Array, field: Field, goal_sign: float, obstacles: Array, radius: float,
-                params: PassParams) -> PassEvaluation:  # fmt: skip
+                params: PassParams) -> PassEvaluation:
     """The pass evaluation function at each candidate point (B.5): arcs a (ball -> p) and
     b (p -> goal), their lengths and open angles, and the deflection between them."""
     points = np.atleast_2d(points)
@@ -204,7 +204,7 @@ def pass_values(ball: Array, points: Array, field: Field, goal_sign: float, obst
     len_a = np.hypot(to_p[:, 0], to_p[:, 1])
     open_a = lane_open_angle(ball, points, obstacles, radius, params.lane_open_angle_rad)
     open_b, aim_y = open_goal_angle(points, field, goal_sign, obstacles, radius, params.goal_samples,
-                                    params.post_margin_m)  # fmt: skip
+                                    params.post_margin_m)
     aims = np.stack([np.full(len(points), goal_sign * field.half_length), aim_y], axis=1)
     to_goal = aims - points
     len_b = np.hypot(to_goal[:, 0], to_goal[:, 1])
@@ -218,12 +218,12 @@ def pass_values(ball: Array, points: Array, field: Field, goal_sign: float, obst
     f_dist = np.exp(-len_b / params.shot_distance_scale_m)
     f_redirect = np.where(turn <= params.max_turn_rad, 1.0, params.trap_factor)
     values = (f_len**params.weight_length * f_lane**params.weight_lane * f_open**params.weight_shot_open
-              * f_dist**params.weight_shot_distance * f_redirect**params.weight_redirect)  # fmt: skip
+              * f_dist**params.weight_shot_distance * f_redirect**params.weight_redirect)
     return PassEvaluation(points, values, aims)
 
 
 def clearest_direction(ball: Array, toward: float, obstacles: Array, radius: float, reach_m: float, spread_rad: float,
-                       samples: int, cap_rad: float, turn_cost: float) -> tuple[float, float]:  # fmt: skip
+                       samples: int, cap_rad: float, turn_cost: float) -> tuple[float, float]:
     """Among ``samples`` directions within ``spread_rad`` of ``toward``, the one whose lane of length
     ``reach_m`` from the ball is most open (each side capped at ``cap_rad``), less ``turn_cost``
     per radian off ``toward``. Returns (angle, open angle)."""

@@ -120,7 +120,7 @@ def _circle_clearance(pitch: Field, radius: float, p: GameStateParams) -> float:
 
 
 def our_kickoff(intents: Mapping[int, Intent], pitch: Field, own_sign: float, p: GameStateParams, radius: float,
-                kicker: int | None) -> dict[int, Intent]:  # fmt: skip
+                kicker: int | None) -> dict[int, Intent]:
     """At our kickoff everyone but the kicker stays in our half, outside the centre circle (moved
     sideways out of it)."""
     out = {}
@@ -139,7 +139,7 @@ def our_kickoff(intents: Mapping[int, Intent], pitch: Field, own_sign: float, p:
 
 def keep_away(intents: Mapping[int, Intent], ball: BallState, pitch: Field, own_sign: float, p: GameStateParams,
               radius: float, kickoff: bool, slow: bool,
-              distance_m: float | None = None) -> dict[int, Intent]:  # fmt: skip
+              distance_m: float | None = None) -> dict[int, Intent]:
     """Every target at least ``distance_m`` (default ``stop_distance_m``: the rules' 0.5 m plus a
     margin) from the ball, on the field; at their kickoff also in our half and outside the centre
     circle; slow (``stop_speed_m_s``) in a stop. ``radius``: the robots'."""
@@ -175,7 +175,7 @@ def keep_away(intents: Mapping[int, Intent], ball: BallState, pitch: Field, own_
         for turn in (0.0, *(sign * k * math.pi / steps for k in range(1, steps + 1) for sign in (1.0, -1.0))):
             x, y = ball.x + d_min * math.cos(base + turn), ball.y + d_min * math.sin(base + turn)
             if abs(x) <= lim_x and abs(y) <= lim_y \
-                    and pitch.in_defense_area(x, y, radius + p.area_clear_m) in (0, allowed):  # fmt: skip
+                    and pitch.in_defense_area(x, y, radius + p.area_clear_m) in (0, allowed):
                 first = first or (x, y)
                 if all(math.hypot(x - q[0], y - q[1]) >= p.spread_m for q in places.values()):
                     break
@@ -186,13 +186,13 @@ def keep_away(intents: Mapping[int, Intent], ball: BallState, pitch: Field, own_
     for rid, it in intents.items():
         x, y = places[rid]
         out[rid] = Intent(x, y, it.theta, dribbler=0.0, avoid_ball=True, allow_own_defense=it.allow_own_defense,
-                          max_speed_m_s=p.stop_speed_m_s if slow else it.max_speed_m_s)  # fmt: skip
+                          max_speed_m_s=p.stop_speed_m_s if slow else it.max_speed_m_s)
     return out
 
 
 def restart_rules(intents: Mapping[int, Intent], game: GameState, ours: bool, ball: BallState, pitch: Field,
                   own_sign: float, p: GameStateParams, radius: float,
-                  kicker: int | None) -> dict[int, Intent]:  # fmt: skip
+                  kicker: int | None) -> dict[int, Intent]:
     """The normal-play ``intents`` held to the rules of ``game``'s command: keep away in a stop and
     at their kickoff or free kick, our half at our kickoff (``kicker`` excepted). ``ours``: the
     restart is for our team."""
@@ -201,14 +201,14 @@ def restart_rules(intents: Mapping[int, Intent], game: GameState, ours: bool, ba
         # slow in a stop (the rules) and at their kickoff (robots put in formation then cross round the
         # ball to their places: fast, they swing in past the rules' distance)
         out = keep_away(out, ball, pitch, own_sign, p, radius, game.command == RefereeCommand.KICKOFF,
-                        game.command in (RefereeCommand.STOP, RefereeCommand.KICKOFF))  # fmt: skip
+                        game.command in (RefereeCommand.STOP, RefereeCommand.KICKOFF))
     if game.command == RefereeCommand.KICKOFF and ours:
         out = our_kickoff(out, pitch, own_sign, p, radius, kicker)
     return out
 
 
 def _capsule_push(x: float, y: float, a: tuple[float, float], b: tuple[float, float],
-                  d_min: float) -> tuple[float, float]:  # fmt: skip
+                  d_min: float) -> tuple[float, float]:
     """(x, y) moved out of the capsule of radius ``d_min`` round the segment a-b, the short way."""
     ax, ay = a
     dx, dy = b[0] - ax, b[1] - ay
@@ -226,7 +226,7 @@ def _capsule_push(x: float, y: float, a: tuple[float, float], b: tuple[float, fl
 
 
 def _capsule_outline(a: tuple[float, float], b: tuple[float, float], d_min: float,
-                     steps: int) -> list[tuple[float, float]]:  # fmt: skip
+                     steps: int) -> list[tuple[float, float]]:
     """Points on the outline of the capsule of radius ``d_min`` round the segment a-b: both sides in
     ``steps`` pieces and each end's half circle in steps of pi / ``steps``."""
     dx, dy = b[0] - a[0], b[1] - a[1]
@@ -246,7 +246,7 @@ def _capsule_outline(a: tuple[float, float], b: tuple[float, float], d_min: floa
 
 
 def keep_off_line(intents: Mapping[int, Intent], start: tuple[float, float], end: tuple[float, float], pitch: Field,
-                  p: GameStateParams, radius: float) -> dict[int, Intent]:  # fmt: skip
+                  p: GameStateParams, radius: float) -> dict[int, Intent]:
     """Every target ``placement_line_m`` (plus the robot's radius) off the segment from the ball
     ``start`` to the placement's target ``end``, on the field (across the line when the field's
     edge leaves no room on the near side; in a corner, where neither side has room, the nearest point
@@ -265,12 +265,12 @@ def keep_off_line(intents: Mapping[int, Intent], start: tuple[float, float], end
             # mirror through the line: the far side
             far = _capsule_push(2.0 * x - it.x, 2.0 * y - it.y, start, end, d_min)
             room = [far] if on_field(far) else [q for q in _capsule_outline(start, end, d_min, p.free_spot_steps)
-                                                if on_field(q)]  # fmt: skip
+                                                if on_field(q)]
             if room:
                 x, y = min(room, key=lambda q: math.hypot(q[0] - it.x, q[1] - it.y))
         x, y = max(-lim_x, min(lim_x, x)), max(-lim_y, min(lim_y, y))
         out[rid] = Intent(x, y, it.theta, avoid_ball=True, allow_own_defense=it.allow_own_defense,
-                          max_speed_m_s=it.max_speed_m_s)  # fmt: skip
+                          max_speed_m_s=it.max_speed_m_s)
     return out
 
 
@@ -285,7 +285,7 @@ class Placing:
 
 
 def place_ball(robot: RobotState, ball: BallState, target: tuple[float, float], skills: SkillParams,
-               p: GameStateParams, t: float, state: Placing | None = None) -> tuple[Intent, Placing]:  # fmt: skip
+               p: GameStateParams, t: float, state: Placing | None = None) -> tuple[Intent, Placing]:
     """Ball placement by one robot: take the ball on the dribbler from where the robot stands (no
     going round it: a ball by the line or past it is pulled back), carry it without turning until
     it lies within ``placement_done_m`` of ``target``, let go, and back off slowly to
@@ -312,28 +312,28 @@ def place_ball(robot: RobotState, ball: BallState, target: tuple[float, float], 
     # a ball on the face moves as the robot does, whose speed the cameras see only to a few cm/s
     resting = math.hypot(ball.vx, ball.vy) < (p.placement_held_rest_m_s if on_face else p.placement_rest_m_s)
     let_go = (state.released and off <= p.placement_near_m) or (off <= p.placement_done_m and resting) \
-        or (off <= p.placement_near_m and not on_face)  # fmt: skip
+        or (off <= p.placement_near_m and not on_face)
     if let_go:
         away = math.atan2(robot.y - ball.y, robot.x - ball.x)
         reach = contact + p.placement_back_m
         return Intent(ball.x + reach * math.cos(away), ball.y + reach * math.sin(away), robot.theta,
                       allow_any_defense=True, max_speed_m_s=p.placement_back_speed_m_s), \
-            Placing(robot.id, None, released=True)  # fmt: skip
+            Placing(robot.id, None, released=True)
     state = Placing(robot.id, grip_since)
     if held and on_face:  # carry: the robot where the ball lies on the target, facing as it does
         return Intent(target[0] - c * contact, target[1] - s * contact, robot.theta, dribbler=skills.hold_dribbler,
                       avoid_ball=False, allow_any_defense=True,
-                      max_speed_m_s=p.placement_carry_speed_m_s), state  # fmt: skip
+                      max_speed_m_s=p.placement_carry_speed_m_s), state
     heading = math.atan2(ball.y - robot.y, ball.x - robot.x)
     near = math.hypot(ball.x - robot.x, ball.y - robot.y) < contact + p.placement_take_m
     reach = contact - p.placement_press_m  # a little into the ball: the face meets it before the robot stops
     return Intent(ball.x - math.cos(heading) * reach, ball.y - math.sin(heading) * reach, heading,
                   dribbler=skills.hold_dribbler, avoid_ball=False, allow_any_defense=True,
-                  max_speed_m_s=p.placement_take_speed_m_s if near else None), state  # fmt: skip
+                  max_speed_m_s=p.placement_take_speed_m_s if near else None), state
 
 
 def behind_ball(intents: Mapping[int, Intent], ball: BallState, attack_sign: float, pitch: Field,
-                p: GameStateParams, radius: float) -> dict[int, Intent]:  # fmt: skip
+                p: GameStateParams, radius: float) -> dict[int, Intent]:
     """A penalty's rule for everyone but the taker and the defending keeper: ``penalty_behind_m``
     behind the ball (toward the kicking team's own goal), on the field."""
     limit = ball.x - attack_sign * (p.penalty_behind_m + radius)
@@ -346,7 +346,7 @@ def behind_ball(intents: Mapping[int, Intent], ball: BallState, attack_sign: flo
 
 
 def penalty_shot(robot: RobotState, ball: BallState, attack_sign: float, keeper: RobotState | None, pitch: Field,
-                 skills: SkillParams, p: GameStateParams, ready: bool) -> Intent:  # fmt: skip
+                 skills: SkillParams, p: GameStateParams, ready: bool) -> Intent:
     """The taker (the rules: after the normal start the kicker may play the ball as often as it
     likes within 10 s, the ball only ever moving toward the goal). Prepared: behind the ball facing
     the goal's centre. Started: a tap toward the goal's centre so the ball comes to rest
@@ -381,7 +381,7 @@ def penalty_shot(robot: RobotState, ball: BallState, attack_sign: float, keeper:
 
 def penalty_rush(robot: RobotState, ball: BallState, mark: tuple[float, float] | None, pitch: Field,
                  own_sign: float, skills: SkillParams, defense: DefenseParams,
-                 p: GameStateParams) -> Intent | None:  # fmt: skip
+                 p: GameStateParams) -> Intent | None:
     """Our keeper at their penalty once the ball is in play (the rules: from then on it moves
     freely): out to meet the ball where it can (:func:`intercept`) and clear it back up the field
     before the taker shoots from close in (a shot at full speed from a few metres beats any keeper
@@ -397,7 +397,7 @@ def penalty_rush(robot: RobotState, ball: BallState, mark: tuple[float, float] |
 
 
 def keeper_on_line(ball: BallState, pitch: Field, own_sign: float, skills: SkillParams,
-                   p: GameStateParams) -> Intent:  # fmt: skip
+                   p: GameStateParams) -> Intent:
     """Our keeper while their penalty is prepared: touching the goal line, across from the ball."""
     block = goalie_block(ball, pitch, own_sign, skills)
     x = own_sign * (pitch.half_length - p.penalty_keeper_share * skills.robot_radius_m)

@@ -82,7 +82,7 @@ class StillBall:
 
 
 def _pass_kick(ball: BallState, point: tuple[float, float], receiver: int, shoot_at: tuple[float, float] | None,
-               skills: SkillParams) -> Kick:  # fmt: skip
+               skills: SkillParams) -> Kick:
     """A pass to ``point``, as fast as it must be kicked to arrive there at the receiving speed."""
     dist = math.hypot(point[0] - ball.x, point[1] - ball.y)
     return Kick(KickPurpose.PASS, point, pass_speed(dist, skills), receiver, shoot_at)
@@ -90,7 +90,7 @@ def _pass_kick(ball: BallState, point: tuple[float, float], receiver: int, shoot
 
 def decide_kick(ball: BallState, passer: int, own: Mapping[int, RobotState], supporters: Sequence[int],
                 passes: PassPlay, opponents: Array, pitch: Field, attack_sign: float, radius: float, p: KickParams,
-                passing: PassParams, skills: SkillParams) -> Kick:  # fmt: skip
+                passing: PassParams, skills: SkillParams) -> Kick:
     """The kick of ``passer`` at ``ball`` (where it meets the ball): a shot, a pass to one of
     ``supporters`` (robot ids), or a clear. ``radius``: the opponents' plus the ball's."""
     ball_xy = np.array([ball.x, ball.y])
@@ -118,7 +118,7 @@ def decide_kick(ball: BallState, passer: int, own: Mapping[int, RobotState], sup
     # nothing good: play the ball forward through the most open lane (around a blocker)
     toward = math.atan2(aim[1] - ball.y, aim[0] - ball.x)
     angle, _ = clearest_direction(ball_xy, toward, opponents, radius, p.clear_reach_m, p.clear_spread_rad,
-                                  p.clear_samples, p.clear_lane_cap_rad, p.clear_turn_cost)  # fmt: skip
+                                  p.clear_samples, p.clear_lane_cap_rad, p.clear_turn_cost)
     target = (ball.x + p.clear_reach_m * math.cos(angle), ball.y + p.clear_reach_m * math.sin(angle))
     if (ball.x * attack_sign) > 0 and abs(angle - toward) < p.shot_lane_rad:
         return Kick(KickPurpose.SHOT, target, skills.max_kick_m_s)
@@ -126,7 +126,7 @@ def decide_kick(ball: BallState, passer: int, own: Mapping[int, RobotState], sup
 
 
 def contest_angle(robot: RobotState, ball: BallState, target: tuple[float, float], opponents: Array,
-                  p: KickParams) -> float | None:  # fmt: skip
+                  p: KickParams) -> float | None:
     """The kick direction nearest the aim that needs at most ``contest_turn_rad`` of way around the
     ball, when the ball is slow, the attacker at it and an opponent too; None otherwise."""
     if math.hypot(ball.vx, ball.vy) > p.contest_ball_speed_m_s or len(opponents) == 0:
@@ -147,7 +147,7 @@ class Attacker:
     ball lies still; plans and cancels the team's pass."""
 
     def __init__(self, pitch: Field, params: KickParams, passing: PassParams, skills: SkillParams,
-                 radius: float) -> None:  # fmt: skip
+                 radius: float) -> None:
         self.field, self.p, self.passing, self.skills = pitch, params, passing, skills
         self.radius = radius  # a robot's plus the ball's: whether the ball gets past
         self.still = StillBall(params.stall_moved_m)
@@ -158,7 +158,7 @@ class Attacker:
 
     def play(self, t: float, robot: RobotState, own: Mapping[int, RobotState], supporters: Sequence[int],
              opponents: Array, ball: BallState, attack_sign: float,
-             passes: PassPlay, restart: bool = False) -> tuple[Intent, KickPurpose]:  # fmt: skip
+             passes: PassPlay, restart: bool = False) -> tuple[Intent, KickPurpose]:
         """Play the ball where ``robot`` can meet it: shoot, pass (planned in ``passes``) or play it
         forward; ``restart``: our restart's kick, its only touch (:func:`~strategy.skills.set_kick`).
         Returns the intent and what the kick is for."""
@@ -170,7 +170,7 @@ class Attacker:
             x, y = self.field.free_kick_spot(met.x, met.y, skills.robot_radius_m + p.area_wait_m)
             return Intent(x, y, math.atan2(ball.y - y, ball.x - x)), KickPurpose.WAIT
         kick = decide_kick(met, robot.id, own, supporters, passes, opponents, self.field, attack_sign, self.radius, p,
-                           self.passing, skills)  # fmt: skip
+                           self.passing, skills)
         if kick.kind is KickPurpose.PASS and kick.receiver is not None:
             passes.plan(t, robot.id, kick.receiver, kick.target, kick.shoot_at)
         else:
@@ -184,7 +184,7 @@ class Attacker:
             # the ball comes at the attacker: meet it on its path, redirecting it at the target when the
             # turn allows a one-touch kick, else stopping it with the dribbler
             turn = float(one_touch_turn(np.array([ball.x, ball.y]), np.array([[met.x, met.y]]),
-                                        np.array([kick.target]))[0])  # fmt: skip
+                                        np.array([kick.target]))[0])
             if turn <= self.passing.max_turn_rad:
                 return receive(robot, ball, (met.x, met.y), skills, kick.target, kick.speed), kick.kind
             return receive(robot, ball, (met.x, met.y), skills), kick.kind

@@ -25,7 +25,7 @@ _BISECTIONS = 60  # ... in at most so many halvings
 
 
 def redirected_velocity(heading: float, v_in: tuple[float, float], kick_speed: float,
-                        retention: float) -> tuple[float, float]:  # fmt: skip
+                        retention: float) -> tuple[float, float]:
     """The ball's velocity right after a kick at ``heading`` (the model above)."""
     hx, hy = math.cos(heading), math.sin(heading)
     across = -hy * v_in[0] + hx * v_in[1]
@@ -38,7 +38,7 @@ def _error(heading: float, v_in: tuple[float, float], kick_speed: float, retenti
 
 
 def aim_heading(target_angle: float, v_in: tuple[float, float], kick_speed: float, retention: float,
-                tolerance_rad: float = 1e-6) -> float:  # fmt: skip
+                tolerance_rad: float = 1e-6) -> float:
     """The robot heading (rad) that sends a ball arriving with ``v_in`` off at ``target_angle``."""
     if kick_speed <= 0.0 or retention == 0.0:
         return target_angle

@@ -62,7 +62,7 @@ class PassPlay:
         self.current: Pass | None = None
 
     def plan(self, t: float, passer: int, receiver: int, point: tuple[float, float],
-             shoot_at: tuple[float, float] | None) -> None:  # fmt: skip
+             shoot_at: tuple[float, float] | None) -> None:
         """The passer decides a pass; the one it decided before to the same receiver is kept as it was."""
         ps = self.current
         if ps is None or (ps.receiver, ps.passer) != (receiver, passer):

@@ -95,7 +95,7 @@ def _facing_ball(x: float, y: float, ball: BallState) -> Intent:
 
 
 def off_ball_line(robot: RobotState, intent: Intent, ball: BallState, pitch: Field, radius: float, near_m: float,
-                  clear_m: float, rolling_m_s: float) -> Intent:  # fmt: skip
+                  clear_m: float, rolling_m_s: float) -> Intent:
     """A robot that may not touch the ball (our restart's kicker, the rules' double touch) within
     ``near_m`` of it while it rolls faster than ``rolling_m_s``: sideways out of its way, ``clear_m``
     off its line on the robot's side, facing it (going its own way it ran alongside the ball and
@@ -188,10 +188,10 @@ class Strategy:
         if game.command == RefereeCommand.KICKOFF and not game.ready:
             kicker = None  # prepared, not started: nobody plays the ball yet
         return restart_rules(intents, game, ours, ball, self.field, own_sign, self.p.game_states,
-                             self.p.robot_radius_m, kicker)  # fmt: skip
+                             self.p.robot_radius_m, kicker)
 
     def _double_touch_bar(self, game: GameState, own: Mapping[int, RobotState], opp: list[RobotState],
-                          ball: BallState) -> int | None:  # fmt: skip
+                          ball: BallState) -> int | None:
         """The robot that may not touch the ball now (the rules: a restart's kicker touches it again
         only after another robot has; else a free kick for them): the taker of our kickoff or free
         kick from the normal start that followed it (the ball moved: the restart was taken) until
@@ -211,7 +211,7 @@ class Strategy:
         return next((rid for rid, r in self.roles.roles.items() if r == role), None)
 
     def _placement(self, t: float, intents: dict[int, Intent], own: Mapping[int, RobotState], ball: BallState,
-                   target: tuple[float, float], ours: bool, own_sign: float) -> dict[int, Intent]:  # fmt: skip
+                   target: tuple[float, float], ours: bool, own_sign: float) -> dict[int, Intent]:
         """Ball placement: ours, the robot nearest the ball (the goalie only when alone) places it
         and the others keep off its way; theirs, everyone keeps off the line to the target."""
         p, f, gs = self.p, self.field, self.p.game_states
@@ -227,7 +227,7 @@ class Strategy:
         return out
 
     def _penalty(self, intents: dict[int, Intent], own: Mapping[int, RobotState], opp: list[RobotState],
-                 ball: BallState, game: GameState, ours: bool, own_sign: float) -> dict[int, Intent]:  # fmt: skip
+                 ball: BallState, game: GameState, ours: bool, own_sign: float) -> dict[int, Intent]:
         """A penalty kick: ours, the taker plays it from the normal start (:func:`penalty_shot`),
         everyone else behind the ball; theirs, our keeper on its line until the normal start, then
         out at the ball once it is in play (:func:`penalty_rush`), everyone else behind the ball."""
@@ -240,11 +240,11 @@ class Strategy:
             taker = min(players, key=lambda rid: math.hypot(own[rid].x - ball.x, own[rid].y - ball.y))
             keeper = min(opp, key=lambda r: abs(r.x - attack * f.half_length) + abs(r.y), default=None)
             out = behind_ball({rid: it for rid, it in intents.items() if rid != taker}, ball, attack, f, gs,
-                              p.robot_radius_m)  # fmt: skip
+                              p.robot_radius_m)
             out[taker] = penalty_shot(own[taker], ball, attack, keeper, f, p.skills, gs, ready)
             return out
         out = behind_ball({rid: it for rid, it in intents.items() if rid != goalie_id}, ball, own_sign, f, gs,
-                          p.robot_radius_m)  # fmt: skip
+                          p.robot_radius_m)
         if goalie_id is not None and not ready:
             out[goalie_id] = keeper_on_line(ball, f, own_sign, p.skills, gs)
         elif goalie_id is not None:
@@ -253,7 +253,7 @@ class Strategy:
         return out
 
     def _objectives(self, own: Mapping[int, RobotState], ball: BallState, own_sign: float,
-                    defenders: Mapping[Role, Intent]) -> list[Objective]:  # fmt: skip
+                    defenders: Mapping[Role, Intent]) -> list[Objective]:
         """This frame's roles in priority order, each with where it is played."""
         p, f = self.p, self.field
         goalie_id = p.roles.goalie_id if p.roles.goalie_id in own else None
@@ -274,7 +274,7 @@ class Strategy:
         return objectives
 
     def _normal(self, t: float, own: dict[int, RobotState], opp: list[RobotState], ball: BallState,
-                own_sign: float, restart: bool = False) -> dict[int, Intent]:  # fmt: skip
+                own_sign: float, restart: bool = False) -> dict[int, Intent]:
         """Normal play; ``restart``: our kickoff or free kick (the attacker's kick its only touch)."""
         p, f = self.p, self.field
         attack_sign = -own_sign
@@ -285,9 +285,9 @@ class Strategy:
 
         passing = self.passes.follow(t, own, ball)
         defenders = {Role(RoleKind.DEFENDER, k): defend(ball, f, own_sign, slot, p.skills)
-                     for k, slot in enumerate(defender_slots(p.defense))}  # fmt: skip
+                     for k, slot in enumerate(defender_slots(p.defense))}
         roles = self.roles.assign({rid: (r.x, r.y) for rid, r in own.items()},
-                                  self._objectives(own, ball, own_sign, defenders))  # fmt: skip
+                                  self._objectives(own, ball, own_sign, defenders))
         supporters = [rid for rid, role in roles.items() if role.kind is RoleKind.SUPPORTER]
 
         out: dict[int, Intent] = {}
@@ -301,14 +301,14 @@ class Strategy:
                 out[rid] = _facing_ball(r.x, r.y, ball)  # nobody else to play it: wait for theirs to touch it
             elif role == ATTACKER:
                 out[rid], kind = self.attacker.play(t, r, own, supporters, opp_xy, ball, attack_sign, self.passes,
-                                                    restart)  # fmt: skip
+                                                    restart)
                 self.last_action[rid] = kind
             elif role == RECEIVER and passing is not None and not passing.kicked:
                 out[rid] = _facing_ball(*passing.point, ball)
             elif role == RECEIVER:
                 assert passing is not None
                 out[rid] = receive(r, ball, passing.point, p.skills, passing.shoot_at,
-                                   p.skills.max_kick_m_s if passing.shoot_at else 0.0)  # fmt: skip
+                                   p.skills.max_kick_m_s if passing.shoot_at else 0.0)
                 if passing.shoot_at is not None:
                     self.last_action[rid] = KickPurpose.SHOT  # the one-touch shot at the goal
             elif role.kind is RoleKind.DEFENDER:
@@ -321,8 +321,8 @@ class Strategy:
         # everyone but the goalie and the robot playing the ball leaves it room
         others = {rid: it for rid, it in out.items() if roles.get(rid) not in _BALL_PLAYERS or rid == self._barred}
         out.update(keep_away(others, ball, f, own_sign, p.game_states, p.robot_radius_m, kickoff=False, slow=False,
-                             distance_m=p.ball_room_m))  # fmt: skip
+                             distance_m=p.ball_room_m))
         if self._barred in out:  # whatever its role, it must not meet the ball it kicked on its way
             out[self._barred] = off_ball_line(own[self._barred], out[self._barred], ball, f, p.robot_radius_m,
-                                              p.barred_near_m, p.barred_clear_m, p.barred_rolling_m_s)  # fmt: skip
+                                              p.barred_near_m, p.barred_clear_m, p.barred_rolling_m_s)
         return out

@@ -96,7 +96,7 @@ class RoleAssigner:
         return out
 
     def _uncross(self, out: dict[int, Role], robots: Mapping[int, tuple[float, float]],
-                 objectives: Sequence[Objective]) -> None:  # fmt: skip
+                 objectives: Sequence[Objective]) -> None:
         """Swap the points of two robots of one kind while that shortens their two ways together by
         more than ``swap_margin_m`` (in place). Roles with a fixed robot or their own costs stay."""
         point = {o.role: (o.x, o.y) for o in objectives if o.fixed_robot is None and o.costs is None}

@@ -104,7 +104,7 @@ class SimpleTeam:
             kp = self.sp.kicking
             angle, _ = clearest_direction(np.array([ball.x, ball.y]), toward, others_xy, self.sp.obstacle_radius_m,
                                           kp.clear_reach_m, kp.clear_spread_rad, kp.clear_samples,
-                                          kp.clear_lane_cap_rad, kp.clear_turn_cost)  # fmt: skip
+                                          kp.clear_lane_cap_rad, kp.clear_turn_cost)
             target = (ball.x + self.p.shot_reach_m * math.cos(angle), ball.y + self.p.shot_reach_m * math.sin(angle))
             intents[chaser.id] = kick_to(chaser, ball, target, self.p.shot_speed_m_s, self.sp.skills)
             others = [r for r in field_players if r.id != chaser.id]
@@ -116,7 +116,7 @@ class SimpleTeam:
         gs, radius = self.sp.game_states, self.sp.robot_radius_m
         if game.command == RefereeCommand.STOP or (game.command.kick_restart and not ours):
             intents = keep_away(intents, ball, f, own_sign, gs, radius, game.command == RefereeCommand.KICKOFF,
-                                game.command == RefereeCommand.STOP)  # fmt: skip
+                                game.command == RefereeCommand.STOP)
         elif game.command == RefereeCommand.BALL_PLACEMENT and game.placement is not None:
             intents = keep_off_line(intents, (ball.x, ball.y), game.placement, f, gs, radius)
             if ours and field_players:
@@ -127,7 +127,7 @@ class SimpleTeam:
         return [steer(self.team, r.id, r.x, r.y, r.theta, intents[r.id], self.p) for r in own]
 
     def _penalty(self, intents: dict[int, Intent], own: list[RobotState], world: WorldState, ball: BallState,
-                 ready: bool, ours: bool, own_sign: float) -> dict[int, Intent]:  # fmt: skip
+                 ready: bool, ours: bool, own_sign: float) -> dict[int, Intent]:
         """Its chaser takes the penalty, everyone else behind the ball; defending, its goalie on the line."""
         f, gs, radius = self.field, self.sp.game_states, self.sp.robot_radius_m
         goalie = own[0]
@@ -135,7 +135,7 @@ class SimpleTeam:
             taker = min(own[1:] or own, key=lambda r: math.hypot(r.x - ball.x, r.y - ball.y))
             attack = -own_sign
             keeper = min((r for r in world.robots if r.team != self.team),
-                         key=lambda r: abs(r.x - attack * f.half_length) + abs(r.y), default=None)  # fmt: skip
+                         key=lambda r: abs(r.x - attack * f.half_length) + abs(r.y), default=None)
             out = behind_ball({k: v for k, v in intents.items() if k != taker.id}, ball, attack, f, gs, radius)
             shot = penalty_shot(taker, ball, attack, keeper, f, self.sp.skills, gs, ready)
             out[taker.id] = replace(shot, kick_speed=min(shot.kick_speed, self.p.shot_speed_m_s))

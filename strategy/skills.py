@@ -132,7 +132,7 @@ def waiting_point(ball: BallState, aim: float, p: SkillParams) -> tuple[float, f
 
 
 def kick_to(robot: RobotState, ball: BallState, target: tuple[float, float], speed: float, p: SkillParams,
-            chip: bool = False) -> Intent:  # fmt: skip
+            chip: bool = False) -> Intent:
     """Get behind the ball on the line to ``target``, then drive through it with the kicker armed."""
     aim = _angle(target[0] - ball.x, target[1] - ball.y)
     c, s = math.cos(aim), math.sin(aim)
@@ -145,7 +145,7 @@ def kick_to(robot: RobotState, ball: BallState, target: tuple[float, float], spe
     gap = max(0.0, -along - contact)
     in_cone = (-along < contact + p.approach_distance_m + p.cone_reach_m
                and abs(across) < p.lined_up_m + p.cone_slope * gap
-               and heading_error < p.lined_up_rad + p.cone_heading_rad_m * gap)  # fmt: skip
+               and heading_error < p.lined_up_rad + p.cone_heading_rad_m * gap)
     lined_up = along < -contact + p.contact_slack_m and in_cone
     at_ball = along < 0 and along > -contact - p.at_ball_m and abs(across) < p.at_ball_lateral_share * p.lined_up_m
     if lined_up or at_ball:
@@ -161,7 +161,7 @@ def kick_to(robot: RobotState, ball: BallState, target: tuple[float, float], spe
 
 
 def set_kick(robot: RobotState, ball: BallState, target: tuple[float, float], speed: float,
-             p: SkillParams) -> Intent:  # fmt: skip
+             p: SkillParams) -> Intent:
     """A restart's kick at a ball lying still (a free kick, a kickoff), where any touch before the
     kick is the restart's first and the kick a second one: the approach of :func:`kick_to` without
     its cone (lined up within ``set_lined_up_m`` and ``set_lined_up_rad`` at the waiting point, not on
@@ -170,7 +170,7 @@ def set_kick(robot: RobotState, ball: BallState, target: tuple[float, float], sp
     ``set_approach_m_s`` (a robot that overshoots its waiting point meets the ball off its kicker), and
     the kicker armed all along (a touch on the way is the kick)."""
     lined = dataclasses.replace(p, lined_up_m=p.set_lined_up_m, lined_up_rad=p.set_lined_up_rad, cone_slope=0.0,
-                                cone_heading_rad_m=0.0, push_speed_m_s=p.set_push_m_s)  # fmt: skip
+                                cone_heading_rad_m=0.0, push_speed_m_s=p.set_push_m_s)
     intent = kick_to(robot, ball, target, speed, lined)
     aim = intent.theta
     sliding = abs(-robot.vx * math.sin(aim) + robot.vy * math.cos(aim)) > p.set_settle_m_s
@@ -186,7 +186,7 @@ def drive_through(ball: BallState, aim: float, speed: float, p: SkillParams, chi
     c, s = math.cos(aim), math.sin(aim)
     return Intent(ball.x + c * p.through_m, ball.y + s * p.through_m, aim, kick_speed=speed, chip=chip,
                   avoid_ball=False, max_speed_m_s=p.push_speed_m_s, final_speed_m_s=p.push_speed_m_s,
-                  dribbler=p.through_dribbler)  # fmt: skip
+                  dribbler=p.through_dribbler)
 
 
 def dribble(robot: RobotState, ball: BallState, target: tuple[float, float], p: SkillParams) -> Intent:
@@ -208,7 +208,7 @@ def dribble(robot: RobotState, ball: BallState, target: tuple[float, float], p: 
         return Intent(take.x, take.y, take.theta, dribbler=p.hold_dribbler)  # getting behind the ball
     return Intent(take.x, take.y, take.theta, dribbler=p.hold_dribbler, avoid_ball=False,
                   max_speed_m_s=p.dribble_speed_m_s,
-                  final_speed_m_s=min(p.push_speed_m_s, p.dribble_speed_m_s))  # fmt: skip
+                  final_speed_m_s=min(p.push_speed_m_s, p.dribble_speed_m_s))
 
 
 def speed_after(speed: float, distance: float, p: SkillParams) -> float:
@@ -217,7 +217,7 @@ def speed_after(speed: float, distance: float, p: SkillParams) -> float:
 
 
 def pass_speed(distance: float, p: SkillParams, arrival_m_s: float | None = None,
-               min_m_s: float | None = None) -> float:  # fmt: skip
+               min_m_s: float | None = None) -> float:
     """Kick speed so the ball arrives at ``distance`` with about ``arrival_m_s`` (default
     ``pass_arrival_m_s``; bisection), between ``min_m_s`` (default ``pass_min_m_s``) and ``pass_max_m_s``."""
     arrival = p.pass_arrival_m_s if arrival_m_s is None else arrival_m_s
@@ -256,7 +256,7 @@ def intercept(robot: RobotState, ball: BallState, p: SkillParams, field: Field |
 
 
 def receive(robot: RobotState, ball: BallState, wait_at: tuple[float, float], p: SkillParams,
-            shoot_at: tuple[float, float] | None = None, shot_speed: float = 0.0) -> Intent:  # fmt: skip
+            shoot_at: tuple[float, float] | None = None, shot_speed: float = 0.0) -> Intent:
     """Meet the moving ball on its path near ``wait_at``; with ``shoot_at``, a one-touch shot
     aimed with the kick model (B.6), else stop it with the dribbler facing it."""
     speed = math.hypot(ball.vx, ball.vy)

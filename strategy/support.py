@@ -63,6 +63,6 @@ class Supporters:
         if self.evaluation is not None and frame % self.p.eval_every_frames != 0:
             return
         self.evaluation = pass_values(ball, self.grid, self.field, attack_sign, opponents, self.obstacle_radius,
-                                      self.passing)  # fmt: skip
+                                      self.passing)
         self.evaluated_frame = frame
         self.points = spread_points(self.evaluation, ball, count, self.p)

@@ -15,11 +15,11 @@ ROOT = Path(__file__).resolve().parents[1]
 
 @pytest.mark.slow
 @pytest.mark.skipif(importlib.util.find_spec("mkdocs") is None or importlib.util.find_spec("material") is None,
-                    reason="mkdocs and mkdocs-material are not installed (pip install -e '.[docs]')")  # fmt: skip
+                    reason="mkdocs and mkdocs-material are not installed (pip install -e '.[docs]')")
 def test_the_docs_build_strict(tmp_path: Path) -> None:
     run = subprocess.run([sys.executable, "-m", "mkdocs", "build", "--strict", "--site-dir", str(tmp_path / "site")],
                          cwd=ROOT, capture_output=True, text=True, env={"NO_MKDOCS_2_WARNING": "1", "PATH": ""},
-                         timeout=600)  # fmt: skip
+                         timeout=600)
     assert run.returncode == 0, run.stdout + run.stderr
     cli = (tmp_path / "site" / "reference" / "cli" / "index.html").read_text(encoding="utf-8")
     config = (tmp_path / "site" / "reference" / "config" / "index.html").read_text(encoding="utf-8")

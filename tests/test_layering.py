@@ -35,7 +35,7 @@ OWNERS: dict[str, tuple[str, ...]] = {
 }
 CV2_VIDEO = ("VideoWriter", "VideoCapture")
 CV2_VIDEO_OWNERS = ("cmdragons.videoio", "cmdragons.recording", "vision.sources", "cmdragons.cli",
-                    "cmdragons.runtime", "cmdragons.bench")  # fmt: skip
+                    "cmdragons.runtime", "cmdragons.bench")
 
 
 def module_name(path: Path) -> str:

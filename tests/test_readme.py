@@ -66,7 +66,7 @@ def recordings(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     out = {}
     for key, fmt in (("mp4", "h264"), ("png", "png")):
         assert main(["sim", "--seconds", SECONDS, "--record", "--format", fmt, "--out", str(base / key),
-                     "--no-progress"]) == 0  # fmt: skip
+                     "--no-progress"]) == 0
         out[key] = base / key
     return out
 
@@ -82,7 +82,7 @@ def own_ports() -> list[str]:
     side (pytest -n, other checkouts on this machine) never hear each other."""
     udp = [f"protocols.{key}={_free_port(socket.SOCK_DGRAM)}" for key in (
         "vision.port", "tracker.port", "referee.port", "grsim.port", "grsim.vision_port",
-        "simulation.control_port", "simulation.blue_port", "simulation.yellow_port")]  # fmt: skip
+        "simulation.control_port", "simulation.blue_port", "simulation.yellow_port")]
     tcp = [f"runtime.zenoh.router=tcp/127.0.0.1:{_free_port(socket.SOCK_STREAM)}"]
     return [arg for setting in udp + tcp for arg in ("--set", setting)]
 
@@ -119,7 +119,7 @@ def runnable(line: str, rec: dict[str, Path], tmp: Path) -> list[str]:
 @pytest.mark.slow
 @pytest.mark.parametrize(("page", "line"), EXAMPLES, ids=[f"{p}: {line}" for p, line in EXAMPLES])
 def test_example_runs(page: str, line: str, recordings: dict[str, Path], tmp_path: Path,
-                      capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
+                      capsys: pytest.CaptureFixture[str]) -> None:
     argv = runnable(line, recordings, tmp_path)
     assert main(argv) == 0, (page, argv, capsys.readouterr())
     out, err = capsys.readouterr()

@@ -51,7 +51,7 @@ def test_a_lost_robot_is_stopped_and_kept_where_it_brakes_to() -> None:
     brain = Brain("blue", SETTINGS)
     game = GameState(0.0)
     brain.step(world(0.0, RobotState("blue", 0, -1.0, 0.0, 0.0), RobotState("blue", 1, 0.0, 0.0, 0.0, 1.2, 0.0)),
-               game)  # fmt: skip
+               game)
     later = world(0.1, RobotState("blue", 0, -1.0, 0.0, 0.0))
     out = {c.id: c for c in brain.step(later, game).commands}
     assert (out[1].vx, out[1].vy, out[1].omega) == (0.0, 0.0, 0.0)
@@ -101,7 +101,7 @@ def test_a_robot_held_back_keeps_pressing_on() -> None:
     [("planner.collision.broad_phase=aabb_tree", lambda t1, p: p.broad_phase == "aabb_tree"),
      ("planner.collision.mask_bins=7", lambda t1, p: p.mask_bins == 7),
      ("planner.horizon_s=0.4", lambda t1, p: t1 == 0.4)],
-)  # fmt: skip
+)
 def test_the_brains_planners_answer_to_the_planner_config(
     monkeypatch: pytest.MonkeyPatch, override: str, expect: Callable[[float, CollisionParams], bool]
 ) -> None:
@@ -111,14 +111,14 @@ def test_the_brains_planners_answer_to_the_planner_config(
     compile_world = CollisionWorld.compile
 
     def spy(self: CollisionWorld, radius_m: float, t0_s: float = 0.0, t1_s: float = 0.0,
-            params: CollisionParams | None = None) -> CompiledWorld:  # fmt: skip
+            params: CollisionParams | None = None) -> CompiledWorld:
         seen.append((t1_s, params or CollisionParams()))
         return compile_world(self, radius_m, t0_s, t1_s, params)
 
     brain = Brain("blue", settings)  # (its safety search compiles the static field with its own radius)
     monkeypatch.setattr(CollisionWorld, "compile", spy)
     robots = (RobotState("blue", 0, -3.0, 0.0, 0.0), RobotState("blue", 1, 0.0, 1.0, 0.0),
-              RobotState("yellow", 0, -1.0, 0.0, 0.0))  # fmt: skip
+              RobotState("yellow", 0, -1.0, 0.0, 0.0))
     brain.step(world(0.0, *robots), GameState(0.0))
     assert seen and all(expect(t1, p) for t1, p in seen)
     assert not expect(0.0, CollisionParams())  # the override differs from the default
@@ -134,7 +134,7 @@ def test_the_brains_planners_answer_to_the_planner_config(
      (DSSParams, "own_margin_m", -0.1), (SafetyParams, "method", "dynamic_window"),
      (TrajectoryParams, "command_slip_m_s", -1.0), (DynamicWindowParams, "directions", 2),
      (BrainParams, "navigate_deadline_ms", 0.0), (TeamParams, "navigator", "magic")],
-)  # fmt: skip
+)
 def test_params_check_their_ranges_however_they_are_built(cls: type, field: str, bad: object) -> None:
     with pytest.raises(ValueError, match=field):
         cls(**{field: bad})
@@ -144,7 +144,7 @@ def test_params_check_their_ranges_however_they_are_built(cls: type, field: str,
 def test_the_braking_paths_dss_checked_are_kept_for_the_video() -> None:
     brain = Brain("blue", SETTINGS)
     robots = (RobotState("blue", 0, -1.0, 0.0, 0.0, 1.5, 0.0), RobotState("blue", 2, 1.0, 1.0, 0.0, 0.0, -1.0),
-              RobotState("yellow", 0, 0.0, -2.0, 0.0))  # fmt: skip
+              RobotState("yellow", 0, 0.0, -2.0, 0.0))
     out = brain.step(world(0.0, *robots), GameState(0.0))
     assert sorted(out.braking) == [0, 2]  # our robots only
     for r in robots[:2]:
@@ -196,7 +196,7 @@ def test_a_learnt_braking_replaces_the_configured_one_in_control_and_safety() ->
     assert brain.settings.control.motion.max_accel_m_s2 == SETTINGS.control.motion.max_accel_m_s2
     game = GameState(0.0)
     brain.step(world(0.0, RobotState("blue", 0, -1.0, 0.0, 0.0), RobotState("blue", 1, 0.0, 0.0, 0.0, 1.2, 0.0)),
-               game)  # fmt: skip
+               game)
     (rest,) = brain._lost_robots(world(2.0, RobotState("blue", 0, -1.0, 0.0, 0.0)))
     assert rest.x == pytest.approx(1.2**2 / (2 * 4.0))  # a lost robot brakes as measured
 
@@ -208,7 +208,7 @@ def _arrival(kick_m_s: float, distance_m: float, acc_roll_m_s2: float) -> float:
     from sim.world import BallParams, DribblerParams, KickerParams, PhysicsParams, RobotParams, World
 
     w = World(LeagueParams(), PhysicsParams(), RobotParams(), BallParams(acc_roll_m_s2=acc_roll_m_s2), KickerParams(),
-              DribblerParams(), robots_per_team={"blue": 0, "yellow": 0})  # fmt: skip
+              DribblerParams(), robots_per_team={"blue": 0, "yellow": 0})
     w.place_ball(-2.0, 0.0, vx=kick_m_s)
     for _ in range(60 * 20):
         snap = w.snapshot()

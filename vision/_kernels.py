@@ -83,7 +83,7 @@ def _screen_row(c0: np.ndarray, c1: np.ndarray, c2: np.ndarray, screen: np.ndarr
         lo0, w0, lo1, w1, lo2, w2 = screen[k, 0], screen[k, 1], screen[k, 2], screen[k, 3], screen[k, 4], screen[k, 5]
         for j in range(w):
             hit[j] |= (np.uint8(np.uint8(c0[j] - lo0) <= w0) & np.uint8(np.uint8(c1[j] - lo1) <= w1)
-                       & np.uint8(np.uint8(c2[j] - lo2) <= w2))  # fmt: skip
+                       & np.uint8(np.uint8(c2[j] - lo2) <= w2))
     words = hit.view(np.uint64)
     acc = np.uint64(0)
     for q in range(words.shape[0]):
@@ -113,7 +113,7 @@ def _put_run(runs: np.ndarray, n: int, start: int, end: int, cls: int) -> int:
 
 @numba.njit(cache=True, inline="always")
 def _classify_row(lut: np.ndarray, c0: np.ndarray, c1: np.ndarray, c2: np.ndarray, hit: np.ndarray,
-                  out: np.ndarray, runs: np.ndarray) -> int:  # fmt: skip
+                  out: np.ndarray, runs: np.ndarray) -> int:
     """Finish one screened row: at each hit, the full class bit set (all three tables); writes it
     to ``out`` (non-zero entries only) and runs of one class to ``runs``, a pixel taking its lowest
     class (config order is priority). Blocks of 8 pixels without a hit are skipped whole, so the
@@ -150,7 +150,7 @@ def _classify_row(lut: np.ndarray, c0: np.ndarray, c1: np.ndarray, c2: np.ndarra
 @numba.njit(cache=True, nogil=True)
 def classify(image: np.ndarray, yuv: bool, lut: np.ndarray, screen: np.ndarray, bits: np.ndarray,
              runs: np.ndarray, counts: np.ndarray, gains: np.ndarray, row_cell: np.ndarray, row0: int,
-             row1: int) -> None:  # fmt: skip
+             row1: int) -> None:
     """Classification (thesis A.1.3) and run-length encoding in one pass over rows [row0, row1) of
     the image.
 
@@ -349,7 +349,7 @@ def _file_boxes(stats: np.ndarray, nu: int, nv: int, slots: np.ndarray, items: n
 @numba.njit(cache=True)
 def _next_merge_candidate(stats: np.ndarray, i: int, after: int, rank: np.ndarray, alive: np.ndarray,
                           cell_start: np.ndarray, cell_items: np.ndarray, nu: int, nv: int,
-                          max_gap_px: float) -> int:  # fmt: skip
+                          max_gap_px: float) -> int:
     """The smallest rank above ``after`` of a live region of region ``i``'s class whose bounding box
     is at most ``max_gap_px`` from ``i``'s (per axis), or -1: looked up in the grid cells that the
     box of ``i`` grown by the gap overlaps (a region within the gap overlaps that grown box)."""
@@ -535,7 +535,7 @@ def ball_centre(image: np.ndarray, box: np.ndarray, margin: int) -> tuple[float,
 
 @numba.njit(cache=True, inline="always")
 def _procrustes_sums(centre: np.ndarray, w_centre: float, obs: np.ndarray, w_obs: np.ndarray,
-                     slots: np.ndarray) -> tuple[float, float, float, float, float, float, float, float]:  # fmt: skip
+                     slots: np.ndarray) -> tuple[float, float, float, float, float, float, float, float]:
     """The weighted 2D Procrustes sums of a pattern whose centre dot sits at the template origin
     and whose k id dots sit at ``slots`` (k, 2), against the observed centre and dots ``obs``
     (k, 2): total weight, the observations' and the template's weighted means, the cross and dot
@@ -567,7 +567,7 @@ def _procrustes_sums(centre: np.ndarray, w_centre: float, obs: np.ndarray, w_obs
 
 @numba.njit(cache=True)
 def fit_pattern(centre: np.ndarray, w_centre: float, obs: np.ndarray, w_obs: np.ndarray,
-                slots: np.ndarray) -> tuple[float, float, float, float]:  # fmt: skip
+                slots: np.ndarray) -> tuple[float, float, float, float]:
     """Weighted least-squares rigid fit (2D Procrustes) of a pattern whose centre dot sits at the
     template origin and whose k id dots sit at ``slots`` (k, 2), to the observed centre and dots
     ``obs`` (k, 2). Returns heading, x, y and the weighted RMS residual (m)."""
@@ -642,7 +642,7 @@ def _popcount(x: int) -> int:
 
 @numba.njit(cache=True)
 def _best_assignment(centre: np.ndarray, w_centre: float, obs: np.ndarray, w_obs: np.ndarray, slots: np.ndarray,
-                     assign: np.ndarray, t: np.ndarray) -> int:  # fmt: skip
+                     assign: np.ndarray, t: np.ndarray) -> int:
     """The row of ``assign`` (slot per observed dot) whose fit of the k = len(obs) dots ranks best
     (:func:`fit_score`); ``t`` (k_max, 2) is scratch."""
     k = obs.shape[0]
@@ -662,7 +662,7 @@ def _best_assignment(centre: np.ndarray, w_centre: float, obs: np.ndarray, w_obs
 def match_patterns(cxy: np.ndarray, cw: np.ndarray, dxy: np.ndarray, dw: np.ndarray, dpink: np.ndarray,
                    dgood: np.ndarray, slots: np.ndarray, assign: np.ndarray, search_r: float, min_dots: int,
                    id_of_code: np.ndarray, max_res: float, res_scale: float,
-                   min_conf: float) -> np.ndarray:  # fmt: skip
+                   min_conf: float) -> np.ndarray:
     """For each centre dot (field xy (n, 2), area weight (n,)), the id dots within ``search_r``
     (at most as many as the pattern has slots, those nearest the pattern's ring), fitted to the
     template under every assignment of dots to slots (``assign`` (m, k_max): slot per observed
@@ -784,7 +784,7 @@ def distinct_robots(xy: np.ndarray, conf: np.ndarray, key: np.ndarray, distance:
 def ball_candidates(area: np.ndarray, moments: np.ndarray, bbox: np.ndarray, rays: np.ndarray,
                     pixel_area: np.ndarray, cam: np.ndarray, ball_radius: float, robot_xy: np.ndarray,
                     robot_z: np.ndarray, pattern_radius: float, min_area: float, max_area: float,
-                    max_elongation: float, min_fill: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+                    max_elongation: float, min_fill: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Which orange regions (their areas, central moments, boxes, rays and pixel areas) are ball
     candidates: an area on the ball's plane within ``min_area``..``max_area`` of the ball's, the
     moments' axes no longer than ``max_elongation`` to one, at least ``min_fill`` of the box, and

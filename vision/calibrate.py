@@ -58,11 +58,11 @@ def _model(x: NDArray[np.float64], base: CameraParams, fit_principal: bool, fit_
     return CameraModel(dataclasses.replace(
         base, position_m=(float(px), float(py), float(pz)), yaw_rad=float(yaw), tilt_x_rad=float(tx),
         tilt_y_rad=float(ty), focal_px=float(f), k1=float(k1), k2=float(k2), principal_point_px=pp,
-    ))  # fmt: skip
+    ))
 
 
 def calibrate(pixels: NDArray[np.float64], field: NDArray[np.float64], guess: CameraParams,
-              fit_principal: bool = False, fit_height: bool | None = None) -> CalibrationResult:  # fmt: skip
+              fit_principal: bool = False, fit_height: bool | None = None) -> CalibrationResult:
     """Fit one camera to correspondences ``pixels`` (n, 2) <-> ``field`` (n, 3), starting from
     ``guess`` (its resolution, focal length and principal point are the starting intrinsics).
 
@@ -74,10 +74,10 @@ def calibrate(pixels: NDArray[np.float64], field: NDArray[np.float64], guess: Ca
     if fit_height is None:
         fit_height = float(np.ptp(field[:, 2])) >= 0.5
     k = np.array([[guess.focal_px, 0, guess.principal_point_px[0]], [0, guess.focal_px, guess.principal_point_px[1]],
-                  [0, 0, 1]])  # fmt: skip
+                  [0, 0, 1]])
     # OpenCV measures pixels from the centre of the top-left pixel; our model from its corner
     ok, rvec, tvec = cv2.solvePnP(field.astype(np.float64), (pixels - 0.5).astype(np.float64), k - [[0, 0, 0.5],
-                                  [0, 0, 0.5], [0, 0, 0]], np.zeros(4), flags=cv2.SOLVEPNP_ITERATIVE)  # fmt: skip
+                                  [0, 0, 0.5], [0, 0, 0]], np.zeros(4), flags=cv2.SOLVEPNP_ITERATIVE)
     start = (
         params_from_opencv(np.asarray(rvec, np.float64).ravel(), np.asarray(tvec, np.float64).ravel(), guess)
         if ok
@@ -86,7 +86,7 @@ def calibrate(pixels: NDArray[np.float64], field: NDArray[np.float64], guess: Ca
     if not fit_height:  # keep the measured height, scale the focal length to the solved distance
         scale = guess.position_m[2] / max(start.position_m[2], 0.3)
         start = dataclasses.replace(start, position_m=(*start.position_m[:2], guess.position_m[2]),
-                                    focal_px=guess.focal_px * scale)  # fmt: skip
+                                    focal_px=guess.focal_px * scale)
     x0 = [start.yaw_rad, start.tilt_x_rad, start.tilt_y_rad, *start.position_m[:2], start.focal_px, start.k1, start.k2]
     if fit_height:
         x0.append(start.position_m[2])

@@ -163,7 +163,7 @@ def _screen_boxes(classes: Sequence[ColourClass]) -> NDArray[np.uint8]:
     ``[lo, lo + width]``: the kernel's vectorised screen, which lets a pixel through to the table
     look-ups and the run-length encoding when one class holds it."""
     return np.array([[v for ch in range(3) for v in (c.lo[ch], c.hi[ch] - c.lo[ch])] for c in classes],
-                    dtype=np.uint8).reshape(-1, 6)  # fmt: skip
+                    dtype=np.uint8).reshape(-1, 6)
 
 
 def classify_reference(
@@ -217,10 +217,10 @@ class Regions:
         moments = np.stack(
             [stats[:, kern.R_SUM_UU] / a - mu * mu, stats[:, kern.R_SUM_VV] / a - mv * mv,
              stats[:, kern.R_SUM_UV] / a - mu * mv], axis=1,
-        )  # fmt: skip
+        )
         bbox = stats[:, [kern.R_U0, kern.R_V0, kern.R_U1, kern.R_V1]]
         return Regions(stats[:, kern.R_CLASS].astype(np.int64), a.copy(), np.stack([mu + 0.5, mv + 0.5], axis=1),
-                       bbox.copy(), moments)  # fmt: skip
+                       bbox.copy(), moments)
 
 
 def _finish(stats: NDArray[np.float64], min_area: NDArray[np.float64]) -> Regions:
@@ -234,7 +234,7 @@ class Segmenter:
     """CMVision over images of one size: the compiled tables and reusable run buffers."""
 
     def __init__(self, classes: Mapping[str, ColourClass], space: ColourSpace, params: RegionParams,
-                 split: SplitRule | None = None) -> None:  # fmt: skip
+                 split: SplitRule | None = None) -> None:
         self.split = split
         self.names = list(classes)
         self.classes = [classes[n] for n in self.names]
@@ -271,7 +271,7 @@ class Segmenter:
         """Per pixel, the bit set of classes (bit k: class k) whose box holds it."""
         out = np.empty(image.shape[:2], dtype=np.uint32)
         kern.classify(np.ascontiguousarray(image), self.space == "yuv", self.lut, self._screen, out, self._no_runs,
-                      self._counts, self._gains, self._row_cell, 0, image.shape[0])  # fmt: skip
+                      self._counts, self._gains, self._row_cell, 0, image.shape[0])
         return out
 
     def runs(self, image: NDArray[np.uint8]) -> tuple[NDArray[np.int32], NDArray[np.int64]]:
@@ -288,7 +288,7 @@ class Segmenter:
                 self._pool = ThreadPoolExecutor(threads - 1, thread_name_prefix="cmvision")
             bands = np.linspace(0, h, threads + 1).astype(int).tolist()
             args = (image, yuv, self.lut, self._screen, self._no_bits, self._runs, self._counts, self._gains,
-                    self._row_cell)  # fmt: skip
+                    self._row_cell)
             done = [self._pool.submit(kern.classify, *args, a, b) for a, b in zip(bands[1:-1], bands[2:], strict=True)]
             # the first band in this thread
             kern.classify(*args, 0, bands[1])
@@ -296,7 +296,7 @@ class Segmenter:
                 job.result()
         else:
             kern.classify(image, yuv, self.lut, self._screen, self._no_bits, self._runs, self._counts, self._gains,
-                          self._row_cell, 0, h)  # fmt: skip
+                          self._row_cell, 0, h)
         return self._runs, self._counts
 
     def regions(self, image: NDArray[np.uint8], merge: bool = True) -> Regions:
@@ -314,7 +314,7 @@ class Segmenter:
 
     @staticmethod
     def _split(stats: NDArray[np.float64], flat: NDArray[np.int32], label: NDArray[np.int64],
-               rule: SplitRule) -> NDArray[np.float64]:  # fmt: skip
+               rule: SplitRule) -> NDArray[np.float64]:
         """``stats`` (one row per label) with each region too large for its class replaced by its
         round parts (:func:`split_region`)."""
         big = np.flatnonzero(stats[:, kern.R_AREA] > rule.max_area_px[stats[:, kern.R_CLASS].astype(np.int64)])
@@ -360,7 +360,7 @@ def runs_reference(bits: NDArray[np.uint32]) -> list[list[tuple[int, int, int]]]
     for row in low:
         edges = np.flatnonzero(np.diff(np.concatenate([[-1], row, [-1]])) != 0)
         out.append([(int(a), int(b) - 1, int(row[a])) for a, b in zip(edges[:-1], edges[1:], strict=True)
-                    if row[a] >= 0])  # fmt: skip
+                    if row[a] >= 0])
     return out
 
 

@@ -182,20 +182,20 @@ def rough_start(base: CameraParams, height_m: float, sees: tuple[float, float, f
     return dataclasses.replace(
         base, position_m=((x0 + x1) / 2.0, (y0 + y1) / 2.0, height_m), yaw_rad=0.0 if along_x else -math.pi / 2.0,
         tilt_x_rad=0.0, tilt_y_rad=0.0, focal_px=focal, k1=0.0, k2=0.0,
-    )  # fmt: skip
+    )
 
 
 def _params(x: F64, base: CameraParams, n: int) -> CameraParams:
     """``base`` with the first ``n`` of (yaw, tilt x, tilt y, x, y, focal, k1, k2) from ``x``."""
     full = [base.yaw_rad, base.tilt_x_rad, base.tilt_y_rad, base.position_m[0], base.position_m[1], base.focal_px,
-            base.k1, base.k2]  # fmt: skip
+            base.k1, base.k2]
     full[:n] = [float(v) for v in x[:n]]
     yaw, tx, ty, px, py, f, k1, k2 = full
     return dataclasses.replace(
         base, yaw_rad=math.remainder(yaw, 2 * math.pi), tilt_x_rad=float(np.clip(tx, -0.49, 0.49)),
         tilt_y_rad=float(np.clip(ty, -0.49, 0.49)), position_m=(px, py, base.position_m[2]),
         focal_px=max(f, 10.0), k1=float(np.clip(k1, -0.99, 0.99)), k2=float(np.clip(k2, -0.99, 0.99)),
-    )  # fmt: skip
+    )
 
 
 def _vector(p: CameraParams) -> F64:
@@ -238,7 +238,7 @@ def _bounds(p: CameraParams, n: int, reach_m: float) -> tuple[F64, F64]:
 
 
 def _coarse(start: CameraParams, pts: F64, dist: NDArray[np.float32], line_px: F64,
-            fit: LineFitParams) -> CameraParams:  # fmt: skip
+            fit: LineFitParams) -> CameraParams:
     """The best candidate camera around ``start`` by the truncated chamfer distance: a grid over
     position (+- ``reach_m``), the half turn and the focal length (+- ``focal_range``, five
     steps), then a least-squares refinement (yaw, tilts, position, focal length) of the best few."""
@@ -251,7 +251,7 @@ def _coarse(start: CameraParams, pts: F64, dist: NDArray[np.float32], line_px: F
             for dx in steps:
                 for dy in steps:
                     p = dataclasses.replace(start, yaw_rad=start.yaw_rad + turn, focal_px=start.focal_px * fs,
-                                            position_m=(x0 + dx, y0 + dy, start.position_m[2]))  # fmt: skip
+                                            position_m=(x0 + dx, y0 + dy, start.position_m[2]))
                     cands.append((float(np.mean(_chamfer(p, pts, dist, line_px, cap0))), p))
     cands.sort(key=lambda c: c[0])
     best, best_cost = start, math.inf
@@ -260,7 +260,7 @@ def _coarse(start: CameraParams, pts: F64, dist: NDArray[np.float32], line_px: F
         for cap in (cap0, cap1):
             sol = least_squares(lambda x, p=p, cap=cap: _chamfer(_params(x, p, 6), pts, dist, line_px, cap),
                                 np.clip(_vector(p)[:6], lo, hi), bounds=(lo, hi), diff_step=1e-3, max_nfev=100,
-                                x_scale=np.array([0.01, 0.01, 0.01, 0.02, 0.02, 5.0]))  # fmt: skip
+                                x_scale=np.array([0.01, 0.01, 0.01, 0.02, 0.02, 5.0]))
             p = _params(sol.x, p, 6)
         cost = float(np.mean(_chamfer(p, pts, dist, line_px, cap1)))
         if cost < best_cost:
@@ -278,7 +278,7 @@ def _normals(model: CameraModel, pts: F64, tan: F64) -> tuple[F64, F64]:
 
 
 def _profiles(model: CameraModel, pts: F64, tan: F64, strength: NDArray[np.float32],
-              reach_px: float) -> tuple[NDArray[np.int64], F64, F64, F64, F64]:  # fmt: skip
+              reach_px: float) -> tuple[NDArray[np.int64], F64, F64, F64, F64]:
     """The strength profile across the projected line at each model point in view: the points
     kept, their pixels (k, 2) and normals (k, 2), the offsets (m,) px and the profiles (k, m)."""
     px, nrm = _normals(model, pts, tan)
@@ -299,7 +299,7 @@ def _weighted_centre(prof: F64, offs: F64, around: F64, half: float, floor: F64)
 
 
 def _centres(model: CameraModel, pts: F64, tan: F64, strength: NDArray[np.float32], level: float,
-             reach_px: float, width_px: float) -> tuple[NDArray[np.int64], F64, F64]:  # fmt: skip
+             reach_px: float, width_px: float) -> tuple[NDArray[np.int64], F64, F64]:
     """Where the line of each model point really is: along the projected normal within
     ``reach_px``, the strength profile's peak, then the weighted centroid of the profile over
     the tape's width (``width_px``) around it, taken twice (on a wide tape's flat top the peak
@@ -350,7 +350,7 @@ def _line_width(model: CameraModel, pts: F64, tan: F64, strength: NDArray[np.flo
 
 
 def _fine(start: CameraParams, pts: F64, tan: F64, strength: NDArray[np.float32], level: float,
-          search_px: float, width_px: float) -> CameraParams:  # fmt: skip
+          search_px: float, width_px: float) -> CameraParams:
     """Point-to-line least squares on measured line centres, measured again after each fit: the
     first time ``search_px`` (plus half the tape) across each line and without distortion, then
     ever closer with it."""
@@ -360,11 +360,11 @@ def _fine(start: CameraParams, pts: F64, tan: F64, strength: NDArray[np.float32]
         idx, centres, nrm = _centres(CameraModel(p), pts, tan, strength, level, reach + width_px, width_px)
         if len(idx) < 20:
             raise CalibrationRefused(f"only {len(idx)} line points found near the model: the rough start is too far "
-                                     "off, or this is not the field in field.yaml")  # fmt: skip
+                                     "off, or this is not the field in field.yaml")
         sub = pts[idx]
 
         def resid(x: F64, sub: F64 = sub, centres: F64 = centres, nrm: F64 = nrm, n_fit: int = n_fit,
-                  base: CameraParams = p) -> F64:  # fmt: skip
+                  base: CameraParams = p) -> F64:
             proj = CameraModel(_params(x, base, n_fit)).project(sub)
             out: F64 = np.nan_to_num(np.sum((proj - centres) * nrm, axis=1), nan=50.0)
             return out
@@ -372,7 +372,7 @@ def _fine(start: CameraParams, pts: F64, tan: F64, strength: NDArray[np.float32]
         lo, hi = _bounds(p, n_fit, 0.1)
         sol = least_squares(resid, np.clip(_vector(p)[:n_fit], lo, hi), bounds=(lo, hi), loss="soft_l1",
                             f_scale=max(1.0, 0.1 * width_px),
-                            x_scale=np.array([1e-3, 1e-3, 1e-3, 2e-3, 2e-3, 1.0, 1e-3, 1e-3])[:n_fit])  # fmt: skip
+                            x_scale=np.array([1e-3, 1e-3, 1e-3, 2e-3, 2e-3, 1.0, 1e-3, 1e-3])[:n_fit])
         p = _params(sol.x, p, n_fit)
     return p
 
@@ -391,7 +391,7 @@ class _Match:
 
 
 def _match(params: CameraParams, pts: F64, tan: F64, ids: NDArray[np.int64], strength: NDArray[np.float32],
-           level: float, reach_px: float, width_px: float) -> _Match:  # fmt: skip
+           level: float, reach_px: float, width_px: float) -> _Match:
     model = CameraModel(params)
     idx, centres, nrm = _centres(model, pts, tan, strength, level, reach_px + width_px, width_px)
     res = np.sum((model.project(pts[idx]) - centres) * nrm, axis=1) if idx.size else np.zeros(0)
@@ -406,7 +406,7 @@ def _match(params: CameraParams, pts: F64, tan: F64, ids: NDArray[np.int64], str
             + 2 * int((seen & circle).any()))
     missing = np.flatnonzero((n_view >= 20) & (n_found < 0.25 * n_view))
     return _Match(idx, centres, res, float(idx.size / max(1, int(view.sum()))), int(seen.sum()), min(dirs, 2),
-                  tuple(int(k) for k in missing))  # fmt: skip
+                  tuple(int(k) for k in missing))
 
 
 def _half_turn(p: CameraParams) -> CameraParams:
@@ -428,21 +428,21 @@ def _check(p: CameraParams, m: _Match, width_px: float, league: LeagueParams, fi
     lo, hi = fit.fov_deg
     if not lo <= fov <= hi:
         raise CalibrationRefused(f"the fit's focal length {p.focal_px:.0f} px gives a {fov:.0f} degree field of view "
-                                 f"(plausible: {lo:.0f}-{hi:.0f}): wrong --height or field size")  # fmt: skip
+                                 f"(plausible: {lo:.0f}-{hi:.0f}): wrong --height or field size")
     known = fit.known_focal_px
     if known > 0.0 and abs(p.focal_px / known - 1.0) > fit.known_focal_tolerance:
         raise CalibrationRefused(f"the fit's focal length {p.focal_px:.0f} px is {p.focal_px / known - 1.0:+.0%} off "
                                  f"the known {known:.0f} px (at most {fit.known_focal_tolerance:.0%}): the field's "
-                                 "size in field.yaml or the --height is off by that share")  # fmt: skip
+                                 "size in field.yaml or the --height is off by that share")
     metres = width_px / max(CameraModel(p).pixels_per_metre((p.position_m[0], p.position_m[1]), 0.0), 1e-9)
     if not 0.3 * league.dims.line_width_m <= metres <= max(fit.widest_line_m, 3.0 * league.dims.line_width_m):
         raise CalibrationRefused(f"the lines measure {metres * 1000:.0f} mm across at the fitted scale, field.yaml's "
                                  f"line_width_m is {league.dims.line_width_m * 1000:.0f} mm: the scale is wrong "
-                                 "(--height, the field's size) or line_width_m is")  # fmt: skip
+                                 "(--height, the field's size) or line_width_m is")
     if m.found < fit.min_found:
         raise CalibrationRefused(f"only {m.found:.0%} of the field lines the fit puts in view are in the image (at "
                                  f"least {fit.min_found:.0%} needed): the field in field.yaml (its size, lines, centre "
-                                 "circle) is not the one in the image, or the rough start is too far off")  # fmt: skip
+                                 "circle) is not the one in the image, or the rough start is too far off")
     if m.missing:
         lines = field_lines(league)
         what = "; ".join(_describe(lines[k]) for k in m.missing)
@@ -454,7 +454,7 @@ def _check(p: CameraParams, m: _Match, width_px: float, league: LeagueParams, fi
 
 
 def calibrate_from_lines(image: NDArray[np.uint8], league: LeagueParams, start: CameraParams,
-                         fit: LineFitParams | None = None) -> LineCalibration:  # fmt: skip
+                         fit: LineFitParams | None = None) -> LineCalibration:
     """Fit one camera to the field lines in ``image`` (H, W, 3) BGR uint8, from ``start`` (its
     height is kept; its position may be off by up to about ``fit.reach_m``, its focal length by
     ``fit.focal_range``, its yaw by a few degrees or a half turn).
@@ -485,7 +485,7 @@ def calibrate_from_lines(image: NDArray[np.uint8], league: LeagueParams, start: 
     width_px = _line_width(CameraModel(p), pts, tan, wide, level, 1.5 * widest_px + fit.search_px)
     if width_px <= 0.0:
         raise CalibrationRefused("the field lines were not found where the rough start puts them: too few to "
-                                 "measure their width")  # fmt: skip
+                                 "measure their width")
     strength = line_strength(image, width_px, fit.white_chroma)
     level = 0.5 * float(np.median(strength[_line_mask(strength, fit.min_strength_grey) > 0]))
     p = _fine(p, pts, tan, strength, level, fit.search_px, width_px)
@@ -499,15 +499,15 @@ def calibrate_from_lines(image: NDArray[np.uint8], league: LeagueParams, start: 
         p, m = other, _match(other, pts, tan, ids, strength, level, near, width_px)
     if abs(off[1] - off[0]) < math.radians(30.0):
         notes.append(f"the rough start's yaw is {math.degrees(min(off)):.0f} and {math.degrees(max(off)):.0f} "
-                     "degrees from the two half turns the lines allow: check which goal is +x")  # fmt: skip
+                     "degrees from the two half turns the lines allow: check which goal is +x")
     _check(p, m, width_px, league, fit)
     err = np.abs(m.residuals)
     return LineCalibration(p, float(np.sqrt(np.mean(err**2))), float(err.max()), len(err), int(mask.sum()), width_px,
-                           m.found, m.lines_seen, m.centres, m.residuals, ids[m.idx], tuple(notes))  # fmt: skip
+                           m.found, m.lines_seen, m.centres, m.residuals, ids[m.idx], tuple(notes))
 
 
 def draw_field(image: NDArray[np.uint8], params: CameraParams, league: LeagueParams,
-               fit: LineCalibration | None = None) -> NDArray[np.uint8]:  # fmt: skip
+               fit: LineCalibration | None = None) -> NDArray[np.uint8]:
     """A copy of ``image`` with the field model drawn through the camera (magenta, 1 px); with
     ``fit``, the line centres it used (green within 1 px of the fitted line, red beyond) and each
     line's RMS residual in px written beside it."""
@@ -534,7 +534,7 @@ def draw_field(image: NDArray[np.uint8], params: CameraParams, league: LeaguePar
         at = fit.centres[sel][len(fit.centres[sel]) // 2]
         rms = float(np.sqrt(np.mean(fit.residuals_px[sel] ** 2)))
         cv2.putText(out, f"{rms:.2f} px", (int(at[0]) + 6, int(at[1]) - 6), cv2.FONT_HERSHEY_SIMPLEX, 0.45,
-                    (255, 255, 255), 1, cv2.LINE_AA)  # fmt: skip
+                    (255, 255, 255), 1, cv2.LINE_AA)
     return out
 
 

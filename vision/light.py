@@ -46,7 +46,7 @@ class LightFollower:
     """The gains per cell of one camera, updated from each frame's detections."""
 
     def __init__(self, params: LightParams, league: LeagueParams, camera: CameraModel,
-                 heights: dict[Team, float]) -> None:  # fmt: skip
+                 heights: dict[Team, float]) -> None:
         self.params, self.camera, self.heights = params, camera, heights
         nx, ny = params.grid
         self.gains = np.ones((ny, nx, 3))
@@ -76,7 +76,7 @@ class LightFollower:
         return out
 
     def observe(self, image: NDArray[np.uint8], robots: list[RobotDetection],
-                balls: list[BallDetection]) -> NDArray[np.float64] | None:  # fmt: skip
+                balls: list[BallDetection]) -> NDArray[np.float64] | None:
         """Update the gains from this frame's confident detections, every ``every_frames``-th frame;
         returns them (rows, columns, 3) when they were updated, else None."""
         p = self.params
@@ -122,7 +122,7 @@ class LightFollower:
         measured = np.where(seen_cells[..., None], num / np.where(den > 0.0, den, 1.0), self.gains)
         whole = num.sum(axis=(0, 1)) / den.sum(axis=(0, 1))
         self.gains = np.where(seen_cells[..., None], self.gains + p.rate * (measured - self.gains),
-                              self.gains + 0.5 * p.rate * (whole - self.gains))  # fmt: skip
+                              self.gains + 0.5 * p.rate * (whole - self.gains))
         self.gains = np.clip(self.gains, 1.0 / p.max_change, p.max_change)
         return self.gains
 

@@ -166,7 +166,7 @@ class PatternMatcher:
         self.dot_area = math.pi * (pattern.id_dot_diameter_m / 2.0) ** 2
 
     def detect(self, geo: RegionGeometry, classes: dict[str, int], height_m: dict[Team, float],
-               is_pink: Callable[[NDArray[np.float64]], bool | None]) -> list[RobotDetection]:  # fmt: skip
+               is_pink: Callable[[NDArray[np.float64]], bool | None]) -> list[RobotDetection]:
         """Robots of both teams; ``classes`` maps the roles blue, yellow, pink, green to class
         indices; ``is_pink(pixel)`` reads an id dot's colour at a pixel where no region was found
         (None: neither colour). Duplicates (one robot found twice) are merged."""
@@ -188,7 +188,7 @@ class PatternMatcher:
             table = kern.match_patterns(geo.xy(c_idx, z), cw, geo.xy(dot_idx, z), dw, dpink, (dw >= lo) & (dw <= hi),
                                         self.slots, self.assign, params.search_radius_m, params.min_dots,
                                         self.id_of_code, params.max_residual_m, params.residual_scale_m,
-                                        params.min_confidence)  # fmt: skip
+                                        params.min_confidence)
             for r in np.flatnonzero(table[:, kern.M_VERDICT] != kern.V_REJECT):
                 row, robot_id = table[r], int(table[r, kern.M_ID])
                 conf = float(row[kern.M_CONF])
@@ -200,11 +200,11 @@ class PatternMatcher:
                 pixel = regions.centroid[c_idx[r]]
                 heading = math.remainder(float(row[kern.M_THETA]), 2.0 * math.pi)
                 found.append(RobotDetection(team, robot_id, float(row[kern.M_X]), float(row[kern.M_Y]), heading,
-                                            conf, (float(pixel[0]), float(pixel[1]))))  # fmt: skip
+                                            conf, (float(pixel[0]), float(pixel[1]))))
         return merge_duplicates(found, params.duplicate_distance_m)
 
     def _complete(self, row: NDArray[np.float64], z: float, camera: CameraModel,
-                  is_pink: Callable[[NDArray[np.float64]], bool | None]) -> tuple[int, bool]:  # fmt: skip
+                  is_pink: Callable[[NDArray[np.float64]], bool | None]) -> tuple[int, bool]:
         """The id of a fit with a dot the regions missed (glare, a dark corner), its colour read
         where the fit puts it, and True; where neither colour is there (the dot hidden), the one id
         in play that the three dots seen fit, and False; -1 where the colour read makes a code no
@@ -233,7 +233,7 @@ def merge_duplicates(robots: list[RobotDetection], distance_m: float) -> list[Ro
 
 
 def ball_centre_reference(image: NDArray[np.uint8], box: NDArray[np.float64],
-                          margin: int) -> tuple[float, float, float, float]:  # fmt: skip
+                          margin: int) -> tuple[float, float, float, float]:
     """The ball's centre (u, v at pixel centres) from the coverage of the pixels around its
     region's box (u0, v0, u1, v1 inclusive) grown by ``margin``, the coverage's sum (px) and the
     centre's standard deviation per axis (px) from false coverage: the plain-numpy reference of
@@ -293,7 +293,7 @@ def detect_ball(
         regions.area[idx], regions.moments[idx], regions.bbox[idx], geo.rays[idx], geo.pixel_area[idx],
         geo.camera.center, ball_radius_m, np.array([(r.x, r.y) for r in robots]).reshape(-1, 2),
         np.array(heights, dtype=np.float64), pattern_radius_m, params.min_area_fraction, params.max_area_fraction,
-        params.max_elongation, params.min_fill)  # fmt: skip
+        params.max_elongation, params.min_fill)
     px = regions.centroid[idx]
     z = ball_radius_m + params.blob_height_above_centre_m
     sigma = np.full(idx.size, math.nan)
@@ -317,6 +317,6 @@ def detect_ball(
         conf = float(np.clip(size_conf * shape_conf / 0.6, 0.0, 1.0))
         if conf >= params.min_confidence and in_field(float(xy[j, 0]), float(xy[j, 1])):
             out.append(BallDetection(float(xy[j, 0]), float(xy[j, 1]), conf, (float(px[j, 0]), float(px[j, 1])),
-                                     float(sigma[j])))  # fmt: skip
+                                     float(sigma[j])))
     out.sort(key=lambda b: -b.confidence)
     return out[: params.max_balls]

@@ -151,14 +151,14 @@ class VisionPipeline:
         """
         if image.shape != self.shape or image.dtype != np.uint8:
             raise ValueError(f"camera {self.camera.id}: expected a uint8 image of shape {self.shape}, "
-                             f"got {image.dtype} {image.shape}")  # fmt: skip
+                             f"got {image.dtype} {image.shape}")
         regions = self.segmenter.regions(image)
         self.last_regions = regions
         geo = RegionGeometry(regions, self.camera, self.grid)
         robots = self.matcher.detect(geo, self.classes, self.heights, lambda px: self._is_pink(image, px))
         # a ball seen beside a robot lies outside its top: only a misread marker is well inside
         balls = detect_ball(geo, image, self.classes["ball"], self.league.ball.radius_m, robots, self.heights,
-                            self.pattern_radius_m * 0.8, self.params.ball, self.in_field)  # fmt: skip
+                            self.pattern_radius_m * 0.8, self.params.ball, self.in_field)
         robots = [r for r in robots if self.in_field(r.x, r.y)]
         if self.light is not None:
             gains = self.light.observe(image, robots, balls)
@@ -166,7 +166,7 @@ class VisionPipeline:
                 self.segmenter.set_light(gains, self.camera.width, self.camera.height)
         # no wall clock here: the frame is "sent" at its capture time (latency is the runtime's)
         return DetectionFrame(self.camera.id, frame_number, t_capture, t_capture, tuple(balls),
-                              tuple(sorted(robots, key=lambda r: (r.team, r.id))))  # fmt: skip
+                              tuple(sorted(robots, key=lambda r: (r.team, r.id))))
 
     def _is_pink(self, image: NDArray[np.uint8], pixel: NDArray[np.float64]) -> bool | None:
         """The id-dot colour at ``pixel`` (u, v): the mean colour of the pixels within 0.7 of the
@@ -189,9 +189,9 @@ class VisionPipeline:
             mean = convert_colour(image[i0:i1, j0:j1][inside][None], self.params.colour_space)[0].mean(axis=0)
         else:  # as the classes see it, its cell's gains applied
             bgr = self.light.corrected(image[i0:i1, j0:j1][inside].astype(np.float64).mean(axis=0),
-                                       (float(pixel[0]), float(pixel[1])))  # fmt: skip
+                                       (float(pixel[0]), float(pixel[1])))
             mean = convert_colour(np.clip(np.round(bgr), 0, 255).astype(np.uint8)[None, None],
-                                  self.params.colour_space)[0, 0].astype(np.float64)  # fmt: skip
+                                  self.params.colour_space)[0, 0].astype(np.float64)
         reach = []
         for role in ("pink", "green"):
             box = self.params.colours[getattr(self.params.roles, role)]

@@ -89,7 +89,7 @@ def field_layer(pipe: VisionPipeline) -> tuple[NDArray[np.uint8], NDArray[np.boo
 
 
 def annotate(image: NDArray[np.uint8], pipe: VisionPipeline, det: DetectionFrame,
-             field: tuple[NDArray[np.uint8], NDArray[np.bool_]] | None = None) -> NDArray[np.uint8]:  # fmt: skip
+             field: tuple[NDArray[np.uint8], NDArray[np.bool_]] | None = None) -> NDArray[np.uint8]:
     """A copy of ``image`` with the regions' boxes (grey), the fitted field (``field``, from
     :func:`field_layer`), each robot's outline, heading, team, id and confidence (e.g. ``B3 0.97``,
     blue or yellow), and each ball with its confidence (orange)."""
@@ -113,13 +113,13 @@ def annotate(image: NDArray[np.uint8], pipe: VisionPipeline, det: DetectionFrame
         cv2.circle(out, (cu, cv), radius, colour, 1, cv2.LINE_AA)
         cv2.line(out, (cu, cv), (int(round(tip[0])), int(round(tip[1]))), colour, 1, cv2.LINE_AA)
         cv2.putText(out, f"{r.team[0].upper()}{r.id} {r.confidence:.2f}", (cu + radius, cv - radius),
-                    cv2.FONT_HERSHEY_SIMPLEX, scale, colour, 1, cv2.LINE_AA)  # fmt: skip
+                    cv2.FONT_HERSHEY_SIMPLEX, scale, colour, 1, cv2.LINE_AA)
     for b in det.balls:
         bu, bv = int(round(b.pixel[0])), int(round(b.pixel[1]))
         radius = max(4, int(round(2.0 * league.ball.radius_m * cam.pixels_per_metre((b.x, b.y), 0.0))))
         cv2.circle(out, (bu, bv), radius, COLOURS_BGR["ball"], 1, cv2.LINE_AA)
         cv2.putText(out, f"{b.confidence:.2f}", (bu + radius, bv + radius), cv2.FONT_HERSHEY_SIMPLEX, scale,
-                    COLOURS_BGR["ball"], 1, cv2.LINE_AA)  # fmt: skip
+                    COLOURS_BGR["ball"], 1, cv2.LINE_AA)
     return out
 
 
@@ -151,4 +151,4 @@ def model_for_frames(src: FrameSource, model: CameraModel, image: NDArray[np.uin
     frame = str(src.paths[0]) if src.kind == "images" else "FRAME.png (one frame of it saved as an image)"
     raise FrameSizeError(f"{src.name}: frames are {w}x{h}, camera {model.id}'s model is {model.width}x"
                          f"{model.height} (another aspect ratio, cannot be scaled); calibrate the camera at this "
-                         f"size: cmdragons vision calibrate --lines {frame} --camera {model.id}")  # fmt: skip
+                         f"size: cmdragons vision calibrate --lines {frame} --camera {model.id}")

@@ -80,7 +80,7 @@ def read_labels(path: str | Path) -> list[Label]:
         try:
             u, v = item["pixel"]
             out.append(Label(str(item["colour"]), (float(u), float(v)), float(item.get("radius", 3.0)),
-                             int(item.get("image", 0))))  # fmt: skip
+                             int(item.get("image", 0))))
         except (KeyError, TypeError, ValueError) as exc:
             raise ConfigError(path, f"[{k}]", f"bad label {item!r}: {exc}") from None
     return out
@@ -111,7 +111,7 @@ def samples_from_labels(images: Sequence[NDArray[np.uint8]], labels: Iterable[La
 
 
 def samples_from_truth(recording: Path, league: LeagueParams, roles: Mapping[str, str], space: ColourSpace,
-                       max_frames: int = 60, inner_fraction: float = 0.5) -> Samples:  # fmt: skip
+                       max_frames: int = 60, inner_fraction: float = 0.5) -> Samples:
     """Samples of every pattern dot and the ball a recording's truth says are visible: the inner
     ``inner_fraction`` of each dot's radius, in up to ``max_frames`` frames per camera. ``roles``
     maps ball, blue, yellow, pink, green to colour names."""
@@ -123,7 +123,7 @@ def samples_from_truth(recording: Path, league: LeagueParams, roles: Mapping[str
     out: Samples = {}
 
     def add(name: str, image: NDArray[np.uint8], model: CameraModel, xy: NDArray[np.float64], z: float,
-            r_m: float) -> None:  # fmt: skip
+            r_m: float) -> None:
         px = model.project_xy(xy, z)
         r_px = inner_fraction * r_m * model.pixels_per_metre((float(xy[0]), float(xy[1])), z)
         got = _disc(image, (float(px[0]), float(px[1])), max(r_px, 0.8))
@@ -149,12 +149,12 @@ def samples_from_truth(recording: Path, league: LeagueParams, roles: Mapping[str
             seen = t.ball.pixels.get(cam)
             if seen is not None and seen[2] >= 0.95 and t.ball.z < 2.0 * league.ball.radius_m:
                 add(roles["ball"], image, model, np.array([t.ball.x, t.ball.y]), league.ball.radius_m,
-                    league.ball.radius_m)  # fmt: skip
+                    league.ball.radius_m)
     return out
 
 
 def boxes_from_samples(samples: Samples, share: float = 0.998, margin: int = 8,
-                       min_area_px: int = 6) -> dict[str, ColourClass]:  # fmt: skip
+                       min_area_px: int = 6) -> dict[str, ColourClass]:
     """Per colour, the box holding the central ``share`` of its samples in each channel, widened
     by ``margin`` grey levels."""
     out = {}
@@ -166,7 +166,7 @@ def boxes_from_samples(samples: Samples, share: float = 0.998, margin: int = 8,
         lo = np.clip(np.floor(np.percentile(px, tail, axis=0)) - margin, 0, 255).astype(int)
         hi = np.clip(np.ceil(np.percentile(px, 100.0 - tail, axis=0)) + margin, 0, 255).astype(int)
         out[name] = ColourClass(lo=(int(lo[0]), int(lo[1]), int(lo[2])), hi=(int(hi[0]), int(hi[1]), int(hi[2])),
-                                min_area_px=min_area_px)  # fmt: skip
+                                min_area_px=min_area_px)
     return out
 
 
@@ -209,7 +209,7 @@ class _Blob:
 
 
 def _blobs(image: NDArray[np.uint8], model: CameraModel, league: LeagueParams,
-           p: AutoTuneParams) -> tuple[list[_Blob], NDArray[np.int32], dict[str, NDArray[np.int32]]]:  # fmt: skip
+           p: AutoTuneParams) -> tuple[list[_Blob], NDArray[np.int32], dict[str, NDArray[np.int32]]]:
     """Coloured blobs on the field (its boundary included): pixels far from the carpet's colour
     and from grey, grouped 8-connected. Returns the blobs, the label image and the background's
     samples (YUV): the carpet (the field's pixels near its median colour, off the lines) and the
@@ -267,7 +267,7 @@ def _line_pixels(model: CameraModel, league: LeagueParams) -> NDArray[np.int64]:
 
 
 def auto_samples(images: Sequence[NDArray[np.uint8]], model: CameraModel, league: LeagueParams, space: ColourSpace,
-                 params: AutoTuneParams | None = None) -> AutoTuneReport:  # fmt: skip
+                 params: AutoTuneParams | None = None) -> AutoTuneReport:
     """Colour samples of every role with nothing labelled, from frames of a calibrated camera
     (after Gunnarsson et al., "The Color and the Shape": regions matched to the shapes expected).
 
@@ -378,11 +378,11 @@ def widen_for_light(box: ColourClass, light: tuple[float, float], space: ColourS
     new_lo = np.clip(np.floor(np.min(ends, axis=0)), 0, 255).astype(int)
     new_hi = np.clip(np.ceil(np.max(ends, axis=0)), 0, 255).astype(int)
     return ColourClass(lo=(int(new_lo[0]), int(new_lo[1]), int(new_lo[2])),
-                       hi=(int(new_hi[0]), int(new_hi[1]), int(new_hi[2])), min_area_px=box.min_area_px)  # fmt: skip
+                       hi=(int(new_hi[0]), int(new_hi[1]), int(new_hi[2])), min_area_px=box.min_area_px)
 
 
 def overlaps(boxes: Mapping[str, ColourClass], samples: Mapping[str, NDArray[np.int32]],
-             max_share: float) -> list[tuple[str, str, float]]:  # fmt: skip
+             max_share: float) -> list[tuple[str, str, float]]:
     """(what, box, share): where more than ``max_share`` of ``what``'s samples fall in another
     class's ``box`` (a colour class's or the carpet's or lines' samples)."""
     out = []
@@ -397,7 +397,7 @@ def overlaps(boxes: Mapping[str, ColourClass], samples: Mapping[str, NDArray[np.
 
 
 def keep_apart(boxes: dict[str, ColourClass], samples: Mapping[str, NDArray[np.int32]], movable: set[str],
-               min_share: float = 0.01, space: ColourSpace = "yuv") -> dict[str, ColourClass]:  # fmt: skip
+               min_share: float = 0.01, space: ColourSpace = "yuv") -> dict[str, ColourClass]:
     """``boxes`` with each box of ``movable`` cut back, where more than ``min_share`` of another's
     samples (a class's, the carpet's, the lines') fall in it: the cut along one channel that misplaces the fewest
     samples of either, and of those the one that gives up the least of the box."""
@@ -438,13 +438,13 @@ def keep_apart(boxes: dict[str, ColourClass], samples: Mapping[str, NDArray[np.i
             else:
                 hi[c] = cut
             out[name] = ColourClass(lo=(int(lo[0]), int(lo[1]), int(lo[2])), hi=(int(hi[0]), int(hi[1]), int(hi[2])),
-                                    min_area_px=box.min_area_px)  # fmt: skip
+                                    min_area_px=box.min_area_px)
     return out
 
 
 def learn_boxes(samples: Samples, background: Mapping[str, NDArray[np.int32]], light: Mapping[str, tuple[float, float]],
                 current: Mapping[str, ColourClass], space: ColourSpace, margin: int = 16,
-                max_overlap: float | None = None) -> tuple[dict[str, ColourClass], list[str]]:  # fmt: skip
+                max_overlap: float | None = None) -> tuple[dict[str, ColourClass], list[str]]:
     """The colour boxes from samples per colour name (and, learnt automatically, the background's
     samples and the light each box must reach): each sampled colour's box
     (:func:`boxes_from_samples`, widened by :func:`widen_for_light`), the others as ``current``
@@ -455,8 +455,9 @@ def learn_boxes(samples: Samples, background: Mapping[str, NDArray[np.int32]], l
     boxes = {**current, **{n: widen_for_light(b, light[n], space) if n in light else b for n, b in learnt.items()}}
     pooled = {**{n: np.concatenate(p) for n, p in samples.items()}, **background}
     warnings = [f"{part:.0%} of the {what} samples fall in {other}'s box (lo {list(boxes[other].lo)} hi "
-                f"{list(boxes[other].hi)}): the boxes are cut apart" for what, other, part in overlaps(boxes, pooled, share)]
+                f"{list(boxes[other].hi)}): the boxes are cut apart"
+                for what, other, part in overlaps(boxes, pooled, share)]
     boxes = keep_apart(boxes, pooled, set(boxes), share, space)
     warnings += [f"still {part:.0%} of the {what} samples in {other}'s box: those pixels are misread; label more or "
-                 "other spots" for what, other, part in overlaps(boxes, pooled, share)]  # fmt: skip
+                 "other spots" for what, other, part in overlaps(boxes, pooled, share)]
     return boxes, warnings

@@ -75,7 +75,7 @@ _NAME_WIDTH = 26  # the row name column; longer names wrap onto a second line (t
 _CELL_WIDTH = 9  # a number column, borders included
 # metric name endings that are units, shown under the metric's name in the header
 _UNITS = {"_mm_s": "mm·s", "_m_s2": "m/s²", "_m_s": "m/s", "_ms": "ms", "_us": "µs", "_ns": "ns", "_mm": "mm",
-          "_m": "m", "_s": "s", "_rad": "rad", "_deg": "deg", "_px": "px", "_hz": "Hz"}  # fmt: skip
+          "_m": "m", "_s": "s", "_rad": "rad", "_deg": "deg", "_px": "px", "_hz": "Hz"}
 
 
 def print_table(suite: str, rows: list[Row], width: int = TABLE_WIDTH) -> None:

@@ -57,7 +57,7 @@ class CallLog(BaseStage):
     (``autoref/referee/events``)."""
 
     contract = Contract("bench/calls", (Port("referee", GameState), Port("events", SimEvents), Port("referee/events",
-                                        GameEvents), Port(PASSIVE + "referee/events", GameEvents)))  # fmt: skip
+                                        GameEvents), Port(PASSIVE + "referee/events", GameEvents)))
 
     def __init__(self) -> None:
         self.truth: list[Call] = []
@@ -69,17 +69,17 @@ class CallLog(BaseStage):
             g = self._game
             if g is not None:
                 for team, before, now in (("blue", g.score_blue, message.score_blue),
-                                          ("yellow", g.score_yellow, message.score_yellow)):  # fmt: skip
+                                          ("yellow", g.score_yellow, message.score_yellow)):
                     self.truth += [Call(message.t, "goal", team)] * (now - before)
             self._game = message
         elif isinstance(message, SimEvents):
             g = self._game
             live = g is not None and (g.command.kick_restart or g.command.running
-                                      or (g.command == RefereeCommand.PENALTY and g.ready))  # fmt: skip
+                                      or (g.command == RefereeCommand.PENALTY and g.ready))
             if g is not None and live:
                 sign = -1 if g.blue_defends_negative_x else 1
                 self.truth += [Call(e.t, "ball_out", ball_out_taker(e.last_touch, e.x, sign))
-                               for e in message.events if isinstance(e, BallOut)]  # fmt: skip
+                               for e in message.events if isinstance(e, BallOut)]
         elif topic == "referee/events":
             self.truth += [_call(e) for e in message.events if e.kind in FOUL_KINDS]
         else:
@@ -114,7 +114,7 @@ def rows(truth: Sequence[Call], seen: Sequence[Call], window_s: float = WINDOW_S
         own = sum(1 for c in s if id(c) not in matched_seen)
         return {"name": name, "truth_calls": len(t), "matched": both,
                 "matched_share": both / len(t) if t else None, "autoref_calls": len(s), "own_calls": own,
-                "own_share": own / len(s) if s else None}  # fmt: skip
+                "own_share": own / len(s) if s else None}
 
     kinds = sorted({c.kind for c in (*truth, *seen)}, key=(FLOW_KINDS + FOUL_KINDS).index)
     return [*(row(k, [k]) for k in kinds), row("goals_and_outs", FLOW_KINDS), row("fouls", FOUL_KINDS),

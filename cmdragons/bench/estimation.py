@@ -88,7 +88,7 @@ class Trace:
         return {"name": name, "rms_error_m": float(np.sqrt(np.mean(self.error_m**2))),
                 "mean_nees": float(np.mean(self.nees)),
                 "nees_in_95": float(np.mean((self.nees >= lo) & (self.nees <= hi))),
-                "step_us": float(np.median(self.step_s) * 1e6)}  # fmt: skip
+                "step_us": float(np.median(self.step_s) * 1e6)}
 
 
 def _trace(run: Run, step: Callable[[int], None], estimate: Callable[[], tuple[FloatArray, FloatArray]]) -> Trace:
@@ -185,13 +185,13 @@ def toolbox(method: str, run: Run) -> Trace:
     if method in ("ekf_localisation", "ekf_slam"):
         kwargs = {"map": lmap} if method == "ekf_localisation" else {}
         ekf = EKF(robot=(vehicle, v), sensor=(sensor, run.sensor_cov), P0=START_COV, x0=start_estimate(run),
-                  animate=False, history=False, **kwargs)  # fmt: skip
+                  animate=False, history=False, **kwargs)
         ekf.init()
         return _trace(run, lambda k: ekf.step(), lambda: (ekf.x_est, ekf.P_est[:3, :3]))
     sd, sth = math.sqrt(run.odometry_cov[0, 0]), math.sqrt(run.odometry_cov[2, 2])
     start = np.random.default_rng(SEED + 1).multivariate_normal(start_estimate(run), START_COV, size=PARTICLES)
     pf = ParticleFilter(vehicle, sensor, R=np.diag([sd, sd, sth]) ** 2, L=run.sensor_cov, nparticles=PARTICLES,
-                        seed=SEED, x0=start, animate=False, history=False)  # fmt: skip
+                        seed=SEED, x0=start, animate=False, history=False)
     pf._init(x0=start)  # what its run() does first; stepping it ourselves times each step
 
     equal = np.full(PARTICLES, 1.0 / PARTICLES)  # its cloud after resampling, as its own estimate takes it

@@ -87,7 +87,7 @@ def shoot(settings: Settings, shot: Shot, goalie: bool = True) -> bool:
     s = settings.sim
     robot = dataclasses.replace(s.robot, command_latency_s=0.0)  # the brain sees the truth of now
     w = World(settings.field, s.physics, robot, s.ball, s.kicker, s.dribbler,
-              robots_per_team={"blue": int(goalie), "yellow": 0})  # fmt: skip
+              robots_per_team={"blue": int(goalie), "yellow": 0})
     ref = Referee(w.field, w.robot_keys(), s.referee)
     ref.give(RefereeCommand.FORCE_START)
     own = own_goal_sign("blue", ref.state())
@@ -141,5 +141,5 @@ def run(settings: Settings, quick: bool) -> list[dict[str, Any]]:
         goals = sum(shoot(s, shot) for shot in on_target)
         rows.append({"name": f"reflex {'on' if on else 'off'}", "shots": len(todo), "on_target": len(on_target),
                      "goals": goals, "saved": len(on_target) - goals,
-                     "save_share": (len(on_target) - goals) / len(on_target) if on_target else math.nan})  # fmt: skip
+                     "save_share": (len(on_target) - goals) / len(on_target) if on_target else math.nan})
     return rows

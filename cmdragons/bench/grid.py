@@ -80,7 +80,7 @@ def _map_rows(name: str, free: NDArray[np.bool_], scen_path: Path, quick: bool) 
             times.append((time.perf_counter() - t0) * 1e3)
             errors.append(abs(p.length - sc.optimal))
         rows.append({"name": f"{label}/{name}", "scenarios": len(scenarios), "max_error": max(errors),
-                     "median_ms": statistics.median(times), "max_ms": max(times)})  # fmt: skip
+                     "median_ms": statistics.median(times), "max_ms": max(times)})
     ratios, to_line, times, failed = [], [], [], 0
     for sc in scenarios:
         t0 = time.perf_counter()
@@ -97,7 +97,7 @@ def _map_rows(name: str, free: NDArray[np.bool_], scen_path: Path, quick: bool) 
     rows.append({"name": f"estar/{name}", "scenarios": len(scenarios), "no_path": failed,
                  "ratio_min": min(ratios), "ratio_median": statistics.median(ratios), "ratio_max": max(ratios),
                  "in_0.9_1.0": inside / max(1, len(ratios)), "to_straight_line_min": min(to_line),
-                 "median_ms": statistics.median(times)})  # fmt: skip
+                 "median_ms": statistics.median(times)})
     return rows
 
 
@@ -111,7 +111,7 @@ def _blob(free: NDArray[np.bool_], rng: np.random.Generator, goal: tuple[int, in
     span = range(-BLOB_RADIUS, BLOB_RADIUS + 1)
     out = [(r + dr, c + dc) for dr in span for dc in span
            if dr * dr + dc * dc <= BLOB_RADIUS**2 and 0 <= r + dr < h and 0 <= c + dc < w and free[r + dr, c + dc]]
-    return np.array(out, dtype=np.int64)  # fmt: skip
+    return np.array(out, dtype=np.int64)
 
 
 def _speed_rows(name: str, free: NDArray[np.bool_], quick: bool) -> list[dict[str, Any]]:
@@ -135,7 +135,7 @@ def _speed_rows(name: str, free: NDArray[np.bool_], quick: bool) -> list[dict[st
         skfmm = None
     if skfmm is not None:
         phi = np.ma.MaskedArray(np.hypot(*(np.mgrid[0 : free.shape[0], 0 : free.shape[1]] - np.array(
-            [gr, gc])[:, None, None])) - 2.0, mask=~free)  # fmt: skip
+            [gr, gc])[:, None, None])) - 2.0, mask=~free)
         skfmm.distance(phi)
     for neighbours in (8, 4):
         # side by side, one call each in turn (a loaded machine slows both alike)
@@ -186,7 +186,7 @@ def _speed_rows(name: str, free: NDArray[np.bool_], quick: bool) -> list[dict[st
     rows.append({"name": f"estar_repair/{name}", "median_ms": statistics.median(repair_ms),
                  "full_median_ms": statistics.median(fresh_ms),
                  "speedup_vs_full": statistics.median(fresh_ms) / statistics.median(repair_ms),
-                 "cells_median": statistics.median(touched), "max_diff_to_full": float(same)})  # fmt: skip
+                 "cells_median": statistics.median(touched), "max_diff_to_full": float(same)})
 
     nf1(free, (gr, gc))
     nf1_ms = _median_ms(lambda: nf1(free, (gr, gc)), repeats)

@@ -134,7 +134,7 @@ class NavScene:
             return self
         m = self.mover
         mover = MovingScene(m.field, Scene(m.pos, m.vel, self.start, self.goal), np.random.default_rng(self.seed),
-                            m.max_speed, m.p_turn)  # fmt: skip
+                            m.max_speed, m.p_turn)
         return dataclasses.replace(self, mover=mover)
 
     def step(self, dt_s: float) -> None:
@@ -144,7 +144,7 @@ class NavScene:
 
 
 def _crossing(field: Field, rng: np.random.Generator, radius_m: float, moving: bool) -> tuple[
-        CollisionWorld, FloatArray, FloatArray, tuple[float, float], tuple[float, float]]:  # fmt: skip
+        CollisionWorld, FloatArray, FloatArray, tuple[float, float], tuple[float, float]]:
     """Robots about the field and a start and goal on either side whose straight line they block."""
     r = field.league.robot.radius_m
     while True:
@@ -216,7 +216,7 @@ class Tally:
     def row(self, name: str, time_key: str) -> Row:
         return {"name": name, "queries": len(self.ok), "success_rate": float(np.mean(self.ok)) if self.ok else 0.0,
                 "trap": int(self.trap), "length_ratio": _median(self.ratio), time_key: _median(self.ms),
-                "clearance_m": _median(self.clearance)}  # fmt: skip
+                "clearance_m": _median(self.clearance)}
 
 
 def _median(values: list[float]) -> float:
@@ -239,7 +239,7 @@ Record = dict[tuple[str, str], tuple[bool, float]]  # (method, scene) -> (solved
 
 def _planner_rows(settings: Settings, suite: list[NavScene], frames: int, repeats: int,
                   paths: dict[str, dict[str, FloatArray]],
-                  say: Callable[[str], None]) -> tuple[list[Row], dict[str, list[float]], Record]:  # fmt: skip
+                  say: Callable[[str], None]) -> tuple[list[Row], dict[str, list[float]], Record]:
     """Every planner on every scene; the visibility graph first (its cost is the optimum). Returns
     the rows (``planner/<name>`` on the static scenes and the trap, ``replan/<name>`` every frame of
     the moving scenes), the optimum per query (scene name -> one cost per query) and what each
@@ -291,7 +291,7 @@ def _planner_rows(settings: Settings, suite: list[NavScene], frames: int, repeat
 
 
 def drive(settings: Settings, name: str, scene: NavScene, timeout_s: float) -> tuple[bool, FloatArray, list[float],
-                                                                                     float, float]:  # fmt: skip
+                                                                                     float, float]:
     """Navigator ``name`` drives an ideal robot from the scene's start toward its goal (see the module
     docstring). Returns (arrived without contact, the trajectory (k, 2), ms per step, least
     clearance m, time to the goal s or nan)."""
@@ -325,7 +325,7 @@ def drive(settings: Settings, name: str, scene: NavScene, timeout_s: float) -> t
 
 
 def _navigator_rows(settings: Settings, suite: list[NavScene], optimum: dict[str, list[float]], timeout_s: float,
-                    paths: dict[str, dict[str, FloatArray]], say: Callable[[str], None]) -> list[Row]:  # fmt: skip
+                    paths: dict[str, dict[str, FloatArray]], say: Callable[[str], None]) -> list[Row]:
     rows = []
     for name in sorted(NAVIGATORS):
         say(f"navigator {name}")
@@ -367,7 +367,7 @@ def _search_rows(settings: Settings, suite: list[NavScene], optimum: dict[str, l
                     ratio.append(result.cost / optimum[scene.name][0])
                     expanded.append(float(result.stats.get("expanded", 0)))
             rows.append({"name": f"search/{name}/{method}", "solved": len(ratio), "length_ratio": _median(ratio),
-                         "expanded": _median(expanded), "plan_ms": _median(ms)})  # fmt: skip
+                         "expanded": _median(expanded), "plan_ms": _median(ms)})
     return rows
 
 
@@ -388,7 +388,7 @@ def _to_field(cells: FloatArray, x0: float, y0: float) -> FloatArray:
 
 
 def _toolbox_planner(cls: str, occ: NDArray[np.bool_], start: tuple[int, int], goal: tuple[int, int],
-                     n_nodes: int) -> FloatArray | None:  # fmt: skip
+                     n_nodes: int) -> FloatArray | None:
     """The toolbox planner's path (cells (k, 2) as x, y) or None when it found none."""
     import roboticstoolbox as rtb
 
@@ -416,7 +416,7 @@ def _ours(record: Record, name: str, fixed: list[NavScene]) -> dict[str, float]:
 
 
 def _peer_rows(settings: Settings, suite: list[NavScene], optimum: dict[str, list[float]], record: Record,
-               timeout_s: float, quick: bool, paths: dict[str, dict[str, FloatArray]]) -> list[Row]:  # fmt: skip
+               timeout_s: float, quick: bool, paths: dict[str, dict[str, FloatArray]]) -> list[Row]:
     radius = settings.field.robot.radius_m
     rows: list[Row] = []
     fixed = [s for s in suite if s.mover is None]  # the peers plan once: the static scenes and the trap
@@ -442,7 +442,7 @@ def _peer_rows(settings: Settings, suite: list[NavScene], optimum: dict[str, lis
             occ, x0, y0 = occupancy(scene, radius)
             t0 = time.perf_counter()
             cells = _toolbox_planner(cls, occ, _cell(scene.start, x0, y0), _cell(scene.goal, x0, y0),
-                                     settings.planner.prm.n_nodes)  # fmt: skip
+                                     settings.planner.prm.n_nodes)
             tally.ms.append((time.perf_counter() - t0) * 1e3)
             ok = cells is not None and len(cells) > 1
             tally.ok.append(ok)
@@ -464,7 +464,7 @@ def _peer_rows(settings: Settings, suite: list[NavScene], optimum: dict[str, lis
         else:
             mine = _ours(record, our, fixed)
         rows.append(row | {"our_success_rate": mine["success_rate"], "our_ms": mine["plan_ms"],
-                           "speedup": row["plan_ms"] / mine["plan_ms"], "ours": our})  # fmt: skip
+                           "speedup": row["plan_ms"] / mine["plan_ms"], "ours": our})
     if toolbox:
         rows.append(_bug2_path_row(settings, fixed, optimum, 3 if quick else 5, paths))
     rows.append(_pyvisgraph_row(settings, fixed, optimum, _ours(record, "visgraph", fixed), paths))
@@ -472,7 +472,7 @@ def _peer_rows(settings: Settings, suite: list[NavScene], optimum: dict[str, lis
 
 
 def _bug2_path_row(settings: Settings, fixed: list[NavScene], optimum: dict[str, list[float]], repeats: int,
-                   paths: dict[str, dict[str, FloatArray]]) -> Row:  # fmt: skip
+                   paths: dict[str, dict[str, FloatArray]]) -> Row:
     """Bug2 as a whole path in one query, ours (:func:`~cmdragons.navigation.bug2_path`) beside the
     toolbox's ``Bug2``, on the same occupancy grid with the same start and goal cells, both stepping
     one cell; the two called in turn ``repeats`` times per scene (median). Success: the path ends
@@ -493,7 +493,7 @@ def _bug2_path_row(settings: Settings, fixed: list[NavScene], optimum: dict[str,
         found, cells = our_query(), their_query()
         for tally, ms, ok, route, label in (
                 (ours, ours_ms, found.status is GridBug2Status.REACHED, found.cells, "bug2_path (grid)"),
-                (theirs, theirs_ms, cells is not None and len(cells) > 1, cells, "peer rtb Bug2 (grid)")):  # fmt: skip
+                (theirs, theirs_ms, cells is not None and len(cells) > 1, cells, "peer rtb Bug2 (grid)")):
             tally.ms.append(ms)
             tally.ok.append(ok)
             if ok and route is not None:
@@ -508,11 +508,11 @@ def _bug2_path_row(settings: Settings, fixed: list[NavScene], optimum: dict[str,
     return row | {"our_success_rate": mine["success_rate"], "our_ms": mine["plan_ms"],
                   "speedup": row["plan_ms"] / mine["plan_ms"], "ours": "bug2_path",
                   "our_trap": mine["trap"], "our_length_ratio": mine["length_ratio"],
-                  "our_clearance_m": mine["clearance_m"]}  # fmt: skip
+                  "our_clearance_m": mine["clearance_m"]}
 
 
 def _pyvisgraph_row(settings: Settings, fixed: list[NavScene], optimum: dict[str, list[float]], our: dict[str, float],
-                    paths: dict[str, dict[str, FloatArray]]) -> Row:  # fmt: skip
+                    paths: dict[str, dict[str, FloatArray]]) -> Row:
     name = "peer/pyvisgraph"
     try:
         import pyvisgraph as vg
@@ -543,7 +543,7 @@ def _pyvisgraph_row(settings: Settings, fixed: list[NavScene], optimum: dict[str
             paths.setdefault(scene.name, {})["peer pyvisgraph"] = path
     row = tally.row(name, "plan_ms")
     return row | {"our_success_rate": our["success_rate"], "our_ms": our["plan_ms"],
-                  "speedup": row["plan_ms"] / our["plan_ms"], "ours": "visgraph"}  # fmt: skip
+                  "speedup": row["plan_ms"] / our["plan_ms"], "ours": "visgraph"}
 
 
 def _paired_ms(fns: list[Callable[[], Any]], repeats: int) -> list[float]:
@@ -567,7 +567,7 @@ def _paired_ms(fns: list[Callable[[], Any]], repeats: int) -> list[float]:
 
 
 def grid_astar_row(name: str, free: NDArray[np.bool_], start: tuple[int, int], goal: tuple[int, int],
-                   repeats: int) -> Row:  # fmt: skip
+                   repeats: int) -> Row:
     """Our A* on the 8-connected grid of ``free`` (row = y) against pyastar2d, ``start`` and ``goal``
     as (column, row), lengths in cells: ``search_ms`` the grid search (the graph's neighbours by
     index), ``graph_ms`` the same search over the built CSR graph and ``build_ms`` building it.
@@ -590,9 +590,9 @@ def grid_astar_row(name: str, free: NDArray[np.bool_], start: tuple[int, int], g
         pair.append(lambda: pyastar2d.astar_path(weights, s, g, allow_diagonal=True))
     search_ms, *peer_ms = _paired_ms(pair, repeats)
     graph_ms, build_ms = _paired_ms([lambda: search(graph, src, dst, "astar", never()),
-                                     lambda: grid_graph(free, 0.0, 0.0, 1.0, 8)], repeats)  # fmt: skip
+                                     lambda: grid_graph(free, 0.0, 0.0, 1.0, 8)], repeats)
     row: Row = {"name": f"grid_astar/{name}", "cells": int(free.size), "length": found.cost, "expanded": found.expanded,
-                "search_ms": search_ms, "graph_ms": graph_ms, "build_ms": build_ms}  # fmt: skip
+                "search_ms": search_ms, "graph_ms": graph_ms, "build_ms": build_ms}
     if found.status is not SearchStatus.FOUND:
         row["note"] = "our A* found no path"
     if pyastar2d is None:
@@ -610,13 +610,13 @@ def _grid_astar_rows(settings: Settings, suite: list[NavScene], repeats: int) ->
     scene = suite[0]
     occ, x0, y0 = occupancy(scene, settings.field.robot.radius_m)
     rows = [grid_astar_row(f"{scene.name}_{occ.shape[1]}x{occ.shape[0]}", ~occ, _cell(scene.start, x0, y0),
-                           _cell(scene.goal, x0, y0), repeats)]  # fmt: skip
+                           _cell(scene.goal, x0, y0), repeats)]
     path = default_maps() / "8room_000.map"
     if path.exists() and path.with_name(path.name + ".scen").exists():
         free = read_map(path)
         longest = max(read_scenarios(path.with_name(path.name + ".scen")), key=lambda s: s.optimal)
         rows.append(grid_astar_row(f"8room_000_{free.shape[1]}x{free.shape[0]}", free, longest.start, longest.goal,
-                                   repeats) | {"optimal": longest.optimal})  # fmt: skip
+                                   repeats) | {"optimal": longest.optimal})
     return rows
 
 

@@ -257,7 +257,7 @@ def static_rows(
                 if "raw_length_m" in res.stats:
                     raw.append(float(res.stats["raw_length_m"]) / best[i])
         rows.append(_row(f"static_{name}", ok, ms, ratios, median_search_ms=_median(plan_ms),
-                         length_ratio_raw=float(np.mean(raw)) if raw else math.nan))  # fmt: skip
+                         length_ratio_raw=float(np.mean(raw)) if raw else math.nan))
     rows.append({"name": "static_scenes", "queries": n, "note": f"{n - len(solvable)} unsolvable scenes left out"})
     return rows
 
@@ -372,7 +372,7 @@ class Record:
             p95_iterations=float(np.percentile(self.iterations, 95)) if self.iterations else math.nan,
             median_nodes=_median(self.nodes),
             waypoint_target_rate=float(np.sum(self.waypoint_targets)) / q if q else math.nan,
-        )  # fmt: skip
+        )
 
 
 def _median(xs: Sequence[float]) -> float:
@@ -414,7 +414,7 @@ def replan_rows(
         pos = np.array(episode.start)
         for frame in range(sizes.frames):
             prob = PlanProblem((pos[0], pos[1]), episode.goal(), field.league.robot.radius_m, episode.world(), 0.0,
-                               params.collision)  # fmt: skip
+                               params.collision)
             best = math.inf
             if frame % sizes.optimum_every == 0:
                 opt = optimum.solve(prob, deadline(10.0))
@@ -455,7 +455,7 @@ def replan_rows(
                 "cache_median_ms": float(np.median(a[:, 0])), "nocache_median_ms": float(np.median(b[:, 0])),
                 "cache_median_iterations": float(np.median(a[:, 1])),
                 "nocache_median_iterations": float(np.median(b[:, 1])), "frames": len(a),
-            })  # fmt: skip
+            })
     return rows
 
 

@@ -51,7 +51,7 @@ def _halves(settings: Settings, half_s: float, shootout_kicks: int = 0) -> Setti
     shootout of that many kicks each after the match, whatever its score."""
     ref = settings.sim.referee
     figures = dataclasses.replace(ref.figures, half_s=half_s, half_time_s=0.0, shootout_kicks=shootout_kicks,
-                                  shootout_always=shootout_kicks > 0)  # fmt: skip
+                                  shootout_always=shootout_kicks > 0)
     ref = dataclasses.replace(ref, rules="full", figures=figures)
     return dataclasses.replace(settings, sim=dataclasses.replace(settings.sim, referee=ref))
 
@@ -146,7 +146,7 @@ def _learnt(summary: dict[str, Any]) -> dict[str, Any]:
 
 
 def _other_world_row(settings: Settings, seed: int, seconds: float, opponent: str, roll_m_s2: float,
-                     brake_m_s2: float) -> dict[str, Any]:  # fmt: skip
+                     brake_m_s2: float) -> dict[str, Any]:
     """A match in our simulator made another simulator's world (its ball rolling out at ``roll_m_s2``,
     its robots braking at ``brake_m_s2``; grSim's by default) while our team believes field.yaml:
     what the tracker learns, and how the team plays once it uses it."""
@@ -181,11 +181,11 @@ def _brain_cycle(settings: Settings, division: str, seconds: float) -> dict[str,
     cycle = np.array(brain) + np.array(tracker)
     return {"name": f"brain_cycle_{league.dims.robots_per_team}_robots", "median_ms": float(np.median(cycle)),
             "p95_ms": float(np.percentile(cycle, 95)), "brain_median_ms": float(np.median(brain)),
-            "tracker_median_ms": float(np.median(tracker))}  # fmt: skip
+            "tracker_median_ms": float(np.median(tracker))}
 
 
 def _built_in_match(settings: Settings, blue: BuiltIn, yellow: BuiltIn, seed: int,
-                    seconds: float) -> tuple[dict[str, Any], float]:  # fmt: skip
+                    seconds: float) -> tuple[dict[str, Any], float]:
     """One match of two built-in teams on the true state: the referee's figures and the simulated
     seconds per wall-clock second."""
     sim = Simulator(settings.field, settings.camera_models(), settings.sim, seed=seed, render=False, referee=False)
@@ -213,7 +213,7 @@ def _duel_row(settings: Settings, seed: int, seconds: float) -> dict[str, Any]:
             "fouls_defend_by_kind": _kinds_text({k: v for k, v in ref["fouls"][defend].items() if k != "total"}),
             "cards_defend": ref["cards"][defend]["yellow"] + ref["cards"][defend]["red"],
             "cards_simple": ref["cards"][simple]["yellow"] + ref["cards"][simple]["red"],
-            "realtime_factor": speed}  # fmt: skip
+            "realtime_factor": speed}
 
 
 def _duel_total(rows: list[dict[str, Any]], seconds: float) -> dict[str, Any]:
@@ -226,7 +226,7 @@ def _duel_total(rows: list[dict[str, Any]], seconds: float) -> dict[str, Any]:
             "fouls_defend_per_match": sum(r["fouls_defend"] for r in rows) / n,
             "fouls_simple_per_match": sum(r["fouls_simple"] for r in rows) / n,
             "cards_defend": sum(r["cards_defend"] for r in rows), "cards_simple": sum(r["cards_simple"] for r in rows),
-            "realtime_factor": float(np.median([r["realtime_factor"] for r in rows]))}  # fmt: skip
+            "realtime_factor": float(np.median([r["realtime_factor"] for r in rows]))}
 
 
 def _total(rows: list[dict[str, Any]], seconds: float, opponent: str) -> dict[str, Any]:
@@ -255,7 +255,7 @@ def _total(rows: list[dict[str, Any]], seconds: float, opponent: str) -> dict[st
         "placement_median_of_matches_s": float(np.median(times)) if (times := [r["placement_median_s"] for r in rows
                                                                     if r["placement_median_s"] is not None]) else None,
         "realtime_factor": float(np.median([r["realtime_factor"] for r in rows])),
-    }  # fmt: skip
+    }
 
 
 def run(settings: Settings, quick: bool, opponent: str | None = None, matches: int | None = None,
@@ -275,19 +275,19 @@ def run(settings: Settings, quick: bool, opponent: str | None = None, matches: i
         played = []
         for k, seed in enumerate(seeds):
             print(f"bench play: match {k + 1} of {len(seeds)} (seed {seed}, 2 x {half:g} s, against {opp}) ...",
-                  file=sys.stderr, flush=True)  # fmt: skip
+                  file=sys.stderr, flush=True)
             played.append(_match_row(rules, seed, seconds, opp))
         rows += [*played, _total(played, seconds, opp)]
         if opp == "defend":
             duels = []
             for k, seed in enumerate(seeds[:2]):  # (deterministic: one match in each colour is all there is)
                 print(f"bench play: defend against simple {k + 1} of {len(seeds[:2])} (2 x {half:g} s) ...",
-                      file=sys.stderr, flush=True)  # fmt: skip
+                      file=sys.stderr, flush=True)
                 duels.append(_duel_row(rules, seed, seconds))
             rows += [*duels, _duel_total(duels, seconds)]
     if "simple" in opponents:  # and one more against the simple team in grSim's physics
         print("bench play: a match in grSim's physics (ball 0.70 m/s², braking 4 m/s²) ...", file=sys.stderr,
-              flush=True)  # fmt: skip
+              flush=True)
         other = _other_world_row(rules, seeds[0], seconds, "simple", GRSIM_BALL_ROLL_M_S2, GRSIM_ROBOT_BRAKE_M_S2)
         other.pop("_kinds")
         rows.append(other)

@@ -44,25 +44,25 @@ _FPS = 60.0
 
 
 def _field(settings: Settings, rng: np.random.Generator) -> tuple[list[msg.DetectionFrame], msg.WorldState,
-                                                                  msg.TeamCommands]:  # fmt: skip
+                                                                  msg.TeamCommands]:
     """One frame of a full field: each camera's detections, the world state, one team's commands."""
     n = {t: settings.sim.robots_per_team.get(t, settings.field.dims.robots_per_team) for t in ("blue", "yellow")}
     half = settings.field_geometry().half_length, settings.field_geometry().half_width
     robots = [(team, i, *(rng.uniform(-1, 1, 2) * half), rng.uniform(-math.pi, math.pi))
-              for team in ("blue", "yellow") for i in range(n[team])]  # fmt: skip
+              for team in ("blue", "yellow") for i in range(n[team])]
     cams = settings.camera_models()
     dets = [msg.DetectionFrame(c.id, 7, 0.5, 0.501, (msg.BallDetection(0.3, -0.2, 0.9, (400.5, 300.25), 0.0005),),
                                tuple(msg.RobotDetection(t, i, x, y, th, 0.95, (100.0 + i, 200.0)) for t, i, x, y, th
-                                     in robots)) for c in cams]  # fmt: skip
+                                     in robots)) for c in cams]
     world = msg.WorldState(0.5, msg.BallState(0.3, -0.2, 1.0, 0.5), tuple(
-        msg.RobotState(t, i, x, y, th, 0.5, -0.5, 1.0) for t, i, x, y, th in robots), 7)  # fmt: skip
+        msg.RobotState(t, i, x, y, th, 0.5, -0.5, 1.0) for t, i, x, y, th in robots), 7)
     commands = msg.TeamCommands("blue", 7, 0.5, tuple(msg.RobotCommand("blue", i, 1.0, -0.5, 0.5, 3.0, i % 2 == 0, 0.5)
-                                                      for _, i, *_ in robots[: n["blue"]]))  # fmt: skip
+                                                      for _, i, *_ in robots[: n["blue"]]))
     return dets, world, commands
 
 
 def _through(send: Callable[[bytes], None], receive: Callable[[], bytes | None], decode: Callable[[bytes], Any],
-             packets: list[bytes], count: int) -> tuple[float, int]:  # fmt: skip
+             packets: list[bytes], count: int) -> tuple[float, int]:
     """Packets a second sent, received and decoded, and packets lost."""
     got = 0
     t0 = time.perf_counter()
@@ -102,7 +102,7 @@ def _unicast(decode: Callable[[bytes], Any], packets: list[bytes], count: int) -
 
 
 def _row(name: str, packets: list[bytes], encode: Callable[[], bytes], needed_per_s: float,
-         through: tuple[float, int], count: int) -> dict[str, Any]:  # fmt: skip
+         through: tuple[float, int], count: int) -> dict[str, Any]:
     t0 = time.perf_counter()
     reps = 200
     for _ in range(reps):
@@ -111,7 +111,7 @@ def _row(name: str, packets: list[bytes], encode: Callable[[], bytes], needed_pe
     per_s, lost = through
     return {"name": name, "packets": count, "bytes": int(np.mean([len(p) for p in packets])),
             "encode_us": round(encode_us, 1), "packets_per_s": round(per_s), "lost": lost,
-            "match_needs_per_s": needed_per_s, "headroom": round(per_s / needed_per_s, 1)}  # fmt: skip
+            "match_needs_per_s": needed_per_s, "headroom": round(per_s / needed_per_s, 1)}
 
 
 def _packet_rows(settings: Settings, count: int) -> list[dict[str, Any]]:
@@ -169,12 +169,12 @@ def _match_rows(settings: Settings, seconds: float) -> list[dict[str, Any]]:
     on = load_settings(None, ["protocols.vision.send=true", "protocols.perception=ssl_vision",
                               "protocols.tracker.send=true", "protocols.commands_to=simulation",
                               f"protocols.simulation.blue_port={sink.port}",
-                              f"protocols.simulation.control_port={sink.port}"])  # fmt: skip
+                              f"protocols.simulation.control_port={sink.port}"])
     rows = []
     try:
         # a short match first loads what the matches import and compile lazily (it is not reported)
         for name, s, secs in (("warm-up", on, 0.5), ("match_no_protocols", settings, seconds),
-                              ("match_all_protocols", on, seconds)):  # fmt: skip
+                              ("match_all_protocols", on, seconds)):
             match = Match(s, "simple", "vision", seed=1)
             try:
                 def one_frame(_i: int, match: Match = match) -> None:
@@ -195,7 +195,7 @@ def _match_rows(settings: Settings, seconds: float) -> list[dict[str, Any]]:
             rows.append({"name": f"{name}_{seconds:g}s", "frames": frames, "packets_sent": sent,
                          "packets_received": pr.get("ssl/vision_in", {}).get("packets", 0),
                          "sent_per_match_s": round(sent / seconds, 1), "frame_median_ms": round(frame["median"], 2),
-                         "frame_p95_ms": round(frame["p95"], 2)})  # fmt: skip
+                         "frame_p95_ms": round(frame["p95"], 2)})
     finally:
         sink.close()
     return rows

@@ -64,7 +64,7 @@ def robox_settings(settings: Settings, safety: bool = True) -> Settings:
     ``--opponent-set team.navigator=robox --opponent-set planner.planner=estar`` gives a team); without
     ``safety``, DSS off as well."""
     out = dataclasses.replace(settings, team=dataclasses.replace(settings.team, navigator="robox"),
-                              planner=dataclasses.replace(settings.planner, planner="estar"))  # fmt: skip
+                              planner=dataclasses.replace(settings.planner, planner="estar"))
     return out if safety else dataclasses.replace(out, safety=dataclasses.replace(out.safety, method="none"))
 
 
@@ -79,7 +79,7 @@ def _timing_rows(settings: Settings, steps: int) -> list[dict[str, Any]]:
     robox = make_navigator("robox", sections, settings.control, r, settings.planner.collision)
     assert isinstance(window, DynamicWindowNavigator)
     xy = rng.uniform((-f.half_length + 0.5, -f.half_width + 0.5), (f.half_length - 0.5, f.half_width - 0.5),
-                     (N_MOVING, 2))  # fmt: skip
+                     (N_MOVING, 2))
     vel = rng.normal(0.0, 1.0, (N_MOVING, 2))
     times: dict[str, list[float]] = {"kernel": [], "dynamic_window": [], "robox": []}
     me = np.array([-3.0, 0.0])
@@ -109,7 +109,7 @@ def _timing_rows(settings: Settings, steps: int) -> list[dict[str, Any]]:
         ms = np.array(times[name]) * 1e3
         rows.append({"name": label, "median_ms": float(np.median(ms)), "p95_ms": float(np.percentile(ms, 95)),
                      "ratio_to_pythonrobotics_dwa": float(np.median(ms)) / PYTHONROBOTICS_DWA_MS,
-                     "note": what})  # fmt: skip
+                     "note": what})
     reference = f"PythonRobotics DWA {PYTHONROBOTICS_DWA_MS:g} ms a step (issue #17, not run here)"
     rows[-1]["note"] = f"{parts[-1][2]}; reference: {reference}"
     return rows
@@ -124,7 +124,7 @@ class Crossing:
 
 
 def _wander(world: World, targets: np.ndarray, speeds: np.ndarray, rng: np.random.Generator,
-            half: tuple[float, float]) -> list[RobotCommand]:  # fmt: skip
+            half: tuple[float, float]) -> list[RobotCommand]:
     """The wanderers' commands: straight to their points at their speeds, a new point when reached."""
     snap = world.snapshot().robots
     out = []
@@ -143,7 +143,7 @@ def crossing(settings: Settings, seed: int) -> Crossing:
     """One crossing with ``settings``' planner, navigator and safety; same seed, same scene."""
     sp = settings.sim
     world = World(settings.field, sp.physics, sp.robot, sp.ball, sp.kicker, sp.dribbler,
-                  robots_per_team={"blue": 1, "yellow": WANDERERS})  # fmt: skip
+                  robots_per_team={"blue": 1, "yellow": WANDERERS})
     f = settings.field_geometry()
     half = (f.half_length, f.half_width)
     rng = np.random.default_rng([seed, 41])
@@ -187,7 +187,7 @@ def crossing(settings: Settings, seed: int) -> Crossing:
 def _crossing_rows(settings: Settings, seeds: list[int]) -> list[dict[str, Any]]:
     rows = []
     chosen = {"errt_trajectory_dss": settings, "robox_estar_dss": robox_settings(settings),
-              "robox_estar": robox_settings(settings, safety=False)}  # fmt: skip
+              "robox_estar": robox_settings(settings, safety=False)}
     for method in METHODS:
         s = chosen[method]
         trials = [crossing(s, seed) for seed in seeds]
@@ -199,7 +199,7 @@ def _crossing_rows(settings: Settings, seeds: list[int]) -> list[dict[str, Any]]
             "least_clearance_m": float(min(t.min_clearance_m for t in trials)),
             "incomplete": sum(not math.isfinite(t.time_s) for t in trials),
             "brain_ms": float(np.median([t.brain_ms for t in trials])),
-        })  # fmt: skip
+        })
     return rows
 
 
@@ -225,7 +225,7 @@ def _match_rows(settings: Settings, seeds: list[int], seconds: float) -> list[di
                 "name": f"match_{pairing}_seed_{seed}", "goals_errt": goals[e], "goals_robox": goals[r],
                 "own_collisions_errt": own[e], "own_collisions_robox": own[r],
                 "brain_errt_ms": brain[e], "brain_robox_ms": brain[r], "realtime_factor": s["seconds"] / wall,
-            })  # fmt: skip
+            })
         rows += part
         rows.append({
             "name": f"total_{pairing}_{len(part)}_matches_{seconds:.0f}s",
@@ -235,7 +235,7 @@ def _match_rows(settings: Settings, seeds: list[int], seconds: float) -> list[di
             "brain_errt_ms": float(np.median([p["brain_errt_ms"] for p in part])),
             "brain_robox_ms": float(np.median([p["brain_robox_ms"] for p in part])),
             "realtime_factor": float(np.median([p["realtime_factor"] for p in part])),
-        })  # fmt: skip
+        })
     return rows
 
 

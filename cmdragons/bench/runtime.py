@@ -70,7 +70,7 @@ def _node(role: str, params: RuntimeParams, opponent: str, perception: str) -> s
                              "--set", f"runtime.field_name={params.field_name}",
                              "--set", f"runtime.vision_with_sim={str(params.vision_with_sim).lower()}",
                              "--set", f"runtime.realtime_priority={params.realtime_priority}",
-                             "--set", f"runtime.cpu_latency_us={params.cpu_latency_us}"])  # fmt: skip
+                             "--set", f"runtime.cpu_latency_us={params.cpu_latency_us}"])
 
 
 def _realtime_latency_rows(settings: Settings, seconds: float, rounds: int) -> list[dict[str, Any]]:
@@ -167,7 +167,7 @@ def _latency_rows(settings: Settings, seconds: float, rounds: int, suffix: str =
         p99s.append(float(np.percentile(ms, 99)))
         rows.append({"name": f"frame_to_command_{name}{suffix}", "frames": len(ms), "median_ms": medians[-1],
                      "p99_ms": p99s[-1], "added_median_ms": medians[-1] - medians[0],
-                     "added_p99_ms": p99s[-1] - p99s[0], "realtime_factor": float(np.mean(rtfs))})  # fmt: skip
+                     "added_p99_ms": p99s[-1] - p99s[0], "realtime_factor": float(np.mean(rtfs))})
     return rows
 
 
@@ -185,7 +185,7 @@ def _floor_row(settings: Settings, messages: int, size_bytes: int = 300) -> dict
         router.close()
     one_way = np.asarray(rtt[10:]) / 2
     return {"name": "zenoh_one_hop_floor", "messages": len(one_way), "bytes": size_bytes,
-            "median_ms": float(np.median(one_way)), "p99_ms": float(np.percentile(one_way, 99))}  # fmt: skip
+            "median_ms": float(np.median(one_way)), "p99_ms": float(np.percentile(one_way, 99))}
 
 
 def _throughput_row(settings: Settings, shared_memory: bool, frames: int, limit_s: float) -> dict[str, Any]:
@@ -224,7 +224,7 @@ def _throughput_row(settings: Settings, shared_memory: bool, frames: int, limit_
     elapsed = (got[-1] - t0) if got else float("nan")
     return {"name": f"camera_frames_{'shm' if shared_memory else 'tcp'}", "frames": len(got),
             "frames_per_s": len(got) / elapsed if got else 0.0,
-            "mb_per_s": len(got) * image.nbytes / 1e6 / elapsed if got else 0.0}  # fmt: skip
+            "mb_per_s": len(got) * image.nbytes / 1e6 / elapsed if got else 0.0}
 
 
 def _until(done: Callable[[], bool], timeout_s: float, what: str) -> None:
@@ -251,7 +251,7 @@ def _recovery_row(settings: Settings) -> dict[str, Any]:
     enough = threading.Event()
     taps = [Tap("bench:commands", ("commands/blue",), lambda _t, c: commands.append((time.perf_counter(),
                                                                                      c.frame_number))),
-            Tap("bench:truth", ("truth",), lambda _t, g: frames.append(g.frame_number))]  # fmt: skip
+            Tap("bench:truth", ("truth",), lambda _t, g: frames.append(g.frame_number))]
     result: dict[str, Any] = {}
     runner = threading.Thread(target=lambda: result.update(run_clock(
         spec, clock, 120.0, roles, extra=taps, should_stop=enough.is_set, err=io.StringIO())))  # "stepped without"
@@ -275,7 +275,7 @@ def _recovery_row(settings: Settings) -> dict[str, Any]:
         router.close()
     gone = [f for f in frames if killed_at < f < min(f for _, f in commands if f > killed_at)]
     return {"name": "team_node_recovery", "recovery_s": back_at - t_restart, "frames_without_team": len(gone),
-            "frames": result.get("frames", len(frames))}  # fmt: skip
+            "frames": result.get("frames", len(frames))}
 
 
 def run(settings: Settings, quick: bool) -> list[dict[str, Any]]:
@@ -285,11 +285,11 @@ def run(settings: Settings, quick: bool) -> list[dict[str, Any]]:
     rows = _latency_rows(dataclasses.replace(settings, runtime=normal), seconds, rounds)
     r = settings.runtime  # the real-time rows: the real-time scheduler and CPUs that wake at once
     realtime = dataclasses.replace(r, realtime_priority=r.realtime_priority or 10,
-                                   cpu_latency_us=r.cpu_latency_us if r.cpu_latency_us >= 0 else 0)  # fmt: skip
+                                   cpu_latency_us=r.cpu_latency_us if r.cpu_latency_us >= 0 else 0)
     spawn = multiprocessing.get_context("spawn")  # (never fork a process that has zenoh open)
     with concurrent.futures.ProcessPoolExecutor(1, mp_context=spawn) as pool:
         rows += pool.submit(_realtime_latency_rows, dataclasses.replace(settings, runtime=realtime), seconds,
-                            rounds).result()  # fmt: skip
+                            rounds).result()
     rows.append(_floor_row(settings, 200 if quick else 1000))
     n = 120 if quick else 600
     rows += [_throughput_row(settings, shm, n, 10.0 if quick else 20.0) for shm in (True, False)]

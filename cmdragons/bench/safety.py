@@ -99,17 +99,17 @@ def _layout(settings: Settings, n: int, rng: np.random.Generator) -> tuple[np.nd
         starts[idx, 0] = s * x
         # lateral slots, jittered but kept on the field (0.1 m from the touch lines at the most)
         starts[idx, 1] = np.clip(rng.permutation(slots)[: len(idx)] + rng.uniform(-jitter, jitter, len(idx)),
-                                 -edge - 0.3, edge + 0.3)  # fmt: skip
+                                 -edge - 0.3, edge + 0.3)
         goals[idx, 0] = -s * x
         goals[idx, 1] = np.clip(rng.permutation(slots)[: len(idx)] + rng.uniform(-jitter, jitter, len(idx)),
-                                -edge - 0.3, edge + 0.3)  # fmt: skip
+                                -edge - 0.3, edge + 0.3)
     return starts, goals
 
 
 def keep_right_targets(
     state: np.ndarray, goals: np.ndarray, headings: np.ndarray, control: ControlParams,
     half_size: tuple[float, float] = (math.inf, math.inf),
-) -> np.ndarray:  # fmt: skip
+) -> np.ndarray:
     """Targets (n, 5) for the controller: straight to the goal, or, when another robot stands in the
     way within ``LOOKAHEAD_M``, along a path through a waypoint ``PASS_M`` beside it.
 
@@ -164,7 +164,7 @@ class _StandIn:
         self.settings, self.goals, self.headings = settings, goals, headings
         self.half = (f.half_length, f.half_width)
         self.safety = make_safety(settings.safety, settings.control, settings.field.robot.radius_m,
-                                  field_world(f, defense_areas=False), "dss", stream=seed)  # fmt: skip
+                                  field_world(f, defense_areas=False), "dss", stream=seed)
 
     def drive(self, world: WorldState, n: int) -> list[RobotCommand]:
         seen = {r.id: r for r in world.robots}
@@ -183,7 +183,7 @@ def run_trial(settings: Settings, n: int, method: str, noise: str, seed: int) ->
     and noise for every method."""
     sp = settings.sim
     world = World(settings.field, sp.physics, sp.robot, sp.ball, sp.kicker, sp.dribbler,
-                  robots_per_team={"blue": n, "yellow": 0})  # fmt: skip
+                  robots_per_team={"blue": n, "yellow": 0})
     f = settings.field_geometry()
     world.place_ball(0.0, f.half_width + 0.15)  # in the boundary strip, out of the way
     layout_rng = np.random.default_rng([seed, n])
@@ -208,13 +208,13 @@ def run_trial(settings: Settings, n: int, method: str, noise: str, seed: int) ->
         snap = world.snapshot()
         noisy = snap.robots[:, 2:5] + noise_rng.normal(0.0, 1.0, (n, 3)) * np.array([s_xy, s_xy, s_theta])
         robots = tuple(RobotDetection("blue", int(r[1]), float(p[0]), float(p[1]), float(p[2]), 1.0, (0.0, 0.0))
-                       for r, p in zip(snap.robots, noisy, strict=True))  # fmt: skip
+                       for r, p in zip(snap.robots, noisy, strict=True))
         ball = (BallDetection(float(snap.ball[0]), float(snap.ball[1]), 1.0, (0.0, 0.0)),)
         t0 = time.perf_counter()
         seen = tracker.step([DetectionFrame(0, snap.frame_number, world.t, world.t, ball, robots)])
         if brain is not None:
             commands = brain.drive(seen, {i: it for i, it in intents.items() if any(r.id == i for r in seen.robots)},
-                                   game)  # fmt: skip
+                                   game)
         else:
             assert standin is not None
             commands = standin.drive(seen, n)
@@ -234,7 +234,7 @@ def run_trial(settings: Settings, n: int, method: str, noise: str, seed: int) ->
         n, method, noise, len(contacts), sum(c.relative_speed_m_s > FAST_M_S for c in contacts),
         sum(c.max_depth_m * 1e3 * c.duration_s for c in contacts), completion, done,
         float(np.median(spent)) * 1e3 if spent else 0.0,
-    )  # fmt: skip
+    )
 
 
 _SETTINGS: list[Settings] = []  # handed to the forked workers (settings hold mapping proxies that do not pickle)
@@ -253,7 +253,7 @@ def run(settings: Settings, quick: bool) -> list[dict[str, Any]]:
     chunk = max(1, trials // 4)
     methods = (*METHODS, STANDIN)
     jobs = [(n, m, z, seeds[i : i + chunk]) for n in robots for z in ("default", "high") for m in methods
-            for i in range(0, trials, chunk)]  # fmt: skip
+            for i in range(0, trials, chunk)]
     workers = max(1, min(2, os.cpu_count() or 1))
     results: list[TrialResult] = []
     _SETTINGS[:] = [settings]
@@ -276,5 +276,5 @@ def run(settings: Settings, quick: bool) -> list[dict[str, Any]]:
                     "completion_s": completion, "completion_ratio_to_none": completion / base,
                     "incomplete": sum(not r.completed for r in rs),
                     "ms_per_frame": ms, "ms_per_agent": ms / n,
-                })  # fmt: skip
+                })
     return rows

@@ -55,7 +55,7 @@ def _opencv_draw(model: CameraModel, league: LeagueParams, background: np.ndarra
         for (dx, dy), pink in zip(pat.dot_positions_m, pat.dot_is_pink(int(row[1])), strict=True):
             p = model.project_xy(np.array([row[2] + c * dx - s * dy, row[3] + s * dx + c * dy]), league.robot.height_m)
             cv2.circle(img, (int(p[0]), int(p[1])), int(pat.id_dot_diameter_m / 2 * scale),
-                       (200, 80, 255) if pink else (60, 230, 60), -1)  # fmt: skip
+                       (200, 80, 255) if pink else (60, 230, 60), -1)
     b = model.project_xy(snap.ball[:2], snap.ball[2])
     cv2.circle(img, (int(b[0]), int(b[1])), max(1, int(league.ball.radius_m * scale)), (0, 128, 255), -1)
     return img
@@ -75,7 +75,7 @@ def run(settings: Settings, quick: bool) -> list[dict[str, Any]]:
         ms = _physics_ms(sim, script, frames)
         med = float(np.median(ms))
         rows.append({"name": f"physics_{n}_robots", "median_ms": med, "p95_ms": float(np.percentile(ms, 95)),
-                     "realtime_factor": frame_ms / med})  # fmt: skip
+                     "realtime_factor": frame_ms / med})
 
     # rendering, per camera frame, next to the OpenCV baseline on the same snapshots
     sim, script = _simulator(settings, settings.field, render=True)
@@ -99,9 +99,9 @@ def run(settings: Settings, quick: bool) -> list[dict[str, Any]]:
     res = f"{m.width}x{m.height}"
     rows.append({"name": f"render_per_camera_{res}", "median_ms": float(np.median(ours)),
                  "p95_ms": float(np.percentile(ours, 95)),
-                 "ratio_to_opencv_flat": float(np.median(ours) / np.median(base))})  # fmt: skip
+                 "ratio_to_opencv_flat": float(np.median(ours) / np.median(base))})
     rows.append({"name": f"opencv_flat_per_camera_{res} (baseline)", "median_ms": float(np.median(base)),
-                 "p95_ms": float(np.percentile(base, 95))})  # fmt: skip
+                 "p95_ms": float(np.percentile(base, 95))})
 
     # the whole step: both cameras + scripted commands + physics, as `cmdragons sim` runs it
     step: list[float] = []
@@ -112,5 +112,5 @@ def run(settings: Settings, quick: bool) -> list[dict[str, Any]]:
         step.append((time.perf_counter() - t0) * 1e3)
     med = float(np.median(step))
     rows.append({"name": f"whole_step_{len(sim.cameras)}_cameras", "median_ms": med,
-                 "p95_ms": float(np.percentile(step, 95)), "realtime_factor": frame_ms / med})  # fmt: skip
+                 "p95_ms": float(np.percentile(step, 95)), "realtime_factor": frame_ms / med})
     return rows

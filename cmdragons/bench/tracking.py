@@ -138,14 +138,14 @@ def _timing(settings: Settings, frames: int) -> dict[str, Any]:
     times = []
     # detections as noisy as the tracker is configured to expect from vision
     sb, sr, sa = (settings.tracker.ball.measurement_sigma_m, settings.tracker.robot.measurement_sigma_m,
-                  settings.tracker.robot.measurement_sigma_rad)  # fmt: skip
+                  settings.tracker.robot.measurement_sigma_rad)
     for k in range(frames + 30):
         s = sim.world.snapshot()
         ball = (BallDetection(float(s.ball[0] + rng.normal(0, sb)), float(s.ball[1] + rng.normal(0, sb)), 1.0,
-                              (0.0, 0.0)),)  # fmt: skip
+                              (0.0, 0.0)),)
         robots = tuple(RobotDetection(TEAMS[int(r[0])], int(r[1]), float(r[2] + rng.normal(0, sr)),
                                       float(r[3] + rng.normal(0, sr)), float(r[4] + rng.normal(0, sa)), 1.0,
-                                      (0.0, 0.0)) for r in s.robots)  # fmt: skip
+                                      (0.0, 0.0)) for r in s.robots)
         det = DetectionFrame(0, s.frame_number, s.t, s.t, ball, robots)
         t0 = time.perf_counter()
         tracker.step([det])
@@ -153,7 +153,7 @@ def _timing(settings: Settings, frames: int) -> dict[str, Any]:
             times.append((time.perf_counter() - t0) * 1e3)
         sim.advance(script.commands(s))
     return {"name": "tracker_23_objects", "median_ms": float(np.median(times)),
-            "p95_ms": float(np.percentile(times, 95)), "objects": 1 + len(sim.world.robots)}  # fmt: skip
+            "p95_ms": float(np.percentile(times, 95)), "objects": 1 + len(sim.world.robots)}
 
 
 def run(settings: Settings, quick: bool) -> list[dict[str, Any]]:

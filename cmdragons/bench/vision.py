@@ -61,11 +61,11 @@ def _levels(default: RenderParams) -> dict[str, RenderParams]:
     return {
         "low": dataclasses.replace(
             default, noise_sigma_grey=1.0, vignetting_fraction=0.05, gradient_fraction=0.03, exposure_s=0.001
-        ),  # fmt: skip
+        ),
         "default": default,
         "high": dataclasses.replace(
             default, noise_sigma_grey=6.0, vignetting_fraction=0.25, gradient_fraction=0.15, exposure_s=0.004
-        ),  # fmt: skip
+        ),
     }
 
 
@@ -86,7 +86,7 @@ def opencv_baseline(image: NDArray[np.uint8], boxes: list[tuple[NDArray[np.uint8
 
 
 def _render(settings: Settings, models: list[CameraModel], render: RenderParams,
-            frames: int) -> Iterator[tuple[int, dict[int, NDArray[np.uint8]], GroundTruth]]:  # fmt: skip
+            frames: int) -> Iterator[tuple[int, dict[int, NDArray[np.uint8]], GroundTruth]]:
     """The scripted game's first ``frames`` frames through ``models``: (index, images, truth)."""
     sim_params = dataclasses.replace(settings.sim, render=render)
     sim = Simulator(settings.field, models, sim_params, seed=settings.sim.seed)
@@ -103,7 +103,7 @@ def _quality(name: str, settings: Settings, models: list[CameraModel], score: Sc
     row: Row = {"name": name, **score.summary()}
     if len(models) > 1:
         bias = ball_height_bias_m(score, {m.id: m.center for m in models},
-                                  settings.vision.ball.blob_height_above_centre_m)  # fmt: skip
+                                  settings.vision.ball.blob_height_above_centre_m)
         row["ball_height_bias_mm"] = bias * 1e3
     return row
 
@@ -160,10 +160,10 @@ def run(settings: Settings, quick: bool, frames: int | None = None, lab: bool = 
                 big_samples.append((cam, image.copy()))
     w, h = big_models[0].width, big_models[0].height
     rows.append(_quality(f"vision default, {w}x{h} ({len(big_models)} camera{'s' * (len(big_models) > 1)})",
-                         settings, big_models, big_score))  # fmt: skip
+                         settings, big_models, big_score))
     reps = 3 if quick else 10
     rows += _timing(settings, {m.id: VisionPipeline(settings.vision, settings.field, m) for m in models}, samples,
-                    reps)  # fmt: skip
+                    reps)
     rows += _timing(settings, big_pipes, big_samples, reps)
     if lab:
         from cmdragons.bench.vision_lab import lab_rows  # a lab's camera: the realistic preset, the real frame
@@ -180,7 +180,7 @@ def _big_cameras(settings: Settings) -> list[CameraModel]:
 
 
 def _timing(settings: Settings, pipes: dict[int, VisionPipeline], samples: list[tuple[int, NDArray[np.uint8]]],
-            reps: int) -> list[Row]:  # fmt: skip
+            reps: int) -> list[Row]:
     """Median and 95th percentile of the time per camera frame, all methods on the same frames: each
     method over all the frames in turn, round after round, so that a busy machine slows them alike.
     Each frame is first delivered into the input buffer, untimed, as a camera's capture, a video
@@ -191,7 +191,7 @@ def _timing(settings: Settings, pipes: dict[int, VisionPipeline], samples: list[
         raise ValueError("the OpenCV baseline uses YUV boxes: run the bench with colour_space yuv")
     # OpenCV's YCrCb holds V before U
     boxes = [(np.array([c.lo[0], c.lo[2], c.lo[1]], np.uint8), np.array([c.hi[0], c.hi[2], c.hi[1]], np.uint8))
-             for c in vis.colours.values()]  # fmt: skip
+             for c in vis.colours.values()]
     methods: dict[str, Callable[[int, NDArray[np.uint8]], object]] = {
         "cmvision + patterns": lambda cam, image: pipes[cam].process(image, 0, 0.0),
         "cmvision regions": lambda cam, image: pipes[cam].segmenter.regions(image),
@@ -214,4 +214,4 @@ def _timing(settings: Settings, pipes: dict[int, VisionPipeline], samples: list[
         {"name": f"{name} ({w}x{h})", "median_ms": float(np.median(v)), "p95_ms": float(np.percentile(v, 95)),
          "ratio_to_opencv": float(np.median(v)) / base, "speedup_vs_opencv": base / float(np.median(v))}
         for name, v in times.items()
-    ]  # fmt: skip
+    ]

@@ -67,12 +67,13 @@ def _lab_settings(settings: Settings) -> Settings:
     league = settings.field
     dims = dataclasses.replace(league.dims, line_width_m=LAB_LINE_WIDTH_M)
     league = dataclasses.replace(league, divisions={**league.divisions, league.division: dims},
-                                 ball=dataclasses.replace(league.ball, radius_m=LAB_BALL_RADIUS_M))  # fmt: skip
+                                 ball=dataclasses.replace(league.ball, radius_m=LAB_BALL_RADIUS_M))
     ids = tuple(range(dims.robots_per_team))
     pat = dataclasses.replace(settings.vision.patterns, min_dots=3, ids_in_play=ids)
     light = dataclasses.replace(settings.vision.light, follow=True)
-    return dataclasses.replace(settings, field=league, cameras=dataclasses.replace(settings.cameras, preset="realistic"),
-                               vision=dataclasses.replace(settings.vision, patterns=pat, light=light))  # fmt: skip
+    cameras = dataclasses.replace(settings.cameras, preset="realistic")
+    return dataclasses.replace(settings, field=league, cameras=cameras,
+                               vision=dataclasses.replace(settings.vision, patterns=pat, light=light))
 
 
 def _frames(settings: Settings, look: RealisticParams, n: int) -> Iterator[tuple[NDArray[np.uint8], GroundTruth]]:
@@ -101,7 +102,7 @@ def _colours(settings: Settings, images: Sequence[NDArray[np.uint8]], model: Cam
     rep = auto_samples(images, model, settings.field, vis.colour_space)
     names = {role: getattr(vis.roles, role) for role in ("ball", "blue", "yellow", "pink", "green")}
     boxes, _ = learn_boxes({names[r]: v for r, v in rep.samples.items()}, rep.background,
-                           {names[r]: v for r, v in rep.light.items()}, vis.colours, vis.colour_space)  # fmt: skip
+                           {names[r]: v for r, v in rep.light.items()}, vis.colours, vis.colour_space)
     return dataclasses.replace(vis, colours=boxes)
 
 
@@ -118,8 +119,9 @@ def _refused(image: NDArray[np.uint8], league: LeagueParams, height_m: float) ->
     field.yaml that leaves out a line the image shows, its centre circle say, is no wrong field:
     the fit to the lines it names is right, and taken.)"""
     dims = league.dims
-    wrong = [dataclasses.replace(dims, length_m=dims.length_m * 1.12), dataclasses.replace(dims, width_m=dims.width_m * 1.12),
-             dataclasses.replace(dims, center_circle_radius_m=dims.center_circle_radius_m * 1.2)]  # fmt: skip
+    wrong = [dataclasses.replace(dims, length_m=dims.length_m * 1.12),
+             dataclasses.replace(dims, width_m=dims.width_m * 1.12),
+             dataclasses.replace(dims, center_circle_radius_m=dims.center_circle_radius_m * 1.2)]
     refused = 0
     h, w = image.shape[:2]
     for d in wrong:
@@ -137,7 +139,7 @@ def _refused(image: NDArray[np.uint8], league: LeagueParams, height_m: float) ->
 
 
 def _score(vis: VisionParams, league: LeagueParams, model: CameraModel,
-           frames: Sequence[tuple[NDArray[np.uint8], GroundTruth]]) -> Score:  # fmt: skip
+           frames: Sequence[tuple[NDArray[np.uint8], GroundTruth]]) -> Score:
     pipe = VisionPipeline(vis, league, model)
     score = Score()
     for k, (image, truth) in enumerate(frames):
@@ -148,7 +150,7 @@ def _score(vis: VisionParams, league: LeagueParams, model: CameraModel,
 def _quality(name: str, score: Score) -> Row:
     s = score.summary()
     keys = ("robot_detection_rate", "id_accuracy", "ball_detection_rate", "false_per_frame", "robot_rms_mm",
-            "ball_rms_mm", "camera_frames")  # fmt: skip
+            "ball_rms_mm", "camera_frames")
     return {"name": name, **{k: s[k] for k in keys}}
 
 
@@ -173,11 +175,11 @@ def lab_rows(settings: Settings, quick: bool) -> list[Row]:
     rows: list[Row] = [{"name": "realistic calibration from the lines", "reported_rms_px": fit.rms_px,
                         "true_rms_px": true_error_px(fit.params, true_model.params, lab.field),
                         "position_error_mm": dist * 1e3, "angle_error_deg": angle, "wrong_refused": refused,
-                        "wrong_tried": tried}]  # fmt: skip
+                        "wrong_tried": tried}]
     fixed = _colours(lab, [first[k][0] for k in learn], model)
     for name, frames in rendered.items():
         rows.append(_quality(f"realistic {name}, all from lamps' first {LEARN_S:g} s", _score(fixed, lab.field, model,
-                                                                                               frames)))  # fmt: skip
+                                                                                               frames)))
     for name, frames in rendered.items():
         own = _colours(lab, [frames[k][0] for k in learn], model)
         rows.append(_quality(f"realistic {name}, colours learnt on it", _score(own, lab.field, model, frames)))
@@ -187,7 +189,7 @@ def lab_rows(settings: Settings, quick: bool) -> list[Row]:
 
 
 def _timing(vis: VisionParams, league: LeagueParams, model: CameraModel, images: Sequence[NDArray[np.uint8]],
-            reps: int) -> Row:  # fmt: skip
+            reps: int) -> Row:
     pipe = VisionPipeline(vis, league, model)
     pipe.process(images[0], 0, 0.0)  # numba compilation or cache load
     frame = np.empty_like(images[0])
@@ -198,8 +200,9 @@ def _timing(vis: VisionParams, league: LeagueParams, model: CameraModel, images:
             t0 = time.perf_counter()
             pipe.process(frame, 0, 0.0)
             times.append((time.perf_counter() - t0) * 1e3)
-    return {"name": f"realistic cmvision + patterns ({model.width}x{model.height})", "median_ms": float(np.median(times)),
-            "p95_ms": float(np.percentile(times, 95))}  # fmt: skip
+    return {"name": f"realistic cmvision + patterns ({model.width}x{model.height})",
+            "median_ms": float(np.median(times)),
+            "p95_ms": float(np.percentile(times, 95))}
 
 
 def _real_frame_row(settings: Settings) -> Row:
@@ -217,16 +220,16 @@ def _real_frame_row(settings: Settings) -> Row:
     # the lab's field.yaml: a 5.54 x 3.77 m field between walls, no centre circle, 84 mm balls; its
     # vision.yaml: the covers' ids 0-7, three dots of four read, several balls
     lab = FieldDims(length_m=5.54, width_m=3.77, boundary_width_m=0.0, goal_width_m=1.0, defense_width_m=2.0,
-                    defense_depth_m=1.0, center_circle=False, goal_to_goal_line=False, outer_lines="walls")  # fmt: skip
+                    defense_depth_m=1.0, center_circle=False, goal_to_goal_line=False, outer_lines="walls")
     league = dataclasses.replace(settings.field, divisions={**settings.field.divisions, "B": lab}, division="B",
-                                 ball=BallShape(radius_m=LAB_BALL_RADIUS_M))  # fmt: skip
+                                 ball=BallShape(radius_m=LAB_BALL_RADIUS_M))
     h, w = image.shape[:2]
     start = rough_start(CameraParams(id=0, resolution_px=(w, h), principal_point_px=(w / 2, h / 2)), 4.0,
-                        (-3.45, -1.94, 3.45, 1.94))  # fmt: skip
+                        (-3.45, -1.94, 3.45, 1.94))
     model = CameraModel(calibrate_from_lines(image, league, start).params)
     vis = settings.vision
     vis = dataclasses.replace(vis, patterns=dataclasses.replace(vis.patterns, min_dots=3, ids_in_play=tuple(range(8))),
-                              ball=dataclasses.replace(vis.ball, max_balls=4))  # fmt: skip
+                              ball=dataclasses.replace(vis.ball, max_balls=4))
     vis = _colours(dataclasses.replace(settings, field=league, vision=vis), [image], model)
     det = VisionPipeline(vis, league, model).process(image, 0, 0.0)
     near = 10.0
@@ -240,5 +243,5 @@ def _real_frame_row(settings: Settings) -> Row:
     found = sum(any(close(b.pixel, t["pixel"]) for b in det.balls) for t in balls)
     false_balls = sum(not any(close(b.pixel, t["pixel"]) for t in balls) for b in det.balls)
     return {"name": name, "covers_right": right, "covers": len(truth["robots"]), "balls_found": found,
-            "balls": len(balls), "false_robots": false_robots, "false_balls": false_balls}  # fmt: skip
+            "balls": len(balls), "false_robots": false_robots, "false_balls": false_balls}
 

@@ -80,7 +80,7 @@ def _common(parser: argparse.ArgumentParser, example: str) -> None:
     parser.add_argument(
         "--set", metavar="KEY=VALUE", action="append", default=[],
         help=f"override one config value, e.g. --set {example} (repeatable)",
-    )  # fmt: skip
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -91,7 +91,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     p = sub.add_parser("sim", help="run the simulator with scripted motion; record camera frames and truth; or "
-                       "(--serve) serve it to teams as a league simulator")  # fmt: skip
+                       "(--serve) serve it to teams as a league simulator")
     _common(p, "sim.physics.substeps=8")
     p.add_argument("--seconds", type=_positive, default=None,
                    help="simulated seconds (default 10; with --serve: until interrupted)")
@@ -159,7 +159,7 @@ def build_parser() -> argparse.ArgumentParser:
         "vision", help="detect ball and robots in camera frames (also: vision calibrate ..., vision tune ...)",
         description="SOURCE: a recording folder, a video file, an image folder or a glob (one per camera). "
         "`cmdragons vision calibrate -h` and `cmdragons vision tune -h` for the other two commands.",
-    )  # fmt: skip
+    )
     _common(p, "vision.regions.merge_gap_px=2")
     p.add_argument("source", nargs="+", metavar="SOURCE")
     p.add_argument("--out", metavar="DIR", default=None, help="output folder (default logs/<time>-vision)")
@@ -234,13 +234,13 @@ def main(argv: Sequence[str] | None = None) -> int:
             if args.command == "play":
                 if args.team != "blue":
                     print("cmdragons play: --team is for an outside simulator: in ours, our team plays blue",
-                          file=sys.stderr)  # fmt: skip
+                          file=sys.stderr)
                     return 2
                 args.opponent = args.opponent or "simple"
                 args.perception = args.perception or "vision"
             if args.command == "play" and args.distributed and args.opponent == "simulation":
                 print("cmdragons play: --opponent simulation plays in the embedded match: leave out --distributed",
-                      file=sys.stderr)  # fmt: skip
+                      file=sys.stderr)
                 return 2
             if args.command == "play" and args.distributed:
                 return play_distributed(args, stop)
@@ -265,7 +265,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             return 2
         except KeyboardInterrupt:
             print(f"cmdragons {args.command}: interrupted by {stop.signal or 'SIGINT'} before any result; "
-                  "nothing more was written", file=sys.stderr)  # fmt: skip
+                  "nothing more was written", file=sys.stderr)
             return stop.exit_code or 130
     return 2
 
@@ -323,7 +323,7 @@ def _cmd_sim(args: argparse.Namespace, stop: Interrupt) -> int:
 
 
 def _finish_sim(args: argparse.Namespace, stop: Interrupt, sim: Any, models: Sequence[Any], folder: Path,
-                images: dict[int, Any], wall: float, n_frames: int) -> int:  # fmt: skip
+                images: dict[int, Any], wall: float, n_frames: int) -> int:
     """summary.json, the line that sums the run up, and the snapshot of the last frame's ``images``."""
     import cv2
 
@@ -337,7 +337,7 @@ def _finish_sim(args: argparse.Namespace, stop: Interrupt, sim: Any, models: Seq
     summary["cycle_ms"] = {
         name: {"median": float(np.median(v)), "p95": float(np.percentile(v, 95))}
         for name, v in (("physics", sim.times.physics_ms), ("render", sim.times.render_ms)) if v
-    }  # fmt: skip
+    }
     (folder / "summary.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
     faults = sum(summary["command_faults"].values())
     score = summary["score"]
@@ -351,11 +351,11 @@ def _finish_sim(args: argparse.Namespace, stop: Interrupt, sim: Any, models: Seq
     code = stop.exit_code
     if args.snapshot and images and not cv2.imwrite(args.snapshot, tile_cameras(images, models)):
         print(f"sim: could not write the snapshot {args.snapshot} (summary.json is written); give a .png path",
-              file=sys.stderr)  # fmt: skip
+              file=sys.stderr)
         code = code or 1
     if stop.requested:
         print(f"sim: interrupted by {stop.signal} after {plural(summary['frames'], 'frame')} of {n_frames}: "
-              "the output so far is closed and readable, summary.json says \"interrupted\": true")  # fmt: skip
+              "the output so far is closed and readable, summary.json says \"interrupted\": true")
     print(f"sim: output -> {folder}")
     return code
 
@@ -386,7 +386,7 @@ def _play(args: argparse.Namespace, stop: Interrupt, status: Any) -> int:
     overrides += [f"sim.referee.rules={args.rules}"] if args.rules else []
     if args.opponent_set and args.opponent != "self":
         print(f"cmdragons play: --opponent-set configures a copy of our team: it needs --opponent self, "
-              f"not {args.opponent}", file=sys.stderr)  # fmt: skip
+              f"not {args.opponent}", file=sys.stderr)
         return 2
     settings = load_settings(args.config, overrides)
     theirs = load_team_settings(args.config, overrides, args.opponent_set) if args.opponent_set else None
@@ -397,22 +397,22 @@ def _play(args: argparse.Namespace, stop: Interrupt, status: Any) -> int:
     n_frames = max(1, round(args.seconds * fps))
     game = [GameState(0.0)]  # the referee's latest word, for the progress bar
     scene = SceneStage(log, settings.field_geometry(), settings.field.robot.radius_m, settings.field.robot.height_m,
-                       settings.field.ball.radius_m)  # fmt: skip
+                       settings.field.ball.radius_m)
     report = ReportStage(OURS)
     extra: list[Stage] = [LoggerStage(log), scene, report,
-                          Tap("progress", ("referee",), lambda _topic, g: game.__setitem__(0, g))]  # fmt: skip
+                          Tap("progress", ("referee",), lambda _topic, g: game.__setitem__(0, g))]
     video = None
     if args.video:
         video = MatchVideoStage(folder / "match.mp4", args.view, OURS, settings.camera_models(),
                                 settings.field_geometry(), settings.field.robot.radius_m, settings.field.robot.height_m,
-                                fps)  # fmt: skip
+                                fps)
         extra.append(video)
     watch = CompileWatch()
     built: list[Match] = []
     try:
         def build() -> Match:
             return Match(settings, args.opponent, args.perception, seed=args.seed, render=images, extra=extra,
-                         opponent_settings=theirs)  # fmt: skip
+                         opponent_settings=theirs)
 
         def prepare() -> None:
             """A first run builds the match while its kernels compile in other processes, and loads
@@ -433,7 +433,7 @@ def _play(args: argparse.Namespace, stop: Interrupt, status: Any) -> int:
             watch.start()
             run_shown(lambda _i: match.step(), n_frames, stop, progress, task,
                       lambda _i: f"t={game[0].t:6.1f}s  blue {game[0].score_blue}:{game[0].score_yellow} yellow  "
-                                 f"{game[0].command}")  # fmt: skip
+                                 f"{game[0].command}")
         with stop.shield():
             wall = time.perf_counter() - wall0
             summary = match.summary()  # the stages' summaries go into the log as well
@@ -455,7 +455,7 @@ def _play(args: argparse.Namespace, stop: Interrupt, status: Any) -> int:
         summary["realtime_factor"] = round(summary["seconds"] / run_wall, 2) if run_wall > 0 else None
         geometry = settings.field_geometry()
         _finish_play(folder, report.collector.result(), summary, args, stop,
-                     (geometry.half_length, geometry.half_width))  # fmt: skip
+                     (geometry.half_length, geometry.half_width))
     return stop.exit_code
 
 
@@ -466,7 +466,7 @@ def _utc(t: float) -> str:
 
 
 def _finish_play(folder: Path, run: RunData, summary: dict[str, Any], args: argparse.Namespace, stop: Interrupt,
-                 half_size_m: tuple[float, float]) -> None:  # fmt: skip
+                 half_size_m: tuple[float, float]) -> None:
     """summary.json (with its warnings), the match report of ``run`` and the summary lines; the last
     line names the output folder."""
     from cmdragons.runtime.report import run_warnings, write_report
@@ -481,7 +481,7 @@ def _finish_play(folder: Path, run: RunData, summary: dict[str, Any], args: argp
     brain = summary["cycle_ms"].get("brain", {}).get("median", float("nan"))
     rtf = summary["realtime_factor"]
     compile_note = f", not counting {summary['compile_seconds']:.0f} s of first-run compile" \
-        if summary["compile_seconds"] >= 1 else ""  # fmt: skip
+        if summary["compile_seconds"] >= 1 else ""
     played = f"{summary['seconds']:.1f} s of {args.seconds:g} s" if stop.requested else f"{summary['seconds']:.0f} s"
     print(
         f"play: {played} against {args.opponent} ({args.perception}) in {summary['wall_seconds']:.1f} s "
@@ -499,7 +499,7 @@ def _finish_play(folder: Path, run: RunData, summary: dict[str, Any], args: argp
         print(f"play: warning: {w}")
     if stop.requested:
         print(f"play: interrupted by {stop.signal}: the output so far is closed and readable, "
-              "summary.json says \"interrupted\": true")  # fmt: skip
+              "summary.json says \"interrupted\": true")
     files = ["run.mcap", "summary.json"] + (["match.mp4"] if args.video and (folder / "match.mp4").exists() else [])
     files += [report.name] if report is not None else []
     print(f"play: {', '.join(files)} -> {folder}")
@@ -517,7 +517,7 @@ def physics_line(physics: dict[str, Any]) -> str:
             continue
         state = "in use" if e["used"] else "confident" if e["confident"] else "unsure"
         parts.append(f"{_FACT_WORDS.get(name, name)} {e['value_m_s2']:.2f} (configured {e['configured_m_s2']:g}, "
-                     f"{plural(e['samples'], 'window')}, {state})")  # fmt: skip
+                     f"{plural(e['samples'], 'window')}, {state})")
     return "physics measured (m/s²): " + ("; ".join(parts) if parts else "nothing yet")
 
 
@@ -535,11 +535,11 @@ def _their_line(summary: dict[str, Any]) -> str:
     brain = summary["cycle_ms"].get("opponent_brain", {}).get("median", float("nan"))
     return (f"; theirs: {plural(them['shots'], 'shot')}, {plural(them['collisions']['own'], 'own collision')}"
             f"{_pushed(them['collisions'])}, "
-            f"brain {brain:.2f} ms median")  # fmt: skip
+            f"brain {brain:.2f} ms median")
 
 
 def _compile_kernels(args: argparse.Namespace, settings: Settings, images: bool,
-                     meanwhile: Callable[[], None]) -> float:  # fmt: skip
+                     meanwhile: Callable[[], None]) -> float:
     """Compile the play's numba kernels before the match when they have no cache yet, with a
     progress line, running ``meanwhile`` as it goes; returns the wall seconds it took (0 when every
     kernel was cached, and then ``meanwhile`` is not run)."""
@@ -565,7 +565,7 @@ def _compile_kernels(args: argparse.Namespace, settings: Settings, images: bool,
         progress.update(task, completed=parts, info=f"{counted[0]} kernels, cached")
     if args.no_progress:
         print(f"{args.command}: compiled {counted[0]} kernels in {seconds:.0f} s (cached for next time)",
-              file=sys.stderr, flush=True)  # fmt: skip
+              file=sys.stderr, flush=True)
     return seconds
 
 
@@ -593,7 +593,7 @@ def _cmd_vision(args: argparse.Namespace) -> int:
         try:
             summary = run_vision(sources, {m.id: m for m in settings.camera_models()}, settings.vision, settings.field,
                                  folder, args.video, fps, recording, lambda n: progress.advance(task, n),
-                                 args.overlay)  # fmt: skip
+                                 args.overlay)
         except (SourceError, RecordingError) as exc:
             print(f"cmdragons vision: {exc}", file=sys.stderr)
             return 2
@@ -603,16 +603,16 @@ def _cmd_vision(args: argparse.Namespace) -> int:
     print(f"vision: {summary.frames} frames from {len(sources)} camera(s), {d['captures']} captures; the whole "
           f"field per capture (any camera): {d['robots_per_capture']:.2f} robots, the ball in "
           f"{100 * d['ball_seen_share']:.0f} %; " + (f"{ms:.2f} ms per frame (median)" if ms else "no frame")
-          + f" -> {folder}")  # fmt: skip
+          + f" -> {folder}")
     if args.overlay:
         pngs = len(list((folder / "overlay").glob("*.png"))) if (folder / "overlay").is_dir() else 0
         videos = sorted(p.name for p in folder.glob("annotated_camera_*.mp4"))
         print("vision: overlays -> " + ", ".join(([f"{pngs} PNG in {folder / 'overlay'}"] if pngs else [])
-                                                   + [str(folder / v) for v in videos]))  # fmt: skip
+                                                   + [str(folder / v) for v in videos]))
     for name, frames in d["bad_frames"].items():
         if frames:
             print(f"vision: {len(frames)} {name.replace('_', ' ')} frame(s): {', '.join(frames[:20])}"
-                  + (" ..." if len(frames) > 20 else ""))  # fmt: skip
+                  + (" ..." if len(frames) > 20 else ""))
     for message in summary.broken_off:
         print(f"cmdragons vision: {message}", file=sys.stderr)
     if summary.score:
@@ -659,7 +659,7 @@ def _cmd_bench(args: argparse.Namespace) -> int:
             write_json(args.json, args.suite, rows)
         except OSError as exc:  # checked before the bench; gone since (a folder removed, a full disk)
             print(f"cmdragons bench: --json {args.json}: not written ({exc.strerror}); the table above has "
-                  "the rows", file=sys.stderr)  # fmt: skip
+                  "the rows", file=sys.stderr)
             return 2
     return 0
 

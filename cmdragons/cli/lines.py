@@ -27,5 +27,5 @@ def rules_line(rules: dict[str, Any], ours: str = "blue") -> str:
         shootout = f", shootout {shot['scored']}/{shot['taken']}" if shot.get("taken") else ""
         parts.append(f"{team} ({who}) {plural(fouls['total'], 'foul')}{f' ({kinds})' if kinds else ''}, "
                      f"cards {cards['yellow']} yellow {cards['red']} red, placements {placed['succeeded']}/"
-                     f"{placed['tried']}{median}{cut}{shootout}")  # fmt: skip
+                     f"{placed['tried']}{median}{cut}{shootout}")
     return "rules: " + "; ".join(parts)

@@ -24,7 +24,7 @@ def _refused(args: argparse.Namespace) -> str | None:
     """Why these options cannot play in an outside simulator (None: they can)."""
     if args.opponent not in (None, "none", "self"):
         return (f"--opponent {args.opponent} plays in our own simulator; in an outside one the other side is our "
-                "team too (self) or its robots stand idle (none)")  # fmt: skip
+                "team too (self) or its robots stand idle (none)")
     if args.perception not in (None, "vision"):
         return "--perception truth needs our own simulator's truth: an outside simulator's vision is all we see"
     if args.distributed:
@@ -71,7 +71,7 @@ def play_outside(args: argparse.Namespace, stop: Interrupt, compile_kernels: Cal
     where = f"{p.vision.group}:{p.vision.port}"
     compile_kernels(args, settings, False, lambda: None)
     receiver = MulticastReceiver(p.vision.group, p.vision.port, p.interface, p.receive_buffer_bytes,
-                                 p.max_datagram_bytes)  # fmt: skip
+                                 p.max_datagram_bytes)
     match: OutsideMatch | None = None
     log = video = None
     try:
@@ -90,13 +90,13 @@ def play_outside(args: argparse.Namespace, stop: Interrupt, compile_kernels: Cal
         log = RunLog(folder / "run.mcap")
         game = [GameState(0.0)]
         scene = SceneStage(log, geometry, settings.field.robot.radius_m, settings.field.robot.height_m,
-                           settings.field.ball.radius_m)  # fmt: skip
+                           settings.field.ball.radius_m)
         report = ReportStage(ours, positions=f"world/{ours}")
         extra: list[Stage] = [LoggerStage(log), scene, report,
-                              Tap("progress", ("referee",), lambda _topic, g: game.__setitem__(0, g))]  # fmt: skip
+                              Tap("progress", ("referee",), lambda _topic, g: game.__setitem__(0, g))]
         if args.video:  # drawn from the log once the match is over: the match is in real time
             video = MatchVideoStage(folder / "match.mp4", "field", ours, [], geometry, settings.field.robot.radius_m,
-                                    settings.field.robot.height_m, settings.sim.physics.frame_rate_hz)  # fmt: skip
+                                    settings.field.robot.height_m, settings.sim.physics.frame_rate_hz)
         warm_team(settings)
         match = OutsideMatch(settings, kind, teams, heard, receiver, extra)
         match.skip_stale()  # what came while the team was built is gone by now
@@ -148,7 +148,7 @@ def _draw(video: Any, log: Any, ours: str) -> None:
 
 
 def _finish(folder: Any, run: Any, summary: dict[str, Any], args: argparse.Namespace,
-            half_size_m: tuple[float, float]) -> None:  # fmt: skip
+            half_size_m: tuple[float, float]) -> None:
     """summary.json, the report and the summary lines; the last names the output folder."""
     from cmdragons.runtime.report import run_warnings, write_report
 
@@ -163,11 +163,11 @@ def _finish(folder: Any, run: Any, summary: dict[str, Any], args: argparse.Names
           f"({summary['realtime_factor']}x real time): {summary['frames']} frames, {summary['frames_behind']} "
           f"came while we were busy; brain {brain.get('median', float('nan')):.2f} ms median, "
           f"{brain.get('p95', float('nan')):.2f} ms p95; cameras {cams}; field {length:g} x {width:g} m "
-          f"(division {summary['division']})")  # fmt: skip
+          f"(division {summary['division']})")
     if "score" in summary:  # refereed by ours on the tracked world
         score = summary["score"]
         print(f"play: refereed on our tracked world: blue {score['blue']}:{score['yellow']} yellow, "
-              f"{plural(summary['balls_out'], 'ball')} out, {plural(summary['kicks'], 'kick')} seen")  # fmt: skip
+              f"{plural(summary['balls_out'], 'ball')} out, {plural(summary['kicks'], 'kick')} seen")
         if summary["rules"].get("rules") == "full":
             print("play: " + rules_line(summary["rules"], args.team))
     for w in summary["warnings"]:

@@ -27,7 +27,7 @@ def progress_bar(enabled: bool, counts: bool = True):  # type: ignore[no-untyped
         TextColumn("[bold]{task.description}"), BarColumn(), *([MofNCompleteColumn()] if counts else []),
         TextColumn("{task.fields[info]}"), TimeElapsedColumn(), TimeRemainingColumn(), disable=not enabled,
         transient=False,
-    )  # fmt: skip
+    )
 
 
 def compile_bar(enabled: bool, console: Any = None):  # type: ignore[no-untyped-def]
@@ -39,7 +39,7 @@ def compile_bar(enabled: bool, console: Any = None):  # type: ignore[no-untyped-
         TextColumn("[bold]{task.description}"), BarColumn(bar_width=10), MofNCompleteColumn(),
         TextColumn("parts, {task.fields[info]}"), TimeElapsedColumn(), disable=not enabled, transient=False,
         console=console,
-    )  # fmt: skip
+    )
 
 
 def starting(enabled: bool, text: str) -> Any:
@@ -58,7 +58,7 @@ def starting(enabled: bool, text: str) -> Any:
 
 
 def run_shown(step: Callable[[int], None], n: int, stop: Interrupt, progress: Any, task: Any,
-              info: Callable[[int], str]) -> int:  # fmt: skip
+              info: Callable[[int], str]) -> int:
     """:func:`~cmdragons.runtime.bus.run_frames` with the bar ``task`` of ``progress`` moved on
     (``info(i)``: its text after frame ``i``) every few frames and on the last, until ``stop`` is
     requested; the frames run."""

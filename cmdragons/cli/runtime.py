@@ -21,7 +21,7 @@ __all__ = ["add_parsers", "cmd_log", "cmd_node", "cmd_replay", "play_distributed
 
 def _match_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--opponent", choices=("simple", "defend", "self", "none", "outside"), default="simple",
-                   help="as cmdragons play: every node of a match must be given the same")  # fmt: skip
+                   help="as cmdragons play: every node of a match must be given the same")
     p.add_argument("--perception", choices=("vision", "truth"), default="vision", help="as cmdragons play")
     p.add_argument("--seed", type=int, default=None, help="override sim.seed (every node the same)")
 
@@ -71,9 +71,9 @@ def add_parsers(sub: Any, common: Callable[[argparse.ArgumentParser, str], None]
                    help="league log: a match our team played with this config; the tracker takes the brain's commands "
                    "as the robots' control input, as in the match (without: the detections alone)")
     p.add_argument("--from", dest="start", type=_non_negative, default=0.0, metavar="S",
-                   help="start S seconds into the log (default 0)")  # fmt: skip
+                   help="start S seconds into the log (default 0)")
     p.add_argument("--speed", type=_speed, default=1.0, metavar="X",
-                   help="X times the log's pace (default 1: as recorded)")  # fmt: skip
+                   help="X times the log's pace (default 1: as recorded)")
     p.add_argument("--skip", action="append", default=[], metavar="TOPIC",
                    help="leave out a topic or pattern (repeatable), e.g. --skip 'commands/blue' for a live blue team")
     p.add_argument("--wait", default=None, metavar="ROLES",
@@ -149,12 +149,12 @@ def cmd_node(args: argparse.Namespace, stop: Interrupt) -> int:
                 folder = Path(args.out) if args.out else run_folder("play")
                 folder.mkdir(parents=True, exist_ok=True)
                 summary = run_clock(spec, transport, args.seconds, ["sim", *roles], realtime=args.realtime,
-                                    should_stop=lambda: stop.requested)  # fmt: skip
+                                    should_stop=lambda: stop.requested)
                 summary["interrupted"] = stop.requested
                 write_summary(folder, summary)
                 s = summary.get("score", {})
                 print(f"node sim: {summary.get('frames', 0)} frames, score blue {s.get('blue')}:{s.get('yellow')} "
-                      f"yellow, {summary.get('realtime_factor')}x real time -> {folder}")  # fmt: skip
+                      f"yellow, {summary.get('realtime_factor')}x real time -> {folder}")
                 return stop.exit_code
             extra: list[Any] = []
             if args.role == "log":
@@ -195,7 +195,7 @@ def play_distributed(args: argparse.Namespace, stop: Interrupt) -> int:
             if role != "sim":
                 extra = ["--out", str(folder)] if role == "log" else []
                 children.append(subprocess.Popen([sys.executable, "-m", "cmdragons.cli", "node", role, *common,
-                                                  *extra]))  # fmt: skip
+                                                  *extra]))
         wall0 = time.perf_counter()
         with stop.soft():
             summary = run_clock(spec, transport, args.seconds, roles, should_stop=lambda: stop.requested)
@@ -206,7 +206,7 @@ def play_distributed(args: argparse.Namespace, stop: Interrupt) -> int:
         s = summary.get("score", {})
         print(f"play --distributed: {len(roles)} nodes, {summary.get('frames', 0)} frames in "
               f"{time.perf_counter() - wall0:.1f} s ({summary.get('realtime_factor')}x real time), score blue "
-              f"{s.get('blue')}:{s.get('yellow')} yellow -> {folder}")  # fmt: skip
+              f"{s.get('blue')}:{s.get('yellow')} yellow -> {folder}")
         return stop.exit_code
     finally:
         with stop.shield():
@@ -279,7 +279,7 @@ def cmd_log(args: argparse.Namespace) -> int:
         d = json.loads(run_summary.read_text())
         s = d.get("score", {})
         print(f"summary: score blue {s.get('blue')}:{s.get('yellow')} yellow, seed {d.get('seed')}, "
-              f"{d.get('seconds')} s, kicks {d.get('kicks')}, shots {d.get('shots')}")  # fmt: skip
+              f"{d.get('seconds')} s, kicks {d.get('kicks')}, shots {d.get('shots')}")
     return 0
 
 
@@ -324,7 +324,7 @@ def cmd_replay(args: argparse.Namespace, stop: Interrupt) -> int:
                 transport.wait_for(lambda: stop.requested, params.settle_s)
             result = replay(path, transport, args.start, args.speed, skip=args.skip, wait_for=wait,
                             wait_timeout_s=params.start_timeout_s, should_stop=lambda: stop.requested,
-                            on_progress=show)  # fmt: skip
+                            on_progress=show)
     except (LogError, TimeoutError) as exc:
         print(f"cmdragons replay: {exc}", file=sys.stderr)
         return 2
@@ -335,7 +335,7 @@ def cmd_replay(args: argparse.Namespace, stop: Interrupt) -> int:
                 router.close()
     cut = f", interrupted by {stop.signal}" if result.interrupted else ""
     print(f"replay: {result.messages} messages, log time {result.first_s - first:.2f} .. {result.last_s - first:.2f} s "
-          f"at {args.speed:g}x on cmdragons/{params.field_name}{cut}")  # fmt: skip
+          f"at {args.speed:g}x on cmdragons/{params.field_name}{cut}")
     return stop.exit_code
 
 
@@ -351,10 +351,10 @@ def _replay_league(args: argparse.Namespace, path: Path, stop: Interrupt) -> int
 
     zenoh_only = [name for name, given in (("--from", args.start != 0.0), ("--speed", args.speed != 1.0),
                                            ("--skip", bool(args.skip)), ("--wait", args.wait is not None),
-                                           ("--router", args.router)) if given]  # fmt: skip
+                                           ("--router", args.router)) if given]
     if zenoh_only:
         print(f"cmdragons replay: {', '.join(zenoh_only)} are for MCAP logs on zenoh; a league log plays into our "
-              "tracker and brain as fast as it goes: leave them out", file=sys.stderr)  # fmt: skip
+              "tracker and brain as fast as it goes: leave them out", file=sys.stderr)
         return 2
     settings = load_settings(args.config, args.set)
     folder = run_folder("replay", args.out, overwrite=args.overwrite)
@@ -369,7 +369,7 @@ def _replay_league(args: argparse.Namespace, path: Path, stop: Interrupt) -> int
                     progress.update(task, completed=n, info=f"{n} records")
 
             result = replay_league_log(path, settings, args.team, extra=(LoggerStage(log),), own=args.own,
-                                       should_stop=lambda: stop.requested, on_record=show)  # fmt: skip
+                                       should_stop=lambda: stop.requested, on_record=show)
     except (LogFileError, LogError) as exc:
         print(f"cmdragons replay: {exc}", file=sys.stderr)
         return 2
@@ -377,19 +377,19 @@ def _replay_league(args: argparse.Namespace, path: Path, stop: Interrupt) -> int
         with stop.shield():
             log.close()
     span = (result.last_ns - result.first_ns) / 1e9 if result.first_ns is not None and result.last_ns is not None \
-        else 0.0  # fmt: skip
+        else 0.0
     vision = result.figures.get("ssl/vision_in", {})
     tracker = result.figures.get(f"tracker/{args.team}", {})
     summary = {"log": str(path), "team": args.team, "own": args.own, "records": result.records,
                "cameras": result.cameras, "seconds": round(span, 3), "truncated": result.truncated,
                "interrupted": result.interrupted, "field_m": list(result.field_m), "field_from": result.field_from,
                "vision": vision,
-               "referee": result.figures.get("ssl/referee_in", {}), "tracker": tracker}  # fmt: skip
+               "referee": result.figures.get("ssl/referee_in", {}), "tracker": tracker}
     (folder / "summary.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
     dropped = vision.get("dropped", {})
     print(f"replay: {path}: {sum(result.records.values())} records over {span:.2f} s, cameras "
           f"{', '.join(map(str, result.cameras)) or 'none'}; {vision.get('detections', 0)} detections into the "
-          f"{args.team} tracker and brain" + (f", dropped {dropped}" if dropped else "") + f" -> {folder}")  # fmt: skip
+          f"{args.team} tracker and brain" + (f", dropped {dropped}" if dropped else "") + f" -> {folder}")
     if result.truncated is not None:
         print(f"cmdragons replay: warning: {result.truncated}", file=sys.stderr)
     return stop.exit_code

@@ -28,7 +28,7 @@ def refused_options(args: argparse.Namespace) -> str | None:
     given = [flag for key, flag in _RECORDING if getattr(args, key) not in (None, False)]
     if given:
         return (f"cmdragons sim: --serve renders no images, so {', '.join(given)} cannot be used with it "
-                "(it sends SSL-Vision packets; record them with a client)")  # fmt: skip
+                "(it sends SSL-Vision packets; record them with a client)")
     return None
 
 
@@ -62,7 +62,7 @@ def cmd_serve(args: argparse.Namespace, stop: Interrupt) -> int:
         s = settings.protocols.simulation
         print(f"cmdragons sim: --serve cannot open its sockets ({exc.strerror or exc}): another simulator may hold "
               f"{s.address} ports {s.control_port}, {s.blue_port} or {s.yellow_port}; stop it or move ours with "
-              "--set protocols.simulation.control_port=... (and blue_port, yellow_port)", file=sys.stderr)  # fmt: skip
+              "--set protocols.simulation.control_port=... (and blue_port, yellow_port)", file=sys.stderr)
         return 2
     try:
         folder = run_folder("serve", args.out, overwrite=args.overwrite)
@@ -117,11 +117,11 @@ def _listening(settings: Any, camera_ids: list[int]) -> str:
     return (f"sim --serve: Division {settings.field.division}, cameras {', '.join(map(str, camera_ids))}: SSL-Vision "
             f"on {p.vision.group}:{p.simulation.vision_port}, Referee on {p.referee.group}:{p.referee.port} (interface "
             f"{p.interface}, ttl {p.ttl}); simulation protocol on {s.address}: control {s.control_port}, blue "
-            f"{s.blue_port}, yellow {s.yellow_port}")  # fmt: skip
+            f"{s.blue_port}, yellow {s.yellow_port}")
 
 
 def _finish(args: argparse.Namespace, stop: Interrupt, folder: Any, f: dict[str, Any], wall: float, late: int,
-            frame_ms: list[float], cameras: int) -> int:  # fmt: skip
+            frame_ms: list[float], cameras: int) -> int:
     """summary.json and the line that sums the run up."""
     sim, referee = f["sim"], f["referee"]
     seconds = float(sim["seconds"])
@@ -133,12 +133,12 @@ def _finish(args: argparse.Namespace, stop: Interrupt, folder: Any, f: dict[str,
         "balls_out": referee["balls_out"], "command_faults": sim["command_faults"],
         "rules": {k: referee[k] for k in ("rules", "game_stage", "fouls", "cards", "placements")},
         "protocols": {k: v for k, v in f.items() if k.startswith("ssl/")},
-    }  # fmt: skip
+    }
     (folder / "summary.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
     score, received = summary["score"], f["ssl/simulation_in"]
     late_frames = f"{late} late frame{'' if late == 1 else 's'}"
     print(f"sim --serve: {seconds:.1f} s served in {wall:.1f} s ({late_frames}), score blue "
           f"{score['blue']}:{score['yellow']} yellow, {received['packets']} robot commands and "
           f"{received['teleports']} teleports taken{', interrupted by ' + str(stop.signal) if stop.requested else ''}; "
-          f"output -> {folder}")  # fmt: skip
+          f"output -> {folder}")
     return stop.exit_code

@@ -109,7 +109,7 @@ def _calibrate(args: argparse.Namespace, settings: object) -> int:
         if tuple(guess.resolution_px) != (w, h):
             sx = w / guess.resolution_px[0]
             guess = dataclasses.replace(guess, resolution_px=(w, h), principal_point_px=(w / 2, h / 2),
-                                        focal_px=guess.focal_px * sx)  # fmt: skip
+                                        focal_px=guess.focal_px * sx)
     if args.focal:
         guess = dataclasses.replace(guess, focal_px=args.focal)
     if image is not None:
@@ -131,9 +131,9 @@ def _calibrate(args: argparse.Namespace, settings: object) -> int:
         fit = calibrate_from_lines(image, settings.field, start, fit_params)  # type: ignore[attr-defined]
         params, rms, worst = fit.params, fit.rms_px, fit.max_px
         what = (f"{fit.points} line centres on {fit.lines_seen} lines ({fit.found:.0%} of those in view found; "
-                f"tape {fit.line_width_px:.1f} px wide)")  # fmt: skip
+                f"tape {fit.line_width_px:.1f} px wide)")
         overlay = Path(args.overlay) if args.overlay else Path(args.lines).with_name(
-            Path(args.lines).stem + "_calibration.png")  # fmt: skip
+            Path(args.lines).stem + "_calibration.png")
         overlay.parent.mkdir(parents=True, exist_ok=True)
         if not cv2.imwrite(str(overlay), draw_field(image, params, settings.field, fit)):  # type: ignore[attr-defined]
             raise ValueError(f"could not write {overlay}")
@@ -147,7 +147,7 @@ def _calibrate(args: argparse.Namespace, settings: object) -> int:
     p = params
     print(f"calibrate: camera {p.id} from {what}: position {[round(v, 4) for v in p.position_m]} m, yaw "
           f"{p.yaw_rad:.4f} rad, tilts {p.tilt_x_rad:.4f} {p.tilt_y_rad:.4f} rad, focal {p.focal_px:.2f} px, "
-          f"k1 {p.k1:.4f} k2 {p.k2:.4f}; reprojection RMS {rms:.3f} px (max {worst:.3f}) -> {out}")  # fmt: skip
+          f"k1 {p.k1:.4f} k2 {p.k2:.4f}; reprojection RMS {rms:.3f} px (max {worst:.3f}) -> {out}")
     if image is not None:
         for note in fit.notes:
             print(f"calibrate: note: {note}")
@@ -162,7 +162,7 @@ def _footprint(params: CameraParams) -> tuple[float, float, float, float]:
     m = CameraModel(params)
     corners = m.unproject(np.array([[0.0, 0.0], [m.width, 0.0], [0.0, m.height], [m.width, m.height]]), 0.0)
     return (float(corners[:, 0].min()), float(corners[:, 1].min()), float(corners[:, 0].max()),
-            float(corners[:, 1].max()))  # fmt: skip
+            float(corners[:, 1].max()))
 
 
 def _camera_map(p: CameraParams, entry: Any = None) -> Any:
@@ -173,7 +173,7 @@ def _camera_map(p: CameraParams, entry: Any = None) -> Any:
         "tilt_x_rad": round(p.tilt_x_rad, 6), "tilt_y_rad": round(p.tilt_y_rad, 6), "focal_px": round(p.focal_px, 3),
         "principal_point_px": [round(v, 3) for v in p.principal_point_px], "k1": round(p.k1, 6), "k2": round(p.k2, 6),
         "resolution_px": list(p.resolution_px),
-    }  # fmt: skip
+    }
     for key, value in values.items():
         if isinstance(value, list):
             if isinstance(entry.get(key), CommentedSeq):
@@ -310,7 +310,7 @@ def _auto_samples(args: argparse.Namespace,
                              f"{params.resolution_px[1]}: calibrate it at this size (vision calibrate --lines)")
         params = dataclasses.replace(params, resolution_px=(w, h), focal_px=params.focal_px * s,
                                      principal_point_px=(params.principal_point_px[0] * s,
-                                                         params.principal_point_px[1] * s))  # fmt: skip
+                                                         params.principal_point_px[1] * s))
     vis = settings.vision
     rep = auto_samples(images, CameraModel(params), settings.field, vis.colour_space)
     print(f"tune: --auto: {len(images)} frame(s): {rep.patterns} robot patterns, {rep.balls} balls found")
@@ -319,7 +319,7 @@ def _auto_samples(args: argparse.Namespace,
         if role not in rep.samples:
             print(f"tune: --auto: nothing seen of {role} ({names[role]}): its box stays as it is", file=sys.stderr)
     return ({names[r]: parts for r, parts in rep.samples.items()}, rep.background,
-            {names[r]: v for r, v in rep.light.items()})  # fmt: skip
+            {names[r]: v for r, v in rep.light.items()})
 
 
 def _yaml() -> YAML:

@@ -167,7 +167,7 @@ def phases_state(ph: np.ndarray, v0: float, t: float) -> tuple[float, float]:
 def split_2d(
     dx: float, dy: float, v0x: float, v0y: float, vtx: float, vty: float,
     vmax: float, a: float, b: float, iterations: int,
-) -> tuple[float, float, float]:  # fmt: skip
+) -> tuple[float, float, float]:
     """Split the limits between x and y (x gets cos(theta), y sin(theta) of every limit) so that both
     axes arrive together; binary search on theta in [0, pi/2]. Returns (theta, Tx, Ty)."""
     lo, hi = 0.0, 0.5 * math.pi
@@ -188,7 +188,7 @@ def split_2d(
 def command_2d(
     dx: float, dy: float, v0x: float, v0y: float, vtx: float, vty: float,
     vmax: float, a: float, b: float, period: float, iterations: int,
-) -> tuple[float, float, float]:  # fmt: skip
+) -> tuple[float, float, float]:
     """Velocity (vx, vy) at the end of the next control period along the 2D profile, and the
     arrival time (max of the axes)."""
     theta, tx, ty = split_2d(dx, dy, v0x, v0y, vtx, vty, vmax, a, b, iterations)
@@ -200,7 +200,7 @@ def command_2d(
 
 @njit(cache=True)
 def heading_command(theta: float, omega: float, target_theta: float, wmax: float, alpha: float,
-                    period: float) -> float:  # fmt: skip
+                    period: float) -> float:
     """The turn rate (rad/s) one ``period`` ahead on the heading's trapezoid from ``theta`` (rad),
     turning at ``omega``, to rest at ``target_theta``, under ``wmax`` and the angular ``alpha``."""
     dth: float = wrap_angle(target_theta - theta)
@@ -212,7 +212,7 @@ def heading_command(theta: float, omega: float, target_theta: float, wmax: float
 def motion_commands(
     states: np.ndarray, targets: np.ndarray, vmax: float, accel: float, brake: float, wmax: float, alpha: float,
     period: float, iterations: int,
-) -> np.ndarray:  # fmt: skip
+) -> np.ndarray:
     """Commands (n, 3) vx, vy, omega for every robot: the 2D trapezoid toward the target position and
     velocity, the heading's trapezoid toward the target heading, both then held to the limits.
 
@@ -223,7 +223,7 @@ def motion_commands(
     for i in range(states.shape[0]):
         x, y, th, vx, vy, w = states[i, 0], states[i, 1], states[i, 2], states[i, 3], states[i, 4], states[i, 5]
         cx, cy, _ = command_2d(targets[i, 0] - x, targets[i, 1] - y, vx, vy, targets[i, 2], targets[i, 3],
-                               vmax, accel, brake, period, iterations)  # fmt: skip
+                               vmax, accel, brake, period, iterations)
         out[i, 0], out[i, 1] = limit_velocity(vx, vy, cx, cy, vmax, accel, brake, period)
         out[i, 2] = heading_command(th, w, targets[i, 4], wmax, alpha, period)
     return out

@@ -76,7 +76,7 @@ def feasible(vx: float, vy: float, ax: float, ay: float, lim: Limits, dt: float)
 # --- the robot's braking trajectory (Bruce 2006 §5.1, §5.3): where it will be ---------------------------
 @njit(cache=True)
 def _put(tr: np.ndarray, k: int, t0: float, t1: float, px: float, py: float, vx: float, vy: float,
-         ax: float, ay: float) -> tuple[float, float, float, float]:  # fmt: skip
+         ax: float, ay: float) -> tuple[float, float, float, float]:
     # write segment k and return the position and velocity at its end
     tr[k, 0], tr[k, 1], tr[k, 2], tr[k, 3], tr[k, 4], tr[k, 5], tr[k, 6], tr[k, 7] = t0, t1, px, py, vx, vy, ax, ay
     h = t1 - t0
@@ -121,7 +121,7 @@ def seg_at(tr: np.ndarray, k: int, t: float) -> tuple[float, float, float, float
     """Position and velocity of segment k of a trajectory at absolute time t (inside the segment)."""
     h = t - tr[k, 0]
     return (tr[k, 2] + tr[k, 4] * h + 0.5 * tr[k, 6] * h * h, tr[k, 3] + tr[k, 5] * h + 0.5 * tr[k, 7] * h * h,
-            tr[k, 4] + tr[k, 6] * h, tr[k, 5] + tr[k, 7] * h)  # fmt: skip
+            tr[k, 4] + tr[k, 6] * h, tr[k, 5] + tr[k, 7] * h)
 
 
 @njit(cache=True)

@@ -62,7 +62,7 @@ class MotionParams(Validated):
     def limits(self) -> Limits:
         """The limits by name, for the kernels."""
         return Limits(self.max_speed_m_s, self.max_accel_m_s2, self.max_brake_m_s2, self.max_omega_rad_s,
-                        self.max_alpha_rad_s2)  # fmt: skip
+                        self.max_alpha_rad_s2)
 
 
 @dataclass(frozen=True)
@@ -101,7 +101,7 @@ def motion_commands(states: ArrayLike, targets: ArrayLike, params: ControlParams
     t = np.ascontiguousarray(targets, dtype=np.float64).reshape(-1, 5)
     m = params.motion
     return np.asarray(K.motion_commands(s, t, m.max_speed_m_s, m.max_accel_m_s2, m.max_brake_m_s2, m.max_omega_rad_s,
-                                        m.max_alpha_rad_s2, m.period_s, params.trapezoid.split_iterations))  # fmt: skip
+                                        m.max_alpha_rad_s2, m.period_s, params.trapezoid.split_iterations))
 
 
 def motion_command(robot: RobotState, target: MotionTarget, params: ControlParams) -> RobotCommand:

@@ -82,7 +82,7 @@ def trapezoid_2d(
     p = params or TrapezoidParams()
     dx, dy = float(delta[0]), float(delta[1])
     theta, _, _ = K.split_2d(dx, dy, float(v0[0]), float(v0[1]), float(v_target[0]), float(v_target[1]),
-                             float(v_max), float(accel), float(decel), p.split_iterations)  # fmt: skip
+                             float(v_max), float(accel), float(decel), p.split_iterations)
     c, s = float(np.cos(theta)), float(np.sin(theta))
     px = trapezoid_1d(dx, v0[0], v_target[0], v_max * c, accel * c, decel * c)
     py = trapezoid_1d(dy, v0[1], v_target[1], v_max * s, accel * s, decel * s)

@@ -35,7 +35,7 @@ def _pose_filters(name: str) -> str:
     x0 = run.truth[0]
     if steered:
         f: EKFLocalisation | EKFSlam | ParticleLocalisation = filters.EKFSteered(run.landmarks, x0, p0, run.sensor_cov,
-                                                                         run.dt_s, WHEELBASE_M)  # fmt: skip
+                                                                         run.dt_s, WHEELBASE_M)
     elif name == "localise":
         f = EKFLocalisation(run.landmarks, x0, p0, run.sensor_cov)
     elif name == "slam":

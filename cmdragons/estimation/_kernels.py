@@ -238,7 +238,7 @@ def gaussian_draws(low: np.ndarray, n: int, s: np.ndarray, zx: np.ndarray, zf: n
 # interpolant of atan(sqrt v) / sqrt v over v in [0, tan^2(pi/8)] (near-minimax; see fast_atan2)
 _ATAN_P = (0.9999999999999991, -0.3333333333321608, 0.19999999977656527, -0.14285712623685048,
            0.1111104783166958, -0.09089513851204174, 0.07673380890211737, -0.06505092777792344,
-           0.050219307903911777, -0.025278269277016503)  # fmt: skip
+           0.050219307903911777, -0.025278269277016503)
 _TAN_PI_8 = math.tan(math.pi / 8.0)
 # the turn whose cosine and sine come from their Taylor series (to d^8 and d^9: the first omitted
 # terms, d^10 / 10! and d^11 / 11!, are below 2.7e-10 and 1.2e-11 at |d| = 0.5; below 3e-20 at 0.05)
@@ -326,7 +326,7 @@ def move(cloud: np.ndarray, u: np.ndarray, low: np.ndarray, s: np.ndarray, zx: n
 
 @njit(cache=True, error_model="numpy")
 def weigh(cloud: np.ndarray, log_l: np.ndarray, lx: float, ly: float, z_range: float, z_bearing: float,
-          r_inv: np.ndarray) -> None:  # fmt: skip
+          r_inv: np.ndarray) -> None:
     """Adds to ``log_l`` each particle's log-likelihood (less its constant) of a sighting of the
     landmark at (lx, ly) at range ``z_range`` (m) and bearing ``z_bearing`` (rad), the sensor's
     inverse covariance ``r_inv`` (2, 2): -e^T R^-1 e / 2, e the residual. The bearing's residual,
@@ -486,7 +486,7 @@ def regularise(cloud: np.ndarray, low: np.ndarray, s: np.ndarray, zx: np.ndarray
 
 @njit(cache=True)
 def correct(cloud: np.ndarray, weights: np.ndarray, seen: np.ndarray, r_inv: np.ndarray, bandwidth: float,
-            s: np.ndarray, zx: np.ndarray, zf: np.ndarray, scratch: np.ndarray) -> bool:  # fmt: skip
+            s: np.ndarray, zx: np.ndarray, zf: np.ndarray, scratch: np.ndarray) -> bool:
     """The measurement half of a step: :func:`weigh` by each row of ``seen`` (m, 4: landmark x, y,
     range, bearing), :func:`reweigh`, and when the effective sample size falls below n / 2
     :func:`resample` (``scratch`` the cloud's shape, its work space) and :func:`regularise` by
@@ -513,7 +513,7 @@ def correct(cloud: np.ndarray, weights: np.ndarray, seen: np.ndarray, r_inv: np.
 @njit(cache=True)
 def particle_step(cloud: np.ndarray, weights: np.ndarray, u: np.ndarray, u_cov: np.ndarray, seen: np.ndarray,
                   r_inv: np.ndarray, bandwidth: float, s: np.ndarray, zx: np.ndarray, zf: np.ndarray,
-                  scratch: np.ndarray, mean: np.ndarray, cov: np.ndarray) -> bool:  # fmt: skip
+                  scratch: np.ndarray, mean: np.ndarray, cov: np.ndarray) -> bool:
     """One step of the regularised particle filter: :func:`move` by the odometry ``u`` (3,) of
     covariance ``u_cov`` (3, 3), :func:`correct` by the sightings ``seen``, and the cloud's
     estimate into ``mean`` (3,) and ``cov`` (3, 3). Returns whether it resampled."""

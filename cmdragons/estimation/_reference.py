@@ -24,7 +24,7 @@ def _noise(low: FloatArray, n: int, s: NDArray[np.uint64], zx: FloatArray, zf: F
 
 def particle_step(particles: FloatArray, weights: FloatArray, u: FloatArray, u_cov: FloatArray, seen: FloatArray,
                   r_inv: FloatArray, bandwidth: float, s: NDArray[np.uint64], zx: FloatArray,
-                  zf: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, bool]:  # fmt: skip
+                  zf: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, bool]:
     """The step on copies: new particles and weights, the estimate (mean, covariance) and whether
     it resampled; advances the stream ``s``."""
     p, w = particles.copy(), weights.copy()

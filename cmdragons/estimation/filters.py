@@ -100,7 +100,7 @@ def lander_filter(lander: Lander, altitude_m: float, speed_m_s: float) -> Kalman
 
 
 def simulate_lander(lander: Lander, seed: int = 0, altitude_m: float = 10000.0, speed_m_s: float = -300.0,
-                    steps: int = 5000) -> dict[str, FloatArray]:  # fmt: skip
+                    steps: int = 5000) -> dict[str, FloatArray]:
     """A descent (the engine braking to hold a speed schedule from the filter's estimate) with its
     truth, the radar's readings and the filter's estimates and variances, per step."""
     rng = np.random.default_rng(seed)
@@ -108,7 +108,7 @@ def simulate_lander(lander: Lander, seed: int = 0, altitude_m: float = 10000.0, 
     x = np.array([altitude_m, speed_m_s])
     dt = lander.dt_s
     out: dict[str, list[float]] = {k: [] for k in ("t", "altitude", "speed", "radar", "est_altitude", "est_speed",
-                                                   "var_altitude", "var_speed")}  # fmt: skip
+                                                   "var_altitude", "var_speed")}
     for k in range(steps):
         est_h, est_v = float(kf.x[0, 0]), float(kf.x[1, 0])
         target_v = -max(2.0, 0.02 * max(est_h, 0.0))  # slow down near the ground
@@ -120,7 +120,7 @@ def simulate_lander(lander: Lander, seed: int = 0, altitude_m: float = 10000.0, 
         kf.update(np.array([[z]]))
         for key, value in (("t", (k + 1) * dt), ("altitude", x[0]), ("speed", x[1]), ("radar", z),
                            ("est_altitude", kf.x[0, 0]), ("est_speed", kf.x[1, 0]), ("var_altitude", kf.P[0, 0]),
-                           ("var_speed", kf.P[1, 1])):  # fmt: skip
+                           ("var_speed", kf.P[1, 1])):
             out[key].append(float(value))
         if x[0] <= 0.0:
             break
@@ -179,7 +179,7 @@ class EKFLocalisation:
             lm = self.landmarks[s.landmark]
             self.ekf.update(s.z.reshape(2, 1), lambda x, lm=lm: observe_jacobians(x[:, 0], lm)[0],
                             lambda x, lm=lm: observe(x[:, 0], lm).reshape(2, 1), R=self.R,
-                            residual=_residual)  # fmt: skip
+                            residual=_residual)
             self.ekf.x[2, 0] = wrap_angle(float(self.ekf.x[2, 0]))
 
     def nees(self, truth: ArrayLike) -> float:
@@ -192,7 +192,7 @@ class EKFSteered(EKFLocalisation):
     noise carried into the pose by the model's Jacobian), corrected by sightings of known landmarks."""
 
     def __init__(self, landmarks: ArrayLike, start: ArrayLike, start_cov: ArrayLike, sensor_cov: ArrayLike,
-                 dt_s: float, wheelbase_m: float) -> None:  # fmt: skip
+                 dt_s: float, wheelbase_m: float) -> None:
         if dt_s <= 0.0 or wheelbase_m <= 0.0:
             raise ValueError(f"dt_s and wheelbase_m must be positive, got {dt_s} and {wheelbase_m}")
         super().__init__(landmarks, start, start_cov, sensor_cov)
@@ -204,7 +204,7 @@ class EKFSteered(EKFLocalisation):
         pose, u = self.ekf.x[:3, 0].copy(), np.asarray(odometry, dtype=np.float64)
         fx, fu = velocity_steer_jacobians(pose, u, self.dt_s, self.wheelbase_m)
         self.ekf.predict_pose(velocity_steer(pose, u, self.dt_s, self.wheelbase_m), fx, fu,
-                              np.asarray(odometry_cov, dtype=np.float64))  # fmt: skip
+                              np.asarray(odometry_cov, dtype=np.float64))
 
 
 # --- EKF-SLAM -----------------------------------------------------------------------------------
@@ -271,7 +271,7 @@ class EKFSlam:
                 return h
 
             self.ekf.update(sgt.z.reshape(2, 1), jac, lambda x, s=s: observe(x[:3, 0], x[s, 0]).reshape(2, 1),
-                            R=self.R, residual=_residual)  # fmt: skip
+                            R=self.R, residual=_residual)
             self.ekf.x[2, 0] = wrap_angle(float(self.ekf.x[2, 0]))
 
     def nees(self, truth: ArrayLike) -> float:
@@ -307,14 +307,14 @@ class ParticleLocalisation:
     noise comes from a random stream of the filter's own, seeded from ``seed``'s generator."""
 
     def __init__(self, landmarks: ArrayLike, start: ArrayLike, start_cov: ArrayLike, sensor_cov: ArrayLike,
-                 n: int = 500, seed: int = 0, bandwidth_share: float = 0.6) -> None:  # fmt: skip
+                 n: int = 500, seed: int = 0, bandwidth_share: float = 0.6) -> None:
         if bandwidth_share < 0.0:
             raise ValueError(f"bandwidth_share must be >= 0 (0: no regularisation), not {bandwidth_share}")
         self.bandwidth_share = bandwidth_share
         self.rng = np.random.default_rng(seed)
         self.landmarks = np.asarray(landmarks, dtype=np.float64)
         poses = self.rng.multivariate_normal(np.asarray(start, dtype=np.float64),
-                                             np.asarray(start_cov, dtype=np.float64), size=n)  # fmt: skip
+                                             np.asarray(start_cov, dtype=np.float64), size=n)
         poses[:, 2] = wrap_angle(poses[:, 2])
         # the kernels' layout: one row per quantity (x, y, theta, cos theta, sin theta), the particles along it
         # (C order: a stack of the poses' transpose would be Fortran-ordered, each row strided)
@@ -348,14 +348,14 @@ class ParticleLocalisation:
 
     def update(self, sightings: list[Sighting]) -> None:
         K.correct(self.cloud, self.weights, self._seen(sightings), self.R_inv, self.bandwidth, self.stream,
-                  *_ZIGGURAT, self._scratch)  # fmt: skip
+                  *_ZIGGURAT, self._scratch)
         self._estimated = False
 
     def step(self, odometry: ArrayLike, odometry_cov: ArrayLike, sightings: list[Sighting]) -> None:
         """:meth:`predict` then :meth:`update`, and the estimate, in one kernel call."""
         K.particle_step(self.cloud, self.weights, np.asarray(odometry, dtype=np.float64),
                         np.asarray(odometry_cov, dtype=np.float64), self._seen(sightings), self.R_inv,
-                        self.bandwidth, self.stream, *_ZIGGURAT, self._scratch, self._mean, self._cov)  # fmt: skip
+                        self.bandwidth, self.stream, *_ZIGGURAT, self._scratch, self._mean, self._cov)
         self._estimated = True
 
     def _estimate(self) -> None:

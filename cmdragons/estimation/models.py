@@ -100,16 +100,16 @@ def velocity_steer(pose: ArrayLike, control: ArrayLike, dt_s: float, wheelbase_m
     x, y, t = np.asarray(pose, dtype=np.float64)
     v, phi = np.asarray(control, dtype=np.float64)
     return np.array([x + dt_s * v * math.cos(t + phi), y + dt_s * v * math.sin(t + phi),
-                     wrap_angle(t + dt_s * v * math.sin(phi) / wheelbase_m)])  # fmt: skip
+                     wrap_angle(t + dt_s * v * math.sin(phi) / wheelbase_m)])
 
 
 def velocity_steer_jacobians(pose: ArrayLike, control: ArrayLike, dt_s: float,
-                             wheelbase_m: float) -> tuple[FloatArray, FloatArray]:  # fmt: skip
+                             wheelbase_m: float) -> tuple[FloatArray, FloatArray]:
     """d velocity_steer / d pose (3, 3) and d velocity_steer / d (v, phi) (3, 2)."""
     _, _, t = np.asarray(pose, dtype=np.float64)
     v, phi = np.asarray(control, dtype=np.float64)
     c, s = math.cos(t + phi), math.sin(t + phi)
     fx = np.array([[1.0, 0.0, -dt_s * v * s], [0.0, 1.0, dt_s * v * c], [0.0, 0.0, 1.0]])
     fu = np.array([[dt_s * c, -dt_s * v * s], [dt_s * s, dt_s * v * c],
-                   [dt_s * math.sin(phi) / wheelbase_m, dt_s * v * math.cos(phi) / wheelbase_m]])  # fmt: skip
+                   [dt_s * math.sin(phi) / wheelbase_m, dt_s * v * math.cos(phi) / wheelbase_m]])
     return fx, fu

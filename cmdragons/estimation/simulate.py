@@ -43,7 +43,7 @@ def simulate_run(seed: int = 0, steps: int = 600, dt_s: float = 0.1, n_landmarks
                  area_m: float = 20.0, speed_m_s: float = 1.5, max_range_m: float = 8.0,
                  odometry_sigma: tuple[float, float, float] = (0.02, 0.01, 0.005),
                  sensor_sigma: tuple[float, float] = (0.1, 0.01),
-                 max_sightings: int | None = None) -> Run:  # fmt: skip
+                 max_sightings: int | None = None) -> Run:
     """The vehicle circles the area's centre at radius ``area_m / 3``, wobbling, among landmarks
     scattered over the square area. ``max_sightings``: at most that many sightings a step, drawn
     at random among the landmarks in range (one, as the Robotics Toolbox's RangeBearingSensor
@@ -66,7 +66,7 @@ def simulate_run(seed: int = 0, steps: int = 600, dt_s: float = 0.1, n_landmarks
 
 
 def _loop(rng: np.random.Generator, n_landmarks: int, area_m: float, speed_m_s: float,
-          steps: int) -> tuple[FloatArray, FloatArray, list[float]]:  # fmt: skip
+          steps: int) -> tuple[FloatArray, FloatArray, list[float]]:
     """The landmarks scattered over the square area, the start pose on the loop (radius
     ``area_m / 3`` about the centre, heading along it) and each step's turn rate (rad/s): the
     circle's, wobbling."""
@@ -77,7 +77,7 @@ def _loop(rng: np.random.Generator, n_landmarks: int, area_m: float, speed_m_s: 
 
 
 def _sightings(pose: FloatArray, landmarks: FloatArray, rng: np.random.Generator, max_range_m: float,
-               sensor_sigma: tuple[float, float], max_sightings: int | None) -> list[Sighting]:  # fmt: skip
+               sensor_sigma: tuple[float, float], max_sightings: int | None) -> list[Sighting]:
     """Noisy sightings of the landmarks within range of ``pose`` (at most ``max_sightings``, drawn
     at random)."""
     seen = []
@@ -94,7 +94,7 @@ def _sightings(pose: FloatArray, landmarks: FloatArray, rng: np.random.Generator
 def simulate_steered_run(seed: int = 0, steps: int = 600, dt_s: float = 0.1, n_landmarks: int = 20,
                          area_m: float = 20.0, speed_m_s: float = 1.5, wheelbase_m: float = 0.5,
                          max_range_m: float = 8.0, control_sigma: tuple[float, float] = (0.1, 0.02),
-                         sensor_sigma: tuple[float, float] = (0.1, 0.01)) -> Run:  # fmt: skip
+                         sensor_sigma: tuple[float, float] = (0.1, 0.01)) -> Run:
     """A velocity-steered vehicle (:func:`velocity_steer`, wheels ``wheelbase_m`` apart) on the loop
     of :func:`simulate_run`: it steers to circle the area's centre, wobbling; its odometry reports
     the speed (m/s) and steering angle (rad) it drove with, each with Gaussian noise of

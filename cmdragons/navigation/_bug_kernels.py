@@ -51,7 +51,7 @@ def bug2_line_step(px: int, py: int, sx: int, sy: int, gx: int, gy: int) -> tupl
 
 @njit(cache=True)
 def bug2_grid(occupied: np.ndarray, sx: int, sy: int, gx: int, gy: int, turn: int,
-              max_steps: int) -> tuple[int, np.ndarray]:  # fmt: skip
+              max_steps: int) -> tuple[int, np.ndarray]:
     """Bug2 (lecture notes 001 "Obstacle Avoidance: Bug2", 004 §2.5; Lumelsky and Stepanov 1987) on
     the occupancy grid ``occupied`` (row = y, column = x; the outside is an obstacle), the robot
     moving one cell to one of its eight neighbours a step, from cell (sx, sy) to cell (gx, gy).

@@ -10,7 +10,7 @@ FloatArray = NDArray[np.float64]
 
 
 def bug2_grid(occupied: NDArray[np.bool_], start: tuple[int, int], goal: tuple[int, int], turn: int,
-              max_steps: int) -> tuple[str, list[tuple[int, int]]]:  # fmt: skip
+              max_steps: int) -> tuple[str, list[tuple[int, int]]]:
     """Bug2 on the occupancy grid as :func:`cmdragons.navigation._bug_kernels.bug2_grid` states it,
     written the obvious way: a neighbour's direction by its angle, the boundary followed by sorting
     the eight neighbours by their angle from the obstacle cell last touched, a loop found by a set of
@@ -64,7 +64,7 @@ def bug2_grid(occupied: NDArray[np.bool_], start: tuple[int, int], goal: tuple[i
                 around = [(here[0] + dx, here[1] + dy) for dx in (-1, 0, 1) for dy in (-1, 0, 1) if dx or dy]
                 # counter-clockwise (turn +1) or clockwise from the obstacle cell, the obstacle cell itself last
                 turned = sorted(around, key=lambda c: (turn * (np.arctan2(c[1] - here[1], c[0] - here[0]) - base)
-                                                       - 1e-9) % (2 * np.pi))  # fmt: skip
+                                                       - 1e-9) % (2 * np.pi))
                 free = [i for i, c in enumerate(turned) if not blocked(c)]
                 if not free:
                     return "blocked", path

@@ -51,7 +51,7 @@ def window_velocity(
 def dynamic_window(
     obs: np.ndarray, inner: np.ndarray, px: float, py: float, vx: float, vy: float, dx: float, dy: float,
     window: np.ndarray, lim: Limits, cfg: WindowConfig, limit: int,
-) -> tuple[float, float, int, int]:  # fmt: skip
+) -> tuple[float, float, int, int]:
     """The dynamic window for one robot at (px, py) moving at (vx, vy) that wants (dx, dy).
 
     A candidate velocity (:func:`window_velocity`, the desired one first) is admissible when the

@@ -17,7 +17,7 @@ FloatArray = NDArray[np.float64]
 def window_scores(
     obs: FloatArray, inner: FloatArray, px: float, py: float, vx: float, vy: float, dx: float, dy: float,
     window: FloatArray, lim: Limits, cfg: WindowConfig,
-) -> tuple[FloatArray, FloatArray, FloatArray]:  # fmt: skip
+) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Per candidate of the window (the desired velocity first): the velocity (k, 2), the least
     clearance of its trajectory minus the clearance it needs (k,; < 0 not admissible: it needs
     ``margin``, or to come no closer where it starts closer), and its score (k,)."""

@@ -94,7 +94,7 @@ def evade_vector(px: float, py: float, objects: np.ndarray, cfg: EvadeConfig) ->
         if v < cfg.min_speed:
             continue
         dx, dy, nx, ny = path_offset(px, py, objects[j, 0], objects[j, 1], objects[j, 2], objects[j, 3],
-                                     objects[j, 4])  # fmt: skip
+                                     objects[j, 4])
         if dx < 0.0:
             continue
         vy_var = objects[j, 6]

@@ -62,7 +62,7 @@ def _weight(ax: float, ay: float, mx: float, my: float, cfg: PotentialConfig) ->
 def potential(
     obs: np.ndarray, inner: np.ndarray, px: float, py: float, gx: float, gy: float, mx: float, my: float,
     cfg: PotentialConfig,
-) -> tuple[float, float, float]:  # fmt: skip
+) -> tuple[float, float, float]:
     """The potential E (m^2) at (px, py) and its gradient (ex, ey) (m): the goal's well at (gx, gy)
     plus every obstacle's and wall's source (lecture notes 001, "Potential Field Path Planning").
     (mx, my): the unit direction of motion for the extended field's rotation and task weights

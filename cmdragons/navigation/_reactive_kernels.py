@@ -31,7 +31,7 @@ def wall(inner: np.ndarray, side: int, px: float, py: float) -> tuple[float, flo
 def march(
     obs: np.ndarray, inner: np.ndarray, px: float, py: float, theta: float, curvature: float, length: float,
     threshold: float, tol: float,
-) -> float:  # fmt: skip
+) -> float:
     """How far (m, along the arc) the robot's centre gets from (px, py) heading ``theta`` on an arc
     of ``curvature`` (1/m; 0 a straight ray) before its clearance falls to ``threshold``, at most
     ``length``. Sphere tracing: the clearance is 1-Lipschitz and an arc is never shorter than its
@@ -55,7 +55,7 @@ def march(
 def ranges(
     obs: np.ndarray, inner: np.ndarray, px: float, py: float, angles: np.ndarray, length: float, threshold: float,
     tol: float,
-) -> np.ndarray:  # fmt: skip
+) -> np.ndarray:
     """A simulated range sensor: :func:`march` along straight rays at ``angles`` (rad), at most
     ``length`` (the sensor's range), until the clearance falls to ``threshold`` (0: contact)."""
     out = np.empty(angles.shape[0])
@@ -76,7 +76,7 @@ def _stop_speed(c: float, margin: float, decel: float, dt: float) -> float:
 def brake_guard(
     obs: np.ndarray, inner: np.ndarray, px: float, py: float, wx: float, wy: float, margin: float, decel: float,
     dt: float,
-) -> tuple[float, float]:  # fmt: skip
+) -> tuple[float, float]:
     """The velocity (wx, wy) with its component toward each obstacle and wall cut to the speed that
     still stops ``margin`` short of it (:func:`_stop_speed`), obstacle after obstacle; the
     components sideways and away stay."""

@@ -61,7 +61,7 @@ def polar_histogram(obs: np.ndarray, inner: np.ndarray, px: float, py: float, cf
 def turning_limits(
     obs: np.ndarray, inner: np.ndarray, px: float, py: float, theta: float, r_turn: float, enlarge: float,
     cfg: HistogramConfig,
-) -> tuple[float, float]:  # fmt: skip
+) -> tuple[float, float]:
     """VFH+'s masked histogram: the limits (rad from the direction of motion ``theta``, left >= 0,
     right <= 0) of the directions the robot can still turn into, moving on circles of radius
     ``r_turn``, left and right of it, when an occupied cell within ``r_turn + enlarge`` of a circle's

@@ -93,7 +93,7 @@ class NavigatorType(Protocol):
         ...
 
     def configure(self, name: str, sections: Mapping[str, Any], control: ControlParams, robot_radius_m: float,
-                  collision: CollisionParams) -> Navigator:  # fmt: skip
+                  collision: CollisionParams) -> Navigator:
         """A fresh navigator for one robot, registered as ``name``, from ``sections`` (each of
         :attr:`SECTIONS` by name, parsed), the robot model, its radius (m) and the collision queries'
         parameters."""

@@ -120,7 +120,7 @@ class GridBug2:
 
 
 def bug2_path(occupied: NDArray[np.bool_], start: tuple[int, int], goal: tuple[int, int],
-              params: BugParams | None = None) -> GridBug2:  # fmt: skip
+              params: BugParams | None = None) -> GridBug2:
     """Bug2's whole path on the occupancy grid ``occupied`` (row = y) from cell ``start`` to cell
     ``goal`` (each (column, row)), one cell a step (:func:`cmdragons.navigation._bug_kernels.bug2_grid`:
     along the m-line; round an obstacle it meets with it on the right (``params.side`` left) or
@@ -131,7 +131,7 @@ def bug2_path(occupied: NDArray[np.bool_], start: tuple[int, int], goal: tuple[i
     if grid.ndim != 2:
         raise ValueError(f"occupied must be a 2-d grid, not of shape {grid.shape}")
     status, cells = K.bug2_grid(grid, int(start[0]), int(start[1]), int(goal[0]), int(goal[1]),
-                                1 if p.side == "left" else -1, p.grid_max_steps)  # fmt: skip
+                                1 if p.side == "left" else -1, p.grid_max_steps)
     steps = np.abs(np.diff(cells, axis=0)).sum(axis=1)
     length = float(np.count_nonzero(steps == 1) + math.sqrt(2.0) * np.count_nonzero(steps == 2))
     return GridBug2(GridBug2Status(int(status)), cells, length)
@@ -163,11 +163,11 @@ class BugNavigator(ReactiveNavigator):
             raise ValueError(f"a bug navigator is one of {', '.join(BUG_VARIANTS)}, not {name!r}")
         tangent = sections["tangent_bug"] if name == "tangent_bug" else None
         return cls(typing.cast(BugVariant, name), sections["bug"], sections["reactive"], control, robot_radius_m,
-                   collision, sections["trajectory"], tangent)  # fmt: skip
+                   collision, sections["trajectory"], tangent)
 
     def __init__(self, variant: BugVariant, params: BugParams, reactive: ReactiveParams,
                  control: ControlParams, robot_radius_m: float, collision: CollisionParams | None = None,
-                 follow: TrajectoryParams | None = None, tangent: TangentBugParams | None = None) -> None:  # fmt: skip
+                 follow: TrajectoryParams | None = None, tangent: TangentBugParams | None = None) -> None:
         super().__init__(reactive, control, robot_radius_m, collision, follow)
         self.name = variant
         self.variant = variant
@@ -298,11 +298,11 @@ class BugNavigator(ReactiveNavigator):
         # passing within the hit's overshoot of it
         tol = p.leave_tolerance_m + self._overshoot
         back = self.hit is not None and self.followed > p.min_follow_m and self.away > 2.0 * tol \
-            and math.dist(here, self.hit) < tol  # fmt: skip
+            and math.dist(here, self.hit) < tol
         if self.variant == "bug2":
             if d < self.contact_d - p.leave_tolerance_m \
                     and _to_line(here, self.start, goal) < p.m_line_tolerance_m \
-                    and self._free_toward(here, goal, c, gx, gy):  # fmt: skip
+                    and self._free_toward(here, goal, c, gx, gy):
                 return True
             if back:
                 self.status = NavStatus.BLOCKED
@@ -372,7 +372,7 @@ class BugNavigator(ReactiveNavigator):
         return best
 
     def _d_reach(self, cw: CompiledWorld, here: Point, goal: Point, r: np.ndarray,
-                 inside: float) -> tuple[float, Point]:  # fmt: skip
+                 inside: float) -> tuple[float, Point]:
         """d_reach and its point: the free point the sensor sees nearest the goal (on each ray, on the
         level line's side of a hit, ``inside`` short of it; the straight way to the goal as far as it
         stays clear)."""
@@ -380,7 +380,7 @@ class BugNavigator(ReactiveNavigator):
         dg = math.dist(here, goal)
         s = self._sees(cw, here, goal, min(dg, rng))
         best_d, best = dg - s, (here[0] + (goal[0] - here[0]) * s / max(dg, 1e-12),
-                                here[1] + (goal[1] - here[1]) * s / max(dg, 1e-12))  # fmt: skip
+                                here[1] + (goal[1] - here[1]) * s / max(dg, 1e-12))
         top = np.where(r < rng - 1e-6, np.maximum(r - inside, 0.0), rng)
         along = np.clip((goal[0] - here[0]) * self.cos + (goal[1] - here[1]) * self.sin, 0.0, top)
         xs, ys = here[0] + along * self.cos, here[1] + along * self.sin
@@ -391,11 +391,11 @@ class BugNavigator(ReactiveNavigator):
         return best_d, best
 
     def _tangent(self, cw: CompiledWorld, here: Point, goal: Point, c: float, gx: float,
-                 gy: float) -> tuple[float, float]:  # fmt: skip
+                 gy: float) -> tuple[float, float]:
         t = self.tangent
         dg = math.dist(here, goal)
         if self.via is not None and (dg <= math.dist(self.via, goal) + self.params.leave_tolerance_m
-                                     or math.dist(here, self.via) < self.params.leave_tolerance_m):  # fmt: skip
+                                     or math.dist(here, self.via) < self.params.leave_tolerance_m):
             self.via = None  # as near the goal as the point it left the boundary for
         look = min(dg, t.sensor_range_m)
         if self._sees(cw, here, goal, look) >= look - 1e-6:  # the straight way free as far as the sensor sees

@@ -87,11 +87,11 @@ class CurvatureVelocityNavigator(ReactiveNavigator):
         read the shared ``reactive`` and ``trajectory``."""
         lanes = sections["lane_curvature"] if name == "lane_curvature" else None
         return cls(sections["curvature_velocity"], sections["reactive"], control, robot_radius_m, collision,
-                   sections["trajectory"], lanes)  # fmt: skip
+                   sections["trajectory"], lanes)
 
     def __init__(self, params: CurvatureParams, reactive: ReactiveParams, control: ControlParams,
                  robot_radius_m: float, collision: CollisionParams | None = None,
-                 follow: TrajectoryParams | None = None, lanes: LaneParams | None = None) -> None:  # fmt: skip
+                 follow: TrajectoryParams | None = None, lanes: LaneParams | None = None) -> None:
         super().__init__(reactive, control, robot_radius_m, collision, follow)
         self.params = params
         self.lanes = lanes
@@ -112,7 +112,7 @@ class CurvatureVelocityNavigator(ReactiveNavigator):
             for w in q.lane_widths_m:
                 length = K.march(cw.obs, cw.inner, here[0], here[1], phi, 0.0, p.horizon_m, 0.5 * w + p.margin_m, 1e-3)
                 f = q.length_weight * length / p.horizon_m + q.width_weight * w / widest \
-                    + q.goal_weight * (1.0 - abs(float(off)) / math.pi)  # fmt: skip
+                    + q.goal_weight * (1.0 - abs(float(off)) / math.pi)
                 if f > best_f:
                     best, best_f = phi, f
                     self.last_lane = (phi, w)

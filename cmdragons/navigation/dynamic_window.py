@@ -69,7 +69,7 @@ class DynamicWindowNavigator:
     def __init__(
         self, params: DynamicWindowParams, control: ControlParams, robot_radius_m: float,
         collision: CollisionParams | None = None, follow: TrajectoryParams | None = None,
-    ) -> None:  # fmt: skip
+    ) -> None:
         """``follow``: how the wanted velocity follows the path (the trajectory navigator's section)."""
         self.params = params
         self.control = control
@@ -79,7 +79,7 @@ class DynamicWindowNavigator:
         self.window = window_points(params)
         self.cfg = K.WindowConfig(dt=control.motion.period_s, margin=params.margin_m, step=params.step_m,
                                   clearance_weight=params.clearance_weight_1_s,
-                                  clearance_cap=params.clearance_cap_m)  # fmt: skip
+                                  clearance_cap=params.clearance_cap_m)
         self.last_evaluated = 0  # candidates the last command evaluated
         self.last_choice = -1  # the candidate it took: 0 the wanted velocity, -1 none (the stop)
 
@@ -100,7 +100,7 @@ class DynamicWindowNavigator:
         return self._choose(robot, world, termination, vx_want, vy_want, omega)
 
     def command_toward(self, robot: RobotState, world: CollisionWorld, termination: Termination,
-                       want: tuple[float, float]) -> VelocityCommand:  # fmt: skip
+                       want: tuple[float, float]) -> VelocityCommand:
         """The admissible velocity of the window closest to ``want`` (m/s, field frame: a velocity the
         caller chose, such as the Robox stack's heading along its band), the path's omega."""
         if termination.reached(0):
@@ -109,12 +109,12 @@ class DynamicWindowNavigator:
         return self._choose(robot, world, termination, want[0], want[1], omega)
 
     def _choose(self, robot: RobotState, world: CollisionWorld, termination: Termination, vx_want: float,
-                vy_want: float, omega: float) -> VelocityCommand:  # fmt: skip
+                vy_want: float, omega: float) -> VelocityCommand:
         start = self.follow.start_state(robot)
         cw = world.compile(self.radius, 0.0, 0.0, self.collision)
         limits = self.follow.target(robot)[1].motion.limits()
         limit = termination.work_left(0, len(self.window) + 1)
         vx, vy, evaluated, chosen = K.dynamic_window(cw.obs, cw.inner, robot.x, robot.y, start.vx, start.vy, vx_want,
-                                                     vy_want, self.window, limits, self.cfg, limit)  # fmt: skip
+                                                     vy_want, self.window, limits, self.cfg, limit)
         self.last_evaluated, self.last_choice = int(evaluated), int(chosen)
         return float(vx), float(vy), omega

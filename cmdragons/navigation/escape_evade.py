@@ -114,7 +114,7 @@ def reflex(here: tuple[float, float], objects: FloatArray, params: EscapeEvadePa
     sx, sy = K.escape_vector(here[0], here[1], objs, cfg)
     ex, ey = K.evade_vector(here[0], here[1], objs, cfg)
     return params.escape_speed_m_s * sx + params.evade_speed_m_s * ex, params.escape_speed_m_s * sy + \
-        params.evade_speed_m_s * ey  # fmt: skip
+        params.evade_speed_m_s * ey
 
 
 class EscapeEvadeNavigator(ReactiveNavigator):
@@ -129,11 +129,11 @@ class EscapeEvadeNavigator(ReactiveNavigator):
                   collision: CollisionParams) -> EscapeEvadeNavigator:
         """From the section ``escape_evade`` and the shared ``reactive`` and ``trajectory``."""
         return cls(sections["escape_evade"], sections["reactive"], control, robot_radius_m, collision,
-                   sections["trajectory"])  # fmt: skip
+                   sections["trajectory"])
 
     def __init__(self, params: EscapeEvadeParams, reactive: ReactiveParams, control: ControlParams,
                  robot_radius_m: float, collision: CollisionParams | None = None,
-                 follow: TrajectoryParams | None = None) -> None:  # fmt: skip
+                 follow: TrajectoryParams | None = None) -> None:
         super().__init__(reactive, control, robot_radius_m, collision, follow)
         self.params = params
         self.model = MovementModel(params, control.motion.period_s)

@@ -44,7 +44,7 @@ from cmdragons.planning.grid.planners import descend_nf1, nf1
 from cmdragons.planning.world import CollisionParams, CompiledWorld
 
 __all__ = ["ExtendedFieldParams", "PotentialFieldNavigator", "PotentialFieldParams", "escape_path",
-           "potential_config"]  # fmt: skip
+           "potential_config"]
 
 
 @dataclass(frozen=True)
@@ -77,18 +77,18 @@ class ExtendedFieldParams(Validated):
 
 
 def potential_config(p: PotentialFieldParams, radius_m: float, extended: ExtendedFieldParams | None = None
-                     ) -> K.PotentialConfig:  # fmt: skip
+                     ) -> K.PotentialConfig:
     """The kernel's numbers from the config sections (``extended`` None: the plain field)."""
     floor, cos_sector = 1.0, -2.0
     if extended is not None:
         floor, cos_sector = extended.rotation_floor, math.cos(extended.sector_half_angle_rad)
     return K.PotentialConfig(p.goal_gain, p.goal_well_m, K.GAUSSIAN if p.obstacle == "gaussian" else K.INVERSE,
                              p.gaussian_height_m2, 1.0 / p.gaussian_sigma_m**2, p.inverse_gain_m4, p.influence_m,
-                             p.min_distance_m, radius_m, floor, cos_sector)  # fmt: skip
+                             p.min_distance_m, radius_m, floor, cos_sector)
 
 
 def escape_path(cw: CompiledWorld, start: tuple[float, float], goal: tuple[float, float], resolution_m: float,
-                clearance_m: float) -> NDArray[np.float64]:  # fmt: skip
+                clearance_m: float) -> NDArray[np.float64]:
     """NF1's path (k, 2), field frame, from ``start`` to ``goal`` over the cells of ``resolution_m``
     whose centre keeps ``clearance_m`` (8-connected wavefront, steepest descent), the exact start
     and goal at its ends; empty when the goal's cell cannot be reached."""
@@ -127,12 +127,12 @@ class PotentialFieldNavigator(ReactiveNavigator):
         Both read the shared ``reactive`` and ``trajectory``."""
         extended = sections["extended_potential_field"] if name == "extended_potential_field" else None
         return cls(sections["potential_field"], sections["reactive"], control, robot_radius_m, collision,
-                   sections["trajectory"], extended)  # fmt: skip
+                   sections["trajectory"], extended)
 
     def __init__(self, params: PotentialFieldParams, reactive: ReactiveParams, control: ControlParams,
                  robot_radius_m: float, collision: CollisionParams | None = None,
                  follow: TrajectoryParams | None = None,
-                 extended: ExtendedFieldParams | None = None) -> None:  # fmt: skip
+                 extended: ExtendedFieldParams | None = None) -> None:
         super().__init__(reactive, control, robot_radius_m, collision, follow)
         self.params = params
         self.extended = extended

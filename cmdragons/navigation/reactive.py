@@ -68,7 +68,7 @@ class ReactiveNavigator(ABC):
     SECTIONS: ClassVar[Mapping[str, type]] = {"reactive": ReactiveParams, "trajectory": TrajectoryParams}
 
     def __init__(self, reactive: ReactiveParams, control: ControlParams, robot_radius_m: float,
-                 collision: CollisionParams | None = None, follow: TrajectoryParams | None = None) -> None:  # fmt: skip
+                 collision: CollisionParams | None = None, follow: TrajectoryParams | None = None) -> None:
         self.reactive = reactive
         self.control = control
         self.radius = robot_radius_m
@@ -131,24 +131,24 @@ class ReactiveNavigator(ABC):
         omega = STOP[2]
         if not termination.reached(0):
             omega = heading_command(start.theta, start.omega, target.theta, motion.max_omega_rad_s,
-                                    motion.max_alpha_rad_s2, motion.period_s)  # fmt: skip
+                                    motion.max_alpha_rad_s2, motion.period_s)
         # a turned velocity changes at the smaller of the two: the guard must hold while turning too
         wx, wy = K.brake_guard(cw.obs, cw.inner, here[0], here[1], wx, wy, self.reactive.brake_margin_m,
-                               min(motion.max_accel_m_s2, motion.max_brake_m_s2), motion.period_s)  # fmt: skip
+                               min(motion.max_accel_m_s2, motion.max_brake_m_s2), motion.period_s)
         top = motion.max_speed_m_s * (1.0 - 1e-9)  # a hair under: the step toward it must not round above
         speed = math.hypot(wx, wy)
         if speed > top:
             wx, wy = wx * top / speed, wy * top / speed
         decel = min(motion.max_accel_m_s2, motion.max_brake_m_s2)
         vx, vy = limit_velocity(start.vx, start.vy, wx, wy, top, motion.max_accel_m_s2, motion.max_brake_m_s2,
-                                motion.period_s)  # fmt: skip
+                                motion.period_s)
         gx, gy = K.brake_guard(cw.obs, cw.inner, here[0], here[1], vx, vy, self.reactive.brake_margin_m, decel,
-                               motion.period_s)  # fmt: skip
+                               motion.period_s)
         if (gx, gy) != (vx, vy):  # the step toward the wanted velocity closes too fast: brake along the normals
             bx, by = K.brake_guard(cw.obs, cw.inner, here[0], here[1], start.vx, start.vy,
-                                   self.reactive.brake_margin_m, decel, motion.period_s)  # fmt: skip
+                                   self.reactive.brake_margin_m, decel, motion.period_s)
             vx, vy = limit_velocity(start.vx, start.vy, bx, by, top, motion.max_accel_m_s2, motion.max_brake_m_s2,
-                                    motion.period_s)  # fmt: skip
+                                    motion.period_s)
         return float(vx), float(vy), omega
 
     # --- for the methods -------------------------------------------------------------------------

@@ -52,14 +52,14 @@ def config_sections() -> dict[str, type]:
         for section, params in nav.SECTIONS.items():
             if out.setdefault(section, params) is not params:
                 raise TypeError(f"navigator {name!r} reads section {section!r} as {params.__name__}, "
-                                f"another as {out[section].__name__}")  # fmt: skip
+                                f"another as {out[section].__name__}")
     return out
 
 
 def make_navigator(
     name: str, sections: Mapping[str, Any], control: ControlParams, robot_radius_m: float,
     collision: CollisionParams | None = None,
-) -> Navigator:  # fmt: skip
+) -> Navigator:
     """A fresh navigator ``name`` for one robot, configured from ``sections`` (the team config's
     sections by name: :attr:`cmdragons.team.TeamParams.navigator_sections`); a section it reads that
     ``sections`` lacks takes its defaults."""

@@ -70,12 +70,12 @@ class RoboxNavigator:
         """From the sections ``robox`` and ``elastic_band`` (its band), ``dynamic_window`` and ``trajectory``
         (the window that executes the band)."""
         return cls(sections["robox"], sections["elastic_band"], sections["dynamic_window"], control, robot_radius_m,
-                   collision, sections["trajectory"])  # fmt: skip
+                   collision, sections["trajectory"])
 
     def __init__(
         self, params: RoboxParams, band: BandParams, window: DynamicWindowParams, control: ControlParams,
         robot_radius_m: float, collision: CollisionParams | None = None, follow: TrajectoryParams | None = None,
-    ) -> None:  # fmt: skip
+    ) -> None:
         self.params = params
         self.band_params = band
         self.radius = robot_radius_m
@@ -112,7 +112,7 @@ class RoboxNavigator:
         plan = np.vstack([here, self.plan[1:]]) if len(self.plan) > 1 else np.vstack([here, goal])
         band = self.band
         fresh = (not self._banded or math.dist(tuple(band.points[-1]), tuple(goal)) > self.params.goal_tolerance_m
-                 or path_length(plan) < self.params.reseed_share * band.length)  # fmt: skip
+                 or path_length(plan) < self.params.reseed_share * band.length)
         if fresh:
             band.set_path(plan, clearance)
             self._banded = True

@@ -105,7 +105,7 @@ class TrajectoryNavigator:
                 ux, uy = (gx - start[0]) / d, (gy - start[1]) / d
                 beyond = self.params.through_beyond_m
                 target = MotionTarget(gx + ux * beyond, gy + uy * beyond, ux * through, uy * through,
-                                      self.arrival.heading_rad)  # fmt: skip
+                                      self.arrival.heading_rad)
         return target, control
 
     def start_state(self, robot: RobotState) -> RobotState:
@@ -114,7 +114,7 @@ class TrajectoryNavigator:
         sent = self._sent
         if sent is not None and math.hypot(sent[0] - robot.vx, sent[1] - robot.vy) <= self.params.command_slip_m_s:
             return RobotState(robot.team, robot.id, robot.x, robot.y, robot.theta, sent[0], sent[1], robot.omega,
-                              robot.visible)  # fmt: skip
+                              robot.visible)
         return robot
 
     def command(self, robot: RobotState, world: CollisionWorld, termination: Termination) -> VelocityCommand:

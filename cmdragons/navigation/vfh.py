@@ -107,11 +107,11 @@ class VFHNavigator(ReactiveNavigator):
         ``reactive`` and ``trajectory``."""
         plus = sections["vfh_plus"] if name == "vfh_plus" else None
         return cls(sections["vfh"], sections["reactive"], control, robot_radius_m, collision, sections["trajectory"],
-                   plus)  # fmt: skip
+                   plus)
 
     def __init__(self, params: VFHParams, reactive: ReactiveParams, control: ControlParams, robot_radius_m: float,
                  collision: CollisionParams | None = None, follow: TrajectoryParams | None = None,
-                 plus: VFHPlusParams | None = None) -> None:  # fmt: skip
+                 plus: VFHPlusParams | None = None) -> None:
         super().__init__(reactive, control, robot_radius_m, collision, follow)
         self.params = params
         self.plus = plus
@@ -158,7 +158,7 @@ class VFHNavigator(ReactiveNavigator):
                 theta = math.atan2(robot.vy, robot.vx)
                 r_turn = speed_now**2 / self.control.motion.max_accel_m_s2
                 left, right = K.turning_limits(src.obs, src.inner, here[0], here[1], theta, r_turn,
-                                               self.cfg.enlarge, self.cfg)  # fmt: skip
+                                               self.cfg.enlarge, self.cfg)
                 centres = ((np.arange(n) + 0.5) * alpha - math.pi).astype(np.float64)
                 rel = wrap_angle(centres - theta)
                 masked |= (rel > left) | (rel < right)
@@ -218,6 +218,6 @@ class VFHNavigator(ReactiveNavigator):
 
         def cost(c: float) -> float:
             return q.target_weight * _gap(c, target, n) + q.motion_weight * _gap(c, motion, n) \
-                + q.previous_weight * _gap(c, prev, n)  # fmt: skip
+                + q.previous_weight * _gap(c, prev, n)
 
         return min(candidates, key=cost)

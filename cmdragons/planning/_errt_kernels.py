@@ -123,7 +123,7 @@ def kd_nearest(
 def _nearest(
     nodes: np.ndarray, tree: np.ndarray, n: int, t: int, qx: float, qy: float, nn: int,
     kdc: np.ndarray, kdd: np.ndarray, roots: np.ndarray, stack: np.ndarray,
-) -> int:  # fmt: skip
+) -> int:
     if nn == NN_KDTREE:
         return kd_nearest(nodes, kdc, kdd, roots[t], qx, qy, stack)
     return nearest_brute(nodes, tree, n, t, qx, qy)

@@ -155,7 +155,7 @@ def _pop(mode: int, frontier: np.ndarray, head: int, size: int) -> tuple[int, in
 
 @njit(cache=True, inline="always")
 def _reach(mode: int, v: int, u: int, nd: float, dx: float, dy: float, octile: bool, g: np.ndarray,
-           prev: np.ndarray, frontier: np.ndarray, size: int) -> int:  # fmt: skip
+           prev: np.ndarray, frontier: np.ndarray, size: int) -> int:
     """Node u reaches its neighbour v at cost ``nd``: record it and put v on the frontier as ``mode``
     does ((dx, dy): v's offset from the goal, for the heuristic). Returns the frontier's new size."""
     if mode == SEARCH_DIJKSTRA or mode == SEARCH_ASTAR:
@@ -181,7 +181,7 @@ def graph_search(
     pts: np.ndarray, indptr: np.ndarray, adj: np.ndarray, w: np.ndarray, free: np.ndarray, res: float,
     connectivity: int, dst: int, mode: int, octile: bool, g: np.ndarray, prev: np.ndarray, closed: np.ndarray,
     frontier: np.ndarray, counters: np.ndarray, max_expand: int,
-) -> int:  # fmt: skip
+) -> int:
     """Run a graph search until ``dst`` is expanded, the frontier is empty or ``max_expand`` more
     nodes have been expanded, over either graph:
 
@@ -231,7 +231,7 @@ def graph_search(
                 if not cells[v] or closed[v]:
                     continue
                 size = _reach(mode, v, u, gu + (res if d < 4 else diag), (uk + GRID_DK[d]) * res - gx,
-                              (ui + GRID_DI[d]) * res - gy, True, g, prev, frontier, size)  # fmt: skip
+                              (ui + GRID_DI[d]) * res - gy, True, g, prev, frontier, size)
         else:
             for e in range(indptr[u], indptr[u + 1]):
                 v = adj[e]
@@ -281,7 +281,7 @@ def grid_astar(
     state: np.ndarray, nx: int, dst: int, heuristic: bool, connectivity: int, ga: np.ndarray, gb: np.ndarray,
     prev: np.ndarray, key: np.ndarray, node: np.ndarray, nxt: np.ndarray, head: np.ndarray, counters: np.ndarray,
     max_expand: int,
-) -> int:  # fmt: skip
+) -> int:
     """A* (``heuristic``: the octile distance, consistent on 4 and 8 neighbours) or Dijkstra on the
     graph :func:`graph_search` searches on a grid, in cell lengths, until ``dst`` is expanded, the
     heap runs empty or ``max_expand`` more cells have been expanded.
@@ -359,7 +359,7 @@ def grid_astar(
 
 @njit(cache=True)
 def grid_graph(free: np.ndarray, x0: float, y0: float, res: float, connectivity: int) -> tuple[
-        np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+        np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The connectivity graph of a uniform grid's free cells (``free`` (ny, nx), cell (i, k) centred at
     x0 + (k + 1/2) res, y0 + (i + 1/2) res): 4 or 8 neighbours, edges weighted by the centres'
     distance. Returns (node of each cell or -1 (ny, nx), centres (n, 2), CSR indptr, adj, lengths)."""

@@ -102,7 +102,7 @@ def vis_start(cw: CW, sx: float, sy: float, gx: float, gy: float, circles: np.nd
 def vis_bitangents(
     cw: CW, circles: np.ndarray, pts: np.ndarray, circ: np.ndarray, e_a: np.ndarray, e_b: np.ndarray,
     e_w: np.ndarray, counts: np.ndarray, c_lo: int, c_hi: int,
-) -> None:  # fmt: skip
+) -> None:
     """Add the free circle-circle bitangents of the circles c1 in [c_lo, c_hi) with every later
     circle to the graph's arrays (in place; ``counts`` as :func:`vis_start`)."""
     nc = circles.shape[0]
@@ -141,7 +141,7 @@ def vis_bitangents(
 def vis_search(
     cw: CW, circles: np.ndarray, pts: np.ndarray, circ: np.ndarray, e_a: np.ndarray, e_b: np.ndarray,
     e_w: np.ndarray, counts: np.ndarray, arc_step_rad: float,
-) -> tuple[Any, ...]:  # fmt: skip
+) -> tuple[Any, ...]:
     """The free arcs between angularly consecutive tangent points on each circle, then Dijkstra from
     the start (node 0) to the goal (node 1). Returns as :func:`visibility_graph`."""
     n, ne = counts[0], counts[1]

@@ -113,7 +113,7 @@ def quadtree(cw: CompiledWorld, min_cell_m: float) -> tuple[Quadtree, Graph]:
             break
         h = parts[:, 2] // 2
         cells = np.vstack([np.column_stack([parts[:, 0] + dx * h, parts[:, 1] + dy * h, h])
-                           for dx in (0, 1) for dy in (0, 1)])  # fmt: skip
+                           for dx in (0, 1) for dy in (0, 1)])
     leaves = np.vstack(free_cells) if free_cells else np.zeros((0, 3), np.int64)
     lo = np.column_stack([x0 + leaves[:, 0] * fx, y0 + leaves[:, 1] * fy])
     boxes = np.hstack([lo, lo + leaves[:, 2:3] * np.array([fx, fy])])

@@ -250,7 +250,7 @@ def clearance_grid(
 def clearance_grid_capped(
     obs: np.ndarray, aabb: np.ndarray, inner: np.ndarray, x0: float, y0: float, res: float, nx: int, ny: int,
     cap: float,
-) -> np.ndarray:  # fmt: skip
+) -> np.ndarray:
     """``min(clearance, cap)`` at the cell centres of :func:`clearance_grid`: each obstacle visits
     only the cells within ``cap`` of its bounding box (what a cost grid needs: its soft costs end at a
     clearance, so the cells farther from every obstacle all take ``cap``)."""
@@ -370,7 +370,7 @@ def _range_area(aabb: np.ndarray, order: np.ndarray, lo: int, hi: int) -> float:
 def build_world(
     circles: np.ndarray, vel: np.ndarray, boxes: np.ndarray, bounds: np.ndarray, radius: float,
     t0: float, t1: float, mode: int, n_bins: int,
-) -> CW:  # fmt: skip
+) -> CW:
     """The compiled world (see the module docstring) for a robot of ``radius`` over the time
     window [t0, t1]: circles (x, y, r) moving at ``vel`` become capsules, boxes get the radius as
     clearance, and the extent masks are built when ``mode`` asks for them (the AABB tree is the

@@ -31,7 +31,7 @@ def obstacle_polygons(cw: CompiledWorld, quad_segs: int) -> list[shapely.Polygon
     out = []
     for kind, a, b, c, d, r in cw.obs:
         core = (shapely.LineString([(a, b), (c, d)]) if (a, b) != (c, d) else shapely.Point(a, b)) if kind == 0.0 \
-            else shapely.box(a, b, c, d)  # fmt: skip
+            else shapely.box(a, b, c, d)
         out.append(core.buffer(r * scale, quad_segs=quad_segs))
     return out
 

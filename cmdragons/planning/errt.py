@@ -159,7 +159,7 @@ class ERRTPlanner:
         old: tuple[NDArray[np.generic], ...] = (self._nodes, self._parent, self._tree, self._cost, self._kdc, self._kdd)
         self._allocate(min(2 * n, MAX_NODES))
         grown: tuple[NDArray[np.generic], ...] = (self._nodes, self._parent, self._tree, self._cost, self._kdc,
-                                                  self._kdd)  # fmt: skip
+                                                  self._kdd)
         for new, a in zip(grown, old, strict=True):
             new[:n] = a
 
@@ -223,7 +223,7 @@ class ERRTPlanner:
     def _grow(
         self, cw: CompiledWorld, s: tuple[float, float], g: tuple[float, float], waypoints: FloatArray,
         termination: Termination,
-    ) -> tuple[int, bool]:  # fmt: skip
+    ) -> tuple[int, bool]:
         """Run the ERRT kernel in chunks until it finishes, spends the termination's budget of nodes
         or its deadline passes."""
         self._nodes[0], self._nodes[1] = s, g
@@ -240,7 +240,7 @@ class ERRTPlanner:
             rand = self._random_rows(chunk)
             before = int(self._counts[K.ITERATIONS])
             trees = K.Trees(self._nodes, self._parent, self._tree, self._cost, self._kdc, self._kdd, self._roots,
-                            self._stack, self._counts, self._bridges)  # fmt: skip
+                            self._stack, self._counts, self._bridges)
             code = K.errt_grow(cw.cw, trees, rand, waypoints, self._config, min(limit, len(self._nodes)))
             self._rand_next += int(self._counts[K.ITERATIONS]) - before
             if code == K.GROW_FULL and len(self._nodes) < min(limit, MAX_NODES):

@@ -142,7 +142,7 @@ class _Frontier:
         return int(self.counters[K.EXPANDED])
 
     def run(self, step: Callable[[int], int], dst: int, termination: Termination, work_done: float,
-            chunk: int) -> SearchResult:  # fmt: skip
+            chunk: int) -> SearchResult:
         """Call the kernel ``step(max_expand)`` in chunks until it ends or ``termination`` stops it."""
         while True:
             left = termination.work_left(work_done + self.expanded, chunk)
@@ -163,21 +163,21 @@ def _mode(method: str) -> int:
 
 
 def search(graph: Graph, src: int, dst: int, method: str, termination: Termination, work_done: float = 0.0,
-           chunk: int = CHUNK) -> SearchResult:  # fmt: skip
+           chunk: int = CHUNK) -> SearchResult:
     """Search ``graph`` from node ``src`` to node ``dst`` by ``method`` (a key of :data:`SEARCHES`)
     until ``termination`` (work: nodes expanded, counted on from ``work_done``)."""
     f = _Frontier(graph.n, len(graph.adj), src, _mode(method))
 
     def step(left: int) -> int:
         return int(K.graph_search(graph.pts, graph.indptr, graph.adj, graph.w, _NO_GRID, 1.0, 0, dst, f.mode,
-                                  graph.octile, f.g, f.prev, f.closed, f.frontier, f.counters, left))  # fmt: skip
+                                  graph.octile, f.g, f.prev, f.closed, f.frontier, f.counters, left))
 
     return f.run(step, dst, termination, work_done, chunk)
 
 
 def grid_search(free: NDArray[np.bool_], start: tuple[int, int], goal: tuple[int, int], method: str,
                 termination: Termination, resolution_m: float = 1.0, connectivity: int = 8,
-                chunk: int = GRID_CHUNK) -> SearchResult:  # fmt: skip
+                chunk: int = GRID_CHUNK) -> SearchResult:
     """:func:`search` on the connectivity graph of a uniform grid's free cells (``free`` (ny, nx),
     cells (row, column), ``resolution_m`` apart, 4 or 8 neighbours; the heuristic the octile
     distance), without building the graph: the same search as over
@@ -191,7 +191,7 @@ def grid_search(free: NDArray[np.bool_], start: tuple[int, int], goal: tuple[int
     src, dst = (start[0] + 1) * width + start[1] + 1, (goal[0] + 1) * width + goal[1] + 1
     if mode in (K.SEARCH_DIJKSTRA, K.SEARCH_ASTAR):
         found = _GridFrontier(free, src, connectivity).run(dst, mode == K.SEARCH_ASTAR, resolution_m, termination,
-                                                            chunk)  # fmt: skip
+                                                            chunk)
     else:
         grid = np.zeros((ny + 2, width), dtype=np.bool_)  # a blocked border: no neighbour falls outside
         grid[1:-1, 1:-1] = free
@@ -200,7 +200,7 @@ def grid_search(free: NDArray[np.bool_], start: tuple[int, int], goal: tuple[int
         def step(left: int) -> int:
             return int(K.graph_search(_NO_POINTS, _NO_INDEX, _NO_INDEX, _NO_WEIGHTS, grid, resolution_m,
                                       connectivity, dst, f.mode, True, f.g, f.prev, f.closed, f.frontier,
-                                      f.counters, left))  # fmt: skip
+                                      f.counters, left))
 
         found = f.run(step, dst, termination, work_done=0.0, chunk=chunk)
     route = (found.route // width - 1) * nx + found.route % width - 1  # back to the unbordered grid's cells
@@ -232,7 +232,7 @@ class _GridFrontier:
         self.counters[K.GRID_POOL] = 1
 
     def run(self, dst: int, heuristic: bool, resolution_m: float, termination: Termination,
-            chunk: int) -> SearchResult:  # fmt: skip
+            chunk: int) -> SearchResult:
         """Call the kernel in chunks until it ends or ``termination`` stops it."""
         while True:
             expanded = int(self.counters[K.EXPANDED])
@@ -241,7 +241,7 @@ class _GridFrontier:
                 return SearchResult(SearchStatus.STOPPED, np.zeros(0, np.int64), np.inf, expanded)
             outcome = K.grid_astar(self.state, self.width, dst, heuristic, self.connectivity, self.ga,
                                    self.gb, self.prev, self.key, self.node, self.nxt, self.head, self.counters,
-                                   left)  # fmt: skip
+                                   left)
             expanded = int(self.counters[K.EXPANDED])
             if outcome == 1:
                 cost = (float(self.ga[dst]) + float(self.gb[dst]) * math.sqrt(2.0)) * resolution_m
@@ -251,7 +251,7 @@ class _GridFrontier:
 
 
 def link_point(cw: CompiledWorld, pts: FloatArray, point: tuple[float, float], k: int,
-               radius_m: float = np.inf) -> tuple[IntArray, FloatArray]:  # fmt: skip
+               radius_m: float = np.inf) -> tuple[IntArray, FloatArray]:
     """The nodes among the ``k`` nearest of ``pts`` (within ``radius_m``) that the robot reaches from
     ``point`` in a straight line (the exact swept-disc query): their indices and distances."""
     if not len(pts):

@@ -62,7 +62,7 @@ class GridParams(CostParams):
         half_diagonal = self.resolution_m * math.sqrt(0.5)
         if self.min_clearance_m < half_diagonal - 1e-12:
             raise ValueError(f"min_clearance_m must be at least half a cell's diagonal ({half_diagonal:.4f} m for "
-                             f"{self.resolution_m} m cells), so that a path through free cells is free")  # fmt: skip
+                             f"{self.resolution_m} m cells), so that a path through free cells is free")
 
 
 @dataclass(frozen=True)
@@ -109,7 +109,7 @@ def cost_grid(cw: CompiledWorld, params: CostParams) -> CostGrid:
 
 
 def _links(cw: CompiledWorld, grid: CostGrid, point: tuple[float, float],
-           radius_m: float) -> tuple[NDArray[np.int64], FloatArray]:  # fmt: skip
+           radius_m: float) -> tuple[NDArray[np.int64], FloatArray]:
     """The free cells within ``radius_m`` of ``point`` (at least its own cell's neighbours) whose centre
     the robot reaches from ``point`` in a straight line: (k, 2) rows (row, col), and each one's
     distance to the point in cell lengths."""
@@ -182,7 +182,7 @@ class _GridPlanner(abc.ABC):
     @abc.abstractmethod
     def _descend(self, grid: CostGrid, goal_cells: NDArray[np.int64], goal_d: FloatArray,
                  start_cells: NDArray[np.int64], start_d: FloatArray, ends: RobustEnds, termination: Termination,
-                 stats: dict[str, Any]) -> tuple[PlanStatus, FloatArray]:  # fmt: skip
+                 stats: dict[str, Any]) -> tuple[PlanStatus, FloatArray]:
         """The status and the descent's points in cell units (x along columns, y along rows) from a
         start link (rows of ``start_cells``, ``start_d`` cells from the start) to a goal link."""
 
@@ -204,7 +204,7 @@ class EStarPlanner(_GridPlanner):
         self._estar, self._key, self._cost = None, None, None
 
     def _field(self, grid: CostGrid, goal_cells: NDArray[np.int64], values: FloatArray,
-               goal: tuple[float, float]) -> tuple[EStar, bool]:  # fmt: skip
+               goal: tuple[float, float]) -> tuple[EStar, bool]:
         """The navigation function toward ``goal``: the last frame's, repaired where the costs changed,
         when the goal and its cells are the same; else a fresh one. Returns it and whether it was kept."""
         key = (grid.x0, grid.y0, grid.resolution_m, grid.shape, goal_cells.tobytes(), values.tobytes())
@@ -223,7 +223,7 @@ class EStarPlanner(_GridPlanner):
 
     def _descend(self, grid: CostGrid, goal_cells: NDArray[np.int64], goal_d: FloatArray,
                  start_cells: NDArray[np.int64], start_d: FloatArray, ends: RobustEnds, termination: Termination,
-                 stats: dict[str, Any]) -> tuple[PlanStatus, FloatArray]:  # fmt: skip
+                 stats: dict[str, Any]) -> tuple[PlanStatus, FloatArray]:
         values = goal_d * grid.cost[goal_cells[:, 0], goal_cells[:, 1]]
         e, kept = self._field(grid, goal_cells, values, ends.goal)
         stats["repaired"] = kept
@@ -269,7 +269,7 @@ class NF1Planner(_GridPlanner):
 
     def _descend(self, grid: CostGrid, goal_cells: NDArray[np.int64], goal_d: FloatArray,
                  start_cells: NDArray[np.int64], start_d: FloatArray, ends: RobustEnds, termination: Termination,
-                 stats: dict[str, Any]) -> tuple[PlanStatus, FloatArray]:  # fmt: skip
+                 stats: dict[str, Any]) -> tuple[PlanStatus, FloatArray]:
         free = np.isfinite(grid.cost)
         stats["cells"] = int(free.sum())
         if termination.reached(float(free.sum())):  # the wavefront visits every free cell it reaches

@@ -31,7 +31,7 @@ class Scene:
     def problem(self, field: Field, collision: CollisionParams | None = None, horizon_s: float = 0.0) -> PlanProblem:
         world = field_world(field, self.robots, self.velocities)
         return PlanProblem(self.start, self.goal, field.league.robot.radius_m, world, horizon_s,
-                           collision or CollisionParams())  # fmt: skip
+                           collision or CollisionParams())
 
 
 def random_free_point(
@@ -56,7 +56,7 @@ def random_scene(field: Field, rng: np.random.Generator, max_robots: int = 21, m
     robots = np.column_stack([
         rng.uniform(-field.half_length + r, field.half_length - r, n),
         rng.uniform(-field.half_width + r, field.half_width - r, n),
-    ])  # fmt: skip
+    ])
     speed = rng.uniform(0.0, max_speed_m_s, n)
     heading = rng.uniform(-np.pi, np.pi, n)
     vel = np.column_stack([speed * np.cos(heading), speed * np.sin(heading)])
@@ -74,7 +74,7 @@ class MovingScene:
     turning to a new random velocity with probability ``p_turn`` a frame."""
 
     def __init__(self, field: Field, scene: Scene, rng: np.random.Generator, max_speed_m_s: float = 2.0,
-                 p_turn: float = 0.02) -> None:  # fmt: skip
+                 p_turn: float = 0.02) -> None:
         self.field = field
         self.rng = rng
         self.pos = scene.robots.copy()
@@ -111,7 +111,7 @@ class CrowdScene:
 
     def __init__(self, field: Field, rng: np.random.Generator, n_robots: int = 21, ring_m: float = 0.55,
                  gap_m: float = 0.12, spacing_m: float = 0.3, max_speed_m_s: float = 0.8,
-                 max_turn_rad_s: float = 0.5) -> None:  # fmt: skip
+                 max_turn_rad_s: float = 0.5) -> None:
         self.field = field
         self.rng = rng
         r = field.league.robot.radius_m
@@ -127,7 +127,7 @@ class CrowdScene:
         y_lim = field.half_width - ring_m - 2 * r
         self.box = np.array([[-x_lim, -y_lim, -ring_m - 2 * r, y_lim], [ring_m + 2 * r, -y_lim, x_lim, y_lim]])
         self.centre = np.column_stack([rng.uniform(self.box[:, 0], self.box[:, 2]),
-                                       rng.uniform(self.box[:, 1], self.box[:, 3])])  # fmt: skip
+                                       rng.uniform(self.box[:, 1], self.box[:, 3])])
         speed = rng.uniform(0.2, max_speed_m_s, 2)
         heading = rng.uniform(-np.pi, np.pi, 2)
         self.vel = np.column_stack([speed * np.cos(heading), speed * np.sin(heading)])
@@ -137,7 +137,7 @@ class CrowdScene:
         n_free = max(0, n_robots - 2 * n_ring)
         others = random_scene(field, rng, max_robots=max(1, n_free), max_speed_m_s=max_speed_m_s)
         self.wander = MovingScene(field, Scene(others.robots[:n_free], others.velocities[:n_free],
-                                               (0.0, 0.0), (0.0, 0.0)), rng, max_speed_m_s)  # fmt: skip
+                                               (0.0, 0.0), (0.0, 0.0)), rng, max_speed_m_s)
         self.target = 1  # the pocket our robot heads for
 
     @property

@@ -84,7 +84,7 @@ class VisibilityGraphPlanner(Stateless):
         return type(result)(result.status, result.path, exact, {**result.stats, **stats})
 
     def _polyline(self, pts: FloatArray, circ: NDArray[np.int64], ang: FloatArray, route: NDArray[np.int64],
-                  circles: FloatArray, dist: FloatArray) -> FloatArray:  # fmt: skip
+                  circles: FloatArray, dist: FloatArray) -> FloatArray:
         """The route's nodes, with each arc between two tangent points replaced by segments tangent
         to the arc (vertices at radius r / cos(half step) keep the polyline outside the disc)."""
         out = [pts[route[0]]]

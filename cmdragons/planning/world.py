@@ -140,7 +140,7 @@ class CollisionWorld:
         # a world of rows already checked (the constructor's checks cost more than a frame can spare)
         w = object.__new__(CollisionWorld)
         for name, value in (("bounds", self.bounds), ("circles", circles), ("velocities", velocities),
-                            ("boxes", boxes), ("_cache", {})):  # fmt: skip
+                            ("boxes", boxes), ("_cache", {})):
             object.__setattr__(w, name, value)
         return w
 
@@ -222,7 +222,7 @@ class CompiledWorld:
         return np.asarray(c), np.asarray(g)
 
     def clearance_grid(self, resolution_m: float | None = None, walls: bool = True,
-                       cap_m: float = math.inf) -> ClearanceGrid:  # fmt: skip
+                       cap_m: float = math.inf) -> ClearanceGrid:
         """The clearance rasterised over the field boundary in square cells of ``resolution_m``
         (default the params' ``grid_resolution_m``); cells cover the boundary box, the last row and
         column reaching up to one cell past it. ``walls=False``: the clearance from the obstacles

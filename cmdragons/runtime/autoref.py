@@ -50,7 +50,7 @@ class AutorefStage(BaseStage):
                         (Port(prefix + "referee", GameState), Port(prefix + "referee/events", GameEvents,
                                                                        sometimes=True),
                          *((Port(prefix + "teleport", Teleport, sometimes=True),) if teleports else ()),
-                         summary_port("autoref")))  # fmt: skip
+                         summary_port("autoref")))
 
     def __init__(self, autoref: AutoRef, prefix: str = "", teleports: bool = True) -> None:
         self.contract = self.declare(prefix, teleports)
@@ -90,7 +90,7 @@ def _autoref(settings: Settings, keys: Sequence[tuple[Team, int]], prefix: str, 
 
 
 def autoref_rows(settings: Settings, detection_topics: Sequence[str], keys: Sequence[tuple[Team, int]],
-                 passive: bool = False) -> list[Entry]:  # fmt: skip
+                 passive: bool = False) -> list[Entry]:
     """The autoref's rows of a set-up's table: its tracker over ``detection_topics`` (every camera's,
     taken in this order each frame) and the referee on it, for the match's robots ``keys`` (team,
     id). It drives the match (writes ``referee``, ``referee/events``, and ``teleport`` with
@@ -108,4 +108,4 @@ def autoref_rows(settings: Settings, detection_topics: Sequence[str], keys: Sequ
     return [Entry(TrackerStage.declare("autoref", topics, take_commands=False), "referee",
                   functools.partial(_tracker, settings, topics)),
             Entry(AutorefStage.declare(prefix, teleports), "referee",
-                  functools.partial(_autoref, settings, tuple(keys), prefix, teleports))]  # fmt: skip
+                  functools.partial(_autoref, settings, tuple(keys), prefix, teleports))]

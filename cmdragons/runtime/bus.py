@@ -170,7 +170,7 @@ class Bus:
 
 
 def run_frames(step: Callable[[int], None], n: int, should_stop: Callable[[], bool] = lambda: False,
-               on_frame: Callable[[int], None] | None = None) -> int:  # fmt: skip
+               on_frame: Callable[[int], None] | None = None) -> int:
     """The frame loop of every set-up: ``step(i)`` for the frames 0 .. ``n`` - 1, ``on_frame(i)``
     after each, until ``should_stop()`` says so before a frame; the frames run."""
     for i in range(n):

@@ -95,7 +95,7 @@ def frame_path_priority(params: RuntimeParams, role: str) -> str | None:
         except (AttributeError, OSError) as exc:
             reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else "not on this system"
             notes.append(f"runtime.realtime_priority: the real-time scheduler is not available ({reason}); "
-                         "normal priority")  # fmt: skip
+                         "normal priority")
     if params.cpu_latency_us >= 0:
         note = _hold_cpu_latency(params.cpu_latency_us)
         if note is not None:
@@ -118,7 +118,7 @@ def _hold_cpu_latency(us: int) -> str | None:
         fd = os.open(CPU_LATENCY_DEVICE, os.O_WRONLY)
     except OSError as exc:
         return (f"runtime.cpu_latency_us: {CPU_LATENCY_DEVICE} cannot be opened ({exc.strerror}); the kernel's "
-                "idle states")  # fmt: skip
+                "idle states")
     os.write(fd, struct.pack("i", us))
     _cpu_latency.append(fd)
     return None
@@ -128,14 +128,14 @@ def node_roles(opponent: Opponent, log: bool, vision_with_sim: bool = False) -> 
     """The nodes a match needs (no opponent node against nobody or a team outside; the log node
     when logging; no vision node when vision runs in the sim node)."""
     return [r for r in ROLES if (r != "opponent" or opponent in (*BUILT_IN, "self")) and (r != "log" or log)
-            and (r != "vision" or not vision_with_sim)]  # fmt: skip
+            and (r != "vision" or not vision_with_sim)]
 
 
 class MatchSpec:
     """What every node of one match agrees on: the settings, the opponent, the perception, the seed."""
 
     def __init__(self, settings: Settings, opponent: Opponent, perception: Perception, seed: int,
-                 opponent_settings: Settings | None = None) -> None:  # fmt: skip
+                 opponent_settings: Settings | None = None) -> None:
         self.settings = settings
         self.opponent: Opponent = opponent
         self.perception: Perception = perception
@@ -150,10 +150,10 @@ class MatchSpec:
 
             return Simulator(self.settings.field, self.settings.camera_models(),
                              match_sim_params(self.settings, self.opponent), seed=self.seed,
-                             render=self.perception == "vision", referee=False)  # fmt: skip
+                             render=self.perception == "vision", referee=False)
 
         return wiring(self.settings, self.opponent, self.perception, self.seed, simulator,
-                      opponent_settings=self.opponent_settings)  # fmt: skip
+                      opponent_settings=self.opponent_settings)
 
     def stages(self, role: str) -> list[Stage]:
         """The stages of ``role``, built as the embedded match builds them, after the whole table is
@@ -202,7 +202,7 @@ def rehearse(spec: MatchSpec, role: str) -> None:
 
     vision = spec.perception == "vision"
     sim = Simulator(settings.field, settings.camera_models(), settings.sim, seed=spec.seed, render=vision,
-                    referee=False)  # fmt: skip
+                    referee=False)
     pipelines = []
     if vision and role == "vision":
         from vision.pipeline import VisionPipeline
@@ -230,7 +230,7 @@ def rehearsal_scene(settings: Settings, frames: int) -> list[DetectionFrame]:
         robots = tuple(RobotDetection(team, i, side * dims.length_m * (0.1 + 0.3 * (i % 2)),
                                       dims.width_m * ((i + 0.5) / n - 0.5) * 0.8, 0.0, 1.0, (0.0, 0.0))
                        for team, side in ((OURS, -1.0), (THEIRS, 1.0)) for n in [counts[team]]
-                       for i in range(n))  # fmt: skip
+                       for i in range(n))
         ball = BallDetection(0.3 * t, 0.1 * t, 1.0, (0.0, 0.0))
         out.append(DetectionFrame(0, k, t, t, (ball,), robots))
     return out
@@ -251,7 +251,7 @@ def _control(transport: ZenohTransport, node: str, command: str) -> None:
 
 
 def run_node(role: str, spec: MatchSpec, transport: ZenohTransport, extra: Sequence[Stage] = (),
-             err: TextIO | None = None, should_stop: Callable[[], bool] = lambda: False) -> int:  # fmt: skip
+             err: TextIO | None = None, should_stop: Callable[[], bool] = lambda: False) -> int:
     """Run one node (not the sim: :func:`run_clock`) until the clock says stop; 0, or 1 when it
     never started (stopped first)."""
     err = err if err is not None else sys.stderr
@@ -275,7 +275,7 @@ def run_node(role: str, spec: MatchSpec, transport: ZenohTransport, extra: Seque
             last_ready = now
         if now - warned >= params.peer_timeout_s and not commands:  # (the clock says when it waits for others)
             print(f"node {role}: no match clock on cmdragons/{params.field_name} for {now - started:.0f} s: is the "
-                  f"sim node running and connected to {params.zenoh.router}?", file=err)  # fmt: skip
+                  f"sim node running and connected to {params.zenoh.router}?", file=err)
             warned = now
         transport.spin(0.05)
     if not set(commands) & STARTS:
@@ -296,7 +296,7 @@ def run_node(role: str, spec: MatchSpec, transport: ZenohTransport, extra: Seque
                 return 0
         if time.monotonic() - transport.last_received > params.peer_timeout_s:
             print(f"node {role}: nothing from the other nodes for {params.peer_timeout_s:.0f} s: is the sim node "
-                  "still running?", file=err)  # fmt: skip
+                  "still running?", file=err)
             transport.last_received = time.monotonic()
     return 0
 
@@ -304,7 +304,7 @@ def run_node(role: str, spec: MatchSpec, transport: ZenohTransport, extra: Seque
 def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles: Sequence[str],
               realtime: bool = False, extra: Sequence[Stage] = (), err: TextIO | None = None,
               should_stop: Callable[[], bool] = lambda: False,
-              on_frame: Callable[[int], None] | None = None) -> dict[str, Any]:  # fmt: skip
+              on_frame: Callable[[int], None] | None = None) -> dict[str, Any]:
     """The sim node: waits for ``roles`` to be ready, starts them, runs ``seconds`` of the match and
     returns the summary (as the embedded match's, gathered over the bus); tells every node to stop."""
     err = err if err is not None else sys.stderr
@@ -351,10 +351,10 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
         now = time.monotonic()
         if now - t0 > params.start_timeout_s:
             raise TimeoutError(f"nodes {', '.join(sorted(set(others) - ready))} did not come up within "
-                               f"{params.start_timeout_s:.0f} s (runtime.start_timeout_s)")  # fmt: skip
+                               f"{params.start_timeout_s:.0f} s (runtime.start_timeout_s)")
         if now - warned >= params.peer_timeout_s and not ready >= set(others):
             print(f"sim: waiting for nodes {', '.join(sorted(set(others) - ready))} on {params.zenoh.router}",
-                  file=err)  # fmt: skip
+                  file=err)
             warned = now
         if now - said >= 0.25:  # the nodes that are ready hear that the clock is there
             _control(transport, "clock", "waiting")
@@ -392,7 +392,7 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
                     if missing:
                         silent[0] += 1
                         print(f"sim: frame {i}: no commands from {', '.join(missing)} within "
-                              f"{params.lockstep_wait_s} s: stepped without", file=err)  # fmt: skip
+                              f"{params.lockstep_wait_s} s: stepped without", file=err)
                     waited = time.monotonic()
         frame_ms.append((time.perf_counter() - f0) * 1e3)
 
@@ -412,10 +412,10 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
     else:  # a node of the match was not there: what the others said
         summary = {"seed": sim.seed, "opponent": spec.opponent, "perception": spec.perception,
                    "missing_nodes": sorted(set(spec.roles(log=False)) - set(roles)),
-                   "score": f["referee"]["score"], "command_faults": f["sim"]["command_faults"]}  # fmt: skip
+                   "score": f["referee"]["score"], "command_faults": f["sim"]["command_faults"]}
     summary.update(frames=len(frame_ms), wall_seconds=round(wall, 3), frames_stepped_without_a_team=silent[0],
                    realtime_factor=round(sim.t / wall, 2) if wall > 0 else None,
-                   dropped_messages=transport.dropped)  # fmt: skip
+                   dropped_messages=transport.dropped)
     return summary
 
 

@@ -23,7 +23,7 @@ __all__ = ["RUN_FILES", "LogError", "OutputError", "RunLog", "check_writable_fil
 
 # what a run writes into its folder (globs): a folder holding one of these holds a run
 RUN_FILES = ("run.mcap", "summary.json", "match.mp4", "match_cameras.mp4", "report.png", "detections.jsonl",
-             "tracks.jsonl", "truth.jsonl", "cameras.yaml", "camera_*", "annotated_camera_*")  # fmt: skip
+             "tracks.jsonl", "truth.jsonl", "cameras.yaml", "camera_*", "annotated_camera_*")
 
 
 class OutputError(Exception):
@@ -45,7 +45,7 @@ def run_folder(command: str, out: str | Path | None = None, logs: str | Path = "
             old = sorted({p for pattern in RUN_FILES for p in folder.glob(pattern)})
             if old and not overwrite and any(p.name != "run.mcap" or holds_messages(p) for p in old):
                 raise OutputError(f"--out {folder}: holds another run ({old[0].name}); give a new folder, "
-                                  "or add --overwrite to replace that run")  # fmt: skip
+                                  "or add --overwrite to replace that run")
             for p in old:
                 if p.is_dir():
                     shutil.rmtree(p)
@@ -63,12 +63,12 @@ def run_folder(command: str, out: str | Path | None = None, logs: str | Path = "
     blocking = _file_in_the_way(folder.parent)
     if blocking is not None:
         raise OutputError(f"cannot create the output folder {folder}: {blocking} is a file, not a folder; "
-                          "give another folder with --out DIR")  # fmt: skip
+                          "give another folder with --out DIR")
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise OutputError(f"cannot create the output folder {folder} ({exc.strerror}); "
-                          "give a writable one with --out DIR") from None  # fmt: skip
+                          "give a writable one with --out DIR") from None
     _check_folder_writable(folder)
     return folder
 
@@ -99,7 +99,7 @@ def _file_in_the_way(folder: Path) -> Path | None:
 def _check_folder_writable(folder: Path) -> None:
     if not os.access(folder, os.W_OK | os.X_OK):
         raise OutputError(f"cannot write into the output folder {folder} (permission denied); "
-                          "give a writable one with --out DIR")  # fmt: skip
+                          "give a writable one with --out DIR")
 
 
 def check_writable_file(path: str | Path, option: str) -> Path:
@@ -115,7 +115,7 @@ def check_writable_file(path: str | Path, option: str) -> Path:
         p.parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise OutputError(f"{option} {p}: cannot create its folder {p.parent} ({exc.strerror}); "
-                          "give a writable path") from None  # fmt: skip
+                          "give a writable path") from None
     existed = p.exists()
     try:  # a real open, not os.access: root passes every permission check but still cannot write in /proc
         with open(p, "a" if existed else "x"):
@@ -159,7 +159,7 @@ class RunLog:
         ns = max(0, int(round(t * 1e9)))
         self._sequence += 1
         self._writer.add_message(channel_id=channel, log_time=ns, data=proto.SerializeToString(deterministic=True),
-                                 publish_time=ns, sequence=self._sequence)  # fmt: skip
+                                 publish_time=ns, sequence=self._sequence)
 
     def _schema(self, proto: Any) -> int:
         from mcap_protobuf.schema import register_schema
@@ -182,7 +182,7 @@ class RunLog:
 
 
 def read_log(path: str | Path, topics: Collection[str] | None = None,
-             start_s: float | None = None) -> Iterator[tuple[str, float, Any]]:  # fmt: skip
+             start_s: float | None = None) -> Iterator[tuple[str, float, Any]]:
     """``(topic, t, message)`` for every message of an MCAP log in log-time order, ``t`` in s: our
     messages for the bus's schemas, the protobuf objects for the rest (Foxglove's scene); only
     ``topics`` if given, only from ``start_s`` on if given. :class:`LogError` for a file that is not
@@ -219,7 +219,7 @@ def read_log(path: str | Path, topics: Collection[str] | None = None,
         with open(path, "rb") as f:
             reader = make_reader(f)
             for schema, channel, m in reader.iter_messages(topics=None if topics is None else list(topics),
-                                                           starting_at=start_ns, log_time_order=True):  # fmt: skip
+                                                           starting_at=start_ns, log_time_order=True):
                 if schema is None:
                     raise LogError(f"{path}: topic {channel.topic} has no schema")
                 proto = message_class(schema).FromString(m.data)

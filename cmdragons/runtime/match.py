@@ -95,7 +95,7 @@ def match_sim_params(settings: Settings, opponent: Opponent) -> SimParams:
 
 def wiring(settings: Settings, opponent: Opponent, perception: Perception, seed: int,
            sim: Callable[[], Simulator], render: bool = False,
-           opponent_settings: Settings | None = None) -> list[Entry]:  # fmt: skip
+           opponent_settings: Settings | None = None) -> list[Entry]:
     """The table of a match's stages, in the order they subscribe (which fixes the order of
     delivery). ``sim``: builds (or gives) the match's simulator, with ``seed``; ``render``: it draws
     the camera images also when the team plays on truth. ``opponent_settings``: the brain and
@@ -108,7 +108,7 @@ def wiring(settings: Settings, opponent: Opponent, perception: Perception, seed:
     entries = [
         Entry(SimStage.declare(drawn), "sim", lambda: SimStage(sim(), playing)),
         Entry(RefereeStage.contract, "referee", functools.partial(_referee_stage, settings, keys)),
-    ]  # fmt: skip
+    ]
     brains: list[Team] = [OURS, THEIRS] if opponent == "self" else [OURS]
     # who is given detections: our team, its copy, or a team outside (``outside``: its own client on
     # the bus, commands on commands/yellow; ``simulation``: over the league's simulation protocol,
@@ -132,7 +132,7 @@ def wiring(settings: Settings, opponent: Opponent, perception: Perception, seed:
         sigmas = (t.ball.measurement_sigma_m, t.robot.measurement_sigma_m, t.robot.measurement_sigma_rad)
         entries += [Entry(TruthPerceptionStage.declare(team), vision_node,
                           functools.partial(TruthPerceptionStage, team, sigmas, seed + k))
-                    for k, team in enumerate(seeing)]  # fmt: skip
+                    for k, team in enumerate(seeing)]
         topics = {team: [f"perception/{team}"] for team in brains}
         synchronized = True  # (one topic)
         if opponent == "simulation":  # the outside team's noisy truth, as SSL-Vision packets
@@ -156,12 +156,12 @@ def wiring(settings: Settings, opponent: Opponent, perception: Perception, seed:
     entries += _ssl_out_stages(settings)
     if opponent in BUILT_IN:
         entries.append(Entry(BuiltInOpponentStage.declare(THEIRS), "opponent",
-                             functools.partial(_built_in_stage, opponent, THEIRS, settings)))  # fmt: skip
+                             functools.partial(_built_in_stage, opponent, THEIRS, settings)))
     entries += [Entry(StatsStage.declare(OURS), "team", functools.partial(_stats_stage, OURS, settings)),
-                Entry(TimingStage.contract, "team", TimingStage)]  # fmt: skip
+                Entry(TimingStage.contract, "team", TimingStage)]
     if opponent == "self":  # the copy of our team: its own figures too
         entries.append(Entry(StatsStage.declare(THEIRS), "opponent",
-                             functools.partial(_stats_stage, THEIRS, opponent_settings or settings)))  # fmt: skip
+                             functools.partial(_stats_stage, THEIRS, opponent_settings or settings)))
     return entries
 
 
@@ -284,13 +284,13 @@ def build(entries: Sequence[Entry], extra: Sequence[Stage] = (), node: str | Non
         stage = e.build()
         if stage.contract != e.contract:
             raise WiringError(f"stage {e.contract.name!r} was built with the contract {stage.contract} but its row "
-                              f"declares {e.contract}")  # fmt: skip
+                              f"declares {e.contract}")
         stages.append(stage)
     return [*stages, *extra]
 
 
 def _ssl_vision_stages(settings: Settings, models: Sequence[CameraModel], topics: dict[Team, list[str]],
-                       outside: bool = False, topics_out: list[str] | None = None) -> list[Entry]:  # fmt: skip
+                       outside: bool = False, topics_out: list[str] | None = None) -> list[Entry]:
     """Our vision as SSL-Vision packets (``protocols.vision.send``, or ``outside``: a team outside
     sees them; ``topics_out``: the detection topics sent, default our cameras') and our trackers on
     SSL-Vision packets (``protocols.perception: ssl_vision``; in lock-step with our own packets when
@@ -305,7 +305,7 @@ def _ssl_vision_stages(settings: Settings, models: Sequence[CameraModel], topics
     if p.vision.send or outside:
         sent_ids = ids if topics_out is None else [0]
         entries.append(_protocol(VisionOutStage, p, sent_ids, geometry_packet(settings.field_geometry(), list(models)),
-                                 topics_out))  # fmt: skip
+                                 topics_out))
     if topics_out is not None:
         return entries
     if p.perception == "ssl_vision":
@@ -376,7 +376,7 @@ class Match:
 
     def __init__(self, settings: Settings, opponent: Opponent = "simple", perception: Perception = "vision",
                  seed: int | None = None, render: bool = False, extra: Sequence[Stage] = (),
-                 transport: Transport | None = None, opponent_settings: Settings | None = None) -> None:  # fmt: skip
+                 transport: Transport | None = None, opponent_settings: Settings | None = None) -> None:
         if opponent_settings is not None and opponent != "self":
             raise ValueError("opponent_settings are for a copy of our team (opponent 'self')")
         self.settings = settings
@@ -386,7 +386,7 @@ class Match:
 
         self.sim = Simulator(settings.field, settings.camera_models(), match_sim_params(settings, opponent), seed=seed,
                              render=render or perception == "vision", referee=False,
-                             look=settings.cameras.look())  # fmt: skip
+                             look=settings.cameras.look())
         self.seed = self.sim.seed
         self.cameras = list(self.sim.cameras)
         self.bus = Bus(transport)
@@ -440,7 +440,7 @@ def summary_stages(opponent: Opponent) -> set[str]:
 
 
 def match_summary(f: dict[str, Any], stage_ms: dict[str, list[float]], seed: int, opponent: Opponent,
-                  perception: Perception) -> dict[str, Any]:  # fmt: skip
+                  perception: Perception) -> dict[str, Any]:
     """summary.json's figures from every stage's summary (``f``: stage name -> figures) and the
     per-frame stage times (ms) the runtime measured."""
     sim, referee, stats = f["sim"], f["referee"], f[f"stats/{OURS}"]
@@ -448,7 +448,7 @@ def match_summary(f: dict[str, Any], stage_ms: dict[str, list[float]], seed: int
     physics = tracker.pop("physics", None)  # what our tracker measured of the ball and robots
     open_pairs = [{a[0], b[0]} for a, b in sim["open_contacts"]]
     cycle = {k: {"median": float(np.median(v)), "p95": float(np.percentile(v, 95))}
-             for k, v in stage_ms.items() if v}  # fmt: skip
+             for k, v in stage_ms.items() if v}
     cycle.update(f["timing"].get(f"team/{OURS}", {}))  # the brain's parts
     return {
         "score": referee["score"],
@@ -480,4 +480,4 @@ def _their_figures(f: dict[str, Any], open_pairs: list[set[str]]) -> dict[str, A
     stats = f[f"stats/{THEIRS}"]
     return {"shots": stats["shots"], "passes": stats["passes"],
             "collisions": {"own": stats["collisions"]["own"] + sum(p == {THEIRS} for p in open_pairs),
-                           "own_pushed": stats["collisions"]["own_pushed"]}}  # fmt: skip
+                           "own_pushed": stats["collisions"]["own_pushed"]}}

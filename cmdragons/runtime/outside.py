@@ -54,7 +54,7 @@ from cmdragons.runtime.ssl.vision import VisionGeometry, decode_wrapper, field_d
 from cmdragons.runtime.stages import SummaryCollector, Tap, TeamStage, TimingStage, TrackerStage
 
 __all__ = ["FrameGate", "Heard", "OutsideError", "OutsideMatch", "SimulatorKind", "field_settings", "listen",
-           "outside_summary", "outside_wiring", "vision_params"]  # fmt: skip
+           "outside_summary", "outside_wiring", "vision_params"]
 
 
 class SimulatorKind(enum.Enum):
@@ -75,7 +75,7 @@ def vision_params(params: ProtocolParams, kind: SimulatorKind) -> ProtocolParams
     port = params.grsim.vision_port if kind is SimulatorKind.GRSIM else params.simulation.vision_port
     commands_to: CommandsTo = "grsim" if kind is SimulatorKind.GRSIM else "simulation"
     return dataclasses.replace(params, vision=dataclasses.replace(params.vision, port=port), commands_to=commands_to,
-                               perception="ssl_vision")  # fmt: skip
+                               perception="ssl_vision")
 
 
 class FrameGate:
@@ -147,7 +147,7 @@ class Heard:
 
 
 def listen(receiver: Any, timeout_s: float, learn_s: float, where: str,
-           clock: Callable[[], float] = time.monotonic) -> Heard:  # fmt: skip
+           clock: Callable[[], float] = time.monotonic) -> Heard:
     """Read the simulator's SSL-Vision packets until its geometry came and ``learn_s`` passed since
     its first detection (the cameras it sends from are those heard by then); :class:`OutsideError`
     naming ``where`` when neither came within ``timeout_s``."""
@@ -165,9 +165,9 @@ def listen(receiver: Any, timeout_s: float, learn_s: float, where: str,
         if now - t0 >= timeout_s:
             lacks = " and ".join(w for w, got in (("a geometry", geometry), ("a detection", seen)) if not got)
             heard = f"{packets} packets heard ({undecodable} undecodable), none with {lacks}" if packets \
-                else "nothing heard"  # fmt: skip
+                else "nothing heard"
             raise OutsideError(f"no SSL-Vision geometry and detections from the simulator on {where} in "
-                               f"{timeout_s:g} s ({heard}): is it running, and sending on that port?")  # fmt: skip
+                               f"{timeout_s:g} s ({heard}): is it running, and sending on that port?")
         data = receiver.receive(min(0.05, max(0.0, timeout_s - (now - t0))))
         if data is None:
             continue
@@ -190,7 +190,7 @@ def listen(receiver: Any, timeout_s: float, learn_s: float, where: str,
 
 # the sizes a geometry packet gives, compared with field.yaml's (m)
 _COMPARED = ("length_m", "width_m", "boundary_width_m", "goal_width_m", "goal_depth_m", "defense_depth_m",
-             "defense_width_m", "center_circle_radius_m", "line_width_m", "goal_height_m")  # fmt: skip
+             "defense_width_m", "center_circle_radius_m", "line_width_m", "goal_height_m")
 _SAME_M = 0.0015  # sent in whole millimetres: a difference below this is rounding
 
 
@@ -208,19 +208,19 @@ def field_settings(settings: Settings, geometry: VisionGeometry) -> tuple[Settin
     new = dataclasses.replace(league, division=division, divisions={**league.divisions, division: dims})
     ours = league.dims
     diffs = [f"{k.removesuffix('_m')} {getattr(dims, k):.3f} m (field.yaml {getattr(ours, k):.3f})" for k in _COMPARED
-             if abs(getattr(ours, k) - getattr(dims, k)) >= _SAME_M]  # fmt: skip
+             if abs(getattr(ours, k) - getattr(dims, k)) >= _SAME_M]
     if division != league.division:
         diffs.insert(0, f"division {division} (field.yaml {league.division})")
     line = None
     if diffs:
         line = f"field: the simulator's differs from field.yaml's division {league.division}: {', '.join(diffs)}; " \
-               "we play on the simulator's"  # fmt: skip
+               "we play on the simulator's"
     return dataclasses.replace(settings, field=new), line
 
 
 def outside_wiring(settings: Settings, kind: SimulatorKind, teams: Sequence[Team], cameras: Sequence[int],
                    receiver: Any, robots: Sequence[tuple[Team, int]],
-                   epoch: UnixEpoch | None = None) -> list[Entry]:  # fmt: skip
+                   epoch: UnixEpoch | None = None) -> list[Entry]:
     """The table of a match in an outside simulator: the simulator's SSL-Vision packets (``cameras``,
     read from ``receiver``) into each of our ``teams``' tracker and brain, their commands out to
     the simulator (``kind``; the referee's teleports through the first team's stage). The referee:
@@ -229,7 +229,7 @@ def outside_wiring(settings: Settings, kind: SimulatorKind, teams: Sequence[Team
     p = vision_params(settings.protocols, kind)
     topics = [f"ssl/vision/{c}" for c in cameras]
     entries = [Entry(VisionInStage.declare(p, cameras, False), "",
-                     lambda: VisionInStage(p, cameras, lockstep=False, receiver=receiver, epoch=epoch))]  # fmt: skip
+                     lambda: VisionInStage(p, cameras, lockstep=False, receiver=receiver, epoch=epoch))]
     referee, referee_topic, teleports = _referee(settings, p, teams[0], topics, robots)
     entries += referee
     chip = settings.sim.kicker.chip_angle_rad
@@ -249,7 +249,7 @@ def outside_wiring(settings: Settings, kind: SimulatorKind, teams: Sequence[Team
 
 
 def _referee(settings: Settings, p: ProtocolParams, ours: Team, topics: Sequence[str],
-             robots: Sequence[tuple[Team, int]]) -> tuple[list[Entry], str, bool]:  # fmt: skip
+             robots: Sequence[tuple[Team, int]]) -> tuple[list[Entry], str, bool]:
     """The referee's rows, the topic of its word and whether it teleports: a game controller's
     packets (``protocols.referee.source: game_controller``), else our referee on the tracked world
     (the autoref: its own tracker on every camera's packets ``topics``, judging the match's
@@ -257,7 +257,7 @@ def _referee(settings: Settings, p: ProtocolParams, ours: Team, topics: Sequence
     if p.referee.source == "game_controller":
         world_topic, moved_m = f"world/{ours}", settings.sim.referee.figures.ball_in_play_m
         return [Entry(RefereeInStage.declare(p, world_topic), "",
-                      lambda: RefereeInStage(p, world_topic, moved_m))], "referee/gc", False  # fmt: skip
+                      lambda: RefereeInStage(p, world_topic, moved_m))], "referee/gc", False
     rows = autoref_rows(settings, topics, robots)
     if p.referee.send:
         rows.append(Entry(RefereeOutStage.contract, "", functools.partial(RefereeOutStage, p)))
@@ -284,7 +284,7 @@ class OutsideMatch:
     stages on the same bus (a logger, a video)."""
 
     def __init__(self, settings: Settings, kind: SimulatorKind, teams: Sequence[Team], heard: Heard, receiver: Any,
-                 extra: Sequence[Stage] = (), transport: Transport | None = None) -> None:  # fmt: skip
+                 extra: Sequence[Stage] = (), transport: Transport | None = None) -> None:
         if kind is SimulatorKind.OWN:
             raise ValueError("our own simulator plays in cmdragons.runtime.match.Match")
         self.settings = settings
@@ -350,7 +350,7 @@ class OutsideMatch:
         return True
 
     def run(self, seconds: float, should_stop: Callable[[], bool] = lambda: False,
-            on_frame: Callable[[int], None] | None = None) -> dict[str, Any]:  # fmt: skip
+            on_frame: Callable[[int], None] | None = None) -> dict[str, Any]:
         """Frames until ``seconds`` of match time passed (or ``should_stop``, or the simulator fell
         silent for ``frame_wait_s``); the summary."""
         while self.seconds < seconds and not should_stop():
@@ -376,7 +376,7 @@ def _timings(ours: Team, teams: Sequence[Team]) -> dict[str, tuple[str, ...]]:
     return {"vision": ("ssl/vision_in",), "tracker": (f"tracker/{ours}",), "brain": (f"team/{ours}",),
             "commands": tuple(f"ssl/commands_out/{t}" for t in teams), "referee": ("tracker/autoref", "autoref"),
             **({"opponent_tracker": tuple(f"tracker/{t}" for t in others),
-                "opponent_brain": tuple(f"team/{t}" for t in others)} if others else {})}  # fmt: skip
+                "opponent_brain": tuple(f"team/{t}" for t in others)} if others else {})}
 
 
 def outside_summary(f: dict[str, Any], stage_ms: dict[str, list[float]], match: OutsideMatch) -> dict[str, Any]:
@@ -384,7 +384,7 @@ def outside_summary(f: dict[str, Any], stage_ms: dict[str, list[float]], match: 
     only as a referee of ours or a game controller told it)."""
     ours = match.teams[0]
     cycle = {k: {"median": float(np.median(v)), "p95": float(np.percentile(v, 95))}
-             for k, v in stage_ms.items() if v}  # fmt: skip
+             for k, v in stage_ms.items() if v}
     cycle.update(f.get("timing", {}).get(f"team/{ours}", {}))
     vision = f.get("ssl/vision_in", {})
     g = match.heard.geometry
@@ -392,7 +392,7 @@ def outside_summary(f: dict[str, Any], stage_ms: dict[str, list[float]], match: 
     return {
         **({"score": referee["score"], "balls_out": referee["balls_out"], "kicks": referee["kicks_seen"],
             "rules": {k: referee[k] for k in ("rules", "game_stage", "fouls", "cards", "placements", "penalties",
-                                              "shootout") if k in referee}} if referee else {}),  # fmt: skip
+                                              "shootout") if k in referee}} if referee else {}),
         "simulator": match.kind.value,
         "teams": list(match.teams),
         "seconds": round(match.seconds, 3),

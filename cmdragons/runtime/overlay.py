@@ -40,7 +40,7 @@ def _px(model: CameraModel, xy: NDArray[np.float64], z: float) -> NDArray[np.int
 
 def draw_overlays(image: NDArray[np.uint8], model: CameraModel, world: WorldState | None, report: TeamReport,
                   commands: Sequence[RobotCommand], robot_height: float,
-                  heat: Heat | None = None) -> NDArray[np.uint8]:  # fmt: skip
+                  heat: Heat | None = None) -> NDArray[np.uint8]:
     """A copy of ``image`` with the overlays drawn (BGR): ``world`` and ``commands`` (after safety)
     of ``report``'s team in the same frame, and the latest pass evaluation ``heat`` (points, values)."""
     out = image.copy()
@@ -65,7 +65,7 @@ def draw_overlays(image: NDArray[np.uint8], model: CameraModel, world: WorldStat
             tip = _px(model, np.array([r.x + 0.12 * np.cos(r.theta), r.y + 0.12 * np.sin(r.theta)]), robot_height)[0]
             cv2.line(out, (int(c[0]), int(c[1])), (int(tip[0]), int(tip[1])), colour, 1, cv2.LINE_AA, 4)
             cv2.putText(out, str(r.id), (int(c[0]) // 16 + 10, int(c[1]) // 16 - 10), cv2.FONT_HERSHEY_SIMPLEX, 0.4,
-                        colour, 1, cv2.LINE_AA)  # fmt: skip
+                        colour, 1, cv2.LINE_AA)
             if r.team != report.team:
                 continue
             plan = report.robot(r.id)
@@ -76,11 +76,11 @@ def draw_overlays(image: NDArray[np.uint8], model: CameraModel, world: WorldStat
                 end = _px(model, base + scale * np.array([cmd.vx, cmd.vy]), 0.0)[0]
                 start = _px(model, base, 0.0)[0]
                 cv2.arrowedLine(out, (int(start[0]), int(start[1])), (int(end[0]), int(end[1])), col, width,
-                                cv2.LINE_AA, 4, 0.2)  # fmt: skip
+                                cv2.LINE_AA, 4, 0.2)
         if world.ball is not None:
             b = _px(model, np.array([world.ball.x, world.ball.y]), 0.0215)[0]
             cv2.circle(out, (int(b[0]), int(b[1])), 8 * 16, (0, 140, 255) if world.ball.visible else (0, 0, 255), 1,
-                       cv2.LINE_AA, 4)  # fmt: skip
+                       cv2.LINE_AA, 4)
     return out
 
 
@@ -92,7 +92,7 @@ def tile_cameras(images: dict[int, NDArray[np.uint8]], models: Sequence[CameraMo
     first = cams[0]
     # field directions of image 'right' and 'up' in the first camera
     c = np.array([[first.width / 2, first.height / 2], [first.width / 2 + 50, first.height / 2],
-                  [first.width / 2, first.height / 2 - 50]])  # fmt: skip
+                  [first.width / 2, first.height / 2 - 50]])
     p = first.unproject(c, 0.0)
     right, up = p[1] - p[0], p[2] - p[0]
     right, up = right / np.linalg.norm(right), up / np.linalg.norm(up)
@@ -115,7 +115,7 @@ class MatchVideoStage(BaseStage):
     the team's overlays, tiled as the cameras hang ("cameras"); H.264 through PyAV."""
 
     def __init__(self, path: Path, view: str, team: Team, models: Sequence[CameraModel], geometry: Field,
-                 robot_radius_m: float, robot_height_m: float, fps: float) -> None:  # fmt: skip
+                 robot_radius_m: float, robot_height_m: float, fps: float) -> None:
         from cmdragons.runtime.topdown import TopDownView
 
         self.contract = Contract("video", tuple(Port(t, ANY) for t in ("camera/*", "truth", "referee", f"world/{team}",
@@ -156,13 +156,13 @@ class MatchVideoStage(BaseStage):
         assert self._report is not None
         if self.view == "field":
             return self.topdown.draw(view_frame(self._truth, self._game, self._world, self._report, commands.commands,
-                                                self._heat))  # fmt: skip
+                                                self._heat))
         frames = {cam: f for cam, f in self._images.items() if f.frame_number == commands.frame_number}
         if not frames:
             return None
         drawn = {cam: draw_overlays(f.image, next(m for m in self.models if m.id == cam), self._world, self._report,
                                     commands.commands, self.robot_height_m, self._heat)
-                 for cam, f in frames.items()}  # fmt: skip
+                 for cam, f in frames.items()}
         return tile_cameras(drawn, self.models)
 
     def _write(self, image: NDArray[np.uint8]) -> None:

@@ -39,10 +39,10 @@ class ZenohParams(Validated):
     def session(self, role: str) -> dict[str, Any]:
         """The zenoh config of a ``role`` ("router" or "client") session, as JSON values."""
         endpoints = {"listen": {"endpoints": [self.router] if role == "router" else []},
-                     "connect": {"endpoints": [] if role == "router" else [self.router]}}  # fmt: skip
+                     "connect": {"endpoints": [] if role == "router" else [self.router]}}
         return {"mode": role, **endpoints,
                 "scouting": {"multicast": {"enabled": self.multicast_scouting}, "gossip": {"enabled": False}},
-                "transport": {"shared_memory": {"enabled": self.shared_memory}}}  # fmt: skip
+                "transport": {"shared_memory": {"enabled": self.shared_memory}}}
 
     def config(self, role: str) -> Any:
         """A ``zenoh.Config`` for a ``role`` session (never a bare default, which listens everywhere)."""

@@ -87,14 +87,14 @@ class PassRecord:
         d["end"] = None if self.end is None else self.end.value
         d["target"] = None if self.target is None else list(self.target)
         return {k: (round(v, 4) if isinstance(v, float) and math.isfinite(v) else v) for k, v in d.items()
-                if not (isinstance(v, float) and not math.isfinite(v))}  # fmt: skip
+                if not (isinstance(v, float) and not math.isfinite(v))}
 
 
 class PassRecorder:
     """One team's passes, from its reports, the simulator's events and true state and the referee."""
 
     def __init__(self, team: Team, pitch: Field, robot: RobotShape, ball_radius_m: float, model: BallModel,
-                 params: PassRecordParams, timeout_s: float) -> None:  # fmt: skip
+                 params: PassRecordParams, timeout_s: float) -> None:
         self.team, self.field, self.p, self.model = team, pitch, params, model
         self.timeout_s = timeout_s
         self.reach_m = robot.radius_m + ball_radius_m + params.touch_m
@@ -115,7 +115,7 @@ class PassRecorder:
         """``team``'s passes judged with its strategy's settings and the league's robots and ball."""
         s, league = settings.strategy, settings.field
         return cls(team, settings.field_geometry(), league.robot, league.ball.radius_m, s.skills.ball_model,
-                   s.pass_record, s.pass_timeout_s)  # fmt: skip
+                   s.pass_record, s.pass_timeout_s)
 
     def report(self, report: TeamReport) -> None:
         self._passing = report.passing
@@ -139,7 +139,7 @@ class PassRecorder:
             return
         ps = self._passing if self._passing is not None and self._passing.passer == e.id else None
         self._open = PassRecord(e.t, e.id, ps.receiver if ps else None, ps.target if ps else None,
-                                bool(ps and ps.shoot_at is not None), e.speed_m_s)  # fmt: skip
+                                bool(ps and ps.shoot_at is not None), e.speed_m_s)
         self._measured = self._passer_left = False
         self._touch_t = None
         self._start_command = self._game.command
@@ -194,7 +194,7 @@ class PassRecorder:
         g = self._game.command
         stopped = g in (RefereeCommand.HALT, RefereeCommand.STOP, RefereeCommand.TIMEOUT,
                         RefereeCommand.BALL_PLACEMENT, RefereeCommand.PENALTY) or (
-            g.kick_restart and g != self._start_command)  # fmt: skip
+            g.kick_restart and g != self._start_command)
         if abs(ball.x) > self.field.half_length or abs(ball.y) > self.field.half_width:
             self._close(PassEnd.OUT, gt.t, None)
         elif stopped:
@@ -238,7 +238,7 @@ class PassRecorder:
             xy = np.array([[r.x, r.y] for r in opp])
             vel = np.array([[r.vx, r.vy] for r in opp])
             ts, _ = interception_times(xy, vel, (b.x, b.y), (b.vx, b.vy), self.model, self.limits, self.latency_s,
-                                       self.reach_m, self.p.horizon_s, self.p.step_s)  # fmt: skip
+                                       self.reach_m, self.p.horizon_s, self.p.step_s)
             k = int(np.argmin(ts))
             if math.isfinite(ts[k]):
                 rec.opponent_s, rec.opponent = float(ts[k]) + (gt.t - rec.t_kick), opp[k].id

@@ -63,7 +63,7 @@ def replay(path: str | Path, transport: Transport, start_s: float = 0.0, speed: 
            skip: Sequence[str] = (), wait_for: Collection[str] = (), wait_timeout_s: float = 60.0,
            should_stop: Callable[[], bool] = lambda: False,
            on_progress: Callable[[float, int], None] | None = None, now: Callable[[], float] = time.monotonic,
-           sleep: Callable[[float], None] = time.sleep) -> ReplayResult:  # fmt: skip
+           sleep: Callable[[float], None] = time.sleep) -> ReplayResult:
     """Publish the log at ``path`` on ``transport`` from ``start_s`` seconds after its first
     message on, at ``speed`` times the log's pace (s of log per s of wall clock).
 
@@ -96,7 +96,7 @@ def replay(path: str | Path, transport: Transport, start_s: float = 0.0, speed: 
             return ReplayResult(0, first + start_s, first + start_s, True)
         if now() - t_wait > wait_timeout_s:
             raise TimeoutError(f"nodes {', '.join(sorted(set(wait_for) - ready))} did not say ready within "
-                               f"{wait_timeout_s:.0f} s")  # fmt: skip
+                               f"{wait_timeout_s:.0f} s")
         wait_until(now() + _POLL_S)
     t0 = first + start_s
     n = 0

@@ -60,7 +60,7 @@ class RunCollector:
         self.ours = ours
         self.positions = positions
         self.topics = tuple(dict.fromkeys((positions, "truth", f"world/{ours}", f"report/{ours}", "referee",
-                                           "events")))  # fmt: skip
+                                           "events")))
         self._run = RunData(ours=ours)
         self._times: list[float] = []
         self._balls: list[tuple[float, float]] = []
@@ -119,7 +119,7 @@ class RunCollector:
         run.ball_seen = self._ball_visible / frames if frames else 0.0
         run.ball_tracked = self._ball_tracked / frames if frames else 0.0
         run.robot_seen = {rid: self._robot_visible.get(rid, 0) / frames if frames else 0.0
-                          for team, rid in run.traces if team == self.ours}  # fmt: skip
+                          for team, rid in run.traces if team == self.ours}
         return run
 
 
@@ -161,7 +161,7 @@ def run_warnings(run: RunData, summary: dict[str, Any]) -> list[str]:
         how = _seen(run.ball_tracked)
         if how:
             out.append(f"our tracker had the ball {how} (seen in {100 * run.ball_seen:.0f} %): the team could "
-                       "hardly play (check the vision colours: cmdragons vision tune)")  # fmt: skip
+                       "hardly play (check the vision colours: cmdragons vision tune)")
         for rid, fraction in sorted(run.robot_seen.items()):
             how = _seen(fraction)
             if how:
@@ -169,7 +169,7 @@ def run_warnings(run: RunData, summary: dict[str, Any]) -> list[str]:
     clamped = summary.get("command_faults", {}).get("clamped", 0)
     if clamped:
         out.append(f"{clamped} command{'s were' if clamped != 1 else ' was'} clamped by the simulator to the "
-                   "robots' limits (the team asked for more than the robots can do)")  # fmt: skip
+                   "robots' limits (the team asked for more than the robots can do)")
     for name in ("non_finite", "timed_out", "unknown_robot"):
         n = summary.get("command_faults", {}).get(name, 0)
         if n:
@@ -194,7 +194,7 @@ def pyplot() -> Any:
 # how each pass ended (cmdragons/runtime/pass_record.py), and its colour in the report
 PASS_END_COLOURS = {"received": "tab:green", "too_fast": "tab:olive", "intercepted": "tab:red", "out": "tab:gray",
                     "stopped": "0.6", "late": "tab:orange", "missed": "tab:purple", "too_slow": "tab:brown",
-                    "reassigned": "tab:pink", "timeout": "tab:cyan"}  # fmt: skip
+                    "reassigned": "tab:pink", "timeout": "tab:cyan"}
 
 
 def _draw_passes(ax_map: Any, ax_time: Any, run: RunData, passes: dict[str, Any], field_axes: Any) -> None:
@@ -219,7 +219,7 @@ def _draw_passes(ax_map: Any, ax_time: Any, run: RunData, passes: dict[str, Any]
     if seen:
         ax_map.legend(loc="upper left", fontsize=8)
     ax_time.set_title("Per pass: ball at target (o), receiver there (^),\nclosest opponent's predicted "
-                      "interception (x)", fontsize=10)  # fmt: skip
+                      "interception (x)", fontsize=10)
     for k, r in enumerate(records):
         colour = PASS_END_COLOURS.get(str(r.get("end")), "black")
         for key, marker in (("ball_s", "o"), ("receiver_s", "^"), ("opponent_s", "x")):
@@ -232,7 +232,7 @@ def _draw_passes(ax_map: Any, ax_time: Any, run: RunData, passes: dict[str, Any]
 
 
 def write_report(run: RunData, summary: dict[str, Any], path: str | Path,
-                 half_size_m: tuple[float, float] = (4.5, 3.0)) -> Path:  # fmt: skip
+                 half_size_m: tuple[float, float] = (4.5, 3.0)) -> Path:
     """The one-page match report PNG (see the module docstring) of a field of ``half_size_m``
     (half length, half width; m); returns its path."""
     from matplotlib.patches import Rectangle
@@ -246,7 +246,7 @@ def write_report(run: RunData, summary: dict[str, Any], path: str | Path,
     fig.suptitle(f"Match report: blue (us) {score.get('blue', 0)} : {score.get('yellow', 0)} yellow (them), "
                  f"{summary.get('seconds', 0):.0f} s against {summary.get('opponent')} "
                  f"({summary.get('perception')}), seed {summary.get('seed')}"
-                 + ("  [interrupted]" if summary.get("interrupted") else ""), fontsize=13)  # fmt: skip
+                 + ("  [interrupted]" if summary.get("interrupted") else ""), fontsize=13)
     fl, fw = half_size_m
     hl = max([fl] + [float(abs(tr[:, 1]).max()) for tr in run.traces.values() if len(tr)])
     hw = max([fw] + [float(abs(tr[:, 2]).max()) for tr in run.traces.values() if len(tr)])
@@ -269,11 +269,11 @@ def write_report(run: RunData, summary: dict[str, Any], path: str | Path,
     for kind, (m, c) in marks.items():
         k = [e for e in run.kicks if e.get("team") == run.ours and e.get("action") == kind]
         ax.scatter([e["x"] for e in k], [e["y"] for e in k], marker=m, color=c, s=50,
-                   label=f"{kind} ({len(k)})")  # fmt: skip
+                   label=f"{kind} ({len(k)})")
     goals = [g for g in run.goals if g.get("scoring_team") == run.ours]
     if goals:
         ax.scatter([g["x"] for g in goals], [g["y"] for g in goals], s=200, facecolors="none", edgecolors="gold",
-                   linewidths=2, label=f"our goals ({len(goals)})")  # fmt: skip
+                   linewidths=2, label=f"our goals ({len(goals)})")
     ax.legend(loc="upper left", fontsize=8)
 
     # robot traces
@@ -281,12 +281,12 @@ def write_report(run: RunData, summary: dict[str, Any], path: str | Path,
     field_axes(ax, "Robot traces (truth): blue us, yellow them; ball black")
     for (team, _rid), tr in sorted(run.traces.items()):
         ax.plot(tr[:, 1], tr[:, 2], lw=0.8, color="tab:blue" if team == run.ours else "goldenrod",
-                alpha=0.9 if team == run.ours else 0.5)  # fmt: skip
+                alpha=0.9 if team == run.ours else 0.5)
     if len(run.ball):
         ax.plot(run.ball[:, 0], run.ball[:, 1], lw=0.6, color="black", alpha=0.6)
 
     _draw_passes(fig.add_subplot(grid[1, 0]), fig.add_subplot(grid[1, 1]), run, summary.get("passes", {}),
-                 field_axes)  # fmt: skip
+                 field_axes)
 
     # possession and passes over time
     ax = fig.add_subplot(grid[2, :])
@@ -298,7 +298,7 @@ def write_report(run: RunData, summary: dict[str, Any], path: str | Path,
         ours_share = float(np.mean(code > 0))
         theirs_share = float(np.mean(code < 0))
         ax.text(0.01, 0.92, f"us {100 * ours_share:.0f} %, them {100 * theirs_share:.0f} %, "
-                f"loose {100 * (1 - ours_share - theirs_share):.0f} %", transform=ax.transAxes, fontsize=9)  # fmt: skip
+                f"loose {100 * (1 - ours_share - theirs_share):.0f} %", transform=ax.transAxes, fontsize=9)
         for kind, (_m, c) in marks.items():
             ts = [e["t"] for e in run.kicks if e.get("team") == run.ours and e.get("action") == kind]
             if ts:
@@ -313,7 +313,7 @@ def write_report(run: RunData, summary: dict[str, Any], path: str | Path,
     ax = fig.add_subplot(grid[3, :])
     cycle = summary.get("cycle_ms", {})
     names = [n for n in ("render", "vision", "tracker", "brain", "strategy", "planning_control", "safety",
-                         "physics_and_opponent", "frame") if n in cycle]  # fmt: skip
+                         "physics_and_opponent", "frame") if n in cycle]
     y = np.arange(len(names))
     ax.barh(y - 0.2, [cycle[n]["median"] for n in names], height=0.4, color="tab:green", label="median")
     ax.barh(y + 0.2, [cycle[n]["p95"] for n in names], height=0.4, color="tab:olive", label="95th percentile")
@@ -324,7 +324,7 @@ def write_report(run: RunData, summary: dict[str, Any], path: str | Path,
     compile_s = summary.get("compile_seconds", 0)
     compiled = f", not counting {compile_s:.0f} s of first-run compile" if compile_s >= 1 else ""
     ax.set_title(f"Stage timings per camera frame (brain and vision are ours); {rtf}x real time{compiled}",
-                 fontsize=11)  # fmt: skip
+                 fontsize=11)
     ax.legend(loc="lower right", fontsize=8)
     fig.tight_layout(rect=(0, 0, 1, 0.96))
     fig.savefig(path)

@@ -44,7 +44,7 @@ class SceneStage(BaseStage):
     contract = Contract("scene", (Port("truth", ANY), Port("report/*", ANY)))
 
     def __init__(self, log: RunLog, field: Field, robot_radius_m: float, robot_height_m: float,
-                 ball_radius_m: float) -> None:  # fmt: skip
+                 ball_radius_m: float) -> None:
         from foxglove_schemas_protobuf import LinePrimitive_pb2, SceneUpdate_pb2
 
         self._update = SceneUpdate_pb2.SceneUpdate
@@ -74,7 +74,7 @@ class SceneStage(BaseStage):
         into.r, into.g, into.b, into.a = rgba
 
     def _line(self, entity: Any, points: Any, rgba: tuple[float, float, float, float], thickness_m: float,
-              kind: str = "LINE_STRIP", z: float = 0.0) -> None:  # fmt: skip
+              kind: str = "LINE_STRIP", z: float = 0.0) -> None:
         line = entity.lines.add(type=self._kinds.Value(kind), thickness=thickness_m)
         line.pose.orientation.w = 1.0
         for x, y in np.asarray(points, dtype=np.float64).reshape(-1, 2):
@@ -95,7 +95,7 @@ class SceneStage(BaseStage):
         a = np.linspace(0.0, 2 * math.pi, _CIRCLE_POINTS, endpoint=False)
         r = d.center_circle_radius_m
         self._line(e, np.stack([r * np.cos(a), r * np.sin(a)], axis=1), _LINE_RGBA, d.line_width_m, "LINE_LOOP",
-                   z=0.001)  # fmt: skip
+                   z=0.001)
         return update
 
     def _objects(self, gt: GroundTruth) -> Any:
@@ -116,7 +116,7 @@ class SceneStage(BaseStage):
             self._rgba(arrow.color, _LINE_RGBA)
             e.texts.add(text=f"{rt.team[0].upper()}{rt.id}", font_size=0.12, billboard=True,
                         pose={"position": {"x": rt.x, "y": rt.y, "z": height + 0.1}, "orientation": {"w": 1.0}},
-                        color={"r": 1.0, "g": 1.0, "b": 1.0, "a": 1.0})  # fmt: skip
+                        color={"r": 1.0, "g": 1.0, "b": 1.0, "a": 1.0})
         b = gt.ball
         s = e.spheres.add()
         s.pose.position.x, s.pose.position.y, s.pose.position.z = b.x, b.y, b.z + self.ball_radius_m

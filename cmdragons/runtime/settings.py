@@ -110,7 +110,7 @@ def load_settings(config_dir: str | Path | None = None, overrides: Sequence[str]
 
 
 def load_team_settings(config_dir: str | Path | None, overrides: Sequence[str], team_overrides: Sequence[str],
-                       flag: str = "--opponent-set") -> Settings:  # fmt: skip
+                       flag: str = "--opponent-set") -> Settings:
     """The settings of one team of a match: the match's (``config_dir`` with ``overrides``) with
     ``team_overrides`` on top, each of which must set a concern of :data:`TEAM_CONCERNS` (a team has
     its own brain and tracker, not its own field or simulator). Raises :class:`ConfigError` naming

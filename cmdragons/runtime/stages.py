@@ -99,7 +99,7 @@ class SimStage(BaseStage):
         return Contract("sim", reads,
                         (Port("truth", GroundTruth), *((Port("referee", GameState),) if referee else ()),
                          *(Port(f"camera/{c}/frame", CameraFrame) for c in camera_ids),
-                         Port("events", SimEvents), summary_port("sim")))  # fmt: skip
+                         Port("events", SimEvents), summary_port("sim")))
 
     def __init__(self, sim: Simulator, teams: Sequence[Team]) -> None:
         # the cameras it draws; the referee when the simulator judges
@@ -171,7 +171,7 @@ class ScriptStage(BaseStage):
     commands. They are the simulator's own players and read its world as it stands."""
 
     contract = Contract("script", (Port("truth", GroundTruth),),
-                        tuple(Port(f"commands/{team}", TeamCommands) for team in TEAMS))  # fmt: skip
+                        tuple(Port(f"commands/{team}", TeamCommands) for team in TEAMS))
 
     def __init__(self, script: ScriptedPlay, world: World) -> None:
         self.script = script
@@ -192,7 +192,7 @@ class RecorderStage(BaseStage):
     @staticmethod
     def declare(camera_ids: Sequence[int]) -> Contract:
         return Contract("recorder", (Port("truth", GroundTruth),
-                                     *(Port(f"camera/{c}/frame", CameraFrame) for c in camera_ids)))  # fmt: skip
+                                     *(Port(f"camera/{c}/frame", CameraFrame) for c in camera_ids)))
 
     def __init__(self, writer: RecordingWriter | None, camera_ids: Sequence[int]) -> None:
         self.contract = self.declare(camera_ids)
@@ -249,7 +249,7 @@ class TruthPerceptionStage(BaseStage):
         n, sb, sxy, sth = self.rng.normal, self.sigma_ball, self.sigma_xy, self.sigma_theta
         ball = (BallDetection(gt.ball.x + n(0, sb), gt.ball.y + n(0, sb), 1.0, (0.0, 0.0)),)
         robots = tuple(RobotDetection(r.team, r.id, r.x + n(0, sxy), r.y + n(0, sxy), r.theta + n(0, sth), 1.0,
-                                      (0.0, 0.0)) for r in gt.robots)  # fmt: skip
+                                      (0.0, 0.0)) for r in gt.robots)
         publish(self.topic, DetectionFrame(0, gt.frame_number, gt.t, gt.t, ball, robots))
 
 
@@ -266,7 +266,7 @@ class CameraTruthStage(BaseStage):
                         tuple(Port(f"detections/{c}", DetectionFrame) for c in camera_ids))
 
     def __init__(self, cameras: Sequence[CameraModel], robot_height_m: float, sigmas: tuple[float, float, float],
-                 seed: int) -> None:  # fmt: skip
+                 seed: int) -> None:
         self.cameras = tuple(cameras)
         self.contract = self.declare([m.id for m in self.cameras])
         self.robot_height_m = robot_height_m
@@ -282,10 +282,10 @@ class CameraTruthStage(BaseStage):
             px = m.project(points)
             seen = m.in_image(px)
             balls = (BallDetection(b.x + n(0, sb), b.y + n(0, sb), 1.0, (float(px[0, 0]), float(px[0, 1]))),) \
-                if seen[0] else ()  # fmt: skip
+                if seen[0] else ()
             robots = tuple(RobotDetection(r.team, r.id, r.x + n(0, sxy), r.y + n(0, sxy),
                                           wrap_angle(r.theta + n(0, sth)), 1.0, (float(p[0]), float(p[1])))
-                           for r, p, s in zip(gt.robots, px[1:], seen[1:], strict=True) if s)  # fmt: skip
+                           for r, p, s in zip(gt.robots, px[1:], seen[1:], strict=True) if s)
             publish(f"detections/{m.id}", DetectionFrame(m.id, gt.frame_number, gt.t, gt.t, balls, robots))
 
 
@@ -308,15 +308,15 @@ class TrackerStage(BaseStage):
 
     @staticmethod
     def declare(team: Team | Literal["autoref"], detection_topics: Sequence[str],
-                take_commands: bool = True) -> Contract:  # fmt: skip
+                take_commands: bool = True) -> Contract:
         name = f"tracker/{team}"
         return Contract(name, (*(Port(t, DetectionFrame) for t in detection_topics),
                                *((Port(f"commands/{team}", TeamCommands),) if take_commands else ())),
                         (Port(f"physics/{team}", PhysicsFacts, sometimes=True), Port(f"world/{team}", WorldState),
-                         summary_port(name)))  # fmt: skip
+                         summary_port(name)))
 
     def __init__(self, team: Team | Literal["autoref"], tracker: Tracker, detection_topics: Sequence[str],
-                 take_commands: bool = True, synchronized: bool = False) -> None:  # fmt: skip
+                 take_commands: bool = True, synchronized: bool = False) -> None:
         self.contract = self.declare(team, detection_topics, take_commands)
         self.team = team
         self.detection_topics = tuple(detection_topics)
@@ -407,7 +407,7 @@ class TeamStage(_PlayingStage):
         return Contract(f"team/{team}", (Port(f"world/{team}", WorldState), Port(referee_topic, GameState),
                                          Port(f"physics/{team}", PhysicsFacts, sometimes=True)),
                         (Port(f"commands/{team}", TeamCommands), Port(f"report/{team}", TeamReport),
-                         Port(f"timing/{team}", Timing)))  # fmt: skip
+                         Port(f"timing/{team}", Timing)))
 
     def __init__(self, team: Team, brain: Brain, referee_topic: str = "referee") -> None:
         super().__init__(self.declare(team, referee_topic), team, referee_topic)
@@ -437,7 +437,7 @@ def _report(team: Team, world: WorldState, out: BrainOutput) -> TeamReport:
         RobotReport(rid, p.status.value, (p.intent.x, p.intent.y, p.intent.theta), _points(p.path), p.command,
                     _points(out.braking.get(rid, ())))
         for rid, p in out.plans.items()
-    )  # fmt: skip
+    )
     points, values = out.pass_heat if out.pass_heat is not None else (_points(()), np.zeros(0))
     return TeamReport(team, world.frame_number, world.t, robots, dict(out.last_actions), points, values, out.passing)
 
@@ -478,7 +478,7 @@ class RefereeStage(BaseStage):
     contract = Contract("referee", (Port("truth", GroundTruth), Port("events", SimEvents)),
                         (Port("teleport", Teleport), Port("referee", GameState),
                          Port("referee/events", GameEvents, sometimes=True),
-                         summary_port("referee")))  # fmt: skip
+                         summary_port("referee")))
 
     def __init__(self, referee: Referee) -> None:
         self.referee = referee
@@ -504,7 +504,7 @@ class RefereeStage(BaseStage):
         r = self.referee
         publish(f"summary/{self.name}", StageSummary(self.name, {
             "score": dict(r.score), "kicks": r.kicks, "balls_out": r.balls_out,
-            "keeper_held_ball": r.keeper_held_ball, "robot_contacts": len(r.contacts), **r.summary()}))  # fmt: skip
+            "keeper_held_ball": r.keeper_held_ball, "robot_contacts": len(r.contacts), **r.summary()}))
 
 
 class StatsStage(BaseStage):
@@ -518,7 +518,7 @@ class StatsStage(BaseStage):
     def declare(team: Team) -> Contract:
         return Contract(f"stats/{team}", (Port("truth", GroundTruth), Port("referee", GameState),
                                           Port(f"report/{team}", TeamReport), Port("events", SimEvents)),
-                        (summary_port(f"stats/{team}"),))  # fmt: skip
+                        (summary_port(f"stats/{team}"),))
 
     def __init__(self, team: Team, passes: PassRecorder) -> None:
         self.contract = self.declare(team)
@@ -582,7 +582,7 @@ class StatsStage(BaseStage):
                                   "each": [None if s is None else round(s, 3) for s in self.kickoff_to_shot_s]},
             "collisions": {"own": self.own_collisions, "own_pushed": self.own_pushed,
                            "opponent": self.opponent_collisions},
-        }))  # fmt: skip
+        }))
 
 
 class TimingStage(BaseStage):
@@ -602,7 +602,7 @@ class TimingStage(BaseStage):
     def summarize(self, publish: Publish) -> None:
         publish(f"summary/{self.name}", StageSummary(self.name, {
             stage: {k: {"median": float(np.median(v)), "p95": float(np.percentile(v, 95))} for k, v in parts.items()}
-            for stage, parts in self.ms.items()}))  # fmt: skip
+            for stage, parts in self.ms.items()}))
 
 
 def message_time(message: Any, default: float) -> float:
@@ -622,7 +622,7 @@ class LoggerStage(BaseStage):
     contract = Contract("logger", (Port("*", ANY),))
 
     def __init__(self, log: RunLog, images: bool = False,
-                 skip: Sequence[str] = ("clock", "control/*", "timing/*", "summary/timing")) -> None:  # fmt: skip
+                 skip: Sequence[str] = ("clock", "control/*", "timing/*", "summary/timing")) -> None:
         self.log = log
         self.skip = tuple(skip) + (() if images else ("camera/*",))
         self._t = 0.0

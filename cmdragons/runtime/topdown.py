@@ -57,7 +57,7 @@ class ViewFrame:
 
 def view_frame(truth: GroundTruth | None, game: GameState, world: WorldState | None, report: TeamReport,
                commands: Sequence[RobotCommand],
-               heat: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None) -> ViewFrame:  # fmt: skip
+               heat: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None) -> ViewFrame:
     """A :class:`ViewFrame` from one frame's messages on the bus: the simulator's truth, the
     referee's game state, our tracked world, our team's report (plans, the braking paths the safety
     search checked), our commands after safety, and the latest pass evaluation (points, values:
@@ -105,7 +105,7 @@ class TopDownView:
             a, b = self._pt(*seg.a), self._pt(*seg.b)
             cv2.line(img, a, b, _LINE, lw, cv2.LINE_AA, 4)
         cv2.circle(img, self._pt(0.0, 0.0), int(self.f.dims.center_circle_radius_m * self.s * 16), _LINE, lw,
-                   cv2.LINE_AA, 4)  # fmt: skip
+                   cv2.LINE_AA, 4)
         g, d = self.f.goal_half_width, self.f.dims.goal_depth_m
         for sx in (-1.0, 1.0):
             x0 = sx * self.f.half_length
@@ -177,14 +177,14 @@ class TopDownView:
         b = v.world.ball
         if b is not None:
             cv2.circle(img, self._pt(b.x, b.y), int(self._ball_px * 16), _BALL if b.visible else _GHOST, -1,
-                       cv2.LINE_AA, 4)  # fmt: skip
+                       cv2.LINE_AA, 4)
 
     def _header(self, img: NDArray[np.uint8], v: ViewFrame) -> None:
         g = v.game
         mins, secs = divmod(v.t, 60.0)
         state = g.command + (f" ({g.for_team})" if g.for_team else "")
         cv2.putText(img, f"blue (us) {g.score_blue} : {g.score_yellow} yellow", (12, 26), _FONT, 0.8, _TEXT, 2,
-                    cv2.LINE_AA)  # fmt: skip
+                    cv2.LINE_AA)
         cv2.putText(img, f"{int(mins):02d}:{secs:05.2f}   {state}", (12, 54), _FONT, 0.6, _TEXT, 1, cv2.LINE_AA)
         x = self.width // 2 - 40
         items = [(_BLUE, "blue robot (tracked)", "disc"), (_YELLOW, "yellow robot", "disc"),

@@ -98,7 +98,7 @@ def check_wiring(contracts: Sequence[Contract], outside: Iterable[Port] = ()) ->
         other = seen.setdefault(p.topic, (name, p.type))
         if other[1] is not p.type:
             raise WiringError(f"topic {p.topic!r} is written as {p.type.__name__} by {name!r} and as "
-                              f"{other[1].__name__} by {other[0]!r}")  # fmt: skip
+                              f"{other[1].__name__} by {other[0]!r}")
     for c in contracts:
         for r in c.reads:
             if r.type is ANY:
@@ -106,11 +106,11 @@ def check_wiring(contracts: Sequence[Contract], outside: Iterable[Port] = ()) ->
             found = [(name, p) for name, p in writers if overlap(r.topic, p.topic)]
             if not found:
                 raise WiringError(f"stage {c.name!r} reads topic {r.topic!r} ({r.type.__name__}), which no stage "
-                                  "writes")  # fmt: skip
+                                  "writes")
             for name, p in found:
                 if p.type is not r.type:
                     raise WiringError(f"stage {c.name!r} reads topic {r.topic!r} as {r.type.__name__}, but stage "
-                                      f"{name!r} writes {p.topic!r} as {p.type.__name__}")  # fmt: skip
+                                      f"{name!r} writes {p.topic!r} as {p.type.__name__}")
 
 
 def _pattern(topic: str) -> str:
@@ -138,7 +138,7 @@ def key_space(contracts: Iterable[Contract]) -> tuple[tuple[str, Any], ...]:
             key = _key(p.topic)
             if out.setdefault(key, p.type) is not p.type:
                 raise WiringError(f"topics {key!r} carry two message types: {out[key].__name__} and "
-                                  f"{p.type.__name__}")  # fmt: skip
+                                  f"{p.type.__name__}")
     exact = sorted(k for k in out if "*" not in k)
     return tuple((k, out[k]) for k in [*exact, *sorted((k for k in out if "*" in k), key=lambda k: (-len(k), k))])
 
@@ -153,7 +153,7 @@ def topic_table(contracts: Iterable[Contract]) -> str:
             continue
         writers = sorted({_pattern(c.name) for c in contracts for p in c.writes if _key(p.topic) == key})
         readers = sorted({_pattern(c.name) for c in contracts for p in c.reads
-                          if p.type is not ANY and _key(p.topic) == key})  # fmt: skip
+                          if p.type is not ANY and _key(p.topic) == key})
         rows.append(f"| `{key}` | `{cls.__name__}` | {', '.join(writers)} | {', '.join(readers)} |")
     return "\n".join(["| topic | message | written by | read by |", "|---|---|---|---|", *rows,
                       "| `summary/<stage>` | `StageSummary` | every stage, on request | the match summary |"])

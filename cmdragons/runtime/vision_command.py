@@ -59,7 +59,7 @@ class DetectionsOutStage(BaseStage):
     @staticmethod
     def declare(camera_ids: Sequence[int]) -> Contract:
         return Contract(DETECTIONS_OUT, tuple(Port(f"detections/{i}", DetectionFrame) for i in camera_ids),
-                        (summary_port(DETECTIONS_OUT),))  # fmt: skip
+                        (summary_port(DETECTIONS_OUT),))
 
     def __init__(self, camera_ids: Sequence[int], jsonl: IO[str], truth: dict[int, GroundTruth]) -> None:
         self.contract = self.declare(camera_ids)
@@ -91,7 +91,7 @@ class OverlaidVisionStage(VisionStage):
         return Contract(c.name, (*c.reads, *c.writes), c.writes)
 
     def __init__(self, camera_id: int, pipeline: VisionPipeline, png_dir: Path | None, video_path: Path | None,
-                 fps: float) -> None:  # fmt: skip
+                 fps: float) -> None:
         super().__init__(camera_id, pipeline)
         self.contract = self.declare_overlaid(camera_id)
         self.png_dir, self.video_path, self.fps = png_dir, video_path, fps
@@ -126,7 +126,7 @@ class OverlaidVisionStage(VisionStage):
 
 def vision_wiring(cameras: Sequence[tuple[FrameSource, CameraModel]], params: VisionParams, league: LeagueParams,
                   out: Path, jsonl: IO[str], truth: dict[int, GroundTruth], video: bool, overlay: bool,
-                  fps: float) -> list[Entry]:  # fmt: skip
+                  fps: float) -> list[Entry]:
     """The table of ``cmdragons vision``: a vision stage per source's camera (``cameras``: each
     source with its camera model, sized to its frames), drawing overlays where asked (``video``:
     an annotated video per camera; ``overlay``: a video per video source, PNGs per still image),
@@ -138,7 +138,7 @@ def vision_wiring(cameras: Sequence[tuple[FrameSource, CameraModel]], params: Vi
         if as_video or as_png:
             build_stage: Callable[[], Stage] = functools.partial(
                 _overlaid, model.id, pipeline, out / "overlay" if as_png else None,
-                out / f"annotated_camera_{model.id}.mp4" if as_video else None, fps)  # fmt: skip
+                out / f"annotated_camera_{model.id}.mp4" if as_video else None, fps)
             rows.append(Entry(OverlaidVisionStage.declare_overlaid(model.id), "", build_stage))
         else:
             rows.append(Entry(VisionStage.declare(model.id), "", functools.partial(_plain, model.id, pipeline)))
@@ -152,13 +152,13 @@ def _plain(camera_id: int, pipeline: Callable[[], VisionPipeline]) -> Stage:
 
 
 def _overlaid(camera_id: int, pipeline: Callable[[], VisionPipeline], png_dir: Path | None, video_path: Path | None,
-              fps: float) -> Stage:  # fmt: skip
+              fps: float) -> Stage:
     return OverlaidVisionStage(camera_id, pipeline(), png_dir, video_path, fps)
 
 
 def run_vision(sources: Sequence[FrameSource], cameras: dict[int, CameraModel], params: VisionParams,
                league: LeagueParams, out: Path, video: bool, fps: float, recording: Path | None = None,
-               progress: Callable[[int], None] | None = None, overlay: bool = False) -> RunSummary:  # fmt: skip
+               progress: Callable[[int], None] | None = None, overlay: bool = False) -> RunSummary:
     """Process every frame of every source through :func:`vision_wiring`'s stages; ``cameras``
     gives the model of a source that brings none (by its camera id). Writes ``out/detections.jsonl``,
     the overlays asked for and ``out/summary.json``; with a recording's truth, the detections are
@@ -169,7 +169,7 @@ def run_vision(sources: Sequence[FrameSource], cameras: dict[int, CameraModel], 
     if missing:  # before any frame is processed
         raise SourceError(f"{len(sources)} sources but only {len(cameras)} camera model(s) in the config: "
                           f"{missing[0].name} would be camera {missing[0].camera_id}; give one source per camera "
-                          "(or a config whose cameras.yaml lists more)")  # fmt: skip
+                          "(or a config whose cameras.yaml lists more)")
     # every source's first frame read and its size checked before any frame is processed
     opened: list[tuple[FrameSource, Iterator[Frame], CameraModel]] = []
     for src in sources:
@@ -178,7 +178,7 @@ def run_vision(sources: Sequence[FrameSource], cameras: dict[int, CameraModel], 
     ids = [model.id for _, _, model in opened]
     if len(set(ids)) < len(ids):
         raise SourceError(f"two sources are camera {next(i for i in ids if ids.count(i) > 1)}: give one source per "
-                          "camera")  # fmt: skip
+                          "camera")
     truth: dict[int, GroundTruth] = {}
     if recording is not None:
         reader = RecordingReader(recording)
@@ -188,7 +188,7 @@ def run_vision(sources: Sequence[FrameSource], cameras: dict[int, CameraModel], 
     collector = SummaryCollector()
     with open(out / "detections.jsonl", "w", encoding="utf-8") as jsonl:
         table = vision_wiring([(src, model) for src, _, model in opened], params, league, out, jsonl, truth, video,
-                              overlay, fps)  # fmt: skip
+                              overlay, fps)
         frame_ports = [Port(f"camera/{i}/frame", CameraFrame) for i in ids]
         bus = Bus()
         stages = build(table, [collector], outside=frame_ports)

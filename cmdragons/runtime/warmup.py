@@ -128,7 +128,7 @@ _CHILD_PARTS = {True: ("planning", "motion", "render"), False: ("planning", "mot
 
 def warm_up(settings: Settings, images: bool, on_progress: Callable[[int, str], None],
             meanwhile: Callable[[], None] | None = None,
-            on_part: Callable[[int], None] | None = None) -> float:  # fmt: skip
+            on_part: Callable[[int], None] | None = None) -> float:
     """Compile the play's kernels now (see the module docstring); returns the wall seconds it took.
     ``on_progress(kernels compiled so far, last kernel's name)`` is called from this thread and a
     reader thread; ``on_part(parts done)`` as each part ends (of :func:`warm_up_parts`). ``meanwhile``
@@ -231,9 +231,9 @@ def _warm_vision(settings: Settings) -> None:
     for r in sim.renderers:
         p = r.params
         plan = kern.plan_objects_reference(r.model, robots, ball, r.shape, r.pink, r.palette, p.exposure_s,
-                                           p.max_blur_samples, p.blur_step_px)  # fmt: skip
+                                           p.max_blur_samples, p.blur_step_px)
         image = kern.render_frame_reference(r.background, r.noise, None, r.rays, r.foot, r.gain, r.cam, r.shape,
-                                            r.dots, r.palette, plan)[0]  # fmt: skip
+                                            r.dots, r.palette, plan)[0]
         VisionPipeline(settings.vision, settings.field, r.model).process(image, 0, 0.0)
 
 
@@ -302,7 +302,7 @@ def _warm_motion(settings: Any) -> None:
     # strategy's kernels (the shot and pass evaluation) on a few robots round the ball
     strategy = Strategy("blue", settings.field_geometry(), settings.strategy)
     robots = tuple(RobotState(t, i, (-1.0 if t == "blue" else 1.0) * (0.5 + i), 0.3 * i, 0.0)
-                   for t in ("blue", "yellow") for i in range(3))  # fmt: skip
+                   for t in ("blue", "yellow") for i in range(3))
     strategy.decide(WorldState(0.0, BallState(0.2, 0.1, 0.0, 0.0), robots), GameState(0.0))
 
 

@@ -73,7 +73,7 @@ from cmdragons.runtime.proto import ssl_simulation_control_pb2 as ctl_pb
 from cmdragons.runtime.proto import ssl_tracked_pb2 as trk_pb
 
 __all__ = ["CODECS", "LOSSY", "Codec", "canonical", "canonical_and_chunks", "decode", "encode",
-           "encode_chunks", "from_proto", "is_known", "parse", "schema", "to_proto"]  # fmt: skip
+           "encode_chunks", "from_proto", "is_known", "parse", "schema", "to_proto"]
 
 MM = 1000.0  # millimetres a metre: the league's vision speaks millimetres
 
@@ -102,7 +102,7 @@ def _pairs(values: Any) -> np.ndarray[Any, np.dtype[np.float64]]:
 
 def _detection_to(d: DetectionFrame) -> Any:
     m = det_pb.SSL_DetectionFrame(frame_number=d.frame_number, t_capture=d.t_capture, t_sent=d.t_sent,
-                                  camera_id=d.camera_id)  # fmt: skip
+                                  camera_id=d.camera_id)
     for b in d.balls:
         ball = m.balls.add(confidence=b.confidence, x=b.x * MM, y=b.y * MM, pixel_x=b.pixel[0], pixel_y=b.pixel[1])
         if math.isfinite(b.sigma_m):
@@ -110,7 +110,7 @@ def _detection_to(d: DetectionFrame) -> Any:
     for r in d.robots:
         rows = m.robots_blue if r.team == "blue" else m.robots_yellow
         rows.add(confidence=r.confidence, robot_id=r.id, x=r.x * MM, y=r.y * MM, orientation=r.theta,
-                 pixel_x=r.pixel[0], pixel_y=r.pixel[1])  # fmt: skip
+                 pixel_x=r.pixel[0], pixel_y=r.pixel[1])
     return m
 
 
@@ -121,10 +121,10 @@ def _rows_by_team(m: Any) -> tuple[tuple[Team, Any], tuple[Team, Any]]:
 def _detection_from(m: Any) -> DetectionFrame:
     balls = tuple(BallDetection(b.x / MM, b.y / MM, b.confidence, (b.pixel_x, b.pixel_y),
                                 b.position_sigma_mm / MM if b.HasField("position_sigma_mm") else math.nan)
-                  for b in m.balls)  # fmt: skip
+                  for b in m.balls)
     robots = tuple(RobotDetection(team, r.robot_id, r.x / MM, r.y / MM, r.orientation, r.confidence,
                                   (r.pixel_x, r.pixel_y))
-                   for team, rows in _rows_by_team(m) for r in rows)  # fmt: skip
+                   for team, rows in _rows_by_team(m) for r in rows)
     return DetectionFrame(m.camera_id, m.frame_number, m.t_capture, m.t_sent, balls, robots)
 
 
@@ -136,11 +136,11 @@ def _world_to(w: WorldState) -> Any:
     if w.ball is not None:
         b = w.ball
         m.balls.add(pos=trk_pb.Vector3(x=b.x, y=b.y, z=0.0), vel=trk_pb.Vector3(x=b.vx, y=b.vy, z=0.0),
-                    visibility=1.0 if b.visible else 0.0)  # fmt: skip
+                    visibility=1.0 if b.visible else 0.0)
     for r in w.robots:
         m.robots.add(robot_id=trk_pb.RobotId(id=r.id, team=_TEAM_PB[r.team]), pos=trk_pb.Vector2(x=r.x, y=r.y),
                      orientation=r.theta, vel=trk_pb.Vector2(x=r.vx, y=r.vy), vel_angular=r.omega,
-                     visibility=1.0 if r.visible else 0.0)  # fmt: skip
+                     visibility=1.0 if r.visible else 0.0)
     return m
 
 
@@ -150,7 +150,7 @@ def _world_from(m: Any) -> WorldState:
         b = m.balls[0]
         ball = BallState(b.pos.x, b.pos.y, b.vel.x, b.vel.y, b.visibility > 0.5)
     robots = tuple(RobotState(_team(r.robot_id.team), r.robot_id.id, r.pos.x, r.pos.y, r.orientation, r.vel.x,
-                              r.vel.y, r.vel_angular, r.visibility > 0.5) for r in m.robots)  # fmt: skip
+                              r.vel.y, r.vel_angular, r.visibility > 0.5) for r in m.robots)
     return WorldState(m.timestamp, ball, robots, m.frame_number)
 
 
@@ -209,14 +209,14 @@ def _team_info_to(i: TeamInfo, into: Any) -> None:
 
 def _team_info_from(m: Any) -> TeamInfo:
     return TeamInfo(m.red_cards, m.yellow_cards, tuple(m.yellow_card_times), m.fouls, m.goalkeeper, m.timeouts,
-                    m.timeout_time, m.placement_failures, m.can_place_ball, m.max_robots)  # fmt: skip
+                    m.timeout_time, m.placement_failures, m.can_place_ball, m.max_robots)
 
 
 def _game_to(g: GameState) -> Any:
     m = pb.GameState(t=g.t, command=_COMMAND_PB[g.command], score_blue=g.score_blue, score_yellow=g.score_yellow,
                      blue_defends_negative_x=g.blue_defends_negative_x, ready=g.ready, stage=_STAGE_PB[g.stage],
                      stage_time_left=g.stage_time_left_s, command_counter=g.command_counter, command_t=g.command_t,
-                     action_time_left=g.action_time_left_s)  # fmt: skip
+                     action_time_left=g.action_time_left_s)
     if g.for_team is not None:
         m.for_team = _TEAM_PB[g.for_team]
     if g.placement is not None:
@@ -242,7 +242,7 @@ def _game_from(m: Any) -> GameState:
                      _PB_STAGE[m.stage], m.stage_time_left, m.command_counter, m.command_t, m.action_time_left,
                      _PB_COMMAND[m.next_command] if m.HasField("next_command") else None,
                      _team(m.next_for_team) if m.HasField("next_for_team") else None,
-                     _team_info_from(m.blue_team), _team_info_from(m.yellow_team))  # fmt: skip
+                     _team_info_from(m.blue_team), _team_info_from(m.yellow_team))
 
 
 def _game_event_to(e: GameEvent, into: Any) -> None:
@@ -259,7 +259,7 @@ def _game_event_to(e: GameEvent, into: Any) -> None:
 def _game_event_from(m: Any) -> GameEvent:
     return GameEvent(m.t, m.kind, _team(m.team) if m.HasField("team") else None,
                      m.robot if m.HasField("robot") else None, m.value, m.limit, m.unit, m.restart or None,
-                     _team(m.for_team) if m.HasField("for_team") else None)  # fmt: skip
+                     _team(m.for_team) if m.HasField("for_team") else None)
 
 
 def _game_events_to(ev: GameEvents) -> Any:
@@ -284,7 +284,7 @@ def _truth_to(gt: GroundTruth) -> Any:
         m.ball.cameras.add(camera_id=cam, u=u, v=v, visible_fraction=f)
     for r in gt.robots:
         rm = m.robots.add(team=_TEAM_PB[r.team], id=r.id, x=r.x, y=r.y, theta=r.theta, vx=r.vx, vy=r.vy,
-                          omega=r.omega)  # fmt: skip
+                          omega=r.omega)
         for cam, (u, v) in r.pixels.items():
             rm.cameras.add(camera_id=cam, u=u, v=v)
     return m
@@ -294,7 +294,7 @@ def _truth_from(m: Any) -> GroundTruth:
     b = m.ball
     ball = BallTruth(b.x, b.y, b.z, b.vx, b.vy, b.vz, {c.camera_id: (c.u, c.v, c.visible_fraction) for c in b.cameras})
     robots = tuple(RobotTruth(_team(r.team), r.id, r.x, r.y, r.theta, r.vx, r.vy, r.omega,
-                              {c.camera_id: (c.u, c.v) for c in r.cameras}) for r in m.robots)  # fmt: skip
+                              {c.camera_id: (c.u, c.v) for c in r.cameras}) for r in m.robots)
     return GroundTruth(m.frame_number, m.t, ball, robots)
 
 
@@ -314,7 +314,7 @@ def _event_to(e: Event, into: Any) -> None:
         into.contact.CopyFrom(pb.Contact(
             t_start=e.t_start, duration_s=e.duration_s, a=trk_pb.RobotId(id=e.a[1], team=_TEAM_PB[e.a[0]]),
             b=trk_pb.RobotId(id=e.b[1], team=_TEAM_PB[e.b[0]]), max_depth_m=e.max_depth_m,
-            relative_speed_m_s=e.relative_speed_m_s))  # fmt: skip
+            relative_speed_m_s=e.relative_speed_m_s))
         if e.pushed_by is not None:
             into.contact.pushed_by.CopyFrom(trk_pb.RobotId(id=e.pushed_by[1], team=_TEAM_PB[e.pushed_by[0]]))
 
@@ -334,7 +334,7 @@ def _event_from(m: Any) -> Event:
         c = m.contact
         pushed = (_team(c.pushed_by.team), c.pushed_by.id) if c.HasField("pushed_by") else None
         return Contact(c.t_start, c.duration_s, (_team(c.a.team), c.a.id), (_team(c.b.team), c.b.id), c.max_depth_m,
-                       c.relative_speed_m_s, pushed)  # fmt: skip
+                       c.relative_speed_m_s, pushed)
     raise MessageError("event without a kind")
 
 
@@ -360,13 +360,13 @@ def _teleport_to(tp: Teleport) -> Any:
 
 def _teleport_from(m: Any) -> Teleport:
     return Teleport(m.t, tuple((_team(r.team), r.id, r.x, r.y, r.theta) for r in m.robots),
-                    (m.ball.x, m.ball.y) if m.HasField("ball") else None)  # fmt: skip
+                    (m.ball.x, m.ball.y) if m.HasField("ball") else None)
 
 
 def _camera_to(f: CameraFrame) -> Any:
     h, w = f.image.shape[:2]
     return pb.CameraFrame(camera_id=f.camera_id, frame_number=f.frame_number, t_capture=f.t_capture, width=w,
-                          height=h, encoding="bgr8", data=np.ascontiguousarray(f.image).tobytes())  # fmt: skip
+                          height=h, encoding="bgr8", data=np.ascontiguousarray(f.image).tobytes())
 
 
 def _varint(n: int) -> bytes:
@@ -388,7 +388,7 @@ def _camera_chunks(f: CameraFrame) -> tuple[bytes, bytes]:
     copies the image once, into its buffer, instead of through a message and its serialisation."""
     h, w = f.image.shape[:2]
     head = pb.CameraFrame(camera_id=f.camera_id, frame_number=f.frame_number, t_capture=f.t_capture, width=w,
-                          height=h, encoding="bgr8")  # fmt: skip
+                          height=h, encoding="bgr8")
     image = np.ascontiguousarray(f.image).tobytes()
     return head.SerializePartialToString(deterministic=True) + _IMAGE_KEY + _varint(len(image)), image
 
@@ -407,11 +407,11 @@ def _camera_from(m: Any) -> CameraFrame:
 
 def _report_to(r: TeamReport) -> Any:
     m = pb.TeamReport(team=_TEAM_PB[r.team], frame_number=r.frame_number, t=r.t, pass_points=_flat(r.pass_points),
-                      pass_values=_flat(r.pass_values))  # fmt: skip
+                      pass_values=_flat(r.pass_values))
     for rr in r.robots:
         x, y, th = rr.target
         rm = m.robots.add(id=rr.id, status=rr.status, target_x=x, target_y=y, target_theta=th, path=_flat(rr.path),
-                          braking=_flat(rr.braking))  # fmt: skip
+                          braking=_flat(rr.braking))
         if rr.command is not None:
             _command_to(rr.command, rm.command)
     for rid, action in r.actions.items():
@@ -429,14 +429,14 @@ def _report_from(m: Any) -> TeamReport:
     team = _team(m.team)
     robots = tuple(RobotReport(r.id, r.status, (r.target_x, r.target_y, r.target_theta), _pairs(r.path),
                                _command_from(r.command, team) if r.HasField("command") else None, _pairs(r.braking))
-                   for r in m.robots)  # fmt: skip
+                   for r in m.robots)
     passing = None
     if m.HasField("passing"):
         ps = m.passing
         aim = (ps.shoot_x, ps.shoot_y) if ps.HasField("shoot_x") else None
         passing = PassReport(ps.passer, ps.receiver, (ps.target_x, ps.target_y), aim, ps.kicked)
     return TeamReport(team, m.frame_number, m.t, robots, {a.id: a.action for a in m.actions}, _pairs(m.pass_points),
-                      np.asarray(m.pass_values, dtype=np.float64), passing)  # fmt: skip
+                      np.asarray(m.pass_values, dtype=np.float64), passing)
 
 
 def _timing_to(t: Timing) -> Any:
@@ -450,7 +450,7 @@ def _timing_from(m: Any) -> Timing:
 def _physics_to(p: PhysicsFacts) -> Any:
     def fact(e: FactEstimate) -> Any:
         out = pb.PhysicsFact(fact=e.fact.value, configured=e.configured_m_s2, samples=e.samples, confident=e.confident,
-                             used=e.used)  # fmt: skip
+                             used=e.used)
         if math.isfinite(e.value_m_s2):
             out.value = e.value_m_s2
         if math.isfinite(e.spread_m_s2):
@@ -465,7 +465,7 @@ def _physics_from(m: Any) -> PhysicsFacts:
         return PhysicsFacts(m.t, tuple(
             FactEstimate(Fact(f.fact), f.value if f.HasField("value") else math.nan, f.configured, f.samples,
                          f.spread if f.HasField("spread") else math.nan, f.confident, f.used)
-            for f in m.facts))  # fmt: skip
+            for f in m.facts))
     except ValueError as exc:
         raise MessageError(f"bad physics facts: {exc}") from None
 
@@ -511,7 +511,7 @@ CODECS: dict[type[Any], Codec] = {c.message: c for c in (
     Codec(PhysicsFacts, pb.PhysicsFacts, _physics_to, _physics_from),
     Codec(NodeControl, pb.NodeControl, lambda c: pb.NodeControl(node=c.node, command=c.command),
           lambda m: NodeControl(m.node, m.command)),
-)}  # fmt: skip
+)}
 _BY_NAME: dict[str, Codec] = {c.proto.DESCRIPTOR.full_name: c for c in CODECS.values()}
 
 # the messages whose wire form rounds (32-bit floats): what a remote stage receives is not what was sent

@@ -49,9 +49,9 @@ def _open(params: RuntimeParams, role: str) -> Any:
         endpoint = params.zenoh.router
         if role == "router":
             raise RouterError(f"cannot listen on {endpoint} (runtime.zenoh.router): is a router running there "
-                              "already?") from None  # fmt: skip
+                              "already?") from None
         raise RouterError(f"no zenoh router at {endpoint} (runtime.zenoh.router): start the match (or a node "
-                          "with --router) first") from None  # fmt: skip
+                          "with --router) first") from None
 
 
 def open_router(params: RuntimeParams) -> Any:
@@ -126,7 +126,7 @@ class ZenohTransport:
     ``name``: who this is, in reports."""
 
     def __init__(self, params: RuntimeParams, name: str = "node", session: Any = None,
-                 err: TextIO | None = None) -> None:  # fmt: skip
+                 err: TextIO | None = None) -> None:
         import zenoh
 
         self._zenoh = zenoh
@@ -218,7 +218,7 @@ class ZenohTransport:
             z = self._zenoh
             return lambda payload: self.session.put(out.key, payload, encoding=out.encoding,
                                                     congestion_control=z.CongestionControl.BLOCK,
-                                                    allowed_destination=z.Locality.REMOTE)  # fmt: skip
+                                                    allowed_destination=z.Locality.REMOTE)
         if out.young:
             out.settle()
         return (lambda payload: out.publisher.put(payload, encoding=out.encoding)) if out.heard else None
@@ -256,7 +256,7 @@ class ZenohTransport:
             z = self._zenoh
             key = f"{self.prefix}/{topic}"
             pub = self.session.declare_publisher(key, congestion_control=z.CongestionControl.BLOCK,
-                                                 allowed_destination=z.Locality.REMOTE)  # fmt: skip
+                                                 allowed_destination=z.Locality.REMOTE)
             out = self._outlets[topic] = _Outlet(key, pub)
         if out.encoding is None and message is not None:
             out.encoding = self._zenoh.Encoding.APPLICATION_PROTOBUF.with_schema(wire.schema(message))
@@ -281,7 +281,7 @@ class ZenohTransport:
                 except queue.Empty:
                     break
             newest = {topic: i for i, (topic, _, remote) in enumerate(batch)
-                      if remote and any(topic_matches(p, topic) for p in self.latest_only)}  # fmt: skip
+                      if remote and any(topic_matches(p, topic) for p in self.latest_only)}
             for i, (topic, payload, remote) in enumerate(batch):
                 if remote and newest.get(topic, i) != i:
                     self.superseded += 1

@@ -128,7 +128,7 @@ def _gap_coeffs(
 def _interval_hits(
     d0x: float, d0y: float, d1x: float, d1y: float, ex: float, ey: float,
     r0: float, r1: float, r2: float, T: float,
-) -> bool:  # fmt: skip
+) -> bool:
     """Does |d0 + d1 t + e t^2| fall below r0 + r1 t + r2 t^2 (r's >= 0) for some t in [0, T]?"""
     # cheap rejection: the distance cannot shrink faster than its derivative bounds allow
     lower = math.hypot(d0x, d0y) - math.hypot(d1x, d1y) * T - math.hypot(ex, ey) * T * T
@@ -218,7 +218,7 @@ def opponent_hits(tr: np.ndarray, ox: float, oy: float, ovx: float, ovy: float, 
         # the opponent's reach grows as accel (t0 + h)^2 / 2 = r0 + r1 h + r2 h^2
         g0, g1, g2 = r + 0.5 * accel * t0 * t0, accel * t0, 0.5 * accel
         if _interval_hits(tr[k, 2] - qx, tr[k, 3] - qy, tr[k, 4] - ovx, tr[k, 5] - ovy, 0.5 * tr[k, 6],
-                          0.5 * tr[k, 7], g0, g1, g2, t1 - t0):  # fmt: skip
+                          0.5 * tr[k, 7], g0, g1, g2, t1 - t0):
             return True
     return False
 
@@ -240,7 +240,7 @@ def exposed(states: np.ndarray, opp: np.ndarray, reach: float) -> np.ndarray:
 def _trajectory_hits(
     i: int, tr: np.ndarray, trs: np.ndarray, pushed: np.ndarray, opp: np.ndarray, obs: np.ndarray,
     inner: np.ndarray, cfg: DSSConfig,
-) -> bool:  # fmt: skip
+) -> bool:
     # robot i's trajectory tr against the other own robots' trajectories, the opponents and the world
     for j in range(trs.shape[0]):
         radius = cfg.pushed_radius if pushed[i] or pushed[j] else cfg.own_radius
@@ -265,7 +265,7 @@ def _store(trs: np.ndarray, i: int, tr: np.ndarray) -> None:
 def dss(
     states: np.ndarray, desired: np.ndarray, stop_asked: np.ndarray, opp: np.ndarray, obs: np.ndarray,
     inner: np.ndarray, lim: Limits, cfg: DSSConfig, unit_samples: np.ndarray, heuristics: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Cooperative Dynamics Safety Search (Bruce 2006 §5.3) over the own robots in turn.
 
     ``states`` (n, 4) x, y, vx, vy; ``desired`` (n, 2) each robot's commanded acceleration;
@@ -344,14 +344,14 @@ def dss(
 def trajectories_clear(
     states: np.ndarray, acc: np.ndarray, opp: np.ndarray, obs: np.ndarray, inner: np.ndarray, lim: Limits,
     cfg: DSSConfig,
-) -> np.ndarray:  # fmt: skip
+) -> np.ndarray:
     """For each robot: is its trajectory under ``acc`` clear of every other's, the opponents and the
     static obstacles? (The check a finished search must pass.)"""
     n = states.shape[0]
     trs = np.empty((n, N_SEG, 8))
     for i in range(n):
         _store(trs, i, trajectory(states[i, 0], states[i, 1], states[i, 2], states[i, 3], acc[i, 0], acc[i, 1],
-                                  cfg.dt, lim.accel, lim.brake))  # fmt: skip
+                                  cfg.dt, lim.accel, lim.brake))
     out = np.empty(n, dtype=np.bool_)
     pushed = exposed(states, opp, cfg.push_reach)
     for i in range(n):

@@ -73,7 +73,7 @@ def heuristic_table(params: DSSParams) -> FloatArray:
 
 
 def crash_hold(states: FloatArray, velocities: FloatArray, opponents: FloatArray, body_m: float, closing_m_s: float,
-               brake_m_s2: float, latency_s: float) -> FloatArray:  # fmt: skip
+               brake_m_s2: float, latency_s: float) -> FloatArray:
     """The commands (n, 2) with each robot's speed toward each opponent held to ``sqrt(c**2 + 2 b g)``:
     ``c`` the closing speed allowed at contact less the opponent's speed toward the robot, ``g`` the
     gap between their bodies less ``latency_s`` of their closing speed now, ``b`` the braking. A
@@ -122,7 +122,7 @@ class DynamicsSafetySearch(ArraySafety):
             own_growth=2.0 * params.velocity_error_m_s, opponent_radius=d + params.opponent_margin_m,
             opponent_accel=params.opponent_accel_m_s2, static_margin=params.static_margin_m,
             static_step=params.static_step_m,
-        )  # fmt: skip
+        )
         self.heuristics = heuristic_table(params)
         self.body_m = d  # centre to centre at contact
 
@@ -146,7 +146,7 @@ class DynamicsSafetySearch(ArraySafety):
         stop_asked = np.all(v == 0.0, axis=1)
         st = self.static
         acc, status, trs = K.dss(s, desired, stop_asked, opp, st.obs, st.inner, self.limits, self.cfg,
-                                 self.unit_samples(len(s)), self.heuristics)  # fmt: skip
+                                 self.unit_samples(len(s)), self.heuristics)
         return np.asarray(acc), np.asarray(status), np.asarray(trs)
 
     def filter(self, states: ArrayLike, velocities: ArrayLike, opponents: ArrayLike) -> SafetyResult:
@@ -158,7 +158,7 @@ class DynamicsSafetySearch(ArraySafety):
         p = self.params
         if p.crash_closing_m_s > 0.0 and len(opp):
             v = crash_hold(s, v, opp, self.body_m, p.crash_closing_m_s,
-                           p.crash_brake_share * self.motion.max_brake_m_s2, p.crash_latency_s)  # fmt: skip
+                           p.crash_brake_share * self.motion.max_brake_m_s2, p.crash_latency_s)
         acc, status, trs = self.search(s, v, opp)
         out = s[:, 2:4] + acc * self.motion.period_s
         out[status == K.KEPT] = v[status == K.KEPT]

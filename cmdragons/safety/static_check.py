@@ -33,7 +33,7 @@ def static_hits(tr: np.ndarray, obs: np.ndarray, inner: np.ndarray, margin: floa
         if t1 - t0 <= 0.0:
             continue
         vmax = max(math.hypot(tr[k, 4], tr[k, 5]), math.hypot(tr[k, 4] + tr[k, 6] * (t1 - t0),
-                                                              tr[k, 5] + tr[k, 7] * (t1 - t0)))  # fmt: skip
+                                                              tr[k, 5] + tr[k, 7] * (t1 - t0)))
         n = max(1, int(math.ceil(vmax * (t1 - t0) / step)))
         for i in range(1, n + 1):
             px, py, _, _ = seg_at(tr, k, t0 + (t1 - t0) * i / n)

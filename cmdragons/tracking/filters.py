@@ -145,7 +145,7 @@ class BallFilter:
         # switch (one deceleration for the other), a robot next to it
         switch_sigma = max(p.accel_sigma_m_s2, abs(p.acc_slide_m_s2 - p.acc_roll_m_s2))
         self.caches = (self.cache, _Cache(2, (switch_sigma, switch_sigma)),
-                       _Cache(2, (p.near_robot_accel_sigma_m_s2, p.near_robot_accel_sigma_m_s2)))  # fmt: skip
+                       _Cache(2, (p.near_robot_accel_sigma_m_s2, p.near_robot_accel_sigma_m_s2)))
         # a ball first seen may have just been kicked: sliding until its speed is known (as after a kick)
         self.slide_start_speed = math.inf
         self.t_kick = t
@@ -311,7 +311,7 @@ class RobotFilter:
         kf = kalman().KalmanFilter(dim_x=6, dim_z=3)
         kf.x = np.array([x, y, theta, 0.0, 0.0, 0.0])
         kf.P = np.diag([p.measurement_sigma_m**2] * 2 + [p.measurement_sigma_rad**2]
-                       + [p.initial_speed_sigma_m_s**2] * 2 + [(4 * p.initial_speed_sigma_m_s) ** 2])  # fmt: skip
+                       + [p.initial_speed_sigma_m_s**2] * 2 + [(4 * p.initial_speed_sigma_m_s) ** 2])
         kf.H = np.hstack([np.eye(3), np.zeros((3, 3))])
         kf.R = np.diag([p.measurement_sigma_m**2] * 2 + [p.measurement_sigma_rad**2])
         self.kf = kf
@@ -332,7 +332,7 @@ class RobotFilter:
         return np.array(self._accel_tuple(float(state[3]), float(state[4]), float(state[5]), dt, self.command))
 
     def _accel_tuple(self, vx: float, vy: float, w: float, dt: float,
-                     command: tuple[float, float, float] | None) -> tuple[float, float, float]:  # fmt: skip
+                     command: tuple[float, float, float] | None) -> tuple[float, float, float]:
         if command is None or dt <= 0.0:
             return (0.0, 0.0, 0.0)
         ax, ay = (command[0] - vx) / dt, (command[1] - vy) / dt
@@ -343,7 +343,7 @@ class RobotFilter:
         return (ax, ay, a_ang)
 
     def predicted_state(self, t: float,
-                        commands: Sequence[tuple[float, tuple[float, float, float]]] = ()) -> Vec:  # fmt: skip
+                        commands: Sequence[tuple[float, tuple[float, float, float]]] = ()) -> Vec:
         """State at time ``t`` (no change to the filter; robots hand on no covariance). ``commands``
         (time they take effect, (vx, vy, omega)), in time order, are followed as they come into force
         between now and ``t``: the look-ahead must see the commands already sent."""
@@ -369,12 +369,12 @@ class RobotFilter:
         a = self._accel_tuple(x[3], x[4], x[5], dt, command)
         h = 0.5 * dt * dt
         return [x[0] + x[3] * dt + a[0] * h, x[1] + x[4] * dt + a[1] * h, x[2] + x[5] * dt + a[2] * h,
-                x[3] + a[0] * dt, x[4] + a[1] * dt, x[5] + a[2] * dt]  # fmt: skip
+                x[3] + a[0] * dt, x[4] + a[1] * dt, x[5] + a[2] * dt]
 
     def steady_step(self, t: float) -> bool:
         """Whether the step to ``t`` is a regular one in steady-state mode (the settled gain holds)."""
         return (self._steady is not None and not self._pending_update
-                and abs(t - self.t - self._steady_dt) < 1e-6)  # fmt: skip
+                and abs(t - self.t - self._steady_dt) < 1e-6)
 
     @property
     def steady_pending(self) -> bool:
@@ -410,7 +410,7 @@ class RobotFilter:
             y0, y1, y2 = z[0] - x0, z[1] - x1, wrap_angle(z[2] - x2)
             si = self._steady_list
             return (y0 * (si[0] * y0 + si[1] * y1 + si[2] * y2) + y1 * (si[3] * y0 + si[4] * y1 + si[5] * y2)
-                    + y2 * (si[6] * y0 + si[7] * y1 + si[8] * y2))  # fmt: skip
+                    + y2 * (si[6] * y0 + si[7] * y1 + si[8] * y2))
         y = self.innovation(np.asarray(z, dtype=float))
         s = self.kf.P[:3, :3] + self.kf.R + self._gate_floor
         return float(y @ np.linalg.solve(s, y))
@@ -494,7 +494,7 @@ class SteadyUpdates:
         self._h: Vec = np.zeros((0, 0))
 
     def take(self, robots: Sequence[RobotFilter], z: Sequence[tuple[float, float, float]],
-             gate_chi2: float) -> NDArray[np.bool_]:  # fmt: skip
+             gate_chi2: float) -> NDArray[np.bool_]:
         """Update each of ``robots`` (all :attr:`RobotFilter.steady_pending`) with its detection in
         ``z`` whose Mahalanobis distance squared is within ``gate_chi2``; returns which were taken."""
         if not robots:
@@ -537,7 +537,7 @@ def _block_diag(blocks: Sequence[Vec]) -> Vec:
 
 
 def predicted_states(filters: Sequence[RobotFilter], t: float,
-                     commands: Sequence[Sequence[tuple[float, tuple[float, float, float]]]]) -> Vec:  # fmt: skip
+                     commands: Sequence[Sequence[tuple[float, tuple[float, float, float]]]]) -> Vec:
     """States (one row per filter) at time ``t``, as :meth:`RobotFilter.predicted_state` with each
     filter's ``commands``. Robots without a command (the opponents) move at constant velocity and
     are extrapolated together."""

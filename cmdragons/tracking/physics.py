@@ -83,7 +83,7 @@ class PhysicsFactsParams(Validated):
 
     def configured(self, fact: Fact) -> float:
         return {Fact.BALL_ROLL: self.acc_roll_m_s2, Fact.BALL_SLIDE: self.acc_slide_m_s2,
-                Fact.ROBOT_ACCEL: self.max_accel_m_s2, Fact.ROBOT_BRAKE: self.max_brake_m_s2}[fact]  # fmt: skip
+                Fact.ROBOT_ACCEL: self.max_accel_m_s2, Fact.ROBOT_BRAKE: self.max_brake_m_s2}[fact]
 
 
 def fit_acceleration(t: Array, xy: Array) -> tuple[Array, Array, Array, float]:
@@ -185,7 +185,7 @@ class PhysicsEstimator:
 
     # --- our robots ---------------------------------------------------------------------------------------
     def robot(self, key: Any, t: float, x: float, y: float, velocity: tuple[float, float],
-              command: tuple[float, float] | None) -> None:  # fmt: skip
+              command: tuple[float, float] | None) -> None:
         """A detection of our robot ``key`` at ``t``, its tracked ``velocity`` and the velocity its
         command in force asks (None: no command of ours)."""
         run = self._robots.setdefault(key, _RobotRun())

@@ -210,7 +210,7 @@ class Tracker:
         if steady:
             settled = [self.robots[key] for key in steady]
             taken = self._steady_updates.take([tr.filter for tr in settled], list(steady.values()),
-                                              self.p.robot_gate_chi2)  # fmt: skip
+                                              self.p.robot_gate_chi2)
             rejected = []
             for (key, z), robot, ok in zip(steady.items(), settled, taken.tolist(), strict=True):
                 if ok:
@@ -292,7 +292,7 @@ class Tracker:
             pts = np.array([(x, y) for _, x, y in recent[-self.p.robot_reinit_detections :]])
             if float(np.max(np.linalg.norm(pts - pts[-1], axis=1))) <= self.p.robot_reinit_spread_m:
                 self.robots[key] = _RobotTrack(RobotFilter(self.p.robot, z[0], z[1], z[2], t), last_seen=t,
-                                               hits=self.p.robot_confirm_detections)  # fmt: skip
+                                               hits=self.p.robot_confirm_detections)
                 self.stats.robot_restarts += 1
 
     # --- ball ---------------------------------------------------------------------------------
@@ -390,10 +390,10 @@ class Tracker:
             self.robots = dict(sorted(self.robots.items()))
             self._robots_sorted = True
         confirmed = [(key, track) for key, track in self.robots.items()
-                     if track.hits >= self.p.robot_confirm_detections]  # fmt: skip
+                     if track.hits >= self.p.robot_confirm_detections]
         self._apply_commands()
         states = filters.predicted_states([track.filter for _, track in confirmed], t,
-                                  [self._commands.get(key, ()) for key, _ in confirmed])  # fmt: skip
+                                  [self._commands.get(key, ()) for key, _ in confirmed])
         robots = tuple(RobotState(team, rid, x[0], x[1], x[2], x[3], x[4], x[5], track.last_seen == self.t)
-                       for ((team, rid), track), x in zip(confirmed, states.tolist(), strict=True))  # fmt: skip
+                       for ((team, rid), track), x in zip(confirmed, states.tolist(), strict=True))
         return WorldState(t, ball, robots)

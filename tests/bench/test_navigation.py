@@ -94,7 +94,7 @@ def test_the_grid_astar_row_finds_the_least_cost() -> None:
 def test_the_figures_are_written(settings: Settings, tmp_path: Path) -> None:
     trap = u_trap(settings.field_geometry())
     out = draw(trap, {"a": np.array([trap.start, trap.goal]), "b": np.array([trap.start, (0.0, 2.0), trap.goal])},
-               tmp_path, 0.09)  # fmt: skip
+               tmp_path, 0.09)
     assert out == tmp_path / "u_trap.png" and out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
@@ -105,4 +105,4 @@ def test_bad_figure_options_stop_with_one_line(tmp_path: Path, capsys: pytest.Ca
     assert main(["bench", "sim", "--quick", "--figures", str(tmp_path)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert err == [f"cmdragons bench: --figures {file} is a file, not a folder",
-                   "cmdragons bench: --figures is for the navigation suite, not sim"]  # fmt: skip
+                   "cmdragons bench: --figures is for the navigation suite, not sim"]

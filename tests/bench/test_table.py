@@ -7,7 +7,7 @@ import pytest
 from cmdragons.bench import TABLE_WIDTH, header, print_table
 
 HEADERS = [("median_ms", "median\nms"), ("max_speed_m_s", "max speed\nm/s"), ("success_rate", "success rate"),
-           ("ns_per_query", "ns per query")]  # fmt: skip
+           ("ns_per_query", "ns per query")]
 
 
 @pytest.mark.parametrize(("metric", "shown"), HEADERS)
@@ -19,7 +19,7 @@ def test_wide_table_fits_and_cuts_nothing(capsys: pytest.CaptureFixture[str]) ->
     long = "moving_errt_cached_waypoints_scene_dense"
     metrics = {f"metric_{k}_ms": 1000.0 + k for k in range(14)}
     rows = [{"name": long, **metrics}, {"name": "static", **metrics},
-            {"name": "ompl_baselines", "note": "skipped: pip install 'cmdragons[bench]'"}]  # fmt: skip
+            {"name": "ompl_baselines", "note": "skipped: pip install 'cmdragons[bench]'"}]
     print_table("planning", rows)
     out = capsys.readouterr().out
     lines = out.splitlines()

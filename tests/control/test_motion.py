@@ -45,7 +45,7 @@ def test_commands_never_exceed_the_limits() -> None:
     rng = np.random.default_rng(2)
     n = 500
     states = np.column_stack([rng.uniform(-4, 4, (n, 2)), rng.uniform(-3, 3, n), rng.normal(0, 1.5, (n, 2)),
-                              rng.normal(0, 5, n)])  # fmt: skip
+                              rng.normal(0, 5, n)])
     speed = np.hypot(states[:, 3], states[:, 4])
     states[:, 3:5] *= np.minimum(1.0, M.max_speed_m_s / speed)[:, None]  # start within the limits
     targets = np.column_stack([rng.uniform(-4, 4, (n, 2)), rng.normal(0, 1, (n, 2)), rng.uniform(-3, 3, n)])
@@ -91,7 +91,7 @@ def test_follow_path_targets_the_next_waypoint_with_a_turnable_speed() -> None:
 def make_world(n: int) -> World:
     # robots that act on a command at once: what the controller sees after the tracker's prediction
     w = World(LeagueParams(), PhysicsParams(), RobotParams(command_latency_s=0.0), BallParams(), KickerParams(),
-              DribblerParams(), robots_per_team={"blue": n, "yellow": 0})  # fmt: skip
+              DribblerParams(), robots_per_team={"blue": n, "yellow": 0})
     w.place_ball(0.0, 3.1)
     return w
 
@@ -124,13 +124,13 @@ def test_closed_loop_in_the_simulator_reaches_the_goal_in_the_profile_time(
 
 
 @pytest.mark.parametrize("theta, omega, target", [(0.0, 0.0, 1.0), (3.0, 2.0, -3.0), (-1.0, -4.0, 0.5),
-                                                  (0.2, 0.0, 0.2)])  # fmt: skip
+                                                  (0.2, 0.0, 0.2)])
 def test_the_heading_command_is_the_motion_command_s_rotation(theta: float, omega: float, target: float) -> None:
     # the reactive navigators take the rotation alone; it must be the full command's
     from cmdragons.control._kernels import heading_command
 
     m = PARAMS.motion
     full = motion_commands(np.array([[0.1, -0.2, theta, 0.5, 0.0, omega]]), np.array([[1.0, 1.0, 0.0, 0.0, target]]),
-                           PARAMS)[0]  # fmt: skip
+                           PARAMS)[0]
     turn = heading_command(theta, omega, target, m.max_omega_rad_s, m.max_alpha_rad_s2, m.period_s)
     assert turn == full[2]  # rad/s, the same arithmetic

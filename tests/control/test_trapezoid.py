@@ -84,7 +84,7 @@ def test_zero_limits_mean_never_unless_already_there() -> None:
     [((3.0, 1.0), (0.0, 0.0), (0.0, 0.0)), ((-2.0, 2.5), (1.5, -1.0), (0.0, 0.0)),
      ((0.2, -4.0), (2.0, 0.0), (0.0, 0.0)), ((1.0, 1.0), (0.0, 0.0), (1.0, 0.5)),
      ((0.0, 2.0), (1.0, 0.0), (0.0, 0.0))],
-)  # fmt: skip
+)
 def test_2d_axes_arrive_together_at_the_target(
     delta: tuple[float, float], v0: tuple[float, float], vt: tuple[float, float]
 ) -> None:
@@ -96,4 +96,4 @@ def test_2d_axes_arrive_together_at_the_target(
     c, s = math.cos(p.theta), math.sin(p.theta)
     assert math.hypot(3.0 * c, 3.0 * s) == pytest.approx(3.0)
     assert p.duration_s >= max(trapezoid_1d(delta[0], v0[0], vt[0], 3, 3, 6).duration_s,
-                               trapezoid_1d(delta[1], v0[1], vt[1], 3, 3, 6).duration_s) - 1e-9  # fmt: skip
+                               trapezoid_1d(delta[1], v0[1], vt[1], 3, 3, 6).duration_s) - 1e-9

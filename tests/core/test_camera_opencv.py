@@ -26,10 +26,10 @@ def test_opencv_projection_equals_the_model_and_the_pose_round_trips(params: Cam
     pts = np.column_stack([rng.uniform(-1.5, 1.5, (50, 2)) + model.center[:2], rng.uniform(0, 0.2, 50)])
     rvec, tvec = opencv_extrinsics(model)
     k = np.array([[params.focal_px, 0, params.principal_point_px[0] - 0.5],
-                  [0, params.focal_px, params.principal_point_px[1] - 0.5], [0, 0, 1]])  # fmt: skip
+                  [0, params.focal_px, params.principal_point_px[1] - 0.5], [0, 0, 1]])
     cv_px, _ = cv2.projectPoints(pts, rvec, tvec, k, np.array([params.k1, params.k2, 0.0, 0.0]))
     np.testing.assert_allclose(cv_px.reshape(-1, 2) + 0.5, model.project(pts), atol=1e-6)
     back = params_from_opencv(rvec, tvec, dataclasses.replace(params, position_m=(0.0, 0.0, 1.0), yaw_rad=0.0))
     np.testing.assert_allclose(back.position_m, params.position_m, atol=1e-9)
     np.testing.assert_allclose([back.yaw_rad, back.tilt_x_rad, back.tilt_y_rad],
-                               [params.yaw_rad, params.tilt_x_rad, params.tilt_y_rad], atol=1e-9)  # fmt: skip
+                               [params.yaw_rad, params.tilt_x_rad, params.tilt_y_rad], atol=1e-9)

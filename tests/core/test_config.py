@@ -39,7 +39,7 @@ def test_shipped_configs_equal_the_dataclass_defaults() -> None:
 
 def test_each_fact_is_configured_once_and_reaches_every_user() -> None:
     s = load_settings(REPO_CONFIGS, ["field.robot.max_accel_m_s2=2.5", "field.robot.command_latency_s=0.05",
-                                     "field.ball.acc_roll_m_s2=0.3"])  # fmt: skip
+                                     "field.ball.acc_roll_m_s2=0.3"])
     assert s.sim.robot.max_accel_m_s2 == s.tracker.robot.max_accel_m_s2 == 2.5
     assert s.sim.robot.command_latency_s == s.tracker.latency_s == 0.05
     assert s.sim.ball.acc_roll_m_s2 == s.tracker.ball.acc_roll_m_s2 == 0.3

@@ -48,7 +48,7 @@ def test_a_team_command_reads_back_from_the_leagues_referee_message(command: Ref
 
 
 @pytest.mark.parametrize(("field", "value"), [("command", "kick_off"), ("stage", "extra_time"),
-                                              ("next_command", "go")])  # fmt: skip
+                                              ("next_command", "go")])
 def test_a_string_that_names_no_member_is_refused_with_the_choices(field: str, value: str) -> None:
     with pytest.raises(MessageError, match="must be one of"):
         GameState(0.0, **{field: value})  # type: ignore[arg-type]

@@ -22,7 +22,7 @@ from cmdragons.geometry import Field, LeagueParams, wrap_angle
 def test_the_angle_wrap_is_in_range_and_the_kernels_is_the_same_to_the_bit() -> None:
     edges = [0.0, -0.0, math.pi, -math.pi, 2.0 * math.pi, -2.0 * math.pi, 3.0 * math.pi, 1e-300, 1e6]
     a = np.concatenate([np.random.default_rng(3).uniform(-50.0, 50.0, 2000), np.nextafter(edges, np.inf),
-                        np.nextafter(edges, -np.inf), edges])  # fmt: skip
+                        np.nextafter(edges, -np.inf), edges])
     w = wrap_angle(a)
     assert np.all(np.abs(w) <= math.pi)  # [-pi, pi): rounding may give pi itself for an angle just under -pi
     np.testing.assert_allclose(np.cos(w), np.cos(a), atol=1e-9)  # the same direction (the 1e6 loses ~1e-10)
@@ -60,7 +60,7 @@ def test_free_kick_spot_is_legal(point: tuple[float, float]) -> None:
 
 def test_projection_round_trip_with_distortion() -> None:
     cam = CameraModel(CameraParams(position_m=(1.0, -0.5, 4.0), yaw_rad=0.3, tilt_x_rad=0.05, tilt_y_rad=-0.03,
-                                   focal_px=600.0, k1=-0.08, k2=0.01))  # fmt: skip
+                                   focal_px=600.0, k1=-0.08, k2=0.01))
     rng = np.random.default_rng(0)
     pts = rng.uniform([-2, -2.5], [4, 1.5], size=(200, 2))
     for z in (0.0, 0.0215, 0.15):
@@ -72,7 +72,7 @@ def test_projection_round_trip_with_distortion() -> None:
 def test_pinhole_closed_form() -> None:
     # looking straight down, no distortion: u = cx + f * dx / dz along the image axes
     cam = CameraModel(CameraParams(position_m=(0.0, 0.0, 4.0), yaw_rad=0.0, focal_px=500.0,
-                                   principal_point_px=(320.0, 240.0), resolution_px=(640, 480)))  # fmt: skip
+                                   principal_point_px=(320.0, 240.0), resolution_px=(640, 480)))
     u, v = cam.project_xy(np.array([1.0, 0.5]), 0.0)
     assert u == pytest.approx(320.0 + 500.0 * 1.0 / 4.0)
     assert v == pytest.approx(240.0 - 500.0 * 0.5 / 4.0)  # v runs along field -y

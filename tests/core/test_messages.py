@@ -31,15 +31,15 @@ DET = DetectionFrame(
     balls=(BallDetection(0.5, -0.25, 0.9, (100.5, 200.25)), BallDetection(-1.0, 2.0, 0.4, (5.0, 6.0), 0.004)),
     robots=(RobotDetection("blue", 3, 1.0, 2.0, 0.5, 0.99, (10.0, 20.0)),
             RobotDetection("yellow", 15, -1.0, -2.0, -3.0, 0.5, (30.0, 40.0))),
-)  # fmt: skip
+)
 WORLD = WorldState(
     t=1.5, ball=BallState(0.1, 0.2, 1.0, -1.0, True),
     robots=(RobotState("blue", 0, 1.0, 1.0, 0.1, 0.5, 0.25, 1.0, True), RobotState("yellow", 7, -1.0, 0.0, 3.0)),
-)  # fmt: skip
+)
 TRUTH = GroundTruth(
     frame_number=9, t=0.15, ball=BallTruth(0.0, 0.1, 0.0215, 1.0, 0.0, 0.0, {0: (10.0, 20.0, 0.75)}),
     robots=(RobotTruth("blue", 1, 1.0, 2.0, 0.3, 0.1, 0.2, 0.3, {0: (5.0, 6.0), 1: (7.0, 8.0)}),),
-)  # fmt: skip
+)
 COMMAND = RobotCommand("yellow", 4, 1.0, -0.5, 2.0, 3.5, True, 0.5)
 GAME = GameState(3.0, "free_kick", "yellow", 2, 1, False, (1.0, -2.8))
 # everything the league's Referee message carries: a placement for blue, a card running for yellow
@@ -98,7 +98,7 @@ def test_nan_survives_json_as_null() -> None:
         {"camera_id": 0, "t_capture": 0.0},
         {"camera_id": 0, "frame_number": 1, "t_capture": "soon"},
     ],
-)  # fmt: skip
+)
 def test_bad_dicts_raise_message_error(bad: dict[str, object]) -> None:
     with pytest.raises(MessageError):
         DetectionFrame.from_dict(bad)

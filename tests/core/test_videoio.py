@@ -55,7 +55,7 @@ def test_h264_round_trip_is_close_and_420(tmp_path: Path, name: str, crf: int, m
     assert max(err) < max_mean_err  # grey levels, mean over the frame (4:2:0 alone costs ~2.3 on this texture)
     # no colour cast: the mean of the frame keeps its grey level (FFmpeg's own scaler loses ~2)
     bias = np.mean([g.astype(float).mean(axis=(0, 1)) - i.mean(axis=(0, 1))
-                    for (_, g), i in zip(got, imgs, strict=True)], axis=0)  # fmt: skip
+                    for (_, g), i in zip(got, imgs, strict=True)], axis=0)
     assert np.all(np.abs(bias) < 0.5)
 
 

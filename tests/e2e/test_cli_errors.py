@@ -67,7 +67,7 @@ CASES = [
 
 @pytest.mark.parametrize(("argv", "words"), CASES, ids=[" ".join(c[0]) for c in CASES])
 def test_bad_input_one_line_exit_2(argv: list[str], words: list[str], tmp_path: Path, a_file: Path,
-                                   capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
+                                   capsys: pytest.CaptureFixture[str]) -> None:
     argv = [a.format(file=a_file, tmp=tmp_path) for a in argv]
     code, out, err = run([*argv, "--no-progress"] if argv[0] in ("play", "sim") else argv, capsys)
     assert code == 2
@@ -78,12 +78,12 @@ def test_bad_input_one_line_exit_2(argv: list[str], words: list[str], tmp_path: 
 
 
 def test_a_served_port_in_use_is_one_line_and_nothing_written(tmp_path: Path,
-                                                              capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
+                                                              capsys: pytest.CaptureFixture[str]) -> None:
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as held:
         held.bind(("127.0.0.1", 0))
         port = held.getsockname()[1]
         code, _, err = run(["sim", "--serve", "--seconds", "0.1", "--out", str(tmp_path / "s"), "--no-progress",
-                            "--set", f"protocols.simulation.control_port={port}"], capsys)  # fmt: skip
+                            "--set", f"protocols.simulation.control_port={port}"], capsys)
     assert code == 2
     line = one_line(err)
     assert "cannot open its sockets" in line and str(port) in line and "--set protocols.simulation" in line
@@ -92,7 +92,7 @@ def test_a_served_port_in_use_is_one_line_and_nothing_written(tmp_path: Path,
 
 def test_snapshot_checked_before_the_run(tmp_path: Path, a_file: Path, capsys: pytest.CaptureFixture[str]) -> None:
     code, _, _ = run(["sim", "--seconds", "0.2", "--snapshot", f"{a_file}/x.png", "--out", str(tmp_path / "s"),
-                      "--no-progress"], capsys)  # fmt: skip
+                      "--no-progress"], capsys)
     assert code == 2
     assert not (tmp_path / "s").exists()  # nothing made: the run never started
 
@@ -101,7 +101,7 @@ def test_snapshot_checked_before_the_run(tmp_path: Path, a_file: Path, capsys: p
 def test_out_refuses_another_run_unless_overwrite(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "run"
     argv = ["play", "--seconds", "0.2", "--perception", "truth", "--opponent", "none", "--no-progress", "--out",
-            str(out)]  # fmt: skip
+            str(out)]
     assert run(argv, capsys)[0] == 0
     (out / "notes.txt").write_text("mine\n")
     first = json.loads((out / "summary.json").read_text())
@@ -144,7 +144,7 @@ def test_a_truth_file_cut_mid_line_keeps_the_frames_before(tmp_path: Path, capsy
 
 @pytest.mark.slow
 def test_more_sources_than_cameras_is_one_line_before_any_work(tmp_path: Path,
-                                                               capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
+                                                               capsys: pytest.CaptureFixture[str]) -> None:
     rec = _recording(tmp_path)
     frames = [str(rec / "camera_0"), str(rec / "camera_1"), str(rec / "camera_0")]
     capsys.readouterr()
@@ -163,7 +163,7 @@ def test_a_distributed_play_on_a_taken_router_port_says_so(tmp_path: Path, capsy
         port = taken.getsockname()[1]
         router = f"runtime.zenoh.router=tcp/127.0.0.1:{port}"
         code, _, err = run(["play", "--distributed", "--perception", "truth", "--seconds", "1", "--out",
-                            str(tmp_path / "run"), "--set", router], capsys)  # fmt: skip
+                            str(tmp_path / "run"), "--set", router], capsys)
     assert code == 2
     assert err.strip().count("\n") == 0
     assert f"cannot listen on tcp/127.0.0.1:{port}" in err and "runtime.zenoh.router" in err
@@ -183,7 +183,7 @@ def test_a_run_log_without_a_message_does_not_block_the_folder(tmp_path: Path, c
         data = (out / "run.mcap").read_bytes()
         (out / "run.mcap").write_bytes(data[: len(data) // 2])
     argv = ["play", "--seconds", "0.2", "--perception", "truth", "--opponent", "none", "--no-progress", "--out",
-            str(out)]  # fmt: skip
+            str(out)]
     code, stdout, err = run(argv, capsys)
     assert code == 0, err
     assert json.loads((out / "summary.json").read_text())["seconds"] > 0
@@ -195,7 +195,7 @@ def test_a_run_log_without_a_message_does_not_block_the_folder(tmp_path: Path, c
 
 @pytest.mark.parametrize("content", [b"hello, not a video\n", bytes(range(256)) * 20], ids=["text", "garbage"])
 def test_a_file_that_is_no_video_is_one_line_exit_2(tmp_path: Path, content: bytes,
-                                                    capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
+                                                    capsys: pytest.CaptureFixture[str]) -> None:
     video = tmp_path / "camera.mp4"
     video.write_bytes(content)
     code, out, err = run(["vision", str(video), "--out", str(tmp_path / "out"), "--no-progress"], capsys)
@@ -236,7 +236,7 @@ def test_each_commands_set_example_is_a_key_it_reads(capsys: pytest.CaptureFixtu
     from cmdragons.runtime.settings import load_settings
 
     fits = {"sim": "sim.", "play": "strategy.", "vision": "vision.", "bench": "planner.", "node": "runtime.",
-            "replay": "runtime.", "vision calibrate": "cameras.", "vision tune": "vision."}  # fmt: skip
+            "replay": "runtime.", "vision calibrate": "cameras.", "vision tune": "vision."}
     for command, concern in fits.items():
         try:
             code, out, _ = run([*command.split(), "-h"], capsys)

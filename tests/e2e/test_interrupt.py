@@ -20,7 +20,7 @@ ROOT = Path(__file__).resolve().parents[2]
 
 def start(args: list[str]) -> subprocess.Popen[str]:
     return subprocess.Popen([sys.executable, "-m", "cmdragons.cli", *args], cwd=ROOT, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)  # fmt: skip
+                            stderr=subprocess.PIPE, text=True)
 
 
 def wait_for_frames(path: Path, child: subprocess.Popen[str]) -> None:
@@ -51,7 +51,7 @@ def mcap_messages(path: Path) -> int:
 def test_play_interrupted_keeps_everything(tmp_path: Path, sig: signal.Signals) -> None:
     out = tmp_path / "run"
     child = start(["play", "--seconds", "600", "--perception", "truth", "--video", "--no-progress", "--out",
-                   str(out)])  # fmt: skip
+                   str(out)])
     wait_for_frames(out / "run.mcap", child)
     child.send_signal(sig)
     stdout, stderr = child.communicate(timeout=300)
@@ -95,7 +95,7 @@ def test_the_served_simulator_runs_until_interrupted_and_keeps_everything(tmp_pa
                    "--set", f"protocols.simulation.vision_port={vision}", "--set", f"protocols.referee.port={referee}",
                    "--set", f"protocols.simulation.control_port={control}",
                    "--set", f"protocols.simulation.blue_port={blue}",
-                   "--set", f"protocols.simulation.yellow_port={yellow}"])  # fmt: skip
+                   "--set", f"protocols.simulation.yellow_port={yellow}"])
     wait_for_frames(out / "run.mcap", child)
     child.send_signal(signal.SIGINT)
     stdout, stderr = child.communicate(timeout=300)

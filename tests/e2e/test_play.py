@@ -44,7 +44,7 @@ def test_play_cli_writes_the_summary(tmp_path: Path) -> None:
     summary = json.loads((out / "summary.json").read_text())
     assert {"score", "shots", "passes", "collisions", "cycle_ms", "seconds", "seed"} <= set(summary)
     assert set(summary["score"]) == {"blue", "yellow"}
-    assert set(summary["passes"]) == {"tried", "completed"}
+    assert set(summary["passes"]) == {"tried", "completed", "ends", "list"}  # (each pass recorded, and how it ended)
     assert set(summary["collisions"]) == {"own", "own_pushed", "opponent"}
     assert {"brain", "vision", "tracker"} <= set(summary["cycle_ms"])
     assert (out / "match.mp4").stat().st_size > 0 and (out / "run.mcap").stat().st_size > 0

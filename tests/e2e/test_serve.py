@@ -36,7 +36,7 @@ def test_a_two_process_match_scores_and_restarts(tmp_path: Path) -> None:
     vision_port, referee_port, control, blue, yellow = free_udp_ports(5)
     sets = [f"protocols.simulation.vision_port={vision_port}", f"protocols.referee.port={referee_port}",
             f"protocols.simulation.control_port={control}", f"protocols.simulation.blue_port={blue}",
-            f"protocols.simulation.yellow_port={yellow}"]  # fmt: skip
+            f"protocols.simulation.yellow_port={yellow}"]
     p = load_settings(None, sets).protocols
     vision = MulticastReceiver(p.vision.group, vision_port, p.interface, p.receive_buffer_bytes)
     referee = MulticastReceiver(p.referee.group, referee_port, p.interface, p.receive_buffer_bytes)
@@ -45,7 +45,7 @@ def test_a_two_process_match_scores_and_restarts(tmp_path: Path) -> None:
     # --seconds bounds the match: the test stops it once the restart came
     server = subprocess.Popen([sys.executable, "-m", "cmdragons.cli", "sim", "--serve", "--seconds", "60",
                                "--no-progress", "--out", str(out), *(f"--set={s}" for s in sets)],
-                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)  # fmt: skip
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     reader = RefereeReader()
     states: list[GameState] = []
     geometry: VisionGeometry | None = None
@@ -73,7 +73,7 @@ def test_a_two_process_match_scores_and_restarts(tmp_path: Path) -> None:
                     m = sim_pb.SimulatorCommand()
                     m.control.teleport_robot.add(id=trk_pb.RobotId(id=KICKER, team=trk_pb.BLUE),
                                                  x=ball[0] - back * math.cos(aim), y=ball[1] - back * math.sin(aim),
-                                                 orientation=aim, present=True)  # fmt: skip
+                                                 orientation=aim, present=True)
                     client.send_to(m.SerializeToString(), ("127.0.0.1", control))
                     teleported = True
                 elif game.ready:  # the normal start: forward, the kicker armed

@@ -19,7 +19,7 @@ def test_sim_record_reads_back(tmp_path: Path, fmt: str) -> None:
     out = tmp_path / "run"
     snap = tmp_path / "snap.png"
     assert main(["sim", "--seconds", "2", "--record", "--format", fmt, "--out", str(out), "--snapshot", str(snap),
-                 "--no-progress"]) == 0  # fmt: skip
+                 "--no-progress"]) == 0
     rec = RecordingReader(out)
     truth = list(rec.truth())
     assert len(truth) == 120
@@ -49,7 +49,7 @@ def test_sim_record_reads_back(tmp_path: Path, fmt: str) -> None:
 def test_same_seed_same_run(tmp_path: Path) -> None:
     for name in ("a", "b"):
         assert main(["sim", "--seconds", "0.5", "--record", "--format", "png", "--out", str(tmp_path / name),
-                     "--no-progress", "--seed", "5"]) == 0  # fmt: skip
+                     "--no-progress", "--seed", "5"]) == 0
     a, b = RecordingReader(tmp_path / "a"), RecordingReader(tmp_path / "b")
     assert (tmp_path / "a" / "truth.jsonl").read_bytes() == (tmp_path / "b" / "truth.jsonl").read_bytes()
     assert (tmp_path / "a" / "run.mcap").read_bytes() == (tmp_path / "b" / "run.mcap").read_bytes()
@@ -57,7 +57,7 @@ def test_same_seed_same_run(tmp_path: Path) -> None:
         for fa, fb in zip(a.frames(cam), b.frames(cam), strict=True):
             assert np.array_equal(fa, fb)
     assert main(["sim", "--seconds", "0.5", "--record", "--format", "png", "--out", str(tmp_path / "c"),
-                 "--no-progress", "--seed", "6"]) == 0  # fmt: skip
+                 "--no-progress", "--seed", "6"]) == 0
     c = RecordingReader(tmp_path / "c")
     assert not np.array_equal(next(a.frames(0)), next(c.frames(0)))
 

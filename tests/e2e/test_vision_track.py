@@ -23,7 +23,7 @@ def test_offline_tracks_are_estimates_at_capture_time_that_beat_raw_detections(t
     rec = tmp_path / "rec"
     assert main(["sim", "--seconds", "2", "--record", "--format", "png", "--out", str(rec), "--no-progress"]) == 0
     truth = {t.frame_number: t for t in (GroundTruth.from_dict(json.loads(line))
-                                         for line in (rec / "truth.jsonl").read_text().splitlines())}  # fmt: skip
+                                         for line in (rec / "truth.jsonl").read_text().splitlines())}
     errors: dict[str, dict[str, list[float]]] = {}
     for name, extra in (("capture", []), ("ahead", ["--track-ahead"])):
         out = tmp_path / name
@@ -41,7 +41,7 @@ def test_offline_tracks_are_estimates_at_capture_time_that_beat_raw_detections(t
                 err["ball"].append(math.hypot(world.ball.x - t.ball.x, world.ball.y - t.ball.y))
             true = {(r.team, r.id): r for r in t.robots}
             err["robot"] += [math.hypot(r.x - true[(r.team, r.id)].x, r.y - true[(r.team, r.id)].y)
-                             for r in world.robots]  # fmt: skip
+                             for r in world.robots]
         errors[name] = err
         if name == "capture":
             raw: dict[str, list[float]] = {"ball": [], "robot": []}
@@ -54,7 +54,7 @@ def test_offline_tracks_are_estimates_at_capture_time_that_beat_raw_detections(t
                     raw["ball"] += [math.hypot(b.x - t.ball.x, b.y - t.ball.y) for b in det.balls]
                 true = {(r.team, r.id): r for r in t.robots}
                 raw["robot"] += [math.hypot(r.x - true[(r.team, r.id)].x, r.y - true[(r.team, r.id)].y)
-                                 for r in det.robots]  # fmt: skip
+                                 for r in det.robots]
     cap, ahead, raw_rms = errors["capture"], errors["ahead"], {k: _rms(v) for k, v in raw.items()}
     assert len(cap["ball"]) > 90 and len(cap["robot"]) > 1000
     # the estimate at capture time beats the raw detections against the truth of that instant

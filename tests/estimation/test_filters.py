@@ -152,14 +152,14 @@ def test_ekf_slam_maps_the_landmarks_and_keeps_the_pose_consistent() -> None:
     # the map's shape: distances between landmarks (the absolute frame carries the start's error)
     pairs = [(i, j) for i in seen for j in seen if i < j]
     shape = [abs(math.dist(slam.landmark(i), slam.landmark(j)) - math.dist(run.landmarks[i], run.landmarks[j]))
-             for i, j in pairs]  # fmt: skip
+             for i, j in pairs]
     assert float(np.median(shape)) < 0.1
     assert math.dist(slam.pose[:2], run.truth[-1][:2]) < 0.5
     # one run: the pose's NEES averaged over time near its dimension, 3
     assert 1.0 < float(np.mean(nees_values)) < 6.0
     # the landmarks' own covariances say how far off they are (2 dof, averaged over the map)
     lm_nees = [float(e @ np.linalg.solve(slam.landmark_cov(i), e))
-               for i, e in ((i, slam.landmark(i) - run.landmarks[i]) for i in seen)]  # fmt: skip
+               for i, e in ((i, slam.landmark(i) - run.landmarks[i]) for i in seen)]
     assert 0.5 < float(np.mean(lm_nees)) < 5.0
 
 
@@ -195,7 +195,7 @@ def test_the_regularised_particle_filter_is_consistent_on_the_bench_s_run() -> N
         x0 = run.truth[0] + np.random.default_rng(seed).multivariate_normal(np.zeros(3), START_COV)
         for share in means:
             pf = ParticleLocalisation(run.landmarks, x0, START_COV, run.sensor_cov, n=500, seed=seed,
-                                      bandwidth_share=share)  # fmt: skip
+                                      bandwidth_share=share)
             values, errors = [], []
             for k in range(len(run.odometry)):
                 pf.step(run.odometry[k], run.odometry_cov, run.sightings[k])
@@ -232,7 +232,7 @@ def test_the_kernels_normal_deviates_are_standard_normal() -> None:
 
 
 @pytest.mark.parametrize("cov", [np.diag([4e-4, 0.0, 2.5e-5]), np.zeros((3, 3)),
-                                 np.array([[2.0, 0.5, 0.1], [0.5, 1.0, 0.2], [0.1, 0.2, 0.5]])])  # fmt: skip
+                                 np.array([[2.0, 0.5, 0.1], [0.5, 1.0, 0.2], [0.1, 0.2, 0.5]])])
 def test_the_semi_definite_factor_reproduces_its_covariance(cov: np.ndarray) -> None:
     from cmdragons.estimation import _kernels as K
 
@@ -322,7 +322,7 @@ def test_the_branch_free_systematic_resampling_picks_as_a_search_of_the_cumulati
     rng = np.random.default_rng(7)
     n = 400
     w = {"random": rng.random(n), "one": np.eye(n)[123], "first_and_last": np.eye(n)[0] + np.eye(n)[-1],
-         "sparse": rng.random(n) * (rng.random(n) < 0.05)}[kind]  # fmt: skip
+         "sparse": rng.random(n) * (rng.random(n) < 0.05)}[kind]
     w = w / w.sum()
     cloud = np.ascontiguousarray(np.vstack([np.arange(n, dtype=np.float64)] * 5))  # each particle's row: its index
     out = np.empty_like(cloud)

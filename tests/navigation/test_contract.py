@@ -32,10 +32,10 @@ CASES = [
 
 
 def drive(name: str, start: tuple[float, float, float], path: list[tuple[float, float]], heading: float,
-          seconds: float) -> tuple[World, list[RobotCommand], list[np.ndarray]]:  # fmt: skip
+          seconds: float) -> tuple[World, list[RobotCommand], list[np.ndarray]]:
     """Run navigator ``name`` in the simulator for ``seconds``: the world, its commands, the states."""
     w = World(LeagueParams(), PhysicsParams(), RobotParams(command_latency_s=0.0), BallParams(), KickerParams(),
-              DribblerParams(), robots_per_team={"blue": 1, "yellow": 0})  # fmt: skip
+              DribblerParams(), robots_per_team={"blue": 1, "yellow": 0})
     w.place_ball(0.0, 3.1)
     w.place_robot("blue", 0, *start)
     nav = make_navigator(name, TeamParams().navigator_sections, CONTROL, RADIUS)

@@ -41,7 +41,7 @@ U_TRAP = np.array([(0.5, -0.8, 0.6, 0.8), (-0.6, 0.7, 0.6, 0.8), (-0.6, -0.8, 0.
 
 def run(nav_name: str, world_at: Callable[[int], CollisionWorld], start: tuple[float, float],
         goal: tuple[float, float], seconds: float, team: TeamParams | None = None
-        ) -> tuple[np.ndarray, list[NavStatus], object]:  # fmt: skip
+        ) -> tuple[np.ndarray, list[NavStatus], object]:
     """Drive ``nav_name`` kinematically: the robot's positions (k, 2), statuses, the navigator."""
     nav = make_navigator(nav_name, (team or TeamParams()).navigator_sections, CONTROL, RADIUS)
     nav.set_plan(np.array([start, goal]), Arrival(0.0))
@@ -126,7 +126,7 @@ def reachable(world: CollisionWorld, start: tuple[float, float], goal: tuple[flo
 
 # seeds 17, 33 and 58 have gaps narrower than the level line's band that the range sensor sees through
 @pytest.mark.parametrize(("name", "seed"), [("bug2", s) for s in range(6)]
-                         + [("tangent_bug", s) for s in (*range(6), 17, 33, 58)])  # fmt: skip
+                         + [("tangent_bug", s) for s in (*range(6), 17, 33, 58)])
 def test_a_bug_method_reaches_the_goal_of_any_finite_obstacle_field(name: str, seed: int) -> None:
     world = random_field(seed)
     start, goal = (-2.5, 0.0), (2.5, 0.0)
@@ -260,9 +260,9 @@ def test_potential_gradient_is_the_potential_s_gradient() -> None:
             _, ex, ey = PK.potential(cw.obs, cw.inner, x, y, 2.0, 0.5, 0.0, 0.0, cfg)
             h = 1e-6
             fx = (PK.potential(cw.obs, cw.inner, x + h, y, 2.0, 0.5, 0.0, 0.0, cfg)[0]
-                  - PK.potential(cw.obs, cw.inner, x - h, y, 2.0, 0.5, 0.0, 0.0, cfg)[0]) / (2 * h)  # fmt: skip
+                  - PK.potential(cw.obs, cw.inner, x - h, y, 2.0, 0.5, 0.0, 0.0, cfg)[0]) / (2 * h)
             fy = (PK.potential(cw.obs, cw.inner, x, y + h, 2.0, 0.5, 0.0, 0.0, cfg)[0]
-                  - PK.potential(cw.obs, cw.inner, x, y - h, 2.0, 0.5, 0.0, 0.0, cfg)[0]) / (2 * h)  # fmt: skip
+                  - PK.potential(cw.obs, cw.inner, x, y - h, 2.0, 0.5, 0.0, 0.0, cfg)[0]) / (2 * h)
             if abs(fx - ex) + abs(fy - ey) > 1e-4 * (1.0 + abs(ex) + abs(ey)):
                 # a kink: where the nearest part of a box switches, or a source's influence ends
                 continue
@@ -381,7 +381,7 @@ def test_polar_histogram_counts_the_cells_inside_discs_and_boxes() -> None:
             beta = math.atan2(y - py, x - px)
             gam = math.asin(min(1.0, enlarge / r)) if enlarge > 0.0 else 0.0
             for s in range(int(math.floor((beta - gam + math.pi) / (2 * math.pi / 72))),
-                           int(math.floor((beta + gam + math.pi) / (2 * math.pi / 72))) + 1):  # fmt: skip
+                           int(math.floor((beta + gam + math.pi) / (2 * math.pi / 72))) + 1):
                 ref[s % 72] += 1.0 - r / 1.0
         assert np.allclose(VK.polar_histogram(cw.obs, cw.inner, px, py, cfg), ref, atol=1e-9)
         assert ref[int((math.pi + math.pi) / (2 * math.pi / 72)) % 72] > 1.0  # the box at -x is in it

@@ -43,7 +43,7 @@ class ToyNavigator:
 
     @classmethod
     def configure(cls, name: str, sections: Mapping[str, Any], control: ControlParams, robot_radius_m: float,
-                  collision: CollisionParams) -> ToyNavigator:  # fmt: skip
+                  collision: CollisionParams) -> ToyNavigator:
         nav = cls(sections["toy"])
         cls.built.append(nav)
         return nav
@@ -119,7 +119,7 @@ def test_a_registered_navigator_reads_its_own_section_of_the_team_config() -> No
      ({"toy": {"sped_m_s": 1.0}}, "toy.sped_m_s", "unknown key; allowed keys: slow_within_m, speed_m_s"),
      ({"toys": {}}, "toys", "did you mean toy?"),
      ({"navigator": "magic"}, "navigator", "allowed: 'trajectory'")],
-)  # fmt: skip
+)
 def test_config_errors_name_the_file_the_key_and_what_is_allowed(raw: dict[str, Any], key: str, message: str) -> None:
     with pytest.raises(ConfigError) as err:
         parse(TeamParams, raw, file="team.yaml")

@@ -32,11 +32,11 @@ MARGIN = TeamParams().navigator_sections["dynamic_window"].margin_m
 
 
 def run(obstacle_path: list[tuple[float, float]], plan: list[tuple[float, float]], seconds: float) -> tuple[
-        np.ndarray, np.ndarray, RoboxNavigator]:  # fmt: skip
+        np.ndarray, np.ndarray, RoboxNavigator]:
     """Drive blue 0 from the plan's start with the robox navigator while yellow 0 is placed along
     ``obstacle_path`` (one point a frame, the last held): our positions and the obstacle's (n, 2)."""
     w = World(LeagueParams(), PhysicsParams(), RobotParams(command_latency_s=0.0), BallParams(), KickerParams(),
-              DribblerParams(), robots_per_team={"blue": 1, "yellow": 1})  # fmt: skip
+              DribblerParams(), robots_per_team={"blue": 1, "yellow": 1})
     w.place_ball(0.0, 3.1)
     w.place_robot("blue", 0, *plan[0], 0.0)
     nav = make_navigator("robox", TeamParams().navigator_sections, CONTROL, RADIUS)

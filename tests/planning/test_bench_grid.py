@@ -29,7 +29,7 @@ def test_the_grid_bench_runs_on_a_users_maps(tmp_path: Path, capsys) -> None:  #
     free = rng.random((40, 60)) > 0.15
     cells = np.argwhere(free)
     pairs = [((int(a[1]), int(a[0])), (int(b[1]), int(b[0])))
-             for a, b in (cells[rng.integers(len(cells), size=2)] for _ in range(12))]  # fmt: skip
+             for a, b in (cells[rng.integers(len(cells), size=2)] for _ in range(12))]
     write_map(tmp_path, "small", free, pairs)
     out = tmp_path / "rows.json"
     assert main(["bench", "grid", "--quick", "--maps", str(tmp_path), "--json", str(out)]) == 0

@@ -126,7 +126,7 @@ def test_deadline_is_kept(name: str, field: Field) -> None:
     # a hard scene (a ring closed around the goal) and no work budget: only the deadline stops it
     params = PlannerParams()
     params = type(params)(errt=type(params.errt)(bidirectional=False),
-                          prm=type(params.prm)(n_nodes=50, max_nodes=10**6, grow_nodes=5))  # fmt: skip
+                          prm=type(params.prm)(n_nodes=50, max_nodes=10**6, grow_nodes=5))
     world = field_world(field, ring((1.0, 0.5), 0.45, 16))
     prob = problem(world, (-3.0, -1.0), (1.0, 0.5))
     planner = make_planner(params, name=name)

@@ -128,7 +128,7 @@ def test_estar_repair_equals_recomputation_cell_for_cell(seed: int, neighbours: 
         # a robot-sized blob appears, moves or goes; some cells change their weight
         r, c = int(rng.integers(h)), int(rng.integers(w))
         blob = np.array([(r + dr, c + dc) for dr in range(-2, 3) for dc in range(-2, 3)
-                         if 0 <= r + dr < h and 0 <= c + dc < w and (r + dr, c + dc) != goal])  # fmt: skip
+                         if 0 <= r + dr < h and 0 <= c + dc < w and (r + dr, c + dc) != goal])
         new = np.full(len(blob), np.inf) if rng.random() < 0.6 else 1.0 + 3.0 * rng.random(len(blob))
         e.set_costs(blob, new)
         cost[blob[:, 0], blob[:, 1]] = new

@@ -116,7 +116,7 @@ def test_clearance_grid_matches_brute_force_distances(field: Field, window_s: fl
     xs, ys = grid.centres()
     x0, y0, x1, y1 = field_world(field).bounds
     assert grid.values.shape == (len(ys), len(xs)) == (int(np.ceil((y1 - y0) / 0.1 - 1e-9)),
-                                                       int(np.ceil((x1 - x0) / 0.1 - 1e-9)))  # fmt: skip
+                                                       int(np.ceil((x1 - x0) / 0.1 - 1e-9)))
     assert xs[0] == pytest.approx(x0 + 0.05) and ys[0] == pytest.approx(y0 + 0.05)
     pts = np.array([(x, y) for y in ys for x in xs])
     inner = cw.inner

@@ -37,7 +37,7 @@ def _table(passive: bool, place_by: str = "teleport") -> list[str]:
     (True, "teleport", {WORLD, PASSIVE + "referee", PASSIVE + "referee/events", PASSIVE + "teleport"}),
     (False, "teleport", {WORLD, "referee", "referee/events", "teleport"}),
     (False, "robots", {WORLD, "referee", "referee/events"}),
-])  # fmt: skip
+])
 def test_the_autoref_rows_fit_a_match_table(passive: bool, place_by: str, written: set[str]) -> None:
     # (its tracker also says what it measured of the physics, as every tracker does)
     assert {t for t in _table(passive, place_by) if not t.startswith("summary/")} == written | {"physics/autoref"}
@@ -53,7 +53,7 @@ def test_a_game_controller_referees_in_place_of_the_autoref() -> None:
 def test_calls_pair_by_kind_team_and_window() -> None:
     truth = [Call(1.0, "goal", "blue"), Call(5.0, "crash", "yellow"), Call(9.0, "ball_out", "blue")]
     seen = [Call(1.1, "goal", "blue"), Call(5.0, "crash", "blue"), Call(9.0 + WINDOW_S + 0.1, "ball_out", "blue"),
-            Call(12.0, "pushing", "blue")]  # fmt: skip
+            Call(12.0, "pushing", "blue")]
     assert match_calls(truth, seen) == [(truth[0], seen[0])]
     table = {r["name"]: r for r in rows(truth, seen)}
     assert table["goal"]["matched_share"] == 1.0

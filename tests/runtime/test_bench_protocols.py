@@ -12,6 +12,6 @@ def test_every_kind_of_packet_crosses_loopback_and_none_is_lost() -> None:
     rows = _packet_rows(load_settings(), 256)
     names = [r["name"] for r in rows]
     assert names == ["ssl_vision_detections_2_cameras", "ssl_vision_geometry", "tracker_packet", "referee",
-                     "grsim_commands", "robot_control", "simulator_command"]  # fmt: skip
+                     "grsim_commands", "robot_control", "simulator_command"]
     for r in rows:
         assert r["packets"] == 256 and r["lost"] == 0 and r["packets_per_s"] > 0 and r["bytes"] > 0, r

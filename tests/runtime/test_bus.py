@@ -29,7 +29,7 @@ SETTINGS = load_settings(CONFIGS)
     ("pattern", "topic", "match"),
     [("world/blue", "world/blue", True), ("world/blue", "world/yellow", False), ("detections/*", "detections/1", True),
      ("detections/*", "detections", False), ("camera/*", "camera/0/frame", True), ("*", "anything/at/all", True)],
-)  # fmt: skip
+)
 def test_topic_patterns(pattern: str, topic: str, match: bool) -> None:
     assert topic_matches(pattern, topic) is match
 
@@ -78,7 +78,7 @@ def test_settings_and_every_message_pickle() -> None:
     m.summary()
     kinds = {type(x) for x in seen}
     assert {msg.CameraFrame, msg.GroundTruth, msg.DetectionFrame, msg.WorldState, msg.TeamCommands, msg.TeamReport,
-            msg.SimEvents, msg.GameState, msg.StageSummary, msg.Tick} <= kinds  # fmt: skip
+            msg.SimEvents, msg.GameState, msg.StageSummary, msg.Tick} <= kinds
     for x in seen:
         data = pickle.dumps(x)
         back = pickle.loads(data)
@@ -112,7 +112,7 @@ def test_the_log_holds_every_topic_each_readable_as_its_message(tmp_path: Path) 
     path = _play(tmp_path, 5.0, seed=2, images=True)
     types = {"truth": msg.GroundTruth, "referee": msg.GameState, "events": msg.SimEvents, "teleport": msg.Teleport,
              "world": msg.WorldState, "commands": msg.TeamCommands, "report": msg.TeamReport,
-             "detections": msg.DetectionFrame, "camera": msg.CameraFrame, "summary": msg.StageSummary}  # fmt: skip
+             "detections": msg.DetectionFrame, "camera": msg.CameraFrame, "summary": msg.StageSummary}
     counts: dict[str, int] = {}
     with path.open("rb") as f:  # every channel has its protobuf schema: decoded from the file alone
         reader = make_reader(f, decoder_factories=[DecoderFactory()])
@@ -124,7 +124,7 @@ def test_the_log_holds_every_topic_each_readable_as_its_message(tmp_path: Path) 
     frames = 5 * 60
     cams = [m.id for m in SMALL.camera_models()]
     for topic in ["/truth", "/events", "/world/blue", "/commands/blue", "/commands/yellow", "/report/blue",
-                  *(f"/detections/{c}" for c in cams), *(f"/camera/{c}/frame" for c in cams)]:  # fmt: skip
+                  *(f"/detections/{c}" for c in cams), *(f"/camera/{c}/frame" for c in cams)]:
         assert counts.get(topic) == frames, topic
     assert counts["/referee"] == frames + 1  # the referee's first word comes before the first frame
     assert counts["/teleport"] >= 1  # the kickoff formation

@@ -26,7 +26,7 @@ ROOT = Path(__file__).resolve().parents[2]
 
 @pytest.mark.parametrize(("opponent", "perception"), [("simple", "truth"), ("defend", "truth"), ("self", "vision")])
 def test_every_topic_published_is_declared_and_every_declared_one_is_published(opponent: str,
-                                                                                perception: str) -> None:  # fmt: skip
+                                                                                perception: str) -> None:
     seen: dict[str, set[type]] = {}
     tap = Tap("every", ("*",), lambda topic, m: seen.setdefault(topic, set()).add(type(m)))
     match = Match(SETTINGS, opponent, perception, seed=1, extra=[tap])  # type: ignore[arg-type]
@@ -74,7 +74,7 @@ def test_a_topic_written_with_another_type_is_refused_naming_both_stages() -> No
     writer = Contract("vision/0", (), (Port("detections/0", DetectionFrame),))
     reader = Contract("tracker/blue", (Port("detections/0", WorldState),))
     with pytest.raises(WiringError, match=r"'tracker/blue' reads topic 'detections/0' as WorldState, but stage "
-                                          r"'vision/0' writes 'detections/0' as DetectionFrame"):  # fmt: skip
+                                          r"'vision/0' writes 'detections/0' as DetectionFrame"):
         check_wiring([writer, reader])
     with pytest.raises(WiringError, match=r"'detections/0'.*'vision/1'.*'vision/0'"):
         check_wiring([writer, Contract("vision/1", (), (Port("detections/0", Tick),))])
@@ -207,7 +207,7 @@ def test_the_vision_command_is_a_table_of_declared_stages_fed_by_its_sources(tmp
         cv2.imwrite(str(tmp_path / f"cam{cam}.png"), np.zeros((m.height, m.width, 3), np.uint8))
     sources, _ = open_sources([str(tmp_path / f"cam{cam}.png") for cam in range(len(models))])
     table = vision_wiring(list(zip(sources, models, strict=True)), SETTINGS.vision, SETTINGS.field, tmp_path,
-                          io.StringIO(), {}, video=False, overlay=True, fps=60.0)  # fmt: skip
+                          io.StringIO(), {}, video=False, overlay=True, fps=60.0)
     assert [e.contract.name for e in table] == [f"vision/{m.id}" for m in models] + ["vision_out"]
     with pytest.raises(WiringError, match=r"'vision/0' reads topic 'camera/0/frame'"):
         build(table)

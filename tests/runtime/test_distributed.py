@@ -68,7 +68,7 @@ def test_lock_step_nodes_play_the_embedded_match(router: Any, perception: Any, v
     settings = dataclasses.replace(base, runtime=dataclasses.replace(router, vision_with_sim=vision_with_sim))
     embedded: list[Any] = []
     m = Match(settings, "simple", perception, seed=SEED,
-              extra=[Tap("rec", ("commands/*", "referee"), lambda t, x: embedded.append((t, x)))])  # fmt: skip
+              extra=[Tap("rec", ("commands/*", "referee"), lambda t, x: embedded.append((t, x)))])
     expected = m.run(SECONDS)
     spec = MatchSpec(settings, "simple", perception, m.seed)
     roles = spec.roles(log=False)
@@ -79,7 +79,7 @@ def test_lock_step_nodes_play_the_embedded_match(router: Any, perception: Any, v
     clock = ZenohTransport(router, "sim")
     try:
         summary = run_clock(spec, clock, SECONDS, roles,
-                            extra=[Tap("rec", ("commands/*", "referee"), lambda t, x: got.append((t, x)))])  # fmt: skip
+                            extra=[Tap("rec", ("commands/*", "referee"), lambda t, x: got.append((t, x)))])
     finally:
         stop.set()
         for th in threads:
@@ -124,7 +124,7 @@ def _team_process(router: Any) -> subprocess.Popen[bytes]:
     """``cmdragons node team`` as its own process on the test's router."""
     return subprocess.Popen([sys.executable, "-m", "cmdragons.cli", "node", "team", "--perception", "truth",
                              "--seed", str(SEED), "--set", f"runtime.zenoh.router={router.zenoh.router}",
-                             "--set", f"runtime.field_name={router.field_name}"], cwd=ROOT)  # fmt: skip
+                             "--set", f"runtime.field_name={router.field_name}"], cwd=ROOT)
 
 
 def _until(done: Callable[[], bool], what: str, timeout_s: float = 120.0) -> None:
@@ -153,7 +153,7 @@ def test_a_killed_team_node_rejoins_and_the_match_goes_on(router: Any) -> None:
     enough = threading.Event()  # the restarted node answered long enough: end the match
     clock = ZenohTransport(settings.runtime, "sim")
     taps = [Tap("rec:commands", ("commands/blue",), lambda _t, c: commands.append(c.frame_number)),
-            Tap("rec:truth", ("truth",), lambda _t, g: frames.append(g.frame_number))]  # fmt: skip
+            Tap("rec:truth", ("truth",), lambda _t, g: frames.append(g.frame_number))]
     result: dict[str, Any] = {}
 
     def match() -> None:
@@ -195,7 +195,7 @@ def _first_moving_frame(truth: list[Any], team: str, speed_m_s: float) -> int | 
     """The first frame of the simulator's truth in which a robot of ``team`` moves faster than
     ``speed_m_s``."""
     return next((g.frame_number for g in truth if any(math.hypot(r.vx, r.vy) > speed_m_s for r in g.robots
-                                                      if r.team == team)), None)  # fmt: skip
+                                                      if r.team == team)), None)
 
 
 # free-running: our robots may start this many frames later than in lock-step (a quarter second:
@@ -211,7 +211,7 @@ def test_free_running_real_time_steps_every_frame_and_our_robots_drive_at_once(r
     settings = dataclasses.replace(SETTINGS, runtime=router)
     lockstep: list[Any] = []
     Match(settings, "simple", "truth", seed=SEED, extra=[Tap("rec", ("truth",), lambda _t, g: lockstep.append(g))]
-          ).run(SECONDS)  # fmt: skip
+          ).run(SECONDS)
     starts = _first_moving_frame(lockstep, "blue", 0.1)
     assert starts is not None  # the reference: when our robots drive in lock-step
     spec = MatchSpec(settings, "simple", "truth", SEED)
@@ -222,7 +222,7 @@ def test_free_running_real_time_steps_every_frame_and_our_robots_drive_at_once(r
     truth: list[Any] = []
     clock = ZenohTransport(router, "sim")
     taps = [Tap("rec:commands", ("commands/*",), lambda _t, c: commands.append(c)),
-            Tap("rec:truth", ("truth",), lambda _t, g: truth.append(g))]  # fmt: skip
+            Tap("rec:truth", ("truth",), lambda _t, g: truth.append(g))]
     try:
         summary = run_clock(spec, clock, SECONDS, roles, realtime=True, extra=taps)
     finally:
@@ -259,7 +259,7 @@ def test_a_node_without_a_clock_says_so_and_not_while_the_clock_waits_for_others
         clock.subscribe("control/*", lambda _t, c, heard=heard: heard.append(c.node))
         enough = lambda heard=heard: len(heard) >= 12  # noqa: E731
         runner = threading.Thread(target=run_node, args=("referee", spec, node),
-                                  kwargs={"err": err, "should_stop": enough}, daemon=True)  # fmt: skip
+                                  kwargs={"err": err, "should_stop": enough}, daemon=True)
         try:
             runner.start()
             while runner.is_alive():  # the node says it is ready four times a second: 3 s in all
@@ -292,7 +292,7 @@ def test_the_frame_paths_nodes_go_on_the_real_time_scheduler_only_when_set(prior
     for the nodes off the frame path; on, the process runs SCHED_FIFO at the priority, or, where the
     system does not allow it, keeps the normal scheduler and says why in one line."""
     out = subprocess.run([sys.executable, "-c", _SCHEDULER_PROBE.format(priority=priority, role=role)], cwd=ROOT,
-                         capture_output=True, text=True, check=True).stdout.split(maxsplit=2)  # fmt: skip
+                         capture_output=True, text=True, check=True).stdout.split(maxsplit=2)
     fifo, level, note = out[0] == "True", int(out[1]), out[2].strip()
     if priority == 0 or role not in ("sim", "vision", "team"):
         assert (fifo, note) == (False, "None")
@@ -327,7 +327,7 @@ def test_the_frame_paths_nodes_hold_a_cpu_latency_request_only_when_set(us: int,
     the frame path; on, the kernel's target is at most the request while the process runs, or,
     where the device may not be opened, the node says why in one line."""
     out = subprocess.run([sys.executable, "-c", _CPU_LATENCY_PROBE.format(us=us, role=role)], cwd=ROOT,
-                         capture_output=True, text=True, check=True).stdout.split(maxsplit=2)  # fmt: skip
+                         capture_output=True, text=True, check=True).stdout.split(maxsplit=2)
     before, during, note = out[0], out[1], out[2].strip()
     if us < 0 or role not in ("sim", "vision", "team"):
         assert (during, note) == (before, "None")

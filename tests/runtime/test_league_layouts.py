@@ -72,12 +72,12 @@ def _schema(tmp: Path, name: str, text: str) -> Path:
 
 def _decode(schema: Path, message: str, data: bytes) -> subprocess.CompletedProcess[str]:
     return subprocess.run(["protoc", f"-I{schema.parent}", f"--decode={message}", schema.name], input=data.decode(
-        "latin-1"), capture_output=True, check=True, text=True, encoding="latin-1")  # fmt: skip
+        "latin-1"), capture_output=True, check=True, text=True, encoding="latin-1")
 
 
 def _encode(schema: Path, message: str, text: str) -> bytes:
     out = subprocess.run(["protoc", f"-I{schema.parent}", f"--encode={message}", schema.name], input=text.encode(),
-                         capture_output=True, check=True)  # fmt: skip
+                         capture_output=True, check=True)
     return out.stdout
 
 
@@ -97,14 +97,14 @@ def test_our_robot_control_response_is_the_leagues_current_layout(tmp_path: Path
 def test_answers_in_the_current_and_the_earlier_layout_are_both_read(tmp_path: Path) -> None:
     now = _encode(_schema(tmp_path, "now.proto", SIMULATION_NOW), "RobotControlResponse",
                   'errors { code: "VELOCITY_TYPE" message: "global velocity" } '
-                  'feedback { id: 7 dribbler_ball_contact: false } feedback { id: 2 }')  # fmt: skip
+                  'feedback { id: 7 dribbler_ball_contact: false } feedback { id: 2 }')
     answer = read_robot_control_response(now)
     assert answer.feedback == (Feedback(7, False), Feedback(2, None))
     assert answer.errors == (SimError("VELOCITY_TYPE", "global velocity"),) and not answer.earlier_layout
     earlier = _encode(_schema(tmp_path, "earlier.proto", SIMULATION_EARLIER), "RobotControlResponse",
                       'errors { code: "unsupported" message: "wheels" '
                       'unsupported_capability: SIMULATOR_CAPABILITY_MOVE_WHEEL_VELOCITY } '
-                      'feedback { id { id: 5 team: BLUE } dribbler_ball_contact: true }')  # fmt: skip
+                      'feedback { id { id: 5 team: BLUE } dribbler_ball_contact: true }')
     answer = read_robot_control_response(earlier)
     assert answer.feedback == (Feedback(5, True),) and answer.earlier_layout and answer.unnamed == 0
     assert answer.errors == (SimError("unsupported", "wheels (SIMULATOR_CAPABILITY_MOVE_WHEEL_VELOCITY)"),)
@@ -155,7 +155,7 @@ LENSES = [((-0.02, 0.0), 0.4, 0.1), ((-0.08, 0.01), 1.1, 0.3), ((0.0, 0.0), 1e-3
 
 @pytest.mark.parametrize("lens, max_px, rms_px", LENSES)
 def test_our_calibrations_project_through_ssl_visions_model_as_through_ours(lens: tuple[float, float], max_px: float,
-                                                                           rms_px: float) -> None:  # fmt: skip
+                                                                           rms_px: float) -> None:
     k1, k2 = lens
     settings = load_settings(None, [f"cameras.auto.k1={k1}", f"cameras.auto.k2={k2}"])
     cams = settings.camera_models()
@@ -179,10 +179,10 @@ def test_an_ssl_vision_calibration_reads_as_our_lens_model(distortion: float, ma
     t = -base.R_cam_to_field.T @ base.center * 1000.0
     wrapper = wrap_pb.SSL_WrapperPacket()
     wrapper.geometry.field.CopyFrom(wrap_pb.SSL_WrapperPacket.FromString(
-        geometry_packet(load_settings().field_geometry(), [base])).geometry.field)  # fmt: skip
+        geometry_packet(load_settings().field_geometry(), [base])).geometry.field)
     cal = wrapper.geometry.calib.add(camera_id=3, focal_length=base.f, principal_point_x=511.5, principal_point_y=383.5,
                                      distortion=distortion, q0=q[0], q1=q[1], q2=q[2], q3=q[3], tx=t[0], ty=t[1],
-                                     tz=t[2], pixel_image_width=base.width, pixel_image_height=base.height)  # fmt: skip
+                                     tz=t[2], pixel_image_width=base.width, pixel_image_height=base.height)
     _, geo = decode_wrapper(wrapper.SerializeToString())
     assert geo is not None
     read = geo.cameras[0]
@@ -250,7 +250,7 @@ def test_a_league_simulator_answers_our_commands_with_the_robots_id(name: str) -
     if not (binary.exists() and (PEERS / script).exists()):
         pytest.skip(f"{name}: its binary ({binary}) and network-namespace script ({PEERS / script}) are needed")
     out = subprocess.run([str(PEERS / script), sys.executable, "-c", PROBE], capture_output=True, text=True,
-                         timeout=180, check=True).stdout  # fmt: skip
+                         timeout=180, check=True).stdout
     local, global_velocity, again = json.loads(out.strip().splitlines()[-1])
     assert local == [[3], [], False] and again == [[3], [], False]
     assert global_velocity[1:] == global_answer[1:]
@@ -264,7 +264,7 @@ def test_a_live_receiver_takes_a_senders_clock_from_its_first_packet() -> None:
         stage = VisionInStage(load_settings().protocols, [0], lockstep=False, receiver=queue)
         w = wrap_pb.SSL_WrapperPacket()
         w.detection.frame_number, w.detection.t_capture, w.detection.t_sent, w.detection.camera_id = 1, first_t, \
-            first_t, 0  # fmt: skip
+            first_t, 0
         queue.push(w.SerializeToString())
         got: list[Any] = []
         stage.on_message("clock", Tick(0), lambda _t, d, got=got: got.append(d))

@@ -199,15 +199,15 @@ def test_two_processes_play_our_team_in_the_served_simulator_as_in_any_league_si
     vision, referee, control, blue, yellow = free_udp_ports(5)
     sets = [f"protocols.simulation.vision_port={vision}", f"protocols.referee.port={referee}",
             f"protocols.simulation.control_port={control}", f"protocols.simulation.blue_port={blue}",
-            f"protocols.simulation.yellow_port={yellow}", "protocols.referee.source=game_controller"]  # fmt: skip
+            f"protocols.simulation.yellow_port={yellow}", "protocols.referee.source=game_controller"]
     flags = [x for k in sets for x in ("--set", k)]
     served = subprocess.Popen(_cmdragons("sim", "--serve", "--seconds", 120, "--no-progress", "--seed", 3,
                                          "--out", tmp_path / "served", *flags),
-                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)  # fmt: skip
+                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
         ours = subprocess.run(_cmdragons("play", "--simulator", "sim-protocol", "--seconds", 12, "--no-progress",
                                          "--out", tmp_path / "ours", *flags),
-                              capture_output=True, text=True, timeout=240)  # fmt: skip
+                              capture_output=True, text=True, timeout=240)
     finally:
         served.send_signal(signal.SIGINT)
         served_out, _ = served.communicate(timeout=60)
@@ -228,16 +228,16 @@ def test_two_processes_play_our_team_in_the_served_simulator_as_in_any_league_si
             continue
         true = {(r.team, r.id): (r.x, r.y) for r in g.robots}
         err += [math.hypot(r.x - true[r.team, r.id][0], r.y - true[r.team, r.id][1]) for r in w.robots
-                if r.visible and (r.team, r.id) in true]  # fmt: skip
+                if r.visible and (r.team, r.id) in true]
     assert len(err) > 1000 and float(np.percentile(err, 95)) < 0.08
     # blue went for the ball and played it
     frames = sorted(truth)
     first, last = truth[frames[0]], truth[frames[-1]]
     ball_path = sum(math.hypot(truth[b].ball.x - truth[a].ball.x, truth[b].ball.y - truth[a].ball.y)
-                    for a, b in itertools.pairwise(frames))  # fmt: skip
+                    for a, b in itertools.pairwise(frames))
     start = {r.id: (r.x, r.y) for r in first.robots if r.team == "blue"}
     moved = max(math.hypot(r.x - start[r.id][0], r.y - start[r.id][1]) for r in last.robots
-                if r.team == "blue" and r.id in start)  # fmt: skip
+                if r.team == "blue" and r.id in start)
     assert ball_path > 1.0 and moved > 0.5
 
 
@@ -252,7 +252,7 @@ def _grsim_netns() -> str | None:
 
 @pytest.mark.slow
 @pytest.mark.skipif(_grsim_netns() is None, reason="no grSim: set GRSIM_NETNS to a script that runs grSim in a "
-                    "network namespace of its own with a command beside it (and GRSIM to its binary)")  # fmt: skip
+                    "network namespace of its own with a command beside it (and GRSIM to its binary)")
 def test_our_team_plays_in_grsim(tmp_path: Path) -> None:
     """grSim's Division B: four cameras learnt, its field played on, our team refereed by our
     autoref on the tracked world moves the ball."""
@@ -260,11 +260,11 @@ def test_our_team_plays_in_grsim(tmp_path: Path) -> None:
     assert script is not None
     done = subprocess.run([script, "--division", "B", *_cmdragons("play", "--simulator", "grsim", "--seconds", 20,
                                                                    "--no-progress", "--out", tmp_path / "ours")],
-                          capture_output=True, text=True, timeout=300)  # fmt: skip
+                          capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr + done.stdout
     summary = json.loads((tmp_path / "ours" / "summary.json").read_text())
     assert summary["cameras"] == [0, 1, 2, 3] and summary["field_m"] == [9.0, 6.0] and summary["division"] == "B"
     assert summary["seconds"] >= 20.0 and summary["frames"] > 300
     balls = [(w.ball.x, w.ball.y) for _topic, _t, w in read_log(tmp_path / "ours" / "run.mcap", {"/world/blue"})
-             if w.ball is not None]  # fmt: skip
+             if w.ball is not None]
     assert sum(math.dist(a, b) for a, b in itertools.pairwise(balls)) > 1.0

@@ -32,7 +32,7 @@ def test_the_example_client_plays_yellow_over_zenoh(router: Any) -> None:  # noq
 
     client = subprocess.Popen([sys.executable, str(ROOT / "examples" / "outside_team.py"), "--router",
                                router.zenoh.router, "--field", router.field_name], stdout=subprocess.PIPE,
-                              stderr=subprocess.PIPE, text=True)  # fmt: skip
+                              stderr=subprocess.PIPE, text=True)
     spec = MatchSpec(dataclasses.replace(SETTINGS, runtime=router), "outside", "truth", 3)
     roles = node_roles("outside", log=False)
     assert "opponent" not in roles

@@ -22,18 +22,18 @@ TARGET = (2.0, 0.0)
 
 
 def scripted_pass(receiver_at: tuple[float, float], opponent_at: tuple[float, float],
-                  kick_m_s: float) -> tuple[PassRecord, list[GroundTruth]]:  # fmt: skip
+                  kick_m_s: float) -> tuple[PassRecord, list[GroundTruth]]:
     """Blue 0 at the centre kicks along +x at ``kick_m_s`` toward ``TARGET``, blue 1 waiting at
     ``receiver_at`` facing it with its dribbler on, yellow 0 standing at ``opponent_at``; the
     record of that pass and the true frames."""
     w = World(LEAGUE, PhysicsParams(), RobotParams(), BallParams(), KickerParams(), DribblerParams(),
-              robots_per_team={"blue": 2, "yellow": 1})  # fmt: skip
+              robots_per_team={"blue": 2, "yellow": 1})
     w.place_robot("blue", 0, 0.0, 0.0, 0.0)
     w.place_robot("blue", 1, *receiver_at, math.pi)
     w.place_robot("yellow", 0, *opponent_at, math.pi)
     w.place_ball(FRONT + 0.003, 0.0)
     recorder = PassRecorder("blue", Field(LEAGUE), LEAGUE.robot, LEAGUE.ball.radius_m, SkillParams().ball_model,
-                            PassRecordParams(), timeout_s=3.0)  # fmt: skip
+                            PassRecordParams(), timeout_s=3.0)
     frames: list[GroundTruth] = []
     for n in range(300):
         gt = w.ground_truth()
@@ -42,9 +42,9 @@ def scripted_pass(receiver_at: tuple[float, float], opponent_at: tuple[float, fl
         if recorder.records:
             break
         recorder.report(TeamReport("blue", n, gt.t, actions={0: KickPurpose.PASS},
-                                   passing=PassReport(0, 1, TARGET, kicked=n > 0)))  # fmt: skip
+                                   passing=PassReport(0, 1, TARGET, kicked=n > 0)))
         commands = [RobotCommand("blue", 0, kick_speed=kick_m_s if n < 5 else 0.0),
-                    RobotCommand("blue", 1, dribbler=1.0)]  # fmt: skip
+                    RobotCommand("blue", 1, dribbler=1.0)]
         for e in w.step_frame(commands):
             if isinstance(e, Kick):
                 recorder.kick(e, KickPurpose.PASS, gt)

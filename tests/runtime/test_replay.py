@@ -52,7 +52,7 @@ class Clock:
 
 @pytest.mark.parametrize(("start_s", "speed"), [(0.0, 1.0), (0.5, 2.5)])
 def test_every_message_comes_in_log_order_at_its_time_over_the_speed(match_log: Path, start_s: float,
-                                                                     speed: float) -> None:  # fmt: skip
+                                                                     speed: float) -> None:
     transport = InProcessTransport()
     clock = Clock()
     got: list[tuple[str, Any, float]] = []
@@ -115,9 +115,9 @@ def test_a_team_node_plays_against_a_replay_over_zenoh(match_log: Path) -> None:
     (lambda p: p / "absent.mcap", [], "no such file"),
     (lambda p: (p / "text.mcap").write_text("hello") and p / "text.mcap", [], "not an MCAP log"),
     (None, ["--from", "99"], "beyond the log's end"),
-])  # fmt: skip
+])
 def test_bad_input_is_one_line_and_exit_code_2(match_log: Path, tmp_path: Path, make: Any, extra: list[str],
-                                               says: str, capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
+                                               says: str, capsys: pytest.CaptureFixture[str]) -> None:
     path = match_log if make is None else make(tmp_path)
     assert main(["replay", str(path), *extra, "--no-progress"]) == 2
     err = capsys.readouterr().err
@@ -129,7 +129,7 @@ def test_the_command_replays_a_log_as_its_own_router(match_log: Path, capsys: py
 
     router = f"runtime.zenoh.router=tcp/127.0.0.1:{free_port()}"
     assert main(["replay", str(match_log), "--router", "--set", router, "--speed", "8", "--from", "0.5",
-                 "--skip", "commands/*", "--no-progress"]) == 0  # fmt: skip
+                 "--skip", "commands/*", "--no-progress"]) == 0
     out = capsys.readouterr().out
     start = next(iter(read_log(match_log)))[1] + 0.5
     expected = 1 + len(logged(match_log, replay_topics(match_log, ["commands/*"]), start))  # the state, then on

@@ -38,12 +38,12 @@ def write_log(path: Path, frames: int, ball_visible_every: int, robot_1_visible:
         for i in range(frames):
             t = i / 60
             robots = tuple(RobotTruth("blue", k, -1.0 + k, 0.0, 0.0, 0.0, 0.0, 0.0) for k in (0, 1)) + (
-                RobotTruth("yellow", 0, 2.0, 0.5, 0.0, 0.0, 0.0, 0.0),)  # fmt: skip
+                RobotTruth("yellow", 0, 2.0, 0.5, 0.0, 0.0, 0.0, 0.0),)
             ball_truth = BallTruth(-0.9 + 0.01 * i, 0.0, 0.0215, 0.0, 0.0)
             log.write("/truth", t, GroundTruth(i, t, ball_truth, robots))
             log.write("/referee", t, GameState(t, score_blue=int(i > frames // 2)))
             seen = (RobotState("blue", 0, -1.0, 0.0, 0.0),) + ((RobotState("blue", 1, 0.0, 0.0, 0.0),)
-                                                               if robot_1_visible else ())  # fmt: skip
+                                                               if robot_1_visible else ())
             visible = i % ball_visible_every == 0
             ball = BallState(0.0, 0.0, 0.0, 0.0, visible=visible) if visible or hidden else None
             log.write("/world/blue", t, WorldState(t, ball, seen, i))
@@ -94,7 +94,7 @@ def test_report_png_is_one_page(tmp_path: Path) -> None:
                              "ball_s": 0.6, "receiver_s": None, "opponent_s": 0.9, "end": "late"}]},
         "realtime_factor": 1.2, "compile_seconds": 0.0,
         "cycle_ms": {"vision": {"median": 1.5, "p95": 2.0}, "brain": {"median": 2.0, "p95": 4.0}},
-    }))  # fmt: skip
+    }))
     path = write_report(load_run(tmp_path / "run.mcap"), summary, tmp_path / "report.png")
     img = cv2.imread(str(path))
     assert img is not None and img.shape == (1400, 1400, 3)
@@ -115,18 +115,18 @@ def test_the_report_stage_gathers_what_the_log_reads_back(tmp_path: Path) -> Non
     for key, trace in live.traces.items():
         np.testing.assert_array_equal(trace, back.traces[key])
     assert (live.possession, live.kicks, live.goals, live.score_t) == (back.possession, back.kicks, back.goals,
-                                                                       back.score_t)  # fmt: skip
+                                                                       back.score_t)
     assert (live.ball_seen, live.ball_tracked, live.robot_seen) == (back.ball_seen, back.ball_tracked, back.robot_seen)
     assert live.kicks  # the match kicked: the comparison covers the kick events
 
 
 @pytest.mark.parametrize(("side", "scorer"), [(-1.0, "blue"), (1.0, "yellow")])
 def test_a_goal_after_half_time_is_the_scorers_in_summary_report_and_log(tmp_path: Path, side: float,
-                                                                         scorer: str) -> None:  # fmt: skip
+                                                                         scorer: str) -> None:
     # halves of 1 s: blue defends -x in the first, +x in the second (the sides change); in the second
     # the ball is rolled into the goal at x of sign ``side``, away from every robot
     settings = load_settings(Path(__file__).resolve().parents[2] / "configs",
-                             ["sim.referee.figures.half_s=1.0", "sim.referee.figures.half_time_s=0.5"])  # fmt: skip
+                             ["sim.referee.figures.half_s=1.0", "sim.referee.figures.half_time_s=0.5"])
     log = RunLog(tmp_path / "run.mcap")
     report = ReportStage("blue")
     match = Match(settings, "none", "truth", seed=1, extra=[LoggerStage(log), report])
@@ -141,7 +141,7 @@ def test_a_goal_after_half_time_is_the_scorers_in_summary_report_and_log(tmp_pat
     log.close()
     assert summary["score"] == {"blue": int(scorer == "blue"), "yellow": int(scorer == "yellow")}
     goals = [e for _topic, _t, ev in read_log(tmp_path / "run.mcap", {"/events"}) for e in ev.events
-             if isinstance(e, Goal)]  # fmt: skip
+             if isinstance(e, Goal)]
     assert [(g.scoring_team, math.copysign(1.0, g.x)) for g in goals] == [(scorer, side)]
     for run in (report.collector.result(), load_run(tmp_path / "run.mcap")):
         assert [g["scoring_team"] for g in run.goals] == [scorer]

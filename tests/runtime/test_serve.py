@@ -40,7 +40,7 @@ def _settings(division: str = "B", *extra: str) -> Settings:
                                 f"protocols.referee.port={referee}", f"protocols.simulation.control_port={control}",
                                 f"protocols.simulation.blue_port={blue}",
                                 f"protocols.simulation.yellow_port={yellow}", "protocols.serve.vision_noise=false",
-                                "sim.referee.rules=basic", *extra])  # fmt: skip
+                                "sim.referee.rules=basic", *extra])
 
 
 @dataclass
@@ -111,14 +111,14 @@ def _teleport(ball: tuple[float, float] | None = None, robots: tuple[Pose, ...] 
     m = sim_pb.SimulatorCommand()
     for team, rid, x, y, theta in robots:
         m.control.teleport_robot.add(id=trk_pb.RobotId(id=rid, team=team), x=x, y=y, orientation=theta,
-                                     present=present)  # fmt: skip
+                                     present=present)
     if ball is not None:
         m.control.teleport_ball.x, m.control.teleport_ball.y = ball
     return m.SerializeToString()  # type: ignore[no-any-return]
 
 
 def _control(rid: int, forward: float = 0.0, left: float = 0.0, angular: float = 0.0,
-             field_v: tuple[float, float] | None = None, dribbler_rpm: float = 0.0) -> bytes:  # fmt: skip
+             field_v: tuple[float, float] | None = None, dribbler_rpm: float = 0.0) -> bytes:
     m = ctl_pb.RobotControl()
     r = m.robot_commands.add(id=rid, dribbler_speed=dribbler_rpm)
     if field_v is None:
@@ -164,7 +164,7 @@ def test_teleports_place_the_ball_and_robots_in_the_served_vision() -> None:
         frames, _ = srv.seen()
         assert [(r.x, r.y) for f in frames.values() for r in f.robots if (r.team, r.id) == ("blue", 2)] and all(
             (r.x, r.y) == pytest.approx((0.5, 2.5), abs=MM) for f in frames.values() for r in f.robots
-            if (r.team, r.id) == ("blue", 2))  # fmt: skip
+            if (r.team, r.id) == ("blue", 2))
 
 
 @pytest.mark.parametrize("team", ["blue", "yellow"])
@@ -190,7 +190,7 @@ def test_robot_control_moves_a_robot_and_the_silent_team_stands(team: str) -> No
         back = srv.robot(team, 1)
         assert back.x - moved.x < -0.6 and (back.vx, back.vy) == pytest.approx((-1.0, 0.0), abs=0.05)
         still = {(r.team, r.id): math.dist((r.x, r.y), others[(r.team, r.id)]) for r in srv.truth[-1].robots
-                 if r.team == other}  # fmt: skip
+                 if r.team == other}
         assert len(still) == len(others) and max(still.values()) < 1e-6
         frames, _ = srv.seen()
         seen = [r for f in frames.values() for r in f.robots if (r.team, r.id) == (team, 1)]
@@ -204,7 +204,7 @@ def test_the_feedback_says_which_robot_has_the_ball_at_its_dribbler() -> None:
     with served(s) as srv:
         srv.tick(2)
         srv.send(_teleport((1.0 + front, 1.0), ((BLUE, 0, 1.0, 1.0, 0.0), (BLUE, 3, -1.0, -1.0, 0.0))),
-                 sim.control_port)  # fmt: skip
+                 sim.control_port)
         response = sim_pb.RobotControlResponse()
         m = ctl_pb.RobotControl()
         for rid in (0, 3):
@@ -228,7 +228,7 @@ def test_every_camera_of_the_division_is_served_with_its_geometry(division: str)
     assert (geometry.field_length_m, geometry.field_width_m, geometry.goal_width_m, geometry.goal_depth_m,
             geometry.penalty_area_depth_m, geometry.penalty_area_width_m, geometry.boundary_width_m) == pytest.approx(
         (dims.length_m, dims.width_m, dims.goal_width_m, dims.goal_depth_m, dims.defense_depth_m,
-         dims.defense_width_m, dims.boundary_width_m), abs=MM)  # fmt: skip
+         dims.defense_width_m, dims.boundary_width_m), abs=MM)
     assert sorted(c.camera_id for c in geometry.cameras) == [m.id for m in models]
     # every robot on the field is seen by some camera
     seen = {(r.team, r.id) for f in frames.values() for r in f.robots}
@@ -275,4 +275,4 @@ def test_the_served_sockets_stay_on_this_machine() -> None:
     assert (p.interface, p.ttl, p.network, p.simulation.address) == ("127.0.0.1", 0, False, "127.0.0.1")
     # where grSim and the ER-Force simulator speak: vision on 10020, commands and teleports on 10301/10302/10300
     assert (p.simulation.vision_port, p.simulation.control_port, p.simulation.blue_port,
-            p.simulation.yellow_port, p.referee.port) == (10020, 10300, 10301, 10302, 10003)  # fmt: skip
+            p.simulation.yellow_port, p.referee.port) == (10020, 10300, 10301, 10302, 10003)

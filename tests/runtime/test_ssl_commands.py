@@ -55,10 +55,10 @@ F32 = 1e-6  # the wire's 32-bit floats, relative
 WORLD = msg.WorldState(
     1.25, msg.BallState(0.5, -0.25, 1.5, -0.5, True),
     (msg.RobotState("blue", 3, 1.0, 2.0, 0.5, 0.1, -0.2, 0.3, True),
-     msg.RobotState("yellow", 15, -1.0, -2.0, -3.0, 0.0, 0.0, 0.0, False)), 77)  # fmt: skip
+     msg.RobotState("yellow", 15, -1.0, -2.0, -3.0, 0.0, 0.0, 0.0, False)), 77)
 COMMANDS = msg.TeamCommands("blue", 77, 1.25, (
     msg.RobotCommand("blue", 3, 1.0, -0.5, 0.25, 4.0, False, 0.0),
-    msg.RobotCommand("blue", 4, -0.3, 0.7, -1.0, 3.0, True, 0.5)))  # fmt: skip
+    msg.RobotCommand("blue", 4, -0.3, 0.7, -1.0, 3.0, True, 0.5)))
 HEADINGS = {3: 0.5, 4: -2.0}
 CHIP = math.radians(45.0)
 
@@ -66,7 +66,7 @@ CHIP = math.radians(45.0)
 def _protoc(schema: str, message: str, data: bytes) -> str:
     path = str((PROTO_DIR / schema).relative_to(ROOT))
     return subprocess.run(["protoc", f"-I{ROOT}", f"--decode=cmdragons.league.{message}", path], input=data,
-                          capture_output=True, check=True).stdout.decode()  # fmt: skip
+                          capture_output=True, check=True).stdout.decode()
 
 
 @pytest.mark.parametrize("theta", [0.0, 0.5, -2.0, math.pi])
@@ -95,7 +95,7 @@ def test_grsim_commands_round_trip_in_the_robots_frame() -> None:
         assert g.velangular == pytest.approx(c.omega, rel=F32)
         angle = CHIP if c.chip else 0.0
         assert (g.kickspeedx, g.kickspeedz) == pytest.approx((c.kick_speed * math.cos(angle),
-                                                              c.kick_speed * math.sin(angle)), rel=F32)  # fmt: skip
+                                                              c.kick_speed * math.sin(angle)), rel=F32)
 
 
 def test_robot_control_round_trips_through_our_reader() -> None:
@@ -103,13 +103,13 @@ def test_robot_control_round_trips_through_our_reader() -> None:
     m = ctl_pb.RobotControl()
     m.ParseFromString(data)
     assert not m.HasField("team") and all(r.move_command.WhichOneof("command") == "local_velocity"
-                                          for r in m.robot_commands)  # fmt: skip
+                                          for r in m.robot_commands)
     back = read_robot_control(data, "blue", HEADINGS, 10000.0)
     assert back.errors == ()
     for c, b in zip(COMMANDS.commands, back.commands, strict=True):
         assert (b.team, b.id, b.chip) == (c.team, c.id, c.chip)
         assert (b.vx, b.vy, b.omega, b.kick_speed, b.dribbler) == pytest.approx(
-            (c.vx, c.vy, c.omega, c.kick_speed, c.dribbler), abs=1e-6)  # fmt: skip
+            (c.vx, c.vy, c.omega, c.kick_speed, c.dribbler), abs=1e-6)
 
 
 def test_robot_control_with_wheel_velocities_is_refused_per_robot() -> None:
@@ -155,10 +155,10 @@ def test_every_message_sent_decodes_with_protoc() -> None:
     out = _protoc("ssl_simulator.proto", "SimulatorCommand", simulator_command_packet(tp))
     assert "teleport_ball" in out and "x: 0.25" in out and "team: YELLOW" in out and "present: true" in out
     out = _protoc("ssl_simulator.proto", "RobotControlResponse",
-                  robot_control_response([Feedback(3)], [SimError(UNSUPPORTED, "robot 4: no")]))  # fmt: skip
+                  robot_control_response([Feedback(3)], [SimError(UNSUPPORTED, "robot 4: no")]))
     assert "message: \"robot 4: no\"" in out and "feedback {\n  id: 3\n}" in out
     out = _protoc("ssl_simulator.proto", "SimulatorResponse",
-                  simulator_response([SimError(UNSUPPORTED, "config: not here")]))  # fmt: skip
+                  simulator_response([SimError(UNSUPPORTED, "config: not here")]))
     assert "message: \"config: not here\"" in out
 
 
@@ -193,11 +193,11 @@ def test_a_match_sends_our_commands_to_a_league_simulator(to: str) -> None:
     port_key = "grsim.port" if to == "grsim" else "simulation.blue_port"
     control = UdpEndpoint("127.0.0.1")
     settings = load_settings(None, [f"protocols.commands_to={to}", f"protocols.{port_key}={peer.port}",
-                                    f"protocols.simulation.control_port={control.port}"])  # fmt: skip
+                                    f"protocols.simulation.control_port={control.port}"])
     worlds: list[msg.WorldState] = []
     sent: list[msg.TeamCommands] = []
     extra = [Tap("w", ("world/blue", "commands/blue"),
-                 lambda t, m: (worlds if t.startswith("world") else sent).append(m))]  # fmt: skip
+                 lambda t, m: (worlds if t.startswith("world") else sent).append(m))]
     match = Match(settings, "simple", "truth", seed=1, extra=extra)
     try:
         packets: list[bytes] = []
@@ -223,7 +223,7 @@ def test_a_match_sends_our_commands_to_a_league_simulator(to: str) -> None:
             p = grsim_pb.grSim_Packet()
             p.ParseFromString(data)
             rows = [(g.id, *to_field(g.veltangent, g.velnormal, headings[g.id]), g.velangular)
-                    for g in p.commands.robot_commands]  # fmt: skip
+                    for g in p.commands.robot_commands]
         else:
             back = read_robot_control(data, "blue", headings, settings.protocols.simulation.dribbler_full_rpm)
             rows = [(c.id, c.vx, c.vy, c.omega) for c in back.commands]
@@ -244,7 +244,7 @@ def _outside_match(**extra: Any) -> tuple[Match, list[msg.GroundTruth], dict[str
     control, yellow = free_udp_ports(2)
     settings = load_settings(None, [f"protocols.simulation.control_port={control}",
                                     f"protocols.simulation.yellow_port={yellow}", "protocols.simulation.wait_s=0",
-                                    *(f"protocols.{k}={v}" for k, v in extra.items())])  # fmt: skip
+                                    *(f"protocols.{k}={v}" for k, v in extra.items())])
     truths: list[msg.GroundTruth] = []
     match = Match(settings, "simulation", "truth", seed=1, extra=[Tap("t", ("truth",), lambda _t, g: truths.append(g))])
     return match, truths, {"control": control, "yellow": yellow}
@@ -328,10 +328,10 @@ def test_garbage_and_cut_packets_to_our_simulator_are_counted_and_dropped() -> N
     g.vel_x, g.vel_y, g.vel_angular = 0.5, 0.0, 0.0
     good = m.SerializeToString()
     gt = msg.GroundTruth(0, 0.0, msg.BallTruth(0.0, 0.0, 0.0, 0.0, 0.0),
-                         (msg.RobotTruth("yellow", 1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),))  # fmt: skip
+                         (msg.RobotTruth("yellow", 1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),))
     try:
         for data, port in ((b"\xff\x13garbage", yellow), (good[:-2], yellow), (b"\x0a\xff\xff", control),
-                           (good, yellow)):  # fmt: skip
+                           (good, yellow)):
             client.send_to(data, ("127.0.0.1", port))
         out: list[tuple[str, Any]] = []
         time.sleep(0.1)  # loopback delivery
@@ -355,7 +355,7 @@ def test_the_example_client_plays_yellow_in_our_simulator_over_the_leagues_proto
                                     f"protocols.simulation.yellow_port={yellow}", "protocols.simulation.wait_s=1.0"])
     client = subprocess.Popen([sys.executable, str(root / "examples" / "simulation_team.py"), "--vision-port",
                                str(udp_port), "--port", str(yellow)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                              text=True)  # fmt: skip
+                              text=True)
     truths: list[msg.GroundTruth] = []
     match = None
     try:
@@ -386,7 +386,7 @@ def test_garbage_answers_to_our_commands_are_counted_and_dropped() -> None:
 
     sim_port, control = free_udp_ports(2)
     settings = load_settings(None, ["protocols.commands_to=simulation", f"protocols.simulation.blue_port={sim_port}",
-                                    f"protocols.simulation.control_port={control}"])  # fmt: skip
+                                    f"protocols.simulation.control_port={control}"])
     err = io.StringIO()
     stage = CommandsOutStage(settings.protocols, "blue", CHIP, err=err)
     stage.drops.interval_s = 0.0

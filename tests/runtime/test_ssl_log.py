@@ -20,7 +20,7 @@ from cmdragons.runtime.ssl.referee import referee_packet
 from cmdragons.runtime.ssl.vision import decode_wrapper, detection_packet
 
 RECORDS = [LogRecord(1_700_000_000_000_000_000 + i * 16_666_667, MessageType.VISION_2014,
-                     detection_packet(msg.DetectionFrame(i % 2, i, i / 60, i / 60))) for i in range(6)]  # fmt: skip
+                     detection_packet(msg.DetectionFrame(i % 2, i, i / 60, i / 60))) for i in range(6)]
 RECORDS.insert(3, LogRecord(RECORDS[2].receive_time_ns, MessageType.REFBOX_2013, referee_packet(msg.GameState(0.05))))
 
 
@@ -45,7 +45,7 @@ def test_a_log_written_reads_back(tmp_path: Path, name: str, index: bool) -> Non
         t_ns, kind, size = struct.unpack(">qii", raw[index_at: index_at + 16])
         assert (kind, size, index_at + 16 + size) == (MessageType.INDEX_2021, 8 * len(RECORDS) + 8 + 7, len(raw))
         assert struct.unpack(f">{len(RECORDS)}q", raw[index_at + 16: index_at + 16 + 8 * len(RECORDS)]) == \
-            tuple(reader.index)  # fmt: skip
+            tuple(reader.index)
     else:
         assert reader.index is None
 
@@ -103,7 +103,7 @@ def test_convert_a_match_log_to_a_league_log_and_back(tmp_path: Path, capsys: py
     games = [m for topic, _, m in read_log(mcap) if topic == "/referee"]
     back_games = [m for topic, _, m in read_log(back) if topic == "/referee/gc"]
     assert [(g.command, g.for_team, g.ready, g.score_blue) for g in games] == \
-        [(g.command, g.for_team, g.ready, g.score_blue) for g in back_games]  # fmt: skip
+        [(g.command, g.for_team, g.ready, g.score_blue) for g in back_games]
 
 
 def test_log_info_of_a_cut_log_says_so_in_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -29,7 +29,7 @@ FULL = msg.GameState(41.5, "ball_placement", "blue", 1, 0, True, (-2.0, 1.5), st
                      blue_team=msg.TeamInfo(fouls=2, goalkeeper=1, placement_failures=1, max_robots=6),
                      yellow_team=msg.TeamInfo(red_cards=1, yellow_cards=2, yellow_card_times_s=(75.5, 3.25), fouls=6,
                                               timeouts=3, timeout_time_s=120.0, can_place_ball=False,
-                                              max_robots=3))  # fmt: skip
+                                              max_robots=3))
 STATES = [
     FULL, msg.GameState(0.0), msg.GameState(0.0, "kickoff", "blue"),
     msg.GameState(3.1, "kickoff", "yellow", ready=False),
@@ -39,7 +39,7 @@ STATES = [
                                                                  next_for_team="yellow"),
     msg.GameState(10.0, "force_start", stage="post_game"), msg.GameState(11.0, "timeout", "yellow", stage="pre_game"),
     msg.GameState(12.0, "free_kick", "yellow", placement=(1.0, -2.8)),
-]  # fmt: skip
+]
 
 
 def _same(a: Any, b: Any) -> None:
@@ -82,7 +82,7 @@ def _gc(command: int, counter: int, t_s: float, **fields: Any) -> bytes:
     team = dict(name="x", score=0, red_cards=0, yellow_cards=0, timeouts=4, timeout_time=300_000_000, goalkeeper=0)
     m = R(packet_timestamp=round(t_s * 1e6), stage=fields.pop("stage", R.NORMAL_FIRST_HALF), command=command,
           command_counter=counter, command_timestamp=round(t_s * 1e6), yellow=R.TeamInfo(**team),
-          blue=R.TeamInfo(**team), **fields)  # fmt: skip
+          blue=R.TeamInfo(**team), **fields)
     return m.SerializeToString()  # type: ignore[no-any-return]
 
 
@@ -114,7 +114,7 @@ def _ball_at(x: float, y: float) -> msg.WorldState:
 
 @pytest.mark.parametrize("prepare_at", [(0.0, 0.0), None], ids=["prepare-says-the-spot", "no-spot-at-all"])
 def test_a_game_controllers_normal_start_without_designated_position_ends_when_the_ball_moves(
-        prepare_at: tuple[float, float] | None) -> None:  # fmt: skip
+        prepare_at: tuple[float, float] | None) -> None:
     """A game controller clears designated_position at NORMAL_START: the kickoff still ends by the
     ball moving the rules' ball-in-play distance (0.05 m) from its spot, and not before."""
     queue = DatagramQueue()
@@ -125,7 +125,7 @@ def test_a_game_controllers_normal_start_without_designated_position_ends_when_t
     queue.push(_gc(R.NORMAL_START, 3, 3.0))  # no designated position, no ball_in_play: the league's fields
     stage.on_message("clock", msg.Tick(0), lambda _t, g: states.append(g))
     assert [(g.command, g.ready, g.placement) for g in states] == [
-        ("kickoff", False, prepare_at), ("kickoff", True, None)]  # fmt: skip
+        ("kickoff", False, prepare_at), ("kickoff", True, None)]
     for x in (0.0, 0.02, 0.049):  # the ball resting on the mark, nudged less than 0.05 m
         stage.on_message("world/blue", _ball_at(x, 0.0), lambda _t, g: states.append(g))
     assert len(states) == 2
@@ -146,7 +146,7 @@ def test_garbage_and_cut_short_packets_are_message_errors(data: bytes) -> None:
 def test_referee_bytes_decode_with_protoc() -> None:
     schema = str((PROTO_DIR / "ssl_referee.proto").relative_to(ROOT))
     out = subprocess.run(["protoc", f"-I{ROOT}", "--decode=cmdragons.league.Referee", schema],
-                         input=referee_packet(FULL), capture_output=True, check=True).stdout.decode()  # fmt: skip
+                         input=referee_packet(FULL), capture_output=True, check=True).stdout.decode()
     for line in ("command: BALL_PLACEMENT_BLUE", "stage: NORMAL_SECOND_HALF", "x: -2000", "foul_counter: 6"):
         assert line in out, (line, out)
 
@@ -154,7 +154,7 @@ def test_referee_bytes_decode_with_protoc() -> None:
 @pytest.mark.slow
 def test_a_match_plays_to_our_referees_packets_over_loopback(udp_port: int) -> None:
     settings = load_settings(None, [f"protocols.referee.port={udp_port}", "protocols.referee.send=true",
-                                    "protocols.referee.source=game_controller"])  # fmt: skip
+                                    "protocols.referee.source=game_controller"])
     sent: list[msg.GameState] = []
     got: list[msg.GameState] = []
     taps = [Tap("sent", ("referee",), lambda _t, g: sent.append(g)),

@@ -52,7 +52,7 @@ def test_a_league_log_of_a_match_replays_to_the_same_tracks(match: tuple[Path, P
 
 
 def test_a_league_log_cut_mid_record_replays_to_its_last_whole_record(
-        match: tuple[Path, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
+        match: tuple[Path, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     mcap, league = match
     cut = tmp_path / "cut.log"
     data = league.read_bytes()
@@ -66,7 +66,7 @@ def test_a_league_log_cut_mid_record_replays_to_its_last_whole_record(
 
 
 def test_a_league_replay_refuses_the_zenoh_options_in_one_line(
-        match: tuple[Path, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
+        match: tuple[Path, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     _, league = match
     assert main(["replay", str(league), "--speed", "2", "--out", str(tmp_path / "x")]) == 2
     err = capsys.readouterr().err
@@ -89,7 +89,7 @@ def test_a_real_matchs_log_is_tracked_to_its_truth(tmp_path: Path) -> None:
             t = 0.2 + k / 60 + cam * 0.002
             robot = msg.RobotDetection("blue", 2, -1.0 + 0.5 * t, 0.3, 0.0, 0.9, (0.0, 0.0))
             det = msg.DetectionFrame(cam, counters[cam], t, t + 0.004, (msg.BallDetection(1.0, 0.0, 0.9, (0.0, 0.0)),),
-                                     (robot,))  # fmt: skip
+                                     (robot,))
             packet = wrap_pb.SSL_WrapperPacket.FromString(detection_packet(det, t0))
             packet.detection.ClearField("t_capture_camera")  # SSL-Vision's cameras have clocks of their own
             records.append(LogRecord(t0.to_unix_ns(t + 0.005), MessageType.VISION_2014, packet.SerializeToString()))
@@ -100,7 +100,7 @@ def test_a_real_matchs_log_is_tracked_to_its_truth(tmp_path: Path) -> None:
     worlds: list[msg.WorldState] = []
     games: list[msg.GameState] = []
     taps = (Tap("w", ("world/blue",), lambda _t, w: worlds.append(w)),
-            Tap("g", ("referee/gc",), lambda _t, g: games.append(g)))  # fmt: skip
+            Tap("g", ("referee/gc",), lambda _t, g: games.append(g)))
     result = replay_league_log(tmp_path / "real.log", load_settings(), extra=taps)
     assert result.cameras == [0, 1, 2, 3] and result.records == {"VISION_2014": 960, "REFBOX_2013": 40}
     assert result.figures["ssl/vision_in"]["dropped"] == {} and len(worlds) >= 950
@@ -148,7 +148,7 @@ def test_a_replay_plays_on_the_logs_geometry(tmp_path: Path) -> None:
     records = [LogRecord(epoch.to_unix_ns(0.0), MessageType.VISION_2014, geometry)]
     for k in range(30):  # a robot standing at x = 5.5 m: inside the 12 m field, past the 9 m field's boundary
         det = msg.DetectionFrame(0, k, k / 60, k / 60, (), (msg.RobotDetection("blue", 1, 5.5, 0.0, 0.0, 0.9,
-                                                                                (0.0, 0.0)),))  # fmt: skip
+                                                                                (0.0, 0.0)),))
         records.append(LogRecord(epoch.to_unix_ns(k / 60), MessageType.VISION_2014, detection_packet(det, epoch)))
     write_log(tmp_path / "a.log", records)
     write_log(tmp_path / "none.log", records[1:])
@@ -156,7 +156,7 @@ def test_a_replay_plays_on_the_logs_geometry(tmp_path: Path) -> None:
     config = load_settings()
     assert (config.field.dims.length_m, config.field.dims.width_m) == (9.0, 6.0)
     result = replay_league_log(tmp_path / "a.log", config, extra=(Tap("w", ("world/blue",), lambda _t, w:
-                                                                       worlds.append(w)),))  # fmt: skip
+                                                                       worlds.append(w)),))
     assert (result.field_m, result.field_from) == ((12.0, 9.0), "log")
     assert worlds and worlds[-1].robots[0].x == pytest.approx(5.5, abs=0.01)
     plain = replay_league_log(tmp_path / "none.log", config)
@@ -164,4 +164,4 @@ def test_a_replay_plays_on_the_logs_geometry(tmp_path: Path) -> None:
     dims = settings_on_geometry(config, decode_wrapper(geometry)[1]).field.dims  # type: ignore[arg-type]
     a = division_a.field.dims
     assert (dims.length_m, dims.width_m, dims.goal_width_m, dims.defense_width_m, dims.defense_depth_m) == \
-        (a.length_m, a.width_m, a.goal_width_m, a.defense_width_m, a.defense_depth_m)  # fmt: skip
+        (a.length_m, a.width_m, a.goal_width_m, a.defense_width_m, a.defense_depth_m)

@@ -37,7 +37,7 @@ DET = msg.DetectionFrame(
     (msg.BallDetection(0.5, -0.25, 0.9, (100.5, 200.25), 0.004),),
     (msg.RobotDetection("blue", 3, 1.0, 2.0, 0.5, 0.99, (10.0, 20.0)),
      msg.RobotDetection("yellow", 15, -1.0, -2.0, -3.0, 0.5, (30.0, 40.0))),
-)  # fmt: skip
+)
 
 
 EPOCH = UnixEpoch(1_764_000_000)  # a Unix time of 2025, in whole seconds
@@ -46,7 +46,7 @@ EPOCH = UnixEpoch(1_764_000_000)  # a Unix time of 2025, in whole seconds
 def _same(a: msg.DetectionFrame, b: msg.DetectionFrame) -> bool:
     """The same detections, times to the microsecond (they crossed the wire as Unix time)."""
     return dataclasses.replace(a, t_capture=b.t_capture, t_sent=b.t_sent) == b and \
-        abs(a.t_capture - b.t_capture) < 1e-6 and abs(a.t_sent - b.t_sent) < 1e-6  # fmt: skip
+        abs(a.t_capture - b.t_capture) < 1e-6 and abs(a.t_sent - b.t_sent) < 1e-6
 
 
 def _params(port: int, **extra: Any) -> ProtocolParams:
@@ -66,7 +66,7 @@ def test_the_defaults_are_the_leagues_and_stay_on_this_machine() -> None:
 
 
 @pytest.mark.parametrize("override", ["protocols.interface=10.1.2.3", "protocols.vision.group=10.0.0.1",
-                                      "protocols.grsim.address=192.168.1.5", "protocols.ttl=-1"])  # fmt: skip
+                                      "protocols.grsim.address=192.168.1.5", "protocols.ttl=-1"])
 def test_an_address_off_this_machine_or_a_bad_group_is_a_config_error(override: str) -> None:
     with pytest.raises(ConfigError):
         load_settings(None, [override])
@@ -130,9 +130,9 @@ def test_wrapper_bytes_decode_with_protoc_as_ssl_wrapper_packet() -> None:
     schema = str((PROTO_DIR / "ssl_wrapper.proto").relative_to(ROOT))
     for data, expect in ((detection_packet(DET), ["frame_number: 42", "robot_id: 15", "x: -1000"]),
                          (geometry_packet(settings.field_geometry(), settings.camera_models()),
-                          ["field_length: 9000", "name: \"CenterCircle\"", "camera_id: 1"])):  # fmt: skip
+                          ["field_length: 9000", "name: \"CenterCircle\"", "camera_id: 1"])):
         out = subprocess.run(["protoc", f"-I{ROOT}", "--decode=cmdragons.league.SSL_WrapperPacket", schema],
-                             input=data, capture_output=True, check=True).stdout.decode()  # fmt: skip
+                             input=data, capture_output=True, check=True).stdout.decode()
         for line in expect:
             assert line in out, (line, out)
 
@@ -146,7 +146,7 @@ def test_bad_packets_are_counted_and_dropped_with_a_line(udp_port: int) -> None:
     good = detection_packet(DET)
     try:
         for data in (b"\xff\x13garbage", good[: len(good) // 2], detection_packet(msg.DetectionFrame(7, 1, 0.0, 0.0)),
-                     good, good, detection_packet(msg.DetectionFrame(1, 41, 0.68, 0.68))):  # fmt: skip
+                     good, good, detection_packet(msg.DetectionFrame(1, 41, 0.68, 0.68))):
             tx.send(data)
         got: list[tuple[str, Any]] = []
         for _ in range(50):
@@ -168,7 +168,7 @@ def _worlds(settings_overrides: list[str], seconds: float) -> tuple[list[msg.Wor
     worlds: list[msg.WorldState] = []
     settings = load_settings(None, settings_overrides)
     match = Match(settings, "simple", "vision", seed=3, extra=[Tap("worlds", ("world/blue",),
-                                                                   lambda _t, w: worlds.append(w))])  # fmt: skip
+                                                                   lambda _t, w: worlds.append(w))])
     try:
         summary = match.run(seconds)
     finally:
@@ -181,7 +181,7 @@ def test_a_match_on_our_own_ssl_vision_packets_plays_as_the_in_process_one(udp_p
     seconds = 1.0
     direct, s0 = _worlds([], seconds)
     wired, s1 = _worlds([f"protocols.vision.port={udp_port}", "protocols.vision.send=true",
-                         "protocols.perception=ssl_vision"], seconds)  # fmt: skip
+                         "protocols.perception=ssl_vision"], seconds)
     frames = round(seconds * 60)
     assert len(direct) == frames and wired == direct  # every world state the same, to the bit
     assert s1["tracker"] == s0["tracker"] and s1["score"] == s0["score"]

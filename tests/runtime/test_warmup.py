@@ -30,7 +30,7 @@ def test_compile_watch_counts_each_compile_once() -> None:
 
 def test_a_fresh_cache_makes_every_play_kernel_cold(tmp_path: Path) -> None:
     code = "import json; from cmdragons.runtime.warmup import cold_kernels; " \
-           "print(json.dumps([cold_kernels(True), cold_kernels(False)]))"  # fmt: skip
+           "print(json.dumps([cold_kernels(True), cold_kernels(False)]))"
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}  # an empty cache, as on a fresh clone
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
     images, brain = json.loads(out.stdout)

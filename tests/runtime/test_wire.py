@@ -23,12 +23,12 @@ DET = msg.DetectionFrame(
     (msg.BallDetection(0.5, -0.25, 0.9, (100.5, 200.25)), msg.BallDetection(-1.0, 2.0, 0.4, (5.0, 6.0), 0.004)),
     (msg.RobotDetection("blue", 3, 1.0, 2.0, 0.5, 0.99, (10.0, 20.0)),
      msg.RobotDetection("yellow", 15, -1.0, -2.0, -3.0, 0.5, (30.0, 40.0))),
-)  # fmt: skip
+)
 WORLD = msg.WorldState(1.5, msg.BallState(0.1, 0.2, 1.0, -1.0, True),
                        (msg.RobotState("blue", 0, 1.0, 1.0, 0.1, 0.5, 0.25, 1.0, True),
-                        msg.RobotState("yellow", 7, -1.0, 0.0, 3.0, visible=False)), 17)  # fmt: skip
+                        msg.RobotState("yellow", 7, -1.0, 0.0, 3.0, visible=False)), 17)
 COMMANDS = msg.TeamCommands("yellow", 17, 1.5, (msg.RobotCommand("yellow", 4, 1.0, -0.5, 2.0, 3.5, True, 0.5),
-                                                msg.RobotCommand("yellow", 0)))  # fmt: skip
+                                                msg.RobotCommand("yellow", 0)))
 # messages whose wire form is exact (64-bit floats): they come back equal
 EXACT: list[Any] = [
     msg.GroundTruth(9, 0.15, msg.BallTruth(0.0, 0.1, 0.0215, 1.0, 0.0, 0.0, {0: (10.0, 20.0, 0.75)}),
@@ -65,7 +65,7 @@ REPORT = msg.TeamReport(
      msg.RobotReport(1, "halt", (0.0, 0.0, 0.0))),
     {0: msg.KickPurpose.PASS, 1: msg.KickPurpose.WAIT}, np.array([[1.0, 1.0], [2.0, -1.0]]), np.array([0.25, 0.75]),
     msg.PassReport(0, 1, (2.0, -1.0), (4.5, 0.25), kicked=True),
-)  # fmt: skip
+)
 REPORT_TRAP = msg.TeamReport("blue", 5, 0.08, passing=msg.PassReport(1, 0, (1.0, 1.0)))  # no one-touch aim
 
 

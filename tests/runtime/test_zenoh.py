@@ -85,7 +85,7 @@ def test_messages_arrive_as_the_wire_carries_them_locally_and_remotely(router: R
 
 @pytest.mark.parametrize("latest_only", [True, False])
 def test_a_receiver_behind_skips_to_the_newest_sensor_message_when_asked(router: RuntimeParams,
-                                                                        latest_only: bool) -> None:  # fmt: skip
+                                                                        latest_only: bool) -> None:
     import time
 
     from cmdragons.runtime.zenoh_transport import LATEST_ONLY

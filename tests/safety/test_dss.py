@@ -223,7 +223,7 @@ def test_crash_hold_caps_the_speed_toward_an_opponent_to_what_braking_brings_dow
 
     def hold(state: list[float], command: list[float], opponent: list[float]) -> np.ndarray:
         return crash_hold(np.array([state]), np.array([command]), np.array([opponent]), body, p.crash_closing_m_s,
-                          brake, p.crash_latency_s)[0]  # fmt: skip
+                          brake, p.crash_latency_s)[0]
 
     # at the opponent's body, driving at it: the allowed closing speed
     assert hold([0, 0, 3, 0], [3, 0], [body, 0, 0, 0]) == pytest.approx([p.crash_closing_m_s, 0.0])

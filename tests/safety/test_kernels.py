@@ -83,7 +83,7 @@ def test_static_check_is_conservative_by_at_most_one_step() -> None:
     # the check asks the collision world (boxes and circles grown by the robot radius)
     rng = np.random.default_rng(3)
     world = CollisionWorld((-1.49, -1.09, 1.49, 1.09), circles=np.array([[0.0, -0.5, 0.11], [-0.4, 0.6, 0.06]]),
-                           boxes=np.array([[0.2, 0.2, 0.6, 0.5], [-0.9, -0.8, -0.5, -0.3]]))  # fmt: skip
+                           boxes=np.array([[0.2, 0.2, 0.6, 0.5], [-0.9, -0.8, -0.5, -0.3]]))
     cw = world.compile(0.09)
     margin, step = 0.01, 0.02
     for _ in range(400):

@@ -38,7 +38,7 @@ def scene(params: RefereeParams | None = None) -> tuple[World, Referee, AutoRef]
     """Robots parked apart along the bottom touch line, the ball at rest mid-field; both referees in
     normal play."""
     w = World(LEAGUE, PhysicsParams(), RobotParams(command_latency_s=0.0), BallParams(), KickerParams(),
-              DribblerParams(), robots_per_team={"blue": 2, "yellow": 2})  # fmt: skip
+              DribblerParams(), robots_per_team={"blue": 2, "yellow": 2})
     for i, (team, rid) in enumerate(w.robot_keys()):
         w.place_robot(team, rid, -3.5 + 1.0 * i, -2.6, 0.0)
     w.place_ball(0.0, 1.5)
@@ -63,13 +63,13 @@ class Seen:
         self.n += 1
         ball = (BallDetection(gt.ball.x + n(0, SIGMA_M), gt.ball.y + n(0, SIGMA_M), 1.0, (0.0, 0.0)),)
         robots = tuple(RobotDetection(r.team, r.id, r.x + n(0, SIGMA_M), r.y + n(0, SIGMA_M), r.theta + n(0, 0.01),
-                                      1.0, (0.0, 0.0)) for r in gt.robots)  # fmt: skip
+                                      1.0, (0.0, 0.0)) for r in gt.robots)
         world = self.tracker.step([DetectionFrame(0, self.n, gt.t, gt.t, ball, robots)], ahead_s=0.0)
         return dataclasses.replace(world, frame_number=self.n)
 
 
 def play(w: World, ref: Referee | None, auto: AutoRef, seen: Seen, seconds: float,
-         commands: Commands | None = None) -> tuple[list[GameEvent], list[GameEvent]]:  # fmt: skip
+         commands: Commands | None = None) -> tuple[list[GameEvent], list[GameEvent]]:
     """Both referees judge every frame (the truth referee drives: the world carries out its
     teleports; without it the autoref's); their calls."""
     truth: list[GameEvent] = []
@@ -199,7 +199,7 @@ def test_placed_by_robots_the_autoref_asks_for_no_teleport_and_the_kicking_team_
 
 def test_ball_crossing_calls_each_crossing_once_until_the_ball_is_back() -> None:
     f = World(LEAGUE, PhysicsParams(), RobotParams(), BallParams(), KickerParams(), DribblerParams(),
-              robots_per_team={"blue": 0, "yellow": 0}).field  # fmt: skip
+              robots_per_team={"blue": 0, "yellow": 0}).field
     c = BallCrossing(f)
     past = f.half_length + 0.05
     assert c.see(0.0, 0.0, 0.0, -1, None) is None
@@ -217,7 +217,7 @@ def test_the_kick_detector_ignores_a_ball_put_elsewhere() -> None:
     from cmdragons.messages import BallState, RobotState
 
     f = World(LEAGUE, PhysicsParams(), RobotParams(), BallParams(), KickerParams(), DribblerParams(),
-              robots_per_team={"blue": 0, "yellow": 0}).field  # fmt: skip
+              robots_per_team={"blue": 0, "yellow": 0}).field
     d = KickDetector(f, AutorefParams())
     robot = RobotState("blue", 1, 0.0, 0.0, 0.0)
     assert d.see(WorldState(0.0, BallState(2.0, 2.0, 1.0, 0.0), (robot,))) is None

@@ -22,7 +22,7 @@ def test_a_frame_holds_its_own_calls_and_the_match_all() -> None:
 def test_calls_are_counted_per_team_by_the_kinds_asked_for_in_name_order() -> None:
     calls = Calls()
     for kind, team in (("pushing", "blue"), ("crash", "blue"), ("pushing", "blue"), ("crash", "yellow"),
-                       ("yellow_card", "blue"), ("stage_half_time", None)):  # fmt: skip
+                       ("yellow_card", "blue"), ("stage_half_time", None)):
         calls.call(GameEvent(0.0, kind, team))  # type: ignore[arg-type]
     counted = calls.by_kind({"crash", "pushing"})
     assert counted == {"blue": {"crash": 1, "pushing": 2}, "yellow": {"crash": 1}}

@@ -44,9 +44,9 @@ def test_the_counter_and_time_move_only_when_the_command_changes() -> None:
     (C.BALL_PLACEMENT, True, False, False), (C.KICKOFF, False, False, True), (C.FREE_KICK, True, False, True),
     (C.NORMAL, True, True, True), (C.FORCE_START, True, True, True), (C.PENALTY, False, False, False),
     (C.PENALTY, True, True, True),
-])  # fmt: skip
+])
 def test_which_commands_have_the_ball_in_play(command: RefereeCommand, ready: bool, in_play: bool,
-                                              live: bool) -> None:  # fmt: skip
+                                              live: bool) -> None:
     gc = GameController(RulesParams(), halves=True)
     gc.give(0.0, command, None if command in (C.HALT, C.STOP, C.NORMAL, C.FORCE_START) else "blue", ready)
     assert (gc.in_play(), gc.live()) == (in_play, live)
@@ -57,9 +57,9 @@ def test_which_commands_have_the_ball_in_play(command: RefereeCommand, ready: bo
     (S.HALF_TIME, 300.0, 0, False, True, S.SECOND_HALF), (S.SECOND_HALF, 300.0, 0, False, True, S.POST_GAME),
     (S.SECOND_HALF, 300.0, 5, False, True, S.PENALTY_SHOOTOUT), (S.SECOND_HALF, 300.0, 5, False, False, S.POST_GAME),
     (S.SECOND_HALF, 300.0, 5, True, False, S.PENALTY_SHOOTOUT), (S.PENALTY_SHOOTOUT, 300.0, 5, True, True, S.POST_GAME),
-])  # fmt: skip
+])
 def test_the_stages_follow_in_the_rules_order(stage: GameStage, half_time_s: float, kicks: int, always: bool,
-                                              drawn: bool, after: GameStage) -> None:  # fmt: skip
+                                              drawn: bool, after: GameStage) -> None:
     rules = RulesParams(half_time_s=half_time_s, shootout_kicks=kicks, shootout_always=always)
     assert stage_after(stage, rules, drawn) is after
 
@@ -71,7 +71,7 @@ def test_each_stage_lasts_what_the_rules_give_it() -> None:
     gc = GameController(rules, halves=True)
     assert not gc.stage_over(24.9) and gc.stage_over(25.0)
     for stage, end in ((S.HALF_TIME, 35.0), (S.SECOND_HALF, 55.0), (S.PENALTY_SHOOTOUT, math.inf),
-                       (S.POST_GAME, math.inf)):  # fmt: skip
+                       (S.POST_GAME, math.inf)):
         gc.enter(stage, 30.0)
         assert (gc.stage, gc.stage_end) == (stage, end)
 
@@ -85,9 +85,9 @@ def _kicks(blue: tuple[int, int], yellow: tuple[int, int]) -> dict[Team, dict[st
     ((5, 3), (5, 3), False, "yellow"),  # drawn after five each: one each more
     ((6, 4), (6, 3), False, None), ((5, 3), (5, 2), False, None), ((5, 3), (5, 3), True, None),
     ((2, 0), (3, 3), False, "blue"),  # decided already, but not over before blue's kick
-])  # fmt: skip
+])
 def test_the_shootouts_kickers_in_turn_until_decided(blue: tuple[int, int], yellow: tuple[int, int], always: bool,
-                                                     kicker: Team | None) -> None:  # fmt: skip
+                                                     kicker: Team | None) -> None:
     assert shootout_kicker(_kicks(blue, yellow), RulesParams(shootout_kicks=5, shootout_always=always)) == kicker
 
 

@@ -26,7 +26,7 @@ def snap(t: float, robots: list[tuple[float, ...]]) -> Snapshot:
     for k, r in enumerate(robots):
         rows[k, : len(r)] = r
     return Snapshot(t=t, frame_number=round(t * 60), ball=np.array([0.5, 0.3, LEAGUE.ball.radius_m, 0, 0, 0]),
-                    robots=rows)  # fmt: skip
+                    robots=rows)
 
 
 ROBOTS = [(0, 2, -1.0, 0.5, 0.3), (1, 4, 1.2, -0.8, -1.0)]
@@ -61,7 +61,7 @@ def test_light_drifts_and_auto_exposure_follows() -> None:
     """With the lamps and daylight wandering by half, the carpet's brightness in the middle moves
     less than the light does: auto exposure steers the mean back (within 15% of its target)."""
     look = dataclasses.replace(LOOK, lamp_drift_fraction=0.5, daylight_drift_fraction=0.5, lamp_drift_period_s=4.0,
-                               daylight_drift_period_s=4.0, codec="none")  # fmt: skip
+                               daylight_drift_period_s=4.0, codec="none")
     r = renderer(3, look)
     lighting = r.look.lighting if r.look is not None else None
     assert lighting is not None

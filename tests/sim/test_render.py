@@ -57,7 +57,7 @@ def small_camera() -> CameraModel:
     """A small distorted view of a 1 m patch, so the numpy references stay quick."""
     return CameraModel(CameraParams(id=7, position_m=(0.3, -0.2, 4.0), yaw_rad=0.3, tilt_x_rad=0.02,
                                     focal_px=560.0, principal_point_px=(80.0, 60.0), k1=-0.05, k2=0.01,
-                                    resolution_px=(160, 120)))  # fmt: skip
+                                    resolution_px=(160, 120)))
 
 
 def classify(pixels: NDArray[np.uint8], colours: dict[str, tuple[int, int, int]]) -> NDArray[np.str_]:
@@ -107,7 +107,7 @@ def test_pattern_dots_project_to_the_truth(
     p = clean.params
     colours = {"cover": p.cover_bgr, "side": p.side_bgr, "carpet": p.carpet_bgr, "line": p.line_bgr,
                "pink": p.pink_bgr, "green": p.green_bgr, "blue": p.blue_bgr, "yellow": p.yellow_bgr,
-               "boundary": p.boundary_bgr}  # fmt: skip
+               "boundary": p.boundary_bgr}
     for team, rid, x, y, th in robots:
         assert (team, rid) in truth.robots, "every top of the layout lies inside the image"
         top = model.project_xy(np.array([x, y]), ROBOT.height_m)
@@ -136,7 +136,7 @@ def test_pattern_dots_project_to_the_truth(
     ("pixel", "z_m"),
     [((512.0, 384.0), LEAGUE.ball.radius_m), ((30.0, 700.0), LEAGUE.ball.radius_m), ((990.0, 25.0), 0.0215),
      ((700.0, 200.0), 0.35), ((150.0, 400.0), 0.8)],
-)  # fmt: skip
+)
 def test_ball_centroid_projects_to_the_truth(clean: CameraRenderer, pixel: tuple[float, float], z_m: float) -> None:
     model = clean.model
     x, y = model.unproject(np.array(pixel), z_m)
@@ -237,7 +237,7 @@ def test_truth_lists_only_what_is_inside_the_image(clean: CameraRenderer) -> Non
 def test_same_seed_same_bytes_other_seed_other_noise(small_camera: CameraModel) -> None:
     params = RenderParams()
     frames = [snapshot([(0, 5, 0.3, -0.2, 0.4, 1.0, -0.5, 4.0)], np.array([0.5, -0.1, 0.0215, 3.0, 1.0, 0.0]), k)
-              for k in range(3)]  # fmt: skip
+              for k in range(3)]
     a, b = CameraRenderer(small_camera, LEAGUE, params, 11), CameraRenderer(small_camera, LEAGUE, params, 11)
     other = CameraRenderer(small_camera, LEAGUE, params, 12)
     for snap in frames:
@@ -295,7 +295,7 @@ def test_project_points_matches_the_camera_model(small_camera: CameraModel, came
     pts = np.column_stack([rng.uniform(-5, 5, 200), rng.uniform(-3.5, 3.5, 200), rng.uniform(0, 1, 200)])
     for model in [small_camera, *cameras]:
         np.testing.assert_allclose(kern.project_points(kern.camera_vector(model), pts), model.project(pts),
-                                   rtol=0, atol=1e-9)  # fmt: skip
+                                   rtol=0, atol=1e-9)
 
 
 def scene(model: CameraModel, renderer: CameraRenderer) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -319,7 +319,7 @@ def test_plan_objects_matches_reference(small_camera: CameraModel) -> None:
     plan = kern.ObjectPlan(len(robots), p.max_blur_samples)
     kern.plan_objects(plan, robots, ball, r.cam, r.shape, r.pink, r.dots, r.palette, p.exposure_s, p.blur_step_px)
     ref = kern.plan_objects_reference(small_camera, robots, ball, r.shape, r.pink, r.palette, p.exposure_s,
-                                      p.max_blur_samples, p.blur_step_px)  # fmt: skip
+                                      p.max_blur_samples, p.blur_step_px)
     np.testing.assert_array_equal(plan.rob_k, ref.rob_k)
     assert plan.rob_k.max() > 1 and plan.ball_k > 1, "the scene exercises motion blur"
     for k in range(len(robots)):
@@ -360,9 +360,9 @@ def test_render_frame_matches_reference(small_camera: CameraModel, noise: bool) 
     key: int | None = 2**64 - 1234 if noise else None
     out = np.empty_like(r.background)
     vis, sil = kern.render_frame(out, r.background, r.noise, key, r.rays, r.foot, r.gain, r.cam, r.shape, r.dots,
-                                 r.palette, plan, np.zeros((out.shape[0], 2)), n_chunks=3)  # fmt: skip
+                                 r.palette, plan, np.zeros((out.shape[0], 2)), n_chunks=3)
     ref, vis_ref, sil_ref = kern.render_frame_reference(r.background, r.noise, key, r.rays, r.foot, r.gain, r.cam,
-                                                        r.shape, r.dots, r.palette, plan)  # fmt: skip
+                                                        r.shape, r.dots, r.palette, plan)
     diff = np.abs(out.astype(np.int16) - ref)
     assert diff.max() <= 1, "float rounding may move a level by one, never more"
     assert (diff > 0).mean() < 0.002

@@ -35,7 +35,7 @@ FIELD = Field(LeagueParams())
 @pytest.mark.parametrize(("kind", "command"), [
     (K.KICKOFF, C.KICKOFF), (K.FREE_KICK, C.FREE_KICK), (K.PLACED_FREE_KICK, C.FREE_KICK),
     (K.REFEREE_FREE_KICK, C.FREE_KICK), (K.PENALTY, C.PENALTY), (K.FORCE_START, C.FORCE_START),
-])  # fmt: skip
+])
 def test_each_kind_leads_to_its_command(kind: RestartKind, command: RefereeCommand) -> None:
     assert kind.command is command
     team: Team | None = None if kind is K.FORCE_START else "blue"
@@ -46,9 +46,9 @@ def test_each_kind_leads_to_its_command(kind: RestartKind, command: RefereeComma
     (K.FREE_KICK, True, C.BALL_PLACEMENT), (K.FREE_KICK, False, C.FREE_KICK),
     (K.PLACED_FREE_KICK, True, C.FREE_KICK), (K.REFEREE_FREE_KICK, True, C.FREE_KICK),
     (K.KICKOFF, True, C.KICKOFF), (K.PENALTY, True, C.PENALTY),
-])  # fmt: skip
+])
 def test_only_a_free_kick_to_be_placed_is_preceded_by_the_teams_placement(
-        kind: RestartKind, may_place: bool, expected: RefereeCommand) -> None:  # fmt: skip
+        kind: RestartKind, may_place: bool, expected: RefereeCommand) -> None:
     assert Restart(0.0, kind, "yellow", (1.0, 2.0)).next_command(may_place) == (expected, "yellow")
 
 
@@ -69,21 +69,21 @@ def test_a_call_restarts_with_nothing_else(call: RefereeCommand) -> None:
 
 @pytest.mark.parametrize(("x", "blue_sign", "defender"), [
     (-1.0, -1, "blue"), (1.0, -1, "yellow"), (-1.0, 1, "yellow"), (1.0, 1, "blue"), (0.0, -1, "yellow"),
-])  # fmt: skip
+])
 def test_the_team_defending_a_half(x: float, blue_sign: int, defender: Team) -> None:
     assert defender_of(x, blue_sign) == defender
     assert attack_sign(other(defender), blue_sign) == (1.0 if x >= 0.0 else -1.0)
 
 
 @pytest.mark.parametrize(("team", "blue_sign", "side"), [("blue", -1, 1.0), ("yellow", -1, -1.0),
-                                                         ("blue", 1, -1.0), ("yellow", 1, 1.0)])  # fmt: skip
+                                                         ("blue", 1, -1.0), ("yellow", 1, 1.0)])
 def test_the_penalty_mark_is_in_front_of_the_goal_the_team_attacks(team: Team, blue_sign: int, side: float) -> None:
     x, y = penalty_mark(FIELD, 1.5, team, blue_sign)
     assert (x, y) == pytest.approx((side * (FIELD.half_length - 1.5), 0.0), abs=1e-12)
 
 
 @pytest.mark.parametrize(("moved", "taken"), [(0.0, False), (0.049, False), (0.0499, False), (0.0501, True),
-                                              (1.0, True)])  # fmt: skip
+                                              (1.0, True)])
 def test_a_kick_is_taken_once_the_ball_moved_the_rules_distance(moved: float, taken: bool) -> None:
     placed = (1.0, -2.0)
     for ux, uy in ((1.0, 0.0), (0.0, -1.0), (0.6, 0.8)):
@@ -93,9 +93,9 @@ def test_a_kick_is_taken_once_the_ball_moved_the_rules_distance(moved: float, ta
 @pytest.mark.parametrize(("last_touch", "x", "blue_sign", "taker"), [
     ("blue", 3.0, -1, "yellow"), ("yellow", 3.0, -1, "blue"), (None, 3.0, -1, "yellow"), (None, -3.0, -1, "blue"),
     (None, -3.0, 1, "yellow"), ("blue", -3.0, 1, "yellow"),
-])  # fmt: skip
+])
 def test_the_free_kick_after_the_ball_left_the_field(last_touch: Team | None, x: float, blue_sign: int,
-                                                     taker: Team) -> None:  # fmt: skip
+                                                     taker: Team) -> None:
     assert ball_out_taker(last_touch, x, blue_sign) == taker
 
 
@@ -131,10 +131,10 @@ def test_a_robot_comes_back_in_its_half_by_its_touch_line_on_the_first_free_spot
 
 def test_robots_on_the_spot_are_moved_aside_to_the_clearance() -> None:
     robots = [_robot("blue", 0, 0.1, 0.0, 1.0), _robot("yellow", 1, 0.0, 0.0), _robot("yellow", 2, 1.0, 0.0),
-              _robot("blue", 3, 0.0, -0.05)]  # fmt: skip
+              _robot("blue", 3, 0.0, -0.05)]
     moved = aside(robots, (0.0, 0.0), 0.2, attack=1.0, off={("blue", 3)})
     assert moved == [("blue", 0, pytest.approx(0.2), pytest.approx(0.0), 1.0),
-                     ("yellow", 1, pytest.approx(-0.2), pytest.approx(0.0), 0.0)]  # fmt: skip
+                     ("yellow", 1, pytest.approx(-0.2), pytest.approx(0.0), 0.0)]
 
 
 def test_a_shootout_kick_puts_the_kicker_behind_the_mark_and_the_other_keeper_on_its_line() -> None:
@@ -165,7 +165,7 @@ def test_a_frames_moves_are_one_teleport_robots_in_order_the_last_ball() -> None
     assert moves.moving() == {("blue", 1), ("yellow", 0), ("blue", 0)}
     px, py = park(FIELD, 1, "blue", 3.0)
     assert moves.take(2.5) == Teleport(2.5, (("blue", 1, px, py, 0.0), ("yellow", 0, 0.5, 0.5, 0.0),
-                                             ("blue", 0, -1.0, 0.0, 0.0)), (3.0, 0.0))  # fmt: skip
+                                             ("blue", 0, -1.0, 0.0, 0.0)), (3.0, 0.0))
     assert moves.take(3.0) is None and moves.moving() == set()
 
 
@@ -175,6 +175,6 @@ def test_the_kickoff_puts_both_teams_in_formation_and_leaves_robots_off_the_fiel
     kickoff = Moves(FIELD, keys, {"B": poses}, 3.0).kickoff(1.0, -1, off={("yellow", 4)})
     mirrored = formation(poses, 1, 1)[0]
     assert kickoff.ball == (0.0, 0.0) and kickoff.robots == (("blue", 0, *poses[0]), ("blue", 1, *poses[1]),
-                                                             ("yellow", 3, *mirrored))  # fmt: skip
+                                                             ("yellow", 3, *mirrored))
     with pytest.raises(ValueError, match=r"sim.referee.formations.B lists 1 poses but the team has 2"):
         Moves(FIELD, keys, {"B": poses[:1]}, 3.0).kickoff(1.0, -1, off=())

@@ -26,7 +26,7 @@ def scene(blue: int = 2, yellow: int = 2, brake: float = 6.0, **figures: object)
     """Robots parked apart along the bottom touch line, the ball at rest mid-field; full rules in normal play."""
     w = World(LEAGUE, PhysicsParams(), RobotParams(command_latency_s=0.0, max_brake_m_s2=brake), BallParams(),
               KickerParams(), DribblerParams(),
-              robots_per_team={"blue": blue, "yellow": yellow})  # fmt: skip
+              robots_per_team={"blue": blue, "yellow": yellow})
     for i, (team, rid) in enumerate(w.robot_keys()):
         w.place_robot(team, rid, -3.5 + 1.0 * i, -2.6, 0.0)
     w.place_ball(0.0, 1.5)
@@ -75,9 +75,9 @@ def test_crash_faster_than_the_limit_is_the_faster_robots_foul(speed: float, cal
     ((0.0, 2.5), (-1.7, 0.0), ["crash:blue"]),  # blue faster on the ground though yellow closes
     ((0.4, 0.0), (-1.7, 0.0), ["crash:yellow"]),
     ((0.0, 2.5), (-1.0, 0.0), []),  # closing at 1 m/s along the line: no crash
-])  # fmt: skip
+])
 def test_crash_fault_goes_by_the_robots_own_speeds(blue_v: tuple[float, float], yellow_v: tuple[float, float],
-                                                    called: list[str]) -> None:  # fmt: skip
+                                                    called: list[str]) -> None:
     # the rules: the velocity difference along the line decides a crash, the robots' own speeds whose it is
     watch = FoulWatch(Field(LEAGUE), RulesParams())
     situation = Situation(RefereeCommand.NORMAL, None, 0.0, -1, True)
@@ -118,7 +118,7 @@ def test_ball_faster_than_the_limit_after_a_touch(speed: float, called: bool) ->
     assert bool(fast) == called
     if called:
         assert (fast[0].team, fast[0].robot, fast[0].restart, fast[0].for_team) == \
-            ("blue", 1, RefereeCommand.FREE_KICK, "yellow")  # fmt: skip
+            ("blue", 1, RefereeCommand.FREE_KICK, "yellow")
         assert fast[0].value == pytest.approx(8.0, abs=0.3)
 
 
@@ -145,7 +145,7 @@ def test_attacker_touching_the_ball_in_the_opponents_defense_area(ball_x: float,
     assert bool(fouls) == called
     if called:
         assert (fouls[0].team, fouls[0].robot, fouls[0].restart, fouls[0].for_team) == \
-            ("blue", 1, RefereeCommand.FREE_KICK, "yellow")  # fmt: skip
+            ("blue", 1, RefereeCommand.FREE_KICK, "yellow")
 
 
 @pytest.mark.parametrize(("rid", "called"), [(1, True), (0, False)])  # 0: the keeper may
@@ -342,7 +342,7 @@ def test_basic_rules_call_no_fouls() -> None:
 
 def test_a_penalty_shootout_alternates_its_kicks_and_ends_the_game() -> None:
     w, ref = scene(half_s=1.0, half_time_s=0.0, shootout_kicks=2, shootout_always=True, prepare_timeout_s=0.5,
-                   penalty_time_s=3.0)  # fmt: skip
+                   penalty_time_s=3.0)
     takers: list[str] = []
     scored = {"n": 0}
 
@@ -418,7 +418,7 @@ def test_a_shootout_kick_has_only_the_kicker_and_the_other_keeper_on_the_field()
     # the rules: one attacker and the keeper per team; during an attempt only the kicker and the
     # other team's keeper move: the robot handlers take the others off and put these two in place
     w, ref = scene(blue=4, yellow=3, half_s=1.0, half_time_s=0.0, shootout_kicks=1, shootout_always=True,
-                   prepare_timeout_s=0.5, penalty_time_s=1.0)  # fmt: skip
+                   prepare_timeout_s=0.5, penalty_time_s=1.0)
     seen = []
 
     def look(k: int) -> list[RobotCommand]:
@@ -492,10 +492,10 @@ def _frame(ball: tuple[float, float, float, float], *robots: tuple[Team, int, fl
     ((1.2, 0.0, 0.0, 0.0), (2.0, 0.0), 0.2, False),  # too far off the target
     ((1.1, 0.0, 0.2, 0.0), (2.0, 0.0), 0.1, False),  # still rolling
     ((1.1, 0.0, 0.0, 0.0), (1.1 + R + 0.03, 0.0), 0.1, False),  # the placer still at the ball
-])  # fmt: skip
+])
 def test_a_placement_succeeds_with_the_ball_near_the_target_at_rest_and_the_placer_clear(
         ball: tuple[float, float, float, float], robot_at: tuple[float, float], off_m: float,
-        done: bool) -> None:  # fmt: skip
+        done: bool) -> None:
     gt = _frame(ball, ("blue", 0, *robot_at), ("yellow", 0, 1.1 + R + 0.03, 0.1))  # the other team may stand there
     off, ok = placed(gt, "blue", (1.0, 0.0), Field(LEAGUE), RulesParams())
     assert off == pytest.approx(off_m) and ok is done
@@ -504,13 +504,13 @@ def test_a_placement_succeeds_with_the_ball_near_the_target_at_rest_and_the_plac
 @pytest.mark.parametrize(("yellow_keeper_x", "blue_mate_x", "ready"), [
     (-4.45, 0.5, True), (-4.0, 0.5, False),  # the keeper off its line
     (-4.45, -2.0, False),  # a team-mate of the kicker 0.5 m behind the mark (at -2.5 m): less than 1 m
-])  # fmt: skip
+])
 def test_a_penalty_is_set_when_all_but_kicker_and_keeper_are_behind_the_mark(
-        yellow_keeper_x: float, blue_mate_x: float, ready: bool) -> None:  # fmt: skip
+        yellow_keeper_x: float, blue_mate_x: float, ready: bool) -> None:
     pitch = Field(LEAGUE)
     mark = (-pitch.half_length + 2.0, 0.0)  # blue attacks -x
     gt = _frame((*mark, 0.0, 0.0), ("blue", 1, mark[0] + 0.2, 0.0), ("blue", 2, blue_mate_x, 1.0),
                 ("yellow", 0, -pitch.half_length + (yellow_keeper_x + 4.5), 0.0), ("yellow", 1, 0.0, -1.0),
-                ("yellow", 2, mark[0] + 0.3, 0.5))  # fmt: skip
+                ("yellow", 2, mark[0] + 0.3, 0.5))
     assert penalty_set(gt, "blue", mark, -1.0, pitch, RulesParams(), off={("yellow", 2)}) is ready
     assert not penalty_set(gt, "blue", mark, -1.0, pitch, RulesParams(), off=set())  # yellow 2 on the field, ahead

@@ -31,7 +31,7 @@ FRONT = LEAGUE.robot.front_distance_m + LEAGUE.ball.radius_m
 
 def make_world(blue: int = 1, yellow: int = 0, robot: RobotParams | None = None) -> World:
     w = World(LEAGUE, PhysicsParams(), robot or RobotParams(), BallParams(), KickerParams(), DribblerParams(),
-              robots_per_team={"blue": blue, "yellow": yellow})  # fmt: skip
+              robots_per_team={"blue": blue, "yellow": yellow})
     for i, (team, rid) in enumerate(w.robot_keys()):
         w.place_robot(team, rid, -3.5 + 1.0 * i, -2.5, 0.0)  # parked apart, out of the way
     w.place_ball(0.0, 1.5)

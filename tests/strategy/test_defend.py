@@ -48,7 +48,7 @@ def yellow_line_up(n: int = 6) -> list[RobotState]:
 def test_a_marker_stands_in_the_receivers_passing_lane(receiver: tuple[float, float]) -> None:
     ball = BallState(-1.0, 0.5, 0.0, 0.0)
     blue = [RobotState("blue", 0, -4.3, 0.0, 0.0), RobotState("blue", 1, -1.2, 0.5, 0.0),  # keeper, passer
-            RobotState("blue", 2, *receiver, 0.0)]  # fmt: skip
+            RobotState("blue", 2, *receiver, 0.0)]
     intents = team().intents(WorldState(0.0, ball, (*blue, *yellow_line_up())), GAME)
     lane = [(it, *_segment((it.x, it.y), receiver, (ball.x, ball.y))) for it in intents.values()]
     it, off, _ = min(lane, key=lambda t: t[1])
@@ -60,7 +60,7 @@ def test_a_marker_stands_in_the_receivers_passing_lane(receiver: tuple[float, fl
 def test_the_opponent_on_the_ball_and_their_keeper_are_not_marked_the_nearest_to_our_goal_first() -> None:
     ball = BallState(-1.0, 0.5, 0.0, 0.0)
     blue = [RobotState("blue", 0, -4.3, 0.0, 0.0), RobotState("blue", 1, -1.2, 0.5, 0.0),
-            RobotState("blue", 2, 0.0, 2.0, 0.0), RobotState("blue", 3, 3.0, -1.0, 0.0)]  # fmt: skip
+            RobotState("blue", 2, 0.0, 2.0, 0.0), RobotState("blue", 3, 3.0, -1.0, 0.0)]
     assert [r.id for r in threats(blue, ball, FIELD, 1.0, P)] == [3, 2]
 
 
@@ -80,7 +80,7 @@ def test_a_blocker_stands_on_the_shots_line_to_the_goal(ball_xy: tuple[float, fl
 def test_no_field_player_is_sent_into_a_defense_area(ball_xy: tuple[float, float], keeper: bool) -> None:
     ball = BallState(*ball_xy, 0.0, 0.0)
     blue = [RobotState("blue", 0, -4.3, 0.0, 0.0), RobotState("blue", 1, ball_xy[0] - 0.2, ball_xy[1], 0.0),
-            RobotState("blue", 2, 4.0, -0.6, 0.0), RobotState("blue", 3, 3.8, 0.9, 0.0)]  # fmt: skip
+            RobotState("blue", 2, 4.0, -0.6, 0.0), RobotState("blue", 3, 3.8, 0.9, 0.0)]
     yellow = yellow_line_up() if keeper else yellow_line_up()[1:]
     intents = team().intents(WorldState(0.0, ball, (*blue, *yellow)), GAME)
     assert sorted(intents) == [r.id for r in yellow]
@@ -100,7 +100,7 @@ def test_it_closes_on_another_robot_no_faster_than_allowed(gap: float, other_v: 
 
 
 @pytest.mark.parametrize(("start", "goal"), [((-1.0, 0.0), (1.0, 0.0)), ((-1.0, 0.3), (1.0, 0.2)),
-                                             ((0.0, -1.0), (0.1, 1.0)), ((-0.8, 0.8), (0.8, -0.8))])  # fmt: skip
+                                             ((0.0, -1.0), (0.1, 1.0)), ((-0.8, 0.8), (0.8, -0.8))])
 def test_a_way_through_the_balls_circle_goes_round_it(start: tuple[float, float], goal: tuple[float, float]) -> None:
     radius, share, x, y = 0.6, 1.2, *start
     for _ in range(400):  # steps of 2 cm toward the way point asked afresh each step
@@ -118,9 +118,9 @@ def test_a_way_through_the_balls_circle_goes_round_it(start: tuple[float, float]
     ((0.3, 0.0), (0.3, 2.0), (0.3, 2.0)),  # from inside, the way leads away from the centre: straight on
     ((0.3, 0.0), (-2.0, 0.0), (0.72, 0.0)),  # from inside toward the centre: straight out first
     ((0.72, 0.0), (-2.0, 0.1), (0.6, 0.72 * math.sin(math.acos(1 / 1.2)))),  # on the way round, the goal's side
-])  # fmt: skip
+])
 def test_the_way_point_of_a_detour(start: tuple[float, float], goal: tuple[float, float],
-                                   expected: tuple[float, float]) -> None:  # fmt: skip
+                                   expected: tuple[float, float]) -> None:
     assert detour(start, goal, (0.0, 0.0), 0.6, 1.2) == pytest.approx(expected, abs=1e-9)
 
 
@@ -128,7 +128,7 @@ def test_the_way_point_of_a_detour(start: tuple[float, float], goal: tuple[float
 def scene(blue: list[tuple[float, float, float]], yellow: int = 6) -> tuple[World, Referee]:
     s = SETTINGS.sim
     w = World(SETTINGS.field, s.physics, s.robot, s.ball, s.kicker, s.dribbler,
-              robots_per_team={"blue": len(blue), "yellow": yellow})  # fmt: skip
+              robots_per_team={"blue": len(blue), "yellow": yellow})
     ref = Referee(w.field, w.robot_keys(), s.referee)
     for k, (x, y, theta) in enumerate(blue):
         w.place_robot("blue", k, x, y, theta)
@@ -138,7 +138,7 @@ def scene(blue: list[tuple[float, float, float]], yellow: int = 6) -> tuple[Worl
 
 
 def play(w: World, ref: Referee, seconds: float, each: Callable[[World], None] | None = None,
-         judge: bool = True, blue: tuple[RobotCommand, ...] = ()) -> list[GameEvent]:  # fmt: skip
+         judge: bool = True, blue: tuple[RobotCommand, ...] = ()) -> list[GameEvent]:
     """The defending team (yellow) plays, blue stands (or keeps to the commands ``blue``); the
     referee judges every frame (``judge``)."""
     yellow, calls = team(), []
@@ -196,7 +196,7 @@ def test_a_blocker_takes_a_shot_at_the_goal() -> None:
     gt = w.ground_truth()
     goal = (FIELD.half_length, 0.0)
     lanes = [_segment((r.x, r.y), (gt.ball.x, gt.ball.y), goal)[0] for r in gt.robots
-             if r.team == "yellow" and r.id != 0]  # fmt: skip
+             if r.team == "yellow" and r.id != 0]
     assert min(lanes) < R + BALL_R  # a field player's body across the line: the ball cannot pass
     dx, dy = goal[0] - gt.ball.x, goal[1] - gt.ball.y
     d = math.hypot(dx, dy)

@@ -70,4 +70,4 @@ def test_the_goalie_s_reflex_moves_it_toward_a_slow_shot_s_line(own_sign: float)
     # a ball going away from our goal: no reflex
     away = BallState(bx, by, -ball.vx, ball.vy)
     assert goalie(robot, away, FIELD, own_sign, on_p, skills)[0] == \
-        goalie(robot, away, FIELD, own_sign, P, skills)[0]  # fmt: skip
+        goalie(robot, away, FIELD, own_sign, P, skills)[0]

@@ -22,14 +22,14 @@ SETTINGS = load_settings(Path(__file__).resolve().parents[2] / "configs")
 @pytest.mark.parametrize(("start", "target"), [
     ((-1.0, 0.5, 0.0), (1.5, -0.5)),  # the ball ahead, on the way
     ((1.0, 0.3, math.pi), (-1.5, 1.0)),  # the target behind the robot: round the ball first
-])  # fmt: skip
+])
 def test_dribble_carries_the_ball_to_the_target(start: tuple[float, float, float], target: tuple[float, float]) -> None:
     s = SETTINGS.sim
     # in a match the tracker predicts the robots through the command latency; here the brain sees
     # the truth of now, so the robots act on their commands at once
     robot_model = dataclasses.replace(s.robot, command_latency_s=0.0)
     world = World(SETTINGS.field, s.physics, robot_model, s.ball, s.kicker, s.dribbler,
-                  robots_per_team={"blue": 1, "yellow": 0})  # fmt: skip
+                  robots_per_team={"blue": 1, "yellow": 0})
     world.place_robot("blue", 0, *start)
     world.place_ball(0.0, 0.0)
     brain = Brain("blue", SETTINGS)

@@ -34,7 +34,7 @@ def _intents(rng: np.random.Generator, n: int) -> dict[int, Intent]:
 
 
 @pytest.mark.parametrize(("team", "blue_negative", "sign"), [
-    ("blue", True, -1.0), ("blue", False, 1.0), ("yellow", True, 1.0), ("yellow", False, -1.0)])  # fmt: skip
+    ("blue", True, -1.0), ("blue", False, 1.0), ("yellow", True, 1.0), ("yellow", False, -1.0)])
 def test_own_goal_sign(team: str, blue_negative: bool, sign: float) -> None:
     game = GameState(0.0, "normal", blue_defends_negative_x=blue_negative)
     assert own_goal_sign(team, game) == sign  # type: ignore[arg-type]
@@ -120,15 +120,15 @@ def _segment_distance(q: tuple[float, float], a: tuple[float, float], b: tuple[f
     ((-4.4, -2.9), (-4.3, -1.5)),  # out of a corner, along the goal line
     ((0.0, 2.9), (1.0, 2.8)),  # along the touch line
     ((1.0, 0.0), (-1.0, 0.5)),  # mid-field
-])  # fmt: skip
+])
 def test_keep_off_line_leaves_the_placement_room_even_in_a_corner(ball: tuple[float, float],
-                                                                  target: tuple[float, float]) -> None:  # fmt: skip
+                                                                  target: tuple[float, float]) -> None:
     """Every place at least placement_line_m (plus the radius) off the ball's way to its target and
     on the field, wherever the robots were: in a corner neither side of the line has room, and a
     robot clamped back into the field stood by the ball in the placer's way."""
     rng = np.random.default_rng(3)
     near = {k: Intent(float(ball[0] + dx), float(ball[1] + dy), 0.0)
-            for k, (dx, dy) in enumerate(rng.uniform(-0.6, 0.6, (12, 2)))}  # fmt: skip
+            for k, (dx, dy) in enumerate(rng.uniform(-0.6, 0.6, (12, 2)))}
     out = keep_off_line(near, ball, target, FIELD, P, RADIUS)
     for it in out.values():
         assert abs(it.x) <= FIELD.half_length - RADIUS + 1e-9 and abs(it.y) <= FIELD.half_width - RADIUS + 1e-9

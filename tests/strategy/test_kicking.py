@@ -26,9 +26,9 @@ def _robot(rid: int, x: float, y: float, theta: float = 0.0) -> RobotState:
 
 
 def _decide(ball: BallState, own: dict[int, RobotState], supporters: list[int], opponents: np.ndarray,
-            passes: PassPlay | None = None) -> Kick:  # fmt: skip
+            passes: PassPlay | None = None) -> Kick:
     return decide_kick(ball, 1, own, supporters, passes or PassPlay(PassPlayParams()), opponents, FIELD, 1.0, R, K,
-                       PASS, SKILLS)  # fmt: skip
+                       PASS, SKILLS)
 
 
 def test_the_kinds_keep_the_match_statistics_names() -> None:
@@ -73,7 +73,7 @@ def test_a_decided_pass_is_kept_to_its_point() -> None:
     ((0.0, 0.0), (1.8, 0.5), True),
     ((1.0, 0.0), (1.8, 0.5), False),  # the ball rolls: not contested
     ((0.0, 0.0), (1.0, 0.5), False),  # the opponent is not at the ball
-])  # fmt: skip
+])
 def test_a_contested_ball_is_kicked_from_the_attackers_side(
     ball_v: tuple[float, float], opponent: tuple[float, float], contested: bool
 ) -> None:
@@ -140,7 +140,7 @@ def test_a_contested_ball_lying_still_is_driven_through_after_the_stall_time() -
     (BallState(FIELD.half_length - FIELD.dims.defense_depth_m - 0.03, 0.5, 0.0, 0.0),  # just outside: the margin
      (FIELD.half_length - 1.6, 0.5)),
     (BallState(FIELD.half_length - 1.6, 0.2, 1.5, 0.0), (FIELD.half_length - 1.4, -0.8)),  # rolling into it
-])  # fmt: skip
+])
 def test_a_ball_in_or_at_their_defense_area_is_left_to_them(ball: BallState, robot: tuple[float, float]) -> None:
     """The rules: an attacker touching the ball in the opponent's defense area is a foul. The attacker
     waits by the area, facing the ball, its edge ``area_wait_m`` off it."""

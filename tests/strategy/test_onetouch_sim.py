@@ -23,7 +23,7 @@ def test_one_touch_leaves_toward_the_target(target_deg: float, turn_deg: float, 
     incoming_deg = target_deg + turn_deg
     kicker = KickerParams()
     w = World(LEAGUE, PhysicsParams(), RobotParams(), BallParams(), kicker, DribblerParams(),
-              robots_per_team={"blue": 1, "yellow": 0})  # fmt: skip
+              robots_per_team={"blue": 1, "yellow": 0})
     # the ball comes from the direction incoming_deg (seen from the robot) and rolls at it
     come_from = math.radians(incoming_deg)
     v_in = (-speed * math.cos(come_from), -speed * math.sin(come_from))

@@ -36,7 +36,7 @@ def test_a_pass_stays_planned_while_the_ball_lies() -> None:
     (3.0, 3.0, False),  # cos 0.71: not toward the point
     (0.4, 0.0, False),  # too slow to be a pass
     (-3.0, 0.0, False),  # away from it
-])  # fmt: skip
+])
 def test_kicked_once_the_ball_runs_toward_the_point(vx: float, vy: float, kicked: bool) -> None:
     play = _planned()
     ps = play.follow(1.0, _own(), BallState(0.1, 0.0, vx, vy))

@@ -88,7 +88,7 @@ def test_a_contested_ball_is_played_from_the_attackers_side() -> None:
     p = StrategyParams()
     ball = BallState(2.0, 0.5, 0.0, 0.0)
     robots = (_robot("blue", 0, -4.3, 0.0), _robot("blue", 1, 2.2, 0.5, math.pi),
-              _robot("yellow", 0, 4.3, 0.0), _robot("yellow", 1, 1.8, 0.5))  # fmt: skip
+              _robot("yellow", 0, 4.3, 0.0), _robot("yellow", 1, 1.8, 0.5))
     strategy = Strategy("blue", FIELD, p)
     game = GameState(0.0, "normal", blue_defends_negative_x=True)
     intent = strategy.decide(WorldState(0.0, ball, robots), game)[1]
@@ -108,7 +108,7 @@ def test_a_decided_pass_goes_where_its_receiver_waits() -> None:
     p = StrategyParams(defense=DefenseParams(defenders=0))
     ball = BallState(-1.0, 0.0, 0.0, 0.0)
     robots = [_robot("blue", 0, -4.3, 0.0), _robot("blue", 1, -1.3, 0.0), _robot("blue", 2, 1.0, 2.0),
-              _robot("yellow", 0, 4.3, 0.0), _robot("yellow", 1, 0.5, -0.3)]  # fmt: skip
+              _robot("yellow", 0, 4.3, 0.0), _robot("yellow", 1, 0.5, -0.3)]
     strategy = Strategy("blue", FIELD, p)
     game = GameState(0.0, "normal", blue_defends_negative_x=True)
     strategy.decide(WorldState(0.0, ball, tuple(robots)), game)
@@ -148,7 +148,7 @@ def test_the_radii_are_read_in_one_place() -> None:
 
 @pytest.mark.parametrize(("section", "key", "value"), [
     ("kicking", "meet_cos", 1.5), ("pass_play", "timeout_s", 0.0), ("support", "eval_every_frames", 0),
-    ("game_states", "stop_distance_m", 0.4), ("defense", "defenders", 11)])  # fmt: skip
+    ("game_states", "stop_distance_m", 0.4), ("defense", "defenders", 11)])
 def test_out_of_range_settings_are_refused_by_name(section: str, key: str, value: float) -> None:
     raw = {section: {key: value}}
     with pytest.raises(ConfigError, match=f"{section}.{key}"):
@@ -159,9 +159,9 @@ def test_out_of_range_settings_are_refused_by_name(section: str, key: str, value
     ((0.3, 0.1), (0.3, 0.4)),  # beside the rolling ball's way: sideways to clear_m off it
     ((-0.3, -0.2), (-0.3, -0.4)),  # behind it, on its right: likewise, on that side
     ((0.5, -0.6), (0.5, -0.6)),  # already clear of its way: stays
-])  # fmt: skip
+])
 def test_the_restart_kicker_steps_out_of_the_rolling_balls_way(robot: tuple[float, float],
-                                                               expected: tuple[float, float]) -> None:  # fmt: skip
+                                                               expected: tuple[float, float]) -> None:
     p = StrategyParams()
     ball = BallState(0.0, 0.0, 1.5, 0.0)
     r = RobotState("blue", 1, *robot, 0.0)
@@ -174,9 +174,9 @@ def test_the_restart_kicker_steps_out_of_the_rolling_balls_way(robot: tuple[floa
 @pytest.mark.parametrize(("robot", "ball"), [
     ((0.3, 0.1), BallState(0.0, 0.0, 0.2, 0.0)),  # the ball (nearly) at rest
     ((1.5, 0.1), BallState(0.0, 0.0, 1.5, 0.0)),  # the robot far from it
-])  # fmt: skip
+])
 def test_the_restart_kicker_goes_its_way_by_a_ball_at_rest_or_far(robot: tuple[float, float],
-                                                                  ball: BallState) -> None:  # fmt: skip
+                                                                  ball: BallState) -> None:
     p = StrategyParams()
     away = Intent(3.0, 0.0, 0.0)
     r = RobotState("blue", 1, *robot, 0.0)

@@ -12,7 +12,7 @@ GOALIE, ATTACKER, DEFENDER = Role(RoleKind.GOALIE), Role(RoleKind.ATTACKER), Rol
 def test_roles_by_priority_with_hysteresis() -> None:
     roles = RoleAssigner(RoleParams(hysteresis_m=0.3))
     objectives = [Objective(GOALIE, -4.2, 0.0, fixed_robot=0), Objective(ATTACKER, 0.0, 0.0),
-                  Objective(DEFENDER, -3.0, 0.0)]  # fmt: skip
+                  Objective(DEFENDER, -3.0, 0.0)]
     robots = {0: (-4.0, 0.0), 1: (0.7, 0.0), 2: (-0.5, 0.0), 3: (-2.5, 0.0)}
     out = roles.assign(robots, objectives)
     assert out == {0: GOALIE, 2: ATTACKER, 3: DEFENDER}
@@ -42,7 +42,7 @@ def test_roles_of_one_kind_are_told_apart_by_index() -> None:
 
 def test_more_objectives_than_robots_leave_the_last_ones_open() -> None:
     objectives = [Objective(GOALIE, -4.2, 0.0, fixed_robot=0), Objective(ATTACKER, 0.0, 0.0),
-                  Objective(DEFENDER, -3.0, 0.0)]  # fmt: skip
+                  Objective(DEFENDER, -3.0, 0.0)]
     out = RoleAssigner(RoleParams()).assign({0: (-4.0, 0.0), 1: (-2.9, 0.0)}, objectives)
     assert out == {0: GOALIE, 1: ATTACKER}  # priority first, however near robot 1 is to the defender's point
 

@@ -32,7 +32,7 @@ def scene(blue: int, yellow: int) -> tuple[World, Referee, Brain]:
     # the brain sees the truth of now: the robots act on their commands at once (no latency to predict through)
     robot = dataclasses.replace(s.robot, command_latency_s=0.0)
     w = World(SETTINGS.field, s.physics, robot, s.ball, s.kicker, s.dribbler,
-              robots_per_team={"blue": blue, "yellow": yellow})  # fmt: skip
+              robots_per_team={"blue": blue, "yellow": yellow})
     ref = Referee(w.field, w.robot_keys(), s.referee)
     w.apply(ref.kickoff_setup("blue"))
     return w, ref, Brain("blue", SETTINGS)
@@ -44,7 +44,7 @@ def play(w: World, ref: Referee, brain: Brain, seconds: float,
          each: Callable[[World, Referee], None] | None = None,
          opponent: Callable[[World, Referee, WorldState], list[RobotCommand]] | None = None,
          see: Callable[[WorldState], WorldState] | None = None,
-         ) -> list[GameEvent]:  # fmt: skip
+         ) -> list[GameEvent]:
     calls: list[GameEvent] = []
     for k in range(round(seconds * 60)):
         truth = w.ground_truth()
@@ -83,7 +83,7 @@ Pose = tuple[int, float, float, float]
     ((2.0, 0.0), (0.0, 0.0), ((1, 1.0, 0.0, 0.0),), ()),  # ... the robot between ball and target
     ((1.0, 0.5), (2.0, 1.5), (), ((0, 1.0, 0.25, math.pi / 2),)),  # an opponent by the ball
     ((-1.0, -1.0), (1.0, 1.0), (), ((0, 1.0, 1.3, 0.0),)),  # an opponent by the target
-])  # fmt: skip
+])
 def test_ball_placement_ends_in_tolerance_in_time(ball: tuple[float, float], target: tuple[float, float],
                                                   ours: tuple[Pose, ...], theirs: tuple[Pose, ...]) -> None:
     w, ref, brain = scene(blue=3, yellow=1)
@@ -93,7 +93,7 @@ def test_ball_placement_ends_in_tolerance_in_time(ball: tuple[float, float], tar
     w.place_ball(*ball)
     ref.start_placement("blue", target)
     calls = play(w, ref, brain, RULES.placement_time_s + 1.0,
-                 until=lambda c: any(e.kind.startswith("placement_") for e in c))  # fmt: skip
+                 until=lambda c: any(e.kind.startswith("placement_") for e in c))
     done = [e for e in calls if e.kind == "placement_succeeded"]
     assert done, [e.kind for e in calls]
     assert done[0].value <= RULES.placement_time_s
@@ -125,7 +125,7 @@ def test_ball_placement_backwards_with_the_ball_seen_nearer_than_it_is() -> None
     target = (-2.68, 0.07)
     ref.start_placement("blue", target)
     calls = play(w, ref, brain, RULES.placement_time_s + 1.0, see=nearer,
-                 until=lambda c: any(e.kind.startswith("placement_") for e in c))  # fmt: skip
+                 until=lambda c: any(e.kind.startswith("placement_") for e in c))
     assert [e.kind for e in calls if e.kind.startswith("placement_")] == ["placement_succeeded"]
     x, y = w.ball_body.position
     assert math.hypot(x - target[0], y - target[1]) <= RULES.placement_tolerance_m
@@ -155,7 +155,7 @@ def test_ball_placement_lets_go_with_the_ball_seen_to_follow_the_robot() -> None
     ref.start_placement("blue", target)
     calls = play(w, ref, brain, RULES.placement_time_s + 1.0, see=follows,
                  each=lambda w, ref: dribbler.append(brain.plans[1].intent.dribbler),
-                 until=lambda c: any(e.kind.startswith("placement_") for e in c))  # fmt: skip
+                 until=lambda c: any(e.kind.startswith("placement_") for e in c))
     assert [e.kind for e in calls if e.kind.startswith("placement_")] == ["placement_succeeded"]
     x, y = w.ball_body.position
     assert math.hypot(x - target[0], y - target[1]) <= RULES.placement_tolerance_m
@@ -166,7 +166,7 @@ def test_ball_placement_lets_go_with_the_ball_seen_to_follow_the_robot() -> None
 @pytest.mark.slow
 @pytest.mark.parametrize("robot", [(-4.42, 1.48, -0.21), (-4.5, 2.1, -1.0)])
 def test_a_robot_beside_the_ball_in_a_corner_at_a_stop_leaves_it_without_touching_it(
-        robot: tuple[float, float, float]) -> None:  # fmt: skip
+        robot: tuple[float, float, float]) -> None:
     """After their placement in our corner a robot stands 0.35 m from the ball with no path round it
     to its place (the field's edge, our defense area): it leaves the ball's circle straight off the
     ball (it had driven straight at its place, across the ball, and moved it)."""
@@ -205,7 +205,7 @@ def test_penalty_scores_against_a_still_keeper() -> None:
     w.place_robot("yellow", 0, w.field.half_length - 0.5 * R, 0.0, math.pi)  # on its goal line, still
     w.apply(ref.start_penalty("blue"))
     calls = play(w, ref, brain, RULES.prepare_timeout_s + RULES.penalty_time_s,
-                 until=lambda c: ref.score["blue"] > 0 or any(e.kind == "penalty_over" for e in c))  # fmt: skip
+                 until=lambda c: ref.score["blue"] > 0 or any(e.kind == "penalty_over" for e in c))
     assert ref.score == {"blue": 1, "yellow": 0}, [e.kind for e in calls]
     assert ref.tally.penalties["blue"] == {"taken": 1, "scored": 1}
 
@@ -223,7 +223,7 @@ def test_our_keeper_stops_a_penalty_kicked_at_its_body() -> None:
         return [RobotCommand("yellow", 0, vx=-0.8, kick_speed=4.0)]
 
     calls = play(w, ref, brain, RULES.prepare_timeout_s + RULES.penalty_time_s, theirs=kicker,
-                 until=lambda c: any(e.kind == "penalty_over" for e in c) or ref.score["yellow"] > 0)  # fmt: skip
+                 until=lambda c: any(e.kind == "penalty_over" for e in c) or ref.score["yellow"] > 0)
     assert ref.score["yellow"] == 0, [e.kind for e in calls]
     assert any(e.kind == "penalty_over" for e in calls)
     assert any(e.kind for e in calls) and ref.kicks >= 1
@@ -242,7 +242,7 @@ def test_our_penalty_beats_the_simple_opponents_keeper(keeper_y: float) -> None:
     w.place_robot("yellow", 0, w.field.half_length - 0.5 * R, keeper_y, math.pi)
     w.apply(ref.start_penalty("blue"))
     calls = play(w, ref, brain, RULES.prepare_timeout_s + RULES.penalty_time_s, opponent=simple_opponent(),
-                 until=lambda c: ref.score["blue"] > 0 or any(e.kind == "penalty_over" for e in c))  # fmt: skip
+                 until=lambda c: ref.score["blue"] > 0 or any(e.kind == "penalty_over" for e in c))
     assert ref.tally.penalties["blue"] == {"taken": 1, "scored": 1}, [e.kind for e in calls]
     assert not [e for e in calls if e.team == "blue" and e.kind != "penalty_over"]  # no foul of ours
 
@@ -251,7 +251,7 @@ def test_our_keeper_saves_the_simple_opponents_penalty() -> None:
     w, ref, brain = scene(blue=2, yellow=2)
     w.apply(ref.start_penalty("yellow"))
     calls = play(w, ref, brain, RULES.prepare_timeout_s + RULES.penalty_time_s, opponent=simple_opponent(),
-                 until=lambda c: ref.score["yellow"] > 0 or any(e.kind == "penalty_over" for e in c))  # fmt: skip
+                 until=lambda c: ref.score["yellow"] > 0 or any(e.kind == "penalty_over" for e in c))
     assert ref.tally.penalties["yellow"] == {"taken": 1, "scored": 0}, [e.kind for e in calls]
     assert any(e.kind == "penalty_over" for e in calls)
     assert not [e for e in calls if e.team == "blue" and e.kind != "penalty_over"]  # no foul of ours
@@ -288,7 +288,7 @@ def test_stop_keeps_every_robot_away_from_the_ball_and_slow_every_frame() -> Non
     (3, (1.0, 0.0), (-0.6, 0.0, 0.0)),  # straight behind the ball
     (3, (3.0, -1.0), (0.3, 0.4, 0.0)),  # beside the ball, the goal ahead
     (2, (-3.0, 0.5), (-0.4, -0.3, 0.0)),  # the taker our only field player: nobody else plays the ball after its kick
-])  # fmt: skip
+])
 def test_our_free_kick_taker_touches_the_ball_once(blue: int, spot: tuple[float, float],
                                                    taker: tuple[float, float, float]) -> None:
     # the rules: the kicker of a restart may touch the ball again only after another robot has; the

@@ -23,7 +23,7 @@ def _evaluation(points: list[tuple[float, float]], values: list[float]) -> PassE
 
 def test_the_best_points_spread_apart_and_off_the_ball() -> None:
     ev = _evaluation([(0.2, 0.0), (2.0, 0.0), (2.5, 0.0), (2.0, 1.5), (-2.0, 0.0)],
-                     [0.99, 0.9, 0.8, 0.7, 0.1])  # fmt: skip
+                     [0.99, 0.9, 0.8, 0.7, 0.1])
     ball = np.array([0.0, 0.0])
     # (0.2, 0) is on the ball, (2.5, 0) too near the better (2.0, 0)
     assert spread_points(ev, ball, 3, P) == [(2.0, 0.0), (2.0, 1.5), (-2.0, 0.0)]

@@ -24,7 +24,7 @@ SIGMA = 0.0005  # m: the tracker's configured vision noise
 def rolled_balls(acc_roll_m_s2: float, seed: int = 1, balls: int = 12) -> Tracker:
     """Balls rolled across the empty field one after another (each 6 s), seen by the tracker."""
     w = World(LeagueParams(), PhysicsParams(), RobotParams(), BallParams(acc_roll_m_s2=acc_roll_m_s2), KickerParams(),
-              DribblerParams(), robots_per_team={"blue": 0, "yellow": 0})  # fmt: skip
+              DribblerParams(), robots_per_team={"blue": 0, "yellow": 0})
     tracker = Tracker(params(sigma=SIGMA))
     rng = np.random.default_rng(seed)
     for _ in range(balls):
@@ -42,7 +42,7 @@ def scripted_stops(brake_m_s2: float, seed: int = 1, stops: int = 25) -> Tracker
     hears its commands."""
     latency = 0.03
     w = World(LeagueParams(), PhysicsParams(), RobotParams(max_brake_m_s2=brake_m_s2, command_latency_s=latency),
-              BallParams(), KickerParams(), DribblerParams(), robots_per_team={"blue": 1, "yellow": 0})  # fmt: skip
+              BallParams(), KickerParams(), DribblerParams(), robots_per_team={"blue": 1, "yellow": 0})
     w.place_robot("blue", 0, -3.0, 0.0, 0.0)
     w.place_ball(0.0, 2.5)
     tracker = Tracker(params(latency=latency, sigma=SIGMA))

@@ -22,7 +22,7 @@ FRONT = 0.07 + 0.0215
 
 def make_world(blue: int = 1, yellow: int = 0) -> World:
     w = World(LeagueParams(), PhysicsParams(), RobotParams(), BallParams(), KickerParams(), DribblerParams(),
-              robots_per_team={"blue": blue, "yellow": yellow})  # fmt: skip
+              robots_per_team={"blue": blue, "yellow": yellow})
     for i, (team, rid) in enumerate(w.robot_keys()):
         w.place_robot(team, rid, -3.5 + i, -2.5, 0.0)
     w.place_ball(0.0, 1.5)
@@ -30,7 +30,7 @@ def make_world(blue: int = 1, yellow: int = 0) -> World:
 
 
 def detect(snap: Snapshot, rng: np.random.Generator, camera: int = 0, ball: bool = True,
-           sigma: float = SIGMA) -> DetectionFrame:  # fmt: skip
+           sigma: float = SIGMA) -> DetectionFrame:
     balls = ()
     if ball:
         bx, by = snap.ball[:2] + rng.normal(0, sigma, 2)
@@ -39,7 +39,7 @@ def detect(snap: Snapshot, rng: np.random.Generator, camera: int = 0, ball: bool
         RobotDetection(TEAMS[int(r[0])], int(r[1]), float(r[2] + rng.normal(0, sigma)),
                        float(r[3] + rng.normal(0, sigma)), float(r[4] + rng.normal(0, 0.02)), 0.9, (0.0, 0.0))
         for r in snap.robots
-    )  # fmt: skip
+    )
     return DetectionFrame(camera, snap.frame_number, snap.t, snap.t, balls, robots)
 
 
@@ -291,7 +291,7 @@ def test_lookahead_follows_commands_already_sent() -> None:
     # not only the one in force now; 6 frames of latency, in the simulator and the tracker alike
     latency = 6 / 60
     w = World(LeagueParams(), PhysicsParams(), RobotParams(command_latency_s=latency), BallParams(), KickerParams(),
-              DribblerParams(), robots_per_team={"blue": 1, "yellow": 0})  # fmt: skip
+              DribblerParams(), robots_per_team={"blue": 1, "yellow": 0})
     w.place_robot("blue", 0, 0.0, 0.0, 0.0)
     tracker = Tracker(params(latency))
     rng = np.random.default_rng(11)
@@ -313,7 +313,7 @@ def test_lookahead_follows_commands_already_sent() -> None:
 
 def roll_ball(x: float, vx: float, seed: int, frames: int,
               balls_seen: Callable[[int, tuple[BallDetection, ...]], tuple[BallDetection, ...]],
-              ) -> Iterator[tuple[int, WorldState, Snapshot]]:  # fmt: skip
+              ) -> Iterator[tuple[int, WorldState, Snapshot]]:
     """A ball rolling along y = 0, its detections of frame k passed through ``balls_seen(k, ...)``."""
     w = make_world(blue=0)
     w.place_ball(x, 0.0, vx=vx)
@@ -379,7 +379,7 @@ def test_two_cameras_that_disagree_a_little_show_no_kick() -> None:
             DetectionFrame(cam, k, t, t, (BallDetection(float(x + off + rng.normal(0, 0.0002)),
                                                         float(0.3 + rng.normal(0, 0.0002)), 0.9, (0.0, 0.0), 0.0002),))
             for cam, off in ((0, 0.0), (1, 0.0012))
-        ]  # fmt: skip
+        ]
         ws = tracker.step(frames)
         if k == 30:  # settled (a ball first seen is taken to slide: a kick may be seen before it rolls)
             kicks = tracker.stats.ball_kicks

@@ -57,7 +57,7 @@ def cameras() -> list[CameraModel]:
 
 
 def render(model: CameraModel, snap: Snapshot, params: RenderParams | None = None,
-           seed: int = 0) -> tuple[NDArray[np.uint8], CameraTruth]:  # fmt: skip
+           seed: int = 0) -> tuple[NDArray[np.uint8], CameraTruth]:
     renderer = CameraRenderer(model, LEAGUE, params or RenderParams(), seed=seed)
     image, truth = renderer.render(snap)
     return image.copy(), truth

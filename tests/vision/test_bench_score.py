@@ -22,13 +22,13 @@ def test_score_counts_found_false_and_wrong_ids() -> None:
         (RobotTruth("blue", 1, 0.0, 0.0, 0.5, 0, 0, 0, pixels={0: (1.0, 1.0)}),
          RobotTruth("yellow", 2, 2.0, 0.0, 0.0, 0, 0, 0, pixels={0: (2.0, 2.0)}),
          RobotTruth("yellow", 3, 3.0, 0.0, 0.0, 0, 0, 0, pixels={1: (2.0, 2.0)})),
-    )  # fmt: skip
+    )
     det = DetectionFrame(
         0, 3, 0.05, 0.05, (BallDetection(1.003, 1.004, 1.0, (0, 0)), BallDetection(-2.0, 0.0, 0.5, (0, 0))),
         (RobotDetection("blue", 1, 0.002, 0.0, 0.5 + math.radians(1.0), 1.0, (0, 0)),
          RobotDetection("yellow", 7, 2.0, 0.01, 0.0, 1.0, (0, 0)),
          RobotDetection("blue", 4, -1.0, -1.0, 0.0, 1.0, (0, 0))),
-    )  # fmt: skip
+    )
     score = Score()
     score.add(det, truth)
     s = score.summary()
@@ -47,7 +47,7 @@ def test_tiny_vision_bench_meets_the_quality_targets() -> None:
     # the lab camera's rows run the realistic pipeline test_realistic_pipeline.py holds to its targets
     rows = {r["name"]: r for r in run(load_settings(CONFIGS), True, frames=3, lab=False)}
     quality = ["vision low", "vision default", "vision high", "vision default, h264 crf 18 (sim --record default)",
-               "vision default, h264 crf 23 (4:2:0, x264 default)", "vision default, 1920x1200 (1 camera)"]  # fmt: skip
+               "vision default, h264 crf 23 (4:2:0, x264 default)", "vision default, 1920x1200 (1 camera)"]
     for name in quality:
         row = rows[name]
         assert row["camera_frames"] == (2 if "1920" in name else 6)

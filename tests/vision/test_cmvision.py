@@ -164,7 +164,7 @@ def test_regions_equal_opencv_connected_components(connectivity: int, seed: int)
         ours = regions.of_class(k)
         assert len(ours) == n - 1
         ref = sorted(((stats[j, cv2.CC_STAT_AREA], cents[j, 0] + 0.5, cents[j, 1] + 0.5) for j in range(1, n)),
-                     key=lambda r: (-r[0], r[1], r[2]))  # fmt: skip
+                     key=lambda r: (-r[0], r[1], r[2]))
         got = sorted(((regions.area[j], *regions.centroid[j]) for j in ours), key=lambda r: (-r[0], r[1], r[2]))
         np.testing.assert_allclose(np.array(got), np.array(ref), atol=1e-9)
         # the kernels' statistics also equal plain numpy on OpenCV's labels (moments, boxes)
@@ -219,7 +219,7 @@ def test_kernel_colour_conversion_equals_reference_for_every_colour(space: str) 
     for b in range(0, 256, 32):  # all 2^24 colours, 32 blue levels at a time
         image = np.stack([np.broadcast_to(np.arange(b, b + 32)[:, None, None], (32, 256, 256)),
                           np.broadcast_to(g, (32, 256, 256)), np.broadcast_to(r, (32, 256, 256))],
-                         axis=-1).astype(np.uint8).reshape(32 * 256, 256, 3)  # fmt: skip
+                         axis=-1).astype(np.uint8).reshape(32 * 256, 256, 3)
         np.testing.assert_array_equal(kern.channels(image, space == "yuv"), convert_colour(image, space))  # type: ignore[arg-type]
 
 
@@ -234,7 +234,7 @@ def speckled_stats(seed: int) -> NDArray[np.float64]:
     specks = rng.random(image.shape[:2]) < 0.08
     image[specks] = np.where(rng.random((int(specks.sum()), 1)) < 0.5, [255, 255, 255], [0, 0, 255])
     classes = {"white": ColourClass(lo=(200, 0, 0), hi=(255, 255, 255)),
-               "red": ColourClass(lo=(50, 0, 200), hi=(120, 120, 255))}  # fmt: skip
+               "red": ColourClass(lo=(50, 0, 200), hi=(120, 120, 255))}
     seg = Segmenter(classes, "yuv", RegionParams())
     runs, counts = seg.runs(image)
     flat, label, n = kern.connect_runs(runs, counts, True)

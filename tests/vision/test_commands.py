@@ -29,7 +29,7 @@ def recording(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A short PNG recording with truth from `cmdragons sim`, three frames made bad."""
     out = tmp_path_factory.mktemp("rec")
     assert main(["sim", "--config", str(CONFIGS), "--seconds", "0.1", "--record", "--format", "png",
-                 "--out", str(out), "--no-progress"]) == 0  # fmt: skip
+                 "--out", str(out), "--no-progress"]) == 0
     frames = sorted((out / "camera_0").glob("*.png"))
     frames[1].write_bytes(b"not a png")  # corrupt
     frames[2].write_bytes(b"")  # empty
@@ -44,10 +44,10 @@ Capture = pytest.CaptureFixture[str]
 
 @pytest.mark.slow
 def test_vision_on_a_recording_counts_bad_frames_and_scores_truth(recording: Path, tmp_path: Path,
-                                                                  capsys: Capture) -> None:  # fmt: skip
+                                                                  capsys: Capture) -> None:
     out = tmp_path / "out"
     assert main(["vision", str(recording), "--config", str(CONFIGS), "--out", str(out), "--no-progress",
-                 "--video"]) == 0  # fmt: skip
+                 "--video"]) == 0
     text = capsys.readouterr().out
     assert "1 unreadable frame(s): rec0/camera_0#1" in text.replace(recording.name, "rec0")
     assert "1 empty frame(s)" in text and "1 wrong size frame(s)" in text
@@ -66,7 +66,7 @@ def test_the_summary_counts_the_whole_field_per_capture(tmp_path: Path, capsys: 
     as 0.5 balls per frame); the ball lies at the centre spot, in both cameras' views, and counts once."""
     rec, out = tmp_path / "rec", tmp_path / "out"
     assert main(["sim", "--config", str(CONFIGS), "--seconds", "0.1", "--record", "--format", "png",
-                 "--out", str(rec), "--no-progress"]) == 0  # fmt: skip
+                 "--out", str(rec), "--no-progress"]) == 0
     truth = [json.loads(s) for s in (rec / "truth.jsonl").read_text().splitlines()]
     capsys.readouterr()
     assert main(["vision", str(rec), "--config", str(CONFIGS), "--out", str(out), "--no-progress"]) == 0
@@ -99,7 +99,7 @@ def test_vision_on_a_glob_and_a_video(recording: Path, tmp_path: Path, capsys: p
 def test_vision_on_a_cut_off_video_processes_every_frame_before_the_break(tmp_path: Path, capsys: Capture) -> None:
     rec = tmp_path / "rec"
     assert main(["sim", "--config", str(CONFIGS), "--seconds", "0.5", "--record", "--out", str(rec),
-                 "--no-progress"]) == 0  # fmt: skip
+                 "--no-progress"]) == 0
     meta = yaml.safe_load((rec / "cameras.yaml").read_text())
     assert meta["recording"] == {"codec": "h264", "crf": 18}  # the recording says what it holds
     video = rec / "camera_0.mp4"
@@ -126,7 +126,7 @@ def test_tune_from_truth_and_from_labels(recording: Path, tmp_path: Path, capsys
     # every line but the colour boxes' stays as it was, comments and all
     after = (config / "vision.yaml").read_text()
     box_lines = [k for k, line in enumerate(before.splitlines()) if line.lstrip().startswith(
-        ("orange:", "blue:", "yellow:", "pink:", "green:")) and "lo:" in line]  # fmt: skip
+        ("orange:", "blue:", "yellow:", "pink:", "green:")) and "lo:" in line]
     assert len(box_lines) == 5 and len(after.splitlines()) == len(before.splitlines())
     for k, (a, b) in enumerate(zip(before.splitlines(), after.splitlines(), strict=True)):
         if k in box_lines:
@@ -145,9 +145,9 @@ def test_tune_from_truth_and_from_labels(recording: Path, tmp_path: Path, capsys
     t0 = json.loads((recording / "truth.jsonl").read_text().splitlines()[0])
     ball = t0["ball"]["cameras"]["0"]["pixel"]
     labels.write_text(yaml.safe_dump([{"colour": "orange", "pixel": ball, "radius": 2.5},
-                                      {"colour": "carpet", "pixel": [30, 30], "radius": 10}]))  # fmt: skip
+                                      {"colour": "carpet", "pixel": [30, 30], "radius": 10}]))
     assert main(["vision", "tune", str(frame), "--labels", str(labels), "--config", str(config),
-                 "--out", str(tmp_path / "v.yaml")]) == 0  # fmt: skip
+                 "--out", str(tmp_path / "v.yaml")]) == 0
     data = yaml.safe_load((tmp_path / "v.yaml").read_text())
     assert data["colours"]["carpet"]["lo"][0] < 90 < data["colours"]["carpet"]["hi"][0]
 
@@ -164,7 +164,7 @@ def _field_points() -> np.ndarray:
 @pytest.mark.parametrize("fit_principal", [False, True])
 def test_calibration_recovers_known_parameters(fit_principal: bool) -> None:
     truth = CameraParams(id=2, position_m=(-2.2, 0.15, 4.05), yaw_rad=-1.55, tilt_x_rad=0.03, tilt_y_rad=-0.04,
-                         focal_px=640.0, principal_point_px=(512.0, 384.0), k1=-0.03, k2=0.005)  # fmt: skip
+                         focal_px=640.0, principal_point_px=(512.0, 384.0), k1=-0.03, k2=0.005)
     model = CameraModel(truth)
     xyz = _field_points()
     px = model.project(xyz)
@@ -173,7 +173,7 @@ def test_calibration_recovers_known_parameters(fit_principal: bool) -> None:
     noisy = px[keep] + rng.normal(0.0, 0.2, (int(keep.sum()), 2))
     # the height is measured (points on one plane cannot tell it from the focal length), within 1 cm
     guess = dataclasses.replace(truth, position_m=(0.0, 0.0, 4.06), yaw_rad=0.0, tilt_x_rad=0.0, tilt_y_rad=0.0,
-                                focal_px=600.0, k1=0.0, k2=0.0)  # fmt: skip
+                                focal_px=600.0, k1=0.0, k2=0.0)
     result = calibrate(noisy, xyz[keep], guess, fit_principal)
     assert result.rms_px < 0.4
     p = result.params

@@ -24,7 +24,7 @@ from .conftest import LEAGUE, render, snapshot
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 ROBOTS = [[0, 1, -2.0, 0.5, 0.3], [1, 4, -3.0, -1.0, 2.0], [0, 7, -1.0, -1.5, 1.0], [1, 9, 2.0, 0.2, 0.0],
-          [0, 3, 3.1, -1.2, 1.0], [1, 2, 0.2, 1.1, 2.5]]  # fmt: skip
+          [0, 3, 3.1, -1.2, 1.0], [1, 2, 0.2, 1.1, 2.5]]
 
 
 def pose_errors(got: CameraParams, true: CameraParams) -> tuple[float, float]:
@@ -40,7 +40,7 @@ def off_start(true: CameraParams, dx: float, dy: float) -> CameraParams:
     m = CameraModel(true)
     c = m.unproject(np.array([[0.0, 0.0], [m.width, m.height]]), 0.0)
     sees = (round(c[:, 0].min() + dx, 1), round(c[:, 1].min() + dy, 1), round(c[:, 0].max() + dx, 1),
-            round(c[:, 1].max() + dy, 1))  # fmt: skip
+            round(c[:, 1].max() + dy, 1))
     return rough_start(true, true.position_m[2], sees)
 
 
@@ -61,9 +61,9 @@ def test_lines_recover_the_simulators_cameras(cameras: list[CameraModel], cam: i
 def test_lines_on_a_frame_of_other_colours_tilt_and_distortion(cameras: list[CameraModel]) -> None:
     base = cameras[0].params
     true = dataclasses.replace(base, k1=-0.07, k2=0.01, tilt_x_rad=0.03, tilt_y_rad=-0.02, yaw_rad=base.yaw_rad + 0.02,
-                               position_m=(base.position_m[0] + 0.1, base.position_m[1] - 0.15, 3.7))  # fmt: skip
+                               position_m=(base.position_m[0] + 0.1, base.position_m[1] - 0.15, 3.7))
     look = RenderParams(carpet_bgr=(60, 95, 20), line_bgr=(200, 225, 230), noise_sigma_grey=4.0,
-                        vignetting_fraction=0.2, gradient_fraction=0.15)  # fmt: skip
+                        vignetting_fraction=0.2, gradient_fraction=0.15)
     image, _ = render(CameraModel(true), snapshot(ROBOTS, ball=(-2.5, 0.3, 0.0215)), look, seed=5)
     rough = off_start(base, -0.2, 0.2)
     start = dataclasses.replace(rough, position_m=(*rough.position_m[:2], 3.7))  # the height measured
@@ -78,12 +78,12 @@ def test_lines_on_a_frame_of_other_colours_tilt_and_distortion(cameras: list[Cam
 def test_lines_on_a_small_custom_field() -> None:
     """A 6.05 x 4.05 m field (an older size, as a custom division in field.yaml)."""
     small = FieldDims(length_m=6.05, width_m=4.05, goal_width_m=0.7, defense_width_m=1.4, defense_depth_m=0.8,
-                      center_circle_radius_m=0.5)  # fmt: skip
+                      center_circle_radius_m=0.5)
     league = dataclasses.replace(LEAGUE, divisions={"B": small, "A": LEAGUE.divisions["A"]})
     models = cameras_from_config(CamerasParams(), league)
     true = models[-1].params
     image, _ = CameraRenderer(models[-1], league, RenderParams(), seed=2).render(
-        snapshot(ROBOTS[:2], ball=(1.0, 0.3, 0.0215)))  # fmt: skip
+        snapshot(ROBOTS[:2], ball=(1.0, 0.3, 0.0215)))
     fit = calibrate_from_lines(image.copy(), league, off_start(true, 0.2, 0.2))
     dist, angle = pose_errors(fit.params, true)
     assert dist < 0.01 and angle < 0.5 and fit.rms_px <= 0.5
@@ -91,7 +91,7 @@ def test_lines_on_a_small_custom_field() -> None:
 
 @pytest.mark.slow
 def test_calibrate_lines_command_keeps_comments_and_draws_the_overlay(cameras: list[CameraModel],
-                                                                      tmp_path: Path) -> None:  # fmt: skip
+                                                                      tmp_path: Path) -> None:
     config = tmp_path / "configs"
     shutil.copytree(CONFIGS, config)
     before = (config / "cameras.yaml").read_text()
@@ -103,7 +103,7 @@ def test_calibrate_lines_command_keeps_comments_and_draws_the_overlay(cameras: l
     c = m.unproject(np.array([[0.0, 0.0], [m.width, m.height]]), 0.0)
     sees = [str(round(v, 1)) for v in (c[:, 0].min() - 0.2, c[:, 1].min(), c[:, 0].max() - 0.2, c[:, 1].max())]
     argv = ["vision", "calibrate", "--lines", str(frame), "--camera", "1", "--height", "4.0", "--sees", *sees,
-            "--config", str(config)]  # fmt: skip
+            "--config", str(config)]
     assert main(argv) == 0
     after = (config / "cameras.yaml").read_text()
     comments = [line for line in before.splitlines() if line.lstrip().startswith("#")]
@@ -126,7 +126,7 @@ def test_calibrate_lines_command_keeps_comments_and_draws_the_overlay(cameras: l
 
 
 LAB = FieldDims(length_m=5.54, width_m=3.77, boundary_width_m=0.3, goal_width_m=1.0, defense_width_m=2.0,
-                defense_depth_m=1.0, line_width_m=0.045, center_circle=False, goal_to_goal_line=False)  # fmt: skip
+                defense_depth_m=1.0, line_width_m=0.045, center_circle=False, goal_to_goal_line=False)
 
 
 def _league(dims: FieldDims) -> LeagueParams:
@@ -139,9 +139,9 @@ def lab_render() -> tuple[NDArray[np.uint8], CameraParams]:
     whole by one slightly tilted, distorted 1280x720 camera at 3.2 m."""
     true = CameraParams(id=0, position_m=(0.05, -0.04, 3.2), yaw_rad=0.01, tilt_x_rad=0.01, tilt_y_rad=-0.015,
                         focal_px=700.0, principal_point_px=(640.0, 360.0), k1=-0.03, k2=0.0,
-                        resolution_px=(1280, 720))  # fmt: skip
+                        resolution_px=(1280, 720))
     image, _ = CameraRenderer(CameraModel(true), _league(LAB), RenderParams(noise_sigma_grey=2.0), seed=3).render(
-        snapshot(ROBOTS[:3], ball=(1.0, 0.3, 0.0215)))  # fmt: skip
+        snapshot(ROBOTS[:3], ball=(1.0, 0.3, 0.0215)))
     return image.copy(), true
 
 
@@ -169,13 +169,13 @@ BIGGER = {"length_m": 6.2, "width_m": 4.22, "defense_depth_m": 1.12, "defense_wi
     (dataclasses.replace(LAB, **BIGGER), 700.0, "off the known 700 px"),  # all 12 % too big, the lens known
     (dataclasses.replace(LAB, center_circle=True), 0.0, "not the one in the image"),
     (FieldDims(), 0.0, "not the one in the image"),  # the league's 9 x 6 m field
-])  # fmt: skip
+])
 def test_a_wrong_field_is_refused_with_its_reason(lab_render: tuple[NDArray[np.uint8], CameraParams],
-                                                  field: FieldDims, focal: float, reason: str) -> None:  # fmt: skip
+                                                  field: FieldDims, focal: float, reason: str) -> None:
     image, true = lab_render
     with pytest.raises(CalibrationRefused, match=reason):
         calibrate_from_lines(image, _league(field), rough_start(true, 3.2, (-3.3, -1.7, 3.1, 1.9)),
-                             LineFitParams(known_focal_px=focal))  # fmt: skip
+                             LineFitParams(known_focal_px=focal))
 
 
 REAL = Path(__file__).resolve().parents[3] / "shared" / "realdata" / "lab_frame_lights_on.jpg"
@@ -188,7 +188,7 @@ def test_the_real_lab_frame() -> None:
     image = np.asarray(cv2.imread(str(REAL)), dtype=np.uint8)
     base = CameraParams(id=0, resolution_px=(1920, 1080), principal_point_px=(960.0, 540.0))
     fit = calibrate_from_lines(image, _league(dataclasses.replace(LAB, line_width_m=0.01, outer_lines="walls")),
-                               rough_start(base, 4.0, (-3.45, -1.94, 3.45, 1.94)))  # fmt: skip
+                               rough_start(base, 4.0, (-3.45, -1.94, 3.45, 1.94)))
     mm = fit.line_width_px / CameraModel(fit.params).pixels_per_metre((0.0, 0.0), 0.0) * 1000
     assert 35 < mm < 55 and fit.lines_seen == 7 and fit.found > 0.9 and fit.rms_px < 1.6
     fov = math.degrees(2 * math.atan(960 / fit.params.focal_px))
@@ -197,7 +197,7 @@ def test_the_real_lab_frame() -> None:
 
 def test_calibrate_lines_command_refuses_the_default_field_on_a_lab_frame(
         lab_render: tuple[NDArray[np.uint8], CameraParams], tmp_path: Path,
-        capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
+        capsys: pytest.CaptureFixture[str]) -> None:
     """No --config: the league's 9 x 6 m field against a 5.54 x 3.77 m lab field. Exit 2, the
     reason in one line, cameras.yaml untouched."""
     config = tmp_path / "configs"
@@ -206,7 +206,7 @@ def test_calibrate_lines_command_refuses_the_default_field_on_a_lab_frame(
     frame = tmp_path / "lab.png"
     cv2.imwrite(str(frame), lab_render[0])
     assert main(["vision", "calibrate", "--lines", str(frame), "--config", str(config), "--height", "3.2",
-                 "--sees", "-3.3", "-1.7", "3.1", "1.9"]) == 2  # fmt: skip
+                 "--sees", "-3.3", "-1.7", "3.1", "1.9"]) == 2
     err = capsys.readouterr().err
     assert "not the one in the image" in err and len(err.strip().splitlines()) == 1
     assert (config / "cameras.yaml").read_text() == before

@@ -22,7 +22,7 @@ from vision.sources import FrameSizeError, open_sources
 from .conftest import LEAGUE, grid_of_robots, render, snapshot
 
 CAMERA = CameraParams(id=0, position_m=(-2.3, 0.1, 4.0), yaw_rad=0.03, tilt_x_rad=0.02, tilt_y_rad=-0.01,
-                      focal_px=610.0, principal_point_px=(515.0, 380.0), k1=-0.05, k2=0.01)  # fmt: skip
+                      focal_px=610.0, principal_point_px=(515.0, 380.0), k1=-0.05, k2=0.01)
 
 
 @pytest.mark.parametrize("size", [(1024, 768), (1280, 960), (640, 480), (2048, 1536), (1366, 1025)])
@@ -85,7 +85,7 @@ def test_another_aspect_ratio_stops_before_any_frame_is_processed(tmp_path: Path
     decoded: list[int] = []
     with pytest.raises(FrameSizeError) as err:
         run_vision(sources, {0: CameraModel(CAMERA)}, VisionParams(), LEAGUE, tmp_path / "out", False, 60.0,
-                   progress=decoded.append)  # fmt: skip
+                   progress=decoded.append)
     assert decoded == []  # no frame processed, and only the first read
     text = str(err.value)
     assert "1920x1080" in text and "1024x768" in text and "cmdragons vision calibrate --lines" in text
@@ -108,5 +108,5 @@ def test_a_later_frame_of_another_size_is_counted_not_fatal(tmp_path: Path) -> N
     _frames(tmp_path / "frames", [(2048, 1536), (1920, 1080), (2048, 1536)])
     sources, _ = open_sources([str(tmp_path / "frames")])
     summary = run_vision(sources, {0: CameraModel(dataclasses.replace(CAMERA))}, VisionParams(), LEAGUE,
-                         tmp_path / "out", False, 60.0)  # fmt: skip
+                         tmp_path / "out", False, 60.0)
     assert summary.frames == 3 and len(summary.wrong_size) == 1 and summary.wrong_size[0].endswith("#1")

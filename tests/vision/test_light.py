@@ -23,7 +23,7 @@ from .conftest import LEAGUE, render, snapshot
 
 ROBOTS = [[team, rid, x, y, 0.4 * rid + team] for k, (team, rid, x, y) in enumerate(
     [(0, 0, -3.4, 1.2), (0, 1, -2.6, -1.0), (0, 2, -1.6, 0.6), (1, 0, -3.0, -0.2), (1, 3, -2.0, -1.6),
-     (1, 5, -1.0, 1.5)])]  # fmt: skip
+     (1, 5, -1.0, 1.5)])]
 FULL = np.array([0.55, 0.8, 1.3])  # per BGR channel at the end of the change
 
 
@@ -58,7 +58,8 @@ def scene(cameras: list[CameraModel]) -> tuple[CameraModel, NDArray[np.uint8]]:
 
 def test_classes_follow_a_lighting_change(scene: tuple[CameraModel, NDArray[np.uint8]]) -> None:
     model, image = scene
-    following = dataclasses.replace(VisionParams(), light=LightParams(follow=True, grid=(4, 3), rate=0.2, every_frames=1))
+    light = LightParams(follow=True, grid=(4, 3), rate=0.2, every_frames=1)
+    following = dataclasses.replace(VisionParams(), light=light)
     got = run(following, model, image, 40)
     assert got == [len(ROBOTS)] * 40
     still = run(VisionParams(), model, image, 40)

@@ -31,7 +31,7 @@ def test_region_rays_equal_camera_unproject(cameras: list[CameraModel], z: float
     du = model.unproject(px + [0.5, 0.0], z) - model.unproject(px - [0.5, 0.0], z)
     dv = model.unproject(px + [0.0, 0.5], z) - model.unproject(px - [0.0, 0.5], z)
     np.testing.assert_allclose(area * (model.center[2] - z) ** 2, np.abs(du[:, 0] * dv[:, 1] - du[:, 1] * dv[:, 0]),
-                               rtol=2e-3)  # fmt: skip
+                               rtol=2e-3)
 
 
 @pytest.mark.parametrize("seed", range(4))
@@ -69,7 +69,7 @@ def test_a_missed_dot_is_read_from_the_image_with_three_dots(cameras: list[Camer
     _, _, x, y, th = robots[5]
     sx, sy = LEAGUE.pattern.dot_positions_m[0]
     u, v = model.project_xy(np.array([x + math.cos(th) * sx - math.sin(th) * sy,
-                                      y + math.sin(th) * sx + math.cos(th) * sy]), LEAGUE.robot.height_m)  # fmt: skip
+                                      y + math.sin(th) * sx + math.cos(th) * sy]), LEAGUE.robot.height_m)
     i, j = int(v), int(u)
     keep = image[i - 1 : i + 2, j - 1 : j + 2].copy()
     image[i - 5 : i + 6, j - 5 : j + 6] = (28, 28, 28)  # the matte-black cover
@@ -92,7 +92,7 @@ def test_a_missed_dot_is_read_from_the_image_with_three_dots(cameras: list[Camer
 
 
 def _disc_image(centre: tuple[float, float], radius_px: float, rng: np.random.Generator,
-                noise_grey: float) -> NDArray[np.uint8]:  # fmt: skip
+                noise_grey: float) -> NDArray[np.uint8]:
     """A shaded orange disc on carpet, each pixel mixed by its coverage (16 x 16 samples)."""
     n = 16
     off = (np.arange(n) + 0.5) / n
@@ -116,7 +116,7 @@ def test_ball_centre_kernel_equals_numpy_reference(seed: int) -> None:
     box = np.array([6.0, 7.0, 13.0, 14.0]) + rng.integers(-1, 2, 4)
     margin = int(rng.integers(1, 3))
     np.testing.assert_allclose(kern.ball_centre(image, box, margin), ball_centre_reference(image, box, margin),
-                               atol=1e-9)  # fmt: skip
+                               atol=1e-9)
     # at the image's border (a window cut off) and on a flat image (no ball): the same answers
     for b in (np.array([0.0, 0.0, 4.0, 3.0]), np.array([19.0, 20.0, 23.0, 23.0])):
         np.testing.assert_allclose(kern.ball_centre(image, b, 1), ball_centre_reference(image, b, 1), atol=1e-9)

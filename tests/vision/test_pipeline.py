@@ -97,7 +97,7 @@ def test_calibrated_blob_height_leaves_no_radial_ball_bias(cameras: list[CameraM
     r = LEAGUE.ball.radius_m
     for model in cameras:
         pipes = {"calibrated": VisionPipeline(calibrated, LEAGUE, model),
-                 "at_centre": VisionPipeline(at_centre, LEAGUE, model)}  # fmt: skip
+                 "at_centre": VisionPipeline(at_centre, LEAGUE, model)}
         for k, (fu, fv) in enumerate([(fu, fv) for fu in (0.1, 0.3, 0.5, 0.7, 0.9) for fv in (0.1, 0.5, 0.9)]):
             ball = model.unproject(np.array([[model.width * fu, model.height * fv]]), r)[0]
             snap = snapshot([], ball=(ball[0], ball[1], r), frame=k)

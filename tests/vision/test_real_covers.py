@@ -53,7 +53,7 @@ def test_split_region_keeps_the_disc_of_a_disc_joined_to_a_band() -> None:
     cv2.circle(mask, (20, 20), 6, 1, -1)
     mask[12:15, 20:55] = 1  # the band runs from the disc's top edge to the right
     flat = np.array([(r, a, b, 2) for r in range(mask.shape[0])
-                     for a, b in _runs(mask[r])], dtype=np.int32)  # fmt: skip
+                     for a, b in _runs(mask[r])], dtype=np.int32)
     rows = split_region(flat, SplitRule(np.array([0.0, 0.0, 50.0]), open_radius_px=3.6))
     assert rows.shape[0] == 1 and rows[0, kern.R_CLASS] == 2
     disc = np.count_nonzero(cv2.circle(np.zeros_like(mask), (20, 20), 6, 1, -1))
@@ -104,7 +104,7 @@ def _hide_dot(image: NDArray[np.uint8], model: CameraModel, robot: list[float], 
 
 @pytest.mark.parametrize(("ids_in_play", "found"), [((), False), (tuple(range(8)), True)])
 def test_a_hidden_dot_is_read_from_the_ids_in_play(cameras: list[CameraModel], ids_in_play: tuple[int, ...],
-                                                   found: bool) -> None:  # fmt: skip
+                                                   found: bool) -> None:
     """Robot 0 (PPGP) with its back-left dot under a white blob: its three dots fit ids 0 (PPGP)
     and 9 (PPPP); with ids 0-7 in play only 0 fits and it is found, its confidence at most the
     three-dot half times table_confidence; with every id in play it is ambiguous and nothing is
@@ -124,7 +124,7 @@ def test_a_hidden_dot_is_read_from_the_ids_in_play(cameras: list[CameraModel], i
         assert all(r.confidence > 0.5 for r in det.robots if r.id != 0)
     # four dots needed (the default): the cover is not reported
     strict = VisionPipeline(dataclasses.replace(params, patterns=dataclasses.replace(params.patterns, min_dots=4)),
-                            LEAGUE, model).process(image, 0, 0.0)  # fmt: skip
+                            LEAGUE, model).process(image, 0, 0.0)
     assert sorted(r.id for r in strict.robots) == [2, 5, 7]
 
 
@@ -197,7 +197,7 @@ def test_the_confidence_follows_the_dot_area_the_matcher_accepts(area: float) ->
     table = kern.match_patterns(np.array([[1.0, -0.5]]), np.ones(1), dots, weights, np.array([True, True, False, True]),
                                 weights >= params.min_area_fraction, slots, assign, params.search_radius_m,
                                 params.min_dots, matcher.id_of_code, params.max_residual_m, params.residual_scale_m,
-                                params.min_confidence)  # fmt: skip
+                                params.min_confidence)
     row = table[0]
     assert row[kern.M_VERDICT] == kern.V_ROBOT and row[kern.M_ID] == 0  # PPGP
     assert row[kern.M_CONF] == pytest.approx(min(1.0, area / 0.9), rel=1e-6)
@@ -223,7 +223,7 @@ def test_a_fifth_candidate_on_the_ring_does_not_displace_a_dot() -> None:
     assign = np.array(list(itertools.permutations(range(4))), dtype=np.int64)
     table = kern.match_patterns(np.zeros((1, 2)), np.ones(1), dots, weights, pink, weights > 0, slots, assign,
                                 params.search_radius_m, params.min_dots, matcher.id_of_code, params.max_residual_m,
-                                params.residual_scale_m, params.min_confidence)  # fmt: skip
+                                params.residual_scale_m, params.min_confidence)
     row = table[0]
     assert row[kern.M_VERDICT] == kern.V_ROBOT and row[kern.M_ID] == 1
     assert math.hypot(row[kern.M_X], row[kern.M_Y]) < 0.001 and abs(row[kern.M_THETA]) < 0.01

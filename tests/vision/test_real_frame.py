@@ -29,7 +29,7 @@ pytestmark = pytest.mark.skipif(not FRAME.exists(), reason=f"the real lab frame 
 
 PX_PER_M, HEIGHT_M = 309.0, 3.0
 CAMERA = CameraParams(id=0, position_m=(30.0 / PX_PER_M, 10.0 / PX_PER_M, HEIGHT_M), focal_px=PX_PER_M * HEIGHT_M,
-                      principal_point_px=(960.0, 540.0), resolution_px=(1920, 1080))  # fmt: skip
+                      principal_point_px=(960.0, 540.0), resolution_px=(1920, 1080))
 COLOURS = {
     "orange": ColourClass(lo=(164, 38, 138), hi=(237, 79, 187), min_area_px=10),
     "blue": ColourClass(lo=(77, 165, 40), hi=(143, 210, 93), min_area_px=10),
@@ -54,7 +54,7 @@ def test_the_six_covers_and_the_balls_of_the_real_frame() -> None:
     # covers lying on the carpet; the lab's eight covers carry ids 0-7; a hidden dot allowed
     params = VisionParams(colours=COLOURS, robot_height_m={"blue": 0.01, "yellow": 0.01},
                           patterns=dataclasses.replace(base.patterns, min_dots=3, ids_in_play=tuple(range(8))),
-                          ball=dataclasses.replace(base.ball, max_balls=8))  # fmt: skip
+                          ball=dataclasses.replace(base.ball, max_balls=8))
     det = VisionPipeline(params, _lab(), CameraModel(CAMERA)).process(image, 0, 0.0)
     assert len(det.robots) == 6
     for t in truth["robots"]:
@@ -66,4 +66,4 @@ def test_the_six_covers_and_the_balls_of_the_real_frame() -> None:
     # the orange balls: on the field and in the left goal; nothing on the floor outside the field
     on_field, in_goal = truth["balls"][0]["pixel"], truth["balls"][1]["pixel"]
     assert sorted(min(math.hypot(b.pixel[0] - p[0], b.pixel[1] - p[1]) for p in (on_field, in_goal)) < 5.0
-                  for b in det.balls) == [True, True]  # fmt: skip
+                  for b in det.balls) == [True, True]

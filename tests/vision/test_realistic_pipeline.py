@@ -33,7 +33,7 @@ LAB = ["cameras.preset=realistic", "cameras.realistic.resolution_px=[1280,800]",
        "field.divisions.B.center_circle_radius_m=0.4", "field.divisions.B.defense_width_m=1.6",
        "field.divisions.B.defense_depth_m=0.7", "field.ball.radius_m=0.042", "vision.patterns.min_dots=3",
        "vision.patterns.ids_in_play=[0,1,2,3,4,5]", "vision.light.follow=true",
-       "sim.referee.formations.B=[[-2.3,0,0],[-1.8,0.8,0],[-1.8,-0.8,0],[-1.2,0,0],[-0.6,1.1,0],[-0.6,-1.1,0]]"]  # fmt: skip
+       "sim.referee.formations.B=[[-2.3,0,0],[-1.8,0.8,0],[-1.8,-0.8,0],[-1.2,0,0],[-0.6,1.1,0],[-0.6,-1.1,0]]"]
 
 
 def pose_errors(got: CameraParams, true: CameraParams) -> tuple[float, float]:

@@ -25,11 +25,11 @@ from .conftest import LEAGUE, grid_of_robots, render, snapshot
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 SCENE = [[0, 1, -2.0, 0.5, 0.3], [1, 4, -3.0, -1.0, 2.0], [0, 7, -1.0, -1.5, 1.0], [1, 9, -2.6, 1.2, 0.0],
-         [0, 3, -1.1, -0.2, 1.0], [1, 2, -3.5, 0.4, 2.5]]  # fmt: skip
+         [0, 3, -1.1, -0.2, 1.0], [1, 2, -3.5, 0.4, 2.5]]
 # another light and other paints: the shipped boxes were never tuned on these
 WARM = RenderParams(carpet_bgr=(30, 95, 55), ball_bgr=(10, 140, 255), blue_bgr=(200, 110, 40),
                     yellow_bgr=(40, 200, 230), pink_bgr=(170, 90, 235), green_bgr=(90, 210, 80),
-                    noise_sigma_grey=3.0, vignetting_fraction=0.25, gradient_fraction=0.15)  # fmt: skip
+                    noise_sigma_grey=3.0, vignetting_fraction=0.25, gradient_fraction=0.15)
 
 
 def _score(params: VisionParams, model: CameraModel, look: RenderParams, seed: int) -> tuple[int, int, int, int]:
@@ -68,10 +68,10 @@ def test_overlapping_classes_are_found_and_kept_apart() -> None:
     orange = rng.normal((200, 60, 165), 6, (500, 3)).astype(np.int32)
     yellow = rng.normal((200, 40, 140), 4, (500, 3)).astype(np.int32)
     boxes = {"orange": ColourClass(lo=(170, 40, 150), hi=(230, 80, 185)),
-             "yellow": ColourClass(lo=(157, 0, 122), hi=(238, 74, 181))}  # fmt: skip
+             "yellow": ColourClass(lo=(157, 0, 122), hi=(238, 74, 181))}
     found = overlaps(boxes, {"orange": orange, "yellow": yellow}, 0.01)
     assert ("orange", "yellow", pytest.approx(np.mean(np.all((orange >= (157, 0, 122)) & (orange <= (238, 74, 181)),
-                                                             axis=1)))) in found  # fmt: skip
+                                                             axis=1)))) in found
     apart = keep_apart(boxes, {"orange": orange, "yellow": yellow}, {"orange", "yellow"})
     assert not overlaps(apart, {"orange": orange, "yellow": yellow}, 0.01)
     # a class nobody showed (no samples) gives up the least of its box
@@ -82,7 +82,7 @@ def test_overlapping_classes_are_found_and_kept_apart() -> None:
 
 
 def test_tune_auto_command_writes_the_boxes_and_warns(cameras: list[CameraModel], tmp_path: Path,
-                                                     capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
+                                                     capsys: pytest.CaptureFixture[str]) -> None:
     config = tmp_path / "configs"
     shutil.copytree(CONFIGS, config)
     before = (config / "vision.yaml").read_text()
@@ -127,7 +127,7 @@ def test_the_real_lab_frame_calibrated_and_coloured_with_nothing_labelled() -> N
     image = np.asarray(cv2.imread(str(REAL / "lab_frame_lights_on.jpg")), dtype=np.uint8)
     truth = json.loads((REAL / "ground_truth.json").read_text())["lab_frame_lights_on.jpg"]
     lab = FieldDims(length_m=5.54, width_m=3.77, boundary_width_m=0.0, goal_width_m=1.0, defense_width_m=2.0,
-                    defense_depth_m=1.0, center_circle=False, goal_to_goal_line=False, outer_lines="walls")  # fmt: skip
+                    defense_depth_m=1.0, center_circle=False, goal_to_goal_line=False, outer_lines="walls")
     league = dataclasses.replace(LEAGUE, divisions={"B": lab, "A": LEAGUE.divisions["A"]},
                                  ball=BallShape(radius_m=0.042))
     base = CameraParams(id=0, resolution_px=(1920, 1080), principal_point_px=(960.0, 540.0))
@@ -135,21 +135,21 @@ def test_the_real_lab_frame_calibrated_and_coloured_with_nothing_labelled() -> N
     rep = auto_samples([image], model, league, "yuv")
     names = {"ball": "orange", "blue": "blue", "yellow": "yellow", "pink": "pink", "green": "green"}
     boxes = {**VisionParams().colours, **{names[r]: widen_for_light(b, rep.light[r], "yuv")
-                                          for r, b in boxes_from_samples(rep.samples, margin=16).items()}}  # fmt: skip
+                                          for r, b in boxes_from_samples(rep.samples, margin=16).items()}}
     pooled = {**{names[r]: np.concatenate(v) for r, v in rep.samples.items()}, **rep.background}
     boxes = keep_apart(boxes, pooled, set(boxes))
     params = dataclasses.replace(VisionParams(), colours=boxes, patterns=PatternParams(min_dots=3),
-                                 ball=BallParams(max_balls=4))  # fmt: skip
+                                 ball=BallParams(max_balls=4))
     det = VisionPipeline(params, league, model).process(image, 0, 0.0)
     right = sum(any(r.id == t["id"] and np.hypot(*np.subtract(r.pixel, t["pixel"])) < 10 for r in det.robots)
-                for t in truth["robots"])  # fmt: skip
+                for t in truth["robots"])
     assert right >= 5 and len(det.robots) == right  # measured: 5 of 6 (one cover's segment merges with a dot)
     on_field = truth["balls"][0]["pixel"]
     assert any(np.hypot(*np.subtract(b.pixel, on_field)) < 5 for b in det.balls)
 
 
 def test_tune_auto_on_a_video_learns_from_its_first_seconds(cameras: list[CameraModel], tmp_path: Path,
-                                                           capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
+                                                           capsys: pytest.CaptureFixture[str]) -> None:
     """An H.264 video (4:2:0, as webcams record): frames spread over its first 3 s, each robot
     seen in several of them."""
     from cmdragons.videoio import VideoWriter

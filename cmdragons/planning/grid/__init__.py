@@ -4,4 +4,4 @@ from cmdragons.planning.grid.movingai import MapError, Scenario, read_map, read_
 from cmdragons.planning.grid.planners import EStar, GridPath, descend_nf1, nf1, octile_path
 
 __all__ = ["EStar", "GridPath", "MapError", "Scenario", "descend_nf1", "nf1", "octile_path", "read_map",
-           "read_scenarios"]  # fmt: skip
+           "read_scenarios"]

@@ -23,7 +23,7 @@ INF = np.inf
 
 def new_heap(n_cells: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     return (np.empty(n_cells, np.float64), np.empty(n_cells, np.int64), np.full(n_cells, -1, np.int64),
-            np.zeros(1, np.int64))  # fmt: skip
+            np.zeros(1, np.int64))
 
 
 @njit(cache=True, inline="always")
@@ -152,7 +152,7 @@ def _octile(a: int, b: int, w: int) -> float:
 
 @njit(cache=True)
 def octile_search(cost: np.ndarray, h: int, w: int, start: int, goal: int, heuristic: bool,
-                  parent: np.ndarray) -> tuple[float, int]:  # fmt: skip
+                  parent: np.ndarray) -> tuple[float, int]:
     """Shortest 8-connected path from ``start`` to ``goal`` (goal < 0: to every cell): a straight move
     costs the mean of the two cells' costs, a diagonal one sqrt 2 times that, and a diagonal never
     passes a blocked cell at its corner. ``heuristic``: A* with the octile distance (exact when every
@@ -161,7 +161,7 @@ def octile_search(cost: np.ndarray, h: int, w: int, start: int, goal: int, heuri
     g = np.full(n, INF)
     closed = np.zeros(n, np.bool_)
     keys, items, pos, size = np.empty(n, np.float64), np.empty(n, np.int64), np.full(n, -1, np.int64), np.zeros(
-        1, np.int64)  # fmt: skip
+        1, np.int64)
     parent[:] = -1
     g[start] = 0.0
     heap_set(keys, items, pos, size, start, _octile(start, goal, w) if heuristic and goal >= 0 else 0.0)
@@ -266,7 +266,7 @@ def _offsets(w: int, eight: bool) -> np.ndarray:
 
 @njit(cache=True, inline="always")
 def estar_update(v: np.ndarray, rhs: np.ndarray, cost: np.ndarray, w: int, goal: np.ndarray, keys: np.ndarray,
-                 items: np.ndarray, pos: np.ndarray, size: np.ndarray, i: int, eight: bool) -> None:  # fmt: skip
+                 items: np.ndarray, pos: np.ndarray, size: np.ndarray, i: int, eight: bool) -> None:
     """Recompute the look-ahead of cell ``i`` and queue it if inconsistent."""
     if not goal[i]:
         rhs[i] = estar_kernel(v, cost, w, i, eight)
@@ -279,7 +279,7 @@ def estar_update(v: np.ndarray, rhs: np.ndarray, cost: np.ndarray, w: int, goal:
 @njit(cache=True, inline="always")
 def _update_neighbours(v: np.ndarray, rhs: np.ndarray, cost: np.ndarray, w: int, goal: np.ndarray,
                        keys: np.ndarray, items: np.ndarray, pos: np.ndarray, size: np.ndarray, i: int,
-                       offsets: np.ndarray, eight: bool, below: float) -> None:  # fmt: skip
+                       offsets: np.ndarray, eight: bool, below: float) -> None:
     """New look-aheads for the neighbours of ``i`` whose value may depend on it. A consistent
     neighbour whose value is at most ``below`` (the cell's new value when it was lowered, its old
     one when raised) is skipped: the kernel's result depends only on neighbour values smaller than
@@ -294,7 +294,7 @@ def _update_neighbours(v: np.ndarray, rhs: np.ndarray, cost: np.ndarray, w: int,
 @njit(cache=True)
 def estar_propagate(v: np.ndarray, rhs: np.ndarray, cost: np.ndarray, w: int, goal: np.ndarray,
                     keys: np.ndarray, items: np.ndarray, pos: np.ndarray, size: np.ndarray,
-                    stop_cell: int, max_pops: int, eight: bool) -> tuple[int, bool]:  # fmt: skip
+                    stop_cell: int, max_pops: int, eight: bool) -> tuple[int, bool]:
     """Process queued cells in key order until none is left, or (``stop_cell`` >= 0) until that cell
     is consistent and below every queued key, or ``max_pops`` cells were processed (< 0: no limit).
     A lowered cell takes its look-ahead and updates its neighbours; a raised one is reset to
@@ -322,7 +322,7 @@ def estar_propagate(v: np.ndarray, rhs: np.ndarray, cost: np.ndarray, w: int, go
 @njit(cache=True)
 def estar_set_costs(v: np.ndarray, rhs: np.ndarray, cost: np.ndarray, w: int, goal: np.ndarray,
                     keys: np.ndarray, items: np.ndarray, pos: np.ndarray, size: np.ndarray,
-                    cells: np.ndarray, values: np.ndarray, eight: bool) -> int:  # fmt: skip
+                    cells: np.ndarray, values: np.ndarray, eight: bool) -> int:
     """Change the cost of (inner) ``cells``; each changed cell and its neighbours get new
     look-aheads and are queued where they became inconsistent (the repair then runs in
     :func:`estar_propagate`). Returns how many cells changed."""
@@ -345,7 +345,7 @@ def estar_set_costs(v: np.ndarray, rhs: np.ndarray, cost: np.ndarray, w: int, go
 
 @njit(cache=True)
 def estar_full(v: np.ndarray, rhs: np.ndarray, cost: np.ndarray, w: int, goal: np.ndarray, seeds: np.ndarray,
-               seed_values: np.ndarray, eight: bool) -> int:  # fmt: skip
+               seed_values: np.ndarray, eight: bool) -> int:
     """The whole navigation function from scratch (every ``v`` infinite): fast marching with the
     E* kernel in one pass, a cell final when it leaves the heap (a heap with stale entries, cheaper
     than the indexed heap repairs need). The same values as :func:`estar_propagate` (the same
@@ -470,7 +470,7 @@ def _passable(v: np.ndarray, w: int, a: int, b: int) -> bool:
 
 @njit(cache=True)
 def estar_descend(v: np.ndarray, h: int, w: int, x0: float, y0: float, step: float, max_steps: int,
-                  out: np.ndarray) -> int:  # fmt: skip
+                  out: np.ndarray) -> int:
     """Follow the navigation function down from (x0, y0) (padded-grid cell units: x along columns,
     y along rows, cell centres at integers) to the lowest cell of a goal: each step ``step`` cells
     along the direction bilinearly interpolated between the four surrounding cells' gradients

@@ -117,4 +117,4 @@ class CostGrid:
         """Points in cell units (x along columns, y along rows) -> field frame (k, 2)."""
         p = np.asarray(cells_xy, dtype=np.float64).reshape(-1, 2)
         return np.stack([self.x0 + (p[:, 0] + 0.5) * self.resolution_m, self.y0 + (p[:, 1] + 0.5) * self.resolution_m],
-                        axis=1)  # fmt: skip
+                        axis=1)

@@ -64,7 +64,7 @@ def read_scenarios(path: str | Path) -> list[Scenario]:
         parts = line.split("\t") if "\t" in line else line.split()
         try:
             out.append(Scenario(int(parts[0]), (int(parts[4]), int(parts[5])), (int(parts[6]), int(parts[7])),
-                                float(parts[8])))  # fmt: skip
+                                float(parts[8])))
         except (ValueError, IndexError):
             raise MapError(f"{p}:{k}: expected 9 fields: bucket map width height sx sy gx gy length") from None
     return out

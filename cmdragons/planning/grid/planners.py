@@ -121,7 +121,7 @@ class EStar:
     The repaired field equals a recomputation from scratch cell for cell."""
 
     def __init__(self, cost: FloatArray, goals: Sequence[Cell], neighbours: int = 8,
-                 goal_values: Sequence[float] | None = None, *, padded: FloatArray | None = None) -> None:  # fmt: skip
+                 goal_values: Sequence[float] | None = None, *, padded: FloatArray | None = None) -> None:
         """``neighbours``: the interpolation on the 4-neighbourhood (first-order fast marching) or
         on the 8-neighbourhood (also along the diagonals: about 1% of Euclidean distance instead of
         up to 7%); ``goal_values``: each goal cell's own starting value (default 0), e.g. exact
@@ -157,7 +157,7 @@ class EStar:
 
     @classmethod
     def from_point(cls, cost: FloatArray, goal: tuple[float, float], neighbours: int = 8,
-                   exact_radius: float = 5.0) -> EStar:  # fmt: skip
+                   exact_radius: float = 5.0) -> EStar:
         """E* toward the point ``goal`` (x, y in cell units): the cells within ``exact_radius`` cells of
         it that see it in a straight line start at their exact distance times their cost, so that the
         grid's error near the source (up to 7% at ten cells for a point seed) does not spread; beyond
@@ -222,7 +222,7 @@ class EStar:
         self._queue_seeds()
         stop = -1 if until is None else self._index(*until)
         self.pops, done = k.estar_propagate(self.v, self.rhs, self.cost, self.W, self.goal, *self.heap, stop,
-                                            max_cells, self.eight)  # fmt: skip
+                                            max_cells, self.eight)
         return bool(done)
 
     def set_costs(self, cells: NDArray[np.int64], costs: FloatArray | float) -> int:
@@ -236,10 +236,10 @@ class EStar:
         if np.any(self.goal[flat] & ~np.isfinite(values)):
             raise ValueError("a goal cell cannot become an obstacle")
         return int(k.estar_set_costs(self.v, self.rhs, self.cost, self.W, self.goal, *self.heap, flat, values,
-                                     self.eight))  # fmt: skip
+                                     self.eight))
 
     def path(self, start_xy: tuple[float, float], step: float = 0.5, max_steps: int | None = None,
-             taut: bool = True) -> GridPath:  # fmt: skip
+             taut: bool = True) -> GridPath:
         """Gradient descent from ``start_xy`` (cell units) to a goal cell, then onto its centre (or
         straight on to the goal point of :meth:`from_point`); ``taut``: the descent's points pulled
         taut (a point dropped wherever the one before sees the one after in a straight line). Empty

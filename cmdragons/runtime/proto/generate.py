@@ -27,7 +27,7 @@ def generate(out: Path) -> None:
 
     out.mkdir(parents=True, exist_ok=True)
     args = ["protoc", f"-I{ROOT}", f"--python_out={out}", f"--pyi_out={out}",
-            *(str(p.relative_to(ROOT)) for p in schemas())]  # fmt: skip
+            *(str(p.relative_to(ROOT)) for p in schemas())]
     if protoc.main(args) != 0:
         raise RuntimeError("protoc failed on " + " ".join(args[4:]))
 

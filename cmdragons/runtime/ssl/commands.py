@@ -30,7 +30,7 @@ from cmdragons.runtime.proto import ssl_tracked_pb2 as trk_pb
 __all__ = ["UNSUPPORTED", "ControlAnswer", "Feedback", "ReadCommands", "SimError", "grsim_packet", "local_velocity",
            "read_robot_control", "read_robot_control_response", "read_simulator_command", "read_simulator_response",
            "robot_control_packet", "robot_control_response", "simulator_command_packet", "simulator_response",
-           "to_field"]  # fmt: skip
+           "to_field"]
 
 _TEAM_PB = {"blue": trk_pb.BLUE, "yellow": trk_pb.YELLOW}
 _PB_TEAM: dict[int, Team] = {trk_pb.BLUE: "blue", trk_pb.YELLOW: "yellow"}
@@ -64,12 +64,12 @@ def grsim_packet(tc: TeamCommands, headings: Mapping[int, float], chip_angle_rad
         angle = chip_angle_rad if c.chip else 0.0
         cmds.robot_commands.add(id=c.id, kickspeedx=c.kick_speed * math.cos(angle),
                                 kickspeedz=c.kick_speed * math.sin(angle), veltangent=forward, velnormal=left,
-                                velangular=c.omega, spinner=c.dribbler > 0.0, wheelsspeed=False)  # fmt: skip
+                                velangular=c.omega, spinner=c.dribbler > 0.0, wheelsspeed=False)
     return p.SerializeToString(deterministic=True)  # type: ignore[no-any-return]
 
 
 def robot_control_packet(tc: TeamCommands, headings: Mapping[int, float], chip_angle_rad: float,
-                         dribbler_full_rpm: float) -> bytes:  # fmt: skip
+                         dribbler_full_rpm: float) -> bytes:
     """A ``RobotControl`` with ``tc``'s commands as local velocities, the league's fields only (a
     simulator is told the team by the port)."""
     m = ctl_pb.RobotControl()
@@ -93,7 +93,7 @@ class ReadCommands:
 
 
 def read_robot_control(data: bytes, team: Team, headings: Mapping[int, float],
-                       dribbler_full_rpm: float) -> ReadCommands:  # fmt: skip
+                       dribbler_full_rpm: float) -> ReadCommands:
     """A ``RobotControl``'s bytes -> field-frame commands of ``team`` (local velocities turned by
     ``headings``, rad); :class:`MessageError` for bytes that are not one. Wheel velocities are not
     understood (the robot is left out, with the reason)."""
@@ -223,7 +223,7 @@ def simulator_command_packet(tp: Teleport) -> bytes:
     ctl = m.control
     for team, rid, x, y, theta in tp.robots:
         ctl.teleport_robot.add(id=trk_pb.RobotId(id=rid, team=_TEAM_PB[team]), x=x, y=y, orientation=theta, v_x=0.0,
-                               v_y=0.0, v_angular=0.0, present=True)  # fmt: skip
+                               v_y=0.0, v_angular=0.0, present=True)
     if tp.ball is not None:
         ctl.teleport_ball.x, ctl.teleport_ball.y, ctl.teleport_ball.z = tp.ball[0], tp.ball[1], 0.0
         ctl.teleport_ball.vx = ctl.teleport_ball.vy = ctl.teleport_ball.vz = 0.0
@@ -233,7 +233,7 @@ def simulator_command_packet(tp: Teleport) -> bytes:
 def read_simulator_command(data: bytes, t: float, where: Mapping[tuple[Team, int], tuple[float, float, float]],
                            ball: tuple[float, float],
                            parked: Mapping[tuple[Team, int], tuple[float, float]] | None = None,
-                           ) -> tuple[Teleport | None, list[str]]:  # fmt: skip
+                           ) -> tuple[Teleport | None, list[str]]:
     """A ``SimulatorCommand``'s teleports as our :class:`Teleport` at time ``t`` (a coordinate left
     out keeps the object's own: ``where`` (team, id) -> (x, y, theta) and ``ball`` now), and one
     line per request not carried out (velocities, removing robots without ``parked``,
@@ -261,7 +261,7 @@ def read_simulator_command(data: bytes, t: float, where: Mapping[tuple[Team, int
             continue
         x0, y0, th0 = where[key]
         robots.append((key[0], key[1], r.x if r.HasField("x") else x0, r.y if r.HasField("y") else y0,
-                       r.orientation if r.HasField("orientation") else th0))  # fmt: skip
+                       r.orientation if r.HasField("orientation") else th0))
     ball_at = None
     if c.HasField("teleport_ball"):
         b = c.teleport_ball

@@ -142,4 +142,4 @@ class LogReader:
 
     def _cut(self, offset: int, what: str) -> None:
         self.truncated = (f"{self.path}: cut short in record {self.records + 1} at byte {offset} ({what}); "
-                          f"read up to the {self.records} whole records before it")  # fmt: skip
+                          f"read up to the {self.records} whole records before it")

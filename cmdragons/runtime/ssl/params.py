@@ -127,7 +127,7 @@ class ProtocolParams(Validated):
     def __post_init__(self) -> None:
         super().__post_init__()
         for name, address in (("interface", self.interface), ("grsim.address", self.grsim.address),
-                              ("simulation.address", self.simulation.address)):  # fmt: skip
+                              ("simulation.address", self.simulation.address)):
             try:
                 ip = ipaddress.IPv4Address(address)
             except ValueError:

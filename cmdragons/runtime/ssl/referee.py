@@ -37,22 +37,22 @@ _TEAM_COMMANDS: dict[tuple[RefereeCommand, Team], Any] = {
     (C.FREE_KICK, "yellow"): R.DIRECT_FREE_YELLOW, (C.FREE_KICK, "blue"): R.DIRECT_FREE_BLUE,
     (C.TIMEOUT, "yellow"): R.TIMEOUT_YELLOW, (C.TIMEOUT, "blue"): R.TIMEOUT_BLUE,
     (C.BALL_PLACEMENT, "yellow"): R.BALL_PLACEMENT_YELLOW, (C.BALL_PLACEMENT, "blue"): R.BALL_PLACEMENT_BLUE,
-}  # fmt: skip
+}
 _PLAIN = {C.HALT: R.HALT, C.STOP: R.STOP, C.NORMAL: R.NORMAL_START, C.FORCE_START: R.FORCE_START}
 _FROM_LEAGUE: dict[int, tuple[RefereeCommand, Team | None]] = {
     **{v: k for k, v in _TEAM_COMMANDS.items()}, **{v: (k, None) for k, v in _PLAIN.items()},
     R.INDIRECT_FREE_YELLOW: (C.FREE_KICK, "yellow"), R.INDIRECT_FREE_BLUE: (C.FREE_KICK, "blue"),
     R.GOAL_YELLOW: (C.STOP, None), R.GOAL_BLUE: (C.STOP, None),  # deprecated: the game stopped for a goal
-}  # fmt: skip
+}
 _PREPARED = (C.KICKOFF, C.PENALTY)  # the commands a normal start starts
 _STAGE_TO = {S.PRE_GAME: R.NORMAL_FIRST_HALF_PRE, S.FIRST_HALF: R.NORMAL_FIRST_HALF, S.HALF_TIME: R.NORMAL_HALF_TIME,
              S.SECOND_HALF: R.NORMAL_SECOND_HALF, S.PENALTY_SHOOTOUT: R.PENALTY_SHOOTOUT,
-             S.POST_GAME: R.POST_GAME}  # fmt: skip
+             S.POST_GAME: R.POST_GAME}
 _STAGE_FROM = {**{v: k for k, v in _STAGE_TO.items()},
                R.NORMAL_SECOND_HALF_PRE: S.HALF_TIME, R.EXTRA_TIME_BREAK: S.HALF_TIME,
                R.EXTRA_FIRST_HALF_PRE: S.HALF_TIME, R.EXTRA_FIRST_HALF: S.FIRST_HALF,
                R.EXTRA_HALF_TIME: S.HALF_TIME, R.EXTRA_SECOND_HALF_PRE: S.HALF_TIME,
-               R.EXTRA_SECOND_HALF: S.SECOND_HALF, R.PENALTY_SHOOTOUT_BREAK: S.HALF_TIME}  # fmt: skip
+               R.EXTRA_SECOND_HALF: S.SECOND_HALF, R.PENALTY_SHOOTOUT_BREAK: S.HALF_TIME}
 
 
 def _us(seconds: float) -> int:
@@ -80,11 +80,11 @@ def _team_from(m: Any) -> TeamInfo:
     return TeamInfo(m.red_cards, m.yellow_cards, tuple(t / US for t in m.yellow_card_times), m.foul_counter,
                     m.goalkeeper, m.timeouts, m.timeout_time / US, m.ball_placement_failures,
                     m.can_place_ball if m.HasField("can_place_ball") else d.can_place_ball,
-                    m.max_allowed_bots if m.HasField("max_allowed_bots") else d.max_robots)  # fmt: skip
+                    m.max_allowed_bots if m.HasField("max_allowed_bots") else d.max_robots)
 
 
 def referee_proto(g: GameState, source: str = "cmdragons", names: tuple[str, str] = ("blue", "yellow"),
-                  epoch: UnixEpoch | None = None) -> Any:  # fmt: skip
+                  epoch: UnixEpoch | None = None) -> Any:
     """The league's Referee message of our game state (``names``: the blue and yellow teams'), its
     times in Unix time (``epoch``, by default the run's)."""
     e = run_epoch() if epoch is None else epoch
@@ -92,7 +92,7 @@ def referee_proto(g: GameState, source: str = "cmdragons", names: tuple[str, str
     code = R.NORMAL_START if ready_start else _command_code(g.command, g.for_team)
     m = R(packet_timestamp=e.to_unix_us(g.t), stage=_STAGE_TO[g.stage], command=code,
           command_counter=g.command_counter, command_timestamp=e.to_unix_us(g.command_t),
-          blue_team_on_positive_half=not g.blue_defends_negative_x, source_identifier=source)  # fmt: skip
+          blue_team_on_positive_half=not g.blue_defends_negative_x, source_identifier=source)
     _team_to(g.blue_team, g.score_blue, names[0], m.blue)
     _team_to(g.yellow_team, g.score_yellow, names[1], m.yellow)
     if math.isfinite(g.stage_time_left_s):
@@ -111,7 +111,7 @@ def referee_proto(g: GameState, source: str = "cmdragons", names: tuple[str, str
 
 
 def referee_packet(g: GameState, source: str = "cmdragons", names: tuple[str, str] = ("blue", "yellow"),
-                   epoch: UnixEpoch | None = None) -> bytes:  # fmt: skip
+                   epoch: UnixEpoch | None = None) -> bytes:
     """:func:`referee_proto`'s bytes."""
     m = referee_proto(g, source, names, epoch)
     return m.SerializeToString(deterministic=True)  # type: ignore[no-any-return]
@@ -177,5 +177,5 @@ class RefereeReader:
             m.stage_time_left / US if m.HasField("stage_time_left") else math.inf, m.command_counter,
             self.epoch.from_unix_us(m.command_timestamp),
             m.current_action_time_remaining / US if m.HasField("current_action_time_remaining") else math.inf,
-            nxt[0], nxt[1], _team_from(m.blue), _team_from(m.yellow))  # fmt: skip
+            nxt[0], nxt[1], _team_from(m.blue), _team_from(m.yellow))
         return self.last

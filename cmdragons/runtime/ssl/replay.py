@@ -87,7 +87,7 @@ def camera_ids(path: str | Path) -> list[int]:
 
 
 def league_replay_wiring(settings: Settings, team: Team, cameras: Sequence[int], own: bool, vision: DatagramQueue,
-                         referee: DatagramQueue, epoch: UnixEpoch | None = None) -> list[Entry]:  # fmt: skip
+                         referee: DatagramQueue, epoch: UnixEpoch | None = None) -> list[Entry]:
     """The table of a league log's replay: the log's SSL-Vision packets (``cameras``) and Referee
     packets, fed from the queues ``vision`` and ``referee``, into the receiving stages that read
     them from the network (their Unix times less ``epoch``, by default the run's; a log of our own
@@ -110,7 +110,7 @@ def league_replay_wiring(settings: Settings, team: Team, cameras: Sequence[int],
 
 def replay_league_log(path: str | Path, settings: Settings, team: Team = "blue", extra: tuple[Stage, ...] = (),
                       own: bool = False, should_stop: Callable[[], bool] = lambda: False,
-                      on_record: Callable[[int, int], None] | None = None) -> LeagueReplay:  # fmt: skip
+                      on_record: Callable[[int, int], None] | None = None) -> LeagueReplay:
     """Play the league log at ``path`` into ``team``'s tracker and brain (``settings``); ``extra``:
     more stages on the bus (a logger). ``own``: the log is of a match our team played (with these
     settings): the tracker takes the brain's commands as the robots' control input, as it did in

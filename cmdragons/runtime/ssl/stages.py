@@ -65,7 +65,7 @@ from cmdragons.runtime.topics import Contract, Port, summary_port
 from sim.world import ball_at_front
 
 __all__ = ["CommandsOutStage", "RefereeInStage", "RefereeOutStage", "SimulationInStage", "SocketStage",
-           "TrackerOutStage", "VisionInStage", "VisionOutStage", "close_sockets"]  # fmt: skip
+           "TrackerOutStage", "VisionInStage", "VisionOutStage", "close_sockets"]
 
 
 class Receiver(Protocol):
@@ -98,13 +98,13 @@ class VisionOutStage(SocketStage):
 
     @staticmethod
     def declare(params: ProtocolParams, camera_ids: Sequence[int], geometry: bytes = b"",
-                topics: Sequence[str] | None = None) -> Contract:  # fmt: skip
+                topics: Sequence[str] | None = None) -> Contract:
         read = tuple(topics) if topics is not None else tuple(f"detections/{c}" for c in camera_ids)
         return Contract("ssl/vision_out", tuple(Port(t, DetectionFrame) for t in read),
                         (Port("ssl/vision/sent", Tick), summary_port("ssl/vision_out")))
 
     def __init__(self, params: ProtocolParams, camera_ids: Sequence[int], geometry: bytes,
-                 topics: Sequence[str] | None = None, epoch: UnixEpoch | None = None) -> None:  # fmt: skip
+                 topics: Sequence[str] | None = None, epoch: UnixEpoch | None = None) -> None:
         v = params.vision
         self.epoch = run_epoch() if epoch is None else epoch
         self.contract = self.declare(params, camera_ids, geometry, topics)
@@ -140,7 +140,7 @@ class VisionOutStage(SocketStage):
         wall = time.perf_counter() - self._wall0 if self._wall0 is not None else 0.0
         publish(f"summary/{self.name}", StageSummary(self.name, {
             "packets": self.sender.sent, "geometry_packets": self.geometry_packets, "bytes": self.sender.bytes,
-            "packets_per_s": round(self.sender.sent / wall, 1) if wall > 0 else None}))  # fmt: skip
+            "packets_per_s": round(self.sender.sent / wall, 1) if wall > 0 else None}))
 
     def close(self) -> None:
         self.sender.close()
@@ -157,18 +157,18 @@ class VisionInStage(SocketStage):
         any_camera = () if lockstep else (Port("ssl/vision/*", DetectionFrame),)  # from outside: any camera id
         return Contract("ssl/vision_in", (Port("ssl/vision/sent" if lockstep else "clock", Tick),),
                         (*(Port(f"ssl/vision/{c}", DetectionFrame) for c in sorted(camera_ids)), *any_camera,
-                         summary_port("ssl/vision_in")))  # fmt: skip
+                         summary_port("ssl/vision_in")))
 
     def __init__(self, params: ProtocolParams, camera_ids: Sequence[int], lockstep: bool,
                  err: TextIO | None = None, receiver: Receiver | None = None, epoch: UnixEpoch | None = None,
-                 camera_clock: bool | None = None) -> None:  # fmt: skip
+                 camera_clock: bool | None = None) -> None:
         v = params.vision
         # lock-step: our own sender's epoch; from outside: given, or the first packet's (a sender's clock
         # from 0, grSim's, stays as it is; Unix time becomes match time from that packet's second)
         self.epoch: UnixEpoch | None = run_epoch() if epoch is None and lockstep else epoch
         self.camera_clock = lockstep if camera_clock is None else camera_clock  # our own packets: exact times
         self.receiver: Receiver = receiver if receiver is not None else MulticastReceiver(
-            v.group, v.port, params.interface, params.receive_buffer_bytes, params.max_datagram_bytes)  # fmt: skip
+            v.group, v.port, params.interface, params.receive_buffer_bytes, params.max_datagram_bytes)
         self.camera_ids = frozenset(camera_ids)
         self.lockstep = lockstep
         self.wait_s = v.wait_s
@@ -228,7 +228,7 @@ class VisionInStage(SocketStage):
             "dropped": dict(sorted(self.drops.counts.items())), "frames_late": self.late,
             "robots_left_out": dict(sorted(self.robots_left_out.items())),
             "cameras_seen": sorted(self.cameras_seen),
-            "field_m": None if g is None else [g.field_length_m, g.field_width_m]}))  # fmt: skip
+            "field_m": None if g is None else [g.field_length_m, g.field_width_m]}))
 
     def close(self) -> None:
         self.receiver.close()
@@ -270,10 +270,10 @@ class RefereeInStage(SocketStage):
                         (Port("referee/gc", GameState), summary_port("ssl/referee_in")))
 
     def __init__(self, params: ProtocolParams, world_topic: str, moved_m: float, err: TextIO | None = None,
-                 receiver: Receiver | None = None, epoch: UnixEpoch | None = None) -> None:  # fmt: skip
+                 receiver: Receiver | None = None, epoch: UnixEpoch | None = None) -> None:
         r = params.referee
         self.receiver: Receiver = receiver if receiver is not None else MulticastReceiver(
-            r.group, r.port, params.interface, params.receive_buffer_bytes, params.max_datagram_bytes)  # fmt: skip
+            r.group, r.port, params.interface, params.receive_buffer_bytes, params.max_datagram_bytes)
         self.contract = self.declare(params, world_topic)
         self.moved_m = moved_m
         self.reader = RefereeReader(epoch) if epoch is not None else None  # None: the first packet's epoch
@@ -318,7 +318,7 @@ class RefereeInStage(SocketStage):
     def summarize(self, publish: Publish) -> None:
         publish(f"summary/{self.name}", StageSummary(self.name, {
             "packets": self.received, "restarts_taken": self.restarts_taken,
-            "dropped": dict(sorted(self.drops.counts.items()))}))  # fmt: skip
+            "dropped": dict(sorted(self.drops.counts.items()))}))
 
     def close(self) -> None:
         self.receiver.close()
@@ -346,7 +346,7 @@ class TrackerOutStage(SocketStage):
 
     def summarize(self, publish: Publish) -> None:
         publish(f"summary/{self.name}", StageSummary(self.name, {"packets": self.sender.sent,
-                                                                 "bytes": self.sender.bytes}))  # fmt: skip
+                                                                 "bytes": self.sender.bytes}))
 
     def close(self) -> None:
         self.sender.close()
@@ -368,17 +368,17 @@ class CommandsOutStage(SocketStage):
         takes = params.commands_to != "none" and teleports  # (grSim takes them on the simulation protocol's port too)
         return Contract(name, (Port(f"world/{team}", WorldState), Port(f"commands/{team}", TeamCommands),
                                *((Port("teleport", Teleport),) if takes else ())),
-                        (summary_port(name),))  # fmt: skip
+                        (summary_port(name),))
 
     def __init__(self, params: ProtocolParams, team: Team, chip_angle_rad: float, err: TextIO | None = None,
-                 teleports: bool = True) -> None:  # fmt: skip
+                 teleports: bool = True) -> None:
         self.contract = self.declare(params, team, chip_angle_rad, teleports)
         self.team = team
         self.to = params.commands_to
         sim = params.simulation
         self.endpoint = UdpEndpoint(sim.address if self.to == "simulation" else params.grsim.address)
         self.peer = (params.grsim.address, params.grsim.port) if self.to == "grsim" else (sim.address,
-                                                                                           sim.port(team))  # fmt: skip
+                                                                                           sim.port(team))
         self.control = (sim.address, sim.control_port)
         self.chip_angle_rad = chip_angle_rad
         self.full_rpm = sim.dribbler_full_rpm
@@ -425,7 +425,7 @@ class CommandsOutStage(SocketStage):
             "to": self.to, "packets": self.sent, "resent": self.resent, "teleports": self.teleports,
             "answers": self.answers, "answer_errors": self.answer_errors,
             "answers_earlier_layout": self.answers_earlier_layout,
-            "dropped": dict(sorted(self.drops.counts.items()))}))  # fmt: skip
+            "dropped": dict(sorted(self.drops.counts.items()))}))
 
     def close(self) -> None:
         self.endpoint.close()
@@ -450,12 +450,12 @@ class SimulationInStage(SocketStage):
         ts = _teams(teams)
         name = f"ssl/simulation_in/{ts[0]}" if len(ts) == 1 else "ssl/simulation_in"
         return Contract(name, (Port("truth", GroundTruth),), (*(Port(f"commands/{t}", TeamCommands) for t in ts),
-                        Port("teleport", Teleport), summary_port(name)))  # fmt: skip
+                        Port("teleport", Teleport), summary_port(name)))
 
     def __init__(self, params: ProtocolParams, teams: Team | Sequence[Team], wait_s: float | None = None,
                  league: LeagueParams | None = None, touch_m: float = 0.0,
                  parked: Mapping[tuple[Team, int], tuple[float, float]] | None = None,
-                 err: TextIO | None = None) -> None:  # fmt: skip
+                 err: TextIO | None = None) -> None:
         sim = params.simulation
         self.contract = self.declare(params, teams)
         self.teams = _teams(teams)
@@ -473,7 +473,7 @@ class SimulationInStage(SocketStage):
         self.full_rpm = sim.dribbler_full_rpm
         ports = "/".join(str(sim.port(t)) for t in self.teams)
         self.drops = DropLog(f"simulation protocol {sim.address}:{ports}/{sim.control_port}",
-                             params.drop_report_interval_s, err)  # fmt: skip
+                             params.drop_report_interval_s, err)
         self.packets = self.teleports = self.frames_waited_out = 0
         self.refused: dict[str, int] = {}
 
@@ -509,10 +509,10 @@ class SimulationInStage(SocketStage):
         b = gt.ball
         on_ground = b.z <= self.league.ball.radius_m + 1e-6
         return {r.id: on_ground and ball_at_front(self.league, b.x - r.x, b.y - r.y, r.theta, self.touch_m)[0]
-                for r in gt.robots if r.team == team}  # fmt: skip
+                for r in gt.robots if r.team == team}
 
     def _commands(self, team: Team, got: tuple[bytes, tuple[str, int]], headings: dict[int, float],
-                  contact: dict[int, bool]) -> tuple[RobotCommand, ...]:  # fmt: skip
+                  contact: dict[int, bool]) -> tuple[RobotCommand, ...]:
         data, peer = got
         try:
             read = read_robot_control(data, team, headings, self.full_rpm)
@@ -524,11 +524,11 @@ class SimulationInStage(SocketStage):
             self._refuse(why)
         feedback = [Feedback(c.id, contact.get(c.id)) for c in read.commands]
         self.robots[team].send_to(robot_control_response(feedback, [SimError(UNSUPPORTED, why)
-                                                                    for _, why in read.errors]), peer)  # fmt: skip
+                                                                    for _, why in read.errors]), peer)
         return read.commands
 
     def _teleport(self, got: tuple[bytes, tuple[str, int]], gt: GroundTruth,
-                  where: dict[tuple[Team, int], tuple[float, float, float]], publish: Publish) -> None:  # fmt: skip
+                  where: dict[tuple[Team, int], tuple[float, float, float]], publish: Publish) -> None:
         data, peer = got
         try:
             tp, refused = read_simulator_command(data, gt.t, where, (gt.ball.x, gt.ball.y), self.parked)
@@ -550,7 +550,7 @@ class SimulationInStage(SocketStage):
         publish(f"summary/{self.name}", StageSummary(self.name, {
             "packets": self.packets, "teleports": self.teleports, "frames_waited_out": self.frames_waited_out,
             "refused": dict(sorted(self.refused.items())),
-            "dropped": dict(sorted(self.drops.counts.items()))}))  # fmt: skip
+            "dropped": dict(sorted(self.drops.counts.items()))}))
 
     def close(self) -> None:
         for endpoint in self.robots.values():

@@ -41,7 +41,7 @@ from cmdragons.runtime.ssl.clock import UnixEpoch, run_epoch
 
 __all__ = ["CameraCalibration", "FieldArc", "FieldLine", "VisionGeometry", "decode_wrapper", "detection_packet",
            "WrapperContents", "field_dims_of", "geometry_of", "geometry_packet", "read_wrapper",
-           "settings_on_geometry"]  # fmt: skip
+           "settings_on_geometry"]
 
 MM = wire.MM
 # SSL-Vision's pixel coordinates count from the centre of the top-left pixel (its regions' centroids
@@ -51,7 +51,7 @@ PIXEL_ORIGIN = 0.5
 # our field's straight markings (Field.line_segments' order) by the league's names
 _LINE_NAMES = ("BottomTouchLine", "TopTouchLine", "LeftGoalLine", "RightGoalLine", "HalfwayLine", "CenterLine",
                "LeftFieldRightPenaltyStretch", "LeftFieldLeftPenaltyStretch", "LeftPenaltyStretch",
-               "RightFieldRightPenaltyStretch", "RightFieldLeftPenaltyStretch", "RightPenaltyStretch")  # fmt: skip
+               "RightFieldRightPenaltyStretch", "RightFieldLeftPenaltyStretch", "RightPenaltyStretch")
 
 
 @dataclass(frozen=True)
@@ -94,7 +94,7 @@ class CameraCalibration:
         size = self.resolution_px if min(self.resolution_px) > 0 else (round(2.0 * pp[0]), round(2.0 * pp[1]))
         try:
             base = CameraParams(id=self.camera_id, focal_px=self.focal_px, principal_point_px=pp, k1=self.k1,
-                                k2=self.k2, resolution_px=size)  # fmt: skip
+                                k2=self.k2, resolution_px=size)
             rvec = Rotation.from_quat(self.quaternion).as_rotvec()
             return params_from_opencv(rvec, np.asarray(self.translation_m, dtype=np.float64), base)
         except ValueError as exc:
@@ -140,7 +140,7 @@ def _calibration(cam: CameraModel) -> Any:
         distortion=ssl_vision_distortion(cam.params),
         q0=q[0], q1=q[1], q2=q[2], q3=q[3], tx=t[0], ty=t[1], tz=t[2], derived_camera_world_tx=c[0],
         derived_camera_world_ty=c[1], derived_camera_world_tz=c[2], pixel_image_width=cam.width,
-        pixel_image_height=cam.height)  # fmt: skip
+        pixel_image_height=cam.height)
 
 
 def geometry_packet(field: Field, cameras: list[CameraModel]) -> bytes:
@@ -151,16 +151,16 @@ def geometry_packet(field: Field, cameras: list[CameraModel]) -> bytes:
     f = g.geometry.field
     f.field_length, f.field_width = round(d.length_m * MM), round(d.width_m * MM)
     f.goal_width, f.goal_depth, f.boundary_width = (round(v * MM) for v in (d.goal_width_m, d.goal_depth_m,
-                                                                              d.boundary_width_m))  # fmt: skip
+                                                                              d.boundary_width_m))
     f.penalty_area_depth, f.penalty_area_width = round(d.defense_depth_m * MM), round(d.defense_width_m * MM)
     f.center_circle_radius, f.line_thickness = round(d.center_circle_radius_m * MM), round(d.line_width_m * MM)
     f.goal_height = round(d.goal_height_m * MM)
     f.ball_radius, f.max_robot_radius = league.ball.radius_m * MM, league.robot.radius_m * MM
     for name, seg in zip(_LINE_NAMES, field.line_segments(), strict=True):
         f.field_lines.add(name=name, p1=_v(seg.a), p2=_v(seg.b), thickness=d.line_width_m * MM,
-                          type=geo_pb.SSL_FieldShapeType.Value(name))  # fmt: skip
+                          type=geo_pb.SSL_FieldShapeType.Value(name))
     f.field_arcs.add(name="CenterCircle", center=_v((0.0, 0.0)), radius=d.center_circle_radius_m * MM, a1=0.0,
-                     a2=2.0 * math.pi, thickness=d.line_width_m * MM, type=geo_pb.CenterCircle)  # fmt: skip
+                     a2=2.0 * math.pi, thickness=d.line_width_m * MM, type=geo_pb.CenterCircle)
     for cam in cameras:
         g.geometry.calib.append(_calibration(cam))
     ball: BallShape = league.ball
@@ -187,16 +187,16 @@ def geometry_of(m: Any) -> VisionGeometry:
     """Our reading of an SSL_GeometryData (metres)."""
     f = m.field
     lines = tuple(FieldLine(s.name, (s.p1.x / MM, s.p1.y / MM), (s.p2.x / MM, s.p2.y / MM), s.thickness / MM)
-                  for s in f.field_lines)  # fmt: skip
+                  for s in f.field_lines)
     arcs = tuple(FieldArc(a.name, (a.center.x / MM, a.center.y / MM), a.radius / MM, a.a1, a.a2, a.thickness / MM)
-                 for a in f.field_arcs)  # fmt: skip
+                 for a in f.field_arcs)
     cams = tuple(_calibration_of(c) for c in m.calib)
     s = m.models.straight_two_phase if m.models.HasField("straight_two_phase") else None
     return VisionGeometry(
         f.field_length / MM, f.field_width / MM, f.goal_width / MM, f.goal_depth / MM, f.boundary_width / MM,
         f.penalty_area_depth / MM, f.penalty_area_width / MM, f.center_circle_radius / MM, f.line_thickness / MM,
         f.goal_height / MM, f.ball_radius / MM, f.max_robot_radius / MM, lines, arcs, cams,
-        -s.acc_slide if s else math.nan, -s.acc_roll if s else math.nan, s.k_switch if s else math.nan)  # fmt: skip
+        -s.acc_slide if s else math.nan, -s.acc_roll if s else math.nan, s.k_switch if s else math.nan)
 
 
 def _calibration_of(c: Any) -> CameraCalibration:
@@ -206,9 +206,9 @@ def _calibration_of(c: Any) -> CameraCalibration:
     size = (c.pixel_image_width, c.pixel_image_height)
     fit_size = size if min(size) > 0 else (round(2.0 * pp[0]), round(2.0 * pp[1]))
     k1, k2 = from_ssl_vision_distortion(c.distortion, c.focal_length, pp, fit_size) if c.focal_length > 0 and \
-        min(fit_size) > 0 else (0.0, 0.0)  # fmt: skip
+        min(fit_size) > 0 else (0.0, 0.0)
     return CameraCalibration(c.camera_id, c.focal_length, pp, c.distortion, (c.q0, c.q1, c.q2, c.q3),
-                             (c.tx / MM, c.ty / MM, c.tz / MM), _camera_position(c), size, k1, k2)  # fmt: skip
+                             (c.tx / MM, c.ty / MM, c.tz / MM), _camera_position(c), size, k1, k2)
 
 
 def _camera_position(c: Any) -> tuple[float, float, float]:
@@ -273,7 +273,7 @@ def read_wrapper(data: bytes, epoch: UnixEpoch | None = None, camera_clock: bool
 
 
 def decode_wrapper(data: bytes, epoch: UnixEpoch | None = None,
-                   camera_clock: bool = False) -> tuple[DetectionFrame | None, VisionGeometry | None]:  # fmt: skip
+                   camera_clock: bool = False) -> tuple[DetectionFrame | None, VisionGeometry | None]:
     """:func:`read_wrapper`'s detections and geometry."""
     got = read_wrapper(data, epoch, camera_clock)
     return got.detection, got.geometry
@@ -286,15 +286,15 @@ def field_dims_of(geo: VisionGeometry, base: FieldDims) -> FieldDims:
     :class:`MessageError` for sizes that make no field."""
     sent = {"defense_depth_m": geo.penalty_area_depth_m, "defense_width_m": geo.penalty_area_width_m,
             "center_circle_radius_m": geo.center_circle_radius_m, "line_width_m": geo.line_thickness_m,
-            "goal_height_m": geo.goal_height_m}  # fmt: skip
+            "goal_height_m": geo.goal_height_m}
     try:
         return dataclasses.replace(
             base, length_m=geo.field_length_m, width_m=geo.field_width_m, goal_width_m=geo.goal_width_m,
             goal_depth_m=geo.goal_depth_m, boundary_width_m=geo.boundary_width_m,
-            **{k: v for k, v in sent.items() if v > 0.0})  # fmt: skip
+            **{k: v for k, v in sent.items() if v > 0.0})
     except ValueError as exc:
         raise MessageError(f"the geometry's field ({geo.field_length_m:g} x {geo.field_width_m:g} m) is not one we "
-                           f"can play on: {exc}") from None  # fmt: skip
+                           f"can play on: {exc}") from None
 
 
 def settings_on_geometry(settings: Settings, geo: VisionGeometry) -> Settings:

@@ -488,7 +488,7 @@ class CameraLook:
         if self.exposure is None:  # the camera starts settled on its first scene
             self.exposure = p.exposure_target_grey / max(self._luma(f), 1.0)
         f *= np.float32(self.exposure)
-        f = cv2.transform(f, self.desaturate)
+        f = np.asarray(cv2.transform(f, self.desaturate), dtype=np.float32)
         out = np.clip(f + 0.5, 0, 255).astype(np.uint8)
         if p.exposure_rate > 0.0:
             self.exposure *= (p.exposure_target_grey / max(self._luma(out), 1.0)) ** p.exposure_rate
@@ -499,7 +499,7 @@ class CameraLook:
             out = np.asarray(cv2.imdecode(buf, cv2.IMREAD_COLOR), dtype=np.uint8)
         elif self._h264 is not None:
             out = self._h264(out)
-        return out
+        return np.asarray(out, dtype=np.uint8)
 
     @staticmethod
     def _luma(img: NDArray[Any]) -> float:
@@ -563,5 +563,6 @@ def _demosaic(image: NDArray[np.uint8]) -> NDArray[np.uint8]:
     raw[0::2, 1::2] = image[0::2, 1::2, 1]
     raw[1::2, 0::2] = image[1::2, 0::2, 1]
     raw[1::2, 1::2] = image[1::2, 1::2, 0]
-    out: NDArray[np.uint8] = cv2.cvtColor(raw, cv2.COLOR_BayerBG2BGR)  # OpenCV names the layout by its second row
+    # (OpenCV names the layout by its second row)
+    out = np.asarray(cv2.cvtColor(raw, cv2.COLOR_BayerBG2BGR), dtype=np.uint8)
     return out

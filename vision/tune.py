@@ -340,11 +340,12 @@ def auto_samples(images: Sequence[NDArray[np.uint8]], model: CameraModel, league
             if orange and lo_a * expect <= b.area <= hi_a * expect and fill >= 0.5:
                 sat = math.hypot(b.colour[1] - 128.0, b.colour[2] - 128.0)
                 if best_ball is None or sat * fill > best_ball[0]:
-                    best_ball = (sat * fill, k)
+                    best_ball = (sat * fill, int(k))
         if best_ball is not None:  # one ball a frame, the most saturated and round: glare and clutter are paler
-            k = best_ball[1]
+            kb = best_ball[1]
             n_balls += 1
-            _take(samples, lit, "ball", blobs[k], max(1.0, p.inner_fraction * r_ball * ppm[k]), labels, conv, light_img)
+            _take(samples, lit, "ball", blobs[kb], max(1.0, p.inner_fraction * r_ball * ppm[kb]), labels, conv,
+                  light_img)
     back_all = {k: np.concatenate(v) for k, v in background.items()}
     y = back_all["carpet"][:, 0].astype(np.float64)
     dark, bright = (float(np.percentile(y, q)) for q in (0.5, 99.5))

@@ -284,7 +284,7 @@ def field_dims_of(geo: VisionGeometry, base: FieldDims) -> FieldDims:
     optional one (defense area, centre circle, lines, goal height) where it was sent; what a
     packet does not say (the robots a team, the goal walls' thickness) stays ``base``'s.
     :class:`MessageError` for sizes that make no field."""
-    sent = {"defense_depth_m": geo.penalty_area_depth_m, "defense_width_m": geo.penalty_area_width_m,
+    sent: dict[str, Any] = {"defense_depth_m": geo.penalty_area_depth_m, "defense_width_m": geo.penalty_area_width_m,
             "center_circle_radius_m": geo.center_circle_radius_m, "line_width_m": geo.line_thickness_m,
             "goal_height_m": geo.goal_height_m}
     try:

@@ -41,7 +41,7 @@ from sim.referee import Referee
 from sim.referee_params import AutorefParams, RefereeParams
 from sim.restarts import ball_out_taker, defender_of, other
 
-__all__ = ["AutoRef", "BallCrossing", "KickDetector", "observed"]
+__all__ = ["AutoRef", "BallCrossing", "KickDetector", "OwnContacts", "observed"]
 
 Key = tuple[Team, int]
 
@@ -129,6 +129,37 @@ class KickDetector:
         return None
 
 
+class OwnContacts:
+    """Contacts between robots of one team, from their tracks: no foul (the rules leave a team's own
+    robots to it), but each one a fault of its play. Two robots of a team whose centres come within
+    ``touch_m`` begin one, which lasts until they are ``release_m`` farther apart than that (the
+    tracks' jitter at the edge is no new contact); a robot out of sight ends its contacts."""
+
+    def __init__(self, touch_m: float, release_m: float) -> None:
+        self.touch_m, self.release_m = touch_m, release_m
+        self.count: dict[Team, int] = {"blue": 0, "yellow": 0}
+        self._open: set[tuple[Key, Key]] = set()
+
+    def see(self, robots: Sequence[RobotTruth]) -> int:
+        """One frame's robots (those seen): the contacts that begin in it are counted; how many."""
+        began = 0
+        touching: set[tuple[Key, Key]] = set()
+        ordered = sorted(robots, key=lambda r: (r.team, r.id))
+        for i, a in enumerate(ordered):
+            for b in ordered[i + 1:]:
+                if b.team != a.team:
+                    continue
+                pair = ((a.team, a.id), (b.team, b.id))
+                reach = self.touch_m + (self.release_m if pair in self._open else 0.0)
+                if math.hypot(b.x - a.x, b.y - a.y) < reach:
+                    touching.add(pair)
+                    if pair not in self._open:
+                        self.count[a.team] += 1
+                        began += 1
+        self._open = touching
+        return began
+
+
 class AutoRef:
     """The referee on the tracked world: one :meth:`observe` per world state. ``keys``: the match's
     robots (team, id), as the game controller knows them."""
@@ -138,6 +169,8 @@ class AutoRef:
         self.referee = Referee(pitch, keys, params, a.margins, a.leave_s)
         self.crossing = BallCrossing(pitch)
         self.kicks = KickDetector(pitch, a)
+        self.own_contacts = OwnContacts(2.0 * pitch.league.robot.radius_m + params.figures.contact_margin_m,
+                                        a.own_contact_release_m)
         self._ball = (0.0, 0.0)  # where the ball was last seen
 
     def start(self) -> Teleport:
@@ -161,7 +194,9 @@ class AutoRef:
         if crossing is not None:
             events.append(crossing)
         score, outs, sign = dict(r.score), r.balls_out, r.blue_sign
-        teleport = r.observe(world.t, events, self._ball, observed(world, self._ball))
+        seen = observed(world, self._ball)
+        self.own_contacts.see(seen.robots)
+        teleport = r.observe(world.t, events, self._ball, seen)
         if isinstance(crossing, Goal):
             scorer = next((team for team in r.score if r.score[team] > score[team]), None)
             if scorer is not None:
@@ -183,7 +218,8 @@ class AutoRef:
         return self.referee.state()
 
     def summary(self) -> dict[str, object]:
-        """The match's figures as the referee's summary gives them, with goals and balls out."""
+        """The match's figures as the referee's summary gives them, with goals and balls out, and the
+        contacts between robots of one team (:class:`OwnContacts`)."""
         r = self.referee
         return {"score": dict(r.score), "balls_out": r.balls_out, "kicks_seen": r.kicks,
-                "keeper_held_ball": r.keeper_held_ball, **r.summary()}
+                "keeper_held_ball": r.keeper_held_ball, "own_contacts": dict(self.own_contacts.count), **r.summary()}

@@ -37,6 +37,9 @@ class AutorefParams(Validated):
     margins: TrackMargins = TrackMargins(touch_release_m=0.01, contact_release_m=0.0, distance_m=0.05, speed_m_s=0.1,
                                         fast_ball_frames=2)
     leave_s: float = setting(2.0, lo=0.0, hi=60.0)  # a robot sent off may be seen on the field this long
+    # two robots of one team in contact (counted, no foul): their tracks' centres within two radii and the
+    # rules' contact margin; the contact over once they are this much farther apart (the tracks' jitter)
+    own_contact_release_m: float = setting(0.02, lo=0.0, hi=0.5)
 
 
 @dataclass(frozen=True)

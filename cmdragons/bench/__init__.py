@@ -47,6 +47,7 @@ SUITES: dict[str, Suite] = {
     "runtime": _lazy("cmdragons.bench.runtime"),
     "protocols": _lazy("cmdragons.bench.protocols"),
     "autoref": _lazy("cmdragons.bench.autoref"),
+    "league": _lazy("cmdragons.bench.league"),
 }
 # what each suite measures, one line each (``cmdragons bench -h``)
 ABOUT: dict[str, str] = {
@@ -64,10 +65,14 @@ ABOUT: dict[str, str] = {
     "runtime": "the distributed runtime on zenoh against the embedded one",
     "protocols": "the league's packets through loopback: size, encode and decode time, none lost",
     "autoref": "the auto-referee on vision against the referee on the truth: calls both made, calls of its own",
+    "league": "our team in sim --serve, grSim and the ER-Force simulator (their scripts), refereed by our autoref",
 }
 # the options each suite takes
 OPTIONS: dict[str, tuple[str, ...]] = {"grid": ("maps",), "navigation": ("figures",),
-                                       "play": ("opponent", "matches", "half", "shootout")}
+                                       "play": ("opponent", "matches", "half", "shootout"), "league": ("half",)}
+# the suites that run the command's own processes: they take the bench's --config and --set to hand on
+# (as ``config`` and ``overrides``)
+HANDS_ON: tuple[str, ...] = ("league",)
 
 
 TABLE_WIDTH = 100  # columns: a bench table fits a standard terminal

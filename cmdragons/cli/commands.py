@@ -196,7 +196,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--matches", metavar="N", type=_count, default=None,
                    help="play: this many seeded matches (default 10, --quick 2)")
     p.add_argument("--half", metavar="S", type=_positive, default=None,
-                   help="play: halves of S seconds (default the rules' 300, --quick 30)")
+                   help="play: halves of S seconds (default the rules' 300, --quick 30); league: (default 120, "
+                   "--quick 30)")
     p.add_argument("--shootout", metavar="N", type=_count_or_none, default=None,
                    help="play: the penalty shootout's kicks each way against simple (default 10, --quick 3; 0: none)")
     add_runtime_parsers(sub, _common)
@@ -629,7 +630,7 @@ def _cmd_vision(args: argparse.Namespace) -> int:
 
 
 def _cmd_bench(args: argparse.Namespace) -> int:
-    from cmdragons.bench import OPTIONS, SUITES, print_table, write_json
+    from cmdragons.bench import HANDS_ON, OPTIONS, SUITES, print_table, write_json
     from cmdragons.runtime.log import check_writable_file
     from cmdragons.runtime.settings import load_settings
 
@@ -640,6 +641,8 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     if args.json:
         check_writable_file(args.json, "--json")  # before the bench: its rows are not lost at the end
     options = {k: getattr(args, k) for k in OPTIONS.get(args.suite, ()) if getattr(args, k) is not None}
+    if args.suite in HANDS_ON:
+        options.update(config=args.config, overrides=list(args.set))
     for suite, keys in OPTIONS.items():
         for k in keys:
             if getattr(args, k) is not None and k not in OPTIONS.get(args.suite, ()):

@@ -53,8 +53,8 @@ from cmdragons.runtime.ssl.stages import (
 from cmdragons.runtime.ssl.vision import VisionGeometry, decode_wrapper, field_dims_of
 from cmdragons.runtime.stages import SummaryCollector, Tap, TeamStage, TimingStage, TrackerStage
 
-__all__ = ["FrameGate", "Heard", "OutsideError", "OutsideMatch", "SimulatorKind", "field_settings", "listen",
-           "outside_summary", "outside_wiring", "vision_params"]
+__all__ = ["FrameGate", "Heard", "OutsideError", "OutsideMatch", "SimulatorKind", "beyond_division", "field_settings",
+           "listen", "outside_summary", "outside_wiring", "take_off", "vision_params"]
 
 
 class SimulatorKind(enum.Enum):
@@ -186,6 +186,33 @@ def listen(receiver: Any, timeout_s: float, learn_s: float, where: str,
             robots.update((r.team, r.id) for r in det.robots)
     assert geometry is not None
     return Heard(geometry, tuple(sorted(seen)), packets, tuple(sorted(robots)), epoch)
+
+
+def beyond_division(robots: Sequence[tuple[Team, int]], per_team: int) -> tuple[tuple[Team, int], ...]:
+    """The robots (team, id) beyond the division's ``per_team`` a team: of a team with more, those of
+    the highest ids (the ER-Force simulator puts 11 a team on its Division B field too)."""
+    out: list[tuple[Team, int]] = []
+    for team in ("blue", "yellow"):
+        ids = sorted(rid for t, rid in robots if t == team)
+        out += [(team, rid) for rid in ids[per_team:]]
+    return tuple(out)
+
+
+def take_off(params: ProtocolParams, robots: Sequence[tuple[Team, int]], times: int = 3) -> None:
+    """Take ``robots`` off the simulator's field: a ``SimulatorCommand`` with ``present: false`` for
+    each to its control port (grSim's and every simulation-protocol simulator's), sent ``times``
+    times (UDP: one may be lost; a robot off the field stays off)."""
+    from cmdragons.runtime.ssl.commands import off_field_packet
+    from cmdragons.runtime.ssl.udp import UdpEndpoint
+
+    s = params.simulation
+    endpoint = UdpEndpoint(s.address)
+    try:
+        for _ in range(times):
+            endpoint.send_to(off_field_packet(robots), (s.address, s.control_port))
+            time.sleep(0.05)
+    finally:
+        endpoint.close()
 
 
 # the sizes a geometry packet gives, compared with field.yaml's (m)
@@ -391,6 +418,7 @@ def outside_summary(f: dict[str, Any], stage_ms: dict[str, list[float]], match: 
     referee = f.get("autoref", {})  # our referee on the tracked world (none: a game controller's word)
     return {
         **({"score": referee["score"], "balls_out": referee["balls_out"], "kicks": referee["kicks_seen"],
+            "own_collisions": referee["own_contacts"],
             "rules": {k: referee[k] for k in ("rules", "game_stage", "fouls", "cards", "placements", "penalties",
                                               "shootout") if k in referee}} if referee else {}),
         "simulator": match.kind.value,
@@ -402,6 +430,7 @@ def outside_summary(f: dict[str, Any], stage_ms: dict[str, list[float]], match: 
         "frames_waited_out": match.frames_waited_out,
         "cameras": list(match.heard.cameras),
         "field_m": [g.field_length_m, g.field_width_m],
+        "field": dataclasses.asdict(match.settings.field.dims),  # the sizes played on (the geometry's)
         "division": match.settings.field.division,
         "cycle_ms": cycle,
         "tracker": {t: f.get(f"tracker/{t}", {}) for t in match.teams},

@@ -6,6 +6,10 @@ import socket
 
 import pytest
 
+from cmdragons.runtime.ssl.udp import free_udp_ports
+
+__all__ = ["free_udp_ports"]
+
 
 @pytest.fixture
 def udp_port() -> int:
@@ -14,15 +18,3 @@ def udp_port() -> int:
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
         s.bind(("127.0.0.1", 0))
         return int(s.getsockname()[1])
-
-
-def free_udp_ports(n: int) -> list[int]:
-    """``n`` UDP ports free on loopback now (held open together so they differ)."""
-    socks = [socket.socket(socket.AF_INET, socket.SOCK_DGRAM) for _ in range(n)]
-    try:
-        for s in socks:
-            s.bind(("127.0.0.1", 0))
-        return [int(s.getsockname()[1]) for s in socks]
-    finally:
-        for s in socks:
-            s.close()

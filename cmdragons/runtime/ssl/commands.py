@@ -230,6 +230,14 @@ def simulator_command_packet(tp: Teleport) -> bytes:
     return m.SerializeToString(deterministic=True)  # type: ignore[no-any-return]
 
 
+def off_field_packet(robots: Sequence[tuple[Team, int]]) -> bytes:
+    """A ``SimulatorCommand`` taking ``robots`` (team, id) off the field (``present: false``)."""
+    m = sim_pb.SimulatorCommand()
+    for team, rid in robots:
+        m.control.teleport_robot.add(id=trk_pb.RobotId(id=rid, team=_TEAM_PB[team]), present=False)
+    return m.SerializeToString(deterministic=True)  # type: ignore[no-any-return]
+
+
 def read_simulator_command(data: bytes, t: float, where: Mapping[tuple[Team, int], tuple[float, float, float]],
                            ball: tuple[float, float],
                            parked: Mapping[tuple[Team, int], tuple[float, float]] | None = None,

@@ -19,7 +19,7 @@ import sys
 import time
 from typing import TextIO
 
-__all__ = ["DatagramQueue", "DropLog", "MulticastReceiver", "MulticastSender", "UdpEndpoint"]
+__all__ = ["DatagramQueue", "DropLog", "MulticastReceiver", "MulticastSender", "UdpEndpoint", "free_udp_ports"]
 
 
 def _sockopt_reuse(sock: socket.socket) -> None:
@@ -110,6 +110,19 @@ class DatagramQueue:
 
     def close(self) -> None:
         self._items = []
+
+
+def free_udp_ports(n: int) -> list[int]:
+    """``n`` UDP ports free on loopback now (held open together so they differ): a stream of its own
+    for a test or a bench's match, never heard by another running beside it."""
+    socks = [socket.socket(socket.AF_INET, socket.SOCK_DGRAM) for _ in range(n)]
+    try:
+        for s in socks:
+            s.bind(("127.0.0.1", 0))
+        return [int(s.getsockname()[1]) for s in socks]
+    finally:
+        for s in socks:
+            s.close()
 
 
 class UdpEndpoint:

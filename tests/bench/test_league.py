@@ -1,0 +1,152 @@
+"""``cmdragons bench league``: what a row reads from a match's log (goals in the simulator's own
+vision and truth, stoppages), against sequences whose answer is known by construction; the peers
+looked for and, when absent, skipped with the reason; and the served simulator's row played as the
+suite plays it (two processes, our autoref refereeing), its figures checked against the served truth."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+from pathlib import Path
+
+import pytest
+
+from cmdragons.bench.league import (
+    PEERS,
+    Stoppages,
+    match_row,
+    peer_script,
+    rules_stoppage_s,
+    stoppages,
+    truth_goals,
+    vision_goals,
+)
+from cmdragons.messages import (
+    BallDetection,
+    BallTruth,
+    DetectionFrame,
+    GameStage,
+    GameState,
+    GroundTruth,
+    RefereeCommand,
+)
+from cmdragons.runtime.settings import load_settings
+
+FIELD = load_settings().field_geometry()  # Division B: 9 x 6 m, goals 1 m wide
+PAST_GOAL_X = FIELD.half_length + 0.1  # a ball this far out is past the goal line (radius 21.5 mm)
+
+
+def _frame(t: float, x: float, y: float) -> tuple[str, DetectionFrame]:
+    return "ssl/vision/0", DetectionFrame(0, round(t * 60), t, t, (BallDetection(x, y, 0.9, (0.0, 0.0)),))
+
+
+def _game(t: float, command: RefereeCommand, blue_negative: bool = True) -> tuple[str, GameState]:
+    return "referee", GameState(t, command, blue_defends_negative_x=blue_negative)
+
+
+def test_goals_in_vision_are_crossings_between_the_posts_while_in_play_scored_by_the_sides_then() -> None:
+    stream = [
+        _game(0.0, RefereeCommand.NORMAL),
+        _frame(1.0, 4.0, 0.1), _frame(1.1, PAST_GOAL_X, 0.1),  # into the +x goal: blue defends -x, blue scores
+        _frame(1.2, PAST_GOAL_X + 0.05, 0.1),  # still in it: the same goal
+        _frame(2.0, 0.0, 0.0),  # back on the centre spot
+        _frame(3.0, PAST_GOAL_X, 1.5),  # past the goal line beside the post: out, no goal
+        _frame(4.0, 0.0, 0.0),
+        _game(4.5, RefereeCommand.STOP),
+        _frame(5.0, -PAST_GOAL_X, 0.0),  # into the -x goal while play is stopped: not a goal
+        _frame(6.0, 0.0, 0.0),
+        _game(7.0, RefereeCommand.NORMAL, blue_negative=False),  # the sides changed: blue defends +x
+        _frame(8.0, -PAST_GOAL_X, -0.3),  # into the -x goal: blue scores again
+        _frame(9.0, 0.0, 0.0),
+        _frame(10.0, PAST_GOAL_X, 0.2),  # into the +x goal, blue's own: yellow scores
+    ]
+    assert vision_goals(stream, FIELD) == {"blue": 2, "yellow": 1}
+
+
+def test_goals_in_the_truth_are_counted_at_both_ends_once_each() -> None:
+    path = [(0.0, 0.0), (PAST_GOAL_X, 0.2), (PAST_GOAL_X + 0.05, 0.2), (0.0, 0.0), (-PAST_GOAL_X, -0.2),
+            (0.0, 0.0), (PAST_GOAL_X, 2.0), (0.0, 0.0)]  # two goals, then out beside the post
+    truths = [GroundTruth(k, k / 60, BallTruth(x, y, 0.0, 0.0, 0.0)) for k, (x, y) in enumerate(path)]
+    assert truth_goals(truths, FIELD) == 2
+
+
+def test_stoppages_run_from_a_stop_to_the_next_start_and_the_match_end_closes_the_last() -> None:
+    states = [
+        GameState(0.0, RefereeCommand.KICKOFF, "blue", ready=False),  # 0-5 s: the first kickoff
+        GameState(4.0, RefereeCommand.KICKOFF, "blue", ready=True),
+        GameState(5.0, RefereeCommand.NORMAL),
+        GameState(20.0, RefereeCommand.STOP),  # 20-32 s: a stop, a placement, a free kick
+        GameState(22.0, RefereeCommand.BALL_PLACEMENT, "yellow"),
+        GameState(28.0, RefereeCommand.FREE_KICK, "yellow"),
+        GameState(32.0, RefereeCommand.FORCE_START),
+        GameState(45.0, RefereeCommand.STOP),  # 45 s on: never restarted, the match over at 59 s
+        GameState(59.0, RefereeCommand.HALT, stage=GameStage.POST_GAME),
+    ]
+    assert stoppages(states, 60.0, 10.0) == Stoppages(count=3, restarted=2, longest_s=14.0, over_limit=2)
+    # without the match's end in the states, the stop lasts to the end given
+    assert stoppages(states[:-1], 60.0, 10.0) == Stoppages(count=3, restarted=2, longest_s=15.0, over_limit=2)
+
+
+def test_the_rules_time_of_a_stoppage_adds_each_phase_it_may_pass_through() -> None:
+    r = load_settings().sim.referee
+    f = r.figures
+    assert rules_stoppage_s(r) == pytest.approx(r.restart_delay_s + f.placement_time_s + f.prepare_timeout_s
+                                                + max(r.restart_timeout_s, f.penalty_time_s))
+    longer = dataclasses.replace(r, figures=dataclasses.replace(f, penalty_time_s=r.restart_timeout_s + 5.0))
+    assert rules_stoppage_s(longer) == pytest.approx(rules_stoppage_s(r) + 5.0)
+
+
+def test_a_peer_without_its_script_or_binary_is_skipped_with_the_reason(tmp_path: Path,
+                                                                       monkeypatch: pytest.MonkeyPatch) -> None:
+    grsim = next(p for p in PEERS if p.name == "grsim")
+    monkeypatch.delenv("GRSIM_NETNS", raising=False)
+    monkeypatch.setenv("PATH", str(tmp_path))
+    script, why = peer_script(grsim, checkout=tmp_path / "checkout")
+    assert script is None and "grsim-netns.sh" in why and "GRSIM_NETNS" in why
+    fake = tmp_path / "grsim-netns.sh"  # a script, but no grSim for it
+    fake.write_text("#!/bin/sh\nexit 0\n")
+    fake.chmod(0o755)
+    monkeypatch.setenv("GRSIM", str(tmp_path / "no-grsim"))
+    script, why = peer_script(grsim, checkout=tmp_path / "checkout")
+    assert script is None and str(tmp_path / "no-grsim") in why
+    row = match_row(load_settings(), grsim, "B", "none", 10.0, tmp_path / "out")
+    assert row == {"name": "grsim_B_none", "skipped": why}
+
+
+@pytest.mark.slow
+def test_the_served_simulators_row_agrees_with_the_served_truth(tmp_path: Path) -> None:
+    """Two processes as the suite runs them (sim --serve, play --simulator sim-protocol, our autoref
+    refereeing, both colours ours): the goals our autoref called are those the served truth shows
+    and those the served vision shows, the first kickoff is a stoppage restarted within the rules'
+    time, and the match played its time on the served vision's frames."""
+    settings = load_settings()
+    served = next(p for p in PEERS if p.name == "served")
+    row = match_row(settings, served, "B", "self", 15.0, tmp_path)
+    assert "failed" not in row, row
+    goals = row["goals_ours"] + row["goals_theirs"]
+    assert goals == row["goals_truth"] == row["goals_vision_ours"] + row["goals_vision_theirs"]
+    assert row["stoppages"] >= 1 and row["stoppages_restarted"] >= 1
+    assert row["longest_stoppage_s"] <= rules_stoppage_s(settings.sim.referee)
+    assert row["match_s"] >= 30.0 and row["frames"] > 30.0 * 30  # the served vision: 60 frames a second
+    assert 0 <= row["passes_completed"] <= row["passes_tried"]
+    assert row["ball_roll_simulator_m_s2"] == settings.field.ball.acc_roll_m_s2
+    assert row["ball_roll_configured_m_s2"] == settings.field.ball.acc_roll_m_s2
+    if row["ball_roll_windows"]:  # the served ball rolls as field.yaml says: learnt within 10 %
+        assert math.isclose(row["ball_roll_learnt_m_s2"], row["ball_roll_simulator_m_s2"], rel_tol=0.10)
+    assert (tmp_path / "served_B_self" / "ours" / "run.mcap").exists()
+
+
+def _grsim_found() -> str | None:
+    script, why = peer_script(next(p for p in PEERS if p.name == "grsim"))
+    return None if script is not None else why
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(_grsim_found() is not None, reason=f"grSim not found: {_grsim_found()}")
+def test_the_grsim_row_plays_in_grsim_and_its_goals_are_those_grsims_vision_shows(tmp_path: Path) -> None:
+    row = match_row(load_settings(), next(p for p in PEERS if p.name == "grsim"), "B", "none", 15.0, tmp_path)
+    assert "failed" not in row, row
+    assert row["goals_ours"] + row["goals_theirs"] == row["goals_vision_ours"] + row["goals_vision_theirs"]
+    assert row["goals_truth"] is None and row["match_s"] >= 30.0
+    assert os.path.exists(tmp_path / "grsim_B_none" / "ours" / "summary.json")

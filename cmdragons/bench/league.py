@@ -391,4 +391,5 @@ def run(settings: Settings, quick: bool, half: float | None = None, config: str 
                 print(f"bench league: {peer.name} {division} against {opponent} (2 x {half:g} s) ...",
                       file=sys.stderr, flush=True)
                 rows.append(match_row(settings, peer, division, opponent, half, Path(out), config, overrides))
+                print(f"bench league: {json.dumps(rows[-1])}", file=sys.stderr, flush=True)  # kept if stopped
     return rows

@@ -166,8 +166,10 @@ def _finish(folder: Any, run: Any, summary: dict[str, Any], args: argparse.Names
           f"(division {summary['division']})")
     if "score" in summary:  # refereed by ours on the tracked world
         score = summary["score"]
+        own = summary["collisions"]["own"]
+        collided = ", ".join(f"{team} {plural(n, 'own collision')}" for team, n in own.items())
         print(f"play: refereed on our tracked world: blue {score['blue']}:{score['yellow']} yellow, "
-              f"{plural(summary['balls_out'], 'ball')} out, {plural(summary['kicks'], 'kick')} seen")
+              f"{plural(summary['balls_out'], 'ball')} out, {plural(summary['kicks'], 'kick')} seen; {collided}")
         if summary["rules"].get("rules") == "full":
             print("play: " + rules_line(summary["rules"], args.team))
     for w in summary["warnings"]:

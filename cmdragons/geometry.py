@@ -113,6 +113,17 @@ class RobotShape(Validated):
         """Half the width of the flat front face."""
         return math.sqrt(self.radius_m**2 - self.front_distance_m**2)
 
+    def gap(self, x: float, y: float) -> float:
+        """From the point (``x``, ``y``) in the robot frame (m) to the body, the disc cut flat at the
+        front; negative inside (as deep as the point is in)."""
+        r, f = self.radius_m, self.front_distance_m
+        d = math.hypot(x, y)
+        if d <= r and x <= f:
+            return -min(r - d, f - x)
+        if d > r and x * r <= f * d:  # the nearest point of the body lies on its round side
+            return d - r
+        return math.hypot(x - f, max(abs(y) - self.mouth_half_width_m, 0.0))  # ... else on the flat front
+
     def outline(self, n: int = 24) -> NDArray[np.float64]:
         """Convex outline in the robot frame (x forward), counter-clockwise, shape (k, 2)."""
         a0 = math.atan2(self.mouth_half_width_m, self.front_distance_m)

@@ -8,7 +8,9 @@ the simulator would have told are inferred from the ball's track: a goal or a ba
 track crosses the goal or a touch line (:class:`BallCrossing`), a touch when its velocity jumps with
 a robot at it (:class:`KickDetector`, the kick detector: the double touch, the last touch before a
 ball out, dribbling, the defense areas all start from it). The fouls are then the same checks
-(:mod:`sim.rules`) with margins for the tracks' noise (:class:`~sim.rules.TrackMargins`).
+(:mod:`sim.rules`) with margins for the tracks' noise (:class:`~sim.rules.TrackMargins`). Beside the
+rules it counts the collisions among one team's robots from their tracks (:class:`OwnContacts`), a
+figure of the match where no simulator tells its contacts.
 
 What the referee decides comes out as it does in the simulator: the game state, its calls (with a
 goal and a ball out each a call here, as the league's game events have them) and the teleports a
@@ -22,7 +24,7 @@ import math
 from collections import deque
 from collections.abc import Sequence
 
-from cmdragons.geometry import Field, Team
+from cmdragons.geometry import TEAMS, Field, RobotShape, Team
 from cmdragons.messages import (
     BallOut,
     BallTruth,
@@ -41,7 +43,8 @@ from sim.referee import Referee
 from sim.referee_params import AutorefParams, RefereeParams
 from sim.restarts import ball_out_taker, defender_of, other
 
-__all__ = ["AutoRef", "BallCrossing", "KickDetector", "OwnContacts", "observed"]
+__all__ = ["AutoRef", "BallCrossing", "KickDetector", "OwnContacts", "deflection_path", "hull_gap", "observed",
+           "path_gap"]
 
 Key = tuple[Team, int]
 
@@ -84,30 +87,91 @@ class BallCrossing:
         return BallOut(t, cx, cy, last_touch)
 
 
+def hull_gap(shape: RobotShape, robot: tuple[float, float, float], x: float, y: float) -> float:
+    """From the point (``x``, ``y``) to the body of a robot at ``robot`` (x, y, heading), field frame,
+    m (:meth:`~cmdragons.geometry.RobotShape.gap`); negative inside."""
+    rx, ry, theta = robot
+    c, s = math.cos(theta), math.sin(theta)
+    return shape.gap(c * (x - rx) + s * (y - ry), -s * (x - rx) + c * (y - ry))
+
+
+_SEARCH_STEPS = 40  # the ternary search along a segment: (2/3)^40 of its length, far below a millimetre
+
+
+def path_gap(shape: RobotShape, robot: tuple[float, float, float], path: Sequence[tuple[float, float]]) -> float:
+    """The least :func:`hull_gap` of the points of ``path`` (a polyline, field frame, m): how near the
+    ball's centre passed the robot's body, negative where it went through it. Exact up to
+    :data:`_SEARCH_STEPS`: the gap to a convex body is convex along a segment."""
+    best = math.inf
+    for (ax, ay), (bx, by) in zip(path, path[1:], strict=False):
+        def gap(u: float, ax: float = ax, ay: float = ay, bx: float = bx, by: float = by) -> float:
+            return hull_gap(shape, robot, ax + u * (bx - ax), ay + u * (by - ay))
+
+        lo, hi = 0.0, 1.0
+        for _ in range(_SEARCH_STEPS):
+            m1, m2 = lo + (hi - lo) / 3.0, hi - (hi - lo) / 3.0
+            if gap(m1) < gap(m2):
+                hi = m2
+            else:
+                lo = m1
+        best = min(best, gap(0.0), gap(1.0), gap(0.5 * (lo + hi)))
+    if len(path) == 1:
+        best = hull_gap(shape, robot, *path[0])
+    return best
+
+
+def deflection_path(p0: tuple[float, float], v0: tuple[float, float], p1: tuple[float, float],
+                    v1: tuple[float, float], longest_s: float) -> list[tuple[float, float]]:
+    """The ball's path between two tracked frames (at ``p0`` moving at ``v0``, then at ``p1`` moving at
+    ``v1``; field frame, m, m/s) across the touch that changed its velocity: through the deflection
+    point, where its old line and its new line meet, when they meet ahead of ``p0`` and behind ``p1``
+    within ``longest_s`` of motion on each; else straight from ``p0`` to ``p1`` (a ball stopped, or
+    pushed on along its line)."""
+    den = v0[0] * v1[1] - v0[1] * v1[0]
+    dx, dy = p1[0] - p0[0], p1[1] - p0[1]
+    if abs(den) <= _PARALLEL * math.hypot(*v0) * math.hypot(*v1) or den == 0.0:
+        return [p0, p1]
+    s = (dx * v1[1] - dy * v1[0]) / den  # the time along the old line to the deflection point ...
+    u = (v0[0] * dy - v0[1] * dx) / den  # ... and along the new line from it
+    if not (0.0 <= s <= longest_s and 0.0 <= u <= longest_s):
+        return [p0, p1]
+    return [p0, (p0[0] + s * v0[0], p0[1] + s * v0[1]), p1]
+
+
+_PARALLEL = math.sin(math.radians(5.0))  # lines closer to parallel than this meet nowhere the track can tell
+
+
 class KickDetector:
     """Touches of the ball from its track: its velocity changes by more than
-    ``kick_speed_change_m_s`` between two frames (a kick, a push, a bounce off a robot) with a robot's
-    body within ``kick_reach_m`` of it at some moment of the last ``kick_memory_s``: the robot last at
-    the ball (the nearest in the newest frame that had one) touched it. A ball that jumps farther than
-    it could roll (put somewhere, or another ball taken for it) starts the watch afresh."""
+    ``kick_speed_change_m_s`` between two frames (a kick, a push, a bounce off a robot). The toucher
+    is the robot the ball's path between the two frames went nearest (through the deflection point,
+    where its old and new lines meet: :func:`deflection_path`), its body (:func:`hull_gap`, a disc
+    cut flat at the front, where each robot stood in either frame) within ``kick_reach_m`` of the
+    ball; where robots of both teams are that near, the one whose body the path went deepest into or
+    passed nearest. When no robot is that near (a kick the track shows a few frames late, the ball
+    gone), the robot last at the ball: the nearest within ``kick_reach_m`` in the newest frame of the
+    last ``kick_memory_s`` that had one. A ball that jumps farther than it could roll (put somewhere,
+    or another ball taken for it) starts the watch afresh."""
 
     def __init__(self, pitch: Field, params: AutorefParams, max_ball_speed_m_s: float = 10.0) -> None:
         self.p = params
-        self.robot_r = pitch.league.robot.radius_m
+        self.shape = pitch.league.robot
         self.ball_r = pitch.league.ball.radius_m
         self.max_ball_speed_m_s = max_ball_speed_m_s
         self._last: tuple[float, float, float, float, float] | None = None  # t, x, y, vx, vy
+        self._poses: dict[Key, tuple[float, float, float]] = {}  # where each robot stood the frame before
         self._recent: deque[tuple[float, dict[Key, float]]] = deque()  # t, each robot's gap to the ball (m)
 
     def see(self, world: WorldState) -> Kick | None:
         """The touch ``world``'s ball shows, or None."""
         b, t = world.ball, world.t
+        poses = {(r.team, r.id): (r.x, r.y, r.theta) for r in world.robots if r.visible}
+        before, self._poses = self._poses, poses
         if b is None:
             self._last = None
             self._recent.clear()
             return None
-        gaps = {(r.team, r.id): math.hypot(r.x - b.x, r.y - b.y) - self.robot_r - self.ball_r
-                for r in world.robots if r.visible}
+        gaps = {k: hull_gap(self.shape, pose, b.x, b.y) - self.ball_r for k, pose in poses.items()}
         last, self._last = self._last, (t, b.x, b.y, b.vx, b.vy)
         self._recent.append((t, gaps))
         while self._recent and t - self._recent[0][0] > self.p.kick_memory_s:
@@ -121,43 +185,64 @@ class KickDetector:
             return None
         if math.hypot(b.vx - vx0, b.vy - vy0) <= self.p.kick_speed_change_m_s:
             return None
+        path = deflection_path((x0, y0), (vx0, vy0), (b.x, b.y), (b.vx, b.vy), t - t0 + self.p.kick_memory_s)
+        near = sorted((min(path_gap(self.shape, pose, path) for pose in (before.get(k, now), now)) - self.ball_r, k)
+                      for k, now in poses.items())
+        if near and near[0][0] <= self.p.kick_reach_m:
+            key = near[0][1]
+            return Kick(t, key[0], key[1], math.hypot(b.vx, b.vy), False)
         for _, g in reversed(self._recent):  # the last robot at the ball (the nearest of that frame)
-            near = sorted((gap, k) for k, gap in g.items() if gap <= self.p.kick_reach_m)
-            if near:
-                key = near[0][1]
+            at = sorted((gap, k) for k, gap in g.items() if gap <= self.p.kick_reach_m)
+            if at:
+                key = at[0][1]
                 return Kick(t, key[0], key[1], math.hypot(b.vx, b.vy), False)
         return None
 
 
 class OwnContacts:
-    """Contacts between robots of one team, from their tracks: no foul (the rules leave a team's own
-    robots to it), but each one a fault of its play. Two robots of a team whose centres come within
-    ``touch_m`` begin one, which lasts until they are ``release_m`` farther apart than that (the
-    tracks' jitter at the edge is no new contact); a robot out of sight ends its contacts."""
+    """Collisions among one team's robots, from their tracks (no foul: a figure of the match, what the
+    simulator's contacts give on the truth): two visible robots of one team whose centres come nearer
+    than two radii plus ``own_contact_margin_m`` while closing faster than ``own_contact_closing_m_s``
+    (the difference of their tracked velocities the frame before, along the line between them: two
+    robots standing side by side, their tracks jittering, never collide). Once per meeting: it lasts
+    until they are ``margins.contact_release_m`` farther apart than where it began."""
 
-    def __init__(self, touch_m: float, release_m: float) -> None:
-        self.touch_m, self.release_m = touch_m, release_m
-        self.count: dict[Team, int] = {"blue": 0, "yellow": 0}
-        self._open: set[tuple[Key, Key]] = set()
+    def __init__(self, pitch: Field, params: AutorefParams) -> None:
+        self.p = params
+        self.touch_m = 2.0 * pitch.league.robot.radius_m + params.own_contact_margin_m
+        self.each: list[tuple[float, Key, Key]] = []  # per collision: when it began, the two robots
+        self._prev: dict[Key, tuple[float, float]] = {}  # each robot's tracked velocity the frame before
+        self._meeting: set[tuple[Key, Key]] = set()
 
-    def see(self, robots: Sequence[RobotTruth]) -> int:
-        """One frame's robots (those seen): the contacts that begin in it are counted; how many."""
-        began = 0
-        touching: set[tuple[Key, Key]] = set()
-        ordered = sorted(robots, key=lambda r: (r.team, r.id))
-        for i, a in enumerate(ordered):
-            for b in ordered[i + 1:]:
-                if b.team != a.team:
+    def see(self, world: WorldState) -> list[tuple[float, Key, Key]]:
+        """The collisions that begin in ``world``'s frame."""
+        robots = sorted((r for r in world.robots if r.visible), key=lambda r: (r.team, r.id))
+        new, near = [], set()
+        for i, a in enumerate(robots):
+            for b in robots[i + 1:]:
+                if a.team != b.team:
                     continue
                 pair = ((a.team, a.id), (b.team, b.id))
-                reach = self.touch_m + (self.release_m if pair in self._open else 0.0)
-                if math.hypot(b.x - a.x, b.y - a.y) < reach:
-                    touching.add(pair)
-                    if pair not in self._open:
-                        self.count[a.team] += 1
-                        began += 1
-        self._open = touching
-        return began
+                dx, dy = b.x - a.x, b.y - a.y
+                d = math.hypot(dx, dy)
+                if d >= self.touch_m + (self.p.margins.contact_release_m if pair in self._meeting else 0.0):
+                    continue
+                near.add(pair)
+                if pair in self._meeting or d < 1e-9:
+                    continue
+                (vax, vay), (vbx, vby) = (self._prev.get(k, (0.0, 0.0)) for k in pair)
+                closing = ((vax - vbx) * dx + (vay - vby) * dy) / d
+                if closing > self.p.own_contact_closing_m_s:
+                    self._meeting.add(pair)
+                    new.append((world.t, *pair))
+        self._meeting &= near
+        self._prev = {(r.team, r.id): (r.vx, r.vy) for r in robots}
+        self.each += new
+        return new
+
+    def counts(self) -> dict[Team, int]:
+        """Collisions per team so far."""
+        return {team: sum(a[0] == team for _, a, _ in self.each) for team in TEAMS}
 
 
 class AutoRef:
@@ -169,8 +254,7 @@ class AutoRef:
         self.referee = Referee(pitch, keys, params, a.margins, a.leave_s)
         self.crossing = BallCrossing(pitch)
         self.kicks = KickDetector(pitch, a)
-        self.own_contacts = OwnContacts(2.0 * pitch.league.robot.radius_m + params.figures.contact_margin_m,
-                                        a.own_contact_release_m)
+        self.own_contacts = OwnContacts(pitch, a)
         self._ball = (0.0, 0.0)  # where the ball was last seen
 
     def start(self) -> Teleport:
@@ -184,6 +268,7 @@ class AutoRef:
         if world.ball is not None:
             self._ball = (world.ball.x, world.ball.y)
         events: list[Event] = []
+        self.own_contacts.see(world)
         kick = self.kicks.see(world)
         if kick is not None and (kick.team, kick.id) == r.watch.last_touch:
             kick = None  # the last toucher's own touch seen late (the track's velocity lags the kick): no new one
@@ -194,9 +279,7 @@ class AutoRef:
         if crossing is not None:
             events.append(crossing)
         score, outs, sign = dict(r.score), r.balls_out, r.blue_sign
-        seen = observed(world, self._ball)
-        self.own_contacts.see(seen.robots)
-        teleport = r.observe(world.t, events, self._ball, seen)
+        teleport = r.observe(world.t, events, self._ball, observed(world, self._ball))
         if isinstance(crossing, Goal):
             scorer = next((team for team in r.score if r.score[team] > score[team]), None)
             if scorer is not None:
@@ -219,7 +302,9 @@ class AutoRef:
 
     def summary(self) -> dict[str, object]:
         """The match's figures as the referee's summary gives them, with goals and balls out, and the
-        contacts between robots of one team (:class:`OwnContacts`)."""
+        own collisions (per team, and each: when, whose, which two robots)."""
         r = self.referee
+        own: dict[str, object] = dict(self.own_contacts.counts().items())
+        own["each"] = [{"t": round(t, 4), "team": a[0], "ids": [a[1], b[1]]} for t, a, b in self.own_contacts.each]
         return {"score": dict(r.score), "balls_out": r.balls_out, "kicks_seen": r.kicks,
-                "keeper_held_ball": r.keeper_held_ball, "own_contacts": dict(self.own_contacts.count), **r.summary()}
+                "keeper_held_ball": r.keeper_held_ball, "own_collisions": own, **r.summary()}

@@ -35,11 +35,13 @@ class AutorefParams(Validated):
     kick_reach_m: float = setting(0.05, lo=0.0, hi=1.0)  # ... a robot's body this near the ball ...
     kick_memory_s: float = setting(0.1, lo=0.0, hi=2.0)  # ... at some moment of the last this long
     margins: TrackMargins = TrackMargins(touch_release_m=0.01, contact_release_m=0.0, distance_m=0.05, speed_m_s=0.1,
-                                        fast_ball_frames=2)
+                                        fast_ball_frames=2, touch_pass_speed_m_s=1.0,
+                                        touch_pass_depth_m=0.003)
     leave_s: float = setting(2.0, lo=0.0, hi=60.0)  # a robot sent off may be seen on the field this long
-    # two robots of one team in contact (counted, no foul): their tracks' centres within two radii and the
-    # rules' contact margin; the contact over once they are this much farther apart (the tracks' jitter)
-    own_contact_release_m: float = setting(0.02, lo=0.0, hi=0.5)
+    # an own collision (two robots of one team, counted for the summary): their centres nearer than two
+    # radii plus this ...
+    own_contact_margin_m: float = setting(0.0, lo=-0.05, hi=0.2)
+    own_contact_closing_m_s: float = setting(0.2, lo=0.0, hi=10.0)  # ... while closing faster than this
 
 
 @dataclass(frozen=True)

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, Team
-from cmdragons.messages import GameEvent, GroundTruth, RefereeCommand, RobotTruth
+from cmdragons.messages import BallTruth, GameEvent, GroundTruth, RefereeCommand, RobotTruth
 from sim.restarts import other
 
 __all__ = ["FOUL_RESTARTS", "FoulWatch", "HeldBall", "NoProgress", "RulesParams", "Situation", "TrackMargins",
@@ -87,6 +87,12 @@ class TrackMargins(Validated):
     speed_m_s: float = setting(0.0, lo=0.0, hi=2.0)
     # the ball too fast in this many frames in a row (a track's velocity overshoots for a frame after a kick)
     fast_ball_frames: int = setting(1, lo=1, hi=100)
+    # a ball passing a robot faster than this (relative to it) starts a touch by coming near it only where
+    # its track went into the robot's body deeper than touch_pass_depth_m: near a robot on tracks is not at
+    # it (a ball that passed by unchanged was not touched), but a track that runs on straight through a
+    # robot missed the graze that turned the ball (none on the truth: near is touching)
+    touch_pass_speed_m_s: float = setting(math.inf, lo=0.0)
+    touch_pass_depth_m: float = setting(0.0, lo=0.0, hi=0.1)
 
 
 @dataclass(frozen=True)
@@ -187,7 +193,8 @@ class FoulWatch:
         reach = self.robot_r + self.ball_r + self.p.touch_margin_m
         release = self.margins.touch_release_m
         now = {(r.team, r.id) for r in robots if b.z < 2.0 * self.ball_r + 0.05
-               and math.hypot(r.x - b.x, r.y - b.y) < reach + (release if (r.team, r.id) in self.touching else 0.0)}
+               and math.hypot(r.x - b.x, r.y - b.y) < reach + (release if (r.team, r.id) in self.touching else 0.0)
+               and ((r.team, r.id) in self.touching or not self._passing(r, b))}
         new = [k for k in sorted(now) if k not in self.touching]
         for k in list(self.touching):
             if k not in now:
@@ -201,6 +208,16 @@ class FoulWatch:
         on = {(r.team, r.id) for r in robots}
         kicked, self._kicked = self._kicked, []
         return new + [k for k in kicked if k not in new and k in on]
+
+    def _passing(self, r: RobotTruth, b: BallTruth) -> bool:
+        """Is the ball near ``r`` only passing it by (:class:`TrackMargins`: faster than
+        ``touch_pass_speed_m_s`` relative to it, its centre not ``touch_pass_depth_m`` inside its body)?"""
+        m = self.margins
+        if math.hypot(b.vx - r.vx, b.vy - r.vy) <= m.touch_pass_speed_m_s:
+            return False
+        c, s = math.cos(r.theta), math.sin(r.theta)
+        dx, dy = b.x - r.x, b.y - r.y
+        return self.field.league.robot.gap(c * dx + s * dy, -s * dx + c * dy) - self.ball_r >= -m.touch_pass_depth_m
 
     def _event(self, t: float, kind: str, key: Key | None, value: float, limit: float, unit: str) -> GameEvent:
         restart = FOUL_RESTARTS[kind]

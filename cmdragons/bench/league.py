@@ -258,7 +258,7 @@ def league_row(name: str, folder: Path, settings: Settings, truth_log: Path | No
     stops = stoppages(states, end_t, rules_stoppage_s(played.sim.referee))
     passes = seen_passes(((t, m) for t, m in events if not t.startswith("ssl/vision/")), ours, played)
     fouls = summary["rules"]["fouls"]
-    contacts = summary["own_collisions"]
+    contacts = summary["collisions"]["own"]
     roll = summary["tracker"][ours].get("physics", {}).get("ball_roll", {})
     truth = None
     if truth_log is not None:

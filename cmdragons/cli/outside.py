@@ -80,7 +80,6 @@ def play_outside(args: argparse.Namespace, stop: Interrupt, compile_kernels: Cal
         try:
             heard = listen(receiver, o.geometry_timeout_s, o.learn_s, where)
             settings, line = field_settings(settings, heard.geometry)
-            heard = _division_only(settings, p, heard, receiver, where)
         except OutsideError as exc:
             print(f"cmdragons play --simulator {args.simulator}: {exc}", file=sys.stderr)
             return 2
@@ -137,29 +136,6 @@ def play_outside(args: argparse.Namespace, stop: Interrupt, compile_kernels: Cal
     return stop.exit_code
 
 
-def _division_only(settings: Any, params: Any, heard: Any, receiver: Any, where: str) -> Any:
-    """What the simulator's vision shows once the robots beyond the division's count a team are
-    taken off its field (none beyond: ``heard`` as it is); :class:`OutsideError` when they stay."""
-    from cmdragons.runtime.outside import OutsideError, beyond_division, listen, take_off
-
-    per_team = settings.field.dims.robots_per_team
-    extra = beyond_division(heard.robots, per_team)
-    if not extra:
-        return heard
-    print(f"play: the simulator has {len(extra)} robots beyond Division {settings.field.division}'s {per_team} a "
-          f"team: taken off its field ({', '.join(f'{t} {i}' for t, i in extra)})", file=sys.stderr, flush=True)
-    take_off(params, extra)
-    o = settings.protocols.outside
-    time.sleep(o.learn_s)  # the frames that still show them, passed
-    receiver.drain()
-    heard = listen(receiver, o.geometry_timeout_s, o.learn_s, where)
-    still = beyond_division(heard.robots, per_team)
-    if still:
-        raise OutsideError(f"{len(still)} robots beyond the division's {per_team} a team stay on the simulator's "
-                           "field after being taken off (present: false)")
-    return heard
-
-
 def _draw(video: Any, log: Any, ours: str) -> None:
     """The match video from the match's log (its topics in the order the match wrote them)."""
     from cmdragons.runtime.log import read_log
@@ -190,10 +166,10 @@ def _finish(folder: Any, run: Any, summary: dict[str, Any], args: argparse.Names
           f"(division {summary['division']})")
     if "score" in summary:  # refereed by ours on the tracked world
         score = summary["score"]
-        contacts = summary["own_collisions"]
+        own = summary["collisions"]["own"]
+        collided = ", ".join(f"{team} {plural(n, 'own collision')}" for team, n in own.items())
         print(f"play: refereed on our tracked world: blue {score['blue']}:{score['yellow']} yellow, "
-              f"{plural(summary['balls_out'], 'ball')} out, {plural(summary['kicks'], 'kick')} seen, "
-              + ", ".join(f"{plural(contacts[t], 'own collision')} of {t}" for t in summary["teams"]))
+              f"{plural(summary['balls_out'], 'ball')} out, {plural(summary['kicks'], 'kick')} seen; {collided}")
         if summary["rules"].get("rules") == "full":
             print("play: " + rules_line(summary["rules"], args.team))
     for w in summary["warnings"]:

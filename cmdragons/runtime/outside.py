@@ -418,9 +418,12 @@ def outside_summary(f: dict[str, Any], stage_ms: dict[str, list[float]], match: 
     referee = f.get("autoref", {})  # our referee on the tracked world (none: a game controller's word)
     return {
         **({"score": referee["score"], "balls_out": referee["balls_out"], "kicks": referee["kicks_seen"],
-            "own_collisions": referee["own_contacts"],
             "rules": {k: referee[k] for k in ("rules", "game_stage", "fouls", "cards", "placements", "penalties",
-                                              "shootout") if k in referee}} if referee else {}),
+                                              "shootout") if k in referee},
+            # counted by our referee from the tracks: the collisions among each of our teams' robots
+            "collisions": {"own": {t: referee["own_collisions"][t] for t in match.teams},
+                           "each": [c for c in referee["own_collisions"]["each"] if c["team"] in match.teams]}}
+           if referee else {}),
         "simulator": match.kind.value,
         "teams": list(match.teams),
         "seconds": round(match.seconds, 3),

@@ -19,11 +19,10 @@ from cmdragons.messages import (
     RefereeCommand,
     RobotCommand,
     RobotDetection,
-    RobotTruth,
     WorldState,
 )
 from cmdragons.tracking import Tracker, TrackerParams
-from sim.autoref import AutoRef, BallCrossing, KickDetector, OwnContacts
+from sim.autoref import AutoRef, BallCrossing, KickDetector
 from sim.referee import Referee
 from sim.referee_params import AutorefParams, RefereeParams
 from sim.world import BallParams, DribblerParams, KickerParams, PhysicsParams, RobotParams, World
@@ -231,19 +230,3 @@ def test_placing_by_robots_needs_the_full_rules() -> None:
     with pytest.raises(ValueError, match="place_by"):
         RefereeParams(rules="basic", place_by="robots")
 
-
-def _robot(team: str, rid: int, x: float) -> RobotTruth:
-    return RobotTruth(team, rid, x, 0.0, 0.0, 0.0, 0.0, 0.0)  # type: ignore[arg-type]
-
-
-def test_own_contacts_begin_within_two_radii_and_the_margin_and_end_past_the_release() -> None:
-    r = LEAGUE.robot.radius_m
-    touch, release = 2 * r + 0.01, 0.02
-    count = OwnContacts(touch, release)
-    # blue 1 at 0; blue 2 (and yellow 1 beside it, the other team's) approaching, jittering, leaving, back
-    gaps = [touch + 0.005, touch - 0.002, touch + 0.01, touch - 0.001, touch + release + 0.001, touch - 0.003]
-    began = [count.see((_robot("blue", 1, 0.0), _robot("blue", 2, g), _robot("yellow", 1, -g))) for g in gaps]
-    assert began == [0, 1, 0, 0, 0, 1]  # the jitter inside the release is the same contact
-    assert count.count == {"blue": 2, "yellow": 0}  # blue against yellow is no own contact
-    count.see((_robot("yellow", 3, 1.0), _robot("yellow", 4, 1.0 + touch / 2)))
-    assert count.count == {"blue": 2, "yellow": 1}  # and a robot out of sight ended blue's

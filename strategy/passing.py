@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 from cmdragons.config import Validated, setting
 from cmdragons.messages import BallState, RobotState
+from strategy.ballmodel import BallModel
 
 __all__ = ["Pass", "PassPlay", "PassPlayParams", "PassRecordParams"]
 
@@ -55,10 +56,15 @@ class Pass:
 
 
 class PassPlay:
-    """The team's one pass, followed from frame to frame."""
+    """The team's one pass, followed from frame to frame; with a ball ``model``, a ball that cannot
+    reach the point (rolling from its speed now, it stops more than ``received_m`` short) is not the
+    pass, or no longer: the pass is over and the new attacker takes over (such a ball, played along
+    the lane by a contest's kick, kept its receiver waiting and the team without an attacker until
+    the ball died)."""
 
-    def __init__(self, params: PassPlayParams) -> None:
+    def __init__(self, params: PassPlayParams, model: BallModel | None = None) -> None:
         self.p = params
+        self.model = model
         self.current: Pass | None = None
 
     def plan(self, t: float, passer: int, receiver: int, point: tuple[float, float],
@@ -91,6 +97,13 @@ class PassPlay:
         to_point = (ps.point[0] - ball.x, ps.point[1] - ball.y)
         along = ball.vx * to_point[0] + ball.vy * to_point[1]
         heading_there = speed > p.kicked_speed_m_s and along > p.kicked_cos * speed * math.hypot(*to_point)
+        if heading_there and self.model is not None:
+            reach = speed**2 / (2.0 * max(self.model.acc_roll_m_s2, 1e-9))  # rolling from now: the farthest
+            if reach < math.hypot(*to_point) - p.received_m:
+                if ps.kicked:
+                    self.current = None  # it stops short: over
+                    return None
+                heading_there = False
         if not ps.kicked and heading_there:
             ps = self.current = dataclasses.replace(ps, kicked=True, t_start=t)  # the timeout runs from the kick
         elif ps.kicked and (speed < p.dead_speed_m_s or not heading_there):

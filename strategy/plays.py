@@ -119,7 +119,7 @@ class Strategy:
     def __init__(self, team: Team, pitch: Field, params: StrategyParams) -> None:
         self.team, self.field, self.p = team, pitch, params
         self.roles = RoleAssigner(params.roles)
-        self.passes = PassPlay(params.pass_play)
+        self.passes = PassPlay(params.pass_play, params.skills.ball_model)
         self.supporters = Supporters(pitch, params.passing, params.support, params.obstacle_radius_m)
         self.attacker = Attacker(pitch, params.kicking, params.passing, params.skills, params.obstacle_radius_m)
         self.frame = 0
@@ -133,6 +133,7 @@ class Strategy:
         intercepts), keeping what is kept from frame to frame (roles, the pass under way, placements)."""
         self.p = params
         self.attacker.skills = params.skills
+        self.passes.model = params.skills.ball_model
 
     def own_sign(self, game: GameState) -> float:
         """-1 when we defend the goal at negative x, else +1."""

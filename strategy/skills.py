@@ -31,6 +31,7 @@ __all__ = [
     "pass_speed",
     "receive",
     "set_kick",
+    "turn_with_ball",
     "waiting_point",
 ]
 
@@ -66,6 +67,7 @@ class SkillParams(Validated):
     dribble_speed_m_s: float = setting(1.0, lo=0.05, hi=5.0)  # carrying the ball, and driving onto it to take it
     dribble_hold_m: float = setting(0.03, lo=0.001, hi=0.5)  # ball centre this near the middle of the face: held
     dribble_turn_rad: float = setting(0.3, lo=0.01, hi=3.2)  # ... and the robot facing the target within this
+    turn_step_rad: float = setting(0.15, lo=0.01, hi=1.0)  # turning about a held ball: at most this a frame
     contact_slack_m: float = setting(0.02, lo=0.0, hi=0.2)  # lined up: the face up to this past the ball's back
     at_ball_m: float = setting(0.03, lo=0.0, hi=0.5)  # the face this near behind the ball ...
     at_ball_lateral_share: float = setting(0.5, lo=0.0, hi=1.0)  # ... within this share of lined_up_m across: at it
@@ -77,6 +79,7 @@ class SkillParams(Validated):
     rest_speed_m_s: float = setting(0.1, lo=0.0, hi=2.0)  # a ball slower than this is met where it lies
     intercept_step_s: float = setting(0.05, lo=0.001, hi=1.0)  # the moving ball's path is predicted in these steps
     receive_moving_m_s: float = setting(0.3, lo=0.0, hi=5.0)  # a ball faster than this is met on its path
+    one_touch_facing_rad: float = setting(0.25, lo=0.01, hi=3.2)  # one-touch: kicker armed facing its aim within this
     set_lined_up_m: float = setting(0.015, lo=0.001, hi=0.5)  # a restart's kick: lateral error at the waiting point
     set_lined_up_rad: float = setting(0.05, lo=0.001, hi=1.0)  # ... heading error
     set_settle_m_s: float = setting(0.1, lo=0.0, hi=5.0)  # ... speed across the kick line before driving through
@@ -211,6 +214,26 @@ def dribble(robot: RobotState, ball: BallState, target: tuple[float, float], p: 
                   final_speed_m_s=min(p.push_speed_m_s, p.dribble_speed_m_s))
 
 
+def turn_with_ball(robot: RobotState, ball: BallState, target: tuple[float, float], speed: float,
+                   p: SkillParams) -> Intent | None:
+    """Holding the ball on the kicker face (its centre within ``dribble_hold_m`` of the face's
+    middle): turn about the ball toward ``target``, at most ``turn_step_rad`` a frame (faster, the
+    ball is lost), the dribbler holding it; facing the target within ``lined_up_rad``, drive through
+    it with the kicker armed at ``speed``. None when the ball is not held (going round it to line up
+    would leave it: a trapped ball was given away so)."""
+    contact = p.contact_m
+    face_x, face_y = robot.x + math.cos(robot.theta) * contact, robot.y + math.sin(robot.theta) * contact
+    if math.hypot(ball.x - face_x, ball.y - face_y) >= p.dribble_hold_m:
+        return None
+    aim = _angle(target[0] - ball.x, target[1] - ball.y)
+    error = wrap_angle(aim - robot.theta)
+    if abs(error) < p.lined_up_rad:
+        return drive_through(ball, aim, speed, p)
+    heading = robot.theta + max(-p.turn_step_rad, min(p.turn_step_rad, error))
+    return Intent(ball.x - math.cos(heading) * contact, ball.y - math.sin(heading) * contact, heading,
+                  dribbler=p.hold_dribbler, avoid_ball=False)
+
+
 def speed_after(speed: float, distance: float, p: SkillParams) -> float:
     """Ball speed after rolling ``distance`` from a kick at ``speed`` (0 if it stops before)."""
     return p.ball_model.speed_after(speed, distance)
@@ -258,7 +281,10 @@ def intercept(robot: RobotState, ball: BallState, p: SkillParams, field: Field |
 def receive(robot: RobotState, ball: BallState, wait_at: tuple[float, float], p: SkillParams,
             shoot_at: tuple[float, float] | None = None, shot_speed: float = 0.0) -> Intent:
     """Meet the moving ball on its path near ``wait_at``; with ``shoot_at``, a one-touch shot
-    aimed with the kick model (B.6), else stop it with the dribbler facing it."""
+    aimed with the kick model (B.6), else stop it with the dribbler facing it. The one-touch kick
+    is armed only while the robot faces its heading within ``one_touch_facing_rad``: a kicker fires
+    along the robot's heading, so a ball that arrives before the robot has turned would be sent
+    back the way it came; until then the dribbler is on, and a ball that arrives early is trapped."""
     speed = math.hypot(ball.vx, ball.vy)
     px, py = wait_at
     moving = speed > p.receive_moving_m_s
@@ -275,6 +301,8 @@ def receive(robot: RobotState, ball: BallState, wait_at: tuple[float, float], p:
         heading = aim_heading(target, v_in, shot_speed, p.kicker_retention)
         # stand so the ball meets the middle of the kicker face
         cx, cy = px - math.cos(heading) * contact, py - math.sin(heading) * contact
+        if abs(wrap_angle(heading - robot.theta)) > p.one_touch_facing_rad:
+            return Intent(cx, cy, heading, avoid_ball=False, dribbler=p.hold_dribbler)
         return Intent(cx, cy, heading, kick_speed=shot_speed, avoid_ball=False, dribbler=0.0)
     cx, cy = px - math.cos(toward_ball) * contact, py - math.sin(toward_ball) * contact
     return Intent(cx, cy, toward_ball, dribbler=p.hold_dribbler, avoid_ball=False)

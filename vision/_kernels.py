@@ -318,6 +318,56 @@ def region_stats(flat: np.ndarray, label: np.ndarray, n_regions: int) -> np.ndar
     return out
 
 
+@numba.njit(cache=True)
+def disc_fits(flat: np.ndarray, half_widths: np.ndarray) -> bool:
+    """Whether a structuring element fits inside one region anywhere (the region's erosion by the
+    element is not empty, so neither is its opening): ``flat`` (n, 4) the region's runs (row,
+    u_start, u_end inclusive, class); ``half_widths`` (2r + 1,) the element's rows, row ``k``
+    covering columns ``-half_widths[k] .. half_widths[k]`` around the centre at row offset
+    ``k - r`` (-1: an empty row). Lets :func:`vision.cmvision.split_region` pass by the regions no
+    dot fits in (thin lines) without building their masks; its reference is ``cv2.erode``."""
+    r = (half_widths.shape[0] - 1) // 2
+    widest, k0, k1 = -1, half_widths.shape[0], -1  # the element's widest row, its first and last rows
+    for k in range(half_widths.shape[0]):
+        if half_widths[k] >= 0:
+            widest, k0, k1 = max(widest, half_widths[k]), min(k0, k), k
+    if widest < 0:
+        return True  # an empty element fits everywhere
+    v0, v1, u0, u1 = flat[0, 0], flat[0, 0], flat[0, 1], flat[0, 2]
+    longest = 0
+    for p in range(flat.shape[0]):
+        v0, v1 = min(v0, flat[p, 0]), max(v1, flat[p, 0])
+        u0, u1 = min(u0, flat[p, 1]), max(u1, flat[p, 2])
+        longest = max(longest, flat[p, 2] - flat[p, 1] + 1)
+    if longest < 2 * widest + 1 or v1 - v0 < k1 - k0:
+        return False  # no run holds the element's widest row, or too few rows for its height
+    hh, ww = v1 - v0 + 1, u1 - u0 + 1
+    # per pixel, the length of the region's run through it up to it from the left and from the right
+    left = np.empty((hh, ww), np.int32)
+    right = np.empty((hh, ww), np.int32)
+    for i in range(hh):
+        for j in range(ww):
+            left[i, j] = 0
+            right[i, j] = 0
+    for p in range(flat.shape[0]):
+        i, a, b = flat[p, 0] - v0, flat[p, 1] - u0, flat[p, 2] - u0
+        for j in range(a, b + 1):
+            left[i, j] = j - a + 1
+            right[i, j] = b - j + 1
+    # centres whose element rows all lie within the box
+    for i in range(r - k0, hh + r - k1):
+        for j in range(ww):
+            fits = True
+            for k in range(k0, k1 + 1):
+                hw = half_widths[k]
+                if hw >= 0 and (left[i + k - r, j] <= hw or right[i + k - r, j] <= hw):
+                    fits = False
+                    break
+            if fits:
+                return True
+    return False
+
+
 # side of the grid cells (px) that `merge_regions` files the regions' bounding boxes in
 MERGE_CELL_PX = 16
 

@@ -25,6 +25,7 @@ centre of pixel (i, j) is (j + 0.5, i + 0.5), as in :mod:`cmdragons.camera`.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -102,6 +103,32 @@ class SplitRule:
     max_elongation: float = 1.6
 
 
+def _half_widths(element: NDArray[np.uint8]) -> NDArray[np.int64]:
+    """Per row of a structuring element symmetric about its centre column, how far it reaches to
+    each side of that column (-1: an empty row), as :func:`vision._kernels.disc_fits` takes it."""
+    c = element.shape[1] // 2
+    out = np.full(element.shape[0], -1, dtype=np.int64)
+    for k, row in enumerate(element):
+        on = np.flatnonzero(row)
+        if on.size:
+            if on[0] + on[-1] != 2 * c or on.size != on[-1] - on[0] + 1:
+                raise ValueError("structuring element rows must be contiguous and centred")
+            out[k] = c - on[0]
+    return out
+
+
+@functools.cache
+def _disc(radius_px: int) -> tuple[NDArray[np.uint8], NDArray[np.int64]]:
+    """OpenCV's disc of that radius (px) and its rows' half widths (:func:`_half_widths`)."""
+    import cv2
+
+    disc = np.asarray(cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * radius_px + 1, 2 * radius_px + 1)),
+                      dtype=np.uint8)
+    half = _half_widths(disc)
+    disc.flags.writeable = half.flags.writeable = False  # shared by every call
+    return disc, half
+
+
 def split_region(flat: NDArray[np.int32], rule: SplitRule) -> NDArray[np.float64]:
     """The round parts of one region given by its runs ``flat`` (n, 4: row, u_start, u_end, class)
     after an opening by a disc of ``rule.open_radius_px``: rows of the region table
@@ -109,11 +136,13 @@ def split_region(flat: NDArray[np.int32], rule: SplitRule) -> NDArray[np.float64
     import cv2
 
     r = max(1, int(round(rule.open_radius_px)))
+    disc, half = _disc(r)
+    if not kern.disc_fits(flat, half):
+        return np.zeros((0, kern.R_COLS))  # the opening is empty: no round part (a thin line)
     u0, v0 = int(flat[:, 1].min()) - r, int(flat[:, 0].min()) - r
     mask = np.zeros((int(flat[:, 0].max()) - v0 + r + 1, int(flat[:, 2].max()) - u0 + r + 1), np.uint8)
     for row, a, b, _ in flat:
         mask[row - v0, a - u0 : b - u0 + 1] = 1
-    disc = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * r + 1, 2 * r + 1))
     n, labels = cv2.connectedComponents(cv2.morphologyEx(mask, cv2.MORPH_OPEN, disc), connectivity=8)
     rows = regions_reference(labels.astype(np.int64) - 1, np.full(labels.shape, int(flat[0, 3]), np.int64))
     if n <= 1:

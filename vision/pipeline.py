@@ -19,6 +19,7 @@ from cmdragons.camera import CameraModel
 from cmdragons.config import Validated
 from cmdragons.geometry import TEAMS, Field, LeagueParams, Team
 from cmdragons.messages import DetectionFrame
+from vision import _kernels as kern
 from vision.cmvision import (
     MAX_CLASSES,
     ColourClass,
@@ -27,7 +28,6 @@ from vision.cmvision import (
     Regions,
     Segmenter,
     SplitRule,
-    convert_colour,
 )
 from vision.light import LightFollower, LightParams
 from vision.patterns import BallParams, PatternMatcher, PatternParams, RegionGeometry, detect_ball
@@ -185,13 +185,15 @@ class VisionPipeline:
             return None
         v, u = np.mgrid[i0:i1, j0:j1] + 0.5
         inside = (u - pixel[0]) ** 2 + (v - pixel[1]) ** 2 <= r * r
+        yuv = self.params.colour_space == "yuv"
+        # the kernels' conversion (the same as convert_colour's, without its per-call overhead)
         if self.light is None:
-            mean = convert_colour(image[i0:i1, j0:j1][inside][None], self.params.colour_space)[0].mean(axis=0)
+            mean = kern.channels(image[i0:i1, j0:j1][inside][None], yuv)[0].mean(axis=0)
         else:  # as the classes see it, its cell's gains applied
             bgr = self.light.corrected(image[i0:i1, j0:j1][inside].astype(np.float64).mean(axis=0),
                                        (float(pixel[0]), float(pixel[1])))
-            mean = convert_colour(np.clip(np.round(bgr), 0, 255).astype(np.uint8)[None, None],
-                                  self.params.colour_space)[0, 0].astype(np.float64)
+            px = np.minimum(np.maximum(np.round(bgr), 0.0), 255.0).astype(np.uint8)
+            mean = kern.channels(px[None, None], yuv)[0, 0].astype(np.float64)
         reach = []
         for role in ("pink", "green"):
             box = self.params.colours[getattr(self.params.roles, role)]

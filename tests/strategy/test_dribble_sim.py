@@ -13,8 +13,8 @@ import pytest
 from cmdragons.messages import BallState, GameState, RobotState, WorldState
 from cmdragons.runtime.settings import load_settings
 from cmdragons.team import Brain
-from sim.world import World
-from strategy.skills import dribble
+from sim.world import Kick, World
+from strategy.skills import dribble, turn_with_ball
 
 SETTINGS = load_settings(Path(__file__).resolve().parents[2] / "configs")
 
@@ -54,3 +54,34 @@ def test_dribble_carries_the_ball_to_the_target(start: tuple[float, float, float
     assert world.holding("blue", 0)
     carried = math.hypot(target[0], target[1]) / skills.dribble_speed_m_s
     assert held_frames / 60 > carried
+
+
+@pytest.mark.parametrize("aim", [0.0, 1.0, -2.0])  # from facing -x: half a turn, and less either way
+def test_a_held_ball_is_turned_with_and_kicked_at_the_aim(aim: float) -> None:
+    """The ball on the kicker face: the robot turns about it (at most ``turn_step_rad`` a frame), the
+    dribbler holding it, and kicks it within 5 degrees of the aim, within 2 s."""
+    s = SETTINGS.sim
+    robot_model = dataclasses.replace(s.robot, command_latency_s=0.0)  # the brain sees the truth of now
+    world = World(SETTINGS.field, s.physics, robot_model, s.ball, s.kicker, s.dribbler,
+                  robots_per_team={"blue": 1, "yellow": 0})
+    skills = SETTINGS.strategy.skills
+    world.place_robot("blue", 0, 0.0, 0.0, math.pi)
+    world.place_ball(-skills.contact_m, 0.0)
+    brain = Brain("blue", SETTINGS)
+    target = (-skills.contact_m + 2.0 * math.cos(aim), 2.0 * math.sin(aim))
+    kicked = None
+    for _ in range(2 * 60):
+        truth = world.ground_truth()
+        r, b = truth.robots[0], truth.ball
+        robot = RobotState("blue", 0, r.x, r.y, r.theta, r.vx, r.vy, r.omega)
+        ball = BallState(b.x, b.y, b.vx, b.vy)
+        intent = turn_with_ball(robot, ball, target, 4.0, skills)
+        assert intent is not None, "the ball got away while turning"
+        (cmd,) = brain.drive(WorldState(truth.t, ball, (robot,)), {0: intent}, GameState(0.0))
+        if any(isinstance(e, Kick) for e in world.step_frame([cmd])):
+            kicked = world.ground_truth().ball
+            break
+    assert kicked is not None
+    assert abs(math.degrees(math.remainder(math.atan2(kicked.vy, kicked.vx) - aim, 2 * math.pi))) < 5.0
+    assert turn_with_ball(RobotState("blue", 0, 0.0, 0.0, 0.0), BallState(0.3, 0.0, 0.0, 0.0), target, 4.0,
+                          skills) is None  # a ball not on the face is not held

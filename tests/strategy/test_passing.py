@@ -6,6 +6,7 @@ import pytest
 
 from cmdragons.messages import BallState, RobotState
 from strategy.passing import PassPlay, PassPlayParams
+from strategy.skills import SkillParams
 
 P = PassPlayParams()
 POINT = (2.0, 0.0)
@@ -75,4 +76,29 @@ def test_planning_again_keeps_the_pass_to_the_same_receiver() -> None:
     assert play.current is not None and (play.current.receiver, play.current.point) == (3, (1.0, 1.0))
     assert play.current.t_start == 0.6
     play.cancel()
+    assert play.current is None
+
+
+MODEL = SkillParams().ball_model
+
+
+@pytest.mark.parametrize(("speed", "kicked"), [
+    (2.0, True),  # rolls some 7.7 m: reaches the point 1.9 m off
+    (0.8, False),  # rolls 1.2 m: stops short of the point (more than received_m)
+])
+def test_a_ball_that_stops_short_of_the_point_is_not_the_pass(speed: float, kicked: bool) -> None:
+    play = PassPlay(P, MODEL)
+    play.plan(0.0, passer=1, receiver=2, point=POINT, shoot_at=None)
+    ps = play.follow(0.1, _own(), BallState(0.1, 0.0, speed, 0.0))
+    assert ps is not None and ps.kicked is kicked
+    rolled = speed**2 / (2 * MODEL.acc_roll_m_s2)
+    assert (rolled >= POINT[0] - 0.1 - P.received_m) is kicked  # the rolling ball's reach decides
+
+
+def test_a_kicked_pass_that_slows_short_of_the_point_is_over() -> None:
+    play = PassPlay(P, MODEL)
+    play.plan(0.0, passer=1, receiver=2, point=POINT, shoot_at=None)
+    assert play.follow(0.1, _own(), BallState(0.1, 0.0, 2.0, 0.0)).kicked  # type: ignore[union-attr]
+    # later, at 0.7 m/s 1.4 m from the point it rolls 0.94 m more: short of it, the attacker takes over
+    assert play.follow(1.0, _own(), BallState(0.6, 0.0, 0.7, 0.0)) is None
     assert play.current is None

@@ -67,6 +67,39 @@ def _runs(row: NDArray[np.uint8]) -> list[tuple[int, int]]:
     return [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2], strict=True)]
 
 
+@pytest.mark.parametrize("radius", [1, 3, 5])
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_disc_fits_equals_opencv_erosion(radius: int, seed: int) -> None:
+    """The kernel's test of whether the disc fits a region agrees with OpenCV's erosion being non-empty
+    on random regions: thin arcs, blobs of every size, bands, and single rows."""
+    rng = np.random.default_rng(seed)
+    disc = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * radius + 1, 2 * radius + 1))
+    half = np.array([radius - int(np.flatnonzero(row)[0]) for row in disc], dtype=np.int64)  # rows centred
+    verdicts = set()
+    for _ in range(60):
+        mask = np.zeros((50, 70), np.uint8)
+        kind = rng.integers(4)
+        cx, cy = int(rng.integers(15, 55)), int(rng.integers(15, 35))
+        if kind == 0:
+            cv2.circle(mask, (cx, cy), int(rng.integers(1, 12)), 1, -1)
+        elif kind == 1:
+            axes = (int(rng.integers(3, 14)), int(rng.integers(3, 14)))
+            cv2.ellipse(mask, (cx, cy), axes, float(rng.uniform(0, 180)), 0.0, float(rng.uniform(60, 360)), 1,
+                        int(rng.integers(1, 2 * radius + 3)))
+        elif kind == 2:
+            mask[cy : cy + int(rng.integers(1, 2 * radius + 3)), 5 : 5 + int(rng.integers(1, 40))] = 1
+        else:
+            mask[rng.random(mask.shape) < 0.35] = 1
+        flat = np.array([(r, a, b, 0) for r in range(mask.shape[0]) for a, b in _runs(mask[r])], dtype=np.int32)
+        if flat.size == 0:
+            continue
+        padded = cv2.copyMakeBorder(mask, radius, radius, radius, radius, cv2.BORDER_CONSTANT, value=0)
+        want = bool(cv2.erode(padded, disc).any())
+        assert kern.disc_fits(flat, half) == want
+        verdicts.add(want)
+    assert verdicts == {True, False}
+
+
 def test_a_light_segment_touching_a_dot_is_split_from_it(cameras: list[CameraModel]) -> None:
     """Robot 1 (GPGP) with the flat front's segment of its cover printed in a light green of the
     green class, reaching 2 mm into its green front-left dot (the flat front is cut at 0.055 m):

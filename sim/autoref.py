@@ -122,7 +122,7 @@ def path_gap(shape: RobotShape, robot: tuple[float, float, float], path: Sequenc
 
 def deflection_path(p0: tuple[float, float], v0: tuple[float, float], p1: tuple[float, float],
                     v1: tuple[float, float], longest_s: float) -> list[tuple[float, float]]:
-    """The ball's path between two tracked frames (at ``p0`` moving at ``v0``, then at ``p1`` moving at
+    """The ball's path between two tracked points (at ``p0`` moving at ``v0``, then at ``p1`` moving at
     ``v1``; field frame, m, m/s) across the touch that changed its velocity: through the deflection
     point, where its old line and its new line meet, when they meet ahead of ``p0`` and behind ``p1``
     within ``longest_s`` of motion on each; else straight from ``p0`` to ``p1`` (a ball stopped, or
@@ -144,8 +144,9 @@ _PARALLEL = math.sin(math.radians(5.0))  # lines closer to parallel than this me
 class KickDetector:
     """Touches of the ball from its track: its velocity changes by more than
     ``kick_speed_change_m_s`` between two frames (a kick, a push, a bounce off a robot). The toucher
-    is the robot the ball's path between the two frames went nearest (through the deflection point,
-    where its old and new lines meet: :func:`deflection_path`), its body (:func:`hull_gap`, a disc
+    is the robot the ball's path went nearest, from the earliest frame of the last ``kick_memory_s``
+    that moved as the frame before the change did (a turn the track shows late) to now, through the
+    deflection point where its old and new lines meet (:func:`deflection_path`): its body (:func:`hull_gap`, a disc
     cut flat at the front, where each robot stood in either frame) within ``kick_reach_m`` of the
     ball; where robots of both teams are that near, the one whose body the path went deepest into or
     passed nearest. When no robot is that near (a kick the track shows a few frames late, the ball
@@ -159,6 +160,7 @@ class KickDetector:
         self.ball_r = pitch.league.ball.radius_m
         self.max_ball_speed_m_s = max_ball_speed_m_s
         self._last: tuple[float, float, float, float, float] | None = None  # t, x, y, vx, vy
+        self._ball: deque[tuple[float, float, float, float, float]] = deque()  # the last kick_memory_s of it
         self._poses: dict[Key, tuple[float, float, float]] = {}  # where each robot stood the frame before
         self._recent: deque[tuple[float, dict[Key, float]]] = deque()  # t, each robot's gap to the ball (m)
 
@@ -170,22 +172,35 @@ class KickDetector:
         if b is None:
             self._last = None
             self._recent.clear()
+            self._ball.clear()
             return None
         gaps = {k: hull_gap(self.shape, pose, b.x, b.y) - self.ball_r for k, pose in poses.items()}
         last, self._last = self._last, (t, b.x, b.y, b.vx, b.vy)
         self._recent.append((t, gaps))
+        history = self._ball
+        self._ball.append((t, b.x, b.y, b.vx, b.vy))
         while self._recent and t - self._recent[0][0] > self.p.kick_memory_s:
             self._recent.popleft()
+        while t - self._ball[0][0] > self.p.kick_memory_s:
+            self._ball.popleft()
         if last is None:
             return None
         t0, x0, y0, vx0, vy0 = last
         jump = math.hypot(b.x - x0, b.y - y0)
         if jump > self.max_ball_speed_m_s * max(t - t0, 1e-3) + self.ball_r:
             self._recent = deque([(t, gaps)])  # put somewhere else: a new watch
+            self._ball = deque([(t, b.x, b.y, b.vx, b.vy)])
             return None
         if math.hypot(b.vx - vx0, b.vy - vy0) <= self.p.kick_speed_change_m_s:
             return None
-        path = deflection_path((x0, y0), (vx0, vy0), (b.x, b.y), (b.vx, b.vy), t - t0 + self.p.kick_memory_s)
+        # the old line from the earliest frame remembered that still moved as the last did: a turn the track
+        # shows late has the ball past the deflection point already in the frame before
+        ta, xa, ya = t0, x0, y0
+        for tk, xk, yk, vxk, vyk in reversed(list(history)[:-1]):
+            if math.hypot(vxk - vx0, vyk - vy0) > self.p.kick_speed_change_m_s:
+                break
+            ta, xa, ya = tk, xk, yk
+        path = deflection_path((xa, ya), (vx0, vy0), (b.x, b.y), (b.vx, b.vy), t - ta + self.p.kick_memory_s)
         near = sorted((min(path_gap(self.shape, pose, path) for pose in (before.get(k, now), now)) - self.ball_r, k)
                       for k, now in poses.items())
         if near and near[0][0] <= self.p.kick_reach_m:

@@ -14,15 +14,17 @@ import pytest
 from cmdragons.geometry import LeagueParams
 from cmdragons.messages import (
     BallDetection,
+    BallState,
     DetectionFrame,
     GameEvent,
     RefereeCommand,
     RobotCommand,
     RobotDetection,
+    RobotState,
     WorldState,
 )
 from cmdragons.tracking import Tracker, TrackerParams
-from sim.autoref import AutoRef, BallCrossing, KickDetector
+from sim.autoref import AutoRef, BallCrossing, KickDetector, OwnContacts
 from sim.referee import Referee
 from sim.referee_params import AutorefParams, RefereeParams
 from sim.world import BallParams, DribblerParams, KickerParams, PhysicsParams, RobotParams, World
@@ -214,8 +216,6 @@ def test_ball_crossing_calls_each_crossing_once_until_the_ball_is_back() -> None
 def test_the_kick_detector_ignores_a_ball_put_elsewhere() -> None:
     """A ball that jumps (the referee put it somewhere) is no touch, though its velocity changed and a
     robot stands where it now lies."""
-    from cmdragons.messages import BallState, RobotState
-
     f = World(LEAGUE, PhysicsParams(), RobotParams(), BallParams(), KickerParams(), DribblerParams(),
               robots_per_team={"blue": 0, "yellow": 0}).field
     d = KickDetector(f, AutorefParams())
@@ -230,3 +230,131 @@ def test_placing_by_robots_needs_the_full_rules() -> None:
     with pytest.raises(ValueError, match="place_by"):
         RefereeParams(rules="basic", place_by="robots")
 
+
+# --- touches from scripted tracks: the ball's path and which robot it hit are the ground truth ---------
+R_BALL = LEAGUE.ball.radius_m
+REACH = LEAGUE.robot.radius_m + R_BALL  # a ball's centre this far from a robot's centre touches its round side
+DT = 1 / 60
+
+
+def deflected_track(hit: tuple[float, float], v_in: tuple[float, float], v_out: tuple[float, float],
+                    robots: tuple[RobotState, ...], frames: int = 40, lag: int = 1,
+                    seed: int = 1) -> list[WorldState]:
+    """Tracked frames of a ball that rolls at ``v_in`` to the point ``hit`` (reached between frames 19
+    and 20), is turned there to ``v_out`` by the robot it hit, and rolls on; positions with the noise
+    of our tracks (``SIGMA_M``), the velocity showing the turn ``lag`` frames late (the tracker's)."""
+    rng = np.random.default_rng(seed)
+    t_hit = 19.5 * DT
+    out = []
+    for k in range(frames):
+        t = k * DT
+        v = v_in if t < t_hit else v_out
+        x = hit[0] + v[0] * (t - t_hit) + rng.normal(0, SIGMA_M)
+        y = hit[1] + v[1] * (t - t_hit) + rng.normal(0, SIGMA_M)
+        seen_v = v_in if t < t_hit + lag * DT else v_out
+        out.append(WorldState(t, BallState(x, y, *seen_v), robots, k))
+    return out
+
+
+def touches(track: list[WorldState]) -> list[tuple[str, int]]:
+    """The kick detector's touches along ``track``, in order."""
+    d = KickDetector(scene()[0].field, AutorefParams())
+    kicks = [d.see(w) for w in track]
+    return [(k.team, k.id) for k in kicks if k is not None]
+
+
+def test_a_robots_body_gap_is_the_distance_to_its_disc_cut_flat_at_the_front() -> None:
+    shape = LEAGUE.robot
+    r, f = shape.radius_m, shape.front_distance_m
+    assert shape.gap(-0.5, 0.0) == pytest.approx(0.5 - r, abs=1e-12)  # behind: the round side
+    assert shape.gap(0.0, 0.3) == pytest.approx(0.3 - r, abs=1e-12)
+    assert shape.gap(f + 0.01, 0.0) == pytest.approx(0.01, abs=1e-12)  # in front of the flat face (inside the disc)
+    assert shape.gap(0.0, 0.0) == pytest.approx(-f, abs=1e-12)  # the centre: as deep as the front is near
+    w = shape.mouth_half_width_m
+    ux, uy = 1.0 + f / r, w / r  # between the face's normal and the round side's at the face's corner ...
+    n = math.hypot(ux, uy)
+    assert shape.gap(f + 0.05 * ux / n, w + 0.05 * uy / n) == pytest.approx(0.05, abs=1e-12)  # ... the corner nearest
+    assert shape.gap(f + 0.03, w + 0.04) == pytest.approx(math.hypot(f + 0.03, w + 0.04) - r, abs=1e-12)  # the side
+
+
+@pytest.mark.parametrize("pass_gap", [0.005, 0.01, 0.02])
+def test_a_ball_deflected_by_a_robot_is_its_touch_though_it_then_passes_near_another(pass_gap: float) -> None:
+    """The ball rolls at 3 m/s into yellow 0's round side (45 degrees off its centre line), is turned by
+    90 degrees and passes blue 0 ``pass_gap`` from its body without touching it (the first miss of the
+    autoref bench: blue was taken for the last toucher): the touch is yellow's, and stays yellow's."""
+    a = math.radians(45.0)
+    yellow = RobotState("yellow", 0, 0.0, 0.0, math.pi)  # facing the ball with its back away: the round side hit
+    hit = (-REACH * math.cos(a), REACH * math.sin(a))
+    v_in, v_out = (3.0, 0.0), (0.0, 2.4)
+    # blue 0 beside the outgoing path 0.2 m on, its body pass_gap from the ball
+    blue = RobotState("blue", 0, hit[0] - REACH - pass_gap, hit[1] + 0.2, 0.0)
+    track = deflected_track(hit, v_in, v_out, (yellow, blue))
+    assert touches(track) == [("yellow", 0)]
+    auto = scene()[2]
+    for w in track:
+        auto.observe(w)
+    assert auto.referee.watch.last_touch == ("yellow", 0)
+
+
+@pytest.mark.parametrize("lag", [1, 2, 3])
+def test_of_two_robots_of_both_teams_near_the_deflection_the_one_whose_body_the_path_met_touched(lag: int) -> None:
+    """The ball bounces back off blue 1's front at 2 m/s; yellow 1 stands beside the point of the
+    bounce, as near the ball when the turn shows (``lag`` frames late) as blue 1 is: the path went
+    through blue 1's body, not yellow 1's."""
+    blue = RobotState("blue", 1, 0.0, 0.0, math.pi)  # its flat front toward -x, where the ball comes from
+    hit = (-LEAGUE.robot.front_distance_m - R_BALL, 0.0)
+    yellow = RobotState("yellow", 1, hit[0] - 0.03, -REACH - 0.03, 0.0)
+    track = deflected_track(hit, (2.0, 0.0), (-1.6, -0.3), (blue, yellow), lag=lag)
+    assert touches(track) == [("blue", 1)]
+
+
+@pytest.mark.parametrize(("depth", "touched"), [(0.008, True), (-0.008, False)])
+def test_a_graze_the_track_runs_through_is_a_touch_a_near_pass_is_none(depth: float, touched: bool) -> None:
+    """A ball at 1.5 m/s past blue 0's round side, its track straight on (a graze too slight for the
+    kick detector, the track not turning yet): ``depth`` into the body (m; negative: that far
+    outside it) is a touch by blue 0, a near pass none (yellow 0 kicked it before)."""
+    blue = RobotState("blue", 0, 0.0, 0.0, 0.0)
+    yellow = RobotState("yellow", 0, -1.0, 1.0, 0.0)
+    auto = scene()[2]
+    auto.referee.watch.kicked(("yellow", 0))
+    y = -(REACH - depth)  # the ball's line: its centre REACH - depth below blue 0's
+    for k in range(60):
+        x = -0.6 + 1.5 * k * DT
+        auto.observe(WorldState(k * DT, BallState(x, y, 1.5, 0.0), (blue, yellow), k))
+    assert auto.referee.watch.last_touch == (("blue", 0) if touched else ("yellow", 0))
+
+
+def _robots_meet(a: RobotState, b: RobotState, frames: int = 60) -> list[WorldState]:
+    """Frames of ``a`` and ``b`` moving at their velocities until their centres are two radii apart,
+    then standing there (with the noise of our tracks)."""
+    rng = np.random.default_rng(3)
+    out, pa, pb = [], (a.x, a.y), (b.x, b.y)
+    for k in range(frames):
+        if math.dist(pa, pb) > 2 * LEAGUE.robot.radius_m:
+            pa = (pa[0] + a.vx * DT, pa[1] + a.vy * DT)
+            pb = (pb[0] + b.vx * DT, pb[1] + b.vy * DT)
+            va, vb = (a.vx, a.vy), (b.vx, b.vy)
+        else:
+            va = vb = (0.0, 0.0)
+        robots = tuple(dataclasses.replace(r, x=p[0] + rng.normal(0, SIGMA_M), y=p[1] + rng.normal(0, SIGMA_M),
+                                           vx=v[0], vy=v[1]) for r, p, v in ((a, pa, va), (b, pb, vb)))
+        out.append(WorldState(k * DT, None, robots, k))
+    return out
+
+
+@pytest.mark.parametrize(("a", "b", "collisions"), [
+    # two blue robots driving into each other at 0.5 m/s each: one collision
+    (RobotState("blue", 0, -0.3, 0.0, 0.0, vx=0.5), RobotState("blue", 1, 0.3, 0.0, 0.0, vx=-0.5), {"blue": 1}),
+    # one of them standing, the other at 0.3 m/s: one
+    (RobotState("yellow", 2, 0.0, 0.0, 0.0), RobotState("yellow", 3, 0.0, 0.4, 0.0, vy=-0.3), {"yellow": 1}),
+    # standing side by side 2 mm apart, the tracks' noise closing and opening the gap: none
+    (RobotState("blue", 0, 0.0, 0.0, 0.0), RobotState("blue", 1, 2 * LEAGUE.robot.radius_m + 0.002, 0.0, 0.0), {}),
+    # robots of both teams meeting: no own collision (a crash is the rules')
+    (RobotState("blue", 0, -0.3, 0.0, 0.0, vx=0.5), RobotState("yellow", 0, 0.3, 0.0, 0.0, vx=-0.5), {}),
+])
+def test_own_collisions_are_counted_from_tracks_once_per_meeting(a: RobotState, b: RobotState,
+                                                                  collisions: dict[str, int]) -> None:
+    own = OwnContacts(scene()[0].field, AutorefParams())
+    for w in _robots_meet(a, b):
+        own.see(w)
+    assert own.counts() == {"blue": collisions.get("blue", 0), "yellow": collisions.get("yellow", 0)}

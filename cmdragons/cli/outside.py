@@ -80,6 +80,7 @@ def play_outside(args: argparse.Namespace, stop: Interrupt, compile_kernels: Cal
         try:
             heard = listen(receiver, o.geometry_timeout_s, o.learn_s, where)
             settings, line = field_settings(settings, heard.geometry)
+            heard = _division_only(settings, p, heard, receiver, where)
         except OutsideError as exc:
             print(f"cmdragons play --simulator {args.simulator}: {exc}", file=sys.stderr)
             return 2
@@ -134,6 +135,29 @@ def play_outside(args: argparse.Namespace, stop: Interrupt, compile_kernels: Cal
             summary["field_differs"] = line
         _finish(folder, report.collector.result(), summary, args, (geometry.half_length, geometry.half_width))
     return stop.exit_code
+
+
+def _division_only(settings: Any, params: Any, heard: Any, receiver: Any, where: str) -> Any:
+    """What the simulator's vision shows once the robots beyond the division's count a team are
+    taken off its field (none beyond: ``heard`` as it is); :class:`OutsideError` when they stay."""
+    from cmdragons.runtime.outside import OutsideError, beyond_division, listen, take_off
+
+    per_team = settings.field.dims.robots_per_team
+    extra = beyond_division(heard.robots, per_team)
+    if not extra:
+        return heard
+    print(f"play: the simulator has {len(extra)} robots beyond Division {settings.field.division}'s {per_team} a "
+          f"team: taken off its field ({', '.join(f'{t} {i}' for t, i in extra)})", file=sys.stderr, flush=True)
+    take_off(params, extra)
+    o = settings.protocols.outside
+    time.sleep(o.learn_s)  # the frames that still show them, passed
+    receiver.drain()
+    heard = listen(receiver, o.geometry_timeout_s, o.learn_s, where)
+    still = beyond_division(heard.robots, per_team)
+    if still:
+        raise OutsideError(f"{len(still)} robots beyond the division's {per_team} a team stay on the simulator's "
+                           "field after being taken off (present: false)")
+    return heard
 
 
 def _draw(video: Any, log: Any, ours: str) -> None:

@@ -62,7 +62,7 @@ class PatternParams(Validated):
     max_area_fraction: float = setting(2.5, lo=1.0, hi=20.0)
     # id dots needed; with 3 the missing slot's colour is read from the image, or, where nothing of
     # either colour is there (a dot hidden), taken from the ids in play when only one of them fits
-    min_dots: int = setting(4, lo=3, hi=4)
+    min_dots: int = setting(3, lo=3, hi=4)
     ids_in_play: tuple[int, ...] = setting((), lo=0, hi=15)  # ids of the covers in use; empty: every id
     table_confidence: float = setting(0.8, lo=0.0, hi=1.0)  # times the 3-dot confidence, for an id from the table
     duplicate_distance_m: float = setting(0.12, lo=0.0, hi=1.0)  # closer robots are one robot seen twice

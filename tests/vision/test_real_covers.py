@@ -121,9 +121,10 @@ def test_a_light_segment_touching_a_dot_is_split_from_it(cameras: list[CameraMod
     assert sorted(rb.id for rb in det.robots) == [1, 3, 6, 12]
     one = next(rb for rb in det.robots if rb.id == 1)
     assert math.hypot(one.x - robot[2], one.y - robot[3]) < 0.003 and one.team == TEAMS[0]
-    # the mechanism: without the split the joined region is no dot, and the cover is missed
-    unsplit = VisionPipeline(VisionParams(), LEAGUE, model)
-    params = VisionParams()
+    # the mechanism: without the split the joined region is no dot, and the cover is missed where
+    # four dots are needed (with three it is read without that dot)
+    params = VisionParams(patterns=dataclasses.replace(VisionParams().patterns, min_dots=4))
+    unsplit = VisionPipeline(params, LEAGUE, model)
     unsplit.segmenter = Segmenter(params.colours, params.colour_space, params.regions, None)
     assert sorted(rb.id for rb in unsplit.process(image, 0, 0.0).robots) == [3, 6, 12]
 

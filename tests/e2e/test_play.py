@@ -33,6 +33,7 @@ def test_against_the_simple_opponent_runs(against_simple: dict[str, Any]) -> Non
     assert against_simple["command_faults"]["non_finite"] == 0
 
 
+@pytest.mark.slow
 def test_against_the_simple_opponent_no_own_collision(against_simple: dict[str, Any]) -> None:
     assert against_simple["collisions"]["own"] == 0
 

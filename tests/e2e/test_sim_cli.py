@@ -13,31 +13,34 @@ from cmdragons.cli import main
 from cmdragons.recording import RecordingReader
 
 
+# h264 over two key-frame groups (one a second); the lossless formats have none, and half a second
+# reads back the same way as two
 @pytest.mark.slow
-@pytest.mark.parametrize("fmt", ["h264", "ffv1", "png"])
-def test_sim_record_reads_back(tmp_path: Path, fmt: str) -> None:
+@pytest.mark.parametrize(("fmt", "seconds"), [("h264", 2.0), ("ffv1", 0.5), ("png", 0.5)])
+def test_sim_record_reads_back(tmp_path: Path, fmt: str, seconds: float) -> None:
     out = tmp_path / "run"
     snap = tmp_path / "snap.png"
-    assert main(["sim", "--seconds", "2", "--record", "--format", fmt, "--out", str(out), "--snapshot", str(snap),
-                 "--no-progress"]) == 0
+    assert main(["sim", "--seconds", str(seconds), "--record", "--format", fmt, "--out", str(out), "--snapshot",
+                 str(snap), "--no-progress"]) == 0
+    n = round(seconds * 60)
     rec = RecordingReader(out)
     truth = list(rec.truth())
-    assert len(truth) == 120
-    assert [t.frame_number for t in truth] == list(range(120))
+    assert len(truth) == n
+    assert [t.frame_number for t in truth] == list(range(n))
     assert rec.camera_ids == [0, 1]
     for cam in rec.camera_ids:
         model = rec.camera_model(cam)
         frames = list(rec.frames(cam))
-        assert len(frames) == 120
+        assert len(frames) == n
         assert frames[0].shape == (model.height, model.width, 3) and frames[0].dtype == np.uint8
         # every robot the truth says this camera sees projects where the truth puts its pixel
-        for t in truth[::30]:
+        for t in truth[:: n // 4]:
             for r in t.robots:
                 if cam in r.pixels:
                     px = model.project_xy(np.array([r.x, r.y]), 0.15)
                     assert np.allclose(px, r.pixels[cam], atol=1e-6)
     summary = json.loads((out / "summary.json").read_text())
-    assert summary["frames"] == 120 and summary["seconds"] == pytest.approx(2.0)
+    assert summary["frames"] == n and summary["seconds"] == pytest.approx(seconds)
     assert set(summary["command_faults"]) == {"non_finite", "clamped", "unknown_robot", "timed_out"}
     assert snap.stat().st_size > 10_000
     with open(out / "run.mcap", "rb") as f:

@@ -170,6 +170,7 @@ def test_the_sim_command_is_a_table_of_declared_stages_on_the_bus() -> None:
         check_wiring([*(s.contract for s in stages), Contract("judge", (), (Port("referee", Tick),))])
 
 
+@pytest.mark.slow
 def test_the_team_node_starts_without_loading_the_simulator() -> None:
     """A fresh process that builds the team node's stages and rehearses them (what ``cmdragons node
     team`` does before it is ready) never loads the simulator's module."""

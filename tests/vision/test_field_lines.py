@@ -145,6 +145,7 @@ def lab_render() -> tuple[NDArray[np.uint8], CameraParams]:
     return image.copy(), true
 
 
+@pytest.mark.slow
 def test_wide_tape_centres_and_an_honest_error(lab_render: tuple[NDArray[np.uint8], CameraParams]) -> None:
     """field.yaml's line width at the league's 10 mm, the tape 45 mm: the width is measured, the
     fit runs along the tape's middle and the error it reports is its error against the truth."""
@@ -164,6 +165,7 @@ def test_wide_tape_centres_and_an_honest_error(lab_render: tuple[NDArray[np.uint
 BIGGER = {"length_m": 6.2, "width_m": 4.22, "defense_depth_m": 1.12, "defense_width_m": 2.24}  # all 12 % more
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("field", "focal", "reason"), [
     (dataclasses.replace(LAB, length_m=6.2), 0.0, "not the one in the image"),  # 12 % too long
     (dataclasses.replace(LAB, **BIGGER), 700.0, "off the known 700 px"),  # all 12 % too big, the lens known
@@ -181,6 +183,7 @@ def test_a_wrong_field_is_refused_with_its_reason(lab_render: tuple[NDArray[np.u
 REAL = Path(__file__).resolve().parents[3] / "shared" / "realdata" / "lab_frame_lights_on.jpg"
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not REAL.exists(), reason=f"the real lab frame is not here ({REAL})")
 def test_the_real_lab_frame() -> None:
     """A webcam's frame of a hand-taped lab field: every line found, the tape's 45 mm measured,
@@ -195,6 +198,7 @@ def test_the_real_lab_frame() -> None:
     assert 60 < fov < 100  # the BRIO's 16:9 field of view: 65 to 90 degrees
 
 
+@pytest.mark.slow
 def test_calibrate_lines_command_refuses_the_default_field_on_a_lab_frame(
         lab_render: tuple[NDArray[np.uint8], CameraParams], tmp_path: Path,
         capsys: pytest.CaptureFixture[str]) -> None:

@@ -139,7 +139,6 @@ def test_ball_centre_follows_the_disc_between_pixels(centre: tuple[float, float]
     assert np.hypot(*(got - centre)) < 0.03
 
 
-@pytest.mark.slow
 def test_ball_centre_deviation_grows_with_noise_and_the_visible_area_shrinks_when_cut() -> None:
     # the same 6.6 px ball: clear at low and at high sensor noise, and cut by the image's left edge
     # through its middle; the coverage sum is the visible area (pi 3.3^2 = 34 px clear), the

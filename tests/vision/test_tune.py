@@ -183,6 +183,7 @@ def test_tune_auto_command_writes_the_boxes_and_warns(cameras: list[CameraModel]
 REAL = Path(__file__).resolve().parents[3] / "shared" / "realdata"
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not (REAL / "lab_frame_lights_on.jpg").exists(), reason=f"the real lab frame is not here ({REAL})")
 def test_the_real_lab_frame_calibrated_and_coloured_with_nothing_labelled() -> None:
     """A webcam's frame of a lab field: the camera from the lines, every colour from the frame,
@@ -217,6 +218,7 @@ def test_the_real_lab_frame_calibrated_and_coloured_with_nothing_labelled() -> N
     assert any(np.hypot(*np.subtract(b.pixel, on_field)) < 5 for b in det.balls)
 
 
+@pytest.mark.slow
 def test_tune_auto_on_a_video_learns_from_its_first_seconds(cameras: list[CameraModel], tmp_path: Path,
                                                            capsys: pytest.CaptureFixture[str]) -> None:
     """An H.264 video (4:2:0, as webcams record): frames spread over its first 3 s, each robot

@@ -1,0 +1,27 @@
+"""The suite's start: on a fresh clone (no numba cache) run in parallel, the play's kernels are
+compiled once, before the workers start, instead of once in every worker that meets them at the
+same time."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+CONFIGS = Path(__file__).resolve().parents[1] / "configs"
+
+# the project's own compile step (what `cmdragons play` runs on a fresh clone): four processes at once
+_WARM_UP = (
+    "import sys; from cmdragons.runtime.settings import load_settings; "
+    "from cmdragons.runtime.warmup import cold_kernels, warm_up; "
+    "cold_kernels(True) and warm_up(load_settings(sys.argv[1]), True, lambda n, name: None)"
+)
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    workers = getattr(config.option, "numprocesses", None)
+    if hasattr(config, "workerinput") or not isinstance(workers, int) or workers < 2:
+        return  # a worker, or one process: nothing would compile twice
+    subprocess.run([sys.executable, "-c", _WARM_UP, str(CONFIGS)], check=True)

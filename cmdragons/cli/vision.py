@@ -246,10 +246,6 @@ def _tune(args: argparse.Namespace, settings: object) -> int:
             if img is None:
                 raise ValueError(f"{name}: cannot be read as an image")
             images.append(np.asarray(img, dtype=np.uint8))
-        if vis.light.gains:  # the run classifies the frames with the light's starting gains applied
-            from vision.light import apply_gains
-
-            images = [apply_gains(img, vis.light.start()) for img in images]
         samples = samples_from_labels(images, read_labels(args.labels), vis.colour_space)
     boxes, warnings = learn_boxes(samples, background, light, vis.colours, vis.colour_space, args.margin)
     for line in warnings:

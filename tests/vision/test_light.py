@@ -16,7 +16,7 @@ import pytest
 from numpy.typing import NDArray
 
 from cmdragons.camera import CameraModel
-from vision.light import BAND_PX, LightParams, gain_table
+from vision.light import LightParams
 from vision.pipeline import VisionParams, VisionPipeline
 
 from .conftest import LEAGUE, render, snapshot
@@ -74,57 +74,3 @@ def test_low_confidence_detections_teach_nothing(scene: tuple[CameraModel, NDArr
     for k in range(5):
         pipe.process(cast(image, 0.2 * k), k, 0.0)
     assert pipe.light is not None and np.all(pipe.light.gains == 1.0)
-
-
-@pytest.mark.parametrize("axis", ["across", "down"])
-def test_gains_are_each_cells_at_its_centre_linear_between(axis: str) -> None:
-    """Two cells along one axis with gains 0.6 and 1.8 (per channel scaled by 1, 0.9, 1.1): the
-    table the classifier uses holds the first cell's gain up to its centre, the second's from its
-    centre on, and the straight line between (down the image: at each band of rows' middle), each
-    within the fixed point's rounding (1/256 and a half)."""
-    width, height = (160, 24) if axis == "across" else (24, 160)
-    cells = np.array([0.6, 1.8])[:, None] * np.array([1.0, 0.9, 1.1])  # (2, 3)
-    gains = cells[None, :, :] if axis == "across" else cells[:, None, :]  # (rows, columns, 3)
-    table, band = gain_table(gains, width, height)
-    per_px = table[band].reshape(height, width, 3) / 256.0
-    size = width if axis == "across" else height
-    centres = np.array([0.25, 0.75]) * size
-    if axis == "across":
-        at, got = np.arange(width) + 0.5, per_px[0]
-    else:
-        middles = (np.arange(height) // BAND_PX * BAND_PX + np.minimum(np.arange(height) // BAND_PX * BAND_PX + BAND_PX,
-                                                                      height)) / 2.0
-        at, got = middles, per_px[:, 0]
-    share = np.clip((at - centres[0]) / (centres[1] - centres[0]), 0.0, 1.0)
-    expected = cells[0] + share[:, None] * (cells[1] - cells[0])
-    assert np.max(np.abs(got - expected)) <= 1.5 / 256.0
-    # uniform gains: the same scale everywhere, as a gain per cell had it
-    flat, _ = gain_table(np.full((3, 4, 3), 1.25), width, height)
-    assert np.all(flat == 320)
-
-
-def test_follower_keeps_the_starting_gains_under_steady_light(cameras: list[CameraModel]) -> None:
-    """Light uneven over the field (strong vignetting, half the light toward the -x goal) that does
-    not change: started from the gains ``tune --auto`` measured, the follower (every frame, rate
-    0.2) keeps them within 8% over 30 frames (measured: 5.2%, the markers brought to one colour
-    each; a follower taking each marker's needed gain for its cell's, though the gains between
-    cells' centres are interpolated, moved them 13.8%) and every robot stays found with its id."""
-    from sim.render import RenderParams
-    from vision.tune import auto_samples, learn_boxes
-
-    model = cameras[0]
-    look = RenderParams(vignetting_fraction=0.5, gradient_fraction=0.9, noise_sigma_grey=2.0)
-    image, _ = render(model, snapshot(ROBOTS), look, seed=3)
-    rep = auto_samples([image], model, LEAGUE, "yuv", light=LightParams())
-    assert rep.gains is not None and rep.gains.max() / rep.gains.min() > 1.5
-    names = {"ball": "orange", "blue": "blue", "yellow": "yellow", "pink": "pink", "green": "green"}
-    boxes, _ = learn_boxes({names[r]: v for r, v in rep.samples.items()}, rep.background,
-                           {names[r]: v for r, v in rep.light.items()}, VisionParams().colours, "yuv")
-    light = LightParams(follow=True, rate=0.2, every_frames=1).with_start(rep.gains)
-    pipe = VisionPipeline(dataclasses.replace(VisionParams(), colours=boxes, light=light), LEAGUE, model)
-    right = {(0 if r[0] == 0 else 1, r[1]) for r in ROBOTS}
-    for k in range(30):
-        det = pipe.process(image, k, 0.0)
-        assert {(0 if r.team == "blue" else 1, r.id) for r in det.robots} == right
-    assert pipe.light is not None
-    assert np.max(np.abs(pipe.light.gains / pipe.light.start - 1.0)) < 0.08

@@ -36,7 +36,6 @@ from numpy.typing import NDArray
 
 from cmdragons.config import Validated, setting
 from vision import _kernels as kern
-from vision.light import apply_gains, gain_table
 
 __all__ = [
     "MAX_CLASSES",
@@ -204,7 +203,11 @@ def classify_reference(
     ``gains`` (rows of cells, columns of cells, 3), each pixel's BGR first scaled by its cell's
     (x 256 fixed point, rounded, saturated), cells splitting the image evenly."""
     if gains is not None:
-        image = apply_gains(image, gains)
+        h, w = image.shape[:2]
+        ny, nx = gains.shape[:2]
+        g = np.round(np.clip(gains, 0.0, 8.0) * 256.0).astype(np.int64)
+        per_px = g[np.minimum(np.arange(h) * ny // h, ny - 1)][:, np.minimum(np.arange(w) * nx // w, nx - 1)]
+        image = np.minimum((image.astype(np.int64) * per_px + 128) >> 8, 255).astype(np.uint8)
     c = convert_colour(image, space)
     out = np.zeros(image.shape[:2], dtype=np.uint32)
     for k, cc in enumerate(classes):
@@ -279,13 +282,16 @@ class Segmenter:
 
     def set_light(self, gains: NDArray[np.float64] | None, width: int, height: int) -> None:
         """Colour gains per cell of a grid over images of ``width`` x ``height``: ``gains`` (rows of
-        cells, columns of cells, 3) per BGR channel, each cell's at its centre, each pixel's channels
-        scaled by the gains there (:func:`vision.light.gain_table`: bilinear between the centres) before
+        cells, columns of cells, 3) per BGR channel, each pixel's channels scaled by its cell's before
         it is classified (:func:`vision._kernels.classify`); None: none. Cells split the image evenly."""
         if gains is None:
             self._gains, self._row_cell = np.zeros((0, 0), dtype=np.int32), np.zeros(0, dtype=np.int64)
             return
-        self._gains, self._row_cell = gain_table(gains, width, height)
+        ny, nx = gains.shape[:2]
+        col_cell = np.minimum(np.arange(width) * nx // width, nx - 1)
+        self._row_cell = np.minimum(np.arange(height) * ny // height, ny - 1).astype(np.int64)
+        fixed = np.round(np.clip(gains, 0.0, 8.0) * 256.0).astype(np.int32)  # (ny, nx, 3), x 256
+        self._gains = np.ascontiguousarray(fixed[:, col_cell, :].reshape(ny, width * 3))
 
     def index(self, name: str) -> int:
         return self.names.index(name)

@@ -125,10 +125,8 @@ class VisionPipeline:
         self.mask_half_m = (f.half_length + margin, f.half_width + margin) if margin >= 0.0 else (math.inf, math.inf)
         self.last_regions: Regions | None = None
         self.light: LightFollower | None = None
-        if params.light.follow or params.light.gains:
+        if params.light.follow:
             self.light = LightFollower(params.light, league, camera, self.heights)
-            if params.light.gains:  # the light per cell measured at tuning, from the first frame
-                self.segmenter.set_light(self.light.gains, camera.width, camera.height)
 
     def _smallest_pixel_area(self) -> float:
         """The smallest field area of one pixel per metre of descent squared over the image (where
@@ -162,7 +160,7 @@ class VisionPipeline:
         balls = detect_ball(geo, image, self.classes["ball"], self.league.ball.radius_m, robots, self.heights,
                             self.pattern_radius_m * 0.8, self.params.ball, self.in_field)
         robots = [r for r in robots if self.in_field(r.x, r.y)]
-        if self.light is not None and self.params.light.follow:
+        if self.light is not None:
             gains = self.light.observe(image, robots, balls)
             if gains is not None:
                 self.segmenter.set_light(gains, self.camera.width, self.camera.height)

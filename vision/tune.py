@@ -28,7 +28,6 @@ from cmdragons.config import ConfigError, Validated, setting
 from cmdragons.geometry import Field, LeagueParams
 from cmdragons.recording import RecordingReader
 from vision.cmvision import ColourClass, ColourSpace, convert_colour
-from vision.light import LightParams, apply_gains, start_gains
 from vision.sources import open_sources
 
 __all__ = [
@@ -199,9 +198,6 @@ class AutoTuneReport:
     # per role, how much darker and brighter the carpet gets over the field in view than it is
     # around the blobs sampled (the light's spread the role's box must reach)
     light: dict[str, tuple[float, float]]
-    # the gains per cell of the light grid the frames were corrected by (rows of cells, columns of cells,
-    # 3: B, G, R), when measured
-    gains: NDArray[np.float64] | None = None
 
 
 @dataclass(frozen=True)
@@ -213,12 +209,20 @@ class _Blob:
 
 
 def _blobs(image: NDArray[np.uint8], model: CameraModel, league: LeagueParams,
-           p: AutoTuneParams) -> tuple[list[_Blob], NDArray[np.int32]]:
+           p: AutoTuneParams) -> tuple[list[_Blob], NDArray[np.int32], dict[str, NDArray[np.int32]]]:
     """Coloured blobs on the field (its boundary included): pixels far from the carpet's colour
-    and from grey, grouped 8-connected. Returns the blobs and the label image."""
+    and from grey, grouped 8-connected. Returns the blobs, the label image and the background's
+    samples (YUV): the carpet (the field's pixels near its median colour, off the lines) and the
+    lines (pixels on the centres of the painted lines)."""
     yuv = convert_colour(image, "yuv")
-    inside = _field_mask(model, league)
-    contrast = _carpet_contrast(yuv, inside)
+    ground = model.center[:2] + model.center[2] * model.pixel_rays_grid().astype(np.float64)
+    f = Field(league)
+    inside = (np.abs(ground[..., 0]) <= f.boundary_half_length) & (np.abs(ground[..., 1]) <= f.boundary_half_width)
+    if inside.sum() < 1000:
+        raise ValueError("the calibrated camera sees almost none of the field: calibrate it first (vision calibrate)")
+    carpet = np.median(yuv[inside], axis=0)
+    d = yuv.astype(np.float64) - carpet
+    contrast = np.sqrt((0.5 * d[..., 0]) ** 2 + d[..., 1] ** 2 + d[..., 2] ** 2)
     sat = np.hypot(yuv[..., 1] - 128.0, yuv[..., 2] - 128.0)
     coloured = inside & (contrast > p.min_contrast) & (sat > p.min_saturation)
     depth = float(model.center[2]) - league.robot.height_m
@@ -237,48 +241,19 @@ def _blobs(image: NDArray[np.uint8], model: CameraModel, league: LeagueParams,
         area = float(stats[k, cv2.CC_STAT_AREA])
         if area >= 4:
             blobs.append(_Blob(k, area, cents[k] + 0.5, sums[k] / area))
-    return blobs, labels.astype(np.int32)
-
-
-def _carpet_contrast(yuv: NDArray[Any], inside: NDArray[np.bool_]) -> NDArray[np.float64]:
-    """Each pixel's colour distance (YUV, Y counting half) from the median colour of the field's pixels."""
-    carpet = np.median(yuv[inside], axis=0)
-    d = yuv.astype(np.float64) - carpet
-    out: NDArray[np.float64] = np.sqrt((0.5 * d[..., 0]) ** 2 + d[..., 1] ** 2 + d[..., 2] ** 2)
-    return out
-
-
-def _background(image: NDArray[np.uint8], model: CameraModel, league: LeagueParams,
-                p: AutoTuneParams) -> tuple[dict[str, NDArray[np.int32]], NDArray[np.int32]]:
-    """The background's samples (YUV): the carpet (the field's pixels near its median colour, off
-    the lines) and the lines (pixels on the centres of the painted lines, not saturated); and the
-    carpet's brightness around each pixel (its mean Y over about a robot's width, where it is seen)."""
-    yuv = convert_colour(image, "yuv")
-    inside = _field_mask(model, league)
-    near_carpet = inside & (_carpet_contrast(yuv, inside) < 0.5 * p.min_contrast)
+    # the background: carpet near its median colour, and the painted lines' middles
+    near_carpet = inside & (contrast < 0.5 * p.min_contrast)
+    line_px = _line_pixels(model, league)
     background = {"carpet": yuv[near_carpet][:: max(1, int(near_carpet.sum()) // 20000)]}
+    # the carpet's brightness around each pixel (its mean over about a robot's width), where it is seen
     win = max(9, int(0.4 * model.pixels_per_metre((float(model.center[0]), float(model.center[1])), 0.0)) | 1)
     seen = cv2.boxFilter(near_carpet.astype(np.float32), -1, (win, win), normalize=False)
     total = cv2.boxFilter(np.where(near_carpet, yuv[..., 0], 0).astype(np.float32), -1, (win, win), normalize=False)
-    light = np.where(seen > 0, total / np.maximum(seen, 1.0), 0.0).astype(np.int32)
-    line_px = _line_pixels(model, league)
+    background["light"] = np.where(seen > 0, total / np.maximum(seen, 1.0), 0.0).astype(np.int32)
     if line_px.size:
         on_line = yuv[line_px[:, 1], line_px[:, 0]]
-        sat = np.hypot(on_line[:, 1] - 128.0, on_line[:, 2] - 128.0)
-        background["lines"] = on_line[sat <= p.min_saturation]  # not a dot on it
-    return background, light
-
-
-def _field_mask(model: CameraModel, league: LeagueParams) -> NDArray[np.bool_]:
-    """The pixels (H, W) that see the field or its boundary (on the ground); raises ValueError when
-    almost none do."""
-    ground = model.center[:2] + model.center[2] * model.pixel_rays_grid().astype(np.float64)
-    f = Field(league)
-    inside = (np.abs(ground[..., 0]) <= f.boundary_half_length) & (np.abs(ground[..., 1]) <= f.boundary_half_width)
-    if inside.sum() < 1000:
-        raise ValueError("the calibrated camera sees almost none of the field: calibrate it first (vision calibrate)")
-    out: NDArray[np.bool_] = inside
-    return out
+        background["lines"] = on_line[sat[line_px[:, 1], line_px[:, 0]] <= p.min_saturation]  # not a dot on it
+    return blobs, labels.astype(np.int32), background
 
 
 def _line_pixels(model: CameraModel, league: LeagueParams) -> NDArray[np.int64]:
@@ -292,7 +267,7 @@ def _line_pixels(model: CameraModel, league: LeagueParams) -> NDArray[np.int64]:
 
 
 def auto_samples(images: Sequence[NDArray[np.uint8]], model: CameraModel, league: LeagueParams, space: ColourSpace,
-                 params: AutoTuneParams | None = None, light: LightParams | None = None) -> AutoTuneReport:
+                 params: AutoTuneParams | None = None) -> AutoTuneReport:
     """Colour samples of every role with nothing labelled, from frames of a calibrated camera
     (after Gunnarsson et al., "The Color and the Shape": regions matched to the shapes expected).
 
@@ -304,20 +279,8 @@ def auto_samples(images: Sequence[NDArray[np.uint8]], model: CameraModel, league
     grey's, V's excess at least 0.4 of U's shortfall: not a yellow marker), not on a robot's top
     (a marker blob with an id dot round it), samples the ball: of those in a frame, the one most
     saturated and round. Each blob is sampled within ``inner_fraction`` of its expected
-    radius, in the colour space ``space``.
-
-    With ``light``, the light per cell of its grid is measured first (:func:`vision.light.start_gains`:
-    the carpet's colour per cell against the whole field's); the blobs are found on the frames as
-    they are, but every sample (the blobs', the carpet's, the lines', the light's spread) is taken
-    from the frames corrected by those gains as the classifier will correct them: the boxes are
-    learnt for light made even over the field, and the report carries the gains for the run to
-    start with. (Blobs are not looked for on the corrected frames: a cell's gain brightens the
-    colour fringes along its lines and the noise in its darkest part too.)"""
+    radius, in the colour space ``space``."""
     p = params or AutoTuneParams()
-    gains = None
-    if light is not None:
-        mask = _field_mask(model, league)
-        gains = start_gains([(image, mask) for image in images], light)
     pat, h = league.pattern, league.robot.height_m
     dots = np.array(pat.dot_positions_m)
     dot_dist = float(np.median(np.hypot(dots[:, 0], dots[:, 1])))
@@ -328,12 +291,11 @@ def auto_samples(images: Sequence[NDArray[np.uint8]], model: CameraModel, league
     background: dict[str, list[NDArray[np.int32]]] = {}
     n_patterns = n_balls = 0
     for image in images:
-        blobs, labels = _blobs(image, model, league, p)
-        seen = image if gains is None else apply_gains(image, gains)  # as the classifier will see it
-        back, light_img = _background(seen, model, league, p)
+        blobs, labels, back = _blobs(image, model, league, p)
+        light_img = back.pop("light")
         for key, value in back.items():
             background.setdefault(key, []).append(value)
-        conv = convert_colour(seen, space)
+        conv = convert_colour(image, space)
         if not blobs:
             continue
         ground = np.array([model.unproject(b.pixel, h) for b in blobs])
@@ -387,8 +349,8 @@ def auto_samples(images: Sequence[NDArray[np.uint8]], model: CameraModel, league
     back_all = {k: np.concatenate(v) for k, v in background.items()}
     y = back_all["carpet"][:, 0].astype(np.float64)
     dark, bright = (float(np.percentile(y, q)) for q in (0.5, 99.5))
-    spread = {r: (min(1.0, dark / min(v)), max(1.0, bright / max(v))) for r, v in lit.items()}
-    return AutoTuneReport(samples, back_all, n_patterns, n_balls, spread, gains)
+    light = {r: (min(1.0, dark / min(v)), max(1.0, bright / max(v))) for r, v in lit.items()}
+    return AutoTuneReport(samples, back_all, n_patterns, n_balls, light)
 
 
 def _take(samples: dict[str, list[NDArray[np.int32]]], lit: dict[str, list[float]], role: str, b: _Blob,

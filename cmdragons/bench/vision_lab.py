@@ -97,15 +97,13 @@ def _rough_start(width: int, height: int, league: LeagueParams, height_m: float)
 
 
 def _colours(settings: Settings, images: Sequence[NDArray[np.uint8]], model: CameraModel) -> VisionParams:
-    """vision.yaml with every colour learnt by ``tune --auto`` from ``images``, and the light per
-    cell it measured to start from."""
+    """vision.yaml with every colour learnt by ``tune --auto`` from ``images``."""
     vis = settings.vision
-    rep = auto_samples(images, model, settings.field, vis.colour_space, light=vis.light)
+    rep = auto_samples(images, model, settings.field, vis.colour_space)
     names = {role: getattr(vis.roles, role) for role in ("ball", "blue", "yellow", "pink", "green")}
     boxes, _ = learn_boxes({names[r]: v for r, v in rep.samples.items()}, rep.background,
                            {names[r]: v for r, v in rep.light.items()}, vis.colours, vis.colour_space)
-    light = vis.light if rep.gains is None else vis.light.with_start(rep.gains)
-    return dataclasses.replace(vis, colours=boxes, light=light)
+    return dataclasses.replace(vis, colours=boxes)
 
 
 def _pose_errors(got: CameraParams, true: CameraParams) -> tuple[float, float]:

@@ -227,10 +227,9 @@ def _tune(args: argparse.Namespace, settings: object) -> int:
     first = Path(args.images[0])
     background: dict[str, np.ndarray] = {}
     light: dict[str, tuple[float, float]] = {}
-    gains: np.ndarray | None = None
     samples: dict[str, list[np.ndarray]]
     if args.auto:
-        samples, background, light, gains = _auto_samples(args, settings)
+        samples, background, light = _auto_samples(args, settings)
     elif args.labels is None:
         if not (first.is_dir() and (first / "truth.jsonl").exists()):
             raise ValueError("give --labels, or recording folders with truth.jsonl")
@@ -268,25 +267,16 @@ def _tune(args: argparse.Namespace, settings: object) -> int:
                 entry[key][:] = list(value)  # in place: keeps the list's flow style and comments
             else:
                 entry[key] = _flow(CommentedSeq(list(value)))
-    what = "the colour boxes"
-    if gains is not None:  # the light per cell the boxes were learnt under, for the run to start from
-        section = doc.setdefault("light", CommentedMap())
-        section["grid"] = _flow(CommentedSeq(list(vis.light.grid)))
-        section["gains"] = CommentedSeq(_flow(CommentedSeq([_flow(CommentedSeq(list(g))) for g in row]))
-                                        for row in vis.light.with_start(gains).gains)
-        print(f"tune: light per cell ({vis.light.grid[0]} x {vis.light.grid[1]}), gains B, G, R "
-              f"{np.round(gains.min(axis=(0, 1)), 2).tolist()} .. {np.round(gains.max(axis=(0, 1)), 2).tolist()}")
-        what += " and the light's starting gains (light.gains)"
     _write_round_trip(doc, out, _check_vision)
-    print(f"tune: only {what} changed -> {out}")
+    print(f"tune: only the colour boxes changed -> {out}")
     return 0
 
 
 def _auto_samples(args: argparse.Namespace,
                   settings: Any) -> tuple[dict[str, list[np.ndarray]], dict[str, np.ndarray],
-                                          dict[str, tuple[float, float]], np.ndarray | None]:
-    """``tune --auto``: samples per colour name from the frames given, the background's, per colour
-    name the light's spread its box must reach, and the light's gains per cell measured."""
+                                          dict[str, tuple[float, float]]]:
+    """``tune --auto``: samples per colour name from the frames given, the background's, and per
+    colour name the light's spread its box must reach."""
     from cmdragons.camera import CameraModel
     from cmdragons.videoio import read_video, video_info
     from vision.tune import auto_samples
@@ -322,14 +312,14 @@ def _auto_samples(args: argparse.Namespace,
                                      principal_point_px=(params.principal_point_px[0] * s,
                                                          params.principal_point_px[1] * s))
     vis = settings.vision
-    rep = auto_samples(images, CameraModel(params), settings.field, vis.colour_space, light=vis.light)
+    rep = auto_samples(images, CameraModel(params), settings.field, vis.colour_space)
     print(f"tune: --auto: {len(images)} frame(s): {rep.patterns} robot patterns, {rep.balls} balls found")
     names = {role: getattr(vis.roles, role) for role in ("ball", "blue", "yellow", "pink", "green")}
     for role in names:
         if role not in rep.samples:
             print(f"tune: --auto: nothing seen of {role} ({names[role]}): its box stays as it is", file=sys.stderr)
     return ({names[r]: parts for r, parts in rep.samples.items()}, rep.background,
-            {names[r]: v for r, v in rep.light.items()}, rep.gains)
+            {names[r]: v for r, v in rep.light.items()})
 
 
 def _yaml() -> YAML:

@@ -18,9 +18,8 @@ from cmdragons.camera import CameraModel
 from cmdragons.cli import main
 from sim.render import RenderParams
 from vision.cmvision import ColourClass
-from vision.light import LightParams, cell_index
 from vision.pipeline import VisionParams, VisionPipeline
-from vision.tune import auto_samples, boxes_from_samples, keep_apart, learn_boxes, overlaps, widen_for_light
+from vision.tune import auto_samples, boxes_from_samples, keep_apart, overlaps, widen_for_light
 
 from .conftest import LEAGUE, grid_of_robots, render, snapshot
 
@@ -63,71 +62,6 @@ def test_auto_colours_from_one_frame_find_every_robot(cameras: list[CameraModel]
     assert n >= 30 and right == n and false == 0 and ball == 1
 
 
-# light uneven over the field: strong vignetting and the light falling by half toward the -x goal
-UNEVEN = RenderParams(vignetting_fraction=0.5, gradient_fraction=0.9, noise_sigma_grey=2.0)
-
-
-def _tuned(image: np.ndarray, model: CameraModel, light: LightParams | None) -> VisionParams:
-    """vision.yaml as ``tune --auto`` writes it from ``image``: the boxes, and with ``light`` its
-    starting gains per cell."""
-    rep = auto_samples([image], model, LEAGUE, "yuv", light=light)
-    names = {"ball": "orange", "blue": "blue", "yellow": "yellow", "pink": "pink", "green": "green"}
-    boxes, _ = learn_boxes({names[r]: v for r, v in rep.samples.items()}, rep.background,
-                           {names[r]: v for r, v in rep.light.items()}, VisionParams().colours, "yuv")
-    start = LightParams() if rep.gains is None else LightParams().with_start(rep.gains)
-    return dataclasses.replace(VisionParams(), colours=boxes, light=start)
-
-
-def test_light_per_cell_measured_from_the_carpet(cameras: list[CameraModel]) -> None:
-    """The starting gains against the render's light: the same scene rendered under even light
-    (no vignetting, no gradient) over the uneven one, per cell the mean ratio on the field; the
-    gains times the light the same in every cell, within 2% (measured: 0.04%; what is left: the light's change
-    within a cell, the lines and dots among the carpet's pixels)."""
-    model = cameras[0]
-    snap = snapshot(SCENE, ball=(-2.5, -0.6, 0.0215))
-    uneven, _ = render(model, snap, UNEVEN, seed=1)
-    even, _ = render(model, snap, dataclasses.replace(UNEVEN, vignetting_fraction=0.0, gradient_fraction=0.0), seed=1)
-    light = LightParams()
-    gains = auto_samples([uneven], model, LEAGUE, "yuv", light=light).gains
-    assert gains is not None and gains.shape == (3, 4, 3)
-    nx, ny = light.grid
-    rows, cols = cell_index(model.height, ny), cell_index(model.width, nx)
-    carpet = np.all(np.abs(even.astype(int) - np.median(even.reshape(-1, 3), axis=0)) < 12, axis=2)
-    lit = np.zeros((ny, nx))
-    for i in range(ny):
-        for j in range(nx):
-            cell = carpet & (rows[:, None] == i) & (cols[None, :] == j)
-            lit[i, j] = uneven[cell][:, 1].mean() / even[cell][:, 1].mean()  # green: the carpet's brightest
-    assert lit.max() / lit.min() > 1.6  # uneven indeed
-    product = gains[..., 1] * lit
-    assert product.max() / product.min() < 1.02, np.round(product, 3)
-
-
-def test_light_per_cell_finds_the_covers_global_boxes_miss(cameras: list[CameraModel]) -> None:
-    """Colours learnt from one frame under uneven light, then every id of both teams read on
-    another frame of that light: one set of boxes for the whole field misses covers in its dark
-    corner (measured: 26 of 32 found); the boxes learnt on frames corrected per cell, with the run
-    starting from those gains, find every one with the right id, nothing false, and the ball."""
-    model = cameras[0]
-    image, _ = render(model, snapshot(SCENE, ball=(-2.5, -0.6, 0.0215)), UNEVEN, seed=1)
-    robots = grid_of_robots(model, [0.7], margin_px=50.0)
-    test, truth = render(model, snapshot(robots, ball=(-4.2, -2.6, 0.0215)), UNEVEN, seed=7)
-
-    def read(params: VisionParams) -> tuple[int, int, int]:
-        det = VisionPipeline(params, LEAGUE, model).process(test, 0, 0.0)
-        got = {(0 if r.team == "blue" else 1, r.id): r.pixel for r in det.robots}
-        right = sum(1 for k, px in truth.robots.items() if k in got and np.hypot(*np.subtract(got[k], px)) < 6.0)
-        assert truth.ball is not None
-        ball = sum(np.hypot(*np.subtract(b.pixel, truth.ball[:2])) < 3.0 for b in det.balls)
-        return right, len(got) - right, int(ball)
-
-    n = len(truth.robots)
-    assert n >= 30
-    right, false, _ = read(_tuned(image, model, None))
-    assert right <= n - 3 and false == 0
-    assert read(_tuned(image, model, LightParams())) == (n, 0, 1)
-
-
 def test_overlapping_classes_are_found_and_kept_apart() -> None:
     """A bright orange ball in the yellow box (what a lab's balls do to the shipped boxes)."""
     rng = np.random.default_rng(0)
@@ -163,9 +97,6 @@ def test_tune_auto_command_writes_the_boxes_and_warns(cameras: list[CameraModel]
     assert all(line in after.splitlines() for line in comments)
     data = yaml.safe_load(after)
     assert data["colours"]["orange"]["lo"] != yaml.safe_load(before)["colours"]["orange"]["lo"]
-    # the light per cell it measured, for a run to start from (the render's light is uneven)
-    gains = np.array(data["light"]["gains"])
-    assert gains.shape == (3, 4, 3) and gains.max() / gains.min() > 1.1 and "light.gains" in out.out
     # labels that put an orange ball's pixels into the shipped yellow box: the warning says so
     labels = tmp_path / "labels.yaml"
     labels.write_text("- {colour: orange, pixel: [10, 10], radius: 6}\n")

@@ -6,7 +6,6 @@ for our readers."""
 from __future__ import annotations
 
 import json
-import os
 import shutil
 import subprocess
 import sys
@@ -17,6 +16,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from cmdragons.bench.league import PEERS, peer_script
 from cmdragons.camera import CameraModel
 from cmdragons.messages import Tick
 from cmdragons.runtime.proto import ssl_tracked_pb2 as trk_pb
@@ -211,11 +211,8 @@ def test_answers_of_grsim_and_the_erforce_simulator_read_with_the_robots_id() ->
     assert "velocity type unsupported" in refusal.errors[0].message
 
 
-PEERS = Path(os.environ.get("CMDRAGONS_PEERS", Path(__file__).resolve().parents[3] / "shared" / "peers"))
-# (network-namespace script, binary, what a global velocity gets: refused by its error code, or taken)
-SIMULATORS = {"erforce": ("erforce-netns.sh", Path(os.environ.get("ERFORCE", "/opt/erforce/bin/erforce-simulator-cli")),
-                          [[], ["VELOCITY_TYPE"], False]),
-              "grsim": ("grsim-netns.sh", Path(os.environ.get("GRSIM", "/opt/grsim/bin/grSim")), [[3], [], False])}
+# what a global velocity gets from each: refused by its error code, or taken
+GLOBAL_ANSWER = {"erforce": [[], ["VELOCITY_TYPE"], False], "grsim": [[3], [], False]}
 PROBE = """
 import json, sys
 from cmdragons.runtime.proto import ssl_simulation_control_pb2 as ctl_pb
@@ -242,14 +239,15 @@ print(json.dumps(out))
 """
 
 
-@pytest.mark.parametrize("name", sorted(SIMULATORS))
+@pytest.mark.parametrize("name", sorted(GLOBAL_ANSWER))
 def test_a_league_simulator_answers_our_commands_with_the_robots_id(name: str) -> None:
     """grSim and the league's reference simulator, run in a private network namespace when found:
     their answers read with the robot's id, a refused global velocity as the error's code."""
-    script, binary, global_answer = SIMULATORS[name]
-    if not (binary.exists() and (PEERS / script).exists()):
-        pytest.skip(f"{name}: its binary ({binary}) and network-namespace script ({PEERS / script}) are needed")
-    out = subprocess.run([str(PEERS / script), sys.executable, "-c", PROBE], capture_output=True, text=True,
+    script, why = peer_script(next(p for p in PEERS if p.name == name))
+    if script is None:
+        pytest.skip(why)
+    global_answer = GLOBAL_ANSWER[name]
+    out = subprocess.run([script, sys.executable, "-c", PROBE], capture_output=True, text=True,
                          timeout=180, check=True).stdout
     local, global_velocity, again = json.loads(out.strip().splitlines()[-1])
     assert local == [[3], [], False] and again == [[3], [], False]

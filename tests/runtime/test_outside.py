@@ -10,8 +10,6 @@ from __future__ import annotations
 import itertools
 import json
 import math
-import os
-import shutil
 import signal
 import subprocess
 import sys
@@ -22,6 +20,7 @@ import numpy as np
 import pytest
 
 from cmdragons import messages as msg
+from cmdragons.bench.league import PEERS, peer_script
 from cmdragons.geometry import Field
 from cmdragons.runtime.log import read_log
 from cmdragons.runtime.match import CLOCK
@@ -242,12 +241,10 @@ def test_two_processes_play_our_team_in_the_served_simulator_as_in_any_league_si
 
 
 def _grsim_netns() -> str | None:
-    """The script that runs grSim and a command beside it in a network namespace of their own
-    (grSim multicasts with no pinned interface: never run it outside one): ``GRSIM_NETNS``, else
-    ``grsim-netns.sh`` on PATH; None when there is none or no grSim for it (``GRSIM``)."""
-    script = os.environ.get("GRSIM_NETNS") or shutil.which("grsim-netns.sh")
-    grsim = os.environ.get("GRSIM", "/opt/grsim/bin/grSim")
-    return script if script and os.access(script, os.X_OK) and os.access(grsim, os.X_OK) else None
+    """The script that runs grSim and a command beside it in a network namespace of its own (grSim
+    multicasts with no pinned interface: never run it outside one), found as the league bench finds
+    it; None when there is none or no grSim for it."""
+    return peer_script(next(p for p in PEERS if p.name == "grsim"))[0]
 
 
 @pytest.mark.slow

@@ -14,7 +14,8 @@ What a row says, all from the match's summary.json and run.mcap (what our stages
 - goals as our autoref called them, beside the goals the simulator's own SSL-Vision shows (its raw
   ball detections crossing a goal line between the posts while the ball was in play, the team by
   the sides the referee gave then: :func:`vision_goals`) and, in our served simulator, its truth
-  (the true ball across a goal line, both ends together: :func:`truth_goals`);
+  (the true ball across a goal line, both ends together, while the ball was in play by the referee
+  and within the match: :func:`truth_goals`);
 - fouls per team; own collisions (the autoref's count from tracks, :class:`sim.autoref.OwnContacts`);
 - stoppages (play not running: from a stop to the next normal or force start): how many, how many
   restarted before the match ended, the longest, and how many took longer than the rules allow
@@ -35,6 +36,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 import os
 import shutil
 import signal
@@ -152,10 +154,22 @@ def vision_goals(messages: Iterable[tuple[str, Any]], pitch: Field) -> dict[Team
     return goals
 
 
-def truth_goals(truths: Iterable[GroundTruth], pitch: Field) -> int:
-    """Goals in a simulator's truth, both ends: the true ball across a goal line between the posts."""
+def truth_goals(truths: Iterable[GroundTruth], pitch: Field, states: Sequence[GameState] | None = None,
+                until: float = math.inf) -> int:
+    """Goals in a simulator's truth, both ends: the true ball across a goal line between the posts; with
+    the referee's game ``states`` (in time order, on the truth's clock) only while the ball was in play
+    by them and from the first of them, and none after ``until`` (s; the match's last frame): the
+    simulator runs on before a team joins and after it leaves, when no referee counts a goal."""
     crossing = BallCrossing(pitch)
-    return sum(isinstance(crossing.see(g.t, g.ball.x, g.ball.y, -1, None), Goal) for g in truths)
+    states = states or ()
+    game: GameState | None = None if states else GameState(0.0, RefereeCommand.NORMAL)
+    goals = k = 0
+    for g in truths:
+        while k < len(states) and states[k].t <= g.t:
+            game, k = states[k], k + 1
+        seen = crossing.see(g.t, g.ball.x, g.ball.y, -1, None)
+        goals += isinstance(seen, Goal) and game is not None and _in_play(game) and g.t <= until
+    return goals
 
 
 @dataclass(frozen=True)
@@ -262,7 +276,7 @@ def league_row(name: str, folder: Path, settings: Settings, truth_log: Path | No
     roll = summary["tracker"][ours].get("physics", {}).get("ball_roll", {})
     truth = None
     if truth_log is not None:
-        truth = truth_goals((m for _topic, _t, m in read_log(truth_log, {"/truth"})), pitch)
+        truth = truth_goals((m for _topic, _t, m in read_log(truth_log, {"/truth"})), pitch, states, end_t)
     tried = passes["tried"]
     return {
         "name": name,

@@ -71,6 +71,20 @@ def test_goals_in_the_truth_are_counted_at_both_ends_once_each() -> None:
     assert truth_goals(truths, FIELD) == 2
 
 
+def test_goals_in_the_truth_count_only_while_the_referee_has_the_ball_in_play_and_within_the_match() -> None:
+    path = [(0.0, 0.0), (PAST_GOAL_X, 0.2), (0.0, 0.0), (-PAST_GOAL_X, -0.2), (0.0, 0.0), (PAST_GOAL_X, 0.1),
+            (0.0, 0.0), (-PAST_GOAL_X, 0.0)]  # four crossings, at 1, 3, 5 and 7 s
+    truths = [GroundTruth(k, float(k), BallTruth(x, y, 0.0, 0.0, 0.0)) for k, (x, y) in enumerate(path)]
+    states = [GameState(0.5, RefereeCommand.STOP),  # 1 s: play stopped
+              GameState(2.0, RefereeCommand.NORMAL),  # 3 s: a goal
+              GameState(4.0, RefereeCommand.STOP),  # 5 s: the ball in while stopped
+              GameState(6.0, RefereeCommand.FORCE_START)]  # 7 s: after the match's last frame
+    assert truth_goals(truths, FIELD) == 4
+    assert truth_goals(truths, FIELD, states, until=6.5) == 1
+    assert truth_goals(truths, FIELD, states) == 2
+    assert truth_goals(truths, FIELD, states[1:]) == 2  # nothing before the referee's first word
+
+
 def test_stoppages_run_from_a_stop_to_the_next_start_and_the_match_end_closes_the_last() -> None:
     states = [
         GameState(0.0, RefereeCommand.KICKOFF, "blue", ready=False),  # 0-5 s: the first kickoff

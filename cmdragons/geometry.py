@@ -102,11 +102,21 @@ class RobotShape(Validated):
     max_omega_rad_s: float = setting(20.0, lo=0.01, hi=100.0)
     max_alpha_rad_s2: float = setting(60.0, lo=0.01, hi=1000.0)  # angular acceleration and braking
     command_latency_s: float = setting(0.03, lo=0.0, hi=1.0)  # command sent -> wheels act on it
+    min_kick_m_s: float = setting(0.5, lo=0.01, hi=10.0)  # the kicker's slowest kick, relative to the robot
 
     def __post_init__(self) -> None:
         super().__post_init__()
         if self.front_distance_m >= self.radius_m:
             raise ValueError("front_distance_m must be smaller than radius_m")
+
+    def kicker_speed(self, ground_m_s: float, forward_m_s: float) -> float:
+        """The kicker's speed that sends the ball off at ``ground_m_s`` over the ground from a robot
+        moving ``forward_m_s`` along its heading: a kicker fires relative to the robot that carries
+        it (in every simulator and on the field), so the robot's own speed adds to the kick; never
+        below ``min_kick_m_s``; 0 (no kick) stays 0."""
+        if ground_m_s <= 0.0:
+            return 0.0
+        return max(ground_m_s - forward_m_s, self.min_kick_m_s)
 
     @property
     def mouth_half_width_m(self) -> float:

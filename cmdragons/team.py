@@ -32,7 +32,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cmdragons.config import FrozenMap, Validated, override_derived, sections, setting
-from cmdragons.control.motion import predict_braking
+from cmdragons.control.motion import predict_braking, relative_kick
 from cmdragons.geometry import Team
 from cmdragons.messages import (
     GameState,
@@ -287,6 +287,8 @@ class Brain:
         commands = [self._navigate(frame, index[rid], intent, game) for rid, intent in sorted(intents.items())]
         t2 = time.perf_counter()
         safe = self._make_safe(frame, commands, world) if commands else []
+        heading = {r.id: r.theta for r in world.robots if r.team == self.team}
+        safe = [relative_kick(c, heading.get(c.id, 0.0), self.settings.field.robot) for c in safe]
         sent = {c.id for c in safe}
         for c in safe:
             nav = self.navigators.get(c.id)

@@ -451,10 +451,11 @@ class World:
                 continue
             self._release(r)
             hx, hy = math.cos(r.body.angle), math.sin(r.body.angle)
-            # the ball's velocity relative to the robot, across the heading, partly survives the kick
+            # the kick is relative to the robot (its velocity carries over to the ball); the ball's
+            # velocity relative to the robot, across the heading, partly survives it
             rel = self.ball_body.velocity - r.body.velocity
             across = (-hy * rel.x + hx * rel.y) * self.p_kicker.tangential_retention
-            tx, ty = -hy * across, hx * across
+            tx, ty = -hy * across + r.body.velocity.x, hx * across + r.body.velocity.y
             if r.command.chip:
                 a = self.p_kicker.chip_angle_rad
                 self.ball_body.velocity = (hx * speed * math.cos(a) + tx, hy * speed * math.cos(a) + ty)

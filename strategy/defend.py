@@ -36,6 +36,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cmdragons.config import Validated, derived, setting
+from cmdragons.control.motion import relative_kick
 from cmdragons.geometry import Field, Team, wrap_angle
 from cmdragons.messages import BallState, GameState, RefereeCommand, RobotCommand, RobotState, WorldState
 from strategy.defense import DefenseParams, defender_slots, goalie
@@ -213,7 +214,7 @@ class DefendTeam:
                 it = intents[r.id]
                 x, y = detour((r.x, r.y), (it.x, it.y), (ball.x, ball.y), keep, self.p.detour_share)
                 intents[r.id] = replace(it, x=x, y=y)
-        return [self._steer(r, intents[r.id], on) for r in own]
+        return [relative_kick(self._steer(r, intents[r.id], on), r.theta, self.field.league.robot) for r in own]
 
     def _on_field(self, world: WorldState) -> list[RobotState]:
         """The robots in play (one sent off by a card stands outside the field)."""

@@ -17,6 +17,7 @@ from typing import Protocol
 import numpy as np
 
 from cmdragons.config import Validated, setting
+from cmdragons.control.motion import relative_kick
 from cmdragons.geometry import Field, Team, wrap_angle
 from cmdragons.messages import BallState, GameState, RefereeCommand, RobotCommand, RobotState, WorldState
 from strategy.defense import ball_to_clear, clear_target
@@ -124,7 +125,8 @@ class SimpleTeam:
                 intents[chaser.id], self._placing = placed
         elif game.command == RefereeCommand.PENALTY:
             intents = self._penalty(intents, own, world, ball, game.ready, ours, own_sign)
-        return [steer(self.team, r.id, r.x, r.y, r.theta, intents[r.id], self.p) for r in own]
+        return [relative_kick(steer(self.team, r.id, r.x, r.y, r.theta, intents[r.id], self.p), r.theta,
+                              self.field.league.robot) for r in own]
 
     def _penalty(self, intents: dict[int, Intent], own: list[RobotState], world: WorldState, ball: BallState,
                  ready: bool, ours: bool, own_sign: float) -> dict[int, Intent]:

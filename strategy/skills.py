@@ -220,14 +220,18 @@ def turn_with_ball(robot: RobotState, ball: BallState, target: tuple[float, floa
     middle): turn about the ball toward ``target``, at most ``turn_step_rad`` a frame (faster, the
     ball is lost), the dribbler holding it; facing the target within ``lined_up_rad``, drive through
     it with the kicker armed at ``speed``. None when the ball is not held (going round it to line up
-    would leave it: a trapped ball was given away so)."""
+    would leave it: a trapped ball was given away so). Lined up is judged on the way the ball would
+    leave: the kick is relative to the robot, so the robot's velocity across its heading (turning
+    about the ball) carries over and turns the ball's path by atan(across / speed)."""
     contact = p.contact_m
-    face_x, face_y = robot.x + math.cos(robot.theta) * contact, robot.y + math.sin(robot.theta) * contact
+    c, s = math.cos(robot.theta), math.sin(robot.theta)
+    face_x, face_y = robot.x + c * contact, robot.y + s * contact
     if math.hypot(ball.x - face_x, ball.y - face_y) >= p.dribble_hold_m:
         return None
     aim = _angle(target[0] - ball.x, target[1] - ball.y)
     error = wrap_angle(aim - robot.theta)
-    if abs(error) < p.lined_up_rad:
+    across = -s * robot.vx + c * robot.vy
+    if abs(wrap_angle(error - math.atan2(across, speed))) < p.lined_up_rad:
         return drive_through(ball, aim, speed, p)
     heading = robot.theta + max(-p.turn_step_rad, min(p.turn_step_rad, error))
     return Intent(ball.x - math.cos(heading) * contact, ball.y - math.sin(heading) * contact, heading,

@@ -13,6 +13,7 @@ more than ``corner_overshoot_m`` past the corner.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -23,7 +24,7 @@ from cmdragons.config import Validated, derived, setting
 from cmdragons.control import _kernels as K
 from cmdragons.control.acceleration import Limits, stop_accel, trajectory, trajectory_state
 from cmdragons.control.trapezoid import TrapezoidParams
-from cmdragons.geometry import path_length
+from cmdragons.geometry import RobotShape, path_length
 from cmdragons.messages import RobotCommand, RobotState
 
 __all__ = [
@@ -35,6 +36,7 @@ __all__ = [
     "motion_command",
     "motion_commands",
     "predict_braking",
+    "relative_kick",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -110,6 +112,18 @@ def motion_command(robot: RobotState, target: MotionTarget, params: ControlParam
     goal = np.array([[target.x, target.y, target.vx, target.vy, target.theta]])
     vx, vy, omega = motion_commands(state, goal, params)[0]
     return RobotCommand(robot.team, robot.id, float(vx), float(vy), float(omega))
+
+
+def relative_kick(cmd: RobotCommand, theta: float, robot: RobotShape) -> RobotCommand:
+    """``cmd`` with its kick (the ball's speed over the ground, as strategy asks it) turned into the
+    kicker's speed relative to the robot, which moves at the command's velocity along its heading
+    ``theta`` (rad): a kicker fires relative to the robot that carries it, so a robot driving onto
+    the ball at 1 m/s that kicks at 6 m/s sends it off at 7 (over the rules' 6.5). Flat kicks; a
+    chip's speed is sent as asked."""
+    if cmd.kick_speed <= 0.0 or cmd.chip:
+        return cmd
+    forward = cmd.vx * math.cos(theta) + cmd.vy * math.sin(theta)
+    return dataclasses.replace(cmd, kick_speed=robot.kicker_speed(cmd.kick_speed, forward))
 
 
 def follow_path(position: tuple[float, float], path: ArrayLike, theta: float, params: ControlParams) -> MotionTarget:

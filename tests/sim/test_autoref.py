@@ -119,7 +119,7 @@ def test_a_double_touch_after_a_free_kick_is_seen_by_the_kick_detector() -> None
 
     def commands(k: int) -> list[RobotCommand]:
         if k < 30:  # kick it away, stand, then drive after it again
-            return [RobotCommand("blue", 1, vx=0.5, kick_speed=1.5)]
+            return [RobotCommand("blue", 1, vx=0.5, kick_speed=1.0)]  # off at 1.5 m/s: the kick adds to the robot's 0.5
         return [RobotCommand("blue", 1, vx=1.5 if k > 60 else 0.0)]
 
     truth, mine = play(w, ref, auto, Seen(), 2.5, commands)

@@ -171,7 +171,7 @@ def test_double_touch_after_a_free_kick(again: bool, called: bool) -> None:
 
     def commands(k: int) -> list[RobotCommand]:
         if k < 30:  # kick it away, stand, then drive after it again (or not)
-            return [RobotCommand("blue", 1, vx=0.5, kick_speed=1.5)]
+            return [RobotCommand("blue", 1, vx=0.5, kick_speed=1.0)]  # off at 1.5 m/s: the kick adds to the robot's 0.5
         return [RobotCommand("blue", 1, vx=1.5 if again and k > 60 else 0.0)]
 
     calls = play(w, ref, 2.5, commands)

@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 import pytest
 
+from cmdragons.control.motion import relative_kick
 from cmdragons.geometry import LeagueParams
 from cmdragons.messages import RefereeCommand, RobotCommand
 from sim.referee import Referee
@@ -56,15 +57,20 @@ def test_kick_speed(kick: float) -> None:
     w.place_ball(FRONT + 0.01, 0.0)
     speeds = []
     kicked = None
+    before = after = 0.0  # the robot's speed before and after the frame of the kick
     for _ in range(60):
+        before = next(r.vx for r in w.ground_truth().robots if (r.team, r.id) == ("blue", 0))
         events = w.step_frame([RobotCommand("blue", 0, vx=0.3, kick_speed=kick)])
         kicked = kicked or next((e for e in events if isinstance(e, Kick)), None)
         if kicked:
             speeds.append(ball_speed(w))
+            after = next(r.vx for r in w.ground_truth().robots if (r.team, r.id) == ("blue", 0))
             break
     assert kicked is not None and kicked.speed_m_s == kick
-    # within one frame of sliding friction of the kick speed, along the robot's heading
-    assert speeds[0] == pytest.approx(kick, abs=BallParams().acc_slide_m_s2 / 60 + 1e-6)
+    assert 0.0 < before <= after <= 0.3
+    # the kick is relative to the robot: the kick speed plus the robot's own (within a frame's
+    # acceleration), less at most one frame of sliding friction, along its heading
+    assert kick + before - BallParams().acc_slide_m_s2 / 60 - 1e-6 <= speeds[0] <= kick + after + 1e-6
     assert abs(w.ball_body.velocity.y) < 1e-6
 
 
@@ -334,3 +340,41 @@ def test_kick_keeps_part_of_the_velocity_across_the_heading() -> None:
     vx, vy = w.ball_body.velocity
     assert vx == pytest.approx(4.0, abs=0.1)
     assert vy == pytest.approx(retention * before, abs=0.05)
+
+
+@pytest.mark.parametrize(("drive", "heading"), [(1.0, 0.0), (0.6, 0.8)])
+def test_a_kick_asked_over_the_ground_leaves_at_that_speed_from_a_moving_robot(drive: float, heading: float) -> None:
+    """The team asks the ball's speed over the ground; sent relative to the robot (its forward speed
+    taken off), a kick from a robot driving onto the ball leaves at the speed asked, under the rules'
+    6.5 m/s, where the speed asked sent as it is would go over it."""
+    asked = 6.0
+    for relative in (True, False):
+        w = make_world()
+        c, s = math.cos(heading), math.sin(heading)
+        w.place_robot("blue", 0, 0.0, 0.0, heading)
+        w.place_ball(0.6 * c, 0.6 * s)
+        speed = None
+        for _ in range(120):
+            cmd = RobotCommand("blue", 0, vx=drive * c, vy=drive * s, kick_speed=asked)
+            if relative:
+                cmd = relative_kick(cmd, heading, LEAGUE.robot)
+                assert cmd.kick_speed == pytest.approx(asked - drive)
+            if any(isinstance(e, Kick) for e in w.step_frame([cmd])):
+                speed = ball_speed(w)
+                break
+        assert speed is not None
+        robot = next(r for r in w.ground_truth().robots if r.id == 0)
+        assert math.hypot(robot.vx, robot.vy) == pytest.approx(drive, abs=0.05)  # at its speed when it kicked
+        if relative:
+            assert speed == pytest.approx(asked, abs=0.1) and speed < 6.5
+        else:
+            assert speed == pytest.approx(asked + drive, abs=0.1) and speed > 6.5
+
+
+def test_the_kickers_speed_never_falls_below_its_slowest_and_a_chip_or_no_kick_is_sent_as_asked() -> None:
+    robot = LEAGUE.robot
+    assert robot.kicker_speed(2.0, 2.5) == robot.min_kick_m_s  # asked slower than the robot drives
+    assert robot.kicker_speed(2.0, -1.0) == 3.0  # backing away: faster by as much
+    assert robot.kicker_speed(0.0, 1.0) == 0.0  # no kick stays none
+    chip = RobotCommand("blue", 0, vx=1.0, kick_speed=3.0, chip=True)
+    assert relative_kick(chip, 0.0, robot) == chip

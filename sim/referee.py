@@ -95,6 +95,7 @@ class Referee:
         self._restart: Restart | None = None  # decided while play is stopped, due after the restart delay
         self._restart_ball: tuple[float, float] | None = (0.0, 0.0)
         self._restart_t = 0.0  # when the restart in force was given
+        self._restart_seen = True  # its ball was seen on its spot (one put there waits for it)
         self._held = HeldBall(field, params.keeper_held_ball_s)
         self._no_progress = NoProgress(params.no_progress_s, params.no_progress_m)
         self.keeper_held_ball = 0
@@ -157,6 +158,7 @@ class Referee:
         self._set(RefereeCommand.KICKOFF, kicking_team)
         self._restart_ball = (0.0, 0.0)
         self._restart_t = self.t
+        self._restart_seen = False
         return teleport
 
     # --- one frame --------------------------------------------------------------------------
@@ -222,10 +224,14 @@ class Referee:
 
     def _follow_kick(self, ball_xy: tuple[float, float]) -> None:
         """A kickoff or free kick is taken once the ball moved: normal play; not taken in time, play
-        goes on anyway."""
+        goes on anyway. A ball the referee put on its spot has moved only once it was seen there: an
+        auto-referee on tracked vision sees a teleported ball arrive some frames late (in grSim the
+        kickoff after a goal was taken at once, the ball still seen in the goal)."""
         if not self.game.command.kick_restart or self._restart_ball is None:
             return
-        if kick_taken(ball_xy, self._restart_ball, self.rules.ball_in_play_m):
+        away = kick_taken(ball_xy, self._restart_ball, self.rules.ball_in_play_m)
+        self._restart_seen = self._restart_seen or not away
+        if away and self._restart_seen:
             self._set(RefereeCommand.NORMAL, None)
             self._restart_ball = None
             self.watch.restart_taken(self.watch.last_touch)
@@ -267,6 +273,7 @@ class Referee:
             self._set(kind.command, team)
             self._restart_ball = ball_xy if placed else spot
             self._restart_t = t
+            self._restart_seen = placed
 
     def _clear_spot(self, spot: tuple[float, float], attack: float) -> None:
         """Robots standing where the referee puts the ball moved aside first (straight away from it,

@@ -514,3 +514,26 @@ def test_a_penalty_is_set_when_all_but_kicker_and_keeper_are_behind_the_mark(
                 ("yellow", 2, mark[0] + 0.3, 0.5))
     assert penalty_set(gt, "blue", mark, -1.0, pitch, RulesParams(), off={("yellow", 2)}) is ready
     assert not penalty_set(gt, "blue", mark, -1.0, pitch, RulesParams(), off=set())  # yellow 2 on the field, ahead
+
+
+def test_a_kickoff_whose_ball_is_seen_late_on_the_centre_spot_is_not_taken_until_it_moves_from_there() -> None:
+    """An auto-referee on tracked vision sees the ball it put on the centre spot arrive frames late:
+    the ball still seen where play left it is no kickoff taken; once seen on the spot, moving
+    ``ball_in_play_m`` from it is."""
+    w, ref = scene()
+    left = (3.0, 1.0)  # where play left the ball
+    w.place_ball(*left)
+    teleport = ref.kickoff_setup("yellow")
+    for _ in range(5):  # the teleport not seen yet
+        w.step_frame([])
+        ref.observe(w.t, [], left)
+        assert ref.game.command == RefereeCommand.KICKOFF
+    w.apply(teleport)
+    for _ in range(5):
+        w.step_frame([])
+        ref.observe(w.t, [], tuple(w.ball_body.position))
+        assert ref.game.command == RefereeCommand.KICKOFF
+    w.place_ball(2 * ref.rules.ball_in_play_m, 0.0)
+    w.step_frame([])
+    ref.observe(w.t, [], tuple(w.ball_body.position))
+    assert ref.game.command == RefereeCommand.NORMAL

@@ -14,9 +14,10 @@ the planner
 5. smooths the path (shortcuts, then pulls it taut, §4.6.1) and feeds its points to the cache.
 
 The termination condition (:mod:`cmdragons.planning.termination`) is honoured in tree nodes: the
-kernel stops when the work budget of nodes is spent (NO_PATH) and the deadline is checked between
-chunks of iterations (TIMEOUT); randomness comes from the ``numpy.random.Generator`` given to the
-planner.
+kernel stops when the work budget of nodes is spent (NO_PATH), the planner stops after
+``iteration_budget`` iterations (NO_PATH: trees that cannot grow spend no nodes) and the deadline is
+checked between chunks of iterations (TIMEOUT); randomness comes from the ``numpy.random.Generator``
+given to the planner.
 """
 
 from __future__ import annotations
@@ -79,6 +80,11 @@ class ERRTParams(Validated):
     nearest: Literal["brute", "kdtree"] = setting("brute", choices=("brute", "kdtree"))  # measured: brute wins
     # tree nodes per robot and frame (the work budget of its termination): spent without a path, NO_PATH
     work_budget: int = setting(2000, lo=16, hi=MAX_NODES)
+    # iterations per robot and frame; spent without a path: NO_PATH. Trees that cannot grow (a start
+    # boxed in) add no nodes, so without this bound only the deadline stopped them, after as many
+    # iterations as the machine's speed allowed: the random stream left behind, and every later plan,
+    # then depended on the load
+    iteration_budget: int = setting(20000, lo=1, hi=100_000_000)
     chunk_iterations: int = setting(256, lo=1, hi=100000)  # iterations between deadline checks (fixed)
     reuse_last_plan: bool = True  # keep the last plan while it stays valid and the goal stays
     goal_tolerance_m: float = setting(0.01, lo=0.0, hi=1.0)  # goal moves less than this: same goal
@@ -224,8 +230,8 @@ class ERRTPlanner:
         self, cw: CompiledWorld, s: tuple[float, float], g: tuple[float, float], waypoints: FloatArray,
         termination: Termination,
     ) -> tuple[int, bool]:
-        """Run the ERRT kernel in chunks until it finishes, spends the termination's budget of nodes
-        or its deadline passes."""
+        """Run the ERRT kernel in chunks until it finishes, spends the termination's budget of nodes or
+        the planner's budget of iterations (``iteration_budget``), or its deadline passes."""
         self._nodes[0], self._nodes[1] = s, g
         self._parent[:2] = -1
         self._tree[0], self._tree[1] = 0, 1
@@ -237,7 +243,10 @@ class ERRTPlanner:
         chunk = self.params.chunk_iterations
         limit = termination.work_left(0, MAX_NODES)
         while True:
-            rand = self._random_rows(chunk)
+            left = self.params.iteration_budget - int(self._counts[K.ITERATIONS])
+            if left <= 0:
+                return K.GROW_RUNNING, False  # the iteration budget is spent: NO_PATH unless bridged
+            rand = self._random_rows(min(chunk, left))
             before = int(self._counts[K.ITERATIONS])
             trees = K.Trees(self._nodes, self._parent, self._tree, self._cost, self._kdc, self._kdd, self._roots,
                             self._stack, self._counts, self._bridges)

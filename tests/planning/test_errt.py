@@ -9,6 +9,7 @@ import pytest
 
 from cmdragons.geometry import Field
 from cmdragons.planning import (
+    CollisionWorld,
     ERRTParams,
     ERRTPlanner,
     PlanStatus,
@@ -154,3 +155,35 @@ def test_cached_waypoints_are_aimed_at_with_the_configured_probability(field: Fi
     # exhausting the nodes gives NO_PATH; on a loaded machine the deadline may come first: a failure too
     assert failed.status in (PlanStatus.NO_PATH, PlanStatus.TIMEOUT)
     np.testing.assert_array_equal(errt.cache.view(), before)
+
+
+def boxed_in() -> CollisionWorld:
+    """Seed 2 of the match (2026-12-07, with the kick relative to the robot), blue 1 at 11.4 s: in
+    its own defense area beside the ball and three robots, whose trees find almost no room to grow."""
+    robots = [(-4.3654, 0.4536), (-3.4188, 0.0294), (-2.1046, 0.5944), (-2.2256, 0.2989), (-3.5214, -0.7438),
+              (4.4463, 0.0047), (-3.9404, -1.7092), (-3.5657, -0.5258), (-3.0652, 0.0551), (-3.2777, 0.6626),
+              (-3.8177, 1.8765)]
+    circles = [(x, y, 0.09) for x, y in robots] + [(-3.2676, 0.3344, 0.0715)]  # the ball with its clearance
+    boxes = [(3.5, -1.0, 4.5, 1.0), (-4.5, -1.0, -3.5, 1.0), (4.68, -0.52, 4.7, 0.52), (4.5, 0.5, 4.68, 0.52),
+             (4.5, -0.52, 4.68, -0.5), (-4.7, -0.52, -4.68, 0.52), (-4.68, 0.5, -4.5, 0.52),
+             (-4.68, -0.52, -4.5, -0.5)]
+    return CollisionWorld((-4.8, -3.3, 4.8, 3.3), np.array(circles), boxes=np.array(boxes))
+
+
+def test_trees_that_cannot_grow_stop_at_the_iteration_budget_whatever_the_deadline(field: Field) -> None:
+    """Trees that add (almost) no nodes never spend the budget of nodes: the search must end after
+    ``iteration_budget`` iterations, not at the deadline, or the random stream it leaves (and every
+    later plan of the robot) depends on the machine's speed: the same seed played another match
+    under load. Two deadlines far apart give the same search and the same next plan."""
+    prob = problem(boxed_in(), (-3.4443, 0.3230), (-3.4789, 0.3435))
+    planner().solve(prob, within(0.05))  # the kernels loaded before anything is compared
+    params = ERRTParams()
+    after = []
+    for seconds in (1.0, 3.0):
+        errt = planner()
+        res = errt.solve(prob, within(seconds))
+        assert res.status is PlanStatus.NO_PATH  # the iterations ran out, not the time
+        assert res.stats["iterations"] == params.iteration_budget and res.stats["nodes"] < 100
+        after.append(errt.solve(problem(wall_with_gap(field), (-3.0, -1.0), (3.0, -1.0)), within(10.0)))
+    assert after[0].status is after[1].status is PlanStatus.SOLVED
+    np.testing.assert_array_equal(after[0].path, after[1].path)

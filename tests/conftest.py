@@ -1,6 +1,8 @@
 """The suite's start: on a fresh clone (no numba cache) run in parallel, the play's kernels are
 compiled once, before the workers start, instead of once in every worker that meets them at the
-same time."""
+same time; and the files that hold slow tests run first, so that a parallel run ends on short tests
+(both workers busy to the end) rather than on a long match that one worker plays while the other
+has nothing left."""
 
 from __future__ import annotations
 
@@ -25,3 +27,10 @@ def pytest_configure(config: pytest.Config) -> None:
     if hasattr(config, "workerinput") or not isinstance(workers, int) or workers < 2:
         return  # a worker, or one process: nothing would compile twice
     subprocess.run([sys.executable, "-c", _WARM_UP, str(CONFIGS)], check=True)
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """The files with a test marked slow first, each file's tests together and in their order (a
+    module's fixtures built once), the rest after them in collection order."""
+    slow_files = {item.path for item in items if item.get_closest_marker("slow") is not None}
+    items.sort(key=lambda item: item.path not in slow_files)  # (sorted is stable)

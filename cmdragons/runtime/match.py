@@ -227,7 +227,8 @@ def served_wiring(settings: Settings, sim: Simulator, seed: int) -> list[Entry]:
     """The table of ``cmdragons sim --serve``: our simulator alone as a league simulator. Both
     teams' robots take the simulation protocol (``RobotControl`` on each team's port, teleports on
     the control port, a robot taken off the field parked out of view; a team that sends nothing has
-    its robots stand), the field is seen as
+    its robots stand; with ``protocols.serve.wait_s`` a frame waits for each team that has sent
+    commands: lock-step), the field is seen as
     SSL-Vision packets from every camera of the division (detections made from the truth, with the
     geometry now and then), and the simulator's referee judges on the truth and speaks the league's
     Referee packets. ``sim``: built without rendering and without its own referee; ``seed``: the
@@ -252,8 +253,8 @@ def served_wiring(settings: Settings, sim: Simulator, seed: int) -> list[Entry]:
         Entry(RefereeStage.contract, "sim", functools.partial(_referee_stage, settings, keys)),
         Entry(CameraTruthStage.declare(ids), "sim",
               functools.partial(CameraTruthStage, models, league.robot.height_m, sigmas, seed)),
-        Entry(SimulationInStage.declare(p, TEAMS), "", functools.partial(SimulationInStage, p, TEAMS, 0.0, league,
-                                                                           touch_m, parked)),
+        Entry(SimulationInStage.declare(p, TEAMS), "", functools.partial(SimulationInStage, p, TEAMS, p.serve.wait_s,
+                                                                           league, touch_m, parked, heard_only=True)),
         Entry(VisionOutStage.declare(p, ids, geometry), "", functools.partial(VisionOutStage, p, ids, geometry)),
         Entry(RefereeOutStage.contract, "", functools.partial(RefereeOutStage, p)),
     ]  # fmt: skip

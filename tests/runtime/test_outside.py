@@ -194,11 +194,15 @@ def _cmdragons(*args: str | Path) -> list[str]:
 def test_two_processes_play_our_team_in_the_served_simulator_as_in_any_league_simulator(tmp_path: Path) -> None:
     """``sim --serve`` in one process, ``play --simulator sim-protocol`` in another: our team (blue,
     on the served referee's word) sees the served field where the served truth has it and plays
-    the ball."""
+    the ball. The served simulator runs in lock-step with our team (each frame waits for blue's
+    commands, ``protocols.serve.wait_s``), so that what our team does in its 12 s of the served
+    clock does not hang on how fast a busy machine lets it answer (the served robots brake when
+    their commands are late)."""
     vision, referee, control, blue, yellow = free_udp_ports(5)
     sets = [f"protocols.simulation.vision_port={vision}", f"protocols.referee.port={referee}",
             f"protocols.simulation.control_port={control}", f"protocols.simulation.blue_port={blue}",
-            f"protocols.simulation.yellow_port={yellow}", "protocols.referee.source=game_controller"]
+            f"protocols.simulation.yellow_port={yellow}", "protocols.referee.source=game_controller",
+            "protocols.serve.wait_s=2.0"]
     flags = [x for k in sets for x in ("--set", k)]
     served = subprocess.Popen(_cmdragons("sim", "--serve", "--seconds", 120, "--no-progress", "--seed", 3,
                                          "--out", tmp_path / "served", *flags),

@@ -13,6 +13,7 @@ import signal
 import socket
 import subprocess
 import sys
+import threading
 import time
 from typing import Any
 
@@ -344,6 +345,42 @@ def test_garbage_and_cut_packets_to_our_simulator_are_counted_and_dropped() -> N
     assert len(lines) == 3 and all("dropped a packet (undecodable" in ln for ln in lines)
     commands = [m for t, m in out if t == "commands/yellow"]
     assert len(commands) == 1 and [c.vx for c in commands[0].commands] == [pytest.approx(0.5)]
+
+
+def test_a_served_simulator_in_lock_step_waits_only_for_a_team_it_has_heard() -> None:
+    """``heard_only`` (sim --serve with protocols.serve.wait_s): a team never heard from is not waited
+    for (the served match runs on before a client joins, beside a colour nobody plays); a team heard
+    once is waited for on every frame, and its late packet is taken on that frame."""
+    blue, yellow, control = free_udp_ports(3)
+    settings = load_settings(None, [f"protocols.simulation.blue_port={blue}",
+                                    f"protocols.simulation.yellow_port={yellow}",
+                                    f"protocols.simulation.control_port={control}"])
+    stage = SimulationInStage(settings.protocols, ("blue", "yellow"), 30.0, heard_only=True)
+    client = UdpEndpoint("127.0.0.1")
+    m = ctl_pb.RobotControl()
+    g = m.robot_commands.add(id=1).move_command.global_velocity
+    g.vel_x, g.vel_y, g.vel_angular = 0.5, 0.0, 0.0
+    gt = msg.GroundTruth(0, 0.0, msg.BallTruth(0.0, 0.0, 0.0, 0.0, 0.0),
+                         (msg.RobotTruth("blue", 1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),))
+    out: list[tuple[str, Any]] = []
+    try:
+        stage.on_message("truth", gt, lambda topic, message: out.append((topic, message)))  # nobody heard: no wait
+        assert stage.heard == set() and stage.frames_waited_out == 0
+        client.send_to(m.SerializeToString(), ("127.0.0.1", blue))
+        time.sleep(0.1)  # loopback delivery
+        stage.on_message("truth", gt, lambda topic, message: out.append((topic, message)))  # blue heard
+        assert stage.heard == {"blue"}
+        late = threading.Timer(0.2, lambda: client.send_to(m.SerializeToString(), ("127.0.0.1", blue)))
+        late.start()
+        stage.on_message("truth", gt, lambda topic, message: out.append((topic, message)))  # blue's next, late
+        late.join()
+    finally:
+        close_sockets([stage])
+        client.close()
+    assert stage.heard == {"blue"} and stage.frames_waited_out == 0  # yellow, never heard, never waited for
+    blue_commands = [m.commands for t, m in out if t == "commands/blue"]
+    assert [len(c) for c in blue_commands] == [0, 1, 1] and blue_commands[2][0].vx == pytest.approx(0.5)
+    assert all(m.commands == () for t, m in out if t == "commands/yellow")
 
 
 def test_the_example_client_plays_yellow_in_our_simulator_over_the_leagues_protocols(udp_port: int) -> None:

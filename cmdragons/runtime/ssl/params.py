@@ -104,6 +104,9 @@ class ServeParams(Validated):
     """``cmdragons sim --serve``: our simulator alone as a league simulator."""
 
     vision_noise: bool = True  # its SSL-Vision detections carry the tracker's measurement noise (false: exact)
+    # lock-step: a frame waits up to this long (s) for the RobotControl of each team that has sent one
+    # (0: the wall clock alone, as the league's simulators run)
+    wait_s: float = setting(0.0, lo=0.0, hi=60.0)
 
 
 @dataclass(frozen=True)

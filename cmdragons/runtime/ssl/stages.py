@@ -437,7 +437,9 @@ class SimulationInStage(SocketStage):
     ``SimulatorCommand`` teleports on the control port become teleports. On each captured frame
     (``truth``) it takes what came since; a frame with no new RobotControl waits up to ``wait_s``
     (default ``simulation.wait_s``; 0 for a simulator running on its own clock) for one (the match
-    keeps pace with a team that answers every frame). A team that sent nothing this frame has no
+    keeps pace with a team that answers every frame; ``heard_only``: only for a team that has sent one
+    before, so that a served simulator runs on before a client joins and beside a colour nobody plays).
+    A team that sent nothing this frame has no
     commands for it (its robots stop by their own command timeout). Local velocities turn into the
     field frame by the robot's true heading. Each packet is answered (RobotControlResponse, with each
     robot's ball contact when ``league`` is given, within ``touch_m`` of its front; SimulatorResponse).
@@ -455,7 +457,7 @@ class SimulationInStage(SocketStage):
     def __init__(self, params: ProtocolParams, teams: Team | Sequence[Team], wait_s: float | None = None,
                  league: LeagueParams | None = None, touch_m: float = 0.0,
                  parked: Mapping[tuple[Team, int], tuple[float, float]] | None = None,
-                 err: TextIO | None = None) -> None:
+                 err: TextIO | None = None, heard_only: bool = False) -> None:
         sim = params.simulation
         self.contract = self.declare(params, teams)
         self.teams = _teams(teams)
@@ -469,6 +471,8 @@ class SimulationInStage(SocketStage):
                 endpoint.close()
             raise
         self.wait_s = sim.wait_s if wait_s is None else wait_s
+        self.heard_only = heard_only
+        self.heard: set[Team] = set()  # the teams that have sent a RobotControl
         self.league, self.touch_m, self.parked = league, touch_m, parked
         self.full_rpm = sim.dribbler_full_rpm
         ports = "/".join(str(sim.port(t)) for t in self.teams)
@@ -493,9 +497,11 @@ class SimulationInStage(SocketStage):
         contact = self._contact(team, gt)
         latest: dict[int, RobotCommand] = {}
         got = endpoint.receive()
-        if got is None and self.wait_s > 0:
+        if got is None and self.wait_s > 0 and (team in self.heard or not self.heard_only):
             got = endpoint.receive(self.wait_s)
             self.frames_waited_out += got is None
+        if got is not None:
+            self.heard.add(team)
         while got is not None:
             for c in self._commands(team, got, headings, contact):
                 latest[c.id] = c

@@ -280,18 +280,30 @@ class Segmenter:
         self._gains: NDArray[np.int32] = np.zeros((0, 0), dtype=np.int32)  # the light per cell: none
         self._row_cell: NDArray[np.int64] = np.zeros(0, dtype=np.int64)
 
-    def set_light(self, gains: NDArray[np.float64] | None, width: int, height: int) -> None:
+    def set_light(self, gains: NDArray[np.float64] | None, width: int, height: int,
+                  where: NDArray[np.bool_] | None = None) -> None:
         """Colour gains per cell of a grid over images of ``width`` x ``height``: ``gains`` (rows of
         cells, columns of cells, 3) per BGR channel, each pixel's channels scaled by its cell's before
-        it is classified (:func:`vision._kernels.classify`); None: none. Cells split the image evenly."""
+        it is classified (:func:`vision._kernels.classify`); None: none. Cells split the image evenly.
+        ``where`` (bands of rows, ``width``) bool, the image's rows split evenly into bands: the
+        gains apply only to the band's columns marked (elsewhere the pixels are taken as they are)."""
         if gains is None:
             self._gains, self._row_cell = np.zeros((0, 0), dtype=np.int32), np.zeros(0, dtype=np.int64)
             return
         ny, nx = gains.shape[:2]
         col_cell = np.minimum(np.arange(width) * nx // width, nx - 1)
-        self._row_cell = np.minimum(np.arange(height) * ny // height, ny - 1).astype(np.int64)
         fixed = np.round(np.clip(gains, 0.0, 8.0) * 256.0).astype(np.int32)  # (ny, nx, 3), x 256
-        self._gains = np.ascontiguousarray(fixed[:, col_cell, :].reshape(ny, width * 3))
+        if where is None:
+            self._row_cell = np.minimum(np.arange(height) * ny // height, ny - 1).astype(np.int64)
+            self._gains = np.ascontiguousarray(fixed[:, col_cell, :].reshape(ny, width * 3))
+            return
+        nb = where.shape[0]
+        first = (np.arange(nb) * height + nb - 1) // nb  # each band's first row (row i is in band i * nb // height)
+        band_row = np.minimum(first * ny // height, ny - 1)  # the row of cells holding it
+        per = fixed[band_row][:, col_cell, :]  # (bands, width, 3)
+        per = np.where(where[:, :, None], per, np.int32(256))
+        self._row_cell = np.minimum(np.arange(height) * nb // height, nb - 1).astype(np.int64)
+        self._gains = np.ascontiguousarray(per.reshape(nb, width * 3), dtype=np.int32)
 
     def index(self, name: str) -> int:
         return self.names.index(name)

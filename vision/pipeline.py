@@ -123,10 +123,32 @@ class VisionPipeline:
         margin = f.dims.boundary_width_m if params.field_margin_m is None else params.field_margin_m
         # half extents of the field mask (inf: none)
         self.mask_half_m = (f.half_length + margin, f.half_width + margin) if margin >= 0.0 else (math.inf, math.inf)
+        self.goal_half_m = (f.half_length + f.dims.goal_depth_m, f.goal_half_width)  # inside both goals
         self.last_regions: Regions | None = None
         self.light: LightFollower | None = None
+        self.lift_where: NDArray[np.bool_] | None = None
         if params.light.follow:
             self.light = LightFollower(params.light, league, camera, self.heights)
+            if params.light.measure == "carpet" and math.isfinite(self.mask_half_m[0]):
+                self.lift_where = self._lift_where(params.light.carpet_band_px)
+
+    def _lift_where(self, band_px: int) -> NDArray[np.bool_]:
+        """(bands of rows, width) bool: where the carpet's lift applies, the bands of ``band_px``
+        rows (as many in each row of the light's cells) and the columns holding a pixel that sees
+        the field mask or a goal at the carpet's level; the floor past it is not the carpet and is
+        taken as it is (lifted, a wooden floor passes for pink)."""
+        g = self.grid.astype(np.float64)
+        c = self.camera.center
+        ax, ay = np.abs(c[0] + c[2] * g[..., 0]), np.abs(c[1] + c[2] * g[..., 1])
+        (mx, my), (gx, gy) = self.mask_half_m, self.goal_half_m
+        inside = ((ax <= mx) & (ay <= my)) | ((ax <= gx) & (ay <= gy))
+        h = self.camera.height
+        ny = self.params.light.grid[1]
+        nb = ny * max(1, math.ceil(h / ny / band_px))
+        band = np.minimum(np.arange(h) * nb // h, nb - 1)
+        out = np.zeros((nb, self.camera.width), dtype=bool)
+        np.logical_or.at(out, band, inside)
+        return out
 
     def _smallest_pixel_area(self) -> float:
         """The smallest field area of one pixel per metre of descent squared over the image (where
@@ -138,6 +160,15 @@ class VisionPipeline:
     def in_field(self, x: float, y: float) -> bool:
         """Whether field point (x, y) m lies inside the field mask (the field lines plus the margin)."""
         return abs(x) <= self.mask_half_m[0] and abs(y) <= self.mask_half_m[1]
+
+    def ball_in_field(self, x: float, y: float) -> bool:
+        """Whether a ball centred at (x, y) m lies inside the field mask or inside a goal (a ball in
+        the goal is a goal; a lab's field between walls has its goals past the mask): a ball at the
+        mask's edge (a wall) or at a goal's back or side has its centre a radius inside it."""
+        r = self.league.ball.radius_m
+        ax, ay = abs(x), abs(y)
+        return (ax <= self.mask_half_m[0] - r and ay <= self.mask_half_m[1] - r) or \
+            (ax <= self.goal_half_m[0] - r and ay <= self.goal_half_m[1] - r)
 
     @property
     def shape(self) -> tuple[int, int, int]:
@@ -158,12 +189,12 @@ class VisionPipeline:
         robots = self.matcher.detect(geo, self.classes, self.heights, lambda px: self._is_pink(image, px))
         # a ball seen beside a robot lies outside its top: only a misread marker is well inside
         balls = detect_ball(geo, image, self.classes["ball"], self.league.ball.radius_m, robots, self.heights,
-                            self.pattern_radius_m * 0.8, self.params.ball, self.in_field)
+                            self.pattern_radius_m * 0.8, self.params.ball, self.ball_in_field)
         robots = [r for r in robots if self.in_field(r.x, r.y)]
         if self.light is not None:
             gains = self.light.observe(image, robots, balls)
             if gains is not None:
-                self.segmenter.set_light(gains, self.camera.width, self.camera.height)
+                self.segmenter.set_light(gains, self.camera.width, self.camera.height, self.lift_where)
         # no wall clock here: the frame is "sent" at its capture time (latency is the runtime's)
         return DetectionFrame(self.camera.id, frame_number, t_capture, t_capture, tuple(balls),
                               tuple(sorted(robots, key=lambda r: (r.team, r.id))))

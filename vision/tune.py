@@ -369,15 +369,27 @@ def _take(samples: dict[str, list[NDArray[np.int32]]], lit: dict[str, list[float
             lit.setdefault(role, []).append(local)
 
 
-def widen_for_light(box: ColourClass, light: tuple[float, float], space: ColourSpace) -> ColourClass:
+def widen_for_light(box: ColourClass, light: tuple[float, float], space: ColourSpace,
+                    saturation_reach: float = 1.0) -> ColourClass:
     """``box`` stretched for light ``light`` (darker, brighter) times the light it was sampled in:
     every channel scales with the light (U and V about grey in YUV); a colour sampled in one part
-    of the field is then found in the darker and brighter parts too."""
+    of the field is then found in the darker and brighter parts too. In YUV, a chroma channel (U,
+    V) whose box lies on one side of grey reaches ``saturation_reach`` times as far from grey on
+    its far side: bright markers' samples are mostly clipped by the sensor (a channel at its
+    ceiling pulls their chroma toward grey), and the same colour unclipped, where it is darker or
+    lifted by the light follower, lies further out (:func:`keep_apart` still cuts the box where
+    another class's or the background's samples lie)."""
     lo, hi = np.array(box.lo, np.float64), np.array(box.hi, np.float64)
     grey = np.array([0.0, 128.0, 128.0]) if space == "yuv" else np.zeros(3)
     ends = [grey + (v - grey) * r for v in (lo, hi) for r in light]
     new_lo = np.clip(np.floor(np.min(ends, axis=0)), 0, 255).astype(int)
     new_hi = np.clip(np.ceil(np.max(ends, axis=0)), 0, 255).astype(int)
+    if space == "yuv":
+        for c in (1, 2):
+            if new_lo[c] >= 128 and new_hi[c] > 128:
+                new_hi[c] = min(255, int(128 + (new_hi[c] - 128) * saturation_reach))
+            elif new_hi[c] <= 128 and new_lo[c] < 128:
+                new_lo[c] = max(0, int(128 - (128 - new_lo[c]) * saturation_reach))
     return ColourClass(lo=(int(new_lo[0]), int(new_lo[1]), int(new_lo[2])),
                        hi=(int(new_hi[0]), int(new_hi[1]), int(new_hi[2])), min_area_px=box.min_area_px)
 
@@ -445,7 +457,8 @@ def keep_apart(boxes: dict[str, ColourClass], samples: Mapping[str, NDArray[np.i
 
 def learn_boxes(samples: Samples, background: Mapping[str, NDArray[np.int32]], light: Mapping[str, tuple[float, float]],
                 current: Mapping[str, ColourClass], space: ColourSpace, margin: int = 16,
-                max_overlap: float | None = None) -> tuple[dict[str, ColourClass], list[str]]:
+                max_overlap: float | None = None,
+                saturation_reach: float = 1.0) -> tuple[dict[str, ColourClass], list[str]]:
     """The colour boxes from samples per colour name (and, learnt automatically, the background's
     samples and the light each box must reach): each sampled colour's box
     (:func:`boxes_from_samples`, widened by :func:`widen_for_light`), the others as ``current``
@@ -453,7 +466,8 @@ def learn_boxes(samples: Samples, background: Mapping[str, NDArray[np.int32]], l
     warnings, one line each: where boxes overlapped, and where they still do after the cut."""
     share = AutoTuneParams().max_overlap if max_overlap is None else max_overlap
     learnt = boxes_from_samples(samples, margin=margin)
-    boxes = {**current, **{n: widen_for_light(b, light[n], space) if n in light else b for n, b in learnt.items()}}
+    boxes = {**current, **{n: widen_for_light(b, light[n], space, saturation_reach) if n in light else b
+                           for n, b in learnt.items()}}
     pooled = {**{n: np.concatenate(p) for n, p in samples.items()}, **background}
     warnings = [f"{part:.0%} of the {what} samples fall in {other}'s box (lo {list(boxes[other].lo)} hi "
                 f"{list(boxes[other].hi)}): the boxes are cut apart"

@@ -102,7 +102,8 @@ def _colours(settings: Settings, images: Sequence[NDArray[np.uint8]], model: Cam
     rep = auto_samples(images, model, settings.field, vis.colour_space)
     names = {role: getattr(vis.roles, role) for role in ("ball", "blue", "yellow", "pink", "green")}
     boxes, _ = learn_boxes({names[r]: v for r, v in rep.samples.items()}, rep.background,
-                           {names[r]: v for r, v in rep.light.items()}, vis.colours, vis.colour_space)
+                           {names[r]: v for r, v in rep.light.items()}, vis.colours, vis.colour_space,
+                           saturation_reach=vis.light.saturation_reach)
     return dataclasses.replace(vis, colours=boxes)
 
 

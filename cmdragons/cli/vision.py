@@ -246,7 +246,8 @@ def _tune(args: argparse.Namespace, settings: object) -> int:
                 raise ValueError(f"{name}: cannot be read as an image")
             images.append(np.asarray(img, dtype=np.uint8))
         samples = samples_from_labels(images, read_labels(args.labels), vis.colour_space)
-    boxes, warnings = learn_boxes(samples, background, light, vis.colours, vis.colour_space, args.margin)
+    boxes, warnings = learn_boxes(samples, background, light, vis.colours, vis.colour_space, args.margin,
+                                  saturation_reach=vis.light.saturation_reach)
     for line in warnings:
         print(f"tune: warning: {line}", file=sys.stderr)
     changed = {n for n, b in boxes.items() if n in samples or b != vis.colours.get(n)}

@@ -272,3 +272,22 @@ def test_light_per_cell_equals_the_numpy_reference(space: str) -> None:
     assert not np.array_equal(bits, classify_reference(image, list(classes.values()), space))  # type: ignore[arg-type]
     seg.set_light(None, w, h)
     np.testing.assert_array_equal(seg.classify(image), classify_reference(image, list(classes.values()), space))  # type: ignore[arg-type]
+
+
+def test_light_applies_only_where_marked() -> None:
+    """Gains with ``where`` (bands of rows x columns, as many bands in each row of cells): the pixels
+    of marked band columns are classified as the reference classifies the lit image, the others as it
+    classifies the image as it is."""
+    image = every_colour(5)
+    h, w = image.shape[:2]
+    gains = np.random.default_rng(5).uniform(0.5, 1.6, (3, 4, 3))
+    classes = wide_classes()
+    bands = 3 * 4
+    where = np.random.default_rng(6).uniform(size=(bands, w)) < 0.5
+    seg = Segmenter(classes, "yuv", RegionParams())
+    seg.set_light(gains, w, h, where)
+    lit = classify_reference(image, list(classes.values()), "yuv", gains)
+    plain = classify_reference(image, list(classes.values()), "yuv")
+    per_pixel = where[np.minimum(np.arange(h) * bands // h, bands - 1)]
+    np.testing.assert_array_equal(seg.classify(image), np.where(per_pixel, lit, plain))
+    assert not np.array_equal(lit[per_pixel], plain[per_pixel]) and not np.array_equal(lit, plain)

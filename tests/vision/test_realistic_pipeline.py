@@ -66,7 +66,8 @@ def test_calibration_colours_and_detection_with_nothing_labelled() -> None:
     rep = auto_samples([frames[k][0] for k in range(0, 60, 6)], model, s.field, "yuv")
     assert set(rep.samples) == {"ball", "blue", "yellow", "pink", "green"}
     boxes, _ = learn_boxes({getattr(s.vision.roles, r): v for r, v in rep.samples.items()}, rep.background,
-                           {getattr(s.vision.roles, r): v for r, v in rep.light.items()}, s.vision.colours, "yuv")
+                           {getattr(s.vision.roles, r): v for r, v in rep.light.items()}, s.vision.colours, "yuv",
+                           saturation_reach=s.vision.light.saturation_reach)
     pipe = VisionPipeline(dataclasses.replace(s.vision, colours=boxes), s.field, model)
     score = Score()
     hidden_seen = hidden_found = 0

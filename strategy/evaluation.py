@@ -181,8 +181,9 @@ def shot_chance(ball: Array, field: Field, goal_sign: float, obstacles: Array, r
     edges_y = np.linspace(-gw, gw, samples + 1)
     ys = 0.5 * (edges_y[:-1] + edges_y[1:])
     dx = gx - float(ball[0])
-    edges = np.arctan2(edges_y - float(ball[1]), dx)
-    centres = np.arctan2(ys - float(ball[1]), dx)
+    centre = math.atan2(-float(ball[1]), dx)  # angles from the way to the goal's centre: no wrap across the mouth
+    edges = _wrap(np.arctan2(edges_y - float(ball[1]), dx) - centre)
+    centres = _wrap(np.arctan2(ys - float(ball[1]), dx) - centre)
     free = np.ones(samples, dtype=bool)
     if len(obstacles):
         free = goal_samples_free(np.ascontiguousarray(np.atleast_2d(ball), dtype=np.float64), ys, float(gx),

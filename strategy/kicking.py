@@ -28,7 +28,7 @@ from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, wrap_angle
 from cmdragons.messages import BallState, KickPurpose, RobotState
 from strategy.ballmodel import interception_times, reach_times
-from strategy.evaluation import PassParams, clearest_direction, one_touch_turn, pass_values, shot_chance
+from strategy.evaluation import PassParams, best_shot, clearest_direction, one_touch_turn, pass_values, shot_chance
 from strategy.passing import PassPlay
 from strategy.skills import (
     Intent,
@@ -180,14 +180,16 @@ def _mates(own: Mapping[int, RobotState], passer: int, receiver: int) -> tuple[A
 
 
 def shot(ball_xy: Array, pitch: Field, attack_sign: float, opponents: Array, radius: float, p: KickParams,
-         passing: PassParams, skills: SkillParams) -> tuple[tuple[float, float], float]:
-    """The shot from ``ball_xy``: its aim on the goal line and its value, the chance it goes in with
-    the kick's direction error ``shot_error_rad`` past the opponents (:func:`shot_chance`), fading
-    as exp(-distance / ``shot_distance_scale_m``) (the keeper's time to move, the ball's to slow)."""
+         passing: PassParams) -> tuple[tuple[float, float], float]:
+    """The shot from ``ball_xy``: its aim on the goal line and its value. Aimed where the chance it
+    goes in with the kick's direction error ``shot_error_rad`` is largest (:func:`shot_chance`); its
+    value that chance times the open angle's (:func:`best_shot`: the open angle against
+    ``shot_open_angle_rad``, fading as exp(-distance / ``shot_distance_scale_m``), which stand for the
+    keeper's time to move and the ball's to slow, which the chance leaves out)."""
     chance, aim = shot_chance(ball_xy, pitch, attack_sign, opponents, radius, passing.goal_samples,
                               p.shot_error_rad)
-    d = math.hypot(aim[0] - float(ball_xy[0]), aim[1] - float(ball_xy[1]))
-    return aim, chance * math.exp(-d / passing.shot_distance_scale_m)
+    _, _, open_value = best_shot(ball_xy, pitch, attack_sign, opponents, radius, passing)
+    return aim, chance * open_value
 
 
 def decide_kick(ball: BallState, passer: int, own: Mapping[int, RobotState], supporters: Sequence[int],
@@ -196,9 +198,9 @@ def decide_kick(ball: BallState, passer: int, own: Mapping[int, RobotState], sup
     """The kick of ``passer`` at ``ball`` (where it meets the ball): a shot, a pass to one of
     ``supporters`` (robot ids), or a clear. ``radius``: the opponents' plus the ball's;
     ``opponent_vel``: their velocities (rows of ``opponents``). A pass goes only at a speed
-    :func:`pass_kick_speed` finds."""
+    :func:`pass_kick_speed` finds when it is chosen."""
     ball_xy = np.array([ball.x, ball.y])
-    aim, shot_value = shot(ball_xy, pitch, attack_sign, opponents, radius, p, passing, skills)
+    aim, shot_value = shot(ball_xy, pitch, attack_sign, opponents, radius, p, passing)
     if shot_value >= p.shoot_value:
         return Kick(KickPurpose.SHOT, aim, skills.max_kick_m_s)
     planned = passes.planned_by(passer, own)
@@ -206,10 +208,15 @@ def decide_kick(ball: BallState, passer: int, own: Mapping[int, RobotState], sup
         # a pass already decided goes to the point its receiver waits at while it stays worth playing
         pt = np.array([planned.point])
         ev = pass_values(ball_xy, pt, pitch, attack_sign, opponents, radius, passing)
-        speed = pass_kick_speed(ball, planned.point, own[planned.receiver], opponents, opponent_vel, p, skills,
-                                *_mates(own, passer, planned.receiver))
-        if ev.values[0] >= p.keep_pass_share * p.pass_value and speed is not None:
-            return Kick(KickPurpose.PASS, planned.point, speed, planned.receiver, planned.shoot_at)
+        if ev.values[0] >= p.keep_pass_share * p.pass_value:
+            # kept as it was chosen: the opponents and team-mates that move about the ball while the passer gets
+            # there are not judged again (refused and chosen again frame by frame, the aim turned and the passer
+            # never kicked); its speed for the receiver as it is now
+            none = np.zeros((0, 2))
+            speed = pass_kick_speed(ball, planned.point, own[planned.receiver], none, none, p, skills)
+            dist = math.hypot(planned.point[0] - ball.x, planned.point[1] - ball.y)
+            return Kick(KickPurpose.PASS, planned.point, pass_speed(dist, skills) if speed is None else speed,
+                        planned.receiver, planned.shoot_at)
     receivers = [rid for rid in supporters if (own[rid].x - ball.x) * attack_sign > -p.max_back_pass_m]
     if receivers:
         pts = np.array([[own[rid].x, own[rid].y] for rid in receivers])
@@ -222,7 +229,7 @@ def decide_kick(ball: BallState, passer: int, own: Mapping[int, RobotState], sup
                                     *_mates(own, passer, receivers[k]))
             if speed is None:
                 continue
-            shot_aim, value_there = shot(pts[k], pitch, attack_sign, opponents, radius, p, passing, skills)
+            shot_aim, value_there = shot(pts[k], pitch, attack_sign, opponents, radius, p, passing)
             turn = float(one_touch_turn(ball_xy, pts[k : k + 1], np.array([shot_aim]))[0])
             one_touch = value_there >= p.one_touch_value and turn <= passing.max_turn_rad
             return Kick(KickPurpose.PASS, point, speed, receivers[k], shot_aim if one_touch else None)
@@ -334,7 +341,7 @@ class Attacker:
         forward; ``restart``: our restart's kick, its only touch (:func:`~strategy.skills.set_kick`).
         Returns the intent and what the kick is for."""
         p, skills = self.p, self.skills
-        if not restart and passes.released_by(robot.id, ball):
+        if not restart and passes.released_by(robot, ball):
             # its pass just kicked, the ball on its way to the receiver: not decided afresh (from where the passer
             # meets the ball now, a shot or another pass was, and the receiver left the pass it was to get)
             return Intent(robot.x, robot.y, math.atan2(ball.y - robot.y, ball.x - robot.x)), KickPurpose.PASS

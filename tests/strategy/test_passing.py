@@ -117,4 +117,12 @@ def test_a_pass_is_released_by_its_passer_once_the_ball_runs_toward_the_point(pa
     ball = BallState(0.1, 0.0, vx, vy)
     ps = play.follow(0.05, _own(), ball)
     assert ps is not None and not ps.kicked  # rolling 1.6 m at most, it is not counted kicked yet ...
-    assert play.released_by(passer, ball) is released  # ... but its passer has let it go
+    assert play.released_by(_own()[1] if passer == 1 else _own()[2], ball) is released  # ... its passer let it go
+
+
+def test_a_ball_pushed_along_by_its_passer_is_not_released() -> None:
+    play = PassPlay(P, MODEL)
+    play.plan(0.0, passer=1, receiver=2, point=POINT, shoot_at=None)
+    pushing = RobotState("blue", 1, 0.0, 0.0, 0.0, vx=0.8)
+    assert not play.released_by(pushing, BallState(0.1, 0.0, 0.8, 0.0))  # driving through it toward the point
+    assert play.released_by(pushing, BallState(0.2, 0.0, 2.0, 0.0))  # kicked: it runs away from the passer

@@ -76,3 +76,17 @@ def test_the_aim_with_the_kick_error_scores_more_than_a_posts_end() -> None:
     at_aim = goals_in_simulator(ball, aim, keeper, error_rad, KICKS, np.random.default_rng(11))
     assert at_aim > at_post + 0.1
     assert at_aim == pytest.approx(chance, abs=TOLERANCE)
+
+
+@pytest.mark.parametrize(("ball", "blockers"), [
+    ((FIELD.half_length - 3.0, 0.4), np.zeros((0, 2))),
+    ((FIELD.half_length - 2.0, -0.3), np.array([[FIELD.half_length - 0.15, 0.2]])),
+])
+def test_the_chance_is_the_same_at_either_goal(ball: tuple[float, float], blockers: np.ndarray) -> None:
+    # the other goal is the mirror image: the same chance, the aim mirrored (the angles toward -x wrap at pi)
+    chance, aim = shot_chance(np.array(ball), FIELD, 1.0, blockers, R, PassParams().goal_samples, 0.05)
+    mirrored = np.array([[-x, y] for x, y in blockers]).reshape(-1, 2)
+    other, other_aim = shot_chance(np.array([-ball[0], ball[1]]), FIELD, -1.0, mirrored, R, PassParams().goal_samples,
+                                   0.05)
+    assert other == pytest.approx(chance, abs=1e-9) and 0.5 < chance
+    assert other_aim == pytest.approx((-aim[0], aim[1]), abs=1e-9)

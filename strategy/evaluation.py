@@ -25,7 +25,6 @@ from typing import Any, cast
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.special import ndtr
 
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, wrap_angle
@@ -40,7 +39,6 @@ __all__ = [
     "one_touch_turn",
     "open_goal_angle",
     "pass_values",
-    "shot_chance",
 ]
 
 Array = NDArray[np.float64]
@@ -164,40 +162,6 @@ def best_shot(ball: Array, field: Field, goal_sign: float, obstacles: Array, rad
     d = math.hypot(target[0] - ball[0], target[1] - ball[1])
     value = min(1.0, float(width[0]) / params.shot_open_angle_rad) * math.exp(-d / params.shot_distance_scale_m)
     return float(width[0]), target, value
-
-
-def shot_chance(ball: Array, field: Field, goal_sign: float, obstacles: Array, radius: float, samples: int,
-                error_rad: float) -> tuple[float, tuple[float, float]]:
-    """The chance that a shot from ``ball`` goes in, kicked with a direction error of ``error_rad``
-    (one standard deviation, normal), and the aim point on the goal line that gives the most.
-
-    The mouth between the posts (the ball's centre: a ball that meets a post from inside glances in
-    about as often as out) is cut into ``samples`` cells; a cell no obstacle shadows (as
-    :func:`open_goal_angle` sees them) is open. A shot aimed at angle a goes in with the probability
-    mass of N(a, error) over the open cells' angular extents; the aims tried are the cells' centres.
-    (0, the goal's centre) when no cell is open."""
-    gx = goal_sign * field.half_length
-    gw = field.goal_half_width
-    edges_y = np.linspace(-gw, gw, samples + 1)
-    ys = 0.5 * (edges_y[:-1] + edges_y[1:])
-    dx = gx - float(ball[0])
-    centre = math.atan2(-float(ball[1]), dx)  # angles from the way to the goal's centre: no wrap across the mouth
-    edges = _wrap(np.arctan2(edges_y - float(ball[1]), dx) - centre)
-    centres = _wrap(np.arctan2(ys - float(ball[1]), dx) - centre)
-    free = np.ones(samples, dtype=bool)
-    if len(obstacles):
-        free = goal_samples_free(np.ascontiguousarray(np.atleast_2d(ball), dtype=np.float64), ys, float(gx),
-                                 np.ascontiguousarray(obstacles, dtype=np.float64), float(radius))[0]
-    if not free.any():
-        return 0.0, (gx, 0.0)
-    lo, hi = np.minimum(edges[:-1], edges[1:]), np.maximum(edges[:-1], edges[1:])
-    sd = max(error_rad, 1e-9)
-    # (aims, cells): the mass of each open cell for each aim at an open cell's centre
-    aims = centres[free]
-    mass = ndtr((hi[None, free] - aims[:, None]) / sd) - ndtr((lo[None, free] - aims[:, None]) / sd)
-    chance = mass.sum(axis=1)
-    k = int(np.argmax(chance))
-    return float(chance[k]), (gx, float(ys[free][k]))
 
 
 @dataclass(frozen=True)

@@ -27,8 +27,7 @@ from numpy.typing import NDArray
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, wrap_angle
 from cmdragons.messages import BallState, KickPurpose, RobotState
-from strategy.ballmodel import interception_times, reach_times
-from strategy.evaluation import PassParams, best_shot, clearest_direction, one_touch_turn, pass_values, shot_chance
+from strategy.evaluation import PassParams, best_shot, clearest_direction, one_touch_turn, pass_values
 from strategy.passing import PassPlay
 from strategy.skills import (
     Intent,
@@ -43,7 +42,7 @@ from strategy.skills import (
 )
 
 __all__ = ["Attacker", "Kick", "KickPurpose", "KickParams", "StillBall", "chase", "contest_angle", "decide_kick",
-           "forward_kick", "kick_blocked", "pass_kick_speed", "shot"]
+           "forward_kick", "kick_blocked"]
 
 Array = NDArray[np.float64]
 
@@ -78,12 +77,6 @@ class KickParams(Validated):
     area_margin_m: float = setting(0.05, lo=0.0, hi=1.0)  # a ball met this near their defense area is left alone ...
     area_wait_m: float = setting(0.15, lo=0.0, hi=2.0)  # ... the attacker waiting by it, its edge this far off the area
     area_still_m: float = setting(0.02, lo=0.0, hi=1.0)  # ... unless it lay still stall_s this far outside the area
-    shot_error_rad: float = setting(0.05, lo=0.0, hi=1.0)  # the kick's direction error (one standard deviation)
-    pass_control_m_s: float = setting(2.0, lo=0.1, hi=10.0)  # a pass arrives at most this fast (a receiver traps it)
-    pass_speed_steps: int = setting(5, lo=1, hi=100)  # arrival speeds tried, pass_arrival_m_s to pass_control_m_s
-    pass_margin_m: float = setting(0.05, lo=0.0, hi=1.0)  # an opponent this near the ball's way, past its reach: in it
-    pass_cut_s: float = setting(0.4, lo=0.0, hi=10.0)  # an opponent in the ball's way within this of the kick cuts it
-    pass_step_s: float = setting(0.02, lo=0.001, hi=1.0)  # the ball's run checked against the opponents in these steps
 
 
 @dataclass(frozen=True)
@@ -110,97 +103,20 @@ class StillBall:
             self.at, self.since = (ball.x, ball.y), t
 
 
-def _in_the_way(ball: BallState, u: tuple[float, float], v0: float, t_ball: float, robots: Array, vel: Array,
-                reach: float, step_s: float, skills: SkillParams) -> bool:
-    """Whether a robot (rows of ``robots``, moving on at ``vel``) is within ``reach`` of the ball kicked
-    along ``u`` at ``v0`` (the two-phase model) before ``t_ball``."""
-    ts = np.arange(0.0, t_ball + step_s, step_s)
-    d, _ = skills.ball_model.travel(v0, ts)
-    bx, by = ball.x + u[0] * d, ball.y + u[1] * d
-    rx = robots[:, 0:1] + vel[:, 0:1] * ts[None, :]
-    ry = robots[:, 1:2] + vel[:, 1:2] * ts[None, :]
-    return bool(np.any(np.hypot(rx - bx[None, :], ry - by[None, :]) < reach))
-
-
-def pass_kick_speed(ball: BallState, point: tuple[float, float], receiver: RobotState, opponents: Array,
-                    opponent_vel: Array, p: KickParams, skills: SkillParams, mates: Array | None = None,
-                    mate_vel: Array | None = None) -> float | None:
-    """The kick speed of a pass from ``ball`` to a receiver meeting it at ``point`` (thesis B.5, the
-    pass as it will happen): the ball's run from the two-phase model, arriving between
-    ``pass_arrival_m_s`` and ``pass_control_m_s`` (a receiver traps it), the slowest of
-    ``pass_speed_steps`` such speeds (the kick clamped to ``pass_min_m_s`` .. ``pass_max_m_s``) whose
-    ball the receiver, from where it is with the robot's limits, meets at the point in time and no
-    opponent cuts: an opponent (``opponents`` (M, 2), ``opponent_vel`` (M, 2), the same limits and
-    command latency, ``pass_margin_m`` past its reach) cuts a pass when it can be in the ball's way
-    before the ball gets to the receiver, or at the ball on the receiver's face, within
-    ``pass_cut_s`` of the kick; nor one a team-mate (``mates`` (K, 2) moving on at ``mate_vel``:
-    not the passer, not the receiver) stands in the way of, within ``pass_margin_m`` past its reach.
-    None: no such speed (the passer does not release a pass the receiver cannot make, nor one an
-    opponent cuts or a team-mate deflects)."""
-    model, limits = skills.ball_model, skills.limits
-    mates = np.zeros((0, 2)) if mates is None else mates
-    mate_vel = np.zeros_like(mates) if mate_vel is None else mate_vel
-    dx, dy = point[0] - ball.x, point[1] - ball.y
-    dist = math.hypot(dx, dy)
-    run = max(dist - skills.contact_m, 0.0)  # to the receiver's kicker face
-    if dist < 1e-9:
-        return None
-    ux, uy = dx / dist, dy / dist
-    here = np.array([[receiver.x, receiver.y]])
-    t_receiver = float(reach_times(here, np.array([[receiver.vx, receiver.vy]]), np.array([point]), 0.0, limits,
-                                   skills.robot.command_latency_s)[0, 0])
-    reach = skills.robot_radius_m + skills.ball_radius_m + p.pass_margin_m
-    if len(opponents):
-        face = np.array([[point[0] - ux * skills.contact_m, point[1] - uy * skills.contact_m]])
-        marked = reach_times(opponents, opponent_vel, face, reach, limits, skills.robot.command_latency_s)
-        if float(marked.min()) <= p.pass_cut_s:
-            return None  # an opponent at the received ball
-    arrivals = np.linspace(skills.pass_arrival_m_s, max(p.pass_control_m_s, skills.pass_arrival_m_s),
-                           p.pass_speed_steps)
-    for arrival in arrivals:
-        v0 = model.kick_speed(run, float(arrival), skills.pass_min_m_s, skills.pass_max_m_s)
-        t_ball = model.time_to(v0, run)
-        if not math.isfinite(t_ball) or model.speed_after(v0, run) > p.pass_control_m_s or t_ball < t_receiver:
-            continue
-        if len(mates) and _in_the_way(ball, (ux, uy), v0, t_ball, mates, mate_vel, reach, p.pass_step_s, skills):
-            continue
-        if len(opponents):
-            ts, _ = interception_times(opponents, opponent_vel, (ball.x, ball.y), (v0 * ux, v0 * uy), model, limits,
-                                       skills.robot.command_latency_s, reach, min(t_ball, p.pass_cut_s), p.pass_step_s)
-            if bool(np.any(ts <= min(t_ball, p.pass_cut_s))):
-                continue
-        return v0
-    return None
-
-
-def _mates(own: Mapping[int, RobotState], passer: int, receiver: int) -> tuple[Array, Array]:
-    """Our robots but the passer and the receiver: where they are and their velocities, (K, 2) each."""
-    rest = [r for rid, r in own.items() if rid not in (passer, receiver)]
-    return (np.array([[r.x, r.y] for r in rest]).reshape(-1, 2), np.array([[r.vx, r.vy] for r in rest]).reshape(-1, 2))
-
-
-def shot(ball_xy: Array, pitch: Field, attack_sign: float, opponents: Array, radius: float, p: KickParams,
-         passing: PassParams) -> tuple[tuple[float, float], float]:
-    """The shot from ``ball_xy``: its aim on the goal line and its value. Aimed where the chance it
-    goes in with the kick's direction error ``shot_error_rad`` is largest (:func:`shot_chance`); its
-    value that chance times the open angle's (:func:`best_shot`: the open angle against
-    ``shot_open_angle_rad``, fading as exp(-distance / ``shot_distance_scale_m``), which stand for the
-    keeper's time to move and the ball's to slow, which the chance leaves out)."""
-    chance, aim = shot_chance(ball_xy, pitch, attack_sign, opponents, radius, passing.goal_samples,
-                              p.shot_error_rad)
-    _, _, open_value = best_shot(ball_xy, pitch, attack_sign, opponents, radius, passing)
-    return aim, chance * open_value
+def _pass_kick(ball: BallState, point: tuple[float, float], receiver: int, shoot_at: tuple[float, float] | None,
+               skills: SkillParams) -> Kick:
+    """A pass to ``point``, as fast as it must be kicked to arrive there at the receiving speed."""
+    dist = math.hypot(point[0] - ball.x, point[1] - ball.y)
+    return Kick(KickPurpose.PASS, point, pass_speed(dist, skills), receiver, shoot_at)
 
 
 def decide_kick(ball: BallState, passer: int, own: Mapping[int, RobotState], supporters: Sequence[int],
-                passes: PassPlay, opponents: Array, opponent_vel: Array, pitch: Field, attack_sign: float,
-                radius: float, p: KickParams, passing: PassParams, skills: SkillParams) -> Kick:
+                passes: PassPlay, opponents: Array, pitch: Field, attack_sign: float, radius: float, p: KickParams,
+                passing: PassParams, skills: SkillParams) -> Kick:
     """The kick of ``passer`` at ``ball`` (where it meets the ball): a shot, a pass to one of
-    ``supporters`` (robot ids), or a clear. ``radius``: the opponents' plus the ball's;
-    ``opponent_vel``: their velocities (rows of ``opponents``). A pass goes only at a speed
-    :func:`pass_kick_speed` finds when it is chosen."""
+    ``supporters`` (robot ids), or a clear. ``radius``: the opponents' plus the ball's."""
     ball_xy = np.array([ball.x, ball.y])
-    aim, shot_value = shot(ball_xy, pitch, attack_sign, opponents, radius, p, passing)
+    _, aim, shot_value = best_shot(ball_xy, pitch, attack_sign, opponents, radius, passing)
     if shot_value >= p.shoot_value:
         return Kick(KickPurpose.SHOT, aim, skills.max_kick_m_s)
     planned = passes.planned_by(passer, own)
@@ -209,30 +125,18 @@ def decide_kick(ball: BallState, passer: int, own: Mapping[int, RobotState], sup
         pt = np.array([planned.point])
         ev = pass_values(ball_xy, pt, pitch, attack_sign, opponents, radius, passing)
         if ev.values[0] >= p.keep_pass_share * p.pass_value:
-            # kept as it was chosen: the opponents and team-mates that move about the ball while the passer gets
-            # there are not judged again (refused and chosen again frame by frame, the aim turned and the passer
-            # never kicked); its speed for the receiver as it is now
-            none = np.zeros((0, 2))
-            speed = pass_kick_speed(ball, planned.point, own[planned.receiver], none, none, p, skills)
-            dist = math.hypot(planned.point[0] - ball.x, planned.point[1] - ball.y)
-            return Kick(KickPurpose.PASS, planned.point, pass_speed(dist, skills) if speed is None else speed,
-                        planned.receiver, planned.shoot_at)
+            return _pass_kick(ball, planned.point, planned.receiver, planned.shoot_at, skills)
     receivers = [rid for rid in supporters if (own[rid].x - ball.x) * attack_sign > -p.max_back_pass_m]
     if receivers:
         pts = np.array([[own[rid].x, own[rid].y] for rid in receivers])
         ev = pass_values(ball_xy, pts, pitch, attack_sign, opponents, radius, passing)
-        for k in np.argsort(-ev.values, kind="stable"):
-            if ev.values[k] < p.pass_value:
-                break
+        k = int(np.argmax(ev.values))
+        if ev.values[k] >= p.pass_value:
             point = (float(pts[k, 0]), float(pts[k, 1]))
-            speed = pass_kick_speed(ball, point, own[receivers[k]], opponents, opponent_vel, p, skills,
-                                    *_mates(own, passer, receivers[k]))
-            if speed is None:
-                continue
-            shot_aim, value_there = shot(pts[k], pitch, attack_sign, opponents, radius, p, passing)
+            _, shot_aim, value_there = best_shot(pts[k], pitch, attack_sign, opponents, radius, passing)
             turn = float(one_touch_turn(ball_xy, pts[k : k + 1], np.array([shot_aim]))[0])
             one_touch = value_there >= p.one_touch_value and turn <= passing.max_turn_rad
-            return Kick(KickPurpose.PASS, point, speed, receivers[k], shot_aim if one_touch else None)
+            return _pass_kick(ball, point, receivers[k], shot_aim if one_touch else None, skills)
     # nothing good: play the ball forward through the most open lane (around a blocker)
     toward = math.atan2(aim[1] - ball.y, aim[0] - ball.x)
     angle, _ = clearest_direction(ball_xy, toward, opponents, radius, p.clear_reach_m, p.clear_spread_rad,
@@ -335,16 +239,12 @@ class Attacker:
         self.still.update(t, ball)
 
     def play(self, t: float, robot: RobotState, own: Mapping[int, RobotState], supporters: Sequence[int],
-             opponents: Array, opponent_vel: Array, ball: BallState, attack_sign: float,
+             opponents: Array, ball: BallState, attack_sign: float,
              passes: PassPlay, restart: bool = False) -> tuple[Intent, KickPurpose]:
         """Play the ball where ``robot`` can meet it: shoot, pass (planned in ``passes``) or play it
         forward; ``restart``: our restart's kick, its only touch (:func:`~strategy.skills.set_kick`).
         Returns the intent and what the kick is for."""
         p, skills = self.p, self.skills
-        if not restart and passes.released_by(robot, ball):
-            # its pass just kicked, the ball on its way to the receiver: not decided afresh (from where the passer
-            # meets the ball now, a shot or another pass was, and the receiver left the pass it was to get)
-            return Intent(robot.x, robot.y, math.atan2(ball.y - robot.y, ball.x - robot.x)), KickPurpose.PASS
         met = intercept(robot, ball, skills, self.field)
         lying = t - self.still.since > p.stall_s and self.field.in_defense_area(met.x, met.y, p.area_still_m) == 0
         if self.field.in_defense_area(met.x, met.y, p.area_margin_m) == int(attack_sign) and not lying:
@@ -361,8 +261,7 @@ class Attacker:
             # between passes, clears and contest angles, and the robot backed off to line up anew each time)
             self._plan(t, robot.id, kept.kick, passes)
             return chase(drive_through(met, kept.aim, kept.kick.speed, skills), met), kept.kick.kind
-        intent, kind, kick = self._play(t, robot, own, supporters, opponents, opponent_vel, met, ball, attack_sign,
-                                        passes, restart)
+        intent, kind, kick = self._play(t, robot, own, supporters, opponents, met, ball, attack_sign, passes, restart)
         through = not intent.avoid_ball and intent.kick_speed > 0.0 and slow and not restart
         if not through:
             self.commitment = None
@@ -378,12 +277,12 @@ class Attacker:
             passes.cancel()
 
     def _play(self, t: float, robot: RobotState, own: Mapping[int, RobotState], supporters: Sequence[int],
-              opponents: Array, opponent_vel: Array, met: BallState, ball: BallState, attack_sign: float,
-              passes: PassPlay, restart: bool) -> tuple[Intent, KickPurpose, Kick]:
+              opponents: Array, met: BallState, ball: BallState, attack_sign: float, passes: PassPlay,
+              restart: bool) -> tuple[Intent, KickPurpose, Kick]:
         """The kick decided afresh and how it is played (:meth:`play`)."""
         p, skills = self.p, self.skills
-        kick = decide_kick(met, robot.id, own, supporters, passes, opponents, opponent_vel, self.field, attack_sign,
-                           self.radius, p, self.passing, skills)
+        kick = decide_kick(met, robot.id, own, supporters, passes, opponents, self.field, attack_sign, self.radius, p,
+                           self.passing, skills)
         self._plan(t, robot.id, kick, passes)
         if restart:
             return set_kick(robot, met, kick.target, kick.speed, skills), kick.kind, kick

@@ -84,20 +84,6 @@ class PassPlay:
             return ps
         return None
 
-    def released_by(self, passer: RobotState, ball: BallState) -> bool:
-        """Whether ``passer``'s pass, not counted kicked yet, runs toward its point: the ball faster
-        than ``kicked_speed_m_s`` away from the passer (not pushed along with it) and within
-        ``kicked_cos`` of the point (the tracked speed of a ball just kicked still rises, and
-        :meth:`follow` counts the kick once the ball can reach the point)."""
-        ps = self.current
-        if ps is None or ps.kicked or ps.passer != passer.id:
-            return False
-        vx, vy = ball.vx - passer.vx, ball.vy - passer.vy
-        speed = math.hypot(vx, vy)
-        to_point = (ps.point[0] - ball.x, ps.point[1] - ball.y)
-        along = vx * to_point[0] + vy * to_point[1]
-        return speed > self.p.kicked_speed_m_s and along > self.p.kicked_cos * speed * math.hypot(*to_point)
-
     def follow(self, t: float, own: Mapping[int, RobotState], ball: BallState) -> Pass | None:
         """The pass this frame: kicked once the ball runs toward the point; None once it is over."""
         ps = self.current

@@ -280,7 +280,6 @@ class Strategy:
         p, f = self.p, self.field
         attack_sign = -own_sign
         opp_xy = np.array([[r.x, r.y] for r in opp]) if opp else np.zeros((0, 2))
-        opp_vel = np.array([[r.vx, r.vy] for r in opp]) if opp else np.zeros((0, 2))
         self.attacker.watch(t, ball)
         count = max(0, len(own) - 2 - p.defense.defenders)  # supporters: the robots besides goalie, attacker, defenders
         self.supporters.update(self.frame, np.array([ball.x, ball.y]), attack_sign, opp_xy, count)
@@ -302,8 +301,8 @@ class Strategy:
             elif role == ATTACKER and rid == self._barred:
                 out[rid] = _facing_ball(r.x, r.y, ball)  # nobody else to play it: wait for theirs to touch it
             elif role == ATTACKER:
-                out[rid], kind = self.attacker.play(t, r, own, supporters, opp_xy, opp_vel, ball, attack_sign,
-                                                    self.passes, restart)
+                out[rid], kind = self.attacker.play(t, r, own, supporters, opp_xy, ball, attack_sign, self.passes,
+                                                    restart)
                 self.last_action[rid] = kind
             elif role == RECEIVER and passing is not None and not passing.kicked:
                 out[rid] = _facing_ball(*passing.point, ball)

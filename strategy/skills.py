@@ -14,10 +14,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from cmdragons.config import Validated, derived, setting
-from cmdragons.control.acceleration import Limits
-from cmdragons.geometry import Field, RobotShape, wrap_angle
+from cmdragons.geometry import Field, wrap_angle
 from cmdragons.messages import BallState, RobotState
-from strategy.ballmodel import BallModel, robot_limits
+from strategy.ballmodel import BallModel
 from strategy.onetouch import aim_heading
 
 __all__ = [
@@ -43,9 +42,6 @@ class SkillParams(Validated):
     robot_radius_m: float = derived("field.robot.radius_m", 0.09, lo=0.02, hi=0.5)
     ball_radius_m: float = derived("field.ball.radius_m", 0.0215, lo=0.005, hi=0.2)
     front_distance_m: float = derived("field.robot.front_distance_m", 0.07, lo=0.01, hi=0.5)  # centre to kicker face
-    # the league robot (its driving limits and latency: ours and, the league's robots alike, the opponents'),
-    # configured once, in field.yaml robot
-    robot: RobotShape = derived("field.robot", RobotShape())
     approach_distance_m: float = setting(0.12, lo=0.0, hi=1.0)  # wait this far behind the ball, lined up
     lined_up_rad: float = setting(0.08, lo=0.001, hi=1.0)  # heading error allowed before driving through
     lined_up_m: float = setting(0.03, lo=0.001, hi=0.5)  # lateral error allowed before driving through
@@ -100,11 +96,6 @@ class SkillParams(Validated):
     def ball_model(self) -> BallModel:
         """The ball's two-phase model every prediction of a kicked ball's run reads."""
         return BallModel(self.acc_slide_m_s2, self.acc_roll_m_s2, self.slide_to_roll_fraction)
-
-    @property
-    def limits(self) -> Limits:
-        """The league robot's driving limits, as motion control names them."""
-        return robot_limits(self.robot)
 
     @property
     def contact_m(self) -> float:

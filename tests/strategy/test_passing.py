@@ -102,27 +102,3 @@ def test_a_kicked_pass_that_slows_short_of_the_point_is_over() -> None:
     # later, at 0.7 m/s 1.4 m from the point it rolls 0.94 m more: short of it, the attacker takes over
     assert play.follow(1.0, _own(), BallState(0.6, 0.0, 0.7, 0.0)) is None
     assert play.current is None
-
-
-@pytest.mark.parametrize(("passer", "vx", "vy", "released"), [
-    (1, 0.9, 0.0, True),  # its pass, the ball just kicked toward the point (tracked slower than it runs)
-    (1, 0.4, 0.0, False),  # too slow to be a pass
-    (1, 0.9, 0.9, False),  # not toward the point
-    (2, 0.9, 0.0, False),  # not its pass
-])
-def test_a_pass_is_released_by_its_passer_once_the_ball_runs_toward_the_point(passer: int, vx: float, vy: float,
-                                                                             released: bool) -> None:
-    play = PassPlay(P, MODEL)
-    play.plan(0.0, passer=1, receiver=2, point=POINT, shoot_at=None)
-    ball = BallState(0.1, 0.0, vx, vy)
-    ps = play.follow(0.05, _own(), ball)
-    assert ps is not None and not ps.kicked  # rolling 1.6 m at most, it is not counted kicked yet ...
-    assert play.released_by(_own()[1] if passer == 1 else _own()[2], ball) is released  # ... its passer let it go
-
-
-def test_a_ball_pushed_along_by_its_passer_is_not_released() -> None:
-    play = PassPlay(P, MODEL)
-    play.plan(0.0, passer=1, receiver=2, point=POINT, shoot_at=None)
-    pushing = RobotState("blue", 1, 0.0, 0.0, 0.0, vx=0.8)
-    assert not play.released_by(pushing, BallState(0.1, 0.0, 0.8, 0.0))  # driving through it toward the point
-    assert play.released_by(pushing, BallState(0.2, 0.0, 2.0, 0.0))  # kicked: it runs away from the passer

@@ -110,6 +110,8 @@ def _match_row(settings: Settings, seed: int, seconds: float, opponent: str) -> 
         "shots": s["shots"],
         "passes_tried": s["passes"]["tried"],
         "passes_completed": s["passes"]["completed"],
+        "pass_ends": _kinds_text(s["passes"]["ends"]),
+        "_pass_ends": dict(s["passes"]["ends"]),
         "own_collisions": s["collisions"]["own"],
         "own_collisions_pushed": s["collisions"]["own_pushed"],
         "fouls_ours": ours["total"],
@@ -242,6 +244,7 @@ def _total(rows: list[dict[str, Any]], seconds: float, opponent: str) -> dict[st
         "goals_for": sum(r["goals_for"] for r in rows), "goals_against": sum(r["goals_against"] for r in rows),
         "passes_tried": tried, "passes_completed": sum(r["passes_completed"] for r in rows),
         "pass_completion": sum(r["passes_completed"] for r in rows) / tried if tried else float("nan"),
+        "pass_ends": _kinds_text(_sum_kinds([r.pop("_pass_ends") for r in rows])),
         "shots": sum(r["shots"] for r in rows),
         "own_collisions": sum(r["own_collisions"] for r in rows),
         "own_collisions_pushed": sum(r["own_collisions_pushed"] for r in rows),
@@ -290,6 +293,7 @@ def run(settings: Settings, quick: bool, opponent: str | None = None, matches: i
               flush=True)
         other = _other_world_row(rules, seeds[0], seconds, "simple", GRSIM_BALL_ROLL_M_S2, GRSIM_ROBOT_BRAKE_M_S2)
         other.pop("_kinds")
+        other.pop("_pass_ends")
         rows.append(other)
     if "simple" not in opponents:
         return rows

@@ -43,8 +43,8 @@ from sim.referee import Referee
 from sim.referee_params import AutorefParams, RefereeParams
 from sim.restarts import ball_out_taker, defender_of, other
 
-__all__ = ["AutoRef", "BallCrossing", "KickDetector", "OwnContacts", "deflection_path", "hull_gap", "hull_normal",
-           "observed", "path_gap", "path_nearest", "point_along"]
+__all__ = ["AutoRef", "BallCrossing", "KickDetector", "OwnContacts", "deflection_path", "hull_gap", "observed",
+           "path_gap"]
 
 Key = tuple[Team, int]
 
@@ -98,13 +98,11 @@ def hull_gap(shape: RobotShape, robot: tuple[float, float, float], x: float, y: 
 _SEARCH_STEPS = 40  # the ternary search along a segment: (2/3)^40 of its length, far below a millimetre
 
 
-def path_nearest(shape: RobotShape, robot: tuple[float, float, float],
-                 path: Sequence[tuple[float, float]]) -> tuple[float, float]:
-    """The least :func:`hull_gap` of the points of ``path`` (a polyline, field frame, m), and how far
-    along the path (m from its start) it is: how near the ball's centre passed the robot's body
-    (negative where it went through it) and when on its way. Exact up to :data:`_SEARCH_STEPS`: the
-    gap to a convex body is convex along a segment."""
-    best, along, done = math.inf, 0.0, 0.0
+def path_gap(shape: RobotShape, robot: tuple[float, float, float], path: Sequence[tuple[float, float]]) -> float:
+    """The least :func:`hull_gap` of the points of ``path`` (a polyline, field frame, m): how near the
+    ball's centre passed the robot's body, negative where it went through it. Exact up to
+    :data:`_SEARCH_STEPS`: the gap to a convex body is convex along a segment."""
+    best = math.inf
     for (ax, ay), (bx, by) in zip(path, path[1:], strict=False):
         def gap(u: float, ax: float = ax, ay: float = ay, bx: float = bx, by: float = by) -> float:
             return hull_gap(shape, robot, ax + u * (bx - ax), ay + u * (by - ay))
@@ -116,53 +114,10 @@ def path_nearest(shape: RobotShape, robot: tuple[float, float, float],
                 hi = m2
             else:
                 lo = m1
-        length = math.hypot(bx - ax, by - ay)
-        for u in (0.0, 1.0, 0.5 * (lo + hi)):
-            g = gap(u)
-            if g < best:
-                best, along = g, done + u * length
-        done += length
+        best = min(best, gap(0.0), gap(1.0), gap(0.5 * (lo + hi)))
     if len(path) == 1:
         best = hull_gap(shape, robot, *path[0])
-    return best, along
-
-
-def point_along(path: Sequence[tuple[float, float]], along: float) -> tuple[float, float]:
-    """The point ``along`` m from the start of ``path`` (a polyline, field frame, m); its end beyond."""
-    done = 0.0
-    for (ax, ay), (bx, by) in zip(path, path[1:], strict=False):
-        length = math.hypot(bx - ax, by - ay)
-        if along <= done + length and length > 0.0:
-            u = (along - done) / length
-            return ax + u * (bx - ax), ay + u * (by - ay)
-        done += length
-    return path[-1]
-
-
-def hull_normal(shape: RobotShape, robot: tuple[float, float, float], x: float, y: float) -> tuple[float, float]:
-    """The outward normal (a unit vector, field frame) of the body of a robot at ``robot`` (x, y,
-    heading) where it is nearest the point (``x``, ``y``): the way a contact there pushes a ball (the
-    normal of the side :func:`hull_gap` measures to; for a point inside, of the side it is least deep
-    behind)."""
-    rx, ry, theta = robot
-    c, s = math.cos(theta), math.sin(theta)
-    px, py = c * (x - rx) + s * (y - ry), -s * (x - rx) + c * (y - ry)
-    r, f, w = shape.radius_m, shape.front_distance_m, shape.mouth_half_width_m
-    d = math.hypot(px, py)
-    if d <= r and px <= f:
-        nx, ny = (px / d, py / d) if d > 0.0 and r - d < f - px else (1.0, 0.0)
-    elif d > r and px * r <= f * d:
-        nx, ny = px / d, py / d
-    else:
-        ex, ey = px - f, py - min(max(py, -w), w)
-        e = math.hypot(ex, ey)
-        nx, ny = (ex / e, ey / e) if e > 1e-9 else (1.0, 0.0)
-    return c * nx - s * ny, s * nx + c * ny
-
-
-def path_gap(shape: RobotShape, robot: tuple[float, float, float], path: Sequence[tuple[float, float]]) -> float:
-    """The least :func:`hull_gap` of the points of ``path`` (:func:`path_nearest`'s gap)."""
-    return path_nearest(shape, robot, path)[0]
+    return best
 
 
 def deflection_path(p0: tuple[float, float], v0: tuple[float, float], p1: tuple[float, float],
@@ -189,19 +144,15 @@ _PARALLEL = math.sin(math.radians(5.0))  # lines closer to parallel than this me
 class KickDetector:
     """Touches of the ball from its track: its velocity changes by more than
     ``kick_speed_change_m_s`` between two frames (a kick, a push, a bounce off a robot). The toucher
-    is a robot the ball's path went near, from the earliest frame of the last ``kick_memory_s`` that
-    moved as the frame before the change did (a turn the track shows late) to now, through the
-    deflection point where its old and new lines meet (:func:`deflection_path`): its body
-    (:func:`hull_gap`, a disc cut flat at the front, where each robot stood in either frame) within
-    ``kick_reach_m`` of the ball. Of several that near, the last toucher: a contact pushes the ball
-    along the normal of the body where they meet, so the ball's change of velocity points away from
-    the side of the robot that touched it last (:func:`hull_normal`, where the path passed nearest);
-    the robot whose normal agrees best with the change is taken (a kick into another robot that
-    turns the ball away is that robot's touch, not the kicker's, whose face lies across the new
-    path). When no robot is that near (a kick the track shows a few frames late, the ball gone), the
-    robot last at the ball: the nearest within ``kick_reach_m`` in the newest frame of the last
-    ``kick_memory_s`` that had one. A ball that jumps farther than it could roll (put somewhere, or
-    another ball taken for it) starts the watch afresh."""
+    is the robot the ball's path went nearest, from the earliest frame of the last ``kick_memory_s``
+    that moved as the frame before the change did (a turn the track shows late) to now, through the
+    deflection point where its old and new lines meet (:func:`deflection_path`): its body (:func:`hull_gap`, a disc
+    cut flat at the front, where each robot stood in either frame) within ``kick_reach_m`` of the
+    ball; where robots of both teams are that near, the one whose body the path went deepest into or
+    passed nearest. When no robot is that near (a kick the track shows a few frames late, the ball
+    gone), the robot last at the ball: the nearest within ``kick_reach_m`` in the newest frame of the
+    last ``kick_memory_s`` that had one. A ball that jumps farther than it could roll (put somewhere,
+    or another ball taken for it) starts the watch afresh."""
 
     def __init__(self, pitch: Field, params: AutorefParams, max_ball_speed_m_s: float = 10.0) -> None:
         self.p = params
@@ -250,16 +201,10 @@ class KickDetector:
                 break
             ta, xa, ya = tk, xk, yk
         path = deflection_path((xa, ya), (vx0, vy0), (b.x, b.y), (b.vx, b.vy), t - ta + self.p.kick_memory_s)
-        dvx, dvy = b.vx - vx0, b.vy - vy0
-        dv = math.hypot(dvx, dvy)
-        pushes = []  # per robot the path reached: how well its push explains the change, its depth
-        for k, now in poses.items():
-            gap, along, pose = min((*path_nearest(self.shape, pose, path), pose) for pose in (before.get(k, now), now))
-            if gap - self.ball_r <= self.p.kick_reach_m:
-                nx, ny = hull_normal(self.shape, pose, *point_along(path, along))
-                pushes.append(((nx * dvx + ny * dvy) / dv, -gap, k))
-        if pushes:
-            key = max(pushes)[2]
+        near = sorted((min(path_gap(self.shape, pose, path) for pose in (before.get(k, now), now)) - self.ball_r, k)
+                      for k, now in poses.items())
+        if near and near[0][0] <= self.p.kick_reach_m:
+            key = near[0][1]
             return Kick(t, key[0], key[1], math.hypot(b.vx, b.vy), False)
         for _, g in reversed(self._recent):  # the last robot at the ball (the nearest of that frame)
             at = sorted((gap, k) for k, gap in g.items() if gap <= self.p.kick_reach_m)

@@ -382,33 +382,6 @@ def exact(w: World) -> WorldState:
                       gt.frame_number)
 
 
-@pytest.mark.parametrize(("gap", "face_deg", "dribbler", "last"), [
-    (0.0, -45.0, 0.0, "blue"), (0.01, -35.0, 1.0, "blue"), (0.03, -25.0, 0.0, "blue"),
-    (0.06, -45.0, 1.0, "blue"), (0.01, -15.0, 0.0, "yellow"), (0.03, -15.0, 1.0, "yellow")])
-def test_a_kick_into_another_robot_is_the_touch_of_the_one_the_ball_left_last(gap: float, face_deg: float,
-                                                                              dribbler: float, last: str) -> None:
-    """Yellow 0 kicks the ball at 5 m/s along -x into blue 0's front face, ``gap`` (m) away and turned
-    ``face_deg`` from +x (blue dribbling or not): within a frame the ball leaves off blue's face (or,
-    hit at a slant, off yellow's again) and rolls out over the bottom touch line (the second miss of
-    the autoref bench). The autoref's free kick is the one the simulator's last contact gives."""
-    w, ref, auto = scene()
-    ball = (2.5, -2.0)
-    w.place_ball(*ball)
-    w.place_robot("yellow", 0, ball[0] + FRONT, ball[1], math.pi)
-    a = math.radians(face_deg)
-    w.place_robot("blue", 0, ball[0] - gap - FRONT * math.cos(a), ball[1] - FRONT * math.sin(a), a)
-
-    def commands(k: int) -> list[RobotCommand]:
-        return [RobotCommand("yellow", 0, kick_speed=5.0 if k >= 10 else 0.0), RobotCommand("blue", 0,
-                                                                                            dribbler=dribbler)]
-
-    truth, mine = play(w, ref, auto, Seen(), 1.5, commands)
-    out = next(e for e in w.events if isinstance(e, BallOut))
-    assert out.last_touch == last  # the scene is what it says
-    given, autoref = _out_given_to(w, ref, mine)
-    assert autoref == given
-
-
 @pytest.mark.parametrize("start_x", [0.57, 0.58, 0.585])
 def test_a_robot_closing_on_a_ball_that_rolls_out_before_it_reaches_it_is_no_touch(start_x: float) -> None:
     """Yellow 0 kicks the ball at 1.2 m/s down over the bottom touch line; blue 0, its flat front

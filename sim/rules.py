@@ -93,10 +93,6 @@ class TrackMargins(Validated):
     # robot missed the graze that turned the ball (none on the truth: near is touching)
     touch_pass_speed_m_s: float = setting(math.inf, lo=0.0)
     touch_pass_depth_m: float = setting(0.0, lo=0.0, hi=0.1)
-    # a touch begins where the ball comes within the touch margin of the robot's body, the disc cut flat at
-    # the front (its front face lies 0.02 m inside the disc: a ball that near a robot's face on tracks has
-    # not met it), not of its round disc (False, on the truth: near the disc is touching)
-    touch_body: bool = False
 
 
 @dataclass(frozen=True)
@@ -191,14 +187,18 @@ class FoulWatch:
 
     # --- ball touches -------------------------------------------------------------------------
     def _touches(self, gt: GroundTruth, robots: list[RobotTruth]) -> list[Key]:
-        """Which robots touch the ball now (its centre within their radius plus the ball's and a
-        margin, the ball on the ground); returns those that started touching it this frame."""
+        """Which robots touch the ball now (the ball on the ground): a touch begins with the ball
+        within the touch margin of the robot's body (:meth:`_near`; the simulator's contact is at the
+        body, not at its round disc, whose reach passes 0.02 m in front of the face) and lasts while
+        its centre is within the robot's radius plus the ball's, the margin and the release (a
+        track's jitter at the face is no new touch); returns those that started touching it this
+        frame."""
         b = gt.ball
         reach = self.robot_r + self.ball_r + self.p.touch_margin_m
         release = self.margins.touch_release_m
         now = {(r.team, r.id) for r in robots if b.z < 2.0 * self.ball_r + 0.05
-               and self._near(r, b) < reach + (release if (r.team, r.id) in self.touching else 0.0)
-               and ((r.team, r.id) in self.touching or not self._passing(r, b))}
+               and (math.hypot(r.x - b.x, r.y - b.y) < reach + release if (r.team, r.id) in self.touching
+                    else self._near(r, b) < reach and not self._passing(r, b))}
         new = [k for k in sorted(now) if k not in self.touching]
         for k in list(self.touching):
             if k not in now:
@@ -214,10 +214,9 @@ class FoulWatch:
         return new + [k for k in kicked if k not in new and k in on]
 
     def _near(self, r: RobotTruth, b: BallTruth) -> float:
-        """How near the ball's centre is to ``r``, as a distance from its centre (m): that distance, or
-        with ``touch_body`` (:class:`TrackMargins`) the gap to its body plus its radius."""
-        if not self.margins.touch_body:
-            return math.hypot(r.x - b.x, r.y - b.y)
+        """How near the ball's centre is to the body of ``r``, the disc cut flat at the front, as a
+        distance from its centre (m): the gap to the body plus its radius (its front face lies 0.02 m
+        inside the disc: a ball that near the face, in front of it, has not met it)."""
         c, s = math.cos(r.theta), math.sin(r.theta)
         dx, dy = b.x - r.x, b.y - r.y
         return self.field.league.robot.gap(c * dx + s * dy, -s * dx + c * dy) + self.robot_r

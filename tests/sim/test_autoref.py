@@ -386,15 +386,18 @@ def exact(w: World) -> WorldState:
 def test_a_robot_closing_on_a_ball_that_rolls_out_before_it_reaches_it_is_no_touch(start_x: float) -> None:
     """Yellow 0 kicks the ball at 1.2 m/s down over the bottom touch line; blue 0, its flat front
     toward the ball's path, drives at it at 0.4 m/s and comes nearer than a robot's radius, the
-    ball's and the touch margin (the disc's reach: the first miss of the autoref bench), its face
-    never within the touch margin of the ball, and the simulator has no contact before the ball is
-    out: the free kick is blue's (yellow touched last)."""
+    ball's and the touch margin (the disc's reach), its face never within the touch margin of the
+    ball, and the simulator has no contact before the ball is
+    out: the free kick is blue's (yellow touched last), and the truth referee too keeps yellow's touch
+    (the second miss of the autoref bench; a near pass its disc took for blue's touch cost it seed
+    9's double touch)."""
     w, ref, auto = scene()
     w.place_ball(1.0, -2.4)
     w.place_robot("yellow", 0, 1.0, -2.4 + FRONT, -math.pi / 2)
     w.place_robot("blue", 0, start_x, -w.field.half_width, 0.0)
     margin = RulesParams().touch_margin_m
     nearest, body = [math.inf], [math.inf]
+    last: list[tuple[str, int] | None] = []
 
     def commands(k: int) -> list[RobotCommand]:
         gt = w.ground_truth()
@@ -402,6 +405,7 @@ def test_a_robot_closing_on_a_ball_that_rolls_out_before_it_reaches_it_is_no_tou
         if abs(gt.ball.y) < w.field.half_width + R_BALL:
             nearest[0] = min(nearest[0], math.hypot(blue.x - gt.ball.x, blue.y - gt.ball.y))
             body[0] = min(body[0], hull_gap(LEAGUE.robot, (blue.x, blue.y, blue.theta), gt.ball.x, gt.ball.y) - R_BALL)
+            last[:] = [ref.watch.last_touch, auto.referee.watch.last_touch]  # until the ball is out: the last toucher
         return [RobotCommand("yellow", 0, kick_speed=1.2 if 20 <= k < 23 else 0.0),
                 RobotCommand("blue", 0, vx=0.4 if k > 20 else 0.0)]
 
@@ -410,3 +414,4 @@ def test_a_robot_closing_on_a_ball_that_rolls_out_before_it_reaches_it_is_no_tou
     assert out.last_touch == "yellow"  # the scene is what it says: near the disc, not the body, no contact
     assert nearest[0] < LEAGUE.robot.radius_m + R_BALL + margin and body[0] > margin
     assert _out_given_to(w, ref, mine) == ("blue", "blue")
+    assert last == [("yellow", 0), ("yellow", 0)]

@@ -187,14 +187,18 @@ class FoulWatch:
 
     # --- ball touches -------------------------------------------------------------------------
     def _touches(self, gt: GroundTruth, robots: list[RobotTruth]) -> list[Key]:
-        """Which robots touch the ball now (its centre within their radius plus the ball's and a
-        margin, the ball on the ground); returns those that started touching it this frame."""
+        """Which robots touch the ball now (the ball on the ground): a touch begins with the ball
+        within the touch margin of the robot's body (:meth:`_near`; the simulator's contact is at the
+        body, not at its round disc, whose reach passes 0.02 m in front of the face) and lasts while
+        its centre is within the robot's radius plus the ball's, the margin and the release (a
+        track's jitter at the face is no new touch); returns those that started touching it this
+        frame."""
         b = gt.ball
         reach = self.robot_r + self.ball_r + self.p.touch_margin_m
         release = self.margins.touch_release_m
         now = {(r.team, r.id) for r in robots if b.z < 2.0 * self.ball_r + 0.05
-               and math.hypot(r.x - b.x, r.y - b.y) < reach + (release if (r.team, r.id) in self.touching else 0.0)
-               and ((r.team, r.id) in self.touching or not self._passing(r, b))}
+               and (math.hypot(r.x - b.x, r.y - b.y) < reach + release if (r.team, r.id) in self.touching
+                    else self._near(r, b) < reach and not self._passing(r, b))}
         new = [k for k in sorted(now) if k not in self.touching]
         for k in list(self.touching):
             if k not in now:
@@ -208,6 +212,14 @@ class FoulWatch:
         on = {(r.team, r.id) for r in robots}
         kicked, self._kicked = self._kicked, []
         return new + [k for k in kicked if k not in new and k in on]
+
+    def _near(self, r: RobotTruth, b: BallTruth) -> float:
+        """How near the ball's centre is to the body of ``r``, the disc cut flat at the front, as a
+        distance from its centre (m): the gap to the body plus its radius (its front face lies 0.02 m
+        inside the disc: a ball that near the face, in front of it, has not met it)."""
+        c, s = math.cos(r.theta), math.sin(r.theta)
+        dx, dy = b.x - r.x, b.y - r.y
+        return self.field.league.robot.gap(c * dx + s * dy, -s * dx + c * dy) + self.robot_r
 
     def _passing(self, r: RobotTruth, b: BallTruth) -> bool:
         """Is the ball near ``r`` only passing it by (:class:`TrackMargins`: faster than

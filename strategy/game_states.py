@@ -31,6 +31,8 @@ __all__ = [
     "keep_away",
     "keep_off_line",
     "keeper_on_line",
+    "leave_field",
+    "leaver",
     "our_kickoff",
     "own_goal_sign",
     "penalty_rush",
@@ -87,6 +89,29 @@ class GameStateParams(Validated):
     penalty_rush_away_m_s: float = setting(0.3, lo=0.0, hi=5.0)  # ... unless it moves away from our goal this fast
     penalty_keeper_share: float = setting(0.6, lo=0.0, hi=1.0)  # our keeper's centre this share of its radius
     # inside the goal line while the penalty is prepared (the rules: touching the line)
+    leave_after_s: float = setting(2.0, lo=0.0, hi=60.0)  # more robots on the field than the referee allows this
+    # long (the referee's robot handlers take a robot sent off out at once): one drives out ...
+    leave_out_m: float = setting(0.1, lo=0.0, hi=1.0)  # ... to the touch line at the halfway line, its centre this
+    # far outside the line (the rules: a substitution at most 1 m from the halfway line, partly in the field margin)
+
+
+def leaver(own: Mapping[int, RobotState], keeper: int, pitch: Field) -> int | None:
+    """Of ``own`` robots but the ``keeper``, the one that leaves the field when the team has too many:
+    the nearest to either crossing of the halfway line and the touch lines (where the rules have a
+    robot substituted, and the robot the league's simulation controller takes out first)."""
+    w = pitch.half_width
+    players = [rid for rid in own if rid != keeper] or list(own)
+    if not players:
+        return None
+    return min(players, key=lambda rid: (min(math.hypot(own[rid].x, own[rid].y - w),
+                                             math.hypot(own[rid].x, own[rid].y + w)), rid))
+
+
+def leave_field(robot: RobotState, pitch: Field, p: GameStateParams) -> Intent:
+    """Drive out at the halfway line: onto the nearer touch line, the centre ``leave_out_m`` outside it,
+    facing out (the robot handlers or the simulation controller take it from there)."""
+    side = 1.0 if robot.y >= 0.0 else -1.0
+    return Intent(0.0, side * (pitch.half_width + p.leave_out_m), side * math.pi / 2)
 
 
 def own_goal_sign(team: Team, game: GameState) -> float:

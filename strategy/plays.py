@@ -11,6 +11,7 @@ module puts them together frame by frame.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -32,6 +33,8 @@ from strategy.game_states import (
     keep_away,
     keep_off_line,
     keeper_on_line,
+    leave_field,
+    leaver,
     own_goal_sign,
     penalty_rush,
     penalty_shot,
@@ -127,6 +130,8 @@ class Strategy:
         self._placing: Placing | None = None  # our ball placement, frame to frame
         self._taker: int | None = None  # the kicker of our kickoff or free kick under way
         self._barred: int | None = None  # our restart's taker, until another robot touched the ball
+        self._too_many_since: float | None = None  # since when more of ours are on the field than allowed
+        self._leaver: int | None = None  # the robot of ours driving out
 
     def retune(self, params: StrategyParams) -> None:
         """Decide with ``params`` from now on (the ball model as measured in play: pass speeds, kicks,
@@ -164,8 +169,39 @@ class Strategy:
         return self.supporters.evaluation is not None and self.supporters.evaluated_frame == self.frame
 
     def decide(self, world: WorldState, game: GameState) -> dict[int, Intent]:
-        """An intent for each of our robots in ``world``."""
+        """An intent for each of our robots in ``world``; with more on the field than the referee
+        allows for ``leave_after_s``, one of them drives out (:func:`leaver`, :func:`leave_field`)
+        and the others play."""
         self.frame += 1
+        out = self._leaving(world, game)
+        if out is None or game.command.halted:
+            return self._decide(world, game)
+        rest = dataclasses.replace(world, robots=tuple(r for r in world.robots
+                                                       if (r.team, r.id) != (self.team, out)))
+        intents = self._decide(rest, game)
+        intents[out] = leave_field(next(r for r in world.robots if (r.team, r.id) == (self.team, out)), self.field,
+                                   self.p.game_states)
+        return intents
+
+    def _leaving(self, world: WorldState, game: GameState) -> int | None:
+        """The robot of ours that drives out now, if any: while more of ours are seen on the field
+        (its margin included) than ``game`` allows, from ``leave_after_s`` on, the same one until
+        it is off."""
+        margin = self.field.dims.boundary_width_m
+        on = {r.id: r for r in world.robots
+              if r.team == self.team and r.visible and self.field.in_field(r.x, r.y, -margin)}
+        if len(on) <= game.team_info(self.team).max_robots:
+            self._too_many_since, self._leaver = None, None
+            return None
+        if self._too_many_since is None:
+            self._too_many_since = world.t
+        if world.t - self._too_many_since < self.p.game_states.leave_after_s:
+            return None
+        if self._leaver not in on:
+            self._leaver = leaver(on, game.team_info(self.team).goalkeeper, self.field)
+        return self._leaver
+
+    def _decide(self, world: WorldState, game: GameState) -> dict[int, Intent]:
         own = {r.id: r for r in world.robots if r.team == self.team}
         opp = [r for r in world.robots if r.team != self.team]
         if not own:

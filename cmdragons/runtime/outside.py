@@ -46,12 +46,14 @@ from cmdragons.runtime.ssl.stages import (
     CommandsOutStage,
     RefereeInStage,
     RefereeOutStage,
+    RobotCountStage,
     TrackerOutStage,
     VisionInStage,
     close_sockets,
 )
 from cmdragons.runtime.ssl.vision import VisionGeometry, decode_wrapper, field_dims_of
 from cmdragons.runtime.stages import SummaryCollector, Tap, TeamStage, TimingStage, TrackerStage
+from sim.substitution import RobotCount
 
 __all__ = ["FrameGate", "Heard", "OutsideError", "OutsideMatch", "SimulatorKind", "beyond_division", "field_settings",
            "listen", "outside_summary", "outside_wiring", "take_off", "vision_params"]
@@ -260,6 +262,7 @@ def outside_wiring(settings: Settings, kind: SimulatorKind, teams: Sequence[Team
     referee, referee_topic, teleports = _referee(settings, p, teams[0], topics, robots)
     entries += referee
     chip = settings.sim.kicker.chip_angle_rad
+    pitch = settings.field_geometry()
     for k, team in enumerate(teams):
         sends = teleports and k == 0  # one team's stage sends the referee's teleports
         entries += [
@@ -267,8 +270,12 @@ def outside_wiring(settings: Settings, kind: SimulatorKind, teams: Sequence[Team
             Entry(TeamStage.declare(team, referee_topic), "",
                   functools.partial(_team, team, settings, referee_topic)),
             Entry(CommandsOutStage.declare(p, team, chip, teleports=sends), "",
-                  functools.partial(CommandsOutStage, p, team, chip, teleports=sends)),
+                  functools.partial(CommandsOutStage, p, team, chip, teleports=sends, pitch=pitch)),
         ]  # fmt: skip
+    if p.simulation.robot_count.keep:  # the league's simulation controller's part: robots over the count out
+        world = f"world/{teams[0]}"
+        entries.append(Entry(RobotCountStage.declare(world, referee_topic), "", functools.partial(
+            RobotCountStage, p, RobotCount(pitch, p.simulation.robot_count), world, referee_topic)))
         if p.tracker.send and k == 0:
             entries.append(Entry(TrackerOutStage.declare(p, team), "", functools.partial(TrackerOutStage, p, team)))
     entries.append(Entry(TimingStage.contract, "", TimingStage))

@@ -6,6 +6,7 @@ camera of the division is served with the division's geometry, and every socket 
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import socket
 from collections.abc import Iterator
@@ -21,12 +22,20 @@ from cmdragons.runtime.proto import ssl_simulation_control_pb2 as ctl_pb
 from cmdragons.runtime.proto import ssl_simulator_pb2 as sim_pb
 from cmdragons.runtime.proto import ssl_tracked_pb2 as trk_pb
 from cmdragons.runtime.settings import Settings, load_settings
-from cmdragons.runtime.ssl.stages import RefereeOutStage, SimulationInStage, VisionOutStage, close_sockets
+from cmdragons.runtime.ssl.stages import (
+    CommandsOutStage,
+    RefereeOutStage,
+    RobotCountStage,
+    SimulationInStage,
+    VisionOutStage,
+    close_sockets,
+)
 from cmdragons.runtime.ssl.udp import MulticastReceiver, UdpEndpoint
 from cmdragons.runtime.ssl.vision import VisionGeometry, decode_wrapper
 from cmdragons.runtime.stages import Tap
 from cmdragons.runtime.topics import topic_matches
 from sim.simulator import Simulator
+from sim.substitution import RobotCount, RobotCountParams
 from tests.runtime.conftest import free_udp_ports
 
 MM = 1e-3  # the wire's millimetres: positions within a millimetre of the truth without noise
@@ -276,3 +285,70 @@ def test_the_served_sockets_stay_on_this_machine() -> None:
     # where grSim and the ER-Force simulator speak: vision on 10020, commands and teleports on 10301/10302/10300
     assert (p.simulation.vision_port, p.simulation.control_port, p.simulation.blue_port,
             p.simulation.yellow_port, p.referee.port) == (10020, 10300, 10301, 10302, 10003)
+
+
+def _seen_robots(srv: Served) -> dict[tuple[str, int], tuple[float, float]]:
+    frames, _ = srv.seen()
+    return {(r.team, r.id): (r.x, r.y) for f in frames.values() for r in f.robots}
+
+
+def test_the_robot_count_takes_a_robot_too_many_out_of_the_served_simulator_and_puts_it_back() -> None:
+    """Our side of the league's simulation controller against our served simulator, over its control
+    port: with five of blue's six allowed, the one nearest the halfway line at a touch line leaves the
+    served field (present: false: no camera sees it); allowed six again, it comes back by blue's touch
+    line near the halfway line, where the served cameras see it."""
+    s = _settings()
+    sim = s.protocols.simulation
+    pitch = s.field_geometry()
+    with served(s) as srv:
+        srv.tick(3)
+        srv.send(_teleport((3.0, 0.0), ((BLUE, 3, 0.4, -2.7, 0.0),)), sim.control_port)  # the ball 2 m and more
+        srv.tick(3)  # from the halfway line (a substitution may be made), blue 3 nearest a crossing with a touch line
+        stage = RobotCountStage(s.protocols, RobotCount(pitch, RobotCountParams(settle_s=0.0)), "world/blue",
+                                "referee")
+        try:
+            def judge(allowed: int) -> None:
+                truth = srv.truth[-1]
+                world = msg.WorldState(truth.t, msg.BallState(truth.ball.x, truth.ball.y, 0.0, 0.0), tuple(
+                    msg.RobotState(r.team, r.id, r.x, r.y, r.theta) for r in truth.robots
+                    if pitch.in_field(r.x, r.y, -pitch.dims.boundary_width_m)))
+                info = dataclasses.replace(msg.TeamInfo(), max_robots=allowed)
+                stage.on_message("referee", msg.GameState(truth.t, blue_team=info), lambda *_: None)
+                stage.on_message("world/blue", world, lambda *_: None)
+                srv.tick(3)
+
+            assert ("blue", 3) in _seen_robots(srv)
+            judge(5)
+            seen = _seen_robots(srv)
+            assert ("blue", 3) not in seen
+            assert sorted(rid for team, rid in seen if team == "blue") == [0, 1, 2, 4, 5]
+            judge(6)
+            seen = _seen_robots(srv)
+            x, y = seen[("blue", 3)]
+            r = pitch.league.robot.radius_m
+            assert 0.0 < -x <= 1.0 and y == pytest.approx(-(pitch.half_width - 2 * r), abs=MM)
+            assert stage.count.taken_off == 1 and stage.count.put_back == 1
+        finally:
+            stage.close()
+
+
+def test_a_robot_our_referee_parks_beyond_the_field_leaves_the_served_simulator() -> None:
+    """Our referee's teleport of a robot it sends off, to its spot beyond the field's margin, goes out
+    as ``present: false`` (as the league's simulation controller takes a robot out) and one back on
+    the field as ``present: true``: the served cameras lose it and see it again."""
+    s = _settings()
+    pitch = s.field_geometry()
+    with served(s) as srv:
+        srv.tick(3)
+        stage = CommandsOutStage(dataclasses.replace(s.protocols, commands_to="simulation"),
+                                 "blue", 0.0, pitch=pitch)
+        try:
+            parked = (-pitch.half_length, -(pitch.boundary_half_width + 3.0))
+            stage.on_message("teleport", msg.Teleport(0.0, (("blue", 2, *parked, 0.0),)), lambda *_: None)
+            srv.tick(3)
+            assert ("blue", 2) not in _seen_robots(srv)
+            stage.on_message("teleport", msg.Teleport(0.0, (("blue", 2, 0.5, 2.5, 0.0),)), lambda *_: None)
+            srv.tick(3)
+            assert _seen_robots(srv)[("blue", 2)] == pytest.approx((0.5, 2.5), abs=MM)
+        finally:
+            stage.close()

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 
 import numpy as np
 import pytest
@@ -14,6 +15,7 @@ import pytest
 from cmdragons.geometry import LeagueParams
 from cmdragons.messages import (
     BallDetection,
+    BallOut,
     BallState,
     DetectionFrame,
     GameEvent,
@@ -24,9 +26,11 @@ from cmdragons.messages import (
     WorldState,
 )
 from cmdragons.tracking import Tracker, TrackerParams
-from sim.autoref import AutoRef, BallCrossing, KickDetector, OwnContacts
+from sim.autoref import AutoRef, BallCrossing, KickDetector, OwnContacts, hull_gap
 from sim.referee import Referee
 from sim.referee_params import AutorefParams, RefereeParams
+from sim.restarts import ball_out_taker
+from sim.rules import RulesParams
 from sim.world import BallParams, DribblerParams, KickerParams, PhysicsParams, RobotParams, World
 from tests.sim.test_rules import Commands, drive
 
@@ -70,7 +74,7 @@ class Seen:
         return dataclasses.replace(world, frame_number=self.n)
 
 
-def play(w: World, ref: Referee | None, auto: AutoRef, seen: Seen, seconds: float,
+def play(w: World, ref: Referee | None, auto: AutoRef, seen: Callable[[World], WorldState], seconds: float,
          commands: Commands | None = None) -> tuple[list[GameEvent], list[GameEvent]]:
     """Both referees judge every frame (the truth referee drives: the world carries out its
     teleports; without it the autoref's); their calls."""
@@ -358,3 +362,56 @@ def test_own_collisions_are_counted_from_tracks_once_per_meeting(a: RobotState, 
     for w in _robots_meet(a, b):
         own.see(w)
     assert own.counts() == {"blue": collisions.get("blue", 0), "yellow": collisions.get("yellow", 0)}
+
+
+# --- the last touch before a ball out, against the simulator's contacts (the physics' last toucher) --------
+def _out_given_to(w: World, ref: Referee, mine: list[GameEvent]) -> tuple[str | None, str | None]:
+    """Whose free kick the simulator's ball out is by its physics' last toucher (the ground truth),
+    and whose the autoref gave."""
+    out = next(e for e in w.events if isinstance(e, BallOut))
+    call = next(c for c in mine if c.kind == "ball_out")
+    return ball_out_taker(out.last_touch, out.x, ref.blue_sign), call.for_team
+
+
+def exact(w: World) -> WorldState:
+    """The world as tracks with no noise: the simulator's truth (the touch rule alone is judged)."""
+    gt = w.ground_truth()
+    b = gt.ball
+    return WorldState(gt.t, BallState(b.x, b.y, b.vx, b.vy),
+                      tuple(RobotState(r.team, r.id, r.x, r.y, r.theta, r.vx, r.vy, r.omega) for r in gt.robots),
+                      gt.frame_number)
+
+
+@pytest.mark.parametrize("start_x", [0.57, 0.58, 0.585])
+def test_a_robot_closing_on_a_ball_that_rolls_out_before_it_reaches_it_is_no_touch(start_x: float) -> None:
+    """Yellow 0 kicks the ball at 1.2 m/s down over the bottom touch line; blue 0, its flat front
+    toward the ball's path, drives at it at 0.4 m/s and comes nearer than a robot's radius, the
+    ball's and the touch margin (the disc's reach), its face never within the touch margin of the
+    ball, and the simulator has no contact before the ball is
+    out: the free kick is blue's (yellow touched last), and the truth referee too keeps yellow's touch
+    (the second miss of the autoref bench; a near pass its disc took for blue's touch cost it seed
+    9's double touch)."""
+    w, ref, auto = scene()
+    w.place_ball(1.0, -2.4)
+    w.place_robot("yellow", 0, 1.0, -2.4 + FRONT, -math.pi / 2)
+    w.place_robot("blue", 0, start_x, -w.field.half_width, 0.0)
+    margin = RulesParams().touch_margin_m
+    nearest, body = [math.inf], [math.inf]
+    last: list[tuple[str, int] | None] = []
+
+    def commands(k: int) -> list[RobotCommand]:
+        gt = w.ground_truth()
+        blue = next(r for r in gt.robots if (r.team, r.id) == ("blue", 0))
+        if abs(gt.ball.y) < w.field.half_width + R_BALL:
+            nearest[0] = min(nearest[0], math.hypot(blue.x - gt.ball.x, blue.y - gt.ball.y))
+            body[0] = min(body[0], hull_gap(LEAGUE.robot, (blue.x, blue.y, blue.theta), gt.ball.x, gt.ball.y) - R_BALL)
+            last[:] = [ref.watch.last_touch, auto.referee.watch.last_touch]  # until the ball is out: the last toucher
+        return [RobotCommand("yellow", 0, kick_speed=1.2 if 20 <= k < 23 else 0.0),
+                RobotCommand("blue", 0, vx=0.4 if k > 20 else 0.0)]
+
+    truth, mine = play(w, ref, auto, exact, 2.5, commands)
+    out = next(e for e in w.events if isinstance(e, BallOut))
+    assert out.last_touch == "yellow"  # the scene is what it says: near the disc, not the body, no contact
+    assert nearest[0] < LEAGUE.robot.radius_m + R_BALL + margin and body[0] > margin
+    assert _out_given_to(w, ref, mine) == ("blue", "blue")
+    assert last == [("yellow", 0), ("yellow", 0)]

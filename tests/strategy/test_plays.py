@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -9,7 +10,7 @@ import pytest
 
 from cmdragons.config import ConfigError, parse
 from cmdragons.geometry import Field, LeagueParams
-from cmdragons.messages import BallState, GameState, RefereeCommand, RobotState, WorldState
+from cmdragons.messages import BallState, GameState, RefereeCommand, RobotState, TeamInfo, WorldState
 from strategy.defense import DefenseParams
 from strategy.plays import Strategy, StrategyParams, off_ball_line
 from strategy.roles import Role, RoleKind
@@ -182,3 +183,33 @@ def test_the_restart_kicker_goes_its_way_by_a_ball_at_rest_or_far(robot: tuple[f
     r = RobotState("blue", 1, *robot, 0.0)
     it = off_ball_line(r, away, ball, FIELD, p.robot_radius_m, p.barred_near_m, p.barred_clear_m, p.barred_rolling_m_s)
     assert it is away
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_a_team_with_a_robot_too_many_drives_the_one_nearest_the_halfway_line_at_a_touch_line_out(seed: int) -> None:
+    """Six of ours on the field, five allowed (a yellow card running): from ``leave_after_s`` on, the
+    robot nearest either crossing of the halfway line and the touch lines (never the keeper) drives
+    onto that touch line at the halfway line, partly in the field margin, within the rules' 1 m of
+    the halfway line; before, and with six allowed, nobody leaves."""
+    rng = np.random.default_rng(300 + seed)
+    world = random_world(rng, 6, 6)
+    p = StrategyParams()
+    strategy = Strategy("blue", FIELD, p)
+    info = dataclasses.replace(TeamInfo(), max_robots=5, goalkeeper=int(rng.integers(0, 6)))
+    game = GameState(0.0, "normal", blue_team=info)
+    w = FIELD.half_width
+
+    def out_of(intents: dict[int, Intent]) -> list[int]:  # those going to the touch line at the halfway line
+        return [rid for rid, it in intents.items() if abs(it.x) <= 1.0 and w < abs(it.y) <= w + 0.5]
+
+    assert out_of(strategy.decide(world, game)) == []  # not yet: the referee's handlers may take one first
+    later = dataclasses.replace(world, t=p.game_states.leave_after_s + 0.1)
+    leaving = out_of(strategy.decide(later, game))
+    own = [r for r in world.robots if r.team == "blue" and r.id != info.goalkeeper]
+    nearest = min(own, key=lambda r: min(math.hypot(r.x, r.y - w), math.hypot(r.x, r.y + w)))
+    assert leaving == [nearest.id]
+    it = strategy.decide(later, game)[nearest.id]
+    r = p.robot_radius_m
+    assert abs(it.x) <= 1.0 and w < abs(it.y) < w + r + FIELD.dims.boundary_width_m and it.y * nearest.y >= 0
+    allowed = GameState(0.0, "normal", blue_team=dataclasses.replace(info, max_robots=6))
+    assert out_of(Strategy("blue", FIELD, p).decide(later, allowed)) == []

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 from cmdragons.config import Validated, setting
+from sim.substitution import RobotCountParams
 
 __all__ = ["GrsimParams", "MulticastParams", "OutsideParams", "ProtocolParams", "ServeParams",
            "SimulationParams"]
@@ -84,6 +85,7 @@ class SimulationParams(Validated):
     dribbler_full_rpm: float = setting(10000.0, lo=1.0, hi=1e6)  # dribbler_speed (rpm) that is our full power (1)
     wait_s: float = setting(0.05, lo=0.0, hi=60.0)  # our simulator: a frame without a new RobotControl waits this long
     vision_port: int = setting(10020, lo=1, hi=65535)  # play --simulator sim-protocol: the simulator's SSL-Vision
+    robot_count: RobotCountParams = RobotCountParams()  # an outside simulator: the robots kept at the allowed count
 
     def port(self, team: str) -> int:
         """The RobotControl port of ``team``."""

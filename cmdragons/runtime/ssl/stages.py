@@ -28,7 +28,7 @@ import uuid
 from collections.abc import Mapping, Sequence
 from typing import Any, Protocol, TextIO
 
-from cmdragons.geometry import LeagueParams, Team
+from cmdragons.geometry import Field, LeagueParams, Team
 from cmdragons.messages import (
     DetectionFrame,
     GameState,
@@ -48,6 +48,7 @@ from cmdragons.runtime.ssl.commands import (
     Feedback,
     SimError,
     grsim_packet,
+    off_field_packet,
     read_robot_control,
     read_robot_control_response,
     read_simulator_command,
@@ -62,10 +63,11 @@ from cmdragons.runtime.ssl.tracker import tracker_packet
 from cmdragons.runtime.ssl.udp import DropLog, MulticastReceiver, MulticastSender, UdpEndpoint
 from cmdragons.runtime.ssl.vision import VisionGeometry, detection_packet, read_wrapper
 from cmdragons.runtime.topics import Contract, Port, summary_port
+from sim.substitution import RobotCount
 from sim.world import ball_at_front
 
-__all__ = ["CommandsOutStage", "RefereeInStage", "RefereeOutStage", "SimulationInStage", "SocketStage",
-           "TrackerOutStage", "VisionInStage", "VisionOutStage", "close_sockets"]
+__all__ = ["CommandsOutStage", "RefereeInStage", "RefereeOutStage", "RobotCountStage", "SimulationInStage",
+           "SocketStage", "TrackerOutStage", "VisionInStage", "VisionOutStage", "close_sockets"]
 
 
 class Receiver(Protocol):
@@ -356,7 +358,10 @@ class CommandsOutStage(SocketStage):
     """Our team's commands to a league simulator: grSim (``grSim_Packet`` to ``grsim.address:port``)
     or the simulation protocol (``RobotControl`` to the team's port); our referee's teleports as
     ``SimulatorCommand`` to the simulation protocol's control port (grSim takes them there too;
-    ``teleports``: this team's stage sends them, one of a match's does). Velocities go in each
+    ``teleports``: this team's stage sends them, one of a match's does; a robot placed beyond the
+    field's margin of ``pitch``, where our referee parks a robot it sends off, is taken out of the
+    simulator instead, ``present: false``, and one placed on it again is put back, ``present: true``, as
+    the league's simulation controller does). Velocities go in each
     robot's frame by its heading in our tracker's latest world state. grSim stops a robot whose last
     packet is older than one of its frames: on each world state (a vision frame) the last packet
     goes again, with the new headings, before the frame's own commands come. The simulators'
@@ -371,9 +376,10 @@ class CommandsOutStage(SocketStage):
                         (summary_port(name),))
 
     def __init__(self, params: ProtocolParams, team: Team, chip_angle_rad: float, err: TextIO | None = None,
-                 teleports: bool = True) -> None:
+                 teleports: bool = True, pitch: Field | None = None) -> None:
         self.contract = self.declare(params, team, chip_angle_rad, teleports)
         self.team = team
+        self.pitch = pitch
         self.to = params.commands_to
         sim = params.simulation
         self.endpoint = UdpEndpoint(sim.address if self.to == "simulation" else params.grsim.address)
@@ -390,7 +396,13 @@ class CommandsOutStage(SocketStage):
 
     def on_message(self, topic: str, message: Any, publish: Publish) -> None:
         if topic == "teleport":
-            self.endpoint.send_to(simulator_command_packet(message), self.control)
+            tp: Teleport = message
+            off = [(team, rid) for team, rid, x, y, _ in tp.robots if self.beyond(x, y)]
+            if off:  # sent off: out of the simulator, as the league's simulation controller takes a robot out
+                self.endpoint.send_to(off_field_packet(off), self.control)
+                tp = Teleport(tp.t, tuple(r for r in tp.robots if not self.beyond(r[2], r[3])), tp.ball)
+            if tp.robots or tp.ball is not None:
+                self.endpoint.send_to(simulator_command_packet(tp), self.control)
             self.teleports += 1
         elif isinstance(message, TeamCommands):
             if self.to == "grsim":
@@ -406,6 +418,11 @@ class CommandsOutStage(SocketStage):
                 self.endpoint.send_to(grsim_packet(self._last, self.headings, self.chip_angle_rad), self.peer)
                 self.resent += 1
         self._read_answers()
+
+    def beyond(self, x: float, y: float) -> bool:
+        """Is (``x``, ``y``) beyond the field's margin (where our referee parks a robot it sends off;
+        never, without ``pitch``)?"""
+        return self.pitch is not None and not self.pitch.in_field(x, y, -self.pitch.dims.boundary_width_m)
 
     def _read_answers(self) -> None:
         """The simulation protocol answers each packet (grSim does not): count them and their errors."""
@@ -426,6 +443,50 @@ class CommandsOutStage(SocketStage):
             "answers": self.answers, "answer_errors": self.answer_errors,
             "answers_earlier_layout": self.answers_earlier_layout,
             "dropped": dict(sorted(self.drops.counts.items()))}))
+
+    def close(self) -> None:
+        self.endpoint.close()
+
+
+class RobotCountStage(SocketStage):
+    """The league's simulation controller's part we need in an outside simulator: each team's robots
+    on the field kept at the count the referee allows (:class:`sim.substitution.RobotCount` on our
+    tracked ``world`` and the ``referee_topic``'s game state), robots taken out (``present: false``)
+    and put back (``present: true``) through the simulation protocol's control port."""
+
+    @staticmethod
+    def declare(world: str, referee_topic: str) -> Contract:
+        return Contract("ssl/robot_count", (Port(referee_topic, GameState), Port(world, WorldState)),
+                        (summary_port("ssl/robot_count"),))
+
+    def __init__(self, params: ProtocolParams, count: RobotCount, world: str, referee_topic: str) -> None:
+        self.contract = self.declare(world, referee_topic)
+        self.count = count
+        self.referee_topic = referee_topic
+        sim = params.simulation
+        self.endpoint = UdpEndpoint(sim.address)
+        self.control = (sim.address, sim.control_port)
+        self.game: GameState | None = None
+        self.changes: list[dict[str, Any]] = []
+
+    def on_message(self, topic: str, message: Any, publish: Publish) -> None:
+        if topic == self.referee_topic:
+            self.game = message
+            return
+        if self.game is None:
+            return
+        change = self.count.step(message, self.game)
+        if change.off:
+            self.endpoint.send_to(off_field_packet(change.off), self.control)
+        if change.on:
+            self.endpoint.send_to(simulator_command_packet(Teleport(message.t, change.on)), self.control)
+        if change:
+            self.changes.append({"t": round(message.t, 3), "off": [list(k) for k in change.off],
+                                 "on": [[team, rid] for team, rid, *_ in change.on]})
+
+    def summarize(self, publish: Publish) -> None:
+        publish(f"summary/{self.name}", StageSummary(self.name, {
+            "taken_off": self.count.taken_off, "put_back": self.count.put_back, "each": self.changes}))
 
     def close(self) -> None:
         self.endpoint.close()

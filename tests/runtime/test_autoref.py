@@ -77,11 +77,11 @@ def test_each_missed_call_is_named_with_what_the_autoref_called_instead() -> Non
 
 @pytest.mark.slow
 def test_the_passive_autoref_makes_the_truth_referees_calls_in_a_match_through_the_cameras() -> None:
-    """Seed 7, 10 s, our team through the cameras against the simple opponent, the truth referee
+    """Seed 1, 10 s, our team through the cameras against the simple opponent, the truth referee
     driving: every call of it (a crash) the autoref makes too within the window, and none of its
     own."""
     truth, seen = (
-        [c for c in calls if c.kind != OWN_COLLISION] for calls in watch(load_settings(), 7, 10.0))  # calls only
+        [c for c in calls if c.kind != OWN_COLLISION] for calls in watch(load_settings(), 1, 10.0))  # calls only
     assert truth, "the match has calls to compare"
     pairs = match_calls(truth, seen)
     assert len(pairs) == len(truth)

@@ -4,7 +4,10 @@ same time; and the files that hold slow tests run first, so that a parallel run 
 (every worker busy to the end) rather than on a long match that one worker plays while the other
 has nothing left. ``-n auto`` starts two workers more than the machine has CPUs: about a quarter of
 the suite's wall time is real-time play (served, grSim and outside matches) waiting on the clock,
-in which a worker uses little CPU (on 2 CPUs, warm: 5:12 with 2 workers, 3:54 with 4)."""
+in which a worker uses little CPU (on 2 CPUs, warm: 5:12 with 2 workers, 3:54 with 4). The workers
+already share the CPUs, so BLAS runs one thread in each: OpenBLAS's own threads, one per CPU in every
+worker and in every command a test starts, spin while they wait (tests/vision/test_field_lines.py and
+tests/estimation: 49-53 CPU-s with them, 30-32 without, the same wall time)."""
 
 from __future__ import annotations
 
@@ -14,6 +17,9 @@ import sys
 from pathlib import Path
 
 import pytest
+
+for _threads in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_threads, "1")  # before numpy loads in the workers and the commands tests start
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 
@@ -25,6 +31,7 @@ _WARM_UP = (
 )
 
 
+@pytest.hookimpl(optionalhook=True)  # pytest -p no:xdist still runs
 def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
     """The workers of ``-n auto``: the CPUs and two more for the tests that wait on the clock."""
     return (os.cpu_count() or 1) + 2

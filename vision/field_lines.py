@@ -237,6 +237,33 @@ def _chamfer(params: CameraParams, pts: F64, dist: NDArray[np.float32], line_px:
     return out
 
 
+def _chamfer_jacobian(x: F64, base: CameraParams, pts: F64, dist: NDArray[np.float32],
+                      slope: tuple[NDArray[np.float32], NDArray[np.float32]], line_px: F64, cap_px: float) -> F64:
+    """The Jacobian (m, 6) of :func:`_chamfer` for ``_params(x, base, 6)``: each distance's
+    gradient in the image (``slope``, the distance field's along u and v; the unit vector from the
+    line pixel to its nearest projected point) times its point's derivative along each parameter
+    (a forward difference of the projection), zero where the cap holds."""
+    model = CameraModel(_params(x, base, 6))
+    px = model.project(pts)
+    inside = np.isfinite(px).all(axis=1) & model.in_image(np.nan_to_num(px, nan=-1.0), margin=1.0)
+    jac = np.zeros((len(pts) + len(line_px), 6))
+    if not inside.any():
+        return jac
+    seen, at = pts[inside], px[inside]
+    steps = np.array([1e-6, 1e-6, 1e-6, 1e-6, 1e-6, 1e-4])  # rad, rad, rad, m, m, px
+    moved = [CameraModel(_params(x + h * e, base, 6)).project(seen) for h, e in zip(steps, np.eye(6), strict=True)]
+    dpx = np.stack([(m - at) / h for m, h in zip(moved, steps, strict=True)], axis=2)  # (k, 2, 6) px per unit
+    live = _sample(dist, at) < cap_px
+    du, dv = _sample(slope[0], at[live]), _sample(slope[1], at[live])
+    jac[np.flatnonzero(inside)[live]] = du[:, None] * dpx[live, 0] + dv[:, None] * dpx[live, 1]
+    d, nearest = cKDTree(at).query(line_px, distance_upper_bound=cap_px)
+    near = (d < cap_px) & (d > 0.0)
+    k = nearest[near]
+    toward = (at[k] - line_px[near]) / d[near, None]
+    jac[len(pts) + np.flatnonzero(near)] = toward[:, :1] * dpx[k, 0] + toward[:, 1:] * dpx[k, 1]
+    return jac
+
+
 def _bounds(p: CameraParams, n: int, reach_m: float) -> tuple[F64, F64]:
     """Least-squares bounds around ``p`` for its first ``n`` parameters: what a rough start can
     be off by (tilts 0.2 rad, position ``reach_m``, focal length 25 %, k1 and k2 0.3)."""
@@ -304,11 +331,14 @@ def _coarse(start: CameraParams, pts: F64, dist: NDArray[np.float32], line_px: F
         cands.append((float(np.mean(_chamfer(p, pts, dist, line_px, cap0))), int(k), p))
     cands.sort(key=lambda c: c[:2])  # ties in the grid's order
     best, best_cost = start, math.inf
+    du = np.asarray(np.gradient(dist, axis=1), dtype=np.float32)  # the distance field's slope along u and v
+    dv = np.asarray(np.gradient(dist, axis=0), dtype=np.float32)
     for _, _, p in cands[:4]:
         lo, hi = _bounds(p, 6, 0.15)
         for cap in (cap0, cap1):
             sol = least_squares(lambda x, p=p, cap=cap: _chamfer(_params(x, p, 6), pts, dist, line_px, cap),
-                                np.clip(_vector(p)[:6], lo, hi), bounds=(lo, hi), diff_step=1e-3, max_nfev=100,
+                                np.clip(_vector(p)[:6], lo, hi), bounds=(lo, hi), max_nfev=100,
+                                jac=lambda x, p=p, cap=cap: _chamfer_jacobian(x, p, pts, dist, (du, dv), line_px, cap),
                                 x_scale=np.array([0.01, 0.01, 0.01, 0.02, 0.02, 5.0]))
             p = _params(sol.x, p, 6)
         cost = float(np.mean(_chamfer(p, pts, dist, line_px, cap1)))

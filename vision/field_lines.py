@@ -299,7 +299,8 @@ def _quick_chamfer(p: CameraParams, shifts: F64, pts: F64, dist: NDArray[np.floa
     to_lines = np.full(px.shape[:2], cap_px)
     to_lines[inside] = np.minimum(_sample(dist, px[inside]), cap_px)
     grid, corner = model_dist
-    seen = np.nan_to_num(model.unproject(line_px, 0.0), nan=-1e3)  # beyond the horizon: off the grid
+    # a pixel whose ray misses the carpet: off the grid, as far from the model as the cap
+    seen = np.nan_to_num(model.unproject(line_px, 0.0), nan=-1e3, posinf=-1e3, neginf=-1e3)
     at = (seen[None, :, :] + shifts[:, None, :] - corner) / cell_m
     metres = _sample(grid, at.reshape(-1, 2)).reshape(len(shifts), len(line_px))
     to_model = np.minimum(metres * (model.f / p.position_m[2]), cap_px)
@@ -318,8 +319,10 @@ def _coarse(start: CameraParams, pts: F64, dist: NDArray[np.float32], line_px: F
     shifts = np.array([(dx, dy) for dx in steps for dy in steps])
     x0, y0, z = start.position_m
     cap0, cap1 = fit.coarse_cap_px, fit.refine_cap_px
-    cell_m = z / start.focal_px  # a pixel at the start's scale
-    model_dist = _model_distance(pts, cell_m, cap0 * cell_m / (1.0 - fit.focal_range) + cell_m)
+    pixel_m = z / start.focal_px  # a pixel at the start's scale, on the carpet
+    # the estimate's grid: a pixel's cells, at most 2048 along the field (it only ranks the candidates)
+    cell_m = max(pixel_m, float(np.ptp(pts[:, :2], axis=0).max()) / 2048.0)
+    model_dist = _model_distance(pts, cell_m, cap0 * pixel_m / (1.0 - fit.focal_range) + cell_m)
     views = [dataclasses.replace(start, yaw_rad=start.yaw_rad + turn, focal_px=start.focal_px * fs)
              for turn in (0.0, math.pi / 2.0, math.pi, -math.pi / 2.0)  # which way the image lies: from the lines
              for fs in 1.0 + np.linspace(-fit.focal_range, fit.focal_range, 5)]

@@ -260,13 +260,15 @@ class Attacker:
             # driving through the ball already: the kick is kept (re-deciding frame by frame turned the aim
             # between passes, clears and contest angles, and the robot backed off to line up anew each time)
             self._plan(t, robot.id, kept.kick, passes)
-            return chase(drive_through(met, kept.aim, kept.kick.speed, skills), met), kept.kick.kind
+            return chase(drive_through(robot, met, kept.aim, kept.kick.speed, skills), met), kept.kick.kind
         intent, kind, kick = self._play(t, robot, own, supporters, opponents, met, ball, attack_sign, passes, restart)
         through = not intent.avoid_ball and intent.kick_speed > 0.0 and slow and not restart
         if not through:
             self.commitment = None
         elif kept is None or kept.robot != robot.id or t - kept.since > p.commit_s:
-            self.commitment = Commitment(robot.id, t, intent.theta, replace(kick, kind=kind, speed=intent.kick_speed))
+            # the ball's way, kept: the robot's heading is that less what its motion adds (skills.aiming)
+            aim = math.atan2(kick.target[1] - met.y, kick.target[0] - met.x)
+            self.commitment = Commitment(robot.id, t, aim, replace(kick, kind=kind, speed=intent.kick_speed))
         return (intent if restart else chase(intent, met)), kind
 
     @staticmethod
@@ -310,6 +312,6 @@ class Attacker:
             away = forward_kick(met, contest, self.field, attack_sign, p, skills)
             if t - self.still.since > p.stall_s:
                 # lining up got nowhere (the point behind the ball is taken): drive through it from here
-                return drive_through(met, contest, away.speed, skills), KickPurpose.CLEAR, away
+                return drive_through(robot, met, contest, away.speed, skills), KickPurpose.CLEAR, away
             return kick_to(robot, met, away.target, away.speed, skills), KickPurpose.CLEAR, away
         return kick_to(robot, met, kick.target, kick.speed, skills), kick.kind, kick

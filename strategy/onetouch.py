@@ -1,60 +1,53 @@
-"""One-touch ball control (Bruce 2006, appendix B.6): aim the kicker so that the redirected ball
-leaves in the wanted direction.
+"""Aiming a kick (Bruce 2006, appendix B.6, one-touch ball control, with the kick relative to the
+robot): the heading that sends the ball off in the wanted direction.
 
-Kick model (the simulator's): the kicker pushes along the robot heading h with speed s; the ball's
-velocity across the heading (relative to the robot) partly survives, by the fraction c:
+Kick model (the simulator's, grSim's and the field's): the kicker pushes along the robot heading h
+at the kicker's speed k, relative to the robot, whose velocity v_r carries over to the ball; the
+ball's velocity across the heading relative to the robot, v_b - v_r, partly survives, by the
+fraction c:
 
-    v_out = s h + c (v_in - (v_in . h) h)
+    v_out = k h + v_r + c ((v_b - v_r) . n) n        (n: h turned a quarter left)
 
-so for a ball arriving with v_in, aiming h straight at the target sends the ball off to the side.
-We solve for the heading whose outgoing velocity points at the target: the signed angle between
-v_out(h) and the target direction changes monotonically near the solution, so bisection on the
-heading angle finds it. Field frame, m/s, radians.
+Aiming straight at the target sends the ball off to the side whenever the robot or the ball moves
+across the heading: a robot driving sideways at 1 m/s turns a 6 m/s shot by 0.17 rad. For the ball to
+leave along the unit vector d at s over the ground, v_out = s d: across the heading that asks
+(s d - (1 - c) v_r - c v_b) . n = 0, so the robot faces the direction of
+
+    w = s d - (1 - c) v_r - c v_b
+
+and along it the kicker fires at k = (s d - v_r) . h: s - v_r . h, as ``RobotShape.kicker_speed``
+sends it, but for the cosine of the small angle between d and h. A held ball, a one-touch ball and a
+ball driven through alike: v_b is the ball's velocity before the kick. Field frame, m/s, radians.
 """
 
 from __future__ import annotations
 
 import math
 
-from cmdragons.geometry import wrap_angle
-
-__all__ = ["aim_heading", "redirected_velocity"]
-
-_BRACKET = math.pi / 2 * 0.999  # the heading is searched within this of the target direction (rad) ...
-_BISECTIONS = 60  # ... in at most so many halvings
+__all__ = ["kick_heading", "kicked_velocity"]
 
 
-def redirected_velocity(heading: float, v_in: tuple[float, float], kick_speed: float,
-                        retention: float) -> tuple[float, float]:
-    """The ball's velocity right after a kick at ``heading`` (the model above)."""
+def kicked_velocity(heading: float, kick_speed: float, robot_v: tuple[float, float], ball_v: tuple[float, float],
+                    retention: float) -> tuple[float, float]:
+    """The ball's velocity over the ground right after a flat kick at the kicker's ``kick_speed``
+    (relative to the robot) from a robot at ``heading`` moving at ``robot_v``, the ball at ``ball_v``
+    before it (the model above)."""
     hx, hy = math.cos(heading), math.sin(heading)
-    across = -hy * v_in[0] + hx * v_in[1]
-    return (kick_speed * hx - hy * across * retention, kick_speed * hy + hx * across * retention)
+    across = (-hy * (ball_v[0] - robot_v[0]) + hx * (ball_v[1] - robot_v[1])) * retention
+    return kick_speed * hx + robot_v[0] - hy * across, kick_speed * hy + robot_v[1] + hx * across
 
 
-def _error(heading: float, v_in: tuple[float, float], kick_speed: float, retention: float, target: float) -> float:
-    vx, vy = redirected_velocity(heading, v_in, kick_speed, retention)
-    return wrap_angle(math.atan2(vy, vx) - target)
-
-
-def aim_heading(target_angle: float, v_in: tuple[float, float], kick_speed: float, retention: float,
-                tolerance_rad: float = 1e-6) -> float:
-    """The robot heading (rad) that sends a ball arriving with ``v_in`` off at ``target_angle``."""
-    if kick_speed <= 0.0 or retention == 0.0:
-        return target_angle
-    # the correction is less than a right angle whenever the kick outruns the retained part
-    lo, hi = target_angle - _BRACKET, target_angle + _BRACKET
-    e_lo = _error(lo, v_in, kick_speed, retention, target_angle)
-    e_hi = _error(hi, v_in, kick_speed, retention, target_angle)
-    if e_lo * e_hi > 0:  # the retained part dominates: no heading reaches the target, get closest
-        return lo if abs(e_lo) < abs(e_hi) else hi
-    for _ in range(_BISECTIONS):
-        mid = 0.5 * (lo + hi)
-        e_mid = _error(mid, v_in, kick_speed, retention, target_angle)
-        if abs(e_mid) < tolerance_rad:
-            return mid
-        if (e_mid < 0) == (e_lo < 0):
-            lo, e_lo = mid, e_mid
-        else:
-            hi = mid
-    return 0.5 * (lo + hi)
+def kick_heading(direction: float, speed: float, robot_v: tuple[float, float], ball_v: tuple[float, float],
+                 retention: float) -> float:
+    """The robot heading (rad) that sends the ball off along ``direction`` (rad) at ``speed`` (m/s
+    over the ground) from a robot moving at ``robot_v``, the ball at ``ball_v`` before the kick: the
+    direction of w above. ``direction`` itself when there is no kick (``speed`` 0) or no heading
+    sends the ball so (the robot's and the ball's carried velocity outrun the kick: w points back)."""
+    if speed <= 0.0:
+        return direction
+    dx, dy = math.cos(direction), math.sin(direction)
+    wx = speed * dx - (1.0 - retention) * robot_v[0] - retention * ball_v[0]
+    wy = speed * dy - (1.0 - retention) * robot_v[1] - retention * ball_v[1]
+    if wx * dx + wy * dy <= 0.0:
+        return direction
+    return math.atan2(wy, wx)

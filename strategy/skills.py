@@ -17,13 +17,15 @@ from cmdragons.config import Validated, derived, setting
 from cmdragons.geometry import Field, wrap_angle
 from cmdragons.messages import BallState, RobotState
 from strategy.ballmodel import BallModel
-from strategy.onetouch import aim_heading
+from strategy.onetouch import kick_heading
 
 __all__ = [
     "Intent",
     "SkillParams",
+    "aiming",
     "defend",
     "dribble",
+    "drive_through",
     "goalie_block",
     "intercept",
     "kick_to",
@@ -45,6 +47,7 @@ class SkillParams(Validated):
     approach_distance_m: float = setting(0.12, lo=0.0, hi=1.0)  # wait this far behind the ball, lined up
     lined_up_rad: float = setting(0.08, lo=0.001, hi=1.0)  # heading error allowed before driving through
     lined_up_m: float = setting(0.03, lo=0.001, hi=0.5)  # lateral error allowed before driving through
+    aim_tolerance_m: float = setting(0.1, lo=0.001, hi=2.0)  # a held ball kicked: its way this near the target there
     push_speed_m_s: float = setting(0.8, lo=0.05, hi=5.0)  # speed of the last approach onto the ball
     cone_reach_m: float = setting(0.2, lo=0.0, hi=2.0)  # the approach cone reaches this far past the waiting point
     cone_slope: float = setting(0.25, lo=0.0, hi=2.0)  # lateral error allowed per metre from the ball
@@ -57,7 +60,8 @@ class SkillParams(Validated):
     acc_slide_m_s2: float = derived("field.ball.acc_slide_m_s2", 3.0, lo=0.0, hi=50.0)
     acc_roll_m_s2: float = derived("field.ball.acc_roll_m_s2", 0.26, lo=0.0, hi=10.0)
     slide_to_roll_fraction: float = derived("field.ball.slide_to_roll_fraction", 0.64, lo=0.0, hi=1.0)
-    # the ball velocity across the heading a kick keeps: the kicker's, configured in sim.yaml kicker
+    # the ball velocity across the heading (relative to the robot) a kick keeps: the kicker's, configured in
+    # sim.yaml kicker; a kick aims with it (strategy.onetouch)
     kicker_retention: float = derived("sim.kicker.tangential_retention", 0.3, lo=0.0, hi=1.0)
     goalie_depth_m: float = setting(0.15, lo=0.0, hi=2.0)  # goalie stands this far in front of the goal line
     defense_margin_m: float = setting(0.15, lo=0.0, hi=2.0)  # defenders stand this far outside the area
@@ -142,7 +146,8 @@ def kick_to(robot: RobotState, ball: BallState, target: tuple[float, float], spe
     rx, ry = robot.x - ball.x, robot.y - ball.y
     along, across = rx * c + ry * s, -rx * s + ry * c
     contact = p.contact_m
-    heading_error = abs(wrap_angle(aim - robot.theta))
+    # lined up: a kick now would send the ball along the aim (the robot's velocity carries over to it)
+    heading_error = abs(wrap_angle(aiming(robot, ball, aim, speed, p, chip) - robot.theta))
     # behind the ball, inside a cone around the kick line that narrows to lined_up_m at contact: driving
     # straight through the ball closes the lateral error on the way (heading likewise)
     gap = max(0.0, -along - contact)
@@ -152,7 +157,7 @@ def kick_to(robot: RobotState, ball: BallState, target: tuple[float, float], spe
     lined_up = along < -contact + p.contact_slack_m and in_cone
     at_ball = along < 0 and along > -contact - p.at_ball_m and abs(across) < p.at_ball_lateral_share * p.lined_up_m
     if lined_up or at_ball:
-        return drive_through(ball, aim, speed, p, chip)
+        return drive_through(robot, ball, aim, speed, p, chip)
     behind = contact + p.approach_distance_m
     px, py = waiting_point(ball, aim, p)
     if along > -contact and abs(across) < behind:
@@ -184,10 +189,24 @@ def set_kick(robot: RobotState, ball: BallState, target: tuple[float, float], sp
     return dataclasses.replace(intent, kick_speed=speed, chip=False)
 
 
-def drive_through(ball: BallState, aim: float, speed: float, p: SkillParams, chip: bool = False) -> Intent:
-    """Drive through the ball along ``aim`` with the kicker armed: it fires when the ball touches the front."""
+def aiming(robot: RobotState, ball: BallState, aim: float, speed: float, p: SkillParams, chip: bool = False) -> float:
+    """The heading (rad) ``robot`` kicks ``ball`` from to send it along ``aim`` at ``speed`` over the
+    ground: the kick is relative to the robot, whose velocity (and part of the ball's across the
+    heading) carries over to the ball, so the robot faces the kick's direction less what its
+    motion adds (:func:`~strategy.onetouch.kick_heading`, with the robot's and the ball's velocity
+    now). A chip, and no kick, face the aim."""
+    if chip:
+        return aim
+    return kick_heading(aim, speed, (robot.vx, robot.vy), (ball.vx, ball.vy), p.kicker_retention)
+
+
+def drive_through(robot: RobotState, ball: BallState, aim: float, speed: float, p: SkillParams,
+                  chip: bool = False) -> Intent:
+    """Drive through the ball along ``aim`` with the kicker armed: it fires when the ball touches the
+    front. The robot faces the heading that sends the ball along ``aim`` (:func:`aiming`)."""
     c, s = math.cos(aim), math.sin(aim)
-    return Intent(ball.x + c * p.through_m, ball.y + s * p.through_m, aim, kick_speed=speed, chip=chip,
+    heading = aiming(robot, ball, aim, speed, p, chip)
+    return Intent(ball.x + c * p.through_m, ball.y + s * p.through_m, heading, kick_speed=speed, chip=chip,
                   avoid_ball=False, max_speed_m_s=p.push_speed_m_s, final_speed_m_s=p.push_speed_m_s,
                   dribbler=p.through_dribbler)
 
@@ -218,21 +237,22 @@ def turn_with_ball(robot: RobotState, ball: BallState, target: tuple[float, floa
                    p: SkillParams) -> Intent | None:
     """Holding the ball on the kicker face (its centre within ``dribble_hold_m`` of the face's
     middle): turn about the ball toward ``target``, at most ``turn_step_rad`` a frame (faster, the
-    ball is lost), the dribbler holding it; facing the target within ``lined_up_rad``, drive through
-    it with the kicker armed at ``speed``. None when the ball is not held (going round it to line up
-    would leave it: a trapped ball was given away so). Lined up is judged on the way the ball would
-    leave: the kick is relative to the robot, so the robot's velocity across its heading (turning
-    about the ball) carries over and turns the ball's path by atan(across / speed)."""
+    ball is lost), the dribbler holding it; facing the target within ``lined_up_rad`` and so that the
+    ball passes within ``aim_tolerance_m`` of it, drive through it with the kicker armed at
+    ``speed``. None when the ball is not held (going round it to line up would leave it: a trapped
+    ball was given away so). The heading turned to and judged lined up is the one that sends the
+    ball at the target (:func:`aiming`): the kick is relative to the robot, and turning about the
+    ball moves it across its heading."""
     contact = p.contact_m
-    c, s = math.cos(robot.theta), math.sin(robot.theta)
-    face_x, face_y = robot.x + c * contact, robot.y + s * contact
+    face_x, face_y = robot.x + math.cos(robot.theta) * contact, robot.y + math.sin(robot.theta) * contact
     if math.hypot(ball.x - face_x, ball.y - face_y) >= p.dribble_hold_m:
         return None
     aim = _angle(target[0] - ball.x, target[1] - ball.y)
-    error = wrap_angle(aim - robot.theta)
-    across = -s * robot.vx + c * robot.vy
-    if abs(wrap_angle(error - math.atan2(across, speed))) < p.lined_up_rad:
-        return drive_through(ball, aim, speed, p)
+    error = wrap_angle(aiming(robot, ball, aim, speed, p) - robot.theta)
+    # the kick fires at once: lined up when the ball would pass within aim_tolerance_m of the target
+    reach = math.hypot(target[0] - ball.x, target[1] - ball.y)
+    if abs(error) < min(p.lined_up_rad, math.atan2(p.aim_tolerance_m, reach)):
+        return drive_through(robot, ball, aim, speed, p)
     heading = robot.theta + max(-p.turn_step_rad, min(p.turn_step_rad, error))
     return Intent(ball.x - math.cos(heading) * contact, ball.y - math.sin(heading) * contact, heading,
                   dribbler=p.hold_dribbler, avoid_ball=False)
@@ -285,10 +305,11 @@ def intercept(robot: RobotState, ball: BallState, p: SkillParams, field: Field |
 def receive(robot: RobotState, ball: BallState, wait_at: tuple[float, float], p: SkillParams,
             shoot_at: tuple[float, float] | None = None, shot_speed: float = 0.0) -> Intent:
     """Meet the moving ball on its path near ``wait_at``; with ``shoot_at``, a one-touch shot
-    aimed with the kick model (B.6), else stop it with the dribbler facing it. The one-touch kick
-    is armed only while the robot faces its heading within ``one_touch_facing_rad``: a kicker fires
-    along the robot's heading, so a ball that arrives before the robot has turned would be sent
-    back the way it came; until then the dribbler is on, and a ball that arrives early is trapped."""
+    aimed with the kick model (B.6, :func:`aiming`), else stop it with the dribbler facing it. The
+    one-touch kick is armed only while the robot faces its heading within ``one_touch_facing_rad``:
+    a kicker fires along the robot's heading, so a ball that arrives before the robot has turned
+    would be sent back the way it came; until then the dribbler is on, and a ball that arrives
+    early is trapped."""
     speed = math.hypot(ball.vx, ball.vy)
     px, py = wait_at
     moving = speed > p.receive_moving_m_s
@@ -300,9 +321,7 @@ def receive(robot: RobotState, ball: BallState, wait_at: tuple[float, float], p:
     toward_ball = _angle(ball.x - px, ball.y - py)
     contact = p.contact_m
     if shoot_at is not None and moving:
-        target = _angle(shoot_at[0] - px, shoot_at[1] - py)
-        v_in = (ball.vx - robot.vx, ball.vy - robot.vy)
-        heading = aim_heading(target, v_in, shot_speed, p.kicker_retention)
+        heading = aiming(robot, ball, _angle(shoot_at[0] - px, shoot_at[1] - py), shot_speed, p)
         # stand so the ball meets the middle of the kicker face
         cx, cy = px - math.cos(heading) * contact, py - math.sin(heading) * contact
         if abs(wrap_angle(heading - robot.theta)) > p.one_touch_facing_rad:

@@ -240,7 +240,7 @@ def test_a_ball_rolling_away_is_driven_through_at_the_push_speed_relative_to_it(
     ball_v: tuple[float, float], faster: float
 ) -> None:
     ball = BallState(1.0, 0.0, *ball_v)
-    through = drive_through(ball, 0.0, 3.0, SKILLS)
+    through = drive_through(RobotState("blue", 1, 0.9, 0.0, 0.0), ball, 0.0, 3.0, SKILLS)
     chased = chase(through, ball)
     assert chased.max_speed_m_s == pytest.approx(SKILLS.push_speed_m_s + faster)
     assert chased.final_speed_m_s == pytest.approx(SKILLS.push_speed_m_s + faster)

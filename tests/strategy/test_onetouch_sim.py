@@ -10,7 +10,7 @@ import pytest
 from cmdragons.geometry import LeagueParams
 from cmdragons.messages import RobotCommand
 from sim.world import BallParams, DribblerParams, Kick, KickerParams, PhysicsParams, RobotParams, World
-from strategy.onetouch import aim_heading
+from strategy.onetouch import kick_heading
 
 LEAGUE = LeagueParams()
 CONTACT = LEAGUE.robot.front_distance_m + LEAGUE.ball.radius_m
@@ -29,7 +29,7 @@ def test_one_touch_leaves_toward_the_target(target_deg: float, turn_deg: float, 
     v_in = (-speed * math.cos(come_from), -speed * math.sin(come_from))
     target = math.radians(target_deg)
     kick = 4.0
-    heading = aim_heading(target, v_in, kick, kicker.tangential_retention)
+    heading = kick_heading(target, kick, (0.0, 0.0), v_in, kicker.tangential_retention)  # the robot stands still
     # stand so the ball meets the middle of the kicker face
     rx, ry = -CONTACT * math.cos(heading), -CONTACT * math.sin(heading)
     w.place_robot("blue", 0, rx, ry, heading)

@@ -17,6 +17,8 @@ What a row says, all from the match's summary.json and run.mcap (what our stages
   (the true ball across a goal line, both ends together, while the ball was in play by the referee
   and within the match: :func:`truth_goals`);
 - fouls per team; own collisions (the autoref's count from tracks, :class:`sim.autoref.OwnContacts`);
+- the first kickoff: how long until play ran, and whether it was taken (a normal start) or forced
+  after the rules' time (:func:`first_start`); how far the ball was played (:func:`ball_in_play_m`);
 - stoppages (play not running: from a stop to the next normal or force start): how many, how many
   restarted before the match ended, the longest, and how many took longer than the rules allow
   (:func:`rules_stoppage_s`);
@@ -66,8 +68,8 @@ from sim.autoref import BallCrossing, KickDetector, observed
 from sim.referee_params import RefereeParams
 from sim.restarts import defender_of, other
 
-__all__ = ["OPPONENTS", "PEERS", "Peer", "Stoppages", "league_row", "match_row", "peer_script", "rules_stoppage_s",
-           "run", "seen_passes", "stoppages", "truth_goals", "vision_goals"]
+__all__ = ["OPPONENTS", "PEERS", "Peer", "Stoppages", "ball_in_play_m", "first_start", "league_row", "match_row",
+           "peer_script", "rules_stoppage_s", "run", "seen_passes", "stoppages", "truth_goals", "vision_goals"]
 
 OPPONENTS = ("self", "none")  # whom our team plays: itself in the other colour, or the simulator's idle robots
 _OTHER: dict[Team, Team] = {"blue": "yellow", "yellow": "blue"}
@@ -172,6 +174,40 @@ def truth_goals(truths: Iterable[GroundTruth], pitch: Field, states: Sequence[Ga
     return goals
 
 
+def first_start(states: Iterable[GameState]) -> tuple[float | None, bool]:
+    """The match's first kickoff: how long (s) from the first game state until play first ran, and
+    whether it was taken (a normal start: the kicker moved the ball) rather than forced after the
+    rules' time (None, False: play never ran)."""
+    t0: float | None = None
+    for g in states:
+        t0 = g.t if t0 is None else t0
+        if g.command.running:
+            return g.t - t0, g.command == RefereeCommand.NORMAL
+    return None, False
+
+
+def ball_in_play_m(messages: Iterable[tuple[str, Any]]) -> float:
+    """How far the ball was played (m): the path of the autoref's tracked ball (``world/autoref``)
+    while play ran by the referee (``referee``: a normal or force start), from where it was last
+    seen to where it is seen next; a ball the referee placed while play stood (a restart's
+    teleport) does not count."""
+    last: tuple[float, float] | None = None  # where the ball was last seen while play ran
+    running = False
+    path = 0.0
+    for topic, m in messages:
+        if topic == "referee":
+            running = m.command.running
+            last = last if running else None
+            continue
+        ball = m.ball
+        if not running or ball is None or not ball.visible:
+            continue
+        if last is not None:
+            path += math.dist((ball.x, ball.y), last)
+        last = (ball.x, ball.y)
+    return path
+
+
 @dataclass(frozen=True)
 class Stoppages:
     """Play stopped (from a game state that is not normal or force start to the next that is), the
@@ -270,6 +306,8 @@ def league_row(name: str, folder: Path, settings: Settings, truth_log: Path | No
     states = [m for t, m in events if t == "referee"]
     end_t = max((m.t for t, m in events if t == "world/autoref"), default=0.0)
     stops = stoppages(states, end_t, rules_stoppage_s(played.sim.referee))
+    kickoff_s, kickoff_taken = first_start(states)
+    ball_m = ball_in_play_m((t, m) for t, m in events if t in ("referee", "world/autoref"))
     passes = seen_passes(((t, m) for t, m in events if not t.startswith("ssl/vision/")), ours, played)
     fouls = summary["rules"]["fouls"]
     contacts = summary["collisions"]["own"]
@@ -287,6 +325,8 @@ def league_row(name: str, folder: Path, settings: Settings, truth_log: Path | No
         "fouls_ours_by_kind": ", ".join(f"{k.replace('_', ' ')} {n}" for k, n in fouls[ours].items()
                                         if k != "total") or "none",
         "own_collisions_ours": contacts[ours], "own_collisions_theirs": contacts[theirs] if theirs in teams else None,
+        "first_kickoff_s": None if kickoff_s is None else round(kickoff_s, 2), "first_kickoff_taken": kickoff_taken,
+        "ball_in_play_m": round(ball_m, 2),
         "stoppages": stops.count, "stoppages_restarted": stops.restarted,
         "longest_stoppage_s": round(stops.longest_s, 2), "stoppages_over_rules": stops.over_limit,
         "frames": summary["frames"], "frames_behind": summary["frames_behind"],

@@ -159,7 +159,7 @@ def test_the_field_is_the_simulators_and_a_difference_is_one_line() -> None:
 
 def test_an_outside_simulators_robots_brake_as_configured_for_it_until_measured() -> None:
     """field.yaml's robot is our own simulator's (braking 6 m/s²); in an outside simulator the team
-    assumes protocols.outside's braking (grSim's robots brake at 4) in motion control, the safety
+    assumes protocols.outside's braking (grSim's robots brake at about 3.7) in motion control, the safety
     search and as the tracker's configured value, until it measured the robots; a --set of
     field.yaml's braking stays as given, and 0 keeps field.yaml's."""
     own = load_settings()
@@ -180,13 +180,14 @@ def _own_contacts(settings: Any, seconds: float) -> list[tuple[Any, Any]]:
     return [(c.a, c.b) for e in events for c in e.events if isinstance(c, msg.Contact) and c.a[0] == c.b[0]]
 
 
-def test_in_a_world_whose_robots_brake_at_4_the_braking_assumed_keeps_our_robots_apart() -> None:
+def test_in_grsims_world_the_braking_assumed_keeps_our_robots_apart() -> None:
     """grSim's first kickoff played in our own simulator made grSim's world (its robots braking at
-    4 m/s², sim.world_robot_max_brake_m_s2): from the teleported formation blue's defenders 1 and 2
-    run at each other toward their places 0.32 m apart. Believing field.yaml's 6 m/s² they brake too
-    late and meet (as in grSim, 1 s in); with the braking an outside simulator's robots are assumed
-    to have (:func:`outside_settings`) they stop apart, and nobody else meets either."""
-    grsim_world = ["sim.world_robot_max_brake_m_s2=4.0"]
+    3.6 m/s² as our tracker measured grSim's, sim.world_robot_max_brake_m_s2): from the teleported
+    formation blue's defenders 1 and 2 run at each other toward their places 0.32 m apart.
+    Believing field.yaml's 6 m/s² they brake too late and meet (as in grSim, 1 s in); with the
+    braking an outside simulator's robots are assumed to have (:func:`outside_settings`) they stop
+    apart, and nobody else meets either."""
+    grsim_world = ["sim.world_robot_max_brake_m_s2=3.6"]
     assert (("blue", 1), ("blue", 2)) in _own_contacts(load_settings(None, grsim_world), 3.0)
     assert _own_contacts(outside_settings(None, grsim_world), 3.0) == []
 

@@ -101,7 +101,7 @@ class OutsideParams(Validated):
     frame_wait_s: float = setting(2.0, lo=0.01, hi=600.0)  # no vision for this long ends the match
     # the simulator's robots brake this hard (m/s²) as far as our team knows until our tracker measured it
     # (field.yaml's robot is our own simulator's); 0: field.yaml's
-    robot_max_brake_m_s2: float = setting(4.0, lo=0.0, hi=50.0)
+    robot_max_brake_m_s2: float = setting(3.5, lo=0.0, hi=50.0)
 
 
 @dataclass(frozen=True)

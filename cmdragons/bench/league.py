@@ -69,7 +69,8 @@ from sim.referee_params import RefereeParams
 from sim.restarts import defender_of, other
 
 __all__ = ["OPPONENTS", "PEERS", "Peer", "Stoppages", "ball_in_play_m", "first_start", "league_row", "match_row",
-           "peer_script", "rules_stoppage_s", "run", "seen_passes", "stoppages", "truth_goals", "vision_goals"]
+           "peer_script", "rules_stoppage_s", "run", "seen_passes", "stoppages", "truth_clock_offset", "truth_goals",
+           "vision_goals"]
 
 OPPONENTS = ("self", "none")  # whom our team plays: itself in the other colour, or the simulator's idle robots
 _OTHER: dict[Team, Team] = {"blue": "yellow", "yellow": "blue"}
@@ -156,18 +157,23 @@ def vision_goals(messages: Iterable[tuple[str, Any]], pitch: Field) -> dict[Team
     return goals
 
 
+_SAME_FRAME_S = 1e-3  # two clocks' times this near are one frame's (frames 1/60 s apart; times off by float rounding)
+
+
 def truth_goals(truths: Iterable[GroundTruth], pitch: Field, states: Sequence[GameState] | None = None,
                 until: float = math.inf) -> int:
     """Goals in a simulator's truth, both ends: the true ball across a goal line between the posts; with
     the referee's game ``states`` (in time order, on the truth's clock) only while the ball was in play
     by them and from the first of them, and none after ``until`` (s; the match's last frame): the
-    simulator runs on before a team joins and after it leaves, when no referee counts a goal."""
+    simulator runs on before a team joins and after it leaves, when no referee counts a goal. The
+    state in force at a truth frame is the last one given before it: the referee's word of the same
+    frame (within :data:`_SAME_FRAME_S`) already follows what it saw there, the goal's stop included."""
     crossing = BallCrossing(pitch)
     states = states or ()
     game: GameState | None = None if states else GameState(0.0, RefereeCommand.NORMAL)
     goals = k = 0
     for g in truths:
-        while k < len(states) and states[k].t <= g.t:
+        while k < len(states) and states[k].t < g.t - _SAME_FRAME_S:
             game, k = states[k], k + 1
         seen = crossing.see(g.t, g.ball.x, g.ball.y, -1, None)
         goals += isinstance(seen, Goal) and game is not None and _in_play(game) and g.t <= until
@@ -206,6 +212,18 @@ def ball_in_play_m(messages: Iterable[tuple[str, Any]]) -> float:
             path += math.dist((ball.x, ball.y), last)
         last = (ball.x, ball.y)
     return path
+
+
+def truth_clock_offset(truths: Sequence[GroundTruth], frames: Iterable[DetectionFrame]) -> float:
+    """The served simulator's truth clock less our match clock (s): the served clock runs from its
+    own start, ours from the first frame our match played on (both in whole seconds of Unix time
+    on the wire), so they differ by how long the served simulator ran before; taken from the first
+    of our detection ``frames`` whose frame number the ``truths`` have (0 when none has)."""
+    at = {g.frame_number: g.t for g in truths}
+    for frame in frames:
+        if frame.frame_number in at:
+            return round(at[frame.frame_number] - frame.t_capture, 3)  # (whole seconds, less float rounding)
+    return 0.0
 
 
 @dataclass(frozen=True)
@@ -314,7 +332,10 @@ def league_row(name: str, folder: Path, settings: Settings, truth_log: Path | No
     roll = summary["tracker"][ours].get("physics", {}).get("ball_roll", {})
     truth = None
     if truth_log is not None:
-        truth = truth_goals((m for _topic, _t, m in read_log(truth_log, {"/truth"})), pitch, states, end_t)
+        truths = [m for _topic, _t, m in read_log(truth_log, {"/truth"})]
+        offset = truth_clock_offset(truths, (m for t, m in events if t.startswith("ssl/vision/")))
+        on_truth = [dataclasses.replace(g, t=g.t + offset) for g in states]
+        truth = truth_goals(truths, pitch, on_truth, end_t + offset)
     tried = passes["tried"]
     return {
         "name": name,

@@ -21,6 +21,7 @@ from cmdragons.bench.league import (
     peer_script,
     rules_stoppage_s,
     stoppages,
+    truth_clock_offset,
     truth_goals,
     vision_goals,
 )
@@ -87,6 +88,23 @@ def test_goals_in_the_truth_count_only_while_the_referee_has_the_ball_in_play_an
     assert truth_goals(truths, FIELD, states, until=6.5) == 1
     assert truth_goals(truths, FIELD, states) == 2
     assert truth_goals(truths, FIELD, states[1:]) == 2  # nothing before the referee's first word
+
+
+def test_a_goal_in_the_truth_is_judged_by_the_referees_word_before_its_frame() -> None:
+    """The referee calls a goal in the frame the ball crosses: its stop of that frame follows the goal."""
+    path = [(0.0, 0.0), (4.0, 0.2), (PAST_GOAL_X, 0.2), (PAST_GOAL_X, 0.2)]
+    truths = [GroundTruth(k, k / 60, BallTruth(x, y, 0.0, 0.0, 0.0)) for k, (x, y) in enumerate(path)]
+    states = [GameState(0.0, RefereeCommand.NORMAL), GameState(2 / 60 - 1e-7, RefereeCommand.STOP)]  # (float rounding)
+    assert truth_goals(truths, FIELD, states) == 1
+
+
+def test_the_served_truths_clock_is_matched_to_ours_by_frame_number() -> None:
+    """The served simulator's clock ran 3 s before our match's first frame: the offset between its
+    truth and our detections of the same frame (times as read off the wire, a little rounded)."""
+    truths = [GroundTruth(k, 3.0 + k / 60, BallTruth(0.0, 0.0, 0.0, 0.0, 0.0)) for k in range(180, 240)]
+    ours = [DetectionFrame(0, k, k / 60 + 7e-8, k / 60, ()) for k in (150, 200, 201)]
+    assert truth_clock_offset(truths, ours) == 3.0
+    assert truth_clock_offset(truths, ours[:1]) == 0.0  # no frame in common
 
 
 def test_stoppages_run_from_a_stop_to_the_next_start_and_the_match_end_closes_the_last() -> None:

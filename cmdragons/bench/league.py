@@ -17,6 +17,8 @@ What a row says, all from the match's summary.json and run.mcap (what our stages
   (the true ball across a goal line, both ends together, while the ball was in play by the referee
   and within the match: :func:`truth_goals`);
 - fouls per team; own collisions (the autoref's count from tracks, :class:`sim.autoref.OwnContacts`);
+- the first kickoff: how long until play ran, and whether it was taken (a normal start) or forced
+  after the rules' time (:func:`first_start`); how far the ball was played (:func:`ball_in_play_m`);
 - stoppages (play not running: from a stop to the next normal or force start): how many, how many
   restarted before the match ended, the longest, and how many took longer than the rules allow
   (:func:`rules_stoppage_s`);
@@ -66,8 +68,9 @@ from sim.autoref import BallCrossing, KickDetector, observed
 from sim.referee_params import RefereeParams
 from sim.restarts import defender_of, other
 
-__all__ = ["OPPONENTS", "PEERS", "Peer", "Stoppages", "league_row", "match_row", "peer_script", "rules_stoppage_s",
-           "run", "seen_passes", "stoppages", "truth_goals", "vision_goals"]
+__all__ = ["OPPONENTS", "PEERS", "Peer", "Stoppages", "ball_in_play_m", "first_start", "league_row", "match_row",
+           "peer_script", "rules_stoppage_s", "run", "seen_passes", "stoppages", "truth_clock_offset", "truth_goals",
+           "vision_goals"]
 
 OPPONENTS = ("self", "none")  # whom our team plays: itself in the other colour, or the simulator's idle robots
 _OTHER: dict[Team, Team] = {"blue": "yellow", "yellow": "blue"}
@@ -154,22 +157,73 @@ def vision_goals(messages: Iterable[tuple[str, Any]], pitch: Field) -> dict[Team
     return goals
 
 
+_SAME_FRAME_S = 1e-3  # two clocks' times this near are one frame's (frames 1/60 s apart; times off by float rounding)
+
+
 def truth_goals(truths: Iterable[GroundTruth], pitch: Field, states: Sequence[GameState] | None = None,
                 until: float = math.inf) -> int:
     """Goals in a simulator's truth, both ends: the true ball across a goal line between the posts; with
     the referee's game ``states`` (in time order, on the truth's clock) only while the ball was in play
     by them and from the first of them, and none after ``until`` (s; the match's last frame): the
-    simulator runs on before a team joins and after it leaves, when no referee counts a goal."""
+    simulator runs on before a team joins and after it leaves, when no referee counts a goal. The
+    state in force at a truth frame is the last one given before it: the referee's word of the same
+    frame (within :data:`_SAME_FRAME_S`) already follows what it saw there, the goal's stop included."""
     crossing = BallCrossing(pitch)
     states = states or ()
     game: GameState | None = None if states else GameState(0.0, RefereeCommand.NORMAL)
     goals = k = 0
     for g in truths:
-        while k < len(states) and states[k].t <= g.t:
+        while k < len(states) and states[k].t < g.t - _SAME_FRAME_S:
             game, k = states[k], k + 1
         seen = crossing.see(g.t, g.ball.x, g.ball.y, -1, None)
         goals += isinstance(seen, Goal) and game is not None and _in_play(game) and g.t <= until
     return goals
+
+
+def first_start(states: Iterable[GameState]) -> tuple[float | None, bool]:
+    """The match's first kickoff: how long (s) from the first game state until play first ran, and
+    whether it was taken (a normal start: the kicker moved the ball) rather than forced after the
+    rules' time (None, False: play never ran)."""
+    t0: float | None = None
+    for g in states:
+        t0 = g.t if t0 is None else t0
+        if g.command.running:
+            return g.t - t0, g.command == RefereeCommand.NORMAL
+    return None, False
+
+
+def ball_in_play_m(messages: Iterable[tuple[str, Any]]) -> float:
+    """How far the ball was played (m): the path of the autoref's tracked ball (``world/autoref``)
+    while play ran by the referee (``referee``: a normal or force start), from where it was last
+    seen to where it is seen next; a ball the referee placed while play stood (a restart's
+    teleport) does not count."""
+    last: tuple[float, float] | None = None  # where the ball was last seen while play ran
+    running = False
+    path = 0.0
+    for topic, m in messages:
+        if topic == "referee":
+            running = m.command.running
+            last = last if running else None
+            continue
+        ball = m.ball
+        if not running or ball is None or not ball.visible:
+            continue
+        if last is not None:
+            path += math.dist((ball.x, ball.y), last)
+        last = (ball.x, ball.y)
+    return path
+
+
+def truth_clock_offset(truths: Sequence[GroundTruth], frames: Iterable[DetectionFrame]) -> float:
+    """The served simulator's truth clock less our match clock (s): the served clock runs from its
+    own start, ours from the first frame our match played on (both in whole seconds of Unix time
+    on the wire), so they differ by how long the served simulator ran before; taken from the first
+    of our detection ``frames`` whose frame number the ``truths`` have (0 when none has)."""
+    at = {g.frame_number: g.t for g in truths}
+    for frame in frames:
+        if frame.frame_number in at:
+            return round(at[frame.frame_number] - frame.t_capture, 3)  # (whole seconds, less float rounding)
+    return 0.0
 
 
 @dataclass(frozen=True)
@@ -270,13 +324,18 @@ def league_row(name: str, folder: Path, settings: Settings, truth_log: Path | No
     states = [m for t, m in events if t == "referee"]
     end_t = max((m.t for t, m in events if t == "world/autoref"), default=0.0)
     stops = stoppages(states, end_t, rules_stoppage_s(played.sim.referee))
+    kickoff_s, kickoff_taken = first_start(states)
+    ball_m = ball_in_play_m((t, m) for t, m in events if t in ("referee", "world/autoref"))
     passes = seen_passes(((t, m) for t, m in events if not t.startswith("ssl/vision/")), ours, played)
     fouls = summary["rules"]["fouls"]
     contacts = summary["collisions"]["own"]
     roll = summary["tracker"][ours].get("physics", {}).get("ball_roll", {})
     truth = None
     if truth_log is not None:
-        truth = truth_goals((m for _topic, _t, m in read_log(truth_log, {"/truth"})), pitch, states, end_t)
+        truths = [m for _topic, _t, m in read_log(truth_log, {"/truth"})]
+        offset = truth_clock_offset(truths, (m for t, m in events if t.startswith("ssl/vision/")))
+        on_truth = [dataclasses.replace(g, t=g.t + offset) for g in states]
+        truth = truth_goals(truths, pitch, on_truth, end_t + offset)
     tried = passes["tried"]
     return {
         "name": name,
@@ -287,6 +346,8 @@ def league_row(name: str, folder: Path, settings: Settings, truth_log: Path | No
         "fouls_ours_by_kind": ", ".join(f"{k.replace('_', ' ')} {n}" for k, n in fouls[ours].items()
                                         if k != "total") or "none",
         "own_collisions_ours": contacts[ours], "own_collisions_theirs": contacts[theirs] if theirs in teams else None,
+        "first_kickoff_s": None if kickoff_s is None else round(kickoff_s, 2), "first_kickoff_taken": kickoff_taken,
+        "ball_in_play_m": round(ball_m, 2),
         "stoppages": stops.count, "stoppages_restarted": stops.restarted,
         "longest_stoppage_s": round(stops.longest_s, 2), "stoppages_over_rules": stops.over_limit,
         "frames": summary["frames"], "frames_behind": summary["frames_behind"],

@@ -48,12 +48,12 @@ def play_outside(args: argparse.Namespace, stop: Interrupt, compile_kernels: Cal
         SimulatorKind,
         field_settings,
         listen,
+        outside_settings,
         vision_params,
     )
     from cmdragons.runtime.overlay import MatchVideoStage
     from cmdragons.runtime.report import ReportStage
     from cmdragons.runtime.scene import SceneStage
-    from cmdragons.runtime.settings import load_settings
     from cmdragons.runtime.ssl.udp import MulticastReceiver
     from cmdragons.runtime.stages import LoggerStage, Tap
     from cmdragons.runtime.warmup import warm_team
@@ -64,7 +64,7 @@ def play_outside(args: argparse.Namespace, stop: Interrupt, compile_kernels: Cal
         return 2
     kind = SimulatorKind(args.simulator)
     overrides = list(args.set) + ([f"sim.referee.rules={args.rules}"] if args.rules else [])
-    settings = load_settings(args.config, overrides)
+    settings = outside_settings(args.config, overrides)
     ours = args.team
     teams = [ours, _OTHER[ours]] if args.opponent == "self" else [ours]
     p = vision_params(settings.protocols, kind)

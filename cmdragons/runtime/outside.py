@@ -11,8 +11,9 @@ software would have it:
 - the field: the geometry the simulator sends (its size, goals and defense areas), which our
   planner, strategy and referee play on (:func:`field_settings`; a difference from field.yaml is
   one line on stderr);
-- the clock: vision's capture time. The frame loop waits for the simulator's packets (a frame is
-  the tracker's step on them), and ``--seconds`` is match time on that clock;
+- the clock: vision's capture time, from the whole second of the first frame the match plays on.
+  The frame loop waits for the simulator's packets (a frame is the tracker's step on them), and
+  ``--seconds`` is match time on that clock;
 - commands: grSim packets to its command port, resent on each vision frame (grSim stops a robot
   whose last packet is older than one of its frames), or the simulation protocol (each team's
   ``RobotControl`` to its port, teleports as ``SimulatorCommand`` to the control port).
@@ -56,7 +57,7 @@ from cmdragons.runtime.stages import SummaryCollector, Tap, TeamStage, TimingSta
 from sim.substitution import RobotCount
 
 __all__ = ["FrameGate", "Heard", "OutsideError", "OutsideMatch", "SimulatorKind", "beyond_division", "field_settings",
-           "listen", "outside_summary", "outside_wiring", "take_off", "vision_params"]
+           "listen", "outside_settings", "outside_summary", "outside_wiring", "take_off", "vision_params"]
 
 
 class SimulatorKind(enum.Enum):
@@ -140,7 +141,6 @@ class Heard:
     cameras: tuple[int, ...]
     packets: int
     robots: tuple[tuple[Team, int], ...] = ()  # (team, id) of every robot seen
-    epoch: UnixEpoch = UnixEpoch()  # the simulator's clock -> match time (grSim's counts from 0, others' Unix)
 
     @property
     def uncalibrated(self) -> tuple[int, ...]:
@@ -159,7 +159,6 @@ def listen(receiver: Any, timeout_s: float, learn_s: float, where: str,
     robots: set[tuple[Team, int]] = set()
     packets = undecodable = 0
     t_first: float | None = None  # when the first detection came
-    epoch = UnixEpoch()
     while True:
         now = clock()
         if geometry is not None and t_first is not None and now - t_first >= learn_s:
@@ -183,11 +182,11 @@ def listen(receiver: Any, timeout_s: float, learn_s: float, where: str,
             geometry = geo
         if det is not None:
             if t_first is None:
-                t_first, epoch = clock(), UnixEpoch.of_first(det.t_capture)
+                t_first = clock()
             seen.add(det.camera_id)
             robots.update((r.team, r.id) for r in det.robots)
     assert geometry is not None
-    return Heard(geometry, tuple(sorted(seen)), packets, tuple(sorted(robots)), epoch)
+    return Heard(geometry, tuple(sorted(seen)), packets, tuple(sorted(robots)))
 
 
 def beyond_division(robots: Sequence[tuple[Team, int]], per_team: int) -> tuple[tuple[Team, int], ...]:
@@ -247,18 +246,39 @@ def field_settings(settings: Settings, geometry: VisionGeometry) -> tuple[Settin
     return dataclasses.replace(settings, field=new), line
 
 
+_BRAKE_KEY = "field.robot.max_brake_m_s2"
+
+
+def outside_settings(config: str | None, overrides: Sequence[str]) -> Settings:
+    """The settings of a match in an outside simulator: ``config`` with ``overrides`` (play's --config
+    and --set), the robots' braking the simulator's as far as our team knows before our tracker
+    measured it (``protocols.outside.robot_max_brake_m_s2``; field.yaml's robot is our own
+    simulator's): motion control brakes for it, the safety search keeps two robots apart by it, and
+    the tracker's measurement replaces it once confident and off it. A --set of field.yaml's
+    braking itself stays as given."""
+    from cmdragons.runtime.settings import load_settings
+
+    settings = load_settings(config, overrides)
+    brake = settings.protocols.outside.robot_max_brake_m_s2
+    if brake <= 0.0 or any(o.partition("=")[0].strip() == _BRAKE_KEY for o in overrides):
+        return settings
+    return load_settings(config, [f"{_BRAKE_KEY}={brake!r}", *overrides])
+
+
 def outside_wiring(settings: Settings, kind: SimulatorKind, teams: Sequence[Team], cameras: Sequence[int],
-                   receiver: Any, robots: Sequence[tuple[Team, int]],
-                   epoch: UnixEpoch | None = None) -> list[Entry]:
+                   receiver: Any, robots: Sequence[tuple[Team, int]]) -> list[Entry]:
     """The table of a match in an outside simulator: the simulator's SSL-Vision packets (``cameras``,
     read from ``receiver``) into each of our ``teams``' tracker and brain, their commands out to
-    the simulator (``kind``; the referee's teleports through the first team's stage). The referee:
+    the simulator (``kind``; the referee's teleports through the first team's stage). Match time
+    counts from the first packet the match plays on (its whole second): how long the simulator's
+    clock ran while the team listened and was built is no match time (the referee's first kickoff
+    was most of its time gone when the team first saw it). The referee:
     ours on the tracked world (the autoref, for the match's ``robots``), or a game controller's
     packets with ``protocols.referee.source: game_controller``."""
     p = vision_params(settings.protocols, kind)
     topics = [f"ssl/vision/{c}" for c in cameras]
     entries = [Entry(VisionInStage.declare(p, cameras, False), "",
-                     lambda: VisionInStage(p, cameras, lockstep=False, receiver=receiver, epoch=epoch))]
+                     lambda: VisionInStage(p, cameras, lockstep=False, receiver=receiver))]
     referee, referee_topic, teleports = _referee(settings, p, teams[0], topics, robots)
     entries += referee
     chip = settings.sim.kicker.chip_angle_rad
@@ -331,7 +351,7 @@ class OutsideMatch:
         self.t0: float | None = None  # the first world state's capture time (s, the simulator's clock)
         self.t = math.nan  # the newest
         self.frames_waited_out = 0  # frames whose vision did not come within the wait
-        table = outside_wiring(settings, kind, teams, heard.cameras, self.gate, heard.robots, heard.epoch)
+        table = outside_wiring(settings, kind, teams, heard.cameras, self.gate, heard.robots)
         self.table = table
         watch = Tap("outside/clock", (f"world/{teams[0]}",), self._world)
         for stage in build(table, [*extra, watch, self._summaries]):

@@ -15,21 +15,26 @@ import pytest
 from cmdragons.bench.league import (
     PEERS,
     Stoppages,
+    ball_in_play_m,
+    first_start,
     match_row,
     peer_script,
     rules_stoppage_s,
     stoppages,
+    truth_clock_offset,
     truth_goals,
     vision_goals,
 )
 from cmdragons.messages import (
     BallDetection,
+    BallState,
     BallTruth,
     DetectionFrame,
     GameStage,
     GameState,
     GroundTruth,
     RefereeCommand,
+    WorldState,
 )
 from cmdragons.runtime.settings import load_settings
 
@@ -85,6 +90,23 @@ def test_goals_in_the_truth_count_only_while_the_referee_has_the_ball_in_play_an
     assert truth_goals(truths, FIELD, states[1:]) == 2  # nothing before the referee's first word
 
 
+def test_a_goal_in_the_truth_is_judged_by_the_referees_word_before_its_frame() -> None:
+    """The referee calls a goal in the frame the ball crosses: its stop of that frame follows the goal."""
+    path = [(0.0, 0.0), (4.0, 0.2), (PAST_GOAL_X, 0.2), (PAST_GOAL_X, 0.2)]
+    truths = [GroundTruth(k, k / 60, BallTruth(x, y, 0.0, 0.0, 0.0)) for k, (x, y) in enumerate(path)]
+    states = [GameState(0.0, RefereeCommand.NORMAL), GameState(2 / 60 - 1e-7, RefereeCommand.STOP)]  # (float rounding)
+    assert truth_goals(truths, FIELD, states) == 1
+
+
+def test_the_served_truths_clock_is_matched_to_ours_by_frame_number() -> None:
+    """The served simulator's clock ran 3 s before our match's first frame: the offset between its
+    truth and our detections of the same frame (times as read off the wire, a little rounded)."""
+    truths = [GroundTruth(k, 3.0 + k / 60, BallTruth(0.0, 0.0, 0.0, 0.0, 0.0)) for k in range(180, 240)]
+    ours = [DetectionFrame(0, k, k / 60 + 7e-8, k / 60, ()) for k in (150, 200, 201)]
+    assert truth_clock_offset(truths, ours) == 3.0
+    assert truth_clock_offset(truths, ours[:1]) == 0.0  # no frame in common
+
+
 def test_stoppages_run_from_a_stop_to_the_next_start_and_the_match_end_closes_the_last() -> None:
     states = [
         GameState(0.0, RefereeCommand.KICKOFF, "blue", ready=False),  # 0-5 s: the first kickoff
@@ -100,6 +122,36 @@ def test_stoppages_run_from_a_stop_to_the_next_start_and_the_match_end_closes_th
     assert stoppages(states, 60.0, 10.0) == Stoppages(count=3, restarted=2, longest_s=14.0, over_limit=2)
     # without the match's end in the states, the stop lasts to the end given
     assert stoppages(states[:-1], 60.0, 10.0) == Stoppages(count=3, restarted=2, longest_s=15.0, over_limit=2)
+
+
+def test_the_first_kickoff_is_taken_by_a_normal_start_and_forced_by_a_force_start() -> None:
+    taken = [GameState(0.2, RefereeCommand.KICKOFF, "blue"), GameState(3.0, RefereeCommand.KICKOFF, "blue"),
+             GameState(3.4, RefereeCommand.NORMAL), GameState(9.0, RefereeCommand.STOP),
+             GameState(10.0, RefereeCommand.FORCE_START)]
+    assert first_start(taken) == (pytest.approx(3.2), True)
+    forced = [GameState(0.0, RefereeCommand.KICKOFF, "blue"), GameState(10.0, RefereeCommand.FORCE_START)]
+    assert first_start(forced) == (10.0, False)
+    assert first_start(forced[:1]) == (None, False) and first_start([]) == (None, False)
+
+
+def _world(t: float, xy: tuple[float, float] | None, visible: bool = True) -> tuple[str, WorldState]:
+    ball = None if xy is None else BallState(xy[0], xy[1], 0.0, 0.0, visible)
+    return "world/autoref", WorldState(t, ball)
+
+
+def test_the_ball_is_played_as_far_as_it_went_while_play_ran() -> None:
+    stream = [
+        _game(0.0, RefereeCommand.KICKOFF),
+        _world(0.0, (0.0, 0.0)), _world(0.1, (0.0, 0.0)),  # lying at the kickoff: nothing
+        _game(0.2, RefereeCommand.NORMAL),
+        _world(0.2, (0.3, 0.4)), _world(0.3, (0.6, 0.8)),  # 0.5 m played
+        _world(0.4, None), _world(0.5, (1.0, 0.8), visible=False), _world(0.6, (0.6, 1.8)),  # lost: 1 m once seen
+        _game(0.7, RefereeCommand.STOP),
+        _world(0.7, (-4.0, 0.0)), _world(0.8, (-4.0, 1.0)),  # placed by the referee: not played
+        _game(0.9, RefereeCommand.FORCE_START),
+        _world(0.9, (-4.0, 1.5)), _world(1.0, (-4.0, 2.0)),  # 0.5 m played
+    ]
+    assert ball_in_play_m(stream) == pytest.approx(2.0)
 
 
 def test_the_rules_time_of_a_stoppage_adds_each_phase_it_may_pass_through() -> None:
@@ -159,8 +211,13 @@ def _grsim_found() -> str | None:
 @pytest.mark.slow
 @pytest.mark.skipif(_grsim_found() is not None, reason=f"grSim not found: {_grsim_found()}")
 def test_the_grsim_row_plays_in_grsim_and_its_goals_are_those_grsims_vision_shows(tmp_path: Path) -> None:
-    row = match_row(load_settings(), next(p for p in PEERS if p.name == "grsim"), "B", "none", 15.0, tmp_path)
+    """Against grSim's idle robots, two halves of 10 s (the second half's kickoff is theirs, forced
+    after the rules' 10 s): our first kickoff is taken (it once ran out before our team's first
+    frame), the ball is played, and the goals our autoref called are those grSim's vision shows."""
+    row = match_row(load_settings(), next(p for p in PEERS if p.name == "grsim"), "B", "none", 10.0, tmp_path)
     assert "failed" not in row, row
+    assert row["first_kickoff_taken"], row
+    assert row["ball_in_play_m"] > 1.0, row  # (a ball never moved would make the goals' check 0 = 0)
     assert row["goals_ours"] + row["goals_theirs"] == row["goals_vision_ours"] + row["goals_vision_theirs"]
-    assert row["goals_truth"] is None and row["match_s"] >= 30.0
+    assert row["goals_truth"] is None and row["match_s"] >= 20.0
     assert os.path.exists(tmp_path / "grsim_B_none" / "ours" / "summary.json")

@@ -256,8 +256,9 @@ def test_a_league_simulator_answers_our_commands_with_the_robots_id(name: str) -
 
 def test_a_live_receiver_takes_a_senders_clock_from_its_first_packet() -> None:
     """grSim stamps its frames with its simulation time, SSL-Vision with Unix time: the receiver
-    from outside takes the first packet's epoch, so both read as match time near 0."""
-    for first_t, want in ((5.6, 5.6), (EPOCH.to_unix(0.25), 0.25)):
+    from outside takes the first packet's epoch, so both read as match time near 0 (grSim's clock
+    counts from its own start, long before a match may begin)."""
+    for first_t, want in ((47.6, 0.6), (EPOCH.to_unix(0.25), 0.25)):
         queue = DatagramQueue()
         stage = VisionInStage(load_settings().protocols, [0], lockstep=False, receiver=queue)
         w = wrap_pb.SSL_WrapperPacket()

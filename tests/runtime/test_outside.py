@@ -23,23 +23,25 @@ from cmdragons import messages as msg
 from cmdragons.bench.league import PEERS, peer_script
 from cmdragons.geometry import Field
 from cmdragons.runtime.log import read_log
-from cmdragons.runtime.match import CLOCK
+from cmdragons.runtime.match import CLOCK, Match
 from cmdragons.runtime.outside import (
     FrameGate,
     OutsideError,
     SimulatorKind,
     field_settings,
     listen,
+    outside_settings,
     outside_wiring,
     vision_params,
 )
 from cmdragons.runtime.proto import grsim_pb2 as grsim_pb
 from cmdragons.runtime.settings import load_settings
-from cmdragons.runtime.ssl.clock import UnixEpoch, run_epoch
+from cmdragons.runtime.ssl.clock import UnixEpoch
 from cmdragons.runtime.ssl.stages import CommandsOutStage
 from cmdragons.runtime.ssl.udp import DatagramQueue, UdpEndpoint
 from cmdragons.runtime.ssl.vision import decode_wrapper, geometry_packet
 from cmdragons.runtime.ssl.vision import detection_packet as packet
+from cmdragons.runtime.stages import Tap
 from cmdragons.runtime.topics import check_wiring
 from tests.runtime.conftest import free_udp_ports
 
@@ -92,14 +94,30 @@ def test_listening_learns_the_cameras_that_send_and_the_geometry() -> None:
     settings = load_settings()
     geometry = geometry_packet(settings.field_geometry(), settings.camera_models())  # calibrates cameras 0 and 1
     heard = listen(_queue(_det(3, 1), _det(7, 1), geometry, _det(3, 2)), 5.0, 0.1, "here", _clock(0.01))
-    assert heard.robots == () and heard.epoch == UnixEpoch(0)  # a clock from 0, as grSim's, is match time
-    # Unix time: match time from the first packet's whole second on
-    unix = listen(_queue(geometry, _det(3, 1, None)), 5.0, 0.1, "here", _clock(0.01)).epoch
-    assert unix == UnixEpoch(run_epoch().epoch_s + 10)
+    assert heard.robots == ()
     assert heard.cameras == (3, 7)
     assert heard.geometry.field_length_m == pytest.approx(9.0)
     assert heard.packets == 4
     assert heard.uncalibrated == (3, 7)
+
+
+@pytest.mark.parametrize("epoch", [FROM_ZERO, None], ids=["grsim_clock", "unix_time"])
+def test_match_time_starts_at_the_first_frame_the_match_plays_on(epoch: UnixEpoch | None) -> None:
+    """grSim's clock counts from its own start, SSL-Vision's is Unix time: either way the first frame
+    the match plays on (those that came while the team listened and was built passed over, as
+    :meth:`OutsideMatch.skip_stale` does) is at match time 0 within its whole second, as the
+    referee's first kickoff is (it was 7.6 s in, of the kickoff's 10, on an idle machine)."""
+    gate = FrameGate(DatagramQueue())
+    table = outside_wiring(load_settings(), SimulatorKind.GRSIM, ["blue"], [0], gate, [("blue", 0)])
+    vision = next(e for e in table if e.contract.name == "ssl/vision_in").build()
+    for frame in (1, 60, 120):  # the simulator's clock at 10 s to 12 s while the team is built
+        gate.receiver.push(_det(0, frame, epoch))
+    gate.drain()  # passed over, as skip_stale does
+    gate.receiver.push(_det(0, 2430, epoch))  # its clock at 50.5 s: the match's first frame
+    got: list[Any] = []
+    vision.on_message("clock", msg.Tick(0), lambda _topic, m: got.append(m))
+    assert [d.frame_number for d in got] == [2430] and 0.0 <= got[0].t_capture < 1.0
+    assert got[0].t_capture == pytest.approx(0.5, abs=1e-6)
 
 
 def test_no_geometry_or_detections_in_time_is_an_error_naming_where_it_listened() -> None:
@@ -137,6 +155,41 @@ def test_the_field_is_the_simulators_and_a_difference_is_one_line() -> None:
     played, line = field_settings(b, lab)
     assert played.field.division == "B" and (played.field.dims.length_m, played.field.dims.width_m) == (5.54, 4.0)
     assert line is not None and "(field.yaml B)" not in line and "width 4.000 m (field.yaml 6.000)" in line
+
+
+def test_an_outside_simulators_robots_brake_as_configured_for_it_until_measured() -> None:
+    """field.yaml's robot is our own simulator's (braking 6 m/s²); in an outside simulator the team
+    assumes protocols.outside's braking (grSim's robots brake at about 3.7) in motion control, the safety
+    search and as the tracker's configured value, until it measured the robots; a --set of
+    field.yaml's braking stays as given, and 0 keeps field.yaml's."""
+    own = load_settings()
+    assert own.field.robot.max_brake_m_s2 == 6.0
+    s = outside_settings(None, [])
+    brake = own.protocols.outside.robot_max_brake_m_s2
+    assert 0.0 < brake < 6.0 and s.field.robot.max_brake_m_s2 == brake
+    assert s.control.motion.max_brake_m_s2 == brake and s.tracker.physics.max_brake_m_s2 == brake
+    assert s.field.robot.max_accel_m_s2 == own.field.robot.max_accel_m_s2  # nothing else of the robot changes
+    assert outside_settings(None, ["field.robot.max_brake_m_s2=5.0"]).control.motion.max_brake_m_s2 == 5.0
+    assert outside_settings(None, ["protocols.outside.robot_max_brake_m_s2=0"]).control.motion.max_brake_m_s2 == 6.0
+
+
+def _own_contacts(settings: Any, seconds: float) -> list[tuple[Any, Any]]:
+    events: list[msg.SimEvents] = []
+    Match(settings, "self", "truth", seed=1, extra=[Tap("events", ("events",), lambda _t, e: events.append(e))]).run(
+        seconds)
+    return [(c.a, c.b) for e in events for c in e.events if isinstance(c, msg.Contact) and c.a[0] == c.b[0]]
+
+
+def test_in_grsims_world_the_braking_assumed_keeps_our_robots_apart() -> None:
+    """grSim's first kickoff played in our own simulator made grSim's world (its robots braking at
+    3.6 m/s² as our tracker measured grSim's, sim.world_robot_max_brake_m_s2): from the teleported
+    formation blue's defenders 1 and 2 run at each other toward their places 0.32 m apart.
+    Believing field.yaml's 6 m/s² they brake too late and meet (as in grSim, 1 s in); with the
+    braking an outside simulator's robots are assumed to have (:func:`outside_settings`) they stop
+    apart, and nobody else meets either."""
+    grsim_world = ["sim.world_robot_max_brake_m_s2=3.6"]
+    assert (("blue", 1), ("blue", 2)) in _own_contacts(load_settings(None, grsim_world), 3.0)
+    assert _own_contacts(outside_settings(None, grsim_world), 3.0) == []
 
 
 @pytest.mark.parametrize("kind", [SimulatorKind.GRSIM, SimulatorKind.SIM_PROTOCOL])

@@ -18,16 +18,16 @@ import math
 import time
 from dataclasses import dataclass
 
-__all__ = ["UNIX_FROM_S", "UnixEpoch", "run_epoch"]
+__all__ = ["UnixEpoch", "run_epoch"]
 
-UNIX_FROM_S = 1e9  # a sender's time at or after this (2001-09-09) is Unix time; below, a clock from 0
 _US = 1_000_000
 _NS = 1_000_000_000
 
 
 @dataclass(frozen=True)
 class UnixEpoch:
-    """Match time <-> Unix time: ``unix_s = match_s + epoch_s``."""
+    """Match time <-> Unix time: ``unix_s = match_s + epoch_s`` (a sender whose clock counts from
+    its own start, grSim's simulation time: its time for Unix time)."""
 
     epoch_s: int = 0  # whole seconds: the Unix time of match time 0
 
@@ -54,9 +54,9 @@ class UnixEpoch:
     @staticmethod
     def of_first(t_s: float) -> UnixEpoch:
         """The epoch that makes a sender's first time ``t_s`` (s) the start of match time: its
-        whole second when it is Unix time, 0 for a clock that counts from 0 (grSim's simulation
-        time)."""
-        return UnixEpoch(math.floor(t_s) if t_s >= UNIX_FROM_S else 0)
+        whole second, Unix time or a clock that counts from the sender's own start (grSim's
+        simulation time: how long grSim ran before the match began is no match time)."""
+        return UnixEpoch(math.floor(t_s))
 
 
 @functools.cache

@@ -99,6 +99,9 @@ class OutsideParams(Validated):
     geometry_timeout_s: float = setting(10.0, lo=0.1, hi=600.0)  # before the match: its geometry must come by then
     learn_s: float = setting(0.5, lo=0.0, hi=60.0)  # its cameras: those heard this long from the first detection on
     frame_wait_s: float = setting(2.0, lo=0.01, hi=600.0)  # no vision for this long ends the match
+    # the simulator's robots brake this hard (m/s²) as far as our team knows until our tracker measured it
+    # (field.yaml's robot is our own simulator's); 0: field.yaml's
+    robot_max_brake_m_s2: float = setting(3.5, lo=0.0, hi=50.0)
 
 
 @dataclass(frozen=True)

@@ -152,7 +152,7 @@ class VisionInStage(SocketStage):
     """SSL-Vision packets from multicast -> ``ssl/vision/<camera id>`` detections (metres), the
     latest geometry kept. ``lockstep``: fed by our own sender in this match (see the module).
     Times: the packets' less ``epoch``; by default our sender's in lock-step, else the first
-    packet's second (a sender's clock from 0, grSim's, is taken as it is)."""
+    packet's whole second (Unix time, or a clock from the sender's start: grSim's)."""
 
     @staticmethod
     def declare(params: ProtocolParams, camera_ids: Sequence[int], lockstep: bool) -> Contract:
@@ -165,8 +165,8 @@ class VisionInStage(SocketStage):
                  err: TextIO | None = None, receiver: Receiver | None = None, epoch: UnixEpoch | None = None,
                  camera_clock: bool | None = None) -> None:
         v = params.vision
-        # lock-step: our own sender's epoch; from outside: given, or the first packet's (a sender's clock
-        # from 0, grSim's, stays as it is; Unix time becomes match time from that packet's second)
+        # lock-step: our own sender's epoch; from outside: given, or the first packet's (the sender's time,
+        # Unix or grSim's from its start, becomes match time from that packet's second)
         self.epoch: UnixEpoch | None = run_epoch() if epoch is None and lockstep else epoch
         self.camera_clock = lockstep if camera_clock is None else camera_clock  # our own packets: exact times
         self.receiver: Receiver = receiver if receiver is not None else MulticastReceiver(

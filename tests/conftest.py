@@ -1,13 +1,14 @@
 """The suite's start: on a fresh clone (no numba cache) run in parallel, the play's kernels are
-compiled once, before the workers start, instead of once in every worker that meets them at the
-same time; and the files that hold slow tests run first, so that a parallel run ends on short tests
-(every worker busy to the end) rather than on a long match that one worker plays while the other
-has nothing left. ``-n auto`` starts two workers more than the machine has CPUs: about a quarter of
-the suite's wall time is real-time play (served, grSim and outside matches) waiting on the clock,
-in which a worker uses little CPU (on 2 CPUs, warm: 5:12 with 2 workers, 3:54 with 4). The workers
-already share the CPUs, so BLAS runs one thread in each: OpenBLAS's own threads, one per CPU in every
-worker and in every command a test starts, spin while they wait (tests/vision/test_field_lines.py and
-tests/estimation: 49-53 CPU-s with them, 30-32 without, the same wall time)."""
+compiled once, before the workers start, instead of once in every worker that meets them at the same
+time; and the files that hold slow tests run first, so that a parallel run ends on short tests
+(every worker busy to the end) rather than on a long match that one worker plays while the other has
+nothing left; unless ``--dist`` says otherwise, an idle worker steals from the busiest. ``-n auto``
+starts two workers more than the machine has CPUs: about a quarter of the suite's wall time is real-
+time play (served, grSim and outside matches) waiting on the clock, in which a worker uses little
+CPU (on 2 CPUs, warm: 5:12 with 2 workers, 3:54 with 4). The workers already share the CPUs, so BLAS
+runs one thread in each: OpenBLAS's own threads, one per CPU in every worker and in every command a
+test starts, spin while they wait (tests/vision/test_field_lines.py and tests/estimation: 49-53
+CPU-s with them, 30-32 without, the same wall time)."""
 
 from __future__ import annotations
 
@@ -41,6 +42,11 @@ def pytest_configure(config: pytest.Config) -> None:
     workers = getattr(config.option, "numprocesses", None)
     if hasattr(config, "workerinput") or not isinstance(workers, int) or workers < 2:
         return  # a worker, or one process: nothing would compile twice
+    if config.getoption("dist") == "load" and not any(a.startswith("--dist") for a in config.invocation_params.args):
+        # unless asked otherwise, an idle worker takes half of the busiest one's queue (xdist's
+        # `load` hands out the first quarter of the tests in fixed chunks, the slow files first
+        # among them: on 2 CPUs one worker ended 127 s after another; 3:47 -> 3:20 with stealing)
+        config.option.dist = "worksteal"
     subprocess.run([sys.executable, "-c", _WARM_UP, str(CONFIGS)], check=True)
 
 

@@ -7,8 +7,9 @@ A lab's field.yaml: a 5.54 x 3.77 m field, 45 mm tape, 84 mm balls; one 1280x800
 (the dots about as many pixels across as at 1920x1200 over the league's Division B field); the
 kickoff formation moved onto it.
 Tolerances: the issue's -- pose within 1 cm and 0.5 deg, the reported line error within 0.3 px of
-the error against the true line centres; robots found 99% with every id right, the ball 99%, no
-false detection; the cover with its dot taped over found in 95% of the frames.
+the error against the true line centres; robots found 99% with every id right (here 99.5%: the
+light followed on the carpet measured 99.9%, on the markers 99.5%), the ball 99%, no false
+detection; the cover with its dot taped over found in 95% of the frames.
 """
 
 from __future__ import annotations
@@ -91,7 +92,7 @@ def test_calibration_colours_and_detection_with_nothing_labelled(lab: Lab) -> No
             hidden_seen += 1
             hidden_found += any(r.team == ("blue", "yellow")[team] and r.id == rid for r in det.robots)
     got = score.summary()
-    assert got["robot_detection_rate"] >= 0.99 and got["id_accuracy"] == 1.0, got
+    assert got["robot_detection_rate"] >= 0.995 and got["id_accuracy"] == 1.0, got
     assert got["ball_detection_rate"] >= 0.99 and got["false_per_frame"] == 0.0, got
     assert hidden_seen > 0 and hidden_found >= 0.95 * hidden_seen
 

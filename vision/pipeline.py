@@ -31,6 +31,7 @@ from vision.cmvision import (
 )
 from vision.light import LightFollower, LightParams
 from vision.patterns import BallParams, PatternMatcher, PatternParams, RegionGeometry, detect_ball
+from vision.tune import AutoTuneParams
 
 __all__ = ["ColourRoles", "VisionParams", "VisionPipeline", "default_colours"]
 
@@ -73,6 +74,7 @@ class VisionParams(Validated):
     patterns: PatternParams = PatternParams()
     ball: BallParams = BallParams()
     light: LightParams = LightParams()  # colour classes that follow the light, per cell of a grid
+    auto_tune: AutoTuneParams = AutoTuneParams()  # what ``tune --auto`` takes for a marker, a dot and a ball
     # height of the pattern plane per team, m; a team left out: the robot height of configs/field.yaml
     robot_height_m: Mapping[Team, float] = field(default_factory=dict)
     # the field mask: a detection further than this past the field lines is dropped (m; null: the

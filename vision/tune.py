@@ -35,6 +35,7 @@ __all__ = [
     "AutoTuneReport",
     "Label",
     "auto_samples",
+    "hue_outliers",
     "learn_boxes",
     "boxes_from_samples",
     "keep_apart",
@@ -180,6 +181,10 @@ class AutoTuneParams(Validated):
     dot_distance_tolerance_m: float = setting(0.015, lo=0.001, hi=0.05)  # id dots from the centre dot
     inner_fraction: float = setting(0.6, lo=0.1, hi=1.0)  # sampled within this share of a blob's expected radius
     max_overlap: float = setting(0.01, lo=0.0, hi=1.0)  # share of a class's samples in another's box: warned
+    # a blob whose hue (its angle about grey in U, V) is further than this from its role's median blob's is
+    # left out (a pink dot taken for a blue centre dot by its U, an orange ball for a pink dot): the hue, not the
+    # brightness nor the saturation, since both scale with the light
+    max_hue_off_deg: float = setting(30.0, lo=1.0, hi=180.0)
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -198,6 +203,8 @@ class AutoTuneReport:
     # per role, how much darker and brighter the carpet gets over the field in view than it is
     # around the blobs sampled (the light's spread the role's box must reach)
     light: dict[str, tuple[float, float]]
+    # per role, the blobs left out because their hue is off the role's (``max_hue_off_deg``)
+    left_out: dict[str, int]
 
 
 @dataclass(frozen=True)
@@ -349,14 +356,28 @@ def auto_samples(images: Sequence[NDArray[np.uint8]], model: CameraModel, league
     back_all = {k: np.concatenate(v) for k, v in background.items()}
     y = back_all["carpet"][:, 0].astype(np.float64)
     dark, bright = (float(np.percentile(y, q)) for q in (0.5, 99.5))
-    light = {r: (min(1.0, dark / min(v)), max(1.0, bright / max(v))) for r, v in lit.items()}
-    return AutoTuneReport(samples, back_all, n_patterns, n_balls, light)
+    kept: dict[str, list[NDArray[np.int32]]] = {}
+    light: dict[str, tuple[float, float]] = {}
+    left_out: dict[str, int] = {}
+    for role in [r for r in samples if not r.endswith("/colour")]:
+        off = hue_outliers(np.concatenate(samples[role + "/colour"]).astype(np.float64), p.max_hue_off_deg)
+        parts = [part for part, o in zip(samples[role], off, strict=True) if not o]
+        if parts:
+            kept[role] = parts
+        if off.any():
+            left_out[role] = int(off.sum())
+        seen = np.array(lit[role])[~off]
+        seen = seen[np.isfinite(seen)]
+        if len(seen):
+            light[role] = (min(1.0, dark / float(seen.min())), max(1.0, bright / float(seen.max())))
+    return AutoTuneReport(kept, back_all, n_patterns, n_balls, light, left_out)
 
 
 def _take(samples: dict[str, list[NDArray[np.int32]]], lit: dict[str, list[float]], role: str, b: _Blob,
           r_px: float, labels: NDArray[np.int32], conv: NDArray[Any], light_img: NDArray[Any]) -> None:
     """Sample blob ``b`` for colour class ``role``: its pixels (in ``conv``'s colour space) within
-    ``r_px`` of its centre, and the light at its centre (``light_img``)."""
+    ``r_px`` of its centre, and the light at its centre (``light_img``; NaN where no carpet is
+    seen around it), and its mean colour (YUV) under ``role + "/colour"`` (one entry each, per part)."""
     h, w = labels.shape[:2]
     i0, i1 = max(0, int(b.pixel[1] - r_px)), min(h, int(b.pixel[1] + r_px) + 1)
     j0, j1 = max(0, int(b.pixel[0] - r_px)), min(w, int(b.pixel[0] + r_px) + 1)
@@ -364,9 +385,21 @@ def _take(samples: dict[str, list[NDArray[np.int32]]], lit: dict[str, list[float
     sel = ((uu - b.pixel[0]) ** 2 + (vv - b.pixel[1]) ** 2 <= r_px * r_px) & (labels[i0:i1, j0:j1] == b.label)
     if sel.any():
         samples.setdefault(role, []).append(conv[i0:i1, j0:j1][sel])
+        samples.setdefault(role + "/colour", []).append(np.round(b.colour).astype(np.int32)[None])
         local = float(light_img[min(int(b.pixel[1]), h - 1), min(int(b.pixel[0]), w - 1)])
-        if local > 0.0:
-            lit.setdefault(role, []).append(local)
+        lit.setdefault(role, []).append(local if local > 0.0 else math.nan)
+
+
+def hue_outliers(colours: NDArray[np.float64], max_off_deg: float) -> NDArray[np.bool_]:
+    """Which of the blobs' mean colours ``colours`` (n, 3) YUV have a hue (the angle of (U, V)
+    about grey) further than ``max_off_deg`` from the hue of the blobs' median U and V. The hue
+    holds under brighter or dimmer light (U and V scale about grey with it) where a box's bounds
+    do not; the median stands while fewer than half the blobs are another colour's."""
+    u, v = colours[:, 1] - 128.0, colours[:, 2] - 128.0
+    ref = math.atan2(float(np.median(v)), float(np.median(u)))
+    off = np.abs((np.arctan2(v, u) - ref + math.pi) % (2.0 * math.pi) - math.pi)
+    out: NDArray[np.bool_] = off > math.radians(max_off_deg)
+    return out
 
 
 def widen_for_light(box: ColourClass, light: tuple[float, float], space: ColourSpace,

@@ -99,11 +99,11 @@ def _rough_start(width: int, height: int, league: LeagueParams, height_m: float)
 def _colours(settings: Settings, images: Sequence[NDArray[np.uint8]], model: CameraModel) -> VisionParams:
     """vision.yaml with every colour learnt by ``tune --auto`` from ``images``."""
     vis = settings.vision
-    rep = auto_samples(images, model, settings.field, vis.colour_space)
+    rep = auto_samples(images, model, settings.field, vis.colour_space, vis.auto_tune)
     names = {role: getattr(vis.roles, role) for role in ("ball", "blue", "yellow", "pink", "green")}
     boxes, _ = learn_boxes({names[r]: v for r, v in rep.samples.items()}, rep.background,
                            {names[r]: v for r, v in rep.light.items()}, vis.colours, vis.colour_space,
-                           saturation_reach=vis.light.saturation_reach)
+                           saturation_reach=vis.light.saturation_reach, max_overlap=vis.auto_tune.max_overlap)
     return dataclasses.replace(vis, colours=boxes)
 
 

@@ -247,7 +247,7 @@ def _tune(args: argparse.Namespace, settings: object) -> int:
             images.append(np.asarray(img, dtype=np.uint8))
         samples = samples_from_labels(images, read_labels(args.labels), vis.colour_space)
     boxes, warnings = learn_boxes(samples, background, light, vis.colours, vis.colour_space, args.margin,
-                                  saturation_reach=vis.light.saturation_reach)
+                                  saturation_reach=vis.light.saturation_reach, max_overlap=vis.auto_tune.max_overlap)
     for line in warnings:
         print(f"tune: warning: {line}", file=sys.stderr)
     changed = {n for n, b in boxes.items() if n in samples or b != vis.colours.get(n)}
@@ -313,9 +313,12 @@ def _auto_samples(args: argparse.Namespace,
                                      principal_point_px=(params.principal_point_px[0] * s,
                                                          params.principal_point_px[1] * s))
     vis = settings.vision
-    rep = auto_samples(images, CameraModel(params), settings.field, vis.colour_space)
+    rep = auto_samples(images, CameraModel(params), settings.field, vis.colour_space, vis.auto_tune)
     print(f"tune: --auto: {len(images)} frame(s): {rep.patterns} robot patterns, {rep.balls} balls found")
     names = {role: getattr(vis.roles, role) for role in ("ball", "blue", "yellow", "pink", "green")}
+    for role, n in rep.left_out.items():
+        print(f"tune: --auto: {n} blob(s) taken for {role} ({names[role]}) left out: their hue is more than "
+              f"{vis.auto_tune.max_hue_off_deg:g} deg off the others' (auto_tune.max_hue_off_deg)", file=sys.stderr)
     for role in names:
         if role not in rep.samples:
             print(f"tune: --auto: nothing seen of {role} ({names[role]}): its box stays as it is", file=sys.stderr)

@@ -19,7 +19,7 @@ from cmdragons.cli import main
 from sim.render import RenderParams
 from vision.cmvision import ColourClass
 from vision.pipeline import VisionParams, VisionPipeline
-from vision.tune import auto_samples, boxes_from_samples, keep_apart, overlaps, widen_for_light
+from vision.tune import auto_samples, boxes_from_samples, hue_outliers, keep_apart, overlaps, widen_for_light
 
 from .conftest import LEAGUE, grid_of_robots, render, snapshot
 
@@ -60,6 +60,23 @@ def test_auto_colours_from_one_frame_find_every_robot(cameras: list[CameraModel]
     params = dataclasses.replace(VisionParams(), colours={n: boxes[n] for n in names.values()})
     n, right, false, ball = _score(params, model, look, seed=7)
     assert n >= 30 and right == n and false == 0 and ball == 1
+
+
+@pytest.mark.parametrize(("colour", "light", "kept"), [
+    ((130, 182, 75), 1.0, True), ((130, 182, 75), 0.45, True), ((130, 182, 75), 1.3, True),  # blue, any light
+    ((148, 136, 187), 1.0, False),  # pink whose U is above grey's, taken for blue by it
+    ((175, 149, 182), 0.6, False),  # pink, dim
+    ((120, 80, 60), 1.0, False),  # green
+])  # fmt: skip
+def test_a_blob_off_its_class_hue_is_left_out_whatever_the_light(colour: tuple[int, int, int], light: float,
+                                                                  kept: bool) -> None:
+    """Blue blobs sampled under light from 0.5 to 1.2 (U and V scaled about grey), and one more blob:
+    kept when its hue is blue's (within 30 degrees), whatever its brightness and saturation."""
+    grey = np.array([0.0, 128.0, 128.0])
+    blues = [grey + (np.array([130.0, 182.0, 75.0]) - grey) * k for k in (0.5, 0.7, 0.9, 1.0, 1.2)]
+    blob = grey + (np.array(colour, np.float64) - grey) * light
+    off = hue_outliers(np.array([*blues, blob]), 30.0)
+    assert not off[:-1].any() and bool(off[-1]) is not kept
 
 
 def test_overlapping_classes_are_found_and_kept_apart() -> None:

@@ -3,12 +3,12 @@ compiled once, before the workers start, instead of once in every worker that me
 time; and the files that hold slow tests run first, so that a parallel run ends on short tests
 (every worker busy to the end) rather than on a long match that one worker plays while the other has
 nothing left; unless ``--dist`` says otherwise, an idle worker steals from the busiest. ``-n auto``
-starts two workers more than the machine has CPUs: about a quarter of the suite's wall time is real-
-time play (served, grSim and outside matches) waiting on the clock, in which a worker uses little
-CPU (on 2 CPUs, warm: 5:12 with 2 workers, 3:54 with 4). The workers already share the CPUs, so BLAS
-runs one thread in each: OpenBLAS's own threads, one per CPU in every worker and in every command a
-test starts, spin while they wait (tests/vision/test_field_lines.py and tests/estimation: 49-53
-CPU-s with them, 30-32 without, the same wall time)."""
+starts two workers more than the machine has CPUs: about a quarter of the suite's wall time is
+real-time play (served, grSim and outside matches) waiting on the clock, in which a worker uses
+little CPU (on 2 CPUs, warm: 5:12 with 2 workers, 3:54 with 4). The workers already share the CPUs,
+so BLAS runs one thread in each: OpenBLAS's own threads, one per CPU in every worker and in every
+command a test starts, spin while they wait (tests/vision/test_field_lines.py and tests/estimation:
+49-53 CPU-s with them, 30-32 without, the same wall time)."""
 
 from __future__ import annotations
 

@@ -415,3 +415,66 @@ def test_a_robot_closing_on_a_ball_that_rolls_out_before_it_reaches_it_is_no_tou
     assert nearest[0] < LEAGUE.robot.radius_m + R_BALL + margin and body[0] > margin
     assert _out_given_to(w, ref, mine) == ("blue", "blue")
     assert last == [("yellow", 0), ("yellow", 0)]
+
+
+# a recorded situation (``cmdragons bench autoref``, seed 8, 3.62-3.85 s: the tracked frames of the two
+# robots at the ball): blue 5 holds the ball at its front, yellow 4 faces it from the other side and
+# kicks it into blue 5's front, off which it leaves to +y (the simulator's last touch: blue's; the ball
+# then rolled out over the touch line, yellow's free kick). Per frame: t, ball (x, y, vx, vy), blue 5
+# and yellow 4 (x, y, theta).
+SQUEEZED = (
+    (3.6167, (-0.4439, -1.2422, -0.1655, -0.4793), (-0.5354, -1.2443, 0.0234), (-0.2584, -1.2853, 2.8275)),
+    (3.6333, (-0.4468, -1.2437, -0.1528, -0.4442), (-0.5379, -1.2518, 0.0886), (-0.2697, -1.2829, 2.8291)),
+    (3.65, (-0.4501, -1.2455, -0.1585, -0.4214), (-0.5406, -1.2589, 0.1474), (-0.2821, -1.2801, 2.829)),
+    (3.6667, (-0.4527, -1.2478, -0.0894, -0.4722), (-0.5422, -1.2666, 0.2075), (-0.2946, -1.2773, 2.8283)),
+    (3.6833, (-0.4561, -1.2477, -0.1055, -0.3954), (-0.544, -1.2734, 0.2848), (-0.3079, -1.2741, 2.8279)),
+    (3.7, (-0.4599, -1.2472, -0.0901, -0.3495), (-0.5455, -1.2794, 0.3595), (-0.3205, -1.2716, 2.8265)),
+    (3.7167, (-0.4643, -1.2461, -0.1326, -0.2641), (-0.5476, -1.284, 0.4271), (-0.3336, -1.2683, 2.8265)),
+    (3.7333, (-0.4521, -1.2554, 0.5044, -0.4775), (-0.5493, -1.2884, 0.503), (-0.3467, -1.2663, 2.8226)),
+    (3.75, (-0.4572, -1.2542, -0.2807, 0.0597), (-0.55, -1.2915, 0.5758), (-0.3597, -1.2637, 2.8255)),
+    (3.7667, (-0.4831, -1.2264, -1.0615, 1.0768), (-0.5513, -1.2931, 0.6396), (-0.3729, -1.2614, 2.8249)),
+    (3.7833, (-0.502, -1.1624, -1.0264, 1.0412), (-0.5544, -1.2945, 0.6864), (-0.3836, -1.2588, 2.8202)),
+    (3.8, (-0.5197, -1.0994, -1.0583, 3.7761), (-0.56, -1.2973, 0.7106), (-0.3918, -1.2545, 2.8224)),
+    (3.8167, (-0.5374, -1.0372, -1.0524, 3.7087), (-0.5644, -1.2999, 0.734), (-0.3986, -1.2498, 2.8349)),
+    (3.8333, (-0.5548, -0.976, -1.041, 3.656), (-0.569, -1.3018, 0.7622), (-0.4055, -1.2448, 2.8471)),
+    (3.85, (-0.572, -0.9154, -1.0234, 3.6092), (-0.5732, -1.3036, 0.7946), (-0.4114, -1.239, 2.8535)),
+)
+
+
+def squeezed_autoref() -> AutoRef:
+    """The autoref after the recorded frames of :data:`SQUEEZED`, in normal play."""
+    auto = AutoRef(scene()[0].field, [("blue", 5), ("yellow", 4)], RefereeParams())
+    auto.referee.give(RefereeCommand.NORMAL)
+    for k, (t, ball, blue, yellow) in enumerate(SQUEEZED):
+        auto.observe(WorldState(t, BallState(*ball), (RobotState("blue", 5, *blue), RobotState("yellow", 4, *yellow)),
+                                k))
+    return auto
+
+
+def test_a_ball_kicked_into_another_robots_front_was_touched_last_by_that_robot() -> None:
+    """Yellow 4 kicks the ball blue 5 holds into blue 5's front; the track shows the kick (along
+    yellow's heading, late) and the turn off blue's face to +y, 56 degrees off yellow's heading: the
+    last touch is blue's (the simulator's), not yellow's kick seen late."""
+    auto = squeezed_autoref()
+    assert auto.referee.watch.last_touch == ("blue", 5)
+
+
+def test_a_kick_seen_late_beside_another_robot_stays_the_kickers() -> None:
+    """The same two robots, the ball kicked by yellow 4 along its heading with blue 5 beside it in reach:
+    the track's velocity shows the kick in two steps (a third of its speed, then all of it, both along
+    the heading; yellow's face the nearer in both): both steps are yellow's kick, blue never touched it."""
+    theta = 2.8
+    hx, hy = math.cos(theta), math.sin(theta)
+    yellow = RobotState("yellow", 4, 0.0, 0.0, theta)
+    bx, by = FRONT * hx, FRONT * hy  # the ball at yellow's front ...
+    side = REACH + 0.045  # ... blue beside it, its body 0.045 m from the ball (in the kick detector's reach)
+    blue = RobotState("blue", 5, bx + side * hy, by - side * hx, theta - math.pi / 2)
+    auto = AutoRef(scene()[0].field, [("blue", 5), ("yellow", 4)], RefereeParams())
+    auto.referee.give(RefereeCommand.NORMAL)
+    speed, t_kick = 4.0, 10.5 * DT
+    for k in range(30):
+        t = k * DT
+        d = max(t - t_kick, 0.0) * speed
+        seen = 0.0 if k <= 10 else speed / 3 if k == 11 else speed
+        auto.observe(WorldState(t, BallState(bx + d * hx, by + d * hy, seen * hx, seen * hy), (blue, yellow), k))
+    assert auto.referee.watch.last_touch == ("yellow", 4)

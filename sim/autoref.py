@@ -149,13 +149,14 @@ class KickDetector:
     deflection point where its old and new lines meet (:func:`deflection_path`): its body (:func:`hull_gap`, a disc
     cut flat at the front, where each robot stood in either frame) within ``kick_reach_m`` of the
     ball; where robots of both teams are that near, the one whose body the path went deepest into or
-    passed nearest, but not the last toucher (``last_touch``) when the ball now leaves off its heading
-    by more than ``kick_heading_deg`` and another robot is in reach: a ball kicked into another robot's
-    body, which turned it (the two changes of the track one kick and one bounce), was touched last by
-    that robot, not by the kicker seen late. When no robot is that near (a kick the track shows a few
-    frames late, the ball gone), the robot last at the ball: the nearest within ``kick_reach_m`` in the
-    newest frame of the last ``kick_memory_s`` that had one. A ball that jumps farther than it could
-    roll (put somewhere, or another ball taken for it) starts the watch afresh."""
+    passed nearest; but when the ball sped up (a kick) and leaves that robot off its heading (relative
+    to its velocity) by more than ``kick_heading_deg``, with another robot in reach, the next nearest:
+    a ball kicked into another robot's body, which turned it (a robot kicking the ball another holds,
+    the two changes of the track one kick seen late and one bounce), was touched last by that robot.
+    When no robot is that near (a kick the track shows a few frames late, the ball gone), the robot
+    last at the ball: the nearest within ``kick_reach_m`` in the newest frame of the last
+    ``kick_memory_s`` that had one. A ball that jumps farther than it could roll (put somewhere, or
+    another ball taken for it) starts the watch afresh."""
 
     def __init__(self, pitch: Field, params: AutorefParams, max_ball_speed_m_s: float = 10.0) -> None:
         self.p = params
@@ -167,8 +168,8 @@ class KickDetector:
         self._poses: dict[Key, tuple[float, float, float]] = {}  # where each robot stood the frame before
         self._recent: deque[tuple[float, dict[Key, float]]] = deque()  # t, each robot's gap to the ball (m)
 
-    def see(self, world: WorldState, last_touch: Key | None = None) -> Kick | None:
-        """The touch ``world``'s ball shows, or None; ``last_touch``: the robot that touched it last."""
+    def see(self, world: WorldState) -> Kick | None:
+        """The touch ``world``'s ball shows, or None."""
         b, t = world.ball, world.t
         poses = {(r.team, r.id): (r.x, r.y, r.theta) for r in world.robots if r.visible}
         before, self._poses = self._poses, poses
@@ -209,7 +210,8 @@ class KickDetector:
         reach = [k for gap, k in near if gap <= self.p.kick_reach_m]
         if reach:
             key = reach[0]
-            if key == last_touch and len(reach) > 1 and not self._along_heading(poses[key][2], b.vx, b.vy):
+            kicked = math.hypot(b.vx, b.vy) - math.hypot(vx0, vy0) > self.p.kick_speed_change_m_s
+            if len(reach) > 1 and kicked and not self._along_heading(world, key, b.vx, b.vy):
                 key = reach[1]  # kicked into another robot's body, which turned it
             return Kick(t, key[0], key[1], math.hypot(b.vx, b.vy), False)
         for _, g in reversed(self._recent):  # the last robot at the ball (the nearest of that frame)
@@ -219,11 +221,13 @@ class KickDetector:
                 return Kick(t, key[0], key[1], math.hypot(b.vx, b.vy), False)
         return None
 
-    def _along_heading(self, theta: float, vx: float, vy: float) -> bool:
-        """Does the ball moving at (``vx``, ``vy``) leave along a heading ``theta`` (within
-        ``kick_heading_deg``), as a kick by that robot sends it?"""
-        speed = math.hypot(vx, vy)
-        return speed > 0.0 and (vx * math.cos(theta) + vy * math.sin(theta)) / speed >= math.cos(
+    def _along_heading(self, world: WorldState, key: Key, vx: float, vy: float) -> bool:
+        """Does the ball moving at (``vx``, ``vy``) leave robot ``key`` along its heading (relative to
+        its velocity, within ``kick_heading_deg``), as a kick by it sends the ball?"""
+        r = next(r for r in world.robots if (r.team, r.id) == key)
+        rx, ry = vx - r.vx, vy - r.vy
+        speed = math.hypot(rx, ry)
+        return speed > 0.0 and (rx * math.cos(r.theta) + ry * math.sin(r.theta)) / speed >= math.cos(
             math.radians(self.p.kick_heading_deg))
 
 
@@ -297,7 +301,7 @@ class AutoRef:
             self._ball = (world.ball.x, world.ball.y)
         events: list[Event] = []
         self.own_contacts.see(world)
-        kick = self.kicks.see(world, r.watch.last_touch)
+        kick = self.kicks.see(world)
         if kick is not None and (kick.team, kick.id) == r.watch.last_touch:
             kick = None  # the last toucher's own touch seen late (the track's velocity lags the kick): no new one
         if kick is not None:

@@ -150,9 +150,10 @@ class KickDetector:
     cut flat at the front, where each robot stood in either frame) within ``kick_reach_m`` of the
     ball; where robots of both teams are that near, the one whose body the path went deepest into or
     passed nearest; but when the ball sped up (a kick) and leaves that robot off its heading (relative
-    to its velocity) by more than ``kick_heading_deg``, with another robot in reach, the next nearest:
-    a ball kicked into another robot's body, which turned it (a robot kicking the ball another holds,
-    the two changes of the track one kick seen late and one bounce), was touched last by that robot.
+    to its velocity) by more than ``kick_heading_deg``, with the robot that held the ball before in
+    reach too (``holder``: the last toucher ``kick_memory_s`` ago), the holder: a robot kicked the ball
+    another held into that one's front, which turned it (the changes of the track a kick seen late and
+    a bounce), and touched it last.
     When no robot is that near (a kick the track shows a few frames late, the ball gone), the robot
     last at the ball: the nearest within ``kick_reach_m`` in the newest frame of the last
     ``kick_memory_s`` that had one. A ball that jumps farther than it could roll (put somewhere, or
@@ -168,8 +169,9 @@ class KickDetector:
         self._poses: dict[Key, tuple[float, float, float]] = {}  # where each robot stood the frame before
         self._recent: deque[tuple[float, dict[Key, float]]] = deque()  # t, each robot's gap to the ball (m)
 
-    def see(self, world: WorldState) -> Kick | None:
-        """The touch ``world``'s ball shows, or None."""
+    def see(self, world: WorldState, holder: Key | None = None) -> Kick | None:
+        """The touch ``world``'s ball shows, or None; ``holder``: the robot at the ball before the
+        newest touch (:meth:`AutoRef.holder`)."""
         b, t = world.ball, world.t
         poses = {(r.team, r.id): (r.x, r.y, r.theta) for r in world.robots if r.visible}
         before, self._poses = self._poses, poses
@@ -211,8 +213,8 @@ class KickDetector:
         if reach:
             key = reach[0]
             kicked = math.hypot(b.vx, b.vy) - math.hypot(vx0, vy0) > self.p.kick_speed_change_m_s
-            if len(reach) > 1 and kicked and not self._along_heading(world, key, b.vx, b.vy):
-                key = reach[1]  # kicked into another robot's body, which turned it
+            if holder in reach and len(reach) > 1 and kicked and not self._along_heading(world, key, b.vx, b.vy):
+                key = holder  # kicked out of the holder's front, which turned it
             return Kick(t, key[0], key[1], math.hypot(b.vx, b.vy), False)
         for _, g in reversed(self._recent):  # the last robot at the ball (the nearest of that frame)
             at = sorted((gap, k) for k, gap in g.items() if gap <= self.p.kick_reach_m)
@@ -288,6 +290,18 @@ class AutoRef:
         self.kicks = KickDetector(pitch, a)
         self.own_contacts = OwnContacts(pitch, a)
         self._ball = (0.0, 0.0)  # where the ball was last seen
+        self._touchers: deque[tuple[float, Key | None]] = deque([(-math.inf, None)])  # each last touch, from when
+
+    def holder(self, t: float) -> Key | None:
+        """The robot at the ball before the touches of the last ``kick_memory_s`` (a kick of the ball
+        another held, which the track shows in steps): the last toucher as it was that long ago."""
+        last = self.referee.watch.last_touch
+        if last != self._touchers[-1][1]:
+            self._touchers.append((t, last))
+        then = t - self.kicks.p.kick_memory_s
+        while len(self._touchers) > 1 and self._touchers[1][0] <= then:
+            self._touchers.popleft()
+        return self._touchers[0][1]
 
     def start(self) -> Teleport:
         """The match's first kickoff for blue: both teams in formation, the ball on the centre spot."""
@@ -301,7 +315,7 @@ class AutoRef:
             self._ball = (world.ball.x, world.ball.y)
         events: list[Event] = []
         self.own_contacts.see(world)
-        kick = self.kicks.see(world)
+        kick = self.kicks.see(world, self.holder(world.t))
         if kick is not None and (kick.team, kick.id) == r.watch.last_touch:
             kick = None  # the last toucher's own touch seen late (the track's velocity lags the kick): no new one
         if kick is not None:

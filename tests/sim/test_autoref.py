@@ -459,10 +459,13 @@ SQUEEZED_AGAIN = (
 
 def squeezed_autoref(frames: tuple[tuple[float, tuple[float, ...], tuple[float, ...], tuple[float, ...]], ...]
                      = SQUEEZED) -> AutoRef:
-    """The autoref after the recorded ``frames`` (:data:`SQUEEZED`), in normal play."""
+    """The autoref after the recorded ``frames`` (:data:`SQUEEZED`), in normal play, the first of
+    them held for 0.2 s before (blue 5 holding the ball before the recording)."""
     auto = AutoRef(scene()[0].field, [("blue", 5), ("yellow", 4)], RefereeParams())
     auto.referee.give(RefereeCommand.NORMAL)
-    for k, (t, ball, blue, yellow) in enumerate(frames):
+    t0, *first = frames[0]
+    held = tuple((t0 - 0.2 + k * DT, *first) for k in range(12))
+    for k, (t, ball, blue, yellow) in enumerate((*held, *frames)):
         auto.observe(WorldState(t, BallState(*ball), (RobotState("blue", 5, *blue), RobotState("yellow", 4, *yellow)),
                                 k))
     return auto

@@ -325,7 +325,7 @@ class AutoRef:
         if crossing is not None:
             events.append(crossing)
         score, outs, sign = dict(r.score), r.balls_out, r.blue_sign
-        teleport = r.observe(world.t, events, self._ball, observed(world, self._ball))
+        teleport = r.observe(world.t, events, self._ball, self._within_walls(observed(world, self._ball), world))
         if isinstance(crossing, Goal):
             scorer = next((team for team in r.score if r.score[team] > score[team]), None)
             if scorer is not None:
@@ -336,6 +336,16 @@ class AutoRef:
             r.calls.call(GameEvent(world.t, "ball_out", crossing.last_touch, None if last is None else last[1],
                                    restart=RefereeCommand.FREE_KICK, for_team=taker))
         return teleport
+
+    def _within_walls(self, seen: GroundTruth, world: WorldState) -> GroundTruth:
+        """``seen`` with a ball no camera shows held within the boundary walls: a track coasting on
+        unseen past the wall it bounced off (the cameras' view ends there) is no ball over the boundary."""
+        if world.ball is None or world.ball.visible:
+            return seen
+        f, b = self.crossing.field, seen.ball
+        x = min(max(b.x, -f.boundary_half_length), f.boundary_half_length)
+        y = min(max(b.y, -f.boundary_half_width), f.boundary_half_width)
+        return GroundTruth(seen.frame_number, seen.t, BallTruth(x, y, b.z, b.vx, b.vy), seen.robots)
 
     @property
     def calls(self) -> list[GameEvent]:

@@ -498,3 +498,32 @@ def test_a_kick_seen_late_beside_another_robot_stays_the_kickers() -> None:
         seen = 0.0 if k <= 10 else speed / 3 if k == 11 else speed
         auto.observe(WorldState(t, BallState(bx + d * hx, by + d * hy, seen * hx, seen * hy), (blue, yellow), k))
     assert auto.referee.watch.last_touch == ("yellow", 4)
+
+
+@pytest.mark.parametrize("seen_beyond", [False, True])
+def test_a_ball_track_coasting_unseen_past_the_wall_is_no_boundary_crossing(seen_beyond: bool) -> None:
+    """A ball blue kicked rolls over the touch line at 2.3 m/s to the boundary wall, where no camera sees
+    it any more and its track coasts on through the wall (recorded at seed 6, 20.35-20.55 s: the
+    autoref called a boundary crossing the truth referee did not): a ball out, no boundary crossing.
+    The same track seen past the wall is one."""
+    auto = AutoRef(scene()[0].field, [("blue", 5), ("yellow", 4)], RefereeParams())
+    auto.referee.give(RefereeCommand.NORMAL)
+    f = auto.crossing.field
+    blue = RobotState("blue", 5, -1.0, 0.0, 0.0)
+    yellow = RobotState("yellow", 4, 1.0, 0.0, 0.0)
+    kinds = []
+    x0, y0 = -2.0, f.half_width - 0.3
+    for k in range(40):
+        t = k * DT
+        ball = BallState(x0, y0 + 2.3 * t, 0.0, 2.3)
+        if k == 0:  # blue at the ball: its touch
+            auto.observe(WorldState(t, dataclasses.replace(ball, vy=0.0),
+                                    (dataclasses.replace(blue, x=x0, y=y0 - FRONT, theta=math.pi / 2),
+                                     yellow), k))
+            continue
+        seen = seen_beyond or ball.y + R_BALL <= f.boundary_half_width
+        auto.observe(WorldState(t, dataclasses.replace(ball, visible=seen), (blue, yellow), k))
+        kinds += [(c.kind, c.team) for c in auto.calls]
+    assert auto.referee.watch.last_touch == ("blue", 5)
+    assert ("ball_out", "blue") in kinds
+    assert (("boundary_crossing", "blue") in kinds) == seen_beyond

@@ -149,10 +149,15 @@ class KickDetector:
     deflection point where its old and new lines meet (:func:`deflection_path`): its body (:func:`hull_gap`, a disc
     cut flat at the front, where each robot stood in either frame) within ``kick_reach_m`` of the
     ball; where robots of both teams are that near, the one whose body the path went deepest into or
-    passed nearest. When no robot is that near (a kick the track shows a few frames late, the ball
-    gone), the robot last at the ball: the nearest within ``kick_reach_m`` in the newest frame of the
-    last ``kick_memory_s`` that had one. A ball that jumps farther than it could roll (put somewhere,
-    or another ball taken for it) starts the watch afresh."""
+    passed nearest; but when the ball sped up (a kick) and leaves that robot off its heading (relative
+    to its velocity) by more than ``kick_heading_deg``, with the robot that held the ball before in
+    reach too (``holder``: the last toucher ``kick_memory_s`` ago), the holder: a robot kicked the ball
+    another held into that one's front, which turned it (the changes of the track a kick seen late and
+    a bounce), and touched it last.
+    When no robot is that near (a kick the track shows a few frames late, the ball gone), the robot
+    last at the ball: the nearest within ``kick_reach_m`` in the newest frame of the last
+    ``kick_memory_s`` that had one. A ball that jumps farther than it could roll (put somewhere, or
+    another ball taken for it) starts the watch afresh."""
 
     def __init__(self, pitch: Field, params: AutorefParams, max_ball_speed_m_s: float = 10.0) -> None:
         self.p = params
@@ -164,8 +169,9 @@ class KickDetector:
         self._poses: dict[Key, tuple[float, float, float]] = {}  # where each robot stood the frame before
         self._recent: deque[tuple[float, dict[Key, float]]] = deque()  # t, each robot's gap to the ball (m)
 
-    def see(self, world: WorldState) -> Kick | None:
-        """The touch ``world``'s ball shows, or None."""
+    def see(self, world: WorldState, holder: Key | None = None) -> Kick | None:
+        """The touch ``world``'s ball shows, or None; ``holder``: the robot at the ball before the
+        newest touch (:meth:`AutoRef.holder`)."""
         b, t = world.ball, world.t
         poses = {(r.team, r.id): (r.x, r.y, r.theta) for r in world.robots if r.visible}
         before, self._poses = self._poses, poses
@@ -203,8 +209,12 @@ class KickDetector:
         path = deflection_path((xa, ya), (vx0, vy0), (b.x, b.y), (b.vx, b.vy), t - ta + self.p.kick_memory_s)
         near = sorted((min(path_gap(self.shape, pose, path) for pose in (before.get(k, now), now)) - self.ball_r, k)
                       for k, now in poses.items())
-        if near and near[0][0] <= self.p.kick_reach_m:
-            key = near[0][1]
+        reach = [k for gap, k in near if gap <= self.p.kick_reach_m]
+        if reach:
+            key = reach[0]
+            kicked = math.hypot(b.vx, b.vy) - math.hypot(vx0, vy0) > self.p.kick_speed_change_m_s
+            if holder in reach and len(reach) > 1 and kicked and not self._along_heading(world, key, b.vx, b.vy):
+                key = holder  # kicked out of the holder's front, which turned it
             return Kick(t, key[0], key[1], math.hypot(b.vx, b.vy), False)
         for _, g in reversed(self._recent):  # the last robot at the ball (the nearest of that frame)
             at = sorted((gap, k) for k, gap in g.items() if gap <= self.p.kick_reach_m)
@@ -212,6 +222,15 @@ class KickDetector:
                 key = at[0][1]
                 return Kick(t, key[0], key[1], math.hypot(b.vx, b.vy), False)
         return None
+
+    def _along_heading(self, world: WorldState, key: Key, vx: float, vy: float) -> bool:
+        """Does the ball moving at (``vx``, ``vy``) leave robot ``key`` along its heading (relative to
+        its velocity, within ``kick_heading_deg``), as a kick by it sends the ball?"""
+        r = next(r for r in world.robots if (r.team, r.id) == key)
+        rx, ry = vx - r.vx, vy - r.vy
+        speed = math.hypot(rx, ry)
+        return speed > 0.0 and (rx * math.cos(r.theta) + ry * math.sin(r.theta)) / speed >= math.cos(
+            math.radians(self.p.kick_heading_deg))
 
 
 class OwnContacts:
@@ -271,6 +290,18 @@ class AutoRef:
         self.kicks = KickDetector(pitch, a)
         self.own_contacts = OwnContacts(pitch, a)
         self._ball = (0.0, 0.0)  # where the ball was last seen
+        self._touchers: deque[tuple[float, Key | None]] = deque([(-math.inf, None)])  # each last touch, from when
+
+    def holder(self, t: float) -> Key | None:
+        """The robot at the ball before the touches of the last ``kick_memory_s`` (a kick of the ball
+        another held, which the track shows in steps): the last toucher as it was that long ago."""
+        last = self.referee.watch.last_touch
+        if last != self._touchers[-1][1]:
+            self._touchers.append((t, last))
+        then = t - self.kicks.p.kick_memory_s
+        while len(self._touchers) > 1 and self._touchers[1][0] <= then:
+            self._touchers.popleft()
+        return self._touchers[0][1]
 
     def start(self) -> Teleport:
         """The match's first kickoff for blue: both teams in formation, the ball on the centre spot."""
@@ -284,7 +315,7 @@ class AutoRef:
             self._ball = (world.ball.x, world.ball.y)
         events: list[Event] = []
         self.own_contacts.see(world)
-        kick = self.kicks.see(world)
+        kick = self.kicks.see(world, self.holder(world.t))
         if kick is not None and (kick.team, kick.id) == r.watch.last_touch:
             kick = None  # the last toucher's own touch seen late (the track's velocity lags the kick): no new one
         if kick is not None:
@@ -294,7 +325,7 @@ class AutoRef:
         if crossing is not None:
             events.append(crossing)
         score, outs, sign = dict(r.score), r.balls_out, r.blue_sign
-        teleport = r.observe(world.t, events, self._ball, observed(world, self._ball))
+        teleport = r.observe(world.t, events, self._ball, self._within_walls(observed(world, self._ball), world))
         if isinstance(crossing, Goal):
             scorer = next((team for team in r.score if r.score[team] > score[team]), None)
             if scorer is not None:
@@ -305,6 +336,16 @@ class AutoRef:
             r.calls.call(GameEvent(world.t, "ball_out", crossing.last_touch, None if last is None else last[1],
                                    restart=RefereeCommand.FREE_KICK, for_team=taker))
         return teleport
+
+    def _within_walls(self, seen: GroundTruth, world: WorldState) -> GroundTruth:
+        """``seen`` with a ball no camera shows held within the boundary walls: a track coasting on
+        unseen past the wall it bounced off (the cameras' view ends there) is no ball over the boundary."""
+        if world.ball is None or world.ball.visible:
+            return seen
+        f, b = self.crossing.field, seen.ball
+        x = min(max(b.x, -f.boundary_half_length), f.boundary_half_length)
+        y = min(max(b.y, -f.boundary_half_width), f.boundary_half_width)
+        return GroundTruth(seen.frame_number, seen.t, BallTruth(x, y, b.z, b.vx, b.vy), seen.robots)
 
     @property
     def calls(self) -> list[GameEvent]:

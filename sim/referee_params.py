@@ -34,6 +34,10 @@ class AutorefParams(Validated):
     kick_speed_change_m_s: float = setting(0.8, lo=0.05, hi=20.0)
     kick_reach_m: float = setting(0.05, lo=0.0, hi=1.0)  # ... a robot's body this near the ball ...
     kick_memory_s: float = setting(0.1, lo=0.0, hi=2.0)  # ... at some moment of the last this long
+    # a kick (the ball sped up) leaving the robot nearest its path farther than this off its heading (relative
+    # to its velocity: a kick leaves along the kicker's heading) was turned by the front of the robot that
+    # held the ball, in reach too
+    kick_heading_deg: float = setting(30.0, lo=0.0, hi=180.0)
     margins: TrackMargins = TrackMargins(touch_release_m=0.01, contact_release_m=0.0, distance_m=0.05, speed_m_s=0.1,
                                         fast_ball_frames=2, touch_pass_speed_m_s=1.0,
                                         touch_pass_depth_m=0.003)

@@ -415,3 +415,115 @@ def test_a_robot_closing_on_a_ball_that_rolls_out_before_it_reaches_it_is_no_tou
     assert nearest[0] < LEAGUE.robot.radius_m + R_BALL + margin and body[0] > margin
     assert _out_given_to(w, ref, mine) == ("blue", "blue")
     assert last == [("yellow", 0), ("yellow", 0)]
+
+
+# a recorded situation (``cmdragons bench autoref``, seed 8, 3.62-3.85 s: the tracked frames of the two
+# robots at the ball): blue 5 holds the ball at its front, yellow 4 faces it from the other side and
+# kicks it into blue 5's front, off which it leaves to +y (the simulator's last touch: blue's; the ball
+# then rolled out over the touch line, yellow's free kick). Per frame: t, ball (x, y, vx, vy), blue 5
+# and yellow 4 (x, y, theta).
+SQUEEZED = (
+    (3.6167, (-0.4439, -1.2422, -0.1655, -0.4793), (-0.5354, -1.2443, 0.0234), (-0.2584, -1.2853, 2.8275)),
+    (3.6333, (-0.4468, -1.2437, -0.1528, -0.4442), (-0.5379, -1.2518, 0.0886), (-0.2697, -1.2829, 2.8291)),
+    (3.65, (-0.4501, -1.2455, -0.1585, -0.4214), (-0.5406, -1.2589, 0.1474), (-0.2821, -1.2801, 2.829)),
+    (3.6667, (-0.4527, -1.2478, -0.0894, -0.4722), (-0.5422, -1.2666, 0.2075), (-0.2946, -1.2773, 2.8283)),
+    (3.6833, (-0.4561, -1.2477, -0.1055, -0.3954), (-0.544, -1.2734, 0.2848), (-0.3079, -1.2741, 2.8279)),
+    (3.7, (-0.4599, -1.2472, -0.0901, -0.3495), (-0.5455, -1.2794, 0.3595), (-0.3205, -1.2716, 2.8265)),
+    (3.7167, (-0.4643, -1.2461, -0.1326, -0.2641), (-0.5476, -1.284, 0.4271), (-0.3336, -1.2683, 2.8265)),
+    (3.7333, (-0.4521, -1.2554, 0.5044, -0.4775), (-0.5493, -1.2884, 0.503), (-0.3467, -1.2663, 2.8226)),
+    (3.75, (-0.4572, -1.2542, -0.2807, 0.0597), (-0.55, -1.2915, 0.5758), (-0.3597, -1.2637, 2.8255)),
+    (3.7667, (-0.4831, -1.2264, -1.0615, 1.0768), (-0.5513, -1.2931, 0.6396), (-0.3729, -1.2614, 2.8249)),
+    (3.7833, (-0.502, -1.1624, -1.0264, 1.0412), (-0.5544, -1.2945, 0.6864), (-0.3836, -1.2588, 2.8202)),
+    (3.8, (-0.5197, -1.0994, -1.0583, 3.7761), (-0.56, -1.2973, 0.7106), (-0.3918, -1.2545, 2.8224)),
+    (3.8167, (-0.5374, -1.0372, -1.0524, 3.7087), (-0.5644, -1.2999, 0.734), (-0.3986, -1.2498, 2.8349)),
+    (3.8333, (-0.5548, -0.976, -1.041, 3.656), (-0.569, -1.3018, 0.7622), (-0.4055, -1.2448, 2.8471)),
+    (3.85, (-0.572, -0.9154, -1.0234, 3.6092), (-0.5732, -1.3036, 0.7946), (-0.4114, -1.239, 2.8535)),
+)
+
+
+# the same, recorded at seed 6, 18.60-18.73 s: blue 5 holds the ball, yellow 4 kicks it into blue 5's
+# front (both kick in the simulator, blue at 1.5 m/s, yellow at 4.2 m/s a step later; its last touch:
+# blue's); the track shows one turn, nearest yellow 4's face
+SQUEEZED_AGAIN = (
+    (18.6, (-0.4651, -1.1616, -0.0049, -0.3544), (-0.5493, -1.1974, 0.4019), (-0.3158, -1.2201, 2.8474)),
+    (18.6167, (-0.467, -1.1641, 0.0181, -0.4427), (-0.5491, -1.2046, 0.4581), (-0.3265, -1.2171, 2.844)),
+    (18.6333, (-0.4614, -1.1642, 0.2514, -0.1181), (-0.5491, -1.2114, 0.5105), (-0.3372, -1.2141, 2.846)),
+    (18.65, (-0.4642, -1.1674, -0.142, -0.1898), (-0.549, -1.2175, 0.57), (-0.3487, -1.2101, 2.8456)),
+    (18.6667, (-0.4676, -1.1688, -0.1623, -0.0931), (-0.5487, -1.2225, 0.6121), (-0.3614, -1.206, 2.85)),
+    (18.6833, (-0.485, -1.1549, -0.5972, 0.4149), (-0.5484, -1.2255, 0.646), (-0.374, -1.202, 2.8458)),
+    (18.7, (-0.5224, -1.0975, -0.5561, 0.3864), (-0.553, -1.2272, 0.6618), (-0.3824, -1.1981, 2.8752)),
+    (18.7167, (-0.5502, -1.036, -1.6667, 3.6866), (-0.5587, -1.2286, 0.6662), (-0.3897, -1.1947, 2.9255)),
+    (18.7333, (-0.5779, -0.9753, -1.652, 3.6205), (-0.5636, -1.2292, 0.6615), (-0.3971, -1.1904, 2.9767)),
+)
+
+
+def squeezed_autoref(frames: tuple[tuple[float, tuple[float, ...], tuple[float, ...], tuple[float, ...]], ...]
+                     = SQUEEZED) -> AutoRef:
+    """The autoref after the recorded ``frames`` (:data:`SQUEEZED`), in normal play, the first of
+    them held for 0.2 s before (blue 5 holding the ball before the recording)."""
+    auto = AutoRef(scene()[0].field, [("blue", 5), ("yellow", 4)], RefereeParams())
+    auto.referee.give(RefereeCommand.NORMAL)
+    t0, *first = frames[0]
+    held = tuple((t0 - 0.2 + k * DT, *first) for k in range(12))
+    for k, (t, ball, blue, yellow) in enumerate((*held, *frames)):
+        auto.observe(WorldState(t, BallState(*ball), (RobotState("blue", 5, *blue), RobotState("yellow", 4, *yellow)),
+                                k))
+    return auto
+
+
+def test_a_ball_kicked_into_another_robots_front_was_touched_last_by_that_robot() -> None:
+    """Yellow 4 kicks the ball blue 5 holds into blue 5's front; the track shows the kick (along
+    yellow's heading, late) and the turn off blue's face to +y, 56 degrees off yellow's heading: the
+    last touch is blue's (the simulator's), not yellow's kick seen late."""
+    assert squeezed_autoref().referee.watch.last_touch == ("blue", 5)
+    assert squeezed_autoref(SQUEEZED_AGAIN).referee.watch.last_touch == ("blue", 5)
+
+
+def test_a_kick_seen_late_beside_another_robot_stays_the_kickers() -> None:
+    """The same two robots, the ball kicked by yellow 4 along its heading with blue 5 beside it in reach:
+    the track's velocity shows the kick in two steps (a third of its speed, then all of it, both along
+    the heading; yellow's face the nearer in both): both steps are yellow's kick, blue never touched it."""
+    theta = 2.8
+    hx, hy = math.cos(theta), math.sin(theta)
+    yellow = RobotState("yellow", 4, 0.0, 0.0, theta)
+    bx, by = FRONT * hx, FRONT * hy  # the ball at yellow's front ...
+    side = REACH + 0.045  # ... blue beside it, its body 0.045 m from the ball (in the kick detector's reach)
+    blue = RobotState("blue", 5, bx + side * hy, by - side * hx, theta - math.pi / 2)
+    auto = AutoRef(scene()[0].field, [("blue", 5), ("yellow", 4)], RefereeParams())
+    auto.referee.give(RefereeCommand.NORMAL)
+    speed, t_kick = 4.0, 10.5 * DT
+    for k in range(30):
+        t = k * DT
+        d = max(t - t_kick, 0.0) * speed
+        seen = 0.0 if k <= 10 else speed / 3 if k == 11 else speed
+        auto.observe(WorldState(t, BallState(bx + d * hx, by + d * hy, seen * hx, seen * hy), (blue, yellow), k))
+    assert auto.referee.watch.last_touch == ("yellow", 4)
+
+
+@pytest.mark.parametrize("seen_beyond", [False, True])
+def test_a_ball_track_coasting_unseen_past_the_wall_is_no_boundary_crossing(seen_beyond: bool) -> None:
+    """A ball blue kicked rolls over the touch line at 2.3 m/s to the boundary wall, where no camera sees
+    it any more and its track coasts on through the wall (recorded at seed 6, 20.35-20.55 s: the
+    autoref called a boundary crossing the truth referee did not): a ball out, no boundary crossing.
+    The same track seen past the wall is one."""
+    auto = AutoRef(scene()[0].field, [("blue", 5), ("yellow", 4)], RefereeParams())
+    auto.referee.give(RefereeCommand.NORMAL)
+    f = auto.crossing.field
+    blue = RobotState("blue", 5, -1.0, 0.0, 0.0)
+    yellow = RobotState("yellow", 4, 1.0, 0.0, 0.0)
+    kinds = []
+    x0, y0 = -2.0, f.half_width - 0.3
+    for k in range(40):
+        t = k * DT
+        ball = BallState(x0, y0 + 2.3 * t, 0.0, 2.3)
+        if k == 0:  # blue at the ball: its touch
+            auto.observe(WorldState(t, dataclasses.replace(ball, vy=0.0),
+                                    (dataclasses.replace(blue, x=x0, y=y0 - FRONT, theta=math.pi / 2),
+                                     yellow), k))
+            continue
+        seen = seen_beyond or ball.y + R_BALL <= f.boundary_half_width
+        auto.observe(WorldState(t, dataclasses.replace(ball, visible=seen), (blue, yellow), k))
+        kinds += [(c.kind, c.team) for c in auto.calls]
+    assert auto.referee.watch.last_touch == ("blue", 5)
+    assert ("ball_out", "blue") in kinds
+    assert (("boundary_crossing", "blue") in kinds) == seen_beyond

@@ -56,7 +56,7 @@ def play_outside(args: argparse.Namespace, stop: Interrupt, compile_kernels: Cal
     from cmdragons.runtime.scene import SceneStage
     from cmdragons.runtime.ssl.udp import MulticastReceiver
     from cmdragons.runtime.stages import LoggerStage, Tap
-    from cmdragons.runtime.warmup import warm_team
+    from cmdragons.runtime.warmup import settle_heap, warm_team
 
     why = _refused(args)
     if why is not None:
@@ -100,6 +100,7 @@ def play_outside(args: argparse.Namespace, stop: Interrupt, compile_kernels: Cal
                                     settings.field.robot.height_m, settings.sim.physics.frame_rate_hz)
         warm_team(settings)
         match = OutsideMatch(settings, kind, teams, heard, receiver, extra)
+        settle_heap()
         match.skip_stale()  # what came while the team was built is gone by now
         started = time.time()
         with progress_bar(not args.no_progress, counts=False) as progress, stop.soft():

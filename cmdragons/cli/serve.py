@@ -41,6 +41,7 @@ def cmd_serve(args: argparse.Namespace, stop: Interrupt) -> int:
     from cmdragons.runtime.settings import load_settings
     from cmdragons.runtime.ssl.stages import close_sockets
     from cmdragons.runtime.stages import LoggerStage, SummaryCollector, Tap
+    from cmdragons.runtime.warmup import settle_heap
     from sim.simulator import Simulator
 
     refused = refused_options(args)
@@ -77,6 +78,7 @@ def cmd_serve(args: argparse.Namespace, stop: Interrupt) -> int:
             bus.add(stage)
         print(_listening(settings, [m.id for m in models]), flush=True)
         bus.start()
+        settle_heap()
         late = [0]
         frame_ms: list[float] = []  # each frame's work (the wall time it took, the wait for it left out)
         wall0 = time.monotonic()

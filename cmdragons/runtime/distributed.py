@@ -59,6 +59,7 @@ from cmdragons.runtime.match import (
 from cmdragons.runtime.params import ROLES, RuntimeParams
 from cmdragons.runtime.settings import Settings
 from cmdragons.runtime.stages import SimStage, SummaryCollector, Tap
+from cmdragons.runtime.warmup import settle_heap
 from cmdragons.runtime.zenoh_transport import LATEST_ONLY, ZenohTransport
 from sim.params import robot_counts
 
@@ -236,16 +237,6 @@ def rehearsal_scene(settings: Settings, frames: int) -> list[DetectionFrame]:
     return out
 
 
-def _settle_heap() -> None:
-    """Collect what start-up left behind and keep the objects alive now (settings, stages, modules)
-    out of later collections: Python's full collection walks every tracked object and, after a
-    node's imports and rehearsal, held a frame up for 0.1-0.2 s."""
-    import gc
-
-    gc.collect()
-    gc.freeze()
-
-
 def _control(transport: ZenohTransport, node: str, command: str) -> None:
     transport.publish(f"control/{node}", NodeControl(node, command))
 
@@ -264,7 +255,7 @@ def run_node(role: str, spec: MatchSpec, transport: ZenohTransport, extra: Seque
     bus.add(Tap(f"control:{role}", ("control/clock",), lambda _t, c: commands.append(c.command)))
     for stage in [*stages, *extra]:
         bus.add(stage)
-    _settle_heap()
+    settle_heap()
     started = time.monotonic()
     last_ready = -1.0
     warned = started
@@ -360,7 +351,7 @@ def run_clock(spec: MatchSpec, transport: ZenohTransport, seconds: float, roles:
             _control(transport, "clock", "waiting")
             said = now
         transport.spin(0.05)
-    _settle_heap()
+    settle_heap()
     transport.wait_for(lambda: False, params.settle_s)  # declarations propagate: nothing of frame 0 is lost
     _control(transport, "clock", start)
     started[0] = True

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numba
 
-from cmdragons.runtime.warmup import CompileWatch
+from cmdragons.runtime.warmup import CompileWatch, settle_heap
 
 
 def test_compile_watch_counts_each_compile_once() -> None:
@@ -70,3 +70,17 @@ def test_the_compile_line_fits_80_columns_whole() -> None:
     last = [line for line in text.replace("\r", "\n").splitlines() if line.strip()][-1]
     assert "5/5 parts, 123 kernels, cached" in last and "…" not in last
     assert last.startswith("compiling kernels (first run)")
+
+
+def test_settle_heap_keeps_what_lives_now_out_of_later_full_collections() -> None:
+    import gc
+
+    kept = [[i] for i in range(2000)]  # tracked containers alive at the start of the frames
+    gc.unfreeze()
+    try:
+        settle_heap()
+        assert gc.get_freeze_count() >= len(kept)
+        # a full collection now walks only what came after: the kept lists are not among its objects
+        assert not any(o is kept[0] for o in gc.get_objects(generation=2))
+    finally:
+        gc.unfreeze()

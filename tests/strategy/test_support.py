@@ -66,7 +66,7 @@ def test_at_our_kickoff_the_points_spread_where_the_robots_will_stand() -> None:
     ball = np.array([0.0, 0.0])
     assert spread_points(ev, ball, 2, P) == [(2.0, 1.05), (0.8, 1.3)]  # apart where they were evaluated
     placed = np.array([[-0.14, 1.05], [-0.14, 1.3], [-1.0, -1.5]])
-    assert spread_points(ev, ball, 2, P, placed) == [(-0.14, 1.05), (-1.0, -1.5)]
+    assert spread_points(ev, ball, 2, P, placed=placed) == [(-0.14, 1.05), (-1.0, -1.5)]
 
 
 def _opponents_on(points: list[tuple[float, float]]) -> np.ndarray:

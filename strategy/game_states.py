@@ -17,6 +17,9 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
+import numpy as np
+from numpy.typing import NDArray
+
 from cmdragons.config import Validated, setting
 from cmdragons.geometry import Field, Team
 from cmdragons.messages import BallState, GameState, RefereeCommand, RobotState
@@ -24,6 +27,7 @@ from strategy.defense import DefenseParams, clear_target
 from strategy.skills import Intent, SkillParams, goalie_block, intercept, kick_to, pass_speed, waiting_point
 
 __all__ = [
+    "kickoff_places",
     "GameStateParams",
     "behind_ball",
     "halt",
@@ -142,6 +146,18 @@ def _in_own_half(x: float, own_sign: float, radius: float, p: GameStateParams) -
 def _circle_clearance(pitch: Field, radius: float, p: GameStateParams) -> float:
     """How far a robot's centre keeps from the centre spot at kickoffs."""
     return pitch.dims.center_circle_radius_m + p.center_circle_margin_m + radius
+
+
+def kickoff_places(points: NDArray[np.float64], pitch: Field, own_sign: float, p: GameStateParams,
+                   radius: float) -> NDArray[np.float64]:
+    """Where robots sent to ``points`` (n, 2) stand at our kickoff, as :func:`our_kickoff` moves
+    them: into our half, and sideways out of the centre circle."""
+    x = own_sign * np.maximum(own_sign * points[:, 0], radius + p.halfway_margin_m)
+    y = points[:, 1].copy()
+    r_c = _circle_clearance(pitch, radius, p)
+    inside = np.hypot(x, y) < r_c
+    y[inside] = np.copysign(r_c, np.where(y[inside] != 0.0, y[inside], 1.0))
+    return np.column_stack((x, y))
 
 
 def our_kickoff(intents: Mapping[int, Intent], pitch: Field, own_sign: float, p: GameStateParams, radius: float,

@@ -12,6 +12,7 @@ module puts them together frame by frame.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -33,6 +34,7 @@ from strategy.game_states import (
     keep_away,
     keep_off_line,
     keeper_on_line,
+    kickoff_places,
     leave_field,
     leaver,
     own_goal_sign,
@@ -215,7 +217,8 @@ class Strategy:
         ours = game.for_team == self.team
         restart = ours and game.command.kick_restart
         self._barred = self._double_touch_bar(game, own, opp, ball)
-        intents = self._normal(world.t, own, opp, ball, own_sign, restart)
+        intents = self._normal(world.t, own, opp, ball, own_sign, restart,
+                               restart and game.command == RefereeCommand.KICKOFF)
         self._taker = self._role_robot(ATTACKER) if restart else None
         if game.command == RefereeCommand.BALL_PLACEMENT and game.placement is not None:
             return self._placement(world.t, intents, own, ball, game.placement, ours, own_sign)
@@ -311,14 +314,20 @@ class Strategy:
         return objectives
 
     def _normal(self, t: float, own: dict[int, RobotState], opp: list[RobotState], ball: BallState,
-                own_sign: float, restart: bool = False) -> dict[int, Intent]:
-        """Normal play; ``restart``: our kickoff or free kick (the attacker's kick its only touch)."""
+                own_sign: float, restart: bool = False, kickoff: bool = False) -> dict[int, Intent]:
+        """Normal play; ``restart``: our kickoff or free kick (the attacker's kick its only touch),
+        ``kickoff``: our kickoff."""
         p, f = self.p, self.field
         attack_sign = -own_sign
         opp_xy = np.array([[r.x, r.y] for r in opp]) if opp else np.zeros((0, 2))
         self.attacker.watch(t, ball)
         count = max(0, len(own) - 2 - p.defense.defenders)  # supporters: the robots besides goalie, attacker, defenders
-        self.supporters.update(self.frame, np.array([ball.x, ball.y]), attack_sign, opp_xy, count)
+        places = None
+        if kickoff:  # our kickoff: the supporters wait in our half, where the rules let them stand
+            places = functools.partial(kickoff_places, pitch=f, own_sign=own_sign, p=p.game_states,
+                                       radius=p.robot_radius_m)
+        self.supporters.update(self.frame, np.array([ball.x, ball.y]), attack_sign, opp_xy, count, hold=kickoff,
+                               place=places)
 
         passing = self.passes.follow(t, own, ball)
         defenders = {Role(RoleKind.DEFENDER, k): defend(ball, f, own_sign, slot, p.skills)

@@ -8,6 +8,7 @@ strategy time); the points chosen from it hold in between. Field frame, metres.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,15 +30,18 @@ class SupportParams(Validated):
     min_ball_distance_m: float = setting(1.0, lo=0.0, hi=10.0)  # ... and at least this far from the ball
 
 
-def spread_points(ev: PassEvaluation, ball: Array, count: int, p: SupportParams) -> list[tuple[float, float]]:
+def spread_points(ev: PassEvaluation, ball: Array, count: int, p: SupportParams,
+                  placed: Array | None = None) -> list[tuple[float, float]]:
     """Up to ``count`` of the best points of ``ev``, best first, at least ``spacing_m`` apart and
-    ``min_ball_distance_m`` from ``ball``."""
+    ``min_ball_distance_m`` from ``ball``; ``placed``: where a supporter sent to each of ``ev``'s
+    points stands now (None: on it), the spacing and the points returned being those places."""
     order = np.argsort(-ev.values)
+    places = ev.points if placed is None else placed
     chosen: list[tuple[float, float]] = []
     for i in order:
         if len(chosen) >= count:
             break
-        x, y = float(ev.points[i, 0]), float(ev.points[i, 1])
+        x, y = float(places[i, 0]), float(places[i, 1])
         if math.hypot(x - ball[0], y - ball[1]) < p.min_ball_distance_m:
             continue
         if all(math.hypot(x - a, y - b) >= p.spacing_m for a, b in chosen):
@@ -56,13 +60,25 @@ class Supporters:
         self.evaluation: PassEvaluation | None = None
         self.evaluated_frame = -1  # the frame the evaluation was made on
         self.points: list[tuple[float, float]] = []
+        self._held: int | None = None  # the count the points were held for (None: not held)
 
-    def update(self, frame: int, ball: Array, attack_sign: float, opponents: Array, count: int) -> None:
+    def update(self, frame: int, ball: Array, attack_sign: float, opponents: Array, count: int,
+               hold: bool = False, place: Callable[[Array], Array] | None = None) -> None:
         """Re-evaluate the grid on the first frame and every ``eval_every_frames``-th; ``count``
-        supporters' points from it."""
-        if self.evaluation is not None and frame % self.p.eval_every_frames != 0:
+        supporters' points from it. ``hold``: our kickoff's ball waits for its kick: the points chosen
+        on its first frame hold until it is over (the evaluation goes on for
+        the pass). Chosen anew each time, every point moved as the opponents came to their places, the
+        robots were assigned round among them and the kicker's receiver changed with them: a Division A
+        kickoff waited 5 s, or its 10 s out. ``place``: where a supporter sent to each of the grid's points
+        stands now (our kickoff: in our half; None: on it), the points spread on those places (else
+        two chosen points beyond the halfway line put two robots side by side on it)."""
+        held = hold and self._held == count and bool(self.points)
+        self._held = count if hold else None
+        if self.evaluation is not None and frame % self.p.eval_every_frames != 0 and not (hold and not held):
             return
         self.evaluation = pass_values(ball, self.grid, self.field, attack_sign, opponents, self.obstacle_radius,
                                       self.passing)
         self.evaluated_frame = frame
-        self.points = spread_points(self.evaluation, ball, count, self.p)
+        if not held:
+            placed = place(self.evaluation.points) if place is not None else None
+            self.points = spread_points(self.evaluation, ball, count, self.p, placed)

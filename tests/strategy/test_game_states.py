@@ -160,3 +160,18 @@ def test_restart_rules_by_command() -> None:
         assert rules(command, ours) == keep_away(intents, ball, FIELD, -1.0, P, RADIUS,
                                                  command == RefereeCommand.KICKOFF, slow)
     assert rules("kickoff", True) == our_kickoff(intents, FIELD, -1.0, P, RADIUS, None)
+
+
+def test_kickoff_places_are_where_our_kickoff_puts_its_robots() -> None:
+    from strategy.game_states import kickoff_places, our_kickoff
+
+    p = GameStateParams()
+    radius = 0.09
+    pts = np.array([[2.0, 1.0], [0.3, 0.1], [-2.0, -1.5], [0.2, -0.2]])
+    placed = kickoff_places(pts, FIELD, -1.0, p, radius)  # we defend negative x
+    intents = {i: Intent(float(x), float(y), 0.0) for i, (x, y) in enumerate(pts)}
+    moved = our_kickoff(intents, FIELD, -1.0, p, radius, kicker=None)
+    for i, (x, y) in enumerate(placed):
+        assert (x, y) == pytest.approx((moved[i].x, moved[i].y), abs=1e-12)
+    assert placed[2] == pytest.approx((-2.0, -1.5))  # already a legal place: unmoved
+    assert placed[0, 0] == pytest.approx(-(radius + p.halfway_margin_m))

@@ -57,3 +57,37 @@ def test_the_grid_is_evaluated_on_the_first_frame_and_every_nth() -> None:
     assert supporters.evaluation is first  # held between evaluations
     supporters.update(3, np.array([2.0, 1.0]), 1.0, opponents, 2)
     assert supporters.evaluation is not first
+
+
+def test_at_our_kickoff_the_points_spread_where_the_robots_will_stand() -> None:
+    # two good points beyond the halfway line a robot would stand side by side on (0.25 m apart),
+    # a third well apart on our side
+    ev = _evaluation([(2.0, 1.05), (0.8, 1.3), (-1.0, -1.5)], [0.9, 0.8, 0.5])
+    ball = np.array([0.0, 0.0])
+    assert spread_points(ev, ball, 2, P) == [(2.0, 1.05), (0.8, 1.3)]  # apart where they were evaluated
+    placed = np.array([[-0.14, 1.05], [-0.14, 1.3], [-1.0, -1.5]])
+    assert spread_points(ev, ball, 2, P, placed=placed) == [(-0.14, 1.05), (-1.0, -1.5)]
+
+
+def _opponents_on(points: list[tuple[float, float]]) -> np.ndarray:
+    return np.array(points, dtype=float)
+
+
+def test_the_kickoff_points_hold_while_its_ball_waits() -> None:
+    """The opponents coming to their places move the best points; held, ours stay put until the
+    kickoff is over (then chosen anew)."""
+    ball = np.array([0.0, 0.0])
+    moved = Supporters(FIELD, PassParams(), SupportParams(eval_every_frames=1), obstacle_radius=0.11)
+    held = Supporters(FIELD, PassParams(), SupportParams(eval_every_frames=1), obstacle_radius=0.11)
+    moved.update(0, ball, 1.0, np.zeros((0, 2)), 3)
+    held.update(0, ball, 1.0, np.zeros((0, 2)), 3, hold=True)
+    first = list(held.points)
+    assert first == moved.points
+    blockers = _opponents_on([(x + 0.3, y) for x, y in first])  # an opponent beside each point
+    moved.update(1, ball, 1.0, blockers, 3)
+    held.update(1, ball, 1.0, blockers, 3, hold=True)
+    assert moved.points != first
+    assert held.points == first
+    assert held.evaluation is not None and held.evaluated_frame == 1  # the evaluation goes on
+    held.update(2, ball, 1.0, blockers, 3)  # the kickoff is over
+    assert held.points == moved.points

@@ -1,5 +1,6 @@
 """Supporter placement (Bruce 2006, B.5): the supporters wait at the best receiving points of the
-pass evaluation over a grid of candidate points, spread apart and off the ball.
+pass evaluation over a grid of candidate points, spread apart, off the ball and off the point a pass's
+receiver waits at (that point was a supporter's: without it, the next supporter took the same spot).
 
 The grid is re-evaluated every ``eval_every_frames`` frames (its cost is the bulk of a frame's
 strategy time); the points chosen from it hold in between. Field frame, metres.
@@ -8,6 +9,7 @@ strategy time); the points chosen from it hold in between. Field frame, metres.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,9 +31,11 @@ class SupportParams(Validated):
     min_ball_distance_m: float = setting(1.0, lo=0.0, hi=10.0)  # ... and at least this far from the ball
 
 
-def spread_points(ev: PassEvaluation, ball: Array, count: int, p: SupportParams) -> list[tuple[float, float]]:
-    """Up to ``count`` of the best points of ``ev``, best first, at least ``spacing_m`` apart and
-    ``min_ball_distance_m`` from ``ball``."""
+def spread_points(ev: PassEvaluation, ball: Array, count: int, p: SupportParams,
+                  taken: Sequence[tuple[float, float]] = ()) -> list[tuple[float, float]]:
+    """Up to ``count`` of the best points of ``ev``, best first, at least ``spacing_m`` apart and from
+    each point of ``taken`` (where team-mates of other roles wait), and ``min_ball_distance_m`` from
+    ``ball``."""
     order = np.argsort(-ev.values)
     chosen: list[tuple[float, float]] = []
     for i in order:
@@ -40,7 +44,7 @@ def spread_points(ev: PassEvaluation, ball: Array, count: int, p: SupportParams)
         x, y = float(ev.points[i, 0]), float(ev.points[i, 1])
         if math.hypot(x - ball[0], y - ball[1]) < p.min_ball_distance_m:
             continue
-        if all(math.hypot(x - a, y - b) >= p.spacing_m for a, b in chosen):
+        if all(math.hypot(x - a, y - b) >= p.spacing_m for a, b in (*taken, *chosen)):
             chosen.append((x, y))
     return chosen
 
@@ -56,13 +60,22 @@ class Supporters:
         self.evaluation: PassEvaluation | None = None
         self.evaluated_frame = -1  # the frame the evaluation was made on
         self.points: list[tuple[float, float]] = []
+        self._ball: Array = np.zeros(2)  # the ball the evaluation was made for
+        self._taken: tuple[tuple[float, float], ...] = ()  # the points kept clear when the points were chosen
 
-    def update(self, frame: int, ball: Array, attack_sign: float, opponents: Array, count: int) -> None:
+    def update(self, frame: int, ball: Array, attack_sign: float, opponents: Array, count: int,
+               taken: Sequence[tuple[float, float]] = ()) -> None:
         """Re-evaluate the grid on the first frame and every ``eval_every_frames``-th; ``count``
-        supporters' points from it."""
+        supporters' points from it, clear of ``taken`` (the pass's receiving point): chosen again from
+        the evaluation kept whenever ``taken`` changes in between."""
+        taken = tuple(taken)
         if self.evaluation is not None and frame % self.p.eval_every_frames != 0:
+            if taken != self._taken:
+                self._taken = taken
+                self.points = spread_points(self.evaluation, self._ball, count, self.p, taken)
             return
         self.evaluation = pass_values(ball, self.grid, self.field, attack_sign, opponents, self.obstacle_radius,
                                       self.passing)
         self.evaluated_frame = frame
-        self.points = spread_points(self.evaluation, ball, count, self.p)
+        self._ball, self._taken = ball, taken
+        self.points = spread_points(self.evaluation, ball, count, self.p, taken)

@@ -190,7 +190,10 @@ class Referee:
             due, self._restart = self._restart, None
             self._start_restart(due.kind, due.team, due.spot, ball_xy)
         teleport = self.moves.take(self.t)
-        self._follow_kick(teleport.ball if teleport is not None and teleport.ball is not None else ball_xy)
+        # the ball as seen, not where the teleport puts it: an auto-referee on tracked vision sees it
+        # there frames later (taken for seen on the spot, the ball still seen in the goal the next
+        # frame was the kickoff taken)
+        self._follow_kick(ball_xy)
         return teleport
 
     def _take(self, e: Event) -> None:

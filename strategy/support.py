@@ -1,5 +1,6 @@
 """Supporter placement (Bruce 2006, B.5): the supporters wait at the best receiving points of the
-pass evaluation over a grid of candidate points, spread apart and off the ball.
+pass evaluation over a grid of candidate points, spread apart, off the ball and off the point a pass's
+receiver waits at (that point was a supporter's: without it, the next supporter took the same spot).
 
 The grid is re-evaluated every ``eval_every_frames`` frames (its cost is the bulk of a frame's
 strategy time); the points chosen from it hold in between. Field frame, metres.
@@ -8,7 +9,7 @@ strategy time); the points chosen from it hold in between. Field frame, metres.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -31,10 +32,11 @@ class SupportParams(Validated):
 
 
 def spread_points(ev: PassEvaluation, ball: Array, count: int, p: SupportParams,
-                  placed: Array | None = None) -> list[tuple[float, float]]:
-    """Up to ``count`` of the best points of ``ev``, best first, at least ``spacing_m`` apart and
-    ``min_ball_distance_m`` from ``ball``; ``placed``: where a supporter sent to each of ``ev``'s
-    points stands now (None: on it), the spacing and the points returned being those places."""
+                  taken: Sequence[tuple[float, float]] = (), placed: Array | None = None) -> list[tuple[float, float]]:
+    """Up to ``count`` of the best points of ``ev``, best first, at least ``spacing_m`` apart and from
+    each point of ``taken`` (where team-mates of other roles wait), and ``min_ball_distance_m`` from
+    ``ball``; ``placed``: where a supporter sent to each of ``ev``'s points stands now (None: on it),
+    the spacing and the points returned being those places."""
     order = np.argsort(-ev.values)
     places = ev.points if placed is None else placed
     chosen: list[tuple[float, float]] = []
@@ -44,7 +46,7 @@ def spread_points(ev: PassEvaluation, ball: Array, count: int, p: SupportParams,
         x, y = float(places[i, 0]), float(places[i, 1])
         if math.hypot(x - ball[0], y - ball[1]) < p.min_ball_distance_m:
             continue
-        if all(math.hypot(x - a, y - b) >= p.spacing_m for a, b in chosen):
+        if all(math.hypot(x - a, y - b) >= p.spacing_m for a, b in (*taken, *chosen)):
             chosen.append((x, y))
     return chosen
 
@@ -60,25 +62,46 @@ class Supporters:
         self.evaluation: PassEvaluation | None = None
         self.evaluated_frame = -1  # the frame the evaluation was made on
         self.points: list[tuple[float, float]] = []
-        self._held: int | None = None  # the count the points were held for (None: not held)
+        self._ball: Array = np.zeros(2)  # the ball the evaluation was made for
+        self._taken: tuple[tuple[float, float], ...] = ()  # the points kept clear when the points were chosen
+        self._placed: Array | None = None  # where supporters sent to the grid's points stand (None: on them)
+        self._held: list[tuple[float, float]] | None = None  # the points held through our kickoff
 
     def update(self, frame: int, ball: Array, attack_sign: float, opponents: Array, count: int,
-               hold: bool = False, place: Callable[[Array], Array] | None = None) -> None:
+               taken: Sequence[tuple[float, float]] = (), hold: bool = False,
+               place: Callable[[Array], Array] | None = None) -> None:
         """Re-evaluate the grid on the first frame and every ``eval_every_frames``-th; ``count``
-        supporters' points from it. ``hold``: our kickoff's ball waits for its kick: the points chosen
-        on its first frame hold until it is over (the evaluation goes on for
+        supporters' points from it, clear of ``taken`` (the pass's receiving point): chosen again from
+        the evaluation kept whenever ``taken`` changes in between.
+
+        ``hold``: our kickoff's ball waits for its kick: the points chosen on its first frame hold
+        until it is over (those clear of ``taken``, topped up from the evaluation, which goes on for
         the pass). Chosen anew each time, every point moved as the opponents came to their places, the
         robots were assigned round among them and the kicker's receiver changed with them: a Division A
-        kickoff waited 5 s, or its 10 s out. ``place``: where a supporter sent to each of the grid's points
-        stands now (our kickoff: in our half; None: on it), the points spread on those places (else
-        two chosen points beyond the halfway line put two robots side by side on it)."""
-        held = hold and self._held == count and bool(self.points)
-        self._held = count if hold else None
-        if self.evaluation is not None and frame % self.p.eval_every_frames != 0 and not (hold and not held):
+        kickoff waited 5 s, or its 10 s out. ``place``: where a supporter sent to each of the grid's
+        points stands now (our kickoff: in our half; None: on it), the points spread on those places
+        (else two chosen points beyond the halfway line put two robots side by side on it)."""
+        taken = tuple(taken)
+        if not hold:
+            self._held = None
+        if place is None:
+            self._placed = None  # the places of our kickoff, over with it
+        if self.evaluation is None or frame % self.p.eval_every_frames == 0 or (hold and self._held is None):
+            self.evaluation = pass_values(ball, self.grid, self.field, attack_sign, opponents, self.obstacle_radius,
+                                          self.passing)
+            self.evaluated_frame = frame
+            self._ball = ball
+            self._placed = place(self.evaluation.points) if place is not None else None
+        elif taken == self._taken and not hold:
             return
-        self.evaluation = pass_values(ball, self.grid, self.field, attack_sign, opponents, self.obstacle_radius,
-                                      self.passing)
-        self.evaluated_frame = frame
-        if not held:
-            placed = place(self.evaluation.points) if place is not None else None
-            self.points = spread_points(self.evaluation, ball, count, self.p, placed)
+        self._taken = taken
+        if hold and self._held is not None:
+            keep = [q for q in self._held if all(math.dist(q, t) >= self.p.spacing_m for t in taken)][:count]
+            if len(keep) < count:
+                keep += spread_points(self.evaluation, self._ball, count - len(keep), self.p, (*taken, *keep),
+                                      self._placed)
+            self.points = keep
+            return
+        self.points = spread_points(self.evaluation, self._ball, count, self.p, taken, self._placed)
+        if hold:
+            self._held = list(self.points)

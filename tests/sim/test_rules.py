@@ -10,7 +10,16 @@ from collections.abc import Callable
 import pytest
 
 from cmdragons.geometry import Field, LeagueParams, Team
-from cmdragons.messages import BallTruth, GameEvent, GameStage, GroundTruth, RefereeCommand, RobotCommand, RobotTruth
+from cmdragons.messages import (
+    BallTruth,
+    GameEvent,
+    GameStage,
+    Goal,
+    GroundTruth,
+    RefereeCommand,
+    RobotCommand,
+    RobotTruth,
+)
 from sim.referee import Referee
 from sim.referee_params import RefereeParams
 from sim.rules import FoulWatch, HeldBall, NoProgress, RulesParams, Situation, penalty_set, placed
@@ -536,4 +545,31 @@ def test_a_kickoff_whose_ball_is_seen_late_on_the_centre_spot_is_not_taken_until
     w.place_ball(2 * ref.rules.ball_in_play_m, 0.0)
     w.step_frame([])
     ref.observe(w.t, [], tuple(w.ball_body.position))
+    assert ref.game.command == RefereeCommand.NORMAL
+
+
+def test_the_kickoff_after_a_goal_is_not_taken_while_the_ball_is_still_seen_in_the_goal() -> None:
+    """The kickoff the referee sets up after a goal (its ball put on the centre spot by a teleport):
+    an auto-referee on tracked vision sees the ball still in the goal the frames after the teleport
+    (ER-Force self-play: normal play the frame after, our robot went for the ball in the centre
+    circle and a double touch was called); it is taken once the ball, seen on the spot, moves."""
+    w, ref = scene()
+    left = (w.field.half_length + 0.05, 0.1)  # in the goal
+    w.place_ball(*left)
+    ref.observe(w.t, [Goal(w.t, "blue", *left)], left, w.ground_truth())
+    teleport = None
+    for _ in range(round((ref.params.restart_delay_s + 1.0) * 60)):  # the restart due, its teleport not seen
+        w.step_frame([])
+        put = ref.observe(w.t, [], left, w.ground_truth())
+        teleport = teleport or put
+        assert ref.game.command in (RefereeCommand.STOP, RefereeCommand.KICKOFF)
+    assert teleport is not None and teleport.ball == (0.0, 0.0) and ref.game.command == RefereeCommand.KICKOFF
+    w.apply(teleport)
+    for _ in range(5):
+        w.step_frame([])
+        ref.observe(w.t, [], tuple(w.ball_body.position), w.ground_truth())
+        assert ref.game.command == RefereeCommand.KICKOFF
+    w.place_ball(2 * ref.rules.ball_in_play_m, 0.0)
+    w.step_frame([])
+    ref.observe(w.t, [], tuple(w.ball_body.position), w.ground_truth())
     assert ref.game.command == RefereeCommand.NORMAL

@@ -213,3 +213,34 @@ def test_a_team_with_a_robot_too_many_drives_the_one_nearest_the_halfway_line_at
     assert abs(it.x) <= 1.0 and w < abs(it.y) < w + r + FIELD.dims.boundary_width_m and it.y * nearest.y >= 0
     allowed = GameState(0.0, "normal", blue_team=dataclasses.replace(info, max_robots=6))
     assert out_of(Strategy("blue", FIELD, p).decide(later, allowed)) == []
+
+
+# blue's and yellow's robots (id, x, y, theta) in the ER-Force simulator's self-play (Division B field,
+# 16.5 s in): yellow places the ball in blue's half while blue's attacker has decided a pass to robot
+# 4, which stands at the best supporter point; robot 5, the one supporter left, was sent to that point
+# too (targets 2 cm apart) and drove into 4 for 13 s (38 own collisions counted from the tracks)
+_RECEIVER_SITUATION = (
+    ("blue", 0, -4.35, -0.03, -0.20), ("blue", 1, -3.27, 1.22, -2.50), ("blue", 2, -4.00, -1.50, 2.70),
+    ("blue", 3, -3.08, -0.88, -0.74), ("blue", 4, 2.55, -0.47, 3.11), ("blue", 5, 2.70, -0.38, 3.10),
+    ("yellow", 0, 4.34, 0.0, -3.09), ("yellow", 1, 3.24, 0.13, -3.07), ("yellow", 2, -3.99, -1.24, 0.85),
+    ("yellow", 3, -3.32, 1.04, -1.09), ("yellow", 4, 3.26, -0.20, -3.14), ("yellow", 5, -3.40, -0.15, -1.66),
+)
+
+
+@pytest.mark.parametrize("command", ["ball_placement", "stop"])
+def test_no_supporter_is_sent_to_the_receivers_point_while_play_is_stopped(command: str) -> None:
+    p = StrategyParams()
+    robots = tuple(_robot(team, rid, x, y, th) for team, rid, x, y, th in _RECEIVER_SITUATION)
+    ball = BallState(-3.39, -0.25, 0.0, 0.0)
+    game = GameState(0.0, command, for_team="yellow" if command == "ball_placement" else None,
+                     blue_defends_negative_x=True, placement=(-3.3, 0.57) if command == "ball_placement" else None)
+    strategy = Strategy("blue", FIELD, p)
+    receivers = 0
+    for k in range(2 * p.support.eval_every_frames):  # across a re-evaluation of the supporters' points
+        intents = strategy.decide(WorldState(0.016 * k, ball, robots), game)
+        receivers += RoleKind.RECEIVER in {role.kind for role in strategy.roles.roles.values()}
+        points = sorted((it.x, it.y, rid) for rid, it in intents.items())
+        for i, (xa, ya, a) in enumerate(points):
+            for xb, yb, b in points[i + 1:]:
+                assert math.hypot(xa - xb, ya - yb) >= 2.0 * p.robot_radius_m, (k, a, b)
+    assert receivers > 0  # the situation: a pass decided, its receiver waiting at a supporter's point

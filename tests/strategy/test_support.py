@@ -91,3 +91,23 @@ def test_the_kickoff_points_hold_while_its_ball_waits() -> None:
     assert held.evaluation is not None and held.evaluated_frame == 1  # the evaluation goes on
     held.update(2, ball, 1.0, blockers, 3)  # the kickoff is over
     assert held.points == moved.points
+def test_points_keep_clear_of_a_receivers_point() -> None:
+    ev = _evaluation([(2.0, 0.0), (2.0, 1.5), (-2.0, 0.0)], [0.9, 0.7, 0.1])
+    ball = np.array([0.0, 0.0])
+    # a receiver waits at (2.05, 0.1), by the best point: the supporters take the next ones
+    assert spread_points(ev, ball, 2, P, taken=[(2.05, 0.1)]) == [(2.0, 1.5), (-2.0, 0.0)]
+    assert spread_points(ev, ball, 2, P, taken=[(-2.0, 2.5)]) == [(2.0, 0.0), (2.0, 1.5)]  # far: no change
+
+
+def test_a_receivers_point_is_kept_clear_between_evaluations() -> None:
+    supporters = Supporters(FIELD, PassParams(), SupportParams(eval_every_frames=3), obstacle_radius=0.11)
+    ball, opponents = np.array([0.0, 0.0]), np.array([[1.0, 0.5]])
+    supporters.update(1, ball, 1.0, opponents, 2)
+    first, best = supporters.evaluation, supporters.points[0]
+    supporters.update(2, ball, 1.0, opponents, 2, taken=[best])  # a pass decided to the best point's robot
+    assert supporters.evaluation is first  # not re-evaluated: chosen again from the same evaluation
+    assert all(math.dist(q, best) >= SupportParams().spacing_m for q in supporters.points)
+    supporters.update(3, ball, 1.0, opponents, 2, taken=[best])
+    assert all(math.dist(q, best) >= SupportParams().spacing_m for q in supporters.points)
+    supporters.update(4, ball, 1.0, opponents, 2)  # the pass is over: the best point is a supporter's again
+    assert supporters.points[0] == best

@@ -4,7 +4,8 @@ A pass starts with a kick of ours the strategy meant as a pass (the team report'
 pass it followed then (passer, receiver, target, one-touch or trap), with the kick speed the strategy
 asked (over the ground, the passer's last armed command in the team report) and the kicker's speed
 relative to the robot that fired. On the first true frame after the kick the record takes the kick
-speed measured (the ball's speed over the ground), how far the ball runs off the
+speed measured (the ball's speed over the ground then, with the sliding deceleration since the kick
+added back: the ball's speed as it left the kicker), how far the ball runs off the
 line to the target, and what the models predicted from that frame: when the ball reaches the target
 (the two-phase ball model) and when the closest opponent can be in the ball's way (its limits). Then
 it follows the true frames (the ball at the target: it touches, within ``touch_m``, the kicker face
@@ -44,6 +45,8 @@ if TYPE_CHECKING:
 
 __all__ = ["PassEnd", "PassRecord", "PassRecorder"]
 
+_GROUND_M = 1e-6  # a ball centre this little above its radius lies on the ground (float slack)
+
 
 class PassEnd(enum.StrEnum):
     """How a pass ended (see the module docstring)."""
@@ -71,7 +74,7 @@ class PassRecord:
     one_touch: bool
     speed_asked_m_s: float  # over the ground, as the strategy asked it (NaN: no armed command reported)
     kicker_m_s: float = math.nan  # the kicker's speed, relative to the robot (the simulator's kick)
-    speed_m_s: float = math.nan  # measured over the ground on the first frame after the kick
+    speed_m_s: float = math.nan  # over the ground as it left the kicker, measured on the first frame after the kick
     off_line_rad: float = math.nan  # the ball's direction off the line to the target
     ball_model_s: float | None = None  # the ball at the target, as the model predicted it from the kick
     opponent_s: float | None = None  # the closest opponent's interception, as predicted from the kick
@@ -102,6 +105,7 @@ class PassRecorder:
         self.timeout_s = timeout_s
         self.reach_m = robot.radius_m + ball_radius_m + params.touch_m
         self.contact_m = robot.front_distance_m + ball_radius_m  # the ball on the face of a robot at the target
+        self.ball_radius_m = ball_radius_m  # the ball's centre this high: on the ground
         self.limits, self.latency_s = robot_limits(robot), robot.command_latency_s
         self.records: list[PassRecord] = []
         self._open: PassRecord | None = None
@@ -240,7 +244,9 @@ class PassRecorder:
         b = gt.ball
         self._kick_xy = (b.x, b.y)
         speed = math.hypot(b.vx, b.vy)
-        rec.speed_m_s = speed
+        # the kick came between frames: a ball on the ground slid since (a chip flies undecelerated)
+        on_ground = b.z <= self.ball_radius_m + _GROUND_M
+        rec.speed_m_s = speed + (self.model.acc_slide_m_s2 * (gt.t - rec.t_kick) if on_ground else 0.0)
         opp = [r for r in gt.robots if r.team != self.team]
         if opp and speed > 0.0:
             xy = np.array([[r.x, r.y] for r in opp])

@@ -17,7 +17,7 @@ from cmdragons.config import Validated, derived, setting
 from cmdragons.geometry import Field, wrap_angle
 from cmdragons.messages import BallState, RobotState
 from strategy.ballmodel import BallModel
-from strategy.onetouch import kick_heading
+from strategy.onetouch import chip_heading, kick_heading
 
 __all__ = [
     "Intent",
@@ -63,6 +63,7 @@ class SkillParams(Validated):
     # the ball velocity across the heading (relative to the robot) a kick keeps: the kicker's, configured in
     # sim.yaml kicker; a kick aims with it (strategy.onetouch)
     kicker_retention: float = derived("sim.kicker.tangential_retention", 0.3, lo=0.0, hi=1.0)
+    chip_angle_rad: float = derived("sim.kicker.chip_angle_rad", 0.7854, lo=0.0, hi=1.5707963267948966)  # a chip's tilt
     goalie_depth_m: float = setting(0.15, lo=0.0, hi=2.0)  # goalie stands this far in front of the goal line
     defense_margin_m: float = setting(0.15, lo=0.0, hi=2.0)  # defenders stand this far outside the area
     mark_distance_m: float = setting(0.45, lo=0.2, hi=3.0)  # marker between its opponent and our goal
@@ -194,9 +195,11 @@ def aiming(robot: RobotState, ball: BallState, aim: float, speed: float, p: Skil
     ground: the kick is relative to the robot, whose velocity (and part of the ball's across the
     heading) carries over to the ball, so the robot faces the kick's direction less what its
     motion adds (:func:`~strategy.onetouch.kick_heading`, with the robot's and the ball's velocity
-    now). A chip, and no kick, face the aim."""
+    now). A chip likewise, its ``speed`` the kicker's (:func:`~strategy.onetouch.chip_heading`); no
+    kick faces the aim."""
     if chip:
-        return aim
+        return chip_heading(aim, speed, p.chip_angle_rad, (robot.vx, robot.vy), (ball.vx, ball.vy),
+                            p.kicker_retention)
     return kick_heading(aim, speed, (robot.vx, robot.vy), (ball.vx, ball.vy), p.kicker_retention)
 
 

@@ -1,8 +1,11 @@
 """Every pass of one team accounted for, from the simulator's true state.
 
 A pass starts with a kick of ours the strategy meant as a pass (the team report's action) and the
-pass it followed then (passer, receiver, target, one-touch or trap). On the first true frame after
-the kick the record takes the kick speed measured (the ball's speed), how far the ball runs off the
+pass it followed then (passer, receiver, target, one-touch or trap), with the kick speed the strategy
+asked (over the ground, the passer's last armed command in the team report) and the kicker's speed
+relative to the robot that fired. On the first true frame after the kick the record takes the kick
+speed measured (the ball's speed over the ground then, with the sliding deceleration since the kick
+added back: the ball's speed as it left the kicker), how far the ball runs off the
 line to the target, and what the models predicted from that frame: when the ball reaches the target
 (the two-phase ball model) and when the closest opponent can be in the ball's way (its limits). Then
 it follows the true frames (the ball at the target: it touches, within ``touch_m``, the kicker face
@@ -42,6 +45,8 @@ if TYPE_CHECKING:
 
 __all__ = ["PassEnd", "PassRecord", "PassRecorder"]
 
+_GROUND_M = 1e-6  # a ball centre this little above its radius lies on the ground (float slack)
+
 
 class PassEnd(enum.StrEnum):
     """How a pass ended (see the module docstring)."""
@@ -67,8 +72,9 @@ class PassRecord:
     receiver: int | None  # None: a kick meant as a pass without a pass followed
     target: tuple[float, float] | None
     one_touch: bool
-    speed_asked_m_s: float
-    speed_m_s: float = math.nan  # measured on the first frame after the kick
+    speed_asked_m_s: float  # over the ground, as the strategy asked it (NaN: no armed command reported)
+    kicker_m_s: float = math.nan  # the kicker's speed, relative to the robot (the simulator's kick)
+    speed_m_s: float = math.nan  # over the ground as it left the kicker, measured on the first frame after the kick
     off_line_rad: float = math.nan  # the ball's direction off the line to the target
     ball_model_s: float | None = None  # the ball at the target, as the model predicted it from the kick
     opponent_s: float | None = None  # the closest opponent's interception, as predicted from the kick
@@ -99,6 +105,7 @@ class PassRecorder:
         self.timeout_s = timeout_s
         self.reach_m = robot.radius_m + ball_radius_m + params.touch_m
         self.contact_m = robot.front_distance_m + ball_radius_m  # the ball on the face of a robot at the target
+        self.ball_radius_m = ball_radius_m  # the ball's centre this high: on the ground
         self.limits, self.latency_s = robot_limits(robot), robot.command_latency_s
         self.records: list[PassRecord] = []
         self._open: PassRecord | None = None
@@ -108,6 +115,7 @@ class PassRecorder:
         self._kick_xy = (0.0, 0.0)  # the ball on the first frame after the kick
         self._start_command = RefereeCommand.NORMAL
         self._passing: PassReport | None = None
+        self._asked: dict[int, float] = {}  # robot id -> the kick speed its last armed command asked (m/s)
         self._game = GameState(0.0)
 
     @classmethod
@@ -119,6 +127,9 @@ class PassRecorder:
 
     def report(self, report: TeamReport) -> None:
         self._passing = report.passing
+        for r in report.robots:
+            if r.command is not None and r.command.kick_speed > 0.0:
+                self._asked[r.id] = r.command.kick_speed
         rec = self._open
         if rec is not None and self._measured and rec.dropped_s is None and rec.receiver is not None:
             ps = report.passing
@@ -139,7 +150,8 @@ class PassRecorder:
             return
         ps = self._passing if self._passing is not None and self._passing.passer == e.id else None
         self._open = PassRecord(e.t, e.id, ps.receiver if ps else None, ps.target if ps else None,
-                                bool(ps and ps.shoot_at is not None), e.speed_m_s)
+                                bool(ps and ps.shoot_at is not None), self._asked.get(e.id, math.nan),
+                                e.speed_m_s)
         self._measured = self._passer_left = False
         self._touch_t = None
         self._start_command = self._game.command
@@ -232,7 +244,9 @@ class PassRecorder:
         b = gt.ball
         self._kick_xy = (b.x, b.y)
         speed = math.hypot(b.vx, b.vy)
-        rec.speed_m_s = speed
+        # the kick came between frames: a ball on the ground slid since (a chip flies undecelerated)
+        on_ground = b.z <= self.ball_radius_m + _GROUND_M
+        rec.speed_m_s = speed + (self.model.acc_slide_m_s2 * (gt.t - rec.t_kick) if on_ground else 0.0)
         opp = [r for r in gt.robots if r.team != self.team]
         if opp and speed > 0.0:
             xy = np.array([[r.x, r.y] for r in opp])

@@ -16,7 +16,7 @@ from cmdragons.messages import BallState, RobotCommand, RobotState
 from cmdragons.runtime.settings import load_settings
 from sim.world import Kick, World
 from strategy.onetouch import kick_heading
-from strategy.skills import receive, turn_with_ball
+from strategy.skills import drive_through, receive, turn_with_ball
 
 SETTINGS = load_settings(Path(__file__).resolve().parents[2] / "configs")
 SHOT_M_S = 6.0
@@ -128,3 +128,70 @@ def test_a_robot_driving_sideways_shoots_a_pass_one_touch_at_the_goal_centre(sid
     assert kicked is not None, "no kick"
     assert abs(kicked.robots[0].vy - sideways_m_s) < 0.1  # it kicked driving sideways at the speed asked
     assert abs(goal_line_crossing(world, target[0]) - target[1]) < TOLERANCE_M
+
+
+GRAVITY_M_S2 = 9.81
+CHIP_REACH_M = 2.0  # the chip's target this far from the ball, where a chip from a robot standing still lands
+CHIP_TOLERANCE_M = 0.15  # the aimed chip's first bounce this near its target (unaimed, 0.6 m off at 1 m/s sideways)
+
+
+@pytest.mark.parametrize("sideways_m_s", [1.0, -1.0, 0.0])
+def test_a_robot_driving_sideways_chips_onto_its_target(sideways_m_s: float) -> None:
+    """A robot carries the ball on its dribbler across the field at ``sideways_m_s`` (scripted), turns
+    with it toward a target ``CHIP_REACH_M`` ahead (the team's skill sets the heading, the turn
+    scripted) and chips at the kicker's speed that lands a chip from a robot standing still on the
+    target: the first bounce is within ``CHIP_TOLERANCE_M`` of the target. (The robot's sideways
+    motion carries over to the ball in the air for the whole flight, 0.6 s: a chip facing the target
+    lands 0.6 m to its side. What remains is the chip's length, which the heading does not set: the
+    kicker's horizontal speed K, turned against the motion, leaves sqrt(K² - v²) along the way.)"""
+    s, world = SETTINGS.sim, one_robot_world()
+    skills = SETTINGS.strategy.skills
+    angle = s.kicker.chip_angle_rad
+    kicker_m_s = math.sqrt(CHIP_REACH_M * GRAVITY_M_S2 / math.sin(2.0 * angle))
+    x0, y0 = -1.0, -0.6 * math.copysign(1.0, sideways_m_s)
+    world.place_robot("blue", 0, x0, y0, 0.0)
+    world.place_ball(x0 + skills.contact_m, y0)
+    target = (x0 + skills.contact_m + CHIP_REACH_M, 0.0)
+    dt = 1.0 / s.physics.frame_rate_hz
+    for _ in range(round(0.4 / dt)):  # up to speed sideways, the ball held
+        world.step_frame([RobotCommand("blue", 0, vy=sideways_m_s, dribbler=1.0)])
+    assert world.holding("blue", 0)
+    kicked, last = False, None
+    for _ in range(round(1.0 / dt)):
+        truth = world.ground_truth()
+        r, b = truth.robots[0], truth.ball
+        robot = RobotState("blue", 0, r.x, r.y, r.theta, r.vx, r.vy, r.omega)
+        ball = BallState(b.x, b.y, b.vx, b.vy)
+        aim = math.atan2(target[1] - b.y, target[0] - b.x)
+        heading = drive_through(robot, ball, aim, kicker_m_s, skills, chip=True).theta
+        error = wrap_angle(heading - r.theta)
+        armed = abs(error) < LINED_UP_RAD
+        # the scripted turn: a share of the error a frame, plus how fast the heading asked turns (the aim
+        # turns as the robot drives across it)
+        follow = 0.0 if last is None else wrap_angle(heading - last) / dt
+        last = heading
+        cmd = RobotCommand("blue", 0, vy=sideways_m_s, omega=HEADING_GAIN * error / dt + follow,
+                           kick_speed=kicker_m_s if armed else 0.0, chip=armed, dribbler=1.0)
+        if any(isinstance(e, Kick) for e in world.step_frame([relative_kick(cmd, r.theta, SETTINGS.field.robot)])):
+            kicked = True
+            break
+    assert kicked, "no chip"
+    landing = first_bounce(world)
+    assert math.dist(landing, target) < CHIP_TOLERANCE_M
+
+
+LINED_UP_RAD = 0.005  # the scripted chip fires facing the skill's heading this near
+
+
+def first_bounce(world: World) -> tuple[float, float]:
+    """Where a chipped ball first comes down (m), from the last frame of its flight (no drag in the air)."""
+    dt = 1.0 / SETTINGS.sim.physics.frame_rate_hz
+    before = world.ground_truth().ball
+    for _ in range(round(3.0 / dt)):
+        world.step_frame([])
+        after = world.ground_truth().ball
+        if after.vz > before.vz or after.z <= 0.0:  # bounced (or rolled out) since the last frame
+            t = (before.vz + math.sqrt(before.vz**2 + 2.0 * GRAVITY_M_S2 * before.z)) / GRAVITY_M_S2
+            return before.x + before.vx * t, before.y + before.vy * t
+        before = after
+    raise AssertionError("the chipped ball did not come down")

@@ -138,13 +138,16 @@ def vision_goals(messages: Iterable[tuple[str, Any]], pitch: Field) -> dict[Team
     """Goals in the simulator's own vision: per camera frame (``ssl/vision/<id>`` messages, in capture
     order, the referee's ``referee`` game states among them) its surest ball, across a goal line
     between the posts (:class:`~sim.autoref.BallCrossing`) while the ball is in play; the scorer by
-    the sides the referee gave at that moment."""
+    the sides the referee gave at that moment; one goal until the referee stops play (a ball seen back
+    out of the goal and in again, on the line, is the same goal)."""
     crossing = BallCrossing(pitch)
     game = GameState(0.0)
     goals: dict[Team, int] = {"blue": 0, "yellow": 0}
+    scored = False  # a goal counted since play last stopped
     for topic, m in messages:
         if topic == "referee":
             game = m
+            scored = scored and _in_play(game)
             continue
         frame: DetectionFrame = m
         if not frame.balls:
@@ -152,8 +155,9 @@ def vision_goals(messages: Iterable[tuple[str, Any]], pitch: Field) -> dict[Team
         b = max(frame.balls, key=lambda b: b.confidence)
         sign = -1 if game.blue_defends_negative_x else 1
         seen = crossing.see(frame.t_capture, b.x, b.y, sign, None)
-        if isinstance(seen, Goal) and _in_play(game):
+        if isinstance(seen, Goal) and _in_play(game) and not scored:
             goals[other(defender_of(b.x, sign))] += 1
+            scored = True
     return goals
 
 

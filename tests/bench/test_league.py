@@ -64,9 +64,26 @@ def test_goals_in_vision_are_crossings_between_the_posts_while_in_play_scored_by
         _game(7.0, RefereeCommand.NORMAL, blue_negative=False),  # the sides changed: blue defends +x
         _frame(8.0, -PAST_GOAL_X, -0.3),  # into the -x goal: blue scores again
         _frame(9.0, 0.0, 0.0),
+        _game(9.5, RefereeCommand.STOP, blue_negative=False),
+        _game(9.6, RefereeCommand.NORMAL, blue_negative=False),
         _frame(10.0, PAST_GOAL_X, 0.2),  # into the +x goal, blue's own: yellow scores
     ]
     assert vision_goals(stream, FIELD) == {"blue": 2, "yellow": 1}
+
+
+def test_a_ball_seen_in_the_goal_out_and_in_again_before_the_referee_stops_play_is_one_goal() -> None:
+    """As in a served Division A match: the ball seen 2 cm past the goal line, back on it, then in for good
+    (the autoref and the truth: one goal)."""
+    line = FIELD.half_length + 0.0215
+    stream = [
+        _game(0.0, RefereeCommand.NORMAL),
+        _frame(1.0, 4.0, 0.1), _frame(1.1, line + 0.02, 0.06), _frame(1.2, line - 0.05, 0.06),
+        _frame(1.5, PAST_GOAL_X, 0.1),
+        _game(1.6, RefereeCommand.STOP),
+        _game(5.0, RefereeCommand.KICKOFF), _game(6.0, RefereeCommand.NORMAL),
+        _frame(7.0, 4.0, 0.1), _frame(7.1, PAST_GOAL_X, 0.1),  # the next goal, after play stopped: counted
+    ]
+    assert vision_goals(stream, FIELD) == {"blue": 2, "yellow": 0}
 
 
 def test_goals_in_the_truth_are_counted_at_both_ends_once_each() -> None:

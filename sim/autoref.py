@@ -321,7 +321,11 @@ class AutoRef:
         if kick is not None:
             events.append(kick)
         last = r.watch.last_touch if kick is None else (kick.team, kick.id)
-        crossing = self.crossing.see(world.t, *self._ball, r.blue_sign, None if last is None else last[0])
+        # a line crossed only where a camera shows the ball: a track coasting on unseen (a ball off the post,
+        # a frame passed over) ran past the goal line and was called a goal before the ball went in
+        seen = world.ball is not None and world.ball.visible
+        crossing = self.crossing.see(world.t, *self._ball, r.blue_sign, None if last is None else last[0]) \
+            if seen else None
         if crossing is not None:
             events.append(crossing)
         score, outs, sign = dict(r.score), r.balls_out, r.blue_sign

@@ -527,3 +527,30 @@ def test_a_ball_track_coasting_unseen_past_the_wall_is_no_boundary_crossing(seen
     assert auto.referee.watch.last_touch == ("blue", 5)
     assert ("ball_out", "blue") in kinds
     assert (("boundary_crossing", "blue") in kinds) == seen_beyond
+
+
+@pytest.mark.parametrize("seen_in", [False, True])
+def test_a_ball_track_coasting_unseen_past_the_goal_line_is_no_goal(seen_in: bool) -> None:
+    """A ball blue kicked rolls at 2.25 m/s onto the +x goal's post and back (recorded in grSim: camera
+    0's frame passed over, the track coasted on to 2 cm past the line, 1 cm inside the post, and the
+    autoref called the goal 0.27 s before the ball went in): no goal on a track no camera shows. The same
+    ball seen past the line is a goal."""
+    auto = AutoRef(scene()[0].field, [("blue", 5), ("yellow", 4)], RefereeParams())
+    auto.referee.give(RefereeCommand.NORMAL)
+    f = auto.crossing.field
+    blue = RobotState("blue", 5, -1.0, 2.0, 0.0)
+    yellow = RobotState("yellow", 4, 1.0, 2.0, 0.0)
+    y = f.dims.goal_width_m / 2.0 - 0.01
+    line = f.half_length + R_BALL
+    kinds = []
+    xs = [line - 0.3 + 0.0375 * k for k in range(11)]  # to 0.11 m past the line, 2.25 m/s
+    for k, x in enumerate(xs):
+        past = x > line
+        auto.observe(WorldState(k * DT, BallState(x, y, 2.25, 0.0, visible=seen_in or not past), (blue, yellow), k))
+        kinds += [c.kind for c in auto.calls]
+    # off the post, seen back on the field
+    for j in range(1, 6):
+        k = len(xs) + j
+        auto.observe(WorldState(k * DT, BallState(line - 0.02 * j, y, -0.5, 0.0), (blue, yellow), k))
+        kinds += [c.kind for c in auto.calls]
+    assert ("goal" in kinds) == seen_in

@@ -157,6 +157,11 @@ class _BallState:
     touches: set[int] = field(default_factory=set)  # robots in contact this substep
 
 
+def _contact_order(event: Goal | BallOut | Kick | Contact) -> tuple[tuple[str, int], tuple[str, int]]:
+    """The order of the contacts that end in one physics step: by the pair of robots."""
+    return (event.a, event.b) if isinstance(event, Contact) else (("", -1), ("", -1))
+
+
 def ball_at_front(league: LeagueParams, dx: float, dy: float, theta: float,
                   slack_m: float) -> tuple[bool, float, float]:
     """Is a ball ``(dx, dy)`` m from a robot's centre (field frame) against the flat front of the
@@ -388,7 +393,11 @@ class World:
             self._ball_phase()
             self._dribble()
             self._ball.touches.clear()
+            ended = len(self.events)
             self.space.step(self.dt)
+            # pymunk reports the contacts that end in one step in the order of its arbiter hash (the
+            # shapes' addresses in memory): ordered by the pair, the same match logs the same bytes
+            self.events[ended:] = sorted(self.events[ended:], key=_contact_order)
             self.t += self.dt
             self._kick()
             self._chip_flight()
@@ -571,7 +580,7 @@ class World:
     def _pusher(self, key: tuple[int, int]) -> int | None:
         """A robot of the other team in contact with either robot of the pair ``key`` (one team's), or None."""
         team = self.robots[key[0]].team
-        for pair in self._contacts:
+        for pair in sorted(self._contacts):
             if pair != key and (key[0] in pair or key[1] in pair):
                 other = pair[0] if pair[1] in key else pair[1]
                 if self.robots[other].team != team:

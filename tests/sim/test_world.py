@@ -262,6 +262,26 @@ def test_robot_contacts_are_reported() -> None:
     assert c.duration_s > 0.0 and c.max_depth_m >= 0.0
 
 
+def test_contacts_ending_in_one_step_come_in_the_order_of_their_robots() -> None:
+    # six blue-yellow pairs in contact, all parted at once: the frame's contacts by pair, not in the
+    # order of the physics library's arbiter hash (the shapes' addresses, which differ between runs)
+    n = 6
+    w = make_world(blue=n, yellow=n)
+    gap = 2 * LEAGUE.robot.radius_m + 0.05  # driven into each other
+    for i in range(n):
+        w.place_robot("blue", i, -2.5 + 1.0 * i, 0.0, 0.0)
+        w.place_robot("yellow", n - 1 - i, -2.5 + 1.0 * i + gap, 0.0, math.pi)
+    pushing = [RobotCommand(team, i, vx=0.5 * sign) for team, sign in (("blue", 1), ("yellow", -1)) for i in range(n)]
+    run(w, 0.5, pushing)
+    assert len(w.open_contacts()) == n
+    for i in range(n):
+        w.place_robot("blue", i, -2.5 + 1.0 * i, 2.0, 0.0)
+        w.place_robot("yellow", n - 1 - i, -2.5 + 1.0 * i, -2.0, math.pi)
+    ended = [e for e in w.step_frame([]) if isinstance(e, Contact)]
+    assert len(ended) == n
+    assert [(c.a, c.b) for c in ended] == sorted((c.a, c.b) for c in ended)
+
+
 def test_a_contact_between_team_mates_names_the_opponent_pushing_one_into_the_other() -> None:
     # blue 0 and 1 stand side by side, 2 cm apart; yellow drives into blue 0 from behind at 1 m/s
     w = make_world(blue=2, yellow=1)

@@ -601,7 +601,7 @@ class World:
 
     def open_contacts(self) -> list[Contact]:
         """Contacts still going on now, as if they ended now (for a run's summary)."""
-        return [self._contact_event(k, t) for k, t in self._contacts.items()]
+        return [self._contact_event(k, self._contacts[k]) for k in sorted(self._contacts)]
 
     # --- state out --------------------------------------------------------------------------------
     def snapshot(self) -> Snapshot:

@@ -103,6 +103,9 @@ class RobotShape(Validated):
     max_alpha_rad_s2: float = setting(60.0, lo=0.01, hi=1000.0)  # angular acceleration and braking
     command_latency_s: float = setting(0.03, lo=0.0, hi=1.0)  # command sent -> wheels act on it
     min_kick_m_s: float = setting(0.5, lo=0.01, hi=10.0)  # the kicker's slowest kick, relative to the robot
+    # the ball leaves at this share of the kick asked (1: as asked; another simulator's or a real
+    # kicker differs, and the tracker measures it: tracker.yaml physics)
+    kick_gain: float = setting(1.0, lo=0.1, hi=3.0)
 
     def __post_init__(self) -> None:
         super().__post_init__()

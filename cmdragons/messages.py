@@ -924,6 +924,7 @@ class Fact(StrEnum):
     BALL_SLIDE = "ball_slide"
     ROBOT_ACCEL = "robot_accel"
     ROBOT_BRAKE = "robot_brake"
+    KICK_GAIN = "kick_gain"  # a ratio, not m/s²: the ball's launch speed over the kick asked
 
     @property
     def source(self) -> str:
@@ -936,6 +937,7 @@ _SOURCES = {
     Fact.BALL_SLIDE: "field.ball.acc_slide_m_s2",
     Fact.ROBOT_ACCEL: "field.robot.max_accel_m_s2",
     Fact.ROBOT_BRAKE: "field.robot.max_brake_m_s2",
+    Fact.KICK_GAIN: "field.robot.kick_gain",
 }
 
 

@@ -288,7 +288,8 @@ class Brain:
         t2 = time.perf_counter()
         safe = self._make_safe(frame, commands, world) if commands else []
         heading = {r.id: r.theta for r in world.robots if r.team == self.team}
-        safe = [relative_kick(c, heading.get(c.id, 0.0), self.settings.field.robot) for c in safe]
+        gain = self.settings.control.motion.kick_gain
+        safe = [relative_kick(c, heading.get(c.id, 0.0), self.settings.field.robot, gain) for c in safe]
         sent = {c.id for c in safe}
         for c in safe:
             nav = self.navigators.get(c.id)

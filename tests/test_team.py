@@ -231,3 +231,19 @@ def test_the_pass_model_takes_the_ball_deceleration_learnt_in_a_slower_simulator
     # a 3 m pass kicked as the learnt model says arrives about as meant; as the configured one says, too slow
     assert _arrival(pass_speed(3.0, skills), 3.0, 0.70) == pytest.approx(want, abs=0.15)
     assert _arrival(pass_speed(3.0, SETTINGS.strategy.skills), 3.0, 0.70) < want - 0.3
+
+
+def test_a_kickers_gain_learnt_asks_the_kicker_that_much_more() -> None:
+    from strategy.skills import Intent
+    from tests.tracking.test_physics import scripted_kicks
+
+    learnt = scripted_kicks(0.75).physics  # the tracker's view of a kicker whose ball leaves at 0.75 of the kick
+    brain = Brain("blue", SETTINGS)
+    robot = RobotState("blue", 0, -1.0, 0.0, 0.0)
+    kick = {0: Intent(-1.0, 0.0, 0.0, kick_speed=3.0)}  # at rest, the ball asked at 3 m/s
+    (before,) = brain.drive(world(0.0, robot), kick, GameState(0.0))
+    assert before.kick_speed == pytest.approx(3.0)
+    brain.use_physics(learnt)
+    assert brain.settings.control.motion.kick_gain == pytest.approx(0.75, rel=0.05)
+    (after,) = brain.drive(world(0.1, robot), kick, GameState(0.0))
+    assert after.kick_speed == pytest.approx(3.0 / brain.settings.control.motion.kick_gain)

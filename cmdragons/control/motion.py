@@ -54,6 +54,8 @@ class MotionParams(Validated):
     max_omega_rad_s: float = derived("field.robot.max_omega_rad_s", 20.0, lo=0.01, hi=100.0)
     # angular acceleration and braking
     max_alpha_rad_s2: float = derived("field.robot.max_alpha_rad_s2", 60.0, lo=0.01, hi=1000.0)
+    # the ball leaves at this share of the kick asked (configured, or as the tracker measured it)
+    kick_gain: float = derived("field.robot.kick_gain", 1.0, lo=0.1, hi=3.0)
     frame_rate_hz: float = setting(60.0, lo=1.0, hi=1000.0)  # one command per camera frame
 
     @property
@@ -114,16 +116,18 @@ def motion_command(robot: RobotState, target: MotionTarget, params: ControlParam
     return RobotCommand(robot.team, robot.id, float(vx), float(vy), float(omega))
 
 
-def relative_kick(cmd: RobotCommand, theta: float, robot: RobotShape) -> RobotCommand:
+def relative_kick(cmd: RobotCommand, theta: float, robot: RobotShape, gain: float = 1.0) -> RobotCommand:
     """``cmd`` with its kick (the ball's speed over the ground, as strategy asks it) turned into the
     kicker's speed relative to the robot, which moves at the command's velocity along its heading
     ``theta`` (rad): a kicker fires relative to the robot that carries it, so a robot driving onto
-    the ball at 1 m/s that kicks at 6 m/s sends it off at 7 (over the rules' 6.5). Flat kicks; a
-    chip's speed is sent as asked."""
+    the ball at 1 m/s that kicks at 6 m/s sends it off at 7 (over the rules' 6.5). A kicker whose
+    ball leaves at ``gain`` of the speed asked (MotionParams ``kick_gain``) is asked that much more.
+    Flat kicks; a chip's speed is sent as asked."""
     if cmd.kick_speed <= 0.0 or cmd.chip:
         return cmd
     forward = cmd.vx * math.cos(theta) + cmd.vy * math.sin(theta)
-    return dataclasses.replace(cmd, kick_speed=robot.kicker_speed(cmd.kick_speed, forward))
+    kick = robot.kicker_speed(cmd.kick_speed, forward)
+    return dataclasses.replace(cmd, kick_speed=kick if gain == 1.0 else max(kick / gain, robot.min_kick_m_s))
 
 
 def follow_path(position: tuple[float, float], path: ArrayLike, theta: float, params: ControlParams) -> MotionTarget:

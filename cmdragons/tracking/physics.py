@@ -7,11 +7,20 @@ metres and seconds:
 
 * the ball's rolling deceleration from free-rolling balls: detections of the tracked ball with no
   robot within ``clear_m`` since ``after_touch_s`` (the slide after a kick or touch is over), in
-  consecutive windows of ``window_s``; each window's quadratic fit of position over time gives
-  one deceleration (the acceleration against the direction of travel), kept when the fit is tight
-  (no bounce) and the ball still rolls at its end;
+  consecutive windows of ``window_s`` (and the kick gain's windows below, which the model has
+  rolling); each window's quadratic fit of position over time gives one deceleration (the
+  acceleration against the direction of travel), kept when the fit is tight (no bounce) and the
+  ball still rolls at its end;
 * the ball's sliding deceleration likewise, from the first ``slide_window_s`` a kicked ball runs
   clear of the robots (shots: their slide lasts that long; slow passes mix in some rolling);
+* the kicker's gain (the ball's launch speed over the kick asked) from a window of ``gain_window_s``
+  once the model has a kick of ours rolling, the ball clear of the robots: the window's speed taken
+  back to the kick through the two-phase model (configured slide, the fraction at which rolling
+  starts, the rolling deceleration as measured so far),
+  over the ball's speed the kick asked (the kicker's speed sent plus the robot's own along the
+  ball's run, as a kick is relative to the robot). What a pass needs: the ball rolls on as the model
+  of the kick asked says; a kicker that sends it slower by a share (grSim's kick leaves at about 0.8
+  of the speed asked and slides off a fifth of it at once) is asked that much more;
 * each robot's reachable acceleration and braking from our own robots' detections while the
   command in force asks for a velocity change the robot cannot make at once (more than
   ``saturated_m_s`` from the velocity tracked) and no other robot is within ``robot_clear_m``: the
@@ -44,7 +53,7 @@ __all__ = ["PhysicsEstimator", "PhysicsFactsParams", "fit_acceleration"]
 Array = NDArray[np.float64]
 
 
-FactName = Literal["ball_roll", "ball_slide", "robot_accel", "robot_brake"]
+FactName = Literal["ball_roll", "ball_slide", "robot_accel", "robot_brake", "kick_gain"]
 
 
 @dataclass(frozen=True)
@@ -53,7 +62,7 @@ class PhysicsFactsParams(Validated):
 
     measure: bool = setting(True)  # measure at all
     # the facts whose measured value may replace the configured one
-    learn: tuple[FactName, ...] = setting(("ball_roll", "robot_accel", "robot_brake"))
+    learn: tuple[FactName, ...] = setting(("ball_roll", "robot_accel", "robot_brake", "kick_gain"))
     min_samples: int = setting(10, lo=1, hi=100000)  # windows before a fact can be confident
     max_relative_error: float = setting(0.05, lo=0.0, hi=1.0)  # the median's standard error, of the median
     use_margin: float = setting(0.15, lo=0.0, hi=10.0)  # used only this share off the configured value
@@ -70,6 +79,10 @@ class PhysicsFactsParams(Validated):
     slide_clear_m: float = setting(0.15, lo=0.0, hi=5.0)  # a kicked ball this far from the robots ...
     slide_within_s: float = setting(0.15, lo=0.0, hi=5.0)  # ... this soon after the kick starts a slide window
     slide_window_s: float = setting(0.1, lo=0.01, hi=5.0)
+    kick_within_s: float = setting(0.2, lo=0.0, hi=5.0)  # a kick of ours: its kicker armed this recently ...
+    kick_near_m: float = setting(0.3, lo=0.0, hi=5.0)  # ... on a robot centre this near the ball
+    gain_after_s: float = setting(0.1, lo=0.0, hi=5.0)  # ... its gain window starts this after the model's slide
+    gain_window_s: float = setting(0.4, lo=0.01, hi=5.0)
     # our robots
     robot_window_s: float = setting(0.15, lo=0.01, hi=10.0)
     saturated_m_s: float = setting(0.3, lo=0.0, hi=10.0)  # commanded velocity this far off the tracked one
@@ -80,10 +93,24 @@ class PhysicsFactsParams(Validated):
     acc_slide_m_s2: float = derived("field.ball.acc_slide_m_s2", 3.0, lo=0.0, hi=50.0)
     max_accel_m_s2: float = derived("field.robot.max_accel_m_s2", 3.0, lo=0.0, hi=50.0)
     max_brake_m_s2: float = derived("field.robot.max_brake_m_s2", 6.0, lo=0.0, hi=50.0)
+    slide_to_roll_fraction: float = derived("field.ball.slide_to_roll_fraction", 0.64, lo=0.0, hi=1.0)
+    kick_gain: float = derived("field.robot.kick_gain", 1.0, lo=0.1, hi=3.0)
 
     def configured(self, fact: Fact) -> float:
         return {Fact.BALL_ROLL: self.acc_roll_m_s2, Fact.BALL_SLIDE: self.acc_slide_m_s2,
-                Fact.ROBOT_ACCEL: self.max_accel_m_s2, Fact.ROBOT_BRAKE: self.max_brake_m_s2}[fact]
+                Fact.ROBOT_ACCEL: self.max_accel_m_s2, Fact.ROBOT_BRAKE: self.max_brake_m_s2,
+                Fact.KICK_GAIN: self.kick_gain}[fact]
+
+
+def launch_speed(speed: float, decel: float, after_s: float, acc_slide: float, fraction: float) -> float:
+    """The speed a ball rolling at ``speed`` (m/s, slowing by ``decel`` m/s²) ``after_s`` after its
+    kick was kicked at, by the two-phase model: it slid at ``acc_slide`` from the launch speed v0 until
+    it rolled at ``fraction`` v0, then rolled; so speed = fraction v0 - decel (after_s - (1 - fraction)
+    v0 / acc_slide), solved for v0 (if that still puts the ball in its slide, the slide's own answer)."""
+    v0 = (speed + decel * after_s) / (fraction + decel * (1.0 - fraction) / max(acc_slide, 1e-9))
+    if after_s < (1.0 - fraction) * v0 / max(acc_slide, 1e-9):
+        return speed + acc_slide * after_s
+    return v0
 
 
 def fit_acceleration(t: Array, xy: Array) -> tuple[Array, Array, Array, float]:
@@ -143,16 +170,21 @@ class PhysicsEstimator:
         self._touched = -math.inf  # a robot near the ball or a kick, last
         self._kicked = -math.inf
         self._slide_done = True
+        self._kick: tuple[float, float] | None = None  # our last kick no robot touched since: (t, speed asked)
+        self._gain = _Window()
         self._robots: dict[Any, _RobotRun] = {}
 
     # --- the ball -----------------------------------------------------------------------------------------
-    def ball(self, t: float, x: float, y: float, robot_m: float, kicked: bool) -> None:
+    def ball(self, t: float, x: float, y: float, robot_m: float, kicked: bool, asked_m_s: float | None = None) -> None:
         """A detection of the tracked ball at ``t``; ``robot_m``: the nearest robot centre's distance,
-        ``kicked``: the tracker took it as a kick or bounce."""
+        ``kicked``: the tracker took it as a kick or bounce, ``asked_m_s``: and one of our robots' kick
+        asked the ball this fast over the ground (None: not a kick of ours)."""
         p = self.p
         if kicked:
             self._kicked, self._slide_done = t, False
             self._slide.clear()
+            self._kick = (t, asked_m_s) if asked_m_s is not None else None
+            self._gain.clear()
         if kicked or robot_m < p.clear_m:
             self._touched = t
             self._roll.clear()
@@ -170,8 +202,47 @@ class PhysicsEstimator:
             self._roll.add(t, x, y, p.max_gap_s)
             if self._roll.span() >= p.window_s:
                 self._ball_sample(Fact.BALL_ROLL, self._roll)
+        if self._kick is not None:
+            self._gain_sample(t, x, y, robot_m)
+
+    def _gain_sample(self, t: float, x: float, y: float, robot_m: float) -> None:
+        """The kicker's gain window: from when the model has our kicked ball rolling (its slide at the
+        speed asked over, and ``gain_after_s`` more), ``gain_window_s`` of a ball clear of the robots;
+        its deceleration one rolling sample, its speed halfway through taken back to the kick at the
+        rolling deceleration known now (the window's own until the rolling one has its windows)."""
+        p = self.p
+        t_kick, asked = self._kick  # type: ignore[misc]
+        if t - t_kick < (1.0 - p.slide_to_roll_fraction) * asked / max(p.acc_slide_m_s2, 1e-9) + p.gain_after_s:
+            return
+        if robot_m < p.clear_m:
+            self._kick = None
+            self._gain.clear()
+            return
+        self._gain.add(t, x, y, p.max_gap_s)
+        if self._gain.span() < p.gain_window_s:
+            return
+        self._kick = None  # one window a kick
+        times, xy = self._gain.arrays()
+        self._gain.clear()
+        if len(times) < 4:
+            return
+        accel, v0, v1, rms = fit_acceleration(times, xy)
+        speed0, speed1 = float(np.hypot(*v0)), float(np.hypot(*v1))
+        if rms > p.max_residual_m or min(speed0, speed1) < p.min_speed_m_s:
+            return
+        heading = (v0 + v1) / max(float(np.hypot(*(v0 + v1))), 1e-9)
+        decel = -float(accel @ heading)
+        rolls = self.samples[Fact.BALL_ROLL]
+        rolls.append(decel)  # the model has it rolling: a rolling window too (passes rarely run free longer)
+        if len(rolls) >= p.min_samples:
+            decel = float(np.median(rolls))
+        launch = launch_speed(0.5 * (speed0 + speed1), decel, 0.5 * (times[0] + times[-1]) - t_kick,
+                              p.acc_slide_m_s2, p.slide_to_roll_fraction)
+        self.samples[Fact.KICK_GAIN].append(launch / asked)
 
     def _ball_sample(self, fact: Fact, window: _Window) -> None:
+        """The window's deceleration as one sample of ``fact`` (none: too few detections, a bounce, or
+        too slow)."""
         t, xy = window.arrays()
         window.clear()
         if len(t) < 4:

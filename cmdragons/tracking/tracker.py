@@ -23,6 +23,7 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import NDArray
 
 from cmdragons.config import Validated, derived, override_derived, setting
 from cmdragons.geometry import Team
@@ -115,6 +116,8 @@ class Tracker:
         self.stats = TrackerStats()
         self.t = -math.inf  # capture time of the newest frame taken
         self._commands: dict[tuple[Team, int], deque[tuple[float, tuple[float, float, float]]]] = {}
+        # the last flat kick armed: (from, until (s, in force), m/s)
+        self._kicks: dict[tuple[Team, int], tuple[float, float, float]] = {}
         self._steady_updates = filters.SteadyUpdates()
         self._robots_sorted = True  # self.robots in key order
 
@@ -126,6 +129,10 @@ class Tracker:
                 self._commands.setdefault((c.team, c.id), deque(maxlen=32)).append(
                     (t_sent + self.p.latency_s, (c.vx, c.vy, c.omega))
                 )
+            if c.kick_speed > 0.0 and not c.chip and math.isfinite(c.kick_speed):
+                t_on, armed = t_sent + self.p.latency_s, self._kicks.get((c.team, c.id))
+                since = armed[0] if armed is not None and t_on - armed[1] <= self.p.physics.kick_within_s else t_on
+                self._kicks[(c.team, c.id)] = (since, t_on, c.kick_speed)
 
     def _command_at(self, key: tuple[Team, int], t: float) -> tuple[float, float, float] | None:
         history = self._commands.get(key)
@@ -245,8 +252,9 @@ class Tracker:
         xy = np.array([track.filter.kf.x[:2] for track in self.robots.values()]).reshape(-1, 2)
         ball = self.best_ball()
         if ball is not None and ball.last_seen == t:
-            near = float(np.hypot(*(xy - ball.z).T).min()) if len(xy) else math.inf
-            est.ball(t, ball.z[0], ball.z[1], near, ball.kicked)
+            gaps = np.hypot(*(xy - ball.z).T)
+            near = float(gaps.min()) if len(xy) else math.inf
+            est.ball(t, ball.z[0], ball.z[1], near, ball.kicked, self._kick_asked(keys, gaps) if ball.kicked else None)
         for det in frame.robots:
             key = (det.team, det.id)
             track = self.robots.get(key)
@@ -270,6 +278,20 @@ class Tracker:
             self.p = override_derived(self.configured, new)
             self.p = dataclasses.replace(self.p, physics=self.configured.physics)
         self.physics = facts
+
+    def _kick_asked(self, keys: list[tuple[Team, int]], gaps: NDArray[np.float64]) -> float | None:
+        """A kick just seen: the ball's speed over the ground our kick asked (the kicker's speed sent
+        plus the robot's own along its heading), when one of our robots near the ball had its kicker
+        armed just now (physics ``kick_near_m``, ``kick_within_s``); else None."""
+        p = self.p.physics
+        for i in np.argsort(gaps):
+            if gaps[i] > p.kick_near_m:
+                break
+            armed = self._kicks.get(keys[i])
+            if armed is not None and armed[0] <= self.t <= armed[1] + p.kick_within_s:
+                x = self.robots[keys[i]].filter.kf.x
+                return armed[2] + float(x[3] * math.cos(x[2]) + x[4] * math.sin(x[2]))
+        return None
 
     # --- robots -------------------------------------------------------------------------------
     def _take_robot(self, key: tuple[Team, int], z: tuple[float, float, float], t: float) -> None:

@@ -391,6 +391,28 @@ def test_a_kick_asked_over_the_ground_leaves_at_that_speed_from_a_moving_robot(d
             assert speed == pytest.approx(asked + drive, abs=0.1) and speed > 6.5
 
 
+@pytest.mark.parametrize("gain", [0.75, 1.2])
+def test_a_kicker_off_its_gain_is_asked_that_much_more_and_the_ball_leaves_as_asked(gain: float) -> None:
+    """A kicker whose ball leaves at ``gain`` of the kick sent (sim.yaml kicker.gain), and the team
+    believing it (field.yaml robot.kick_gain, or as its tracker measured): the ball leaves at the
+    speed asked over the ground; a team believing 1 sends it off at ``gain`` of it."""
+    asked = 3.0
+    for believed in (gain, 1.0):
+        w = World(LEAGUE, PhysicsParams(), RobotParams(), BallParams(), KickerParams(gain=gain), DribblerParams(),
+                  robots_per_team={"blue": 1, "yellow": 0})
+        w.place_robot("blue", 0, 0.0, 0.0, 0.0)
+        w.place_ball(FRONT + 0.002, 0.0)
+        cmd = relative_kick(RobotCommand("blue", 0, kick_speed=asked), 0.0, LEAGUE.robot, believed)
+        assert cmd.kick_speed == pytest.approx(asked / believed)
+        for _ in range(6):
+            kicks = [e for e in w.step_frame([cmd]) if isinstance(e, Kick)]
+            if kicks:
+                break
+        assert kicks and kicks[0].speed_m_s == pytest.approx(asked * gain / believed, rel=1e-6)
+        # the frame it was kicked in: sliding (3 m/s²) for a frame at most
+        assert ball_speed(w) == pytest.approx(asked * gain / believed, abs=0.06)
+
+
 def test_the_kickers_speed_never_falls_below_its_slowest_and_a_chip_or_no_kick_is_sent_as_asked() -> None:
     robot = LEAGUE.robot
     assert robot.kicker_speed(2.0, 2.5) == robot.min_kick_m_s  # asked slower than the robot drives

@@ -1,6 +1,6 @@
 """Physics facts learnt by the tracker against what our simulator was configured to do: a rolling
-ball's deceleration and a robot's braking, seen through seeded noisy detections of the simulator's
-true state."""
+ball's deceleration, a robot's braking and the kicker's gain, seen through seeded noisy detections
+of the simulator's true state."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from cmdragons.config import override_derived
 from cmdragons.geometry import LeagueParams
 from cmdragons.messages import DetectionFrame, Fact, PhysicsFacts, RobotCommand
 from cmdragons.tracking import Tracker, TrackerParams
-from cmdragons.tracking.physics import fit_acceleration
+from cmdragons.tracking.physics import fit_acceleration, launch_speed
 from sim.world import BallParams, DribblerParams, KickerParams, PhysicsParams, RobotParams, World
 from tests.tracking.test_tracker import detect, params
 
@@ -56,6 +56,60 @@ def scripted_stops(brake_m_s2: float, seed: int = 1, stops: int = 25) -> Tracker
             w.step_frame([command])
     tracker.finish()
     return tracker
+
+
+def scripted_kicks(gain: float, seed: int = 1, kicks: int = 12, seconds: float = 4.0,
+                   acc_roll_m_s2: float | None = None) -> Tracker:
+    """A robot at rest kicks the ball at 3 m/s across the field, again and again (each ``seconds``),
+    with a kicker whose ball leaves at ``gain`` of the speed asked; the tracker hears the commands."""
+    latency = 0.03
+    league = LeagueParams()
+    ball = BallParams() if acc_roll_m_s2 is None else BallParams(acc_roll_m_s2=acc_roll_m_s2)
+    w = World(league, PhysicsParams(), RobotParams(command_latency_s=latency), ball, KickerParams(gain=gain),
+              DribblerParams(), robots_per_team={"blue": 1, "yellow": 0})
+    tracker = Tracker(params(latency=latency, sigma=SIGMA))
+    rng = np.random.default_rng(seed)
+    front = league.robot.front_distance_m + league.ball.radius_m + 0.002
+    for _ in range(kicks):
+        y = rng.uniform(-1.5, 1.5)
+        w.place_robot("blue", 0, -4.0, y, 0.0)
+        w.place_ball(-4.0 + front, y)
+        for f in range(round(60 * seconds)):
+            snap = w.snapshot()
+            tracker.step([detect(snap, rng, sigma=SIGMA)])
+            command = RobotCommand("blue", 0, kick_speed=3.0 if f < 10 else 0.0)
+            tracker.command_sent([command], snap.t)
+            w.step_frame([command])
+    tracker.finish()
+    return tracker
+
+
+@pytest.mark.parametrize("gain", [1.0, 0.75])  # our simulator's kicker; one like grSim's (about 0.8)
+def test_the_kickers_gain_is_learnt_from_the_balls_our_kicks_roll(gain: float) -> None:
+    tracker = scripted_kicks(gain)
+    est = tracker.physics.estimate(Fact.KICK_GAIN)
+    assert est is not None and est.confident and est.samples >= 10
+    assert est.value_m_s2 == pytest.approx(gain, rel=0.05)
+    assert est.used == (gain != 1.0)
+
+
+def test_short_passes_in_a_world_like_grsims_teach_the_rolling_deceleration_and_the_kick_together() -> None:
+    """Kicks taken away after a second each (a pass received): too short for a ball that ran free
+    ``after_touch_s`` and then a rolling window, but the model has each rolling from its slide's end."""
+    tracker = scripted_kicks(0.75, kicks=14, seconds=1.0, acc_roll_m_s2=0.70)
+    roll, gain = tracker.physics.estimate(Fact.BALL_ROLL), tracker.physics.estimate(Fact.KICK_GAIN)
+    assert roll is not None and roll.confident and roll.used and roll.value_m_s2 == pytest.approx(0.70, rel=0.10)
+    assert gain is not None and gain.confident and gain.used and gain.value_m_s2 == pytest.approx(0.75, rel=0.05)
+
+
+@pytest.mark.parametrize("v0", [1.0, 2.5, 5.0])
+@pytest.mark.parametrize("after_s", [0.05, 0.9, 1.6])
+def test_the_launch_speed_back_through_the_two_phase_model(v0: float, after_s: float) -> None:
+    slide, roll, fraction = 3.0, 0.7, 0.64
+    t_roll = (1.0 - fraction) * v0 / slide
+    speed = v0 - slide * after_s if after_s < t_roll else fraction * v0 - roll * (after_s - t_roll)
+    if speed > 0.0:
+        assert launch_speed(speed, roll, after_s, slide, fraction) == pytest.approx(v0, rel=1e-9)
 
 
 @pytest.mark.parametrize("acc_roll", [0.26, 0.70])  # our simulator's configured value; grSim's

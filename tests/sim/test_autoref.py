@@ -631,3 +631,45 @@ def test_a_penalty_ball_at_rest_whose_track_moves_as_the_kicker_reaches_it_is_st
     kinds = [(c.kind, c.team) for c in calls]
     assert (("penalty_over", "blue") in kinds) == (back_m_s is not None), kinds
     assert (("goal", "blue") in kinds) == (back_m_s is None), kinds
+
+
+# a recorded kick out of sight (``cmdragons bench autoref``, seed 6, 44.30-44.47 s, the autoref's tracked
+# frames): blue 3 kicks the ball at 5.3 m/s along its heading into yellow 2's side 7 cm away, off which it
+# leaves to -y; no camera shows the ball in the two frames between (the truth referee: yellow touched it last,
+# the ball out at 44.62 s blue's free kick; the autoref gave it to yellow). Per frame: t, ball (x, y, vx, vy,
+# seen), blue 3 and yellow 2 (x, y, theta).
+TURNED_UNSEEN = (
+    (44.3000, (1.4908, -2.3106, 0.344, -0.203, True), (1.3914, -2.4064, 0.784), (1.5890, -2.1559, 2.483)),
+    (44.3167, (1.4957, -2.3153, 0.296, -0.275, True), (1.4036, -2.4030, 0.781), (1.5940, -2.1634, 2.482)),
+    (44.3333, (1.5012, -2.3191, 0.322, -0.233, True), (1.4164, -2.3986, 0.777), (1.5999, -2.1705, 2.477)),
+    (44.3500, (1.5063, -2.3236, 0.289, -0.247, True), (1.4297, -2.3946, 0.782), (1.6063, -2.1768, 2.468)),
+    (44.3667, (1.5072, -2.3257, 0.769, 0.249, False), (1.4426, -2.3904, 0.787), (1.6136, -2.1828, 2.447)),
+    (44.3833, (1.5200, -2.3213, 0.773, 0.265, False), (1.4554, -2.3861, 0.787), (1.6218, -2.1874, 2.400)),
+    (44.4000, (1.5995, -2.3778, 3.706, -2.426, True), (1.4684, -2.3819, 0.786), (1.6297, -2.1912, 2.339)),
+    (44.4167, (1.6164, -2.4379, 1.018, -3.601, True), (1.4802, -2.3776, 0.786), (1.6372, -2.1948, 2.299)),
+    (44.4333, (1.6331, -2.4947, 0.988, -3.338, True), (1.4904, -2.3738, 0.801), (1.6462, -2.1981, 2.268)),
+    (44.4500, (1.6496, -2.5506, 0.981, -3.326, True), (1.4998, -2.3707, 0.801), (1.6553, -2.2017, 2.230)),
+    (44.4667, (1.6658, -2.6058, 0.969, -3.282, True), (1.5092, -2.3689, 0.809), (1.6629, -2.2058, 2.194)),
+)
+
+
+@pytest.mark.parametrize(("aside_m", "last"), [(0.0, ("yellow", 2)), (0.35, ("blue", 3))])
+def test_a_kick_out_of_sight_turned_by_the_robot_on_the_kickers_heading_was_touched_last_by_it(
+        aside_m: float, last: tuple[str, int]) -> None:
+    """The recorded frames (:data:`TURNED_UNSEEN`), blue 3 at the ball before them: the ball reappears
+    moving 79 degrees off blue 3's heading, and yellow 2's body lies on that heading within what the ball
+    could roll unseen, the reappeared ball moving away from where it met it: yellow 2 turned it and
+    touched it last (the frame after, the track's velocity settling from the tracker's blend, is no new
+    touch by blue 3 the ball passes). With yellow 2 moved ``aside_m`` off that heading nobody turned it:
+    blue 3's kick stays the last touch."""
+    auto = AutoRef(scene()[0].field, [("blue", 3), ("yellow", 2)], RefereeParams())
+    auto.referee.give(RefereeCommand.NORMAL)
+    t0, *first = TURNED_UNSEEN[0]
+    held = tuple((t0 - 0.2 + k * DT, *first) for k in range(12))
+    dx, dy = aside_m * math.sin(0.784), -aside_m * math.cos(0.784)  # square to blue 3's heading
+    for k, (t, ball, blue, yellow) in enumerate((*held, *TURNED_UNSEEN)):
+        x, y, vx, vy, seen = ball
+        auto.observe(WorldState(t, BallState(x, y, vx, vy, seen),
+                                (RobotState("blue", 3, *blue),
+                                 RobotState("yellow", 2, yellow[0] + dx, yellow[1] + dy, yellow[2])), k))
+    assert auto.referee.watch.last_touch == last

@@ -27,6 +27,7 @@ from collections.abc import Sequence
 from cmdragons.geometry import TEAMS, Field, RobotShape, Team
 from cmdragons.messages import (
     BallOut,
+    BallState,
     BallTruth,
     Event,
     GameEvent,
@@ -138,6 +139,7 @@ def deflection_path(p0: tuple[float, float], v0: tuple[float, float], p1: tuple[
     return [p0, (p0[0] + s * v0[0], p0[1] + s * v0[1]), p1]
 
 
+_RAY_STEP_M = 0.005  # the steps along a kicker's heading looking for the body its kick met (m)
 _PARALLEL = math.sin(math.radians(5.0))  # lines closer to parallel than this meet nowhere the track can tell
 
 
@@ -153,7 +155,11 @@ class KickDetector:
     to its velocity) by more than ``kick_heading_deg``, with the robot that held the ball before in
     reach too (``holder``: the last toucher ``kick_memory_s`` ago), the holder: a robot kicked the ball
     another held into that one's front, which turned it (the changes of the track a kick seen late and
-    a bounce), and touched it last.
+    a bounce), and touched it last. Such a kick where no camera saw the ball (the track coasting the frames
+    before) was turned by the first body the ball meets along the kicker's heading from where it was last
+    seen, when it can have rolled from there to where it reappeared, moving away (:meth:`_turned_by`); the
+    next frame's change that moved the ball on from where that frame showed it (within ``kick_settle_m``)
+    is the track's velocity settling after the turn, no new touch.
     When no robot is that near (a kick the track shows a few frames late, the ball gone), the robot
     last at the ball: the nearest within ``kick_reach_m`` in the newest frame of the last
     ``kick_memory_s`` that had one. A ball that jumps farther than it could roll (put somewhere, or
@@ -168,6 +174,8 @@ class KickDetector:
         self._ball: deque[tuple[float, float, float, float, float]] = deque()  # the last kick_memory_s of it
         self._poses: dict[Key, tuple[float, float, float]] = {}  # where each robot stood the frame before
         self._recent: deque[tuple[float, dict[Key, float]]] = deque()  # t, each robot's gap to the ball (m)
+        self._seen: tuple[float, float, float] | None = None  # t, x, y: where a camera last showed the ball
+        self._turned_t = -math.inf  # when a kick out of sight was last seen turned by another robot
 
     def see(self, world: WorldState, holder: Key | None = None) -> Kick | None:
         """The touch ``world``'s ball shows, or None; ``holder``: the robot at the ball before the
@@ -177,9 +185,11 @@ class KickDetector:
         before, self._poses = self._poses, poses
         if b is None:
             self._last = None
+            self._seen = None
             self._recent.clear()
             self._ball.clear()
             return None
+        seen, self._seen = self._seen, (t, b.x, b.y) if b.visible else self._seen
         gaps = {k: hull_gap(self.shape, pose, b.x, b.y) - self.ball_r for k, pose in poses.items()}
         last, self._last = self._last, (t, b.x, b.y, b.vx, b.vy)
         self._recent.append((t, gaps))
@@ -196,9 +206,13 @@ class KickDetector:
         if jump > self.max_ball_speed_m_s * max(t - t0, 1e-3) + self.ball_r:
             self._recent = deque([(t, gaps)])  # put somewhere else: a new watch
             self._ball = deque([(t, b.x, b.y, b.vx, b.vy)])
+            self._seen = (t, b.x, b.y) if b.visible else None
             return None
         if math.hypot(b.vx - vx0, b.vy - vy0) <= self.p.kick_speed_change_m_s:
             return None
+        if self._turned_t == t0 and math.hypot(x0 + b.vx * (t - t0) - b.x, y0 + b.vy * (t - t0) - b.y) \
+                <= self.p.kick_settle_m:
+            return None  # the turn of the frame before, its velocity settling: the ball went on from there so
         # the old line from the earliest frame remembered that still moved as the last did: a turn the track
         # shows late has the ball past the deflection point already in the frame before
         ta, xa, ya = t0, x0, y0
@@ -213,14 +227,41 @@ class KickDetector:
         if reach:
             key = reach[0]
             kicked = math.hypot(b.vx, b.vy) - math.hypot(vx0, vy0) > self.p.kick_speed_change_m_s
-            if holder in reach and len(reach) > 1 and kicked and not self._along_heading(world, key, b.vx, b.vy):
-                key = holder  # kicked out of the holder's front, which turned it
+            if kicked and not self._along_heading(world, key, b.vx, b.vy):
+                if holder in reach and len(reach) > 1:
+                    key = holder  # kicked out of the holder's front, which turned it
+                elif seen is not None and seen[0] < t0:  # kicked where no camera saw the ball
+                    turned = self._turned_by(poses, key, seen, t, b)
+                    if turned is not None:
+                        key, self._turned_t = turned, t
             return Kick(t, key[0], key[1], math.hypot(b.vx, b.vy), False)
         for _, g in reversed(self._recent):  # the last robot at the ball (the nearest of that frame)
             at = sorted((gap, k) for k, gap in g.items() if gap <= self.p.kick_reach_m)
             if at:
                 key = at[0][1]
                 return Kick(t, key[0], key[1], math.hypot(b.vx, b.vy), False)
+        return None
+
+    def _turned_by(self, poses: dict[Key, tuple[float, float, float]], kicker: Key,
+                   seen: tuple[float, float, float], t: float, b: BallState) -> Key | None:
+        """The robot that turned a ball ``kicker`` kicked out of the cameras' sight: the first body the
+        ball meets going along the kicker's heading from where it was last ``seen`` (t, x, y), from which
+        it can have rolled on to ``b`` (now, at ``t``, no faster than the ball can go, moving away from
+        it); None when there is none."""
+        t_seen, x0, y0 = seen
+        budget = self.max_ball_speed_m_s * (t - t_seen)
+        theta = poses[kicker][2]
+        hx, hy = math.cos(theta), math.sin(theta)
+        steps = max(1, math.ceil(budget / _RAY_STEP_M))
+        for k in range(steps + 1):
+            s = k * budget / steps
+            px, py = x0 + s * hx, y0 + s * hy
+            gaps = ((hull_gap(self.shape, pose, px, py), key) for key, pose in poses.items() if key != kicker)
+            met = sorted((gap, key) for gap, key in gaps if gap <= self.ball_r)
+            if met:
+                on = math.hypot(b.x - px, b.y - py)
+                away = (b.x - px) * b.vx + (b.y - py) * b.vy > 0.0
+                return met[0][1] if s + on <= budget and away else None
         return None
 
     def _along_heading(self, world: WorldState, key: Key, vx: float, vy: float) -> bool:

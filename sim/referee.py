@@ -443,7 +443,8 @@ class Referee:
         # over (the rules) after the kicker's time, or once the ball in play moves away from the goal (the
         # keeper turned it back, or the kicker broke the rule that it only ever moves toward the goal); a
         # ball at rest waits for the kicker, who may play it again
-        if took > self.rules.penalty_time_s or (moved and b.vx * attack < -self.rules.penalty_back_m_s):
+        back_m_s = self.rules.penalty_back_m_s + self.watch.margins.ball_back_m_s
+        if took > self.rules.penalty_time_s or (moved and b.vx * attack < -back_m_s):
             shootout = self.game.stage == GameStage.PENALTY_SHOOTOUT
             self._call(GameEvent(self.t, "penalty_over", pen.team, None, took, self.rules.penalty_time_s, "s",
                                  None if shootout else RefereeCommand.FREE_KICK,

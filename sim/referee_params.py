@@ -38,9 +38,12 @@ class AutorefParams(Validated):
     # to its velocity: a kick leaves along the kicker's heading) was turned by the front of the robot that
     # held the ball, in reach too
     kick_heading_deg: float = setting(30.0, lo=0.0, hi=180.0)
+    # the frame after a kick out of the cameras' sight that another robot turned, a change of the ball's
+    # velocity that moved it there from where it was (within this) is the track's velocity settling, no new touch
+    kick_settle_m: float = setting(0.01, lo=0.0, hi=0.2)
     margins: TrackMargins = TrackMargins(touch_release_m=0.01, contact_release_m=0.0, distance_m=0.05, speed_m_s=0.1,
                                         fast_ball_frames=2, touch_pass_speed_m_s=1.0,
-                                        touch_pass_depth_m=0.003)
+                                        touch_pass_depth_m=0.003, ball_back_m_s=0.25)
     leave_s: float = setting(2.0, lo=0.0, hi=60.0)  # a robot sent off may be seen on the field this long
     # an own collision (two robots of one team, counted for the summary): their centres nearer than two
     # radii plus this ...

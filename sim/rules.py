@@ -93,6 +93,9 @@ class TrackMargins(Validated):
     # robot missed the graze that turned the ball (none on the truth: near is touching)
     touch_pass_speed_m_s: float = setting(math.inf, lo=0.0)
     touch_pass_depth_m: float = setting(0.0, lo=0.0, hi=0.1)
+    # a penalty over by the ball rolling back from the goal only this much faster than the rule's speed: a
+    # ball at rest, a robot's front reaching it, moves on its track (its blob pulled toward the robot's)
+    ball_back_m_s: float = setting(0.0, lo=0.0, hi=2.0)
 
 
 @dataclass(frozen=True)

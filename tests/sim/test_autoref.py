@@ -554,3 +554,122 @@ def test_a_ball_track_coasting_unseen_past_the_goal_line_is_no_goal(seen_in: boo
         auto.observe(WorldState(k * DT, BallState(line - 0.02 * j, y, -0.5, 0.0), (blue, yellow), k))
         kinds += [c.kind for c in auto.calls]
     assert ("goal" in kinds) == seen_in
+
+
+# a recorded penalty (``cmdragons bench autoref``, seed 9, 27.10-27.48 s, the autoref's tracked frames): blue
+# dribbled the ball from the mark to (2.90, 0.00) and left it at rest; blue 2's front reaches it and the ball's
+# track moves back 4 mm (vision's blob pulled toward the robot's), at 0.06 and 0.13 m/s away from the goal,
+# before the kick scores (the truth referee: the goal at 27.47 s; the autoref called the penalty over at
+# 27.13 s and then no goal). Per frame: t, ball (x, y, vx, vy), blue 2 and the yellow keeper (x, y, theta).
+PENALTY = (
+    (27.1000, (2.9027, -0.0042, 0.004, -0.042), (2.7732, -0.0362, 0.193), (4.3508, -0.0004, 3.138)),
+    (27.1167, (2.9027, -0.0043, 0.000, 0.020), (2.7815, -0.0348, 0.192), (4.3509, -0.0008, 3.139)),
+    (27.1333, (2.9019, -0.0047, -0.056, -0.034), (2.7898, -0.0327, 0.182), (4.3510, -0.0007, 3.136)),
+    (27.1500, (2.8990, -0.0051, -0.126, -0.009), (2.7977, -0.0305, 0.181), (4.3507, -0.0005, 3.136)),
+    (27.1667, (2.9001, -0.0050, 0.053, 0.002), (2.8060, -0.0288, 0.183), (4.3508, -0.0008, 3.135)),
+    (27.1833, (2.9703, 0.0091, 0.003, 0.000), (2.8136, -0.0266, 0.184), (4.3508, -0.0004, 3.137)),
+    (27.2000, (3.0703, 0.0277, 5.998, 1.117), (2.8220, -0.0244, 0.191), (4.3507, -0.0003, 3.138)),
+    (27.2167, (3.1695, 0.0463, 5.934, 1.112), (2.8299, -0.0230, 0.194), (4.3508, -0.0006, 3.138)),
+    (27.2333, (3.2680, 0.0647, 5.886, 1.100), (2.8380, -0.0212, 0.187), (4.3508, 0.0004, -3.134)),
+    (27.2500, (3.3657, 0.0830, 5.837, 1.094), (2.8469, -0.0194, 0.180), (4.3504, 0.0017, -3.123)),
+    (27.2667, (3.4623, 0.1013, 5.778, 1.090), (2.8563, -0.0167, 0.167), (4.3497, 0.0035, -3.107)),
+    (27.2833, (3.5583, 0.1195, 5.730, 1.082), (2.8664, -0.0146, 0.130), (4.3499, 0.0062, -3.089)),
+    (27.3000, (3.6534, 0.1374, 5.682, 1.071), (2.8777, -0.0122, 0.069), (4.3497, 0.0107, -3.073)),
+    (27.3167, (3.7478, 0.1551, 5.638, 1.059), (2.8895, -0.0097, 0.003), (4.3495, 0.0154, -3.052)),
+    (27.3333, (3.8412, 0.1728, 5.583, 1.054), (2.9018, -0.0070, -0.074), (4.3498, 0.0207, -3.038)),
+    (27.3500, (3.9339, 0.1904, 5.535, 1.048), (2.9154, -0.0043, -0.146), (4.3499, 0.0273, -3.029)),
+    (27.3667, (4.0257, 0.2075, 5.485, 1.031), (2.9298, -0.0012, -0.215), (4.3498, 0.0340, -3.022)),
+    (27.3833, (4.1169, 0.2247, 5.443, 1.024), (2.9444, 0.0024, -0.278), (4.3500, 0.0417, -3.024)),
+    (27.4000, (4.2072, 0.2417, 5.391, 1.015), (2.9610, 0.0063, -0.345), (4.3499, 0.0510, -3.015)),
+    (27.4167, (4.2965, 0.2585, 5.339, 1.005), (2.9776, 0.0098, -0.425), (4.3500, 0.0601, -3.013)),
+    (27.4333, (4.3852, 0.2751, 5.293, 0.992), (2.9950, 0.0142, -0.520), (4.3502, 0.0712, -3.006)),
+    (27.4500, (4.4724, 0.2916, 5.225, 0.985), (3.0130, 0.0195, -0.631), (4.3505, 0.0825, -3.002)),
+    (27.4667, (4.5596, 0.3080, 5.191, 0.977), (3.0318, 0.0247, -0.761), (4.3503, 0.0918, -2.995)),
+    (27.4833, (4.6459, 0.3243, 5.151, 0.972), (3.0492, 0.0303, -0.904), (4.3503, 0.1020, -2.997)),
+)
+
+
+@pytest.mark.parametrize("back_m_s", [None, 0.5])
+def test_a_penalty_ball_at_rest_whose_track_moves_as_the_kicker_reaches_it_is_still_the_kickers(
+        back_m_s: float | None) -> None:
+    """Blue's penalty, the ball dribbled forward and at rest, then the recorded frames (:data:`PENALTY`):
+    the track's 0.13 m/s back as blue 2's front reaches the ball is no ball turned back, the kick goes on
+    and scores (the goal for blue, as the truth referee called it). The same ball instead rolling back
+    from the goal at 0.5 m/s (a keeper's save, well over the tracks' noise) ends the kick."""
+    params = RefereeParams()
+    params = dataclasses.replace(params, figures=dataclasses.replace(params.figures, prepare_timeout_s=0.5))
+    auto = AutoRef(scene()[0].field, [("blue", 2), ("yellow", 0)], params)
+    r = auto.referee
+    r.start_penalty("blue")
+    pen = r.game.penalty
+    assert pen is not None
+    t0, _, kicker, keeper = PENALTY[0]
+    at_rest = (2.9027, -0.0042, 0.0, 0.0)
+    calls: list[GameEvent] = []
+
+    def see(k: int, t: float, ball: tuple[float, ...], blue: tuple[float, ...], yellow: tuple[float, ...]) -> None:
+        auto.observe(WorldState(t, BallState(*ball), (RobotState("blue", 2, *blue), RobotState("yellow", 0, *yellow)),
+                                k))
+        calls.extend(auto.calls)
+
+    frames = round(3.0 / DT)
+    for k in range(frames):  # prepared on the mark, run, then the ball dribbled forward and left at rest
+        t = t0 - 3.0 + k * DT
+        on_mark = k < frames // 2
+        ball = (*pen.mark, 0.0, 0.0) if on_mark else at_rest
+        blue = (pen.mark[0] - 0.3, 0.0, 0.0) if on_mark else kicker
+        see(k, t, ball, blue, keeper)
+    assert r.game.command == RefereeCommand.PENALTY and r.game.ready
+    recorded = PENALTY if back_m_s is None else PENALTY[:5]
+    for k, (t, ball, blue, yellow) in enumerate(recorded, start=frames):
+        see(k, t, ball, blue, yellow)
+    if back_m_s is not None:  # turned back from where it lay
+        for j in range(1, 10):
+            t = PENALTY[4][0] + j * DT
+            see(frames + 4 + j, t, (at_rest[0] - back_m_s * j * DT, at_rest[1], -back_m_s, 0.0), PENALTY[4][2],
+                PENALTY[4][3])
+    kinds = [(c.kind, c.team) for c in calls]
+    assert (("penalty_over", "blue") in kinds) == (back_m_s is not None), kinds
+    assert (("goal", "blue") in kinds) == (back_m_s is None), kinds
+
+
+# a recorded kick out of sight (``cmdragons bench autoref``, seed 6, 44.30-44.47 s, the autoref's tracked
+# frames): blue 3 kicks the ball at 5.3 m/s along its heading into yellow 2's side 7 cm away, off which it
+# leaves to -y; no camera shows the ball in the two frames between (the truth referee: yellow touched it last,
+# the ball out at 44.62 s blue's free kick; the autoref gave it to yellow). Per frame: t, ball (x, y, vx, vy,
+# seen), blue 3 and yellow 2 (x, y, theta).
+TURNED_UNSEEN = (
+    (44.3000, (1.4908, -2.3106, 0.344, -0.203, True), (1.3914, -2.4064, 0.784), (1.5890, -2.1559, 2.483)),
+    (44.3167, (1.4957, -2.3153, 0.296, -0.275, True), (1.4036, -2.4030, 0.781), (1.5940, -2.1634, 2.482)),
+    (44.3333, (1.5012, -2.3191, 0.322, -0.233, True), (1.4164, -2.3986, 0.777), (1.5999, -2.1705, 2.477)),
+    (44.3500, (1.5063, -2.3236, 0.289, -0.247, True), (1.4297, -2.3946, 0.782), (1.6063, -2.1768, 2.468)),
+    (44.3667, (1.5072, -2.3257, 0.769, 0.249, False), (1.4426, -2.3904, 0.787), (1.6136, -2.1828, 2.447)),
+    (44.3833, (1.5200, -2.3213, 0.773, 0.265, False), (1.4554, -2.3861, 0.787), (1.6218, -2.1874, 2.400)),
+    (44.4000, (1.5995, -2.3778, 3.706, -2.426, True), (1.4684, -2.3819, 0.786), (1.6297, -2.1912, 2.339)),
+    (44.4167, (1.6164, -2.4379, 1.018, -3.601, True), (1.4802, -2.3776, 0.786), (1.6372, -2.1948, 2.299)),
+    (44.4333, (1.6331, -2.4947, 0.988, -3.338, True), (1.4904, -2.3738, 0.801), (1.6462, -2.1981, 2.268)),
+    (44.4500, (1.6496, -2.5506, 0.981, -3.326, True), (1.4998, -2.3707, 0.801), (1.6553, -2.2017, 2.230)),
+    (44.4667, (1.6658, -2.6058, 0.969, -3.282, True), (1.5092, -2.3689, 0.809), (1.6629, -2.2058, 2.194)),
+)
+
+
+@pytest.mark.parametrize(("aside_m", "last"), [(0.0, ("yellow", 2)), (0.35, ("blue", 3))])
+def test_a_kick_out_of_sight_turned_by_the_robot_on_the_kickers_heading_was_touched_last_by_it(
+        aside_m: float, last: tuple[str, int]) -> None:
+    """The recorded frames (:data:`TURNED_UNSEEN`), blue 3 at the ball before them: the ball reappears
+    moving 79 degrees off blue 3's heading, and yellow 2's body lies on that heading within what the ball
+    could roll unseen, the reappeared ball moving away from where it met it: yellow 2 turned it and
+    touched it last (the frame after, the track's velocity settling from the tracker's blend, is no new
+    touch by blue 3 the ball passes). With yellow 2 moved ``aside_m`` off that heading nobody turned it:
+    blue 3's kick stays the last touch."""
+    auto = AutoRef(scene()[0].field, [("blue", 3), ("yellow", 2)], RefereeParams())
+    auto.referee.give(RefereeCommand.NORMAL)
+    t0, *first = TURNED_UNSEEN[0]
+    held = tuple((t0 - 0.2 + k * DT, *first) for k in range(12))
+    dx, dy = aside_m * math.sin(0.784), -aside_m * math.cos(0.784)  # square to blue 3's heading
+    for k, (t, ball, blue, yellow) in enumerate((*held, *TURNED_UNSEEN)):
+        x, y, vx, vy, seen = ball
+        auto.observe(WorldState(t, BallState(x, y, vx, vy, seen),
+                                (RobotState("blue", 3, *blue),
+                                 RobotState("yellow", 2, yellow[0] + dx, yellow[1] + dy, yellow[2])), k))
+    assert auto.referee.watch.last_touch == last

@@ -63,7 +63,8 @@ class PhysicsFactsParams(Validated):
     measure: bool = setting(True)  # measure at all
     # the facts whose measured value may replace the configured one
     learn: tuple[FactName, ...] = setting(("ball_roll", "robot_accel", "robot_brake", "kick_gain"))
-    min_samples: int = setting(10, lo=1, hi=100000)  # windows before a fact can be confident
+    min_samples: int = setting(10, lo=1, hi=100000)  # windows before a fact can be confident ...
+    kick_min_samples: int = setting(5, lo=1, hi=100000)  # ... the kicker's gain (one window a kick: fewer come)
     max_relative_error: float = setting(0.05, lo=0.0, hi=1.0)  # the median's standard error, of the median
     use_margin: float = setting(0.15, lo=0.0, hi=10.0)  # used only this share off the configured value
     retune_change: float = setting(0.05, lo=0.0, hi=10.0)  # a used value handed on again: moved by this share
@@ -299,7 +300,8 @@ class PhysicsEstimator:
             spread = 1.4826 * float(np.median(np.abs(values - median)))
             # the median's standard error: sqrt(pi / 2) times the mean's
             error = 1.2533 * spread / math.sqrt(n)
-            confident = n >= p.min_samples and median > 0.0 and error <= p.max_relative_error * median
+            need = p.kick_min_samples if fact is Fact.KICK_GAIN else p.min_samples
+            confident = n >= need and median > 0.0 and error <= p.max_relative_error * median
             used = confident and fact in learn and abs(median - configured) > p.use_margin * configured
             out.append(FactEstimate(fact, median, configured, n, spread, confident, used))
         return PhysicsFacts(t, tuple(out))

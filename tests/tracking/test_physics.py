@@ -100,6 +100,12 @@ def test_short_passes_in_a_world_like_grsims_teach_the_rolling_deceleration_and_
     roll, gain = tracker.physics.estimate(Fact.BALL_ROLL), tracker.physics.estimate(Fact.KICK_GAIN)
     assert roll is not None and roll.confident and roll.used and roll.value_m_s2 == pytest.approx(0.70, rel=0.10)
     assert gain is not None and gain.confident and gain.used and gain.value_m_s2 == pytest.approx(0.75, rel=0.05)
+    # one window a kick: the gain is confident after kick_min_samples kicks, the rolling deceleration not yet
+    # (and one more: the very first ball is new to the tracker, not a kick it saw)
+    early = scripted_kicks(0.75, kicks=TrackerParams().physics.kick_min_samples + 1, seconds=1.0, acc_roll_m_s2=0.70)
+    gain = early.physics.estimate(Fact.KICK_GAIN)
+    assert gain is not None and gain.used and gain.value_m_s2 == pytest.approx(0.75, rel=0.08)
+    assert not early.physics.estimate(Fact.BALL_ROLL).confident  # type: ignore[union-attr]
 
 
 @pytest.mark.parametrize("v0", [1.0, 2.5, 5.0])

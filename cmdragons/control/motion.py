@@ -121,13 +121,16 @@ def relative_kick(cmd: RobotCommand, theta: float, robot: RobotShape, gain: floa
     kicker's speed relative to the robot, which moves at the command's velocity along its heading
     ``theta`` (rad): a kicker fires relative to the robot that carries it, so a robot driving onto
     the ball at 1 m/s that kicks at 6 m/s sends it off at 7 (over the rules' 6.5). A kicker whose
-    ball leaves at ``gain`` of the speed asked (MotionParams ``kick_gain``) is asked that much more.
+    ball leaves at ``gain`` of the speed asked (MotionParams ``kick_gain``) is asked that much more,
+    up to the robot's ``max_kick_m_s`` (a gain measured on passes must not send a shot over the rules').
     Flat kicks; a chip's speed is sent as asked."""
     if cmd.kick_speed <= 0.0 or cmd.chip:
         return cmd
     forward = cmd.vx * math.cos(theta) + cmd.vy * math.sin(theta)
     kick = robot.kicker_speed(cmd.kick_speed, forward)
-    return dataclasses.replace(cmd, kick_speed=kick if gain == 1.0 else max(kick / gain, robot.min_kick_m_s))
+    if gain != 1.0:
+        kick = min(max(kick / gain, robot.min_kick_m_s), max(kick, robot.max_kick_m_s))
+    return dataclasses.replace(cmd, kick_speed=kick)
 
 
 def follow_path(position: tuple[float, float], path: ArrayLike, theta: float, params: ControlParams) -> MotionTarget:

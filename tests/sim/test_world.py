@@ -413,6 +413,14 @@ def test_a_kicker_off_its_gain_is_asked_that_much_more_and_the_ball_leaves_as_as
         assert ball_speed(w) == pytest.approx(asked * gain / believed, abs=0.06)
 
 
+def test_a_gain_never_makes_a_shot_sent_faster_than_the_robots_fastest_kick() -> None:
+    robot = LEAGUE.robot
+    shot = relative_kick(RobotCommand("blue", 0, kick_speed=6.0), 0.0, robot, 0.58)
+    assert shot.kick_speed == robot.max_kick_m_s  # not 6 / 0.58 = 10.3: grSim's ball would leave at 8
+    fast = relative_kick(RobotCommand("blue", 0, kick_speed=6.5), 0.0, robot, 0.58)
+    assert fast.kick_speed == 6.5  # a kick asked faster still is not made slower by the cap
+
+
 def test_the_kickers_speed_never_falls_below_its_slowest_and_a_chip_or_no_kick_is_sent_as_asked() -> None:
     robot = LEAGUE.robot
     assert robot.kicker_speed(2.0, 2.5) == robot.min_kick_m_s  # asked slower than the robot drives

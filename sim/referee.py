@@ -96,6 +96,7 @@ class Referee:
         self._restart_ball: tuple[float, float] | None = (0.0, 0.0)
         self._restart_t = 0.0  # when the restart in force was given
         self._restart_seen = True  # its ball was seen on its spot (one put there waits for it)
+        self._restart_touches = 0  # the touches counted when it was given
         self._held = HeldBall(field, params.keeper_held_ball_s)
         self._no_progress = NoProgress(params.no_progress_s, params.no_progress_m)
         self.keeper_held_ball = 0
@@ -159,6 +160,7 @@ class Referee:
         self._restart_ball = (0.0, 0.0)
         self._restart_t = self.t
         self._restart_seen = False
+        self._restart_touches = self.watch.touches
         return teleport
 
     # --- one frame --------------------------------------------------------------------------
@@ -235,12 +237,26 @@ class Referee:
         away = kick_taken(ball_xy, self._restart_ball, self.rules.ball_in_play_m)
         self._restart_seen = self._restart_seen or not away
         if away and self._restart_seen:
+            kicking = self.game.for_team
             self._set(RefereeCommand.NORMAL, None)
             self._restart_ball = None
-            self.watch.restart_taken(self.watch.last_touch)
+            self.watch.restart_taken(self._restart_kicker(kicking))
         elif self.t - self._restart_t > self.params.restart_timeout_s:
             self._set(RefereeCommand.FORCE_START if self.full else RefereeCommand.NORMAL, None)
             self._restart_ball = None
+
+    def _restart_kicker(self, kicking: Team | None) -> Key | None:
+        """Who took the restart of ``kicking``: the last robot to touch the ball when it is of that
+        team and touched it since the restart was given (or touches it still); else nobody. (A robot
+        of the other team that touched the ball before a kickoff, when the ball seen moving off the
+        centre spot was a track catching up with the teleported ball, was called for a double touch
+        on its next touch.)"""
+        last = self.watch.last_touch
+        if last is None or last[0] != kicking:
+            return None
+        if self.watch.touches > self._restart_touches or last in self.watch.touching:
+            return last
+        return None
 
     def _start_restart(self, kind: RestartKind, team: Team | None, spot: tuple[float, float],
                        ball_xy: tuple[float, float]) -> None:
@@ -277,6 +293,7 @@ class Referee:
             self._restart_ball = ball_xy if placed else spot
             self._restart_t = t
             self._restart_seen = placed
+            self._restart_touches = self.watch.touches
 
     def _clear_spot(self, spot: tuple[float, float], attack: float) -> None:
         """Robots standing where the referee puts the ball moved aside first (straight away from it,

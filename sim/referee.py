@@ -190,7 +190,7 @@ class Referee:
         self._check_progress(t, ball_xy)
         if self._restart is not None and t >= self._restart.due_t:
             due, self._restart = self._restart, None
-            self._start_restart(due.kind, due.team, due.spot, ball_xy)
+            self._start_restart(due.kind, due.team, due.spot, ball_xy, due.formation)
         teleport = self.moves.take(self.t)
         # the ball as seen, not where the teleport puts it: an auto-referee on tracked vision sees it
         # there frames later (taken for seen on the spot, the ball still seen in the goal the next
@@ -259,8 +259,9 @@ class Referee:
         return None
 
     def _start_restart(self, kind: RestartKind, team: Team | None, spot: tuple[float, float],
-                       ball_xy: tuple[float, float]) -> None:
-        """The restart due now: the ball (and robots) where it wants them, its command given."""
+                       ball_xy: tuple[float, float], formation: bool = False) -> None:
+        """The restart due now: the ball (and robots) where it wants them, its command given
+        (``formation``: a kickoff with both teams put in formation)."""
         t = self.t
         by_robots = not self.moves.teleports
         if kind is RestartKind.FORCE_START or team is None:  # after no progress: where the ball lies, for both
@@ -269,7 +270,7 @@ class Referee:
                 and self.game.stage != GameStage.PENALTY_SHOOTOUT:
             self._set(RefereeCommand.BALL_PLACEMENT, team)  # the kicking team puts the ball on its spot
             self.game.placement = Placement(team, spot, t, kind.placed)
-        elif kind is RestartKind.KICKOFF and self.params.place_robots_on_goal and not by_robots:
+        elif kind is RestartKind.KICKOFF and (self.params.place_robots_on_goal or formation) and not by_robots:
             self.moves.append(self.kickoff_setup(team))
         elif kind is RestartKind.FREE_KICK and self.full and self._can_place(team):
             self._set(RefereeCommand.BALL_PLACEMENT, team)
@@ -492,7 +493,14 @@ class Referee:
             self.blue_sign = -1 if self.blue_sign > 0 else 1
             self._restart = None
             self.game.clear_special()
-            if self.moves.teleports:
+            if self.moves.teleports and self.game.command != RefereeCommand.HALT:
+                # straight from play (no half time): a stop first, then the formation, as after a
+                # goal (a robot holding the ball on its dribbler, teleported at once, flung it off
+                # the field in grSim, whose dribbler holds the ball by a joint)
+                self._set(RefereeCommand.STOP, None)
+                self._restart = Restart(self.t + self.params.restart_delay_s, RestartKind.KICKOFF, "yellow",
+                                        (0.0, 0.0), formation=True)
+            elif self.moves.teleports:
                 self.moves.append(self.kickoff_setup("yellow"))
             else:  # the ball placed on the centre spot by the kicking team first
                 self._award(RestartKind.KICKOFF, "yellow", (0.0, 0.0))

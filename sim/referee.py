@@ -96,6 +96,7 @@ class Referee:
         self._restart_ball: tuple[float, float] | None = (0.0, 0.0)
         self._restart_t = 0.0  # when the restart in force was given
         self._restart_seen = True  # its ball was seen on its spot (one put there waits for it)
+        self._restart_touches = 0  # the touches counted when it was given
         self._held = HeldBall(field, params.keeper_held_ball_s)
         self._no_progress = NoProgress(params.no_progress_s, params.no_progress_m)
         self.keeper_held_ball = 0
@@ -159,6 +160,7 @@ class Referee:
         self._restart_ball = (0.0, 0.0)
         self._restart_t = self.t
         self._restart_seen = False
+        self._restart_touches = self.watch.touches
         return teleport
 
     # --- one frame --------------------------------------------------------------------------
@@ -188,7 +190,7 @@ class Referee:
         self._check_progress(t, ball_xy)
         if self._restart is not None and t >= self._restart.due_t:
             due, self._restart = self._restart, None
-            self._start_restart(due.kind, due.team, due.spot, ball_xy)
+            self._start_restart(due.kind, due.team, due.spot, ball_xy, due.formation)
         teleport = self.moves.take(self.t)
         # the ball as seen, not where the teleport puts it: an auto-referee on tracked vision sees it
         # there frames later (taken for seen on the spot, the ball still seen in the goal the next
@@ -235,16 +237,31 @@ class Referee:
         away = kick_taken(ball_xy, self._restart_ball, self.rules.ball_in_play_m)
         self._restart_seen = self._restart_seen or not away
         if away and self._restart_seen:
+            kicking = self.game.for_team
             self._set(RefereeCommand.NORMAL, None)
             self._restart_ball = None
-            self.watch.restart_taken(self.watch.last_touch)
+            self.watch.restart_taken(self._restart_kicker(kicking))
         elif self.t - self._restart_t > self.params.restart_timeout_s:
             self._set(RefereeCommand.FORCE_START if self.full else RefereeCommand.NORMAL, None)
             self._restart_ball = None
 
+    def _restart_kicker(self, kicking: Team | None) -> Key | None:
+        """Who took the restart of ``kicking``: the last robot to touch the ball when it is of that
+        team and touched it since the restart was given (or touches it still); else nobody. (A robot
+        of the other team that touched the ball before a kickoff, when the ball seen moving off the
+        centre spot was a track catching up with the teleported ball, was called for a double touch
+        on its next touch.)"""
+        last = self.watch.last_touch
+        if last is None or last[0] != kicking:
+            return None
+        if self.watch.touches > self._restart_touches or last in self.watch.touching:
+            return last
+        return None
+
     def _start_restart(self, kind: RestartKind, team: Team | None, spot: tuple[float, float],
-                       ball_xy: tuple[float, float]) -> None:
-        """The restart due now: the ball (and robots) where it wants them, its command given."""
+                       ball_xy: tuple[float, float], formation: bool = False) -> None:
+        """The restart due now: the ball (and robots) where it wants them, its command given
+        (``formation``: a kickoff with both teams put in formation)."""
         t = self.t
         by_robots = not self.moves.teleports
         if kind is RestartKind.FORCE_START or team is None:  # after no progress: where the ball lies, for both
@@ -253,7 +270,7 @@ class Referee:
                 and self.game.stage != GameStage.PENALTY_SHOOTOUT:
             self._set(RefereeCommand.BALL_PLACEMENT, team)  # the kicking team puts the ball on its spot
             self.game.placement = Placement(team, spot, t, kind.placed)
-        elif kind is RestartKind.KICKOFF and self.params.place_robots_on_goal and not by_robots:
+        elif kind is RestartKind.KICKOFF and (self.params.place_robots_on_goal or formation) and not by_robots:
             self.moves.append(self.kickoff_setup(team))
         elif kind is RestartKind.FREE_KICK and self.full and self._can_place(team):
             self._set(RefereeCommand.BALL_PLACEMENT, team)
@@ -277,6 +294,7 @@ class Referee:
             self._restart_ball = ball_xy if placed else spot
             self._restart_t = t
             self._restart_seen = placed
+            self._restart_touches = self.watch.touches
 
     def _clear_spot(self, spot: tuple[float, float], attack: float) -> None:
         """Robots standing where the referee puts the ball moved aside first (straight away from it,
@@ -476,7 +494,14 @@ class Referee:
             self.blue_sign = -1 if self.blue_sign > 0 else 1
             self._restart = None
             self.game.clear_special()
-            if self.moves.teleports:
+            if self.moves.teleports and self.game.command != RefereeCommand.HALT:
+                # straight from play (no half time): a stop first, then the formation, as after a
+                # goal (a robot holding the ball on its dribbler, teleported at once, flung it off
+                # the field in grSim, whose dribbler holds the ball by a joint)
+                self._set(RefereeCommand.STOP, None)
+                self._restart = Restart(self.t + self.params.restart_delay_s, RestartKind.KICKOFF, "yellow",
+                                        (0.0, 0.0), formation=True)
+            elif self.moves.teleports:
                 self.moves.append(self.kickoff_setup("yellow"))
             else:  # the ball placed on the centre spot by the kicking team first
                 self._award(RestartKind.KICKOFF, "yellow", (0.0, 0.0))

@@ -84,6 +84,7 @@ class Restart:
     kind: RestartKind
     team: Team | None
     spot: tuple[float, float]
+    formation: bool = False  # a kickoff with both teams put in formation (the second half's)
 
     def next_command(self, may_place: bool) -> tuple[RefereeCommand, Team | None]:
         """The command that follows the stop: the taking team's ball placement for a free kick it

@@ -138,6 +138,7 @@ class FoulWatch:
         self.ball_r = pitch.league.ball.radius_m
         self.touching: dict[Key, _Touch] = {}
         self.last_touch: Key | None = None
+        self.touches = 0  # new touches so far (a touch's start, whoever's)
         self._prev: dict[Key, RobotTruth] = {}
         self._contacts: dict[tuple[Key, Key], _Contact] = {}
         self._called: set[tuple[str, Key]] = set()  # once per robot per stop or restart
@@ -154,12 +155,14 @@ class FoulWatch:
         double touch and the defense areas, as one seen by distance does."""
         if kicker not in self.touching:
             self._kicked.append(kicker)
+            self.touches += 1
         self.touching.setdefault(kicker, _Touch((math.nan, math.nan), called=True))
         self.last_touch = kicker
         self._fast_ball_called = False
 
     def restart_taken(self, kicker: Key | None) -> None:
-        """A kickoff or free kick was taken by ``kicker``: a second touch before another robot's is a foul."""
+        """A kickoff or free kick was taken by ``kicker`` (None: by no robot seen touching the ball): a
+        second touch before another robot's is a foul."""
         self._restart_kicker = kicker
         self._kicker_left = False
 
@@ -211,6 +214,7 @@ class FoulWatch:
         for k in new:
             self.touching[k] = _Touch((b.x, b.y))
             self.last_touch = k
+            self.touches += 1
             self._fast_ball_called = False
         on = {(r.team, r.id) for r in robots}
         kicked, self._kicked = self._kicked, []

@@ -220,7 +220,7 @@ class Strategy:
         stopped = not (game.command.running or restart)  # the ball not ours to play now: a pass waits
         intents = self._normal(world.t, own, opp, ball, own_sign, restart, stopped,
                                restart and game.command == RefereeCommand.KICKOFF)
-        self._taker = self._role_robot(ATTACKER) if restart else None
+        self._taker = self._restart_taker(ball) if restart else None
         if game.command == RefereeCommand.BALL_PLACEMENT and game.placement is not None:
             return self._placement(world.t, intents, own, ball, game.placement, ours, own_sign)
         if game.command == RefereeCommand.PENALTY:
@@ -247,6 +247,19 @@ class Strategy:
         if any(math.hypot(r.x - ball.x, r.y - ball.y) < reach for r in others):
             return None
         return barred
+
+    def _restart_taker(self, ball: BallState) -> int | None:
+        """Our restart's kicker this frame: the attacker while the ball lies still; once it rolls
+        (``barred_rolling_m_s``: kicked, the normal start not yet given) the one found before, or
+        the passer of a pass under way. (The attacker's role goes to nobody once a pass is kicked, or
+        to a robot nearer the rolling ball: the kicker, unbarred, played the ball again in grSim.)"""
+        attacker = self._role_robot(ATTACKER)
+        if math.hypot(ball.vx, ball.vy) < self.p.barred_rolling_m_s:
+            return attacker
+        passing = self.passes.current
+        if self._taker is None and passing is not None and passing.kicked:
+            return passing.passer
+        return self._taker if self._taker is not None else attacker
 
     def _role_robot(self, role: Role) -> int | None:
         return next((rid for rid, r in self.roles.roles.items() if r == role), None)

@@ -75,6 +75,9 @@ class PathParams(Validated):
 
     waypoint_reached_m: float = setting(0.05, lo=0.0, hi=1.0)  # a waypoint this close counts as passed
     corner_overshoot_m: float = setting(0.03, lo=0.001, hi=1.0)  # drift past a corner while turning
+    # the speed at a waypoint: no more than the robot reaches on the way at this share of max_accel
+    # (the 2D profile splits the acceleration between the axes and also cancels the velocity across)
+    waypoint_accel_share: float = setting(0.8, lo=0.05, hi=1.0)
 
 
 @dataclass(frozen=True)
@@ -133,10 +136,15 @@ def relative_kick(cmd: RobotCommand, theta: float, robot: RobotShape, gain: floa
     return dataclasses.replace(cmd, kick_speed=kick)
 
 
-def follow_path(position: tuple[float, float], path: ArrayLike, theta: float, params: ControlParams) -> MotionTarget:
+def follow_path(position: tuple[float, float], path: ArrayLike, theta: float, params: ControlParams,
+                velocity: tuple[float, float] | None = None) -> MotionTarget:
     """The target on a planned ``path`` (k, 2) for a robot at ``position``: the first waypoint not yet
     reached, to arrive at with the fastest speed that still lets the robot stop at the path's end and
-    turn into the next leg within ``corner_overshoot_m``; at the last point, stop (Bruce 2006 B.4)."""
+    turn into the next leg within ``corner_overshoot_m``; at the last point, stop (Bruce 2006 B.4).
+    With the robot's ``velocity`` (field frame, m/s), also no faster than it can speed up to on the
+    way to the waypoint at ``waypoint_accel_share`` of ``max_accel_m_s2``: a speed it cannot reach
+    there makes the profile back away from the waypoint for a run-up (a robot at rest 0.11 m from a
+    waypoint drove off the other way, into the centre circle at the other team's kickoff)."""
     pts = np.asarray(path, dtype=np.float64).reshape(-1, 2)
     p = np.asarray(position, dtype=np.float64)
     if len(pts) == 0:
@@ -161,6 +169,10 @@ def follow_path(position: tuple[float, float], path: ArrayLike, theta: float, pa
     turn_speed = math.sqrt(2.0 * m.max_accel_m_s2 * params.path.corner_overshoot_m) / max(across, 1e-9)
     speed = min(m.max_speed_m_s, math.sqrt(2.0 * m.max_brake_m_s2 * rest), turn_speed)
     u = incoming / n_in
+    if velocity is not None:
+        along = max(0.0, float(velocity[0] * u[0] + velocity[1] * u[1]))
+        reach = params.path.waypoint_accel_share * m.max_accel_m_s2
+        speed = min(speed, math.sqrt(along * along + 2.0 * reach * n_in))
     return MotionTarget(float(w[0]), float(w[1]), float(u[0] * speed), float(u[1] * speed), theta)
 
 

@@ -95,7 +95,9 @@ class TrajectoryNavigator:
         reached = control.path.waypoint_reached_m
         while self._next < len(self.path) - 1 and math.dist(start, self.path[self._next]) <= reached:
             self._next += 1
-        target = follow_path(start, self.path[self._next - 1 :], self.arrival.heading_rad, control)
+        moving = self.start_state(robot)
+        target = follow_path(start, self.path[self._next - 1 :], self.arrival.heading_rad, control,
+                             (moving.vx, moving.vy))
         through = self.arrival.through_speed_m_s
         if through > 0.0 and len(self.path) and math.dist((target.x, target.y), self.path[-1]) < 1e-9:
             # drive through the goal point (onto the ball) instead of stopping on it

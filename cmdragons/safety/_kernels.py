@@ -237,14 +237,28 @@ def exposed(states: np.ndarray, opp: np.ndarray, reach: float) -> np.ndarray:
 
 
 @njit(cache=True)
+def leaves(tr: np.ndarray, stop: np.ndarray, other: np.ndarray, radius: float) -> bool:
+    """Does a robot that starts closer than ``radius`` to ``other`` get out of it by ``tr``: at
+    rest farther from ``other``'s rest point than its ``stop`` would leave it? (Inside the kept
+    distance no trajectory passes :func:`pair_hits` while the velocities' noise points the two at
+    each other, and the stop, always accepted, then held two touching robots together for seconds.)"""
+    if math.hypot(tr[0, 2] - other[0, 2], tr[0, 3] - other[0, 3]) >= radius:
+        return False
+    ox, oy = other[N_SEG - 1, 2], other[N_SEG - 1, 3]
+    away = math.hypot(tr[N_SEG - 1, 2] - ox, tr[N_SEG - 1, 3] - oy)
+    return away > math.hypot(stop[N_SEG - 1, 2] - ox, stop[N_SEG - 1, 3] - oy) + 1e-9
+
+
+@njit(cache=True)
 def _trajectory_hits(
-    i: int, tr: np.ndarray, trs: np.ndarray, pushed: np.ndarray, opp: np.ndarray, obs: np.ndarray,
-    inner: np.ndarray, cfg: DSSConfig,
+    i: int, tr: np.ndarray, trs: np.ndarray, stops: np.ndarray, pushed: np.ndarray, opp: np.ndarray,
+    obs: np.ndarray, inner: np.ndarray, cfg: DSSConfig,
 ) -> bool:
-    # robot i's trajectory tr against the other own robots' trajectories, the opponents and the world
+    # robot i's trajectory tr against the other own robots' trajectories, the opponents and the
+    # world; a robot already too near a team-mate may still leave it (``stops``: each one's stop)
     for j in range(trs.shape[0]):
         radius = cfg.pushed_radius if pushed[i] or pushed[j] else cfg.own_radius
-        if j != i and pair_hits(tr, trs[j], radius, cfg.own_growth):
+        if j != i and pair_hits(tr, trs[j], radius, cfg.own_growth) and not leaves(tr, stops[i], trs[j], radius):
             return True
     for j in range(opp.shape[0]):
         if opponent_hits(tr, opp[j, 0], opp[j, 1], opp[j, 2], opp[j, 3], cfg.opponent_radius, cfg.opponent_accel):
@@ -283,10 +297,12 @@ def dss(
     trs = np.empty((n, N_SEG, 8))
     acc = np.empty((n, 2))
     status = np.full(n, STOPPED, dtype=np.int64)
+    stops = np.empty((n, N_SEG, 8))
     for i in range(n):
         sx, sy = stop_accel(states[i, 2], states[i, 3], dt)
         acc[i, 0], acc[i, 1] = sx, sy
-        _store(trs, i, trajectory(states[i, 0], states[i, 1], states[i, 2], states[i, 3], sx, sy, dt, accel, brake))
+        _store(stops, i, trajectory(states[i, 0], states[i, 1], states[i, 2], states[i, 3], sx, sy, dt, accel, brake))
+        _store(trs, i, stops[i])
     k_rand = unit_samples.shape[1]
     n_h = heuristics.shape[0]
     cand = np.empty((1 + n_h + k_rand + 1, 2))
@@ -298,7 +314,7 @@ def dss(
         px, py, vx, vy = states[i, 0], states[i, 1], states[i, 2], states[i, 3]
         dx, dy = feasible(vx, vy, desired[i, 0], desired[i, 1], lim, dt)
         tr = trajectory(px, py, vx, vy, dx, dy, dt, accel, brake)
-        if not _trajectory_hits(i, tr, trs, pushed, opp, obs, inner, cfg):
+        if not _trajectory_hits(i, tr, trs, stops, pushed, opp, obs, inner, cfg):
             _store(trs, i, tr)
             acc[i, 0], acc[i, 1] = dx, dy
             status[i] = KEPT
@@ -332,7 +348,7 @@ def dss(
         order = argsort_stable(cost[:m])
         for r in order:
             tr = trajectory(px, py, vx, vy, cand[r, 0], cand[r, 1], dt, accel, brake)
-            if not _trajectory_hits(i, tr, trs, pushed, opp, obs, inner, cfg):
+            if not _trajectory_hits(i, tr, trs, stops, pushed, opp, obs, inner, cfg):
                 _store(trs, i, tr)
                 acc[i, 0], acc[i, 1] = cand[r, 0], cand[r, 1]
                 status[i] = CHANGED
@@ -349,11 +365,15 @@ def trajectories_clear(
     static obstacles? (The check a finished search must pass.)"""
     n = states.shape[0]
     trs = np.empty((n, N_SEG, 8))
+    stops = np.empty((n, N_SEG, 8))
     for i in range(n):
         _store(trs, i, trajectory(states[i, 0], states[i, 1], states[i, 2], states[i, 3], acc[i, 0], acc[i, 1],
                                   cfg.dt, lim.accel, lim.brake))
+        sx, sy = stop_accel(states[i, 2], states[i, 3], cfg.dt)
+        _store(stops, i, trajectory(states[i, 0], states[i, 1], states[i, 2], states[i, 3], sx, sy, cfg.dt,
+                                    lim.accel, lim.brake))
     out = np.empty(n, dtype=np.bool_)
     pushed = exposed(states, opp, cfg.push_reach)
     for i in range(n):
-        out[i] = not _trajectory_hits(i, trs[i], trs, pushed, opp, obs, inner, cfg)
+        out[i] = not _trajectory_hits(i, trs[i], trs, stops, pushed, opp, obs, inner, cfg)
     return out

@@ -48,6 +48,9 @@ class TrackerParams(Validated):
     ball_jump_margin_m: float = setting(0.05, lo=0.0, hi=2.0)  # plus this, for noise and bounces
     ball_hypotheses: int = setting(4, lo=1, hi=32)  # kept at once, at most
     ball_confirm_detections: int = setting(2, lo=1, hi=100)
+    # a hypothesis seen within this of the newest frame counts as seen now: of those, one seen within it
+    # before too is reported (a stray detection taken by a stale hypothesis beat the ball seen a frame before)
+    ball_recent_s: float = setting(0.05, lo=0.0, hi=1.0)
     ball_timeout_s: float = setting(1.0, lo=0.0, hi=60.0)  # unseen this long: hypothesis dropped
     # a ball lost from sight this near the middle of a robot's front (ball centre to where it would
     # lie on the dribbler) is in the robot's mouth, hidden by it: carried with the robot, unseen ...
@@ -95,6 +98,7 @@ class _BallTrack:
     born: float
     hits: int = 1
     last_seen: float = 0.0
+    seen_before: float = -math.inf  # when it was seen before the instant of last_seen
     holder: tuple[Team, int] | None = None  # the robot whose mouth hides the ball from the cameras
     held_since: float = math.nan
     z: tuple[float, float] = (math.nan, math.nan)  # the last detection taken
@@ -303,6 +307,8 @@ class Tracker:
         if track.filter.nis(z) <= self.p.robot_gate_chi2:
             track.filter.update(z)
             track.hits += 1
+            if t > track.last_seen:
+                track.seen_before = track.last_seen
             track.last_seen = t
             track.rejected.clear()
             return
@@ -345,6 +351,8 @@ class Tracker:
                 self.stats.ball_kicks += 1
             track.z = (float(z[0]), float(z[1]))
             track.hits += 1
+            if t > track.last_seen:
+                track.seen_before = track.last_seen
             track.last_seen = t
         for j, (z, _) in enumerate(detections):
             if j not in used_dets:
@@ -383,10 +391,14 @@ class Tracker:
                 x, y, theta, vx, vy = robot.filter.kf.x[:5].tolist()
                 ball.filter.hold(x + front * math.cos(theta), y + front * math.sin(theta), vx, vy, self.p.ball_held_m)
 
-    def _ball_rank(self, track: _BallTrack) -> tuple[bool, float, int]:
+    def _ball_rank(self, track: _BallTrack) -> tuple[bool, bool, bool, float]:
         confirmed = track.hits >= self.p.ball_confirm_detections
-        # a ball seen since beats one hidden in a robot's mouth (the referee moved it, or the robot let it go unseen)
-        return (confirmed, track.last_seen, track.hits)
+        # a ball seen since beats one hidden in a robot's mouth (the referee moved it, or the robot let it go
+        # unseen); of those seen lately, one seen lately before that too (in the ER-Force simulator a stray
+        # detection at a robot's front, taken by a hypothesis held there since the ball was put elsewhere,
+        # was the ball for a frame: 3 m away, a kickoff taken and two robots too near it)
+        recent = self.t - self.p.ball_recent_s
+        return (confirmed, track.last_seen >= recent, track.seen_before >= recent, track.last_seen)
 
     def _held(self, ball: _BallTrack) -> bool:
         return ball.holder is not None and self.t - ball.held_since <= self.p.ball_held_timeout_s

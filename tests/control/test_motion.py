@@ -134,3 +134,45 @@ def test_the_heading_command_is_the_motion_command_s_rotation(theta: float, omeg
                            PARAMS)[0]
     turn = heading_command(theta, omega, target, m.max_omega_rad_s, m.max_alpha_rad_s2, m.period_s)
     assert turn == full[2]  # rad/s, the same arithmetic
+
+
+def test_follow_path_never_backs_away_from_a_near_waypoint_for_a_run_up() -> None:
+    # a robot at rest 0.11 m short of a waypoint whose path goes on 1 m: the speed the leg allows
+    # there (1.45 m/s) is more than it reaches in 0.11 m, and the profile drove it the other way first
+    start, path = (0.14, -0.63), [(0.14, -0.63), (0.17, -0.74), (0.14, -1.70)]
+    u = np.array([0.03, -0.11]) / math.hypot(0.03, -0.11)
+    uncapped = follow_path(start, path, 0.43, PARAMS)
+    cmd = motion_command(RobotState("blue", 4, *start, 0.47, 0.0, 0.0, 0.0), uncapped, PARAMS)
+    assert cmd.vx * u[0] + cmd.vy * u[1] < 0.0  # what the velocity-blind target did
+    # with the robot's velocity: at rest and drifting away, the command heads for the waypoint
+    for v in [(0.0, 0.0), (-0.04, 0.36), (0.2, 0.0)]:
+        t = follow_path(start, path, 0.43, PARAMS, v)
+        cmd = motion_command(RobotState("blue", 4, *start, 0.47, *v, 0.0), t, PARAMS)
+        dv = np.array([cmd.vx - v[0], cmd.vy - v[1]])
+        assert dv @ u > 0.0, v
+    # the speed at the waypoint is what the share of max_accel reaches on the way from rest
+    t = follow_path(start, path, 0.43, PARAMS, (0.0, 0.0))
+    reach = PARAMS.path.waypoint_accel_share * M.max_accel_m_s2
+    assert math.hypot(t.vx, t.vy) == pytest.approx(math.sqrt(2 * reach * math.hypot(0.03, 0.11)))
+
+
+def test_follow_path_with_the_velocity_heads_for_the_waypoint_from_random_states() -> None:
+    # random robots near a waypoint, at rest or moving towards it (a little sideways): the command
+    # never drives away from it
+    rng = np.random.default_rng(3)
+    checked = 0
+    for _ in range(1500):
+        p = rng.uniform(-1.0, 1.0, 2)
+        w = p + rng.uniform(-0.3, 0.3, 2)
+        e = w + rng.uniform(-2.0, 2.0, 2)
+        gap = float(np.hypot(*(w - p)))
+        if gap <= PARAMS.path.waypoint_reached_m:
+            continue
+        u = (w - p) / gap
+        v = u * rng.uniform(0.0, 1.0) + np.array([-u[1], u[0]]) * rng.uniform(-0.05, 0.05)
+        t = follow_path((float(p[0]), float(p[1])), [p, w, e], 0.0, PARAMS, (float(v[0]), float(v[1])))
+        cmd = motion_command(RobotState("blue", 0, float(p[0]), float(p[1]), 0.0, float(v[0]), float(v[1]), 0.0),
+                             t, PARAMS)
+        assert cmd.vx * u[0] + cmd.vy * u[1] >= -1e-9, (p, w, e, v)
+        checked += 1
+    assert checked > 500

@@ -268,3 +268,26 @@ def test_a_robot_meets_an_opponent_that_turns_into_its_way_below_the_crash_speed
         assert closing < 1.5 and ours < 0.7  # no crash; were it one, theirs
     else:
         assert closing > 1.5 and ours > 0.7
+
+
+def test_a_robot_too_near_a_team_mate_may_leave_it_but_not_close_in() -> None:
+    # two defenders body to body (0.175 m apart, closer than the kept 0.21) as tracked in the ER-Force
+    # simulator, their velocities' noise pointing them at each other: the stop held both, and the one
+    # asking to drive off stood there for seconds while the other kept pressing towards it
+    states = np.array([[3.128, -0.144, 0.029, 0.106], [3.244, -0.013, -0.042, 0.013]])
+    asked = np.array([[0.044, -0.024], [0.005, 0.05]])
+    result = make_dss().filter(states, asked, np.zeros((0, 4)))
+    assert result.status[1] == KEPT
+    np.testing.assert_allclose(result.velocities[1], asked[1])
+    # the other ends no closer to it than its stop would leave it
+    trs = trajectories(states, (result.velocities - states[:, 2:4]) / DT)
+    stop = trajectories(states, stop_accels(states))
+    rest = np.hypot(*(trs[0][-1, 2:4] - trs[1][-1, 2:4]))
+    assert rest >= np.hypot(*(stop[0][-1, 2:4] - trs[1][-1, 2:4])) - 1e-9
+    # pressing in is not taken: a robot at rest asking to drive at the other gets its stop or a move off
+    still = states.copy()
+    still[:, 2:4] = 0.0
+    toward = (still[1, :2] - still[0, :2]) / np.hypot(*(still[1, :2] - still[0, :2]))
+    result = make_dss().filter(still, np.array([0.05 * toward, [0.0, 0.0]]), np.zeros((0, 4)))
+    assert result.status[0] in (CHANGED, STOPPED)
+    assert result.velocities[0] @ toward <= 1e-9

@@ -673,3 +673,36 @@ def test_a_kick_out_of_sight_turned_by_the_robot_on_the_kickers_heading_was_touc
                                 (RobotState("blue", 3, *blue),
                                  RobotState("yellow", 2, yellow[0] + dx, yellow[1] + dy, yellow[2])), k))
     assert auto.referee.watch.last_touch == last
+
+
+def test_the_other_teams_touch_before_a_kickoff_does_not_make_it_the_kickoffs_taker() -> None:
+    """Blue 5 touches the ball, then yellow's kickoff: the ball is put on the centre spot, and the
+    track seen moving off it (a vision track catching up with the teleported ball, the ER-Force
+    simulator's second half) gives the normal start. Blue 5, last to touch the ball before the
+    kickoff, did not take it: its next touch is no double touch (it was called)."""
+    auto = AutoRef(scene()[0].field, [("blue", 5), ("yellow", 4)], RefereeParams())
+    auto.referee.give(RefereeCommand.NORMAL)
+    yellow = RobotState("yellow", 4, -3.0, -2.0, 0.0)
+    k, calls = 0, []
+
+    def see(ball: tuple[float, float], blue: tuple[float, float]) -> None:
+        nonlocal k
+        auto.observe(WorldState(k * DT, BallState(*ball, 0.0, 0.0), (RobotState("blue", 5, *blue, 0.0), yellow), k))
+        calls.extend(auto.calls)
+        k += 1
+
+    for _ in range(12):  # blue 5 at the ball, then off
+        see((1.0 + FRONT, 0.5), (1.0, 0.5))
+    for _ in range(12):
+        see((1.0 + FRONT, 0.5), (0.0, 1.5))
+    assert auto.referee.watch.last_touch == ("blue", 5)
+    auto.referee.kickoff_setup("yellow")
+    for _ in range(12):
+        see((0.0, 0.0), (-1.0, 1.5))
+    see((0.3, 0.0), (-1.0, 1.5))  # seen moving off the spot: the kickoff taken
+    assert auto.referee.game.command == RefereeCommand.NORMAL
+    for _ in range(6):
+        see((0.0, 0.0), (-1.0, 1.5))
+    for _ in range(30):  # blue 5 plays the ball
+        see((0.0, 0.0), (-FRONT, 0.0))
+    assert not [e for e in calls if e.kind == "double_touch"], calls

@@ -573,3 +573,36 @@ def test_the_kickoff_after_a_goal_is_not_taken_while_the_ball_is_still_seen_in_t
     w.step_frame([])
     ref.observe(w.t, [], tuple(w.ball_body.position), w.ground_truth())
     assert ref.game.command == RefereeCommand.NORMAL
+
+
+def test_the_second_half_straight_from_play_stops_before_it_puts_the_robots_in_formation() -> None:
+    # no half time: the first half ends in play, a robot holding the ball on its dribbler. The
+    # formation's teleport comes after a stop (as after a goal), once the robots let go of the ball
+    # (grSim holds a dribbled ball by a joint: teleported at once, the robot flung it off the field)
+    w, ref = scene(half_s=3.0, half_time_s=0.0)
+    ref.give(RefereeCommand.NORMAL)
+    teleports: list[tuple[float, RefereeCommand]] = []
+    for _ in range(round(3.0 * 60)):
+        events = w.step_frame([])
+        tp = ref.observe(w.t, events, tuple(w.ball_body.position), w.ground_truth())
+        if tp is not None:
+            teleports.append((w.t, ref.game.command))
+            w.apply(tp)
+    assert ref.game.stage == GameStage.FIRST_HALF and not teleports
+    commands = []
+    for _ in range(round(2.0 * 60)):
+        events = w.step_frame([])
+        tp = ref.observe(w.t, events, tuple(w.ball_body.position), w.ground_truth())
+        commands.append((w.t, ref.game.command, ref.game.for_team))
+        if tp is not None:
+            teleports.append((w.t, ref.game.command))
+            w.apply(tp)
+    assert ref.game.stage == GameStage.SECOND_HALF
+    assert commands[0][1] == RefereeCommand.STOP
+    assert len(teleports) == 1 and teleports[0][1] == RefereeCommand.KICKOFF
+    stop_s = teleports[0][0] - commands[0][0]
+    assert stop_s == pytest.approx(ref.params.restart_delay_s, abs=2.0 / 60)
+    # the formation: robots in their own halves (blue defends +x now), the ball on the centre spot
+    assert tuple(w.ball_body.position) == pytest.approx((0.0, 0.0))
+    robots = w.ground_truth().robots
+    assert robots and all(r.x * (ref.blue_sign if r.team == "blue" else -ref.blue_sign) > 0.0 for r in robots)

@@ -244,3 +244,39 @@ def test_no_supporter_is_sent_to_the_receivers_point_while_play_is_stopped(comma
             for xb, yb, b in points[i + 1:]:
                 assert math.hypot(xa - xb, ya - yb) >= 2.0 * p.robot_radius_m, (k, a, b)
     assert receivers > 0  # the situation: a pass decided, its receiver waiting at a supporter's point
+
+
+def test_our_kickoffs_kicker_stays_barred_when_the_attackers_role_moves_on_before_the_normal_start() -> None:
+    # our kickoff: robot 1 passes to robot 4; the ball rolls for some frames before the referee's
+    # normal start (an auto-referee on vision sees it move late), and meanwhile the pass is under way:
+    # the attacker's role is nobody's. The kicker must stay barred from the ball until another robot
+    # touched it: in grSim it took the role back when the pass fell short and played the ball again,
+    # a double touch
+    still = (_robot("blue", 0, -4.3, 0.0), _robot("blue", 1, -0.15, 0.0), _robot("blue", 2, -3.2, 0.3),
+             _robot("blue", 5, -3.2, -0.3), _robot("blue", 3, -1.0, -1.5), _robot("blue", 4, -0.2, 1.3),
+             _robot("yellow", 0, 4.3, 0.0), _robot("yellow", 1, 2.0, 0.0))
+    strategy = Strategy("blue", FIELD, StrategyParams())
+    kickoff = GameState(0.0, "kickoff", for_team="blue", blue_defends_negative_x=True, ready=True)
+    normal = GameState(0.0, "normal", blue_defends_negative_x=True)
+    t = 0.0
+    for _ in range(10):
+        strategy.decide(WorldState(t, BallState(0.0, 0.0, 0.0, 0.0), still), kickoff)
+        t += 1 / 60
+    planned = strategy.passes.current
+    assert planned is not None and planned.passer == 1 and planned.receiver == 4
+    # kicked towards the pass point at 1.2 m/s, slowing to rest 0.5 m short of the receiver
+    to = np.array(planned.point) / math.hypot(*planned.point)
+    decel = 1.2**2 / (2 * (math.hypot(*planned.point) - 0.5))
+    s, v = 0.0, 1.2
+    attackers, barred = set(), set()
+    for k in range(300):
+        ball = BallState(float(s * to[0]), float(s * to[1]), float(v * to[0]), float(v * to[1]))
+        strategy.decide(WorldState(t, ball, still), kickoff if k < 12 else normal)
+        if k >= 12:
+            attackers |= {rid for rid, role in strategy.roles.roles.items() if role == Role(RoleKind.ATTACKER)}
+            barred.add(strategy._barred)
+        t += 1 / 60
+        s, v = s + v / 60, max(0.0, v - decel / 60)
+    assert v == 0.0
+    assert barred == {1}
+    assert 1 not in attackers

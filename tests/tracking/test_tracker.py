@@ -436,3 +436,32 @@ def test_a_ball_seen_elsewhere_beats_one_hidden_in_a_robots_mouth() -> None:
         ws = tracker.step([detect(w.snapshot(), rng)])
     assert ws.ball is not None and ws.ball.visible
     assert math.hypot(ws.ball.x - 2.0, ws.ball.y - 1.0) < 0.02
+
+
+def test_a_stray_detection_taken_by_a_stale_hypothesis_is_not_the_ball() -> None:
+    # the ball at rest at (1.5, 0), then put on the centre spot (the referee's teleport at half-time):
+    # the old hypothesis lives on unseen. One frame shows only a stray detection 0.4 m from it (the
+    # ER-Force simulator's vision): the old hypothesis takes it and, seen last, was reported as the
+    # ball for that frame, 1.9 m off (a kickoff taken, the ball's restart judged on it)
+    tracker = Tracker(params())
+    rng = np.random.default_rng(3)
+    t, k = 0.0, 0
+
+    def see(*balls: tuple[float, float]) -> WorldState:
+        nonlocal t, k
+        seen = tuple(BallDetection(x + rng.normal(0.0, SIGMA), y + rng.normal(0.0, SIGMA), 0.9, (0.0, 0.0))
+                     for x, y in balls)
+        ws = tracker.step([DetectionFrame(0, k, t, t, seen)])
+        t, k = t + DT, k + 1
+        return ws
+
+    for _ in range(60):
+        see((1.5, 0.0))
+    moved = [see((0.0, 0.0)) for _ in range(20)]
+    # the ball put elsewhere is the ball within ball_recent_s and a frame
+    late = [ws.ball is not None and math.hypot(ws.ball.x, ws.ball.y) < 0.05 for ws in moved]
+    assert all(late[math.ceil(tracker.p.ball_recent_s / DT) + 1 :])
+    stray = see((1.9, 0.0))
+    assert stray.ball is not None and math.hypot(stray.ball.x, stray.ball.y) < 0.05
+    after = see((0.0, 0.0))
+    assert after.ball is not None and math.hypot(after.ball.x, after.ball.y) < 0.05

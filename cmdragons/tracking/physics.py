@@ -204,15 +204,15 @@ class PhysicsEstimator:
             if self._roll.span() >= p.window_s:
                 self._ball_sample(Fact.BALL_ROLL, self._roll)
         if self._kick is not None:
-            self._gain_sample(t, x, y, robot_m)
+            self._gain_sample(self._kick, t, x, y, robot_m)
 
-    def _gain_sample(self, t: float, x: float, y: float, robot_m: float) -> None:
+    def _gain_sample(self, kick: tuple[float, float], t: float, x: float, y: float, robot_m: float) -> None:
         """The kicker's gain window: from when the model has our kicked ball rolling (its slide at the
         speed asked over, and ``gain_after_s`` more), ``gain_window_s`` of a ball clear of the robots;
         its deceleration one rolling sample, its speed halfway through taken back to the kick at the
         rolling deceleration known now (the window's own until the rolling one has its windows)."""
         p = self.p
-        t_kick, asked = self._kick  # type: ignore[misc]
+        t_kick, asked = kick
         if t - t_kick < (1.0 - p.slide_to_roll_fraction) * asked / max(p.acc_slide_m_s2, 1e-9) + p.gain_after_s:
             return
         if robot_m < p.clear_m:
@@ -223,37 +223,32 @@ class PhysicsEstimator:
         if self._gain.span() < p.gain_window_s:
             return
         self._kick = None  # one window a kick
-        times, xy = self._gain.arrays()
-        self._gain.clear()
-        if len(times) < 4:
+        # the model has the ball rolling: a rolling window too (passes rarely run free longer)
+        fit = self._ball_sample(Fact.BALL_ROLL, self._gain)
+        if fit is None:
             return
-        accel, v0, v1, rms = fit_acceleration(times, xy)
-        speed0, speed1 = float(np.hypot(*v0)), float(np.hypot(*v1))
-        if rms > p.max_residual_m or min(speed0, speed1) < p.min_speed_m_s:
-            return
-        heading = (v0 + v1) / max(float(np.hypot(*(v0 + v1))), 1e-9)
-        decel = -float(accel @ heading)
+        t_mid, speed, decel = fit
         rolls = self.samples[Fact.BALL_ROLL]
-        rolls.append(decel)  # the model has it rolling: a rolling window too (passes rarely run free longer)
         if len(rolls) >= p.min_samples:
             decel = float(np.median(rolls))
-        launch = launch_speed(0.5 * (speed0 + speed1), decel, 0.5 * (times[0] + times[-1]) - t_kick,
-                              p.acc_slide_m_s2, p.slide_to_roll_fraction)
+        launch = launch_speed(speed, decel, t_mid - t_kick, p.acc_slide_m_s2, p.slide_to_roll_fraction)
         self.samples[Fact.KICK_GAIN].append(launch / asked)
 
-    def _ball_sample(self, fact: Fact, window: _Window) -> None:
-        """The window's deceleration as one sample of ``fact`` (none: too few detections, a bounce, or
-        too slow)."""
+    def _ball_sample(self, fact: Fact, window: _Window) -> tuple[float, float, float] | None:
+        """The window's deceleration as one sample of ``fact``; the window's middle time, the ball's
+        speed then and that deceleration (None: too few detections, a bounce, or too slow)."""
         t, xy = window.arrays()
         window.clear()
         if len(t) < 4:
-            return
+            return None
         accel, v0, v1, rms = fit_acceleration(t, xy)
         speed0, speed1 = float(np.hypot(*v0)), float(np.hypot(*v1))
         if rms > self.p.max_residual_m or min(speed0, speed1) < self.p.min_speed_m_s:
-            return
+            return None
         heading = (v0 + v1) / max(float(np.hypot(*(v0 + v1))), 1e-9)
-        self.samples[fact].append(-float(accel @ heading))
+        decel = -float(accel @ heading)
+        self.samples[fact].append(decel)
+        return 0.5 * (t[0] + t[-1]), 0.5 * (speed0 + speed1), decel
 
     # --- our robots ---------------------------------------------------------------------------------------
     def robot(self, key: Any, t: float, x: float, y: float, velocity: tuple[float, float],

@@ -307,8 +307,6 @@ class Tracker:
         if track.filter.nis(z) <= self.p.robot_gate_chi2:
             track.filter.update(z)
             track.hits += 1
-            if t > track.last_seen:
-                track.seen_before = track.last_seen
             track.last_seen = t
             track.rejected.clear()
             return

@@ -106,6 +106,9 @@ class RobotShape(Validated):
     # the ball leaves at this share of the kick asked (1: as asked; another simulator's or a real
     # kicker differs, and the tracker measures it: tracker.yaml physics)
     kick_gain: float = setting(1.0, lo=0.1, hi=3.0)
+    # the share of the ball's velocity across the heading (relative to the robot) that a kick keeps:
+    # a one-touch kick aims with it (strategy.onetouch); the tracker measures it
+    kick_retention: float = setting(0.3, lo=0.0, hi=1.5)
     # the fastest kick a gain makes the team send (the rules allow the ball 6.5 m/s: a gain learnt on
     # passes must not push a shot over it)
     max_kick_m_s: float = setting(6.0, lo=0.1, hi=20.0)

@@ -925,6 +925,7 @@ class Fact(StrEnum):
     ROBOT_ACCEL = "robot_accel"
     ROBOT_BRAKE = "robot_brake"
     KICK_GAIN = "kick_gain"  # a ratio, not m/s²: the ball's launch speed over the kick asked
+    KICK_RETENTION = "kick_retention"  # a share: the ball's velocity across the heading a kick keeps
 
     @property
     def source(self) -> str:
@@ -938,6 +939,7 @@ _SOURCES = {
     Fact.ROBOT_ACCEL: "field.robot.max_accel_m_s2",
     Fact.ROBOT_BRAKE: "field.robot.max_brake_m_s2",
     Fact.KICK_GAIN: "field.robot.kick_gain",
+    Fact.KICK_RETENTION: "field.robot.kick_retention",
 }
 
 

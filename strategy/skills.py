@@ -60,9 +60,9 @@ class SkillParams(Validated):
     acc_slide_m_s2: float = derived("field.ball.acc_slide_m_s2", 3.0, lo=0.0, hi=50.0)
     acc_roll_m_s2: float = derived("field.ball.acc_roll_m_s2", 0.26, lo=0.0, hi=10.0)
     slide_to_roll_fraction: float = derived("field.ball.slide_to_roll_fraction", 0.64, lo=0.0, hi=1.0)
-    # the ball velocity across the heading (relative to the robot) a kick keeps: the kicker's, configured in
-    # sim.yaml kicker; a kick aims with it (strategy.onetouch)
-    kicker_retention: float = derived("sim.kicker.tangential_retention", 0.3, lo=0.0, hi=1.0)
+    # the ball velocity across the heading (relative to the robot) a kick keeps, as the team believes it
+    # (field.yaml robot, measured by the tracker); a kick aims with it (strategy.onetouch)
+    kicker_retention: float = derived("field.robot.kick_retention", 0.3, lo=0.0, hi=1.5)
     chip_angle_rad: float = derived("sim.kicker.chip_angle_rad", 0.7854, lo=0.0, hi=1.5707963267948966)  # a chip's tilt
     goalie_depth_m: float = setting(0.15, lo=0.0, hi=2.0)  # goalie stands this far in front of the goal line
     defense_margin_m: float = setting(0.15, lo=0.0, hi=2.0)  # defenders stand this far outside the area

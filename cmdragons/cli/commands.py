@@ -507,12 +507,13 @@ def _finish_play(folder: Path, run: RunData, summary: dict[str, Any], args: argp
 
 
 _FACT_WORDS = {"ball_roll": "ball rolls", "ball_slide": "slides", "robot_accel": "robots accelerate",
-               "robot_brake": "brake", "kick_gain": "kicks leave at (share of the speed asked)"}
+               "robot_brake": "brake", "kick_gain": "kicks leave at (share of the speed asked)",
+               "kick_retention": "keep across the heading (share)"}
 
 
 def physics_line(physics: dict[str, Any]) -> str:
-    """What the tracker measured, each fact against its configured value (m/s², the kick's gain a
-    share), and which are in use."""
+    """What the tracker measured, each fact against its configured value (m/s², the kick's gain and
+    retention shares), and which are in use."""
     parts = []
     for name, e in physics.items():
         if not e["samples"]:

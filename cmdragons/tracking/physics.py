@@ -21,6 +21,15 @@ metres and seconds:
   ball's run, as a kick is relative to the robot). What a pass needs: the ball rolls on as the model
   of the kick asked says; a kicker that sends it slower by a share (grSim's kick leaves at about 0.8
   of the speed asked and slides off a fifth of it at once) is asked that much more;
+* the kick's retention across the heading (the share of the ball's velocity across the kicker's
+  heading, relative to the robot, that the kick keeps: strategy.onetouch's model, which aims a
+  one-touch kick with it) from our kicks of a ball that came in across the heading faster than
+  ``retention_min_across_m_s``: the ball's velocity across the heading as it left, from the slide
+  window above (its run keeps its direction while it slows; its speed taken back to the kick at the
+  sliding deceleration measured so far), less the robot's, over the incoming ball's across the
+  heading relative to the robot. Our simulator's kicker keeps 0.3 of it; grSim's keeps all of it.
+  Judged in shares: confident after ``retention_min_samples`` kicks with the median's standard
+  error within ``retention_max_error``, used when off the configured share by ``retention_use_margin``;
 * each robot's reachable acceleration and braking from our own robots' detections while the
   command in force asks for a velocity change the robot cannot make at once (more than
   ``saturated_m_s`` from the velocity tracked) and no other robot is within ``robot_clear_m``: the
@@ -40,7 +49,7 @@ from __future__ import annotations
 import math
 from collections import deque
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Any, Literal, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -48,12 +57,12 @@ from numpy.typing import NDArray
 from cmdragons.config import Validated, derived, setting
 from cmdragons.messages import Fact, FactEstimate, PhysicsFacts
 
-__all__ = ["PhysicsEstimator", "PhysicsFactsParams", "fit_acceleration"]
+__all__ = ["OurKick", "PhysicsEstimator", "PhysicsFactsParams", "fit_acceleration"]
 
 Array = NDArray[np.float64]
 
 
-FactName = Literal["ball_roll", "ball_slide", "robot_accel", "robot_brake", "kick_gain"]
+FactName = Literal["ball_roll", "ball_slide", "robot_accel", "robot_brake", "kick_gain", "kick_retention"]
 
 
 @dataclass(frozen=True)
@@ -62,9 +71,9 @@ class PhysicsFactsParams(Validated):
 
     measure: bool = setting(True)  # measure at all
     # the facts whose measured value may replace the configured one
-    learn: tuple[FactName, ...] = setting(("ball_roll", "robot_accel", "robot_brake", "kick_gain"))
+    learn: tuple[FactName, ...] = setting(("ball_roll", "robot_accel", "robot_brake", "kick_gain", "kick_retention"))
     min_samples: int = setting(10, lo=1, hi=100000)  # windows before a fact can be confident ...
-    kick_min_samples: int = setting(5, lo=1, hi=100000)  # ... the kicker's gain (one window a kick: fewer come)
+    kick_min_samples: int = setting(5, lo=1, hi=100000)  # ... the kicker's gain and retention (one a kick: fewer)
     max_relative_error: float = setting(0.05, lo=0.0, hi=1.0)  # the median's standard error, of the median
     use_margin: float = setting(0.15, lo=0.0, hi=10.0)  # used only this share off the configured value
     retune_change: float = setting(0.05, lo=0.0, hi=10.0)  # a used value handed on again: moved by this share
@@ -84,6 +93,10 @@ class PhysicsFactsParams(Validated):
     kick_near_m: float = setting(0.3, lo=0.0, hi=5.0)  # ... on a robot centre this near the ball
     gain_after_s: float = setting(0.1, lo=0.0, hi=5.0)  # ... its gain window starts this after the model's slide
     gain_window_s: float = setting(0.4, lo=0.01, hi=5.0)
+    retention_min_across_m_s: float = setting(0.5, lo=0.0, hi=20.0)  # the ball came in this fast across the heading
+    retention_min_samples: int = setting(3, lo=1, hi=100000)  # the retention: kicks before it can be confident ...
+    retention_max_error: float = setting(0.05, lo=0.0, hi=1.0)  # ... its median's standard error at most (a share)
+    retention_use_margin: float = setting(0.1, lo=0.0, hi=1.0)  # used only this far off the configured share
     # our robots
     robot_window_s: float = setting(0.15, lo=0.01, hi=10.0)
     saturated_m_s: float = setting(0.3, lo=0.0, hi=10.0)  # commanded velocity this far off the tracked one
@@ -96,11 +109,42 @@ class PhysicsFactsParams(Validated):
     max_brake_m_s2: float = derived("field.robot.max_brake_m_s2", 6.0, lo=0.0, hi=50.0)
     slide_to_roll_fraction: float = derived("field.ball.slide_to_roll_fraction", 0.64, lo=0.0, hi=1.0)
     kick_gain: float = derived("field.robot.kick_gain", 1.0, lo=0.1, hi=3.0)
+    kick_retention: float = derived("field.robot.kick_retention", 0.3, lo=0.0, hi=1.5)
 
     def configured(self, fact: Fact) -> float:
         return {Fact.BALL_ROLL: self.acc_roll_m_s2, Fact.BALL_SLIDE: self.acc_slide_m_s2,
                 Fact.ROBOT_ACCEL: self.max_accel_m_s2, Fact.ROBOT_BRAKE: self.max_brake_m_s2,
-                Fact.KICK_GAIN: self.kick_gain}[fact]
+                Fact.KICK_GAIN: self.kick_gain, Fact.KICK_RETENTION: self.kick_retention}[fact]
+
+
+@dataclass(frozen=True)
+class OurKick:
+    """A kick of ours just seen: the ball's speed over the ground it asked (m/s), the kicking
+    robot's heading (rad) and velocity and the ball's velocity before the kick (m/s, field frame;
+    None: not known, the ball new to the tracker)."""
+
+    asked_m_s: float
+    heading: float
+    robot_v: tuple[float, float]
+    ball_v: tuple[float, float] | None
+
+
+class _Fit(NamedTuple):
+    """A window's fit: its middle time (s), the ball's mean speed (m/s), deceleration (m/s²) and
+    direction of travel (a unit vector, field frame) over it."""
+
+    t_mid: float
+    speed: float
+    decel: float
+    direction: tuple[float, float]
+
+
+def _across_in(kick: OurKick) -> float:
+    """The incoming ball's velocity relative to the kicking robot, across its heading (m/s; 0 unknown)."""
+    if kick.ball_v is None:
+        return 0.0
+    return (-math.sin(kick.heading) * (kick.ball_v[0] - kick.robot_v[0])
+            + math.cos(kick.heading) * (kick.ball_v[1] - kick.robot_v[1]))
 
 
 def launch_speed(speed: float, decel: float, after_s: float, acc_slide: float, fraction: float) -> float:
@@ -172,19 +216,22 @@ class PhysicsEstimator:
         self._kicked = -math.inf
         self._slide_done = True
         self._kick: tuple[float, float] | None = None  # our last kick no robot touched since: (t, speed asked)
+        self._across: tuple[float, OurKick] | None = None  # our last kick of a ball that came in across: (t, kick)
         self._gain = _Window()
         self._robots: dict[Any, _RobotRun] = {}
 
     # --- the ball -----------------------------------------------------------------------------------------
-    def ball(self, t: float, x: float, y: float, robot_m: float, kicked: bool, asked_m_s: float | None = None) -> None:
+    def ball(self, t: float, x: float, y: float, robot_m: float, kicked: bool, kick: OurKick | None = None) -> None:
         """A detection of the tracked ball at ``t``; ``robot_m``: the nearest robot centre's distance,
-        ``kicked``: the tracker took it as a kick or bounce, ``asked_m_s``: and one of our robots' kick
-        asked the ball this fast over the ground (None: not a kick of ours)."""
+        ``kicked``: the tracker took it as a kick or bounce, ``kick``: and it was one of our robots'
+        kicks (None: not a kick of ours)."""
         p = self.p
         if kicked:
             self._kicked, self._slide_done = t, False
             self._slide.clear()
-            self._kick = (t, asked_m_s) if asked_m_s is not None else None
+            self._kick = (t, kick.asked_m_s) if kick is not None else None
+            across = kick is not None and abs(_across_in(kick)) >= p.retention_min_across_m_s
+            self._across = (t, kick) if kick is not None and across else None
             self._gain.clear()
         if kicked or robot_m < p.clear_m:
             self._touched = t
@@ -195,7 +242,9 @@ class PhysicsEstimator:
             elif robot_m >= p.slide_clear_m:
                 self._slide.add(t, x, y, p.max_gap_s)
                 if self._slide.span() >= p.slide_window_s:
-                    self._ball_sample(Fact.BALL_SLIDE, self._slide)
+                    fit = self._ball_sample(Fact.BALL_SLIDE, self._slide)
+                    if fit is not None and self._across is not None:
+                        self._retention_sample(*self._across, fit)
                     self._slide_done = True
             elif self._slide.t:
                 self._slide_done = True  # back at a robot before the window was full
@@ -227,16 +276,31 @@ class PhysicsEstimator:
         fit = self._ball_sample(Fact.BALL_ROLL, self._gain)
         if fit is None:
             return
-        t_mid, speed, decel = fit
+        t_mid, speed, decel = fit.t_mid, fit.speed, fit.decel
         rolls = self.samples[Fact.BALL_ROLL]
         if len(rolls) >= p.min_samples:
             decel = float(np.median(rolls))
         launch = launch_speed(speed, decel, t_mid - t_kick, p.acc_slide_m_s2, p.slide_to_roll_fraction)
         self.samples[Fact.KICK_GAIN].append(launch / asked)
 
-    def _ball_sample(self, fact: Fact, window: _Window) -> tuple[float, float, float] | None:
-        """The window's deceleration as one sample of ``fact``; the window's middle time, the ball's
-        speed then and that deceleration (None: too few detections, a bounce, or too slow)."""
+    def _retention_sample(self, t_kick: float, kick: OurKick, fit: _Fit) -> None:
+        """One sample of the kick's retention across the heading from the slide window's ``fit`` after
+        ``kick``: the ball left along the window's direction (the slide slows it along its run) at
+        the window's speed taken back to the kick at the sliding deceleration known now (the
+        configured one until its windows are ``min_samples``: grSim's ball does not slide, it rolls
+        from the kick); its velocity across the heading less the robot's, over the incoming ball's
+        relative to the robot."""
+        nx, ny = -math.sin(kick.heading), math.cos(kick.heading)
+        slides = self.samples[Fact.BALL_SLIDE]
+        slide = float(np.median(slides)) if len(slides) >= self.p.min_samples else self.p.acc_slide_m_s2
+        launch = fit.speed + slide * max(0.0, fit.t_mid - t_kick)
+        across_out = launch * (fit.direction[0] * nx + fit.direction[1] * ny) - (kick.robot_v[0] * nx
+                                                                                 + kick.robot_v[1] * ny)
+        self.samples[Fact.KICK_RETENTION].append(across_out / _across_in(kick))
+
+    def _ball_sample(self, fact: Fact, window: _Window) -> _Fit | None:
+        """The window's deceleration as one sample of ``fact``, and the window's fit (None: too few
+        detections, a bounce, or too slow)."""
         t, xy = window.arrays()
         window.clear()
         if len(t) < 4:
@@ -248,7 +312,7 @@ class PhysicsEstimator:
         heading = (v0 + v1) / max(float(np.hypot(*(v0 + v1))), 1e-9)
         decel = -float(accel @ heading)
         self.samples[fact].append(decel)
-        return 0.5 * (t[0] + t[-1]), 0.5 * (speed0 + speed1), decel
+        return _Fit(0.5 * (t[0] + t[-1]), 0.5 * (speed0 + speed1), decel, (float(heading[0]), float(heading[1])))
 
     # --- our robots ---------------------------------------------------------------------------------------
     def robot(self, key: Any, t: float, x: float, y: float, velocity: tuple[float, float],
@@ -295,8 +359,12 @@ class PhysicsEstimator:
             spread = 1.4826 * float(np.median(np.abs(values - median)))
             # the median's standard error: sqrt(pi / 2) times the mean's
             error = 1.2533 * spread / math.sqrt(n)
-            need = p.kick_min_samples if fact is Fact.KICK_GAIN else p.min_samples
-            confident = n >= need and median > 0.0 and error <= p.max_relative_error * median
-            used = confident and fact in learn and abs(median - configured) > p.use_margin * configured
+            if fact is Fact.KICK_RETENTION:  # a share of the incoming ball's across velocity: judged in shares
+                confident = n >= p.retention_min_samples and error <= p.retention_max_error
+                used = confident and fact in learn and abs(median - configured) > p.retention_use_margin
+            else:
+                need = p.kick_min_samples if fact is Fact.KICK_GAIN else p.min_samples
+                confident = n >= need and median > 0.0 and error <= p.max_relative_error * median
+                used = confident and fact in learn and abs(median - configured) > p.use_margin * configured
             out.append(FactEstimate(fact, median, configured, n, spread, confident, used))
         return PhysicsFacts(t, tuple(out))

@@ -30,7 +30,7 @@ from cmdragons.geometry import Team
 from cmdragons.messages import BallState, DetectionFrame, PhysicsFacts, RobotCommand, RobotState, WorldState
 from cmdragons.tracking import filters
 from cmdragons.tracking.filters import BallFilter, BallModelParams, RobotFilter, RobotModelParams
-from cmdragons.tracking.physics import PhysicsEstimator, PhysicsFactsParams
+from cmdragons.tracking.physics import OurKick, PhysicsEstimator, PhysicsFactsParams
 
 __all__ = ["Tracker", "TrackerParams", "TrackerStats"]
 
@@ -258,7 +258,8 @@ class Tracker:
         if ball is not None and ball.last_seen == t:
             gaps = np.hypot(*(xy - ball.z).T)
             near = float(gaps.min()) if len(xy) else math.inf
-            est.ball(t, ball.z[0], ball.z[1], near, ball.kicked, self._kick_asked(keys, gaps) if ball.kicked else None)
+            kick = self._our_kick(keys, gaps, ball) if ball.kicked else None
+            est.ball(t, ball.z[0], ball.z[1], near, ball.kicked, kick)
         for det in frame.robots:
             key = (det.team, det.id)
             track = self.robots.get(key)
@@ -283,10 +284,11 @@ class Tracker:
             self.p = dataclasses.replace(self.p, physics=self.configured.physics)
         self.physics = facts
 
-    def _kick_asked(self, keys: list[tuple[Team, int]], gaps: NDArray[np.float64]) -> float | None:
-        """A kick just seen: the ball's speed over the ground our kick asked (the kicker's speed sent
-        plus the robot's own along its heading), when one of our robots near the ball had its kicker
-        armed just now (physics ``kick_near_m``, ``kick_within_s``); else None."""
+    def _our_kick(self, keys: list[tuple[Team, int]], gaps: NDArray[np.float64], ball: _BallTrack) -> OurKick | None:
+        """A kick just seen, when one of our robots near the ball had its kicker armed just now
+        (physics ``kick_near_m``, ``kick_within_s``): the ball's speed over the ground it asked (the
+        kicker's speed sent plus the robot's own along its heading), the robot's heading and
+        velocity, and the ball's velocity before it (the filter's from before the kick); else None."""
         p = self.p.physics
         for i in np.argsort(gaps):
             if gaps[i] > p.kick_near_m:
@@ -294,7 +296,10 @@ class Tracker:
             armed = self._kicks.get(keys[i])
             if armed is not None and armed[0] <= self.t <= armed[1] + p.kick_within_s:
                 x = self.robots[keys[i]].filter.kf.x
-                return armed[2] + float(x[3] * math.cos(x[2]) + x[4] * math.sin(x[2]))
+                before = ball.filter.held
+                return OurKick(armed[2] + float(x[3] * math.cos(x[2]) + x[4] * math.sin(x[2])), float(x[2]),
+                               (float(x[3]), float(x[4])),
+                               None if before is None else (float(before.kf.x[2]), float(before.kf.x[3])))
         return None
 
     # --- robots -------------------------------------------------------------------------------

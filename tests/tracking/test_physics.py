@@ -12,7 +12,7 @@ import pytest
 
 from cmdragons.config import override_derived
 from cmdragons.geometry import LeagueParams
-from cmdragons.messages import DetectionFrame, Fact, PhysicsFacts, RobotCommand
+from cmdragons.messages import DetectionFrame, Fact, Kick, PhysicsFacts, RobotCommand
 from cmdragons.tracking import Tracker, TrackerParams
 from cmdragons.tracking.physics import fit_acceleration, launch_speed
 from sim.world import BallParams, DribblerParams, KickerParams, PhysicsParams, RobotParams, World
@@ -201,3 +201,42 @@ def test_a_used_value_is_handed_on_again_only_when_it_moved_enough() -> None:
     moved = at(4.0, 4.0 * (1 + 2 * change))
     assert moved is not first and moved.in_use()[Fact.ROBOT_BRAKE.source] == pytest.approx(4.0 * (1 + 2 * change))
     assert at(6.0, 6.0).in_use() == {}  # back at the configured value: nothing in use
+
+
+def scripted_one_touch(retention: float, seed: int = 1, kicks: int = 8, robot_vy: float = 0.0) -> Tracker:
+    """A ball rolled at 2.5 m/s onto the front of a robot facing along +x from 45° to its left (or
+    right, in turn), the robot's kicker armed: a one-touch kick at 3 m/s whose kicker keeps
+    ``retention`` of the ball's velocity across the heading; the robot at rest or driving across
+    its heading at ``robot_vy``. The tracker hears the commands."""
+    latency = 0.03
+    league = LeagueParams()
+    w = World(league, PhysicsParams(), RobotParams(command_latency_s=latency), BallParams(),
+              KickerParams(tangential_retention=retention), DribblerParams(), robots_per_team={"blue": 1, "yellow": 0})
+    tracker = Tracker(params(latency=latency, sigma=SIGMA))
+    rng = np.random.default_rng(seed)
+    front = league.robot.front_distance_m + league.ball.radius_m
+    for k in range(kicks):
+        side = 1.0 if k % 2 == 0 else -1.0
+        y = rng.uniform(-1.0, 1.0)
+        w.place_robot("blue", 0, -2.0, y, 0.0)
+        w.place_ball(-2.0 + front + 0.9, y + side * 0.9, vx=-2.5 / math.sqrt(2.0), vy=-side * 2.5 / math.sqrt(2.0))
+        kicked = False
+        for _ in range(60 * 2):
+            snap = w.snapshot()
+            tracker.step([detect(snap, rng, sigma=SIGMA)])
+            command = RobotCommand("blue", 0, 0.0, robot_vy, kick_speed=0.0 if kicked else 3.0)
+            tracker.command_sent([command], snap.t)
+            events = w.step_frame([command])
+            kicked = kicked or any(isinstance(e, Kick) for e in events)
+        assert kicked
+    tracker.finish()
+    return tracker
+
+
+@pytest.mark.parametrize("retention", [0.3, 1.0])  # our simulator's kicker; grSim's (its kick keeps all of it)
+def test_the_kicks_retention_across_the_heading_is_learnt_from_one_touch_kicks(retention: float) -> None:
+    tracker = scripted_one_touch(retention)
+    est = tracker.physics.estimate(Fact.KICK_RETENTION)
+    assert est is not None and est.confident and est.samples == 8  # each kick one sample
+    assert est.value_m_s2 == pytest.approx(retention, abs=0.05)
+    assert est.used == (retention != 0.3)

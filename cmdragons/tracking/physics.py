@@ -27,7 +27,9 @@ metres and seconds:
   ``retention_min_across_m_s``: the ball's velocity across the heading as it left, from the slide
   window above (its run keeps its direction while it slows; its speed taken back to the kick at the
   sliding deceleration measured so far), less the robot's, over the incoming ball's across the
-  heading relative to the robot. Our simulator's kicker keeps 0.3 of it; grSim's keeps all of it.
+  heading relative to the robot as it came in (tracked clear of the robots, as a one-touch aim
+  reckons with it). Our simulator's kicker keeps 0.3 of it; grSim's keeps all of it, and none when
+  its dribbler caught the ball first.
   Judged in shares: confident after ``retention_min_samples`` kicks with the median's standard
   error within ``retention_max_error``, used when off the configured share by ``retention_use_margin``;
 * each robot's reachable acceleration and braking from our own robots' detections while the
@@ -94,6 +96,7 @@ class PhysicsFactsParams(Validated):
     gain_after_s: float = setting(0.1, lo=0.0, hi=5.0)  # ... its gain window starts this after the model's slide
     gain_window_s: float = setting(0.4, lo=0.01, hi=5.0)
     retention_min_across_m_s: float = setting(0.5, lo=0.0, hi=20.0)  # the ball came in this fast across the heading
+    retention_incoming_s: float = setting(0.3, lo=0.0, hi=5.0)  # ... clear of the robots this recently before the kick
     retention_min_samples: int = setting(3, lo=1, hi=100000)  # the retention: kicks before it can be confident ...
     retention_max_error: float = setting(0.05, lo=0.0, hi=1.0)  # ... its median's standard error at most (a share)
     retention_use_margin: float = setting(0.1, lo=0.0, hi=1.0)  # used only this far off the configured share

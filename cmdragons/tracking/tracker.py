@@ -122,6 +122,7 @@ class Tracker:
         self._commands: dict[tuple[Team, int], deque[tuple[float, tuple[float, float, float]]]] = {}
         # the last flat kick armed: (from, until (s, in force), m/s)
         self._kicks: dict[tuple[Team, int], tuple[float, float, float]] = {}
+        self._free_ball: tuple[float, float, float] | None = None  # the tracked ball clear of robots, last: (t, vx, vy)
         self._steady_updates = filters.SteadyUpdates()
         self._robots_sorted = True  # self.robots in key order
 
@@ -258,8 +259,10 @@ class Tracker:
         if ball is not None and ball.last_seen == t:
             gaps = np.hypot(*(xy - ball.z).T)
             near = float(gaps.min()) if len(xy) else math.inf
-            kick = self._our_kick(keys, gaps, ball) if ball.kicked else None
+            kick = self._our_kick(keys, gaps) if ball.kicked else None
             est.ball(t, ball.z[0], ball.z[1], near, ball.kicked, kick)
+            if near >= est.p.clear_m:
+                self._free_ball = (t, float(ball.filter.kf.x[2]), float(ball.filter.kf.x[3]))
         for det in frame.robots:
             key = (det.team, det.id)
             track = self.robots.get(key)
@@ -284,11 +287,13 @@ class Tracker:
             self.p = dataclasses.replace(self.p, physics=self.configured.physics)
         self.physics = facts
 
-    def _our_kick(self, keys: list[tuple[Team, int]], gaps: NDArray[np.float64], ball: _BallTrack) -> OurKick | None:
+    def _our_kick(self, keys: list[tuple[Team, int]], gaps: NDArray[np.float64]) -> OurKick | None:
         """A kick just seen, when one of our robots near the ball had its kicker armed just now
         (physics ``kick_near_m``, ``kick_within_s``): the ball's speed over the ground it asked (the
         kicker's speed sent plus the robot's own along its heading), the robot's heading and
-        velocity, and the ball's velocity before it (the filter's from before the kick); else None."""
+        velocity, and the ball's velocity as it came in: tracked the last time it was clear of the
+        robots (physics ``clear_m``), at most ``retention_incoming_s`` before (what a one-touch aim
+        reckons with: a kicker that catches the ball first keeps none of it); else None."""
         p = self.p.physics
         for i in np.argsort(gaps):
             if gaps[i] > p.kick_near_m:
@@ -296,10 +301,10 @@ class Tracker:
             armed = self._kicks.get(keys[i])
             if armed is not None and armed[0] <= self.t <= armed[1] + p.kick_within_s:
                 x = self.robots[keys[i]].filter.kf.x
-                before = ball.filter.held
+                free = self._free_ball
+                came = free is not None and self.t - free[0] <= p.retention_incoming_s
                 return OurKick(armed[2] + float(x[3] * math.cos(x[2]) + x[4] * math.sin(x[2])), float(x[2]),
-                               (float(x[3]), float(x[4])),
-                               None if before is None else (float(before.kf.x[2]), float(before.kf.x[3])))
+                               (float(x[3]), float(x[4])), (free[1], free[2]) if free is not None and came else None)
         return None
 
     # --- robots -------------------------------------------------------------------------------

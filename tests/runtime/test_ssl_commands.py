@@ -99,6 +99,19 @@ def test_grsim_commands_round_trip_in_the_robots_frame() -> None:
                                                               c.kick_speed * math.sin(angle)), rel=F32)
 
 
+def test_grsim_holds_the_ball_for_an_armed_kicker_when_asked() -> None:
+    """grSim kicks only a ball touching as the packet arrives: with ``hold_armed`` an armed kicker's
+    robot has its spinner on (grSim then holds a touching ball until the next packet kicks it), a
+    robot not kicking keeps its own dribbler."""
+    commands = msg.TeamCommands("blue", 1, 0.0, (msg.RobotCommand("blue", 0, kick_speed=3.0),
+                                                 msg.RobotCommand("blue", 1, 1.0, dribbler=0.0),
+                                                 msg.RobotCommand("blue", 2, dribbler=0.5)))
+    for hold, spinners in ((False, [False, False, True]), (True, [True, False, True])):
+        p = grsim_pb.grSim_Packet()
+        p.ParseFromString(grsim_packet(commands, {}, CHIP, hold))
+        assert [g.spinner for g in p.commands.robot_commands] == spinners
+
+
 def test_robot_control_round_trips_through_our_reader() -> None:
     data = robot_control_packet(COMMANDS, HEADINGS, CHIP, 10000.0)
     m = ctl_pb.RobotControl()
@@ -214,7 +227,8 @@ def test_a_match_sends_our_commands_to_a_league_simulator(to: str) -> None:
         control.close()
     if to == "grsim":  # grSim hears the last commands again on each vision frame, before the frame's own
         chip = settings.sim.kicker.chip_angle_rad
-        assert packets[1::2] == [grsim_packet(tc, {r.id: r.theta for r in w.robots if r.team == "blue"}, chip)
+        hold = settings.protocols.grsim.hold_armed
+        assert packets[1::2] == [grsim_packet(tc, {r.id: r.theta for r in w.robots if r.team == "blue"}, chip, hold)
                                  for tc, w in zip(sent[:-1], worlds[1:], strict=True)]  # (in the robots' new headings)
         packets = packets[0::2]
     assert len(packets) == len(sent) == 10

@@ -54,8 +54,11 @@ def _heading(headings: Mapping[int, float], rid: int) -> float:
     return headings.get(rid, 0.0)
 
 
-def grsim_packet(tc: TeamCommands, headings: Mapping[int, float], chip_angle_rad: float) -> bytes:
-    """A ``grSim_Packet`` with ``tc``'s commands; ``headings``: robot id -> heading (rad)."""
+def grsim_packet(tc: TeamCommands, headings: Mapping[int, float], chip_angle_rad: float,
+                 hold_armed: bool = False) -> bytes:
+    """A ``grSim_Packet`` with ``tc``'s commands; ``headings``: robot id -> heading (rad). With
+    ``hold_armed`` the spinner turns on while the kicker is armed (grSim kicks only a ball touching
+    as the packet arrives; it holds a ball the spinner touches until then)."""
     p = grsim_pb.grSim_Packet()
     cmds = p.commands
     cmds.timestamp, cmds.isteamyellow = tc.t, tc.team == "yellow"
@@ -64,7 +67,8 @@ def grsim_packet(tc: TeamCommands, headings: Mapping[int, float], chip_angle_rad
         angle = chip_angle_rad if c.chip else 0.0
         cmds.robot_commands.add(id=c.id, kickspeedx=c.kick_speed * math.cos(angle),
                                 kickspeedz=c.kick_speed * math.sin(angle), veltangent=forward, velnormal=left,
-                                velangular=c.omega, spinner=c.dribbler > 0.0, wheelsspeed=False)
+                                velangular=c.omega, spinner=c.dribbler > 0.0 or (hold_armed and c.kick_speed > 0.0),
+                                wheelsspeed=False)
     return p.SerializeToString(deterministic=True)  # type: ignore[no-any-return]
 
 

@@ -71,6 +71,10 @@ class GrsimParams(Validated):
     address: str = _LOOPBACK
     port: int = setting(20011, lo=1, hi=65535)
     vision_port: int = setting(10020, lo=1, hi=65535)
+    # grSim kicks as a command arrives, and only a ball touching the kicker then: a one-touch ball
+    # bounces off between two commands. With this the dribbler turns on while the kicker is armed,
+    # and grSim holds a ball that touches until the next command fires the kick.
+    hold_armed: bool = setting(True)
 
 
 @dataclass(frozen=True)

@@ -387,6 +387,7 @@ class CommandsOutStage(SocketStage):
                                                                                            sim.port(team))
         self.control = (sim.address, sim.control_port)
         self.chip_angle_rad = chip_angle_rad
+        self.hold_armed = params.grsim.hold_armed
         self.full_rpm = sim.dribbler_full_rpm
         self.headings: dict[int, float] = {}
         self.sent = self.teleports = self.answers = self.answer_errors = self.answers_earlier_layout = 0
@@ -406,7 +407,7 @@ class CommandsOutStage(SocketStage):
             self.teleports += 1
         elif isinstance(message, TeamCommands):
             if self.to == "grsim":
-                data = grsim_packet(message, self.headings, self.chip_angle_rad)
+                data = grsim_packet(message, self.headings, self.chip_angle_rad, self.hold_armed)
                 self._last = message
             else:
                 data = robot_control_packet(message, self.headings, self.chip_angle_rad, self.full_rpm)
@@ -415,7 +416,8 @@ class CommandsOutStage(SocketStage):
         else:
             self.headings = {r.id: r.theta for r in message.robots if r.team == self.team}
             if self._last is not None:
-                self.endpoint.send_to(grsim_packet(self._last, self.headings, self.chip_angle_rad), self.peer)
+                self.endpoint.send_to(grsim_packet(self._last, self.headings, self.chip_angle_rad, self.hold_armed),
+                                      self.peer)
                 self.resent += 1
         self._read_answers()
 

@@ -26,7 +26,8 @@ class PassPlayParams(Validated):
     kicked_speed_m_s: float = setting(0.5, lo=0.0, hi=10.0)  # a ball faster than this toward the point: kicked ...
     kicked_cos: float = setting(0.8, lo=-1.0, hi=1.0)  # ... heading at least this straight at it (cosine)
     dead_speed_m_s: float = setting(0.2, lo=0.0, hi=10.0)  # a kicked ball slower than this has died: over
-    received_m: float = setting(0.3, lo=0.0, hi=3.0)  # the ball this near the receiver, off its way: received
+    received_m: float = setting(0.3, lo=0.0, hi=3.0)  # the ball this near the receiver, off its way: received ...
+    arriving_m_s: float = setting(0.2, lo=0.0, hi=10.0)  # ... unless one-touch, still closing on it this fast
 
 
 @dataclass(frozen=True)
@@ -108,7 +109,13 @@ class PassPlay:
             ps = self.current = dataclasses.replace(ps, kicked=True, t_start=t)  # the timeout runs from the kick
         elif ps.kicked and (speed < p.dead_speed_m_s or not heading_there):
             receiver = own[ps.receiver]
-            if math.hypot(receiver.x - ball.x, receiver.y - ball.y) < p.received_m or speed < p.dead_speed_m_s:
+            gap_x, gap_y = receiver.x - ball.x, receiver.y - ball.y
+            gap = math.hypot(gap_x, gap_y)
+            # a one-touch ball that passes by the point runs off its way before it reaches the receiver
+            # there: while it still closes on the receiver the pass (its kick armed) goes on
+            closing = ((ball.vx - receiver.vx) * gap_x + (ball.vy - receiver.vy) * gap_y) / max(gap, 1e-9)
+            arriving = ps.shoot_at is not None and closing > p.arriving_m_s
+            if (gap < p.received_m and not arriving) or speed < p.dead_speed_m_s:
                 self.current = None  # received (or died): the new attacker takes over
                 return None
         return ps

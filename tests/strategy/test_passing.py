@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import pytest
 
 from cmdragons.messages import BallState, RobotState
@@ -57,6 +59,27 @@ def test_over_when_received_or_died() -> None:
     died = _planned()
     died.follow(0.1, _own(), BallState(0.1, 0.0, 3.0, 0.0))
     assert died.follow(0.9, _own(receiver_at=(3.0, 2.0)), BallState(1.0, 0.0, 0.1, 0.0)) is None
+
+
+def test_a_ball_passing_by_the_point_is_not_received_while_it_still_closes_on_the_receiver() -> None:
+    """A one-touch pass runs past the point a few centimetres off it (no longer heading for it)
+    toward the receiver standing just beyond: not yet received (its kick stays armed) until it meets
+    the receiver and leaves it. A pass to be trapped is received there as before."""
+    trap = _planned()
+    trap.follow(0.1, _own(), BallState(0.1, 0.0, 3.0, 0.0))
+    assert trap.follow(0.7, _own(receiver_at=(2.1, 0.0)), BallState(1.95, 0.06, 1.0, -0.2)) is None
+    play = PassPlay(P)
+    play.plan(0.0, passer=1, receiver=2, point=POINT, shoot_at=(4.5, 0.0))
+    play.follow(0.1, _own(), BallState(0.1, 0.0, 3.0, 0.0))
+    receiver = _own(receiver_at=(2.1, 0.0))
+    ball = BallState(1.95, 0.06, 1.0, -0.2)  # 8 cm from the point, 16 cm from the receiver, closing at 1 m/s
+    to_point = (POINT[0] - ball.x, POINT[1] - ball.y)
+    cos = (ball.vx * to_point[0] + ball.vy * to_point[1]) / (math.hypot(ball.vx, ball.vy) * math.hypot(*to_point))
+    assert cos < P.kicked_cos  # off its way to the point
+    ps = play.follow(0.7, receiver, ball)
+    assert ps is not None and ps.kicked
+    # kicked on by the receiver: away from it, received
+    assert play.follow(0.75, receiver, BallState(2.0, 0.03, -1.0, 2.0)) is None
 
 
 def test_over_on_timeout_and_without_its_receiver() -> None:

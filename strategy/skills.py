@@ -76,7 +76,7 @@ class SkillParams(Validated):
     dribble_hold_m: float = setting(0.03, lo=0.001, hi=0.5)  # ball centre this near the middle of the face: held
     dribble_turn_rad: float = setting(0.3, lo=0.01, hi=3.2)  # ... and the robot facing the target within this
     ball_turn_rad_s: float = setting(9.0, lo=0.1, hi=100.0)  # turning with a held ball: at most this fast
-    held_slip_m_s: float = setting(0.3, lo=0.0, hi=5.0)  # a ball on the face moving with it within this: held
+    held_slip_m_s: float = setting(0.5, lo=0.0, hi=5.0)  # a moving ball on the face moving with it within this: held
     contact_slack_m: float = setting(0.02, lo=0.0, hi=0.2)  # lined up: the face up to this past the ball's back
     at_ball_m: float = setting(0.03, lo=0.0, hi=0.5)  # the face this near behind the ball ...
     at_ball_lateral_share: float = setting(0.5, lo=0.0, hi=1.0)  # ... within this share of lined_up_m across: at it
@@ -152,17 +152,21 @@ def on_face(robot: RobotState, ball: BallState, p: SkillParams) -> bool:
 
 
 def held_ball(ball: BallState, robots: Iterable[RobotState], p: SkillParams) -> BallState:
-    """``ball`` as a team plays it: a ball on the kicker face of one of ``robots`` (:func:`on_face`)
-    that moves with the face (within ``held_slip_m_s`` of its velocity, the robot's turn included)
-    goes where the robot takes it, at the robot's velocity. A robot turning with the ball swings it
-    round its centre at the face's speed (0.8 m/s at 9 rad/s): that is no run of the ball's own, and
-    predicted along its tangent it would leave the face in a few frames (met there, the ball was no
-    longer held and the turn was dropped half way). ``ball`` itself when no robot holds it."""
+    """``ball`` as a team plays it: a moving ball (faster than ``rest_speed_m_s``) on the kicker face
+    of one of ``robots`` (:func:`on_face`) that moves with the face (within ``held_slip_m_s`` of its
+    velocity, the robot's turn included) goes where the robot takes it, at the robot's velocity. A
+    robot turning with the ball swings it round its centre at the face's speed (0.8 m/s at 9 rad/s):
+    no run of the ball's own, and predicted along its tangent it would leave the face in a few frames
+    (met there, the ball was no longer held and the turn was dropped half way). A ball at rest stays
+    at rest (a robot driving slowly onto it does not carry it yet). ``ball`` itself when no robot
+    holds it."""
+    if math.hypot(ball.vx, ball.vy) <= p.rest_speed_m_s:
+        return ball
     contact = p.contact_m
     for r in robots:
         if not on_face(r, ball, p):
             continue
-        # the face's middle moves at the robot's velocity plus its turn about the centre
+        # the face's middle moves at the robot's velocity plus the swing of its turn about the centre
         fvx = r.vx - r.omega * contact * math.sin(r.theta)
         fvy = r.vy + r.omega * contact * math.cos(r.theta)
         if math.hypot(ball.vx - fvx, ball.vy - fvy) <= p.held_slip_m_s:

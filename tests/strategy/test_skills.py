@@ -75,3 +75,11 @@ def test_a_ball_moving_with_a_robots_face_is_held(slip: tuple[float, float], off
         assert (played.vx, played.vy) == pytest.approx((robot.vx, robot.vy), abs=1e-12)
     else:
         assert played == ball
+
+
+def test_a_ball_a_robot_drives_onto_is_not_carried() -> None:
+    """A robot driving onto a ball at rest, the ball touching its face: the ball stays at rest as
+    seen (a push onto it slower than the slip does not carry it yet)."""
+    robot = RobotState("blue", 2, 0.0, 0.0, 0.0, 0.8 * SKILLS.held_slip_m_s, 0.0, 0.0)
+    ball = BallState(SKILLS.contact_m, 0.0, 0.0, 0.0)
+    assert held_ball(ball, (robot,), SKILLS) == ball

@@ -105,8 +105,9 @@ def test_a_held_ball_is_turned_with_as_fast_as_the_limits_allow(turn_deg: float)
     the brain's own navigation and motion control: it kicks within ``TURN_SLACK_S`` of the fastest turn
     its limits allow (the turn rate cap with a held ball, ``skills.ball_turn_rad_s``, and the robot's
     angular acceleration, field.yaml ``robot.max_alpha_rad_s2``; rest to rest through the angle it
-    turned), never turning faster than the cap, the dribbler holding the ball every frame. (The turn as
-    heading steps a frame each stopped on: 3.3 rad/s, half the time again.)"""
+    turned), never turning faster than the cap, the dribbler holding the ball every frame. (The turn as a
+    heading 0.15 rad ahead each frame, a target the profile stopped on: 3.4 rad/s, kicked after 0.50-0.55 s
+    where the limits allow 0.31-0.33.)"""
     s = SETTINGS.sim
     robot_model = dataclasses.replace(s.robot, command_latency_s=0.0)  # the brain sees the truth of now
     world = World(SETTINGS.field, s.physics, robot_model, s.ball, s.kicker, s.dribbler,

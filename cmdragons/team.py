@@ -418,7 +418,7 @@ class Brain:
         # drive through the goal only where the path ends at it (not at a stand-in for a blocked goal)
         through = max(it.final_speed_m_s, 0.0) if math.dist(tuple(path[-1]), goal) < 1e-9 else 0.0
         nav = self._navigator(robot.id)
-        nav.set_plan(path, Arrival(it.theta, through, it.max_speed_m_s))
+        nav.set_plan(path, Arrival(it.theta, through, it.max_speed_m_s, it.max_omega_rad_s))
         vx, vy, omega = nav.command(robot, cworld, deadline(self.params.brain.navigate_deadline_ms * 1e-3))
         cmd = RobotCommand(self.team, robot.id, vx, vy, omega, it.kick_speed, it.chip, it.dribbler)
         self.plans[robot.id] = RobotPlan(it, path, status, cmd)

@@ -46,7 +46,7 @@ from strategy.game_states import (
 from strategy.kicking import Attacker, KickParams, KickPurpose
 from strategy.passing import PassPlay, PassPlayParams, PassRecordParams
 from strategy.roles import Objective, Role, RoleAssigner, RoleKind, RoleParams
-from strategy.skills import Intent, SkillParams, defend, intercept, mark, receive
+from strategy.skills import Intent, SkillParams, defend, held_ball, intercept, mark, receive
 from strategy.support import Supporters, SupportParams
 
 __all__ = ["Strategy", "StrategyParams", "off_ball_line"]
@@ -214,6 +214,7 @@ class Strategy:
             return halt(own)
         if ball is None:
             return hold_shape(own, self.field, own_sign, self.p.game_states)
+        ball = held_ball(ball, own.values(), self.p.skills)  # a ball one of ours turns with is no moving ball
         ours = game.for_team == self.team
         restart = ours and game.command.kick_restart
         self._barred = self._double_touch_bar(game, own, opp, ball)

@@ -72,7 +72,8 @@ def steer(team: Team, rid: int, x: float, y: float, theta: float, it: Intent, p:
     cap = p.max_speed_m_s if it.max_speed_m_s is None else min(p.max_speed_m_s, it.max_speed_m_s)
     v = min(cap, p.position_gain_1_s * d + it.final_speed_m_s)
     vx, vy = (dx / d * v, dy / d * v) if d > 1e-6 else (0.0, 0.0)
-    omega = max(-p.max_omega_rad_s, min(p.max_omega_rad_s, p.heading_gain_1_s * wrap_angle(it.theta - theta)))
+    top = p.max_omega_rad_s if it.max_omega_rad_s is None else min(p.max_omega_rad_s, it.max_omega_rad_s)
+    omega = max(-top, min(top, p.heading_gain_1_s * wrap_angle(it.theta - theta)))
     return RobotCommand(team, rid, vx, vy, omega, it.kick_speed, it.chip, it.dribbler)
 
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -27,9 +28,11 @@ __all__ = [
     "dribble",
     "drive_through",
     "goalie_block",
+    "held_ball",
     "intercept",
     "kick_to",
     "mark",
+    "on_face",
     "pass_speed",
     "receive",
     "set_kick",
@@ -72,7 +75,8 @@ class SkillParams(Validated):
     dribble_speed_m_s: float = setting(1.0, lo=0.05, hi=5.0)  # carrying the ball, and driving onto it to take it
     dribble_hold_m: float = setting(0.03, lo=0.001, hi=0.5)  # ball centre this near the middle of the face: held
     dribble_turn_rad: float = setting(0.3, lo=0.01, hi=3.2)  # ... and the robot facing the target within this
-    turn_step_rad: float = setting(0.15, lo=0.01, hi=1.0)  # turning about a held ball: at most this a frame
+    ball_turn_rad_s: float = setting(9.0, lo=0.1, hi=100.0)  # turning with a held ball: at most this fast
+    held_slip_m_s: float = setting(0.5, lo=0.0, hi=5.0)  # a moving ball on the face moving with it within this: held
     contact_slack_m: float = setting(0.02, lo=0.0, hi=0.2)  # lined up: the face up to this past the ball's back
     at_ball_m: float = setting(0.03, lo=0.0, hi=0.5)  # the face this near behind the ball ...
     at_ball_lateral_share: float = setting(0.5, lo=0.0, hi=1.0)  # ... within this share of lined_up_m across: at it
@@ -123,6 +127,7 @@ class Intent:
     allow_any_defense: bool = False  # both defense areas open (placing a ball that lies in or by one)
     max_speed_m_s: float | None = None  # None: the robot's limit
     final_speed_m_s: float = 0.0  # arrive moving (driving through the ball)
+    max_omega_rad_s: float | None = None  # turning at most this fast (rad/s); None: the robot's limit
 
 
 _BISECTIONS = 40  # halvings of the kick speed range in pass_speed: far below a mm/s
@@ -137,6 +142,36 @@ def waiting_point(ball: BallState, aim: float, p: SkillParams) -> tuple[float, f
     centre ``contact_m + approach_distance_m`` behind the ball's on the kick line."""
     behind = p.contact_m + p.approach_distance_m
     return ball.x - math.cos(aim) * behind, ball.y - math.sin(aim) * behind
+
+
+def on_face(robot: RobotState, ball: BallState, p: SkillParams) -> bool:
+    """Whether the ball's centre lies within ``dribble_hold_m`` of the middle of ``robot``'s kicker face."""
+    contact = p.contact_m
+    face_x, face_y = robot.x + math.cos(robot.theta) * contact, robot.y + math.sin(robot.theta) * contact
+    return math.hypot(ball.x - face_x, ball.y - face_y) < p.dribble_hold_m
+
+
+def held_ball(ball: BallState, robots: Iterable[RobotState], p: SkillParams) -> BallState:
+    """``ball`` as a team plays it: a moving ball (faster than ``rest_speed_m_s``) on the kicker face
+    of one of ``robots`` (:func:`on_face`) that moves with the face (within ``held_slip_m_s`` of its
+    velocity, the robot's turn included) goes where the robot takes it, at the robot's velocity. A
+    robot turning with the ball swings it round its centre at the face's speed (0.8 m/s at 9 rad/s):
+    no run of the ball's own, and predicted along its tangent it would leave the face in a few frames
+    (met there, the ball was no longer held and the turn was dropped half way). A ball at rest stays
+    at rest (a robot driving slowly onto it does not carry it yet). ``ball`` itself when no robot
+    holds it."""
+    if math.hypot(ball.vx, ball.vy) <= p.rest_speed_m_s:
+        return ball
+    contact = p.contact_m
+    for r in robots:
+        if not on_face(r, ball, p):
+            continue
+        # the face's middle moves at the robot's velocity plus the swing of its turn about the centre
+        fvx = r.vx - r.omega * contact * math.sin(r.theta)
+        fvy = r.vy + r.omega * contact * math.cos(r.theta)
+        if math.hypot(ball.vx - fvx, ball.vy - fvy) <= p.held_slip_m_s:
+            return dataclasses.replace(ball, vx=r.vx, vy=r.vy)
+    return ball
 
 
 def kick_to(robot: RobotState, ball: BallState, target: tuple[float, float], speed: float, p: SkillParams,
@@ -220,10 +255,8 @@ def dribble(robot: RobotState, ball: BallState, target: tuple[float, float], p: 
     kick), then drive so that the ball arrives at the target, facing the way."""
     aim = _angle(target[0] - ball.x, target[1] - ball.y)
     contact = p.contact_m
-    face_x, face_y = robot.x + math.cos(robot.theta) * contact, robot.y + math.sin(robot.theta) * contact
-    on_face = math.hypot(ball.x - face_x, ball.y - face_y) < p.dribble_hold_m
     arriving = math.hypot(target[0] - ball.x, target[1] - ball.y) < contact  # the aim swings: keep the heading
-    if on_face and (arriving or abs(wrap_angle(aim - robot.theta)) < p.dribble_turn_rad):
+    if on_face(robot, ball, p) and (arriving or abs(wrap_angle(aim - robot.theta)) < p.dribble_turn_rad):
         # where the robot stands when the ball lies on the target
         heading = robot.theta if arriving else aim
         x, y = target[0] - math.cos(heading) * contact, target[1] - math.sin(heading) * contact
@@ -239,26 +272,31 @@ def dribble(robot: RobotState, ball: BallState, target: tuple[float, float], p: 
 def turn_with_ball(robot: RobotState, ball: BallState, target: tuple[float, float], speed: float,
                    p: SkillParams) -> Intent | None:
     """Holding the ball on the kicker face (its centre within ``dribble_hold_m`` of the face's
-    middle): turn about the ball toward ``target``, at most ``turn_step_rad`` a frame (faster, the
-    ball is lost), the dribbler holding it; facing the target within ``lined_up_rad`` and so that the
-    ball passes within ``aim_tolerance_m`` of it, drive through it with the kicker armed at
-    ``speed``. None when the ball is not held (going round it to line up would leave it: a trapped
-    ball was given away so). The heading turned to and judged lined up is the one that sends the
-    ball at the target (:func:`aiming`): the kick is relative to the robot, and turning about the
-    ball moves it across its heading."""
-    contact = p.contact_m
-    face_x, face_y = robot.x + math.cos(robot.theta) * contact, robot.y + math.sin(robot.theta) * contact
-    if math.hypot(ball.x - face_x, ball.y - face_y) >= p.dribble_hold_m:
+    middle): turn where the robot stands toward ``target``, the dribbler holding the ball as it
+    swings round with the face, at most ``ball_turn_rad_s`` (faster, the ball is lost); facing the
+    target within ``lined_up_rad`` and so that the ball passes within ``aim_tolerance_m`` of it,
+    drive through it with the kicker armed at ``speed``. None when the ball is not held (going round
+    it to line up would leave it: a trapped ball was given away so). The heading turned to and judged
+    lined up is the one that sends the ball at the target (:func:`aiming`): the kick is relative to
+    the robot, and the turn moves the ball across its heading.
+
+    The intent's heading is the one to face at the end, under a turn rate cap, so that motion control
+    runs one profile through the whole turn (a heading a short step ahead each frame is a target the
+    heading's profile stops on: it turned at the rate it can stop from within the step, a third of the
+    cap). The robot turns about its own centre: going round the ball instead moves the centre on a
+    circle of ``contact_m``, whose centripetal acceleration the robot's ``max_accel`` holds far below
+    the cap."""
+    if not on_face(robot, ball, p):
         return None
     aim = _angle(target[0] - ball.x, target[1] - ball.y)
-    error = wrap_angle(aiming(robot, ball, aim, speed, p) - robot.theta)
+    heading = aiming(robot, ball, aim, speed, p)
+    error = wrap_angle(heading - robot.theta)
     # the kick fires at once: lined up when the ball would pass within aim_tolerance_m of the target
     reach = math.hypot(target[0] - ball.x, target[1] - ball.y)
     if abs(error) < min(p.lined_up_rad, math.atan2(p.aim_tolerance_m, reach)):
         return drive_through(robot, ball, aim, speed, p)
-    heading = robot.theta + max(-p.turn_step_rad, min(p.turn_step_rad, error))
-    return Intent(ball.x - math.cos(heading) * contact, ball.y - math.sin(heading) * contact, heading,
-                  dribbler=p.hold_dribbler, avoid_ball=False)
+    return Intent(robot.x, robot.y, heading, dribbler=p.hold_dribbler, avoid_ball=False,
+                  max_omega_rad_s=p.ball_turn_rad_s)
 
 
 def speed_after(speed: float, distance: float, p: SkillParams) -> float:

@@ -56,14 +56,16 @@ class NavStatus(Enum):
 class Arrival:
     """How a robot arrives at the end of its path: facing ``heading_rad``; driving through it at
     ``through_speed_m_s`` along the line from the robot to it (0: stop on it); never faster than
-    ``max_speed_m_s`` (None: the robot's limit)."""
+    ``max_speed_m_s`` nor turning faster than ``max_omega_rad_s`` (None: the robot's limits)."""
 
     heading_rad: float = 0.0
     through_speed_m_s: float = 0.0
     max_speed_m_s: float | None = None
+    max_omega_rad_s: float | None = None
 
     def __post_init__(self) -> None:
-        if not self.through_speed_m_s >= 0.0 or (self.max_speed_m_s is not None and not self.max_speed_m_s >= 0.0):
+        caps = (self.max_speed_m_s, self.max_omega_rad_s)
+        if not self.through_speed_m_s >= 0.0 or any(c is not None and not c >= 0.0 for c in caps):
             raise ValueError(f"speeds must be >= 0: {self}")
 
 

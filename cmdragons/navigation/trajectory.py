@@ -40,12 +40,16 @@ class TrajectoryParams(Validated):
     through_beyond_m: float = setting(0.05, lo=0.0, hi=1.0)
 
 
-def capped_control(control: ControlParams, max_speed_m_s: float | None) -> ControlParams:
-    """``control`` with its speed limit lowered to ``max_speed_m_s`` (None or above: unchanged)."""
-    if max_speed_m_s is None or max_speed_m_s >= control.motion.max_speed_m_s:
-        return control
-    motion = dataclasses.replace(control.motion, max_speed_m_s=max(max_speed_m_s, 0.01))
-    return dataclasses.replace(control, motion=motion)
+def capped_control(control: ControlParams, max_speed_m_s: float | None,
+                   max_omega_rad_s: float | None = None) -> ControlParams:
+    """``control`` with its speed limit lowered to ``max_speed_m_s`` and its turn rate limit to
+    ``max_omega_rad_s`` (None or above: unchanged)."""
+    motion = control.motion
+    if max_speed_m_s is not None and max_speed_m_s < motion.max_speed_m_s:
+        motion = dataclasses.replace(motion, max_speed_m_s=max(max_speed_m_s, 0.01))
+    if max_omega_rad_s is not None and max_omega_rad_s < motion.max_omega_rad_s:
+        motion = dataclasses.replace(motion, max_omega_rad_s=max(max_omega_rad_s, 0.01))
+    return control if motion is control.motion else dataclasses.replace(control, motion=motion)
 
 
 class TrajectoryNavigator:
@@ -68,7 +72,7 @@ class TrajectoryNavigator:
         self.arrival = Arrival()
         self._next = 1  # the first waypoint of the path not yet passed
         self._sent: tuple[float, float] | None = None
-        self._capped: dict[float | None, ControlParams] = {}
+        self._capped: dict[tuple[float | None, float | None], ControlParams] = {}
 
     def set_plan(self, path: ArrayLike, arrival: Arrival) -> None:
         self.path = np.asarray(path, dtype=np.float64).reshape(-1, 2)
@@ -86,10 +90,10 @@ class TrajectoryNavigator:
 
     def target(self, robot: RobotState) -> tuple[MotionTarget, ControlParams]:
         """Where the profile leads this frame (field frame) and the limits it runs under."""
-        cap = self.arrival.max_speed_m_s
+        cap = (self.arrival.max_speed_m_s, self.arrival.max_omega_rad_s)
         control = self._capped.get(cap)
         if control is None:
-            control = self._capped[cap] = capped_control(self.control, cap)
+            control = self._capped[cap] = capped_control(self.control, *cap)
         start = (robot.x, robot.y)
         # a waypoint once passed stays passed while the plan lasts (the brain plans anew each frame)
         reached = control.path.waypoint_reached_m

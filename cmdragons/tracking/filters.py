@@ -266,8 +266,12 @@ class BallFilter:
             self._first_var = r_var
         if self.held is not None:
             held, self.held = self.held, None
-            if held.nis(z, sigma_m) <= self.p.kick_gate_chi2:
-                # the motion goes on as before the odd detection: that one was not a kick
+            held_nis, held_nll = held.nis_nll(z, sigma_m)
+            if held_nis <= self.p.kick_gate_chi2 and held_nll <= self.nis_nll(z, sigma_m)[1]:
+                # the motion goes on as before the odd detection: that one was not a kick. Only where
+                # the motion before explains this detection better than the one after the odd
+                # detection does: an uncertain filter (a ball held unseen in a robot's mouth) fits a
+                # detection far off, and taking it from there makes a velocity of that whole jump
                 vars(self).update(vars(held))
                 nis = None
         kicked = (self.nis(z, sigma_m) if nis is None else nis) > self.p.kick_gate_chi2

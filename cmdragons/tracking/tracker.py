@@ -336,18 +336,26 @@ class Tracker:
         """Ball detections (position, its standard deviation per axis or NaN) to hypotheses."""
         if not detections:
             return
+        # each pair's cost: the negative log-likelihood of the detection under the hypothesis, as its
+        # motion predicts it (a Gaussian) or, where likelier, as a jump (a kick, a bounce, another
+        # object): anywhere in the disc the ball can have reached since it was seen, with equal
+        # density. A hypothesis seen a frame ago confines the ball to a few centimetres; one unseen
+        # for a second, held in a robot's mouth, to metres: by normalised error alone that one took
+        # the detection of a ball kicked or stopped next to the ball tracked to a millimetre
         pairs = []
         for i, track in enumerate(self.balls):
             reach = self.p.max_ball_speed_m_s * max(t - track.last_seen, 1e-3) + self.p.ball_jump_margin_m
+            jump = math.log(math.pi * reach * reach)
             px, py = track.filter.position.tolist()
             for j, (z, sigma) in enumerate(detections):
                 d = math.hypot(z[0] - px, z[1] - py)
                 if d <= reach:
-                    pairs.append((track.filter.nis(z, sigma), d, i, j))
+                    nis, cost = track.filter.nis_nll(z, sigma)
+                    pairs.append((min(cost, jump), d, i, j, nis))
         pairs.sort()
         used_tracks: set[int] = set()
         used_dets: set[int] = set()
-        for nis, _, i, j in pairs:
+        for _, _, i, j, nis in pairs:
             if i in used_tracks or j in used_dets:
                 continue
             used_tracks.add(i)

@@ -465,3 +465,88 @@ def test_a_stray_detection_taken_by_a_stale_hypothesis_is_not_the_ball() -> None
     assert stray.ball is not None and math.hypot(stray.ball.x, stray.ball.y) < 0.05
     after = see((0.0, 0.0))
     assert after.ball is not None and math.hypot(after.ball.x, after.ball.y) < 0.05
+
+
+ERFORCE_SIGMA = 0.002  # m: the ER-Force simulator's ball and robot noise (its league rows' recorded detections)
+
+
+def ball_path(kick_at_s: float, speed_m_s: float, decel_m_s2: float = 3.0) -> Callable[[float], tuple[float, float]]:
+    """The ball at the origin until ``kick_at_s``, then along +x at ``speed_m_s`` slowing at ``decel_m_s2``
+    (a slide): (x, speed) at time t."""
+    def at(t: float) -> tuple[float, float]:
+        tau = min(max(0.0, t - kick_at_s), speed_m_s / decel_m_s2)
+        return speed_m_s * tau - 0.5 * decel_m_s2 * tau * tau, speed_m_s - decel_m_s2 * tau if t > kick_at_s else 0.0
+    return at
+
+
+def stale_mouth_frames(path: Callable[[float], tuple[float, float]], yellow_y: float, frames: int,
+                       rng: np.random.Generator) -> Iterator[tuple[DetectionFrame, float, float]]:
+    """A blue robot with the ball at its mouth and an idle yellow robot beside it, ``yellow_y`` off; for three
+    frames a stray detection shows at the yellow robot's mouth (the ER-Force simulator's vision), which the
+    tracker then holds there, unseen; the ball follows ``path``. Frames with the ball's true x and speed."""
+    robots = (("blue", 0, -FRONT, 0.0), ("yellow", 0, -FRONT, yellow_y))
+    for k in range(frames):
+        t = k * DT
+        x, speed = path(t)
+        balls = [BallDetection(x + rng.normal(0, ERFORCE_SIGMA), rng.normal(0, ERFORCE_SIGMA), 0.9, (0.0, 0.0))]
+        if 20 <= k < 23:
+            balls.append(BallDetection(rng.normal(0, ERFORCE_SIGMA), yellow_y + rng.normal(0, ERFORCE_SIGMA), 0.9,
+                                       (0.0, 0.0)))
+        seen = tuple(RobotDetection(team, rid, rx + rng.normal(0, ERFORCE_SIGMA), ry + rng.normal(0, ERFORCE_SIGMA),
+                                    0.0, 0.9, (0.0, 0.0)) for team, rid, rx, ry in robots)
+        yield DetectionFrame(0, k, t, t, tuple(balls), seen), x, speed
+
+
+@pytest.mark.parametrize("seed", range(4))
+@pytest.mark.parametrize(("situation", "yellow_y", "path"), [
+    pytest.param("at rest", 0.6, ball_path(math.inf, 0.0), id="at rest"),
+    pytest.param("kicked", 1.0, ball_path(1.0, 5.0), id="kicked at 5 m/s"),
+])
+def test_a_stale_hypothesis_in_a_robots_mouth_never_makes_the_ball_fast(situation: str, yellow_y: float,
+                                                                         path: Callable[[float], tuple[float, float]],
+                                                                         seed: int) -> None:
+    # the tracker as configured for our vision (0.4 mm) on the ER-Force simulator's (2 mm): the ball tracked
+    # to a millimetre lost a detection (a few millimetres off its prediction, or its kick 8 cm from the mouth)
+    # to a stale hypothesis held in an idle robot's mouth 0.6-1 m away, which by normalised error explained
+    # it better; taking the next from where that one had been put made the ball 12-18 m/s for two frames
+    # ("ball too fast" on a ball at rest or kicked at 5 m/s)
+    tracker = Tracker(TrackerParams(latency_s=0.0))
+    rng = np.random.default_rng(seed)
+    worst_speed = worst_pos = 0.0
+    for k, (frame, x, speed) in enumerate(stale_mouth_frames(path, yellow_y, 150, rng)):
+        ws = tracker.step([frame])
+        if k > 30:
+            assert ws.ball is not None
+            worst_speed = max(worst_speed, math.hypot(ws.ball.vx, ws.ball.vy) - speed)
+            if situation == "at rest" or frame.t_capture > 1.0 + 3 * DT:  # the kick re-acquired
+                worst_pos = max(worst_pos, math.hypot(ws.ball.x - x, ws.ball.y))
+    # 2 mm detections 1/60 s apart, judged at 0.4 mm: velocity noise up to about 0.6 m/s
+    assert worst_speed < 1.0
+    assert worst_pos < 0.02
+
+
+@pytest.mark.parametrize("seed", range(2))
+@pytest.mark.parametrize("unseen_frames", [5, 6])
+def test_a_ball_kicked_unseen_out_of_a_robots_mouth_is_as_fast_as_kicked(unseen_frames: int, seed: int) -> None:
+    # the ball at rest in a robot's mouth, hidden there (the tracker carries it) when the robot kicks it
+    # at 5 m/s, first seen ``unseen_frames`` after the kick, 0.3-0.5 m out: its speed is the kick's, never
+    # one made of the jump from the mouth to that first sighting (11-16 m/s before)
+    tracker = Tracker(TrackerParams(latency_s=0.0))
+    rng = np.random.default_rng(seed)
+    path = ball_path(1.0, 5.0)
+    worst = 0.0
+    for k in range(120):
+        t = k * DT
+        x, speed = path(t)
+        hidden = 54 <= k < 60 + unseen_frames
+        balls = () if hidden else (BallDetection(x + rng.normal(0, ERFORCE_SIGMA), rng.normal(0, ERFORCE_SIGMA), 0.9,
+                                                 (0.0, 0.0)),)
+        robot = (RobotDetection("blue", 0, -FRONT + rng.normal(0, ERFORCE_SIGMA), rng.normal(0, ERFORCE_SIGMA), 0.0,
+                                0.9, (0.0, 0.0)),)
+        ws = tracker.step([DetectionFrame(0, k, t, t, balls, robot)])
+        if k > 30:
+            assert ws.ball is not None
+            worst = max(worst, math.hypot(ws.ball.vx, ws.ball.vy) - speed)
+            if k > 60 + unseen_frames + 2:
+                assert abs(ws.ball.x - x) < 0.02
+    assert worst < 1.0  # the velocity noise of 2 mm detections judged at 0.4 mm: about 0.6 m/s

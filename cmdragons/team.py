@@ -287,9 +287,10 @@ class Brain:
         commands = [self._navigate(frame, index[rid], intent, game) for rid, intent in sorted(intents.items())]
         t2 = time.perf_counter()
         safe = self._make_safe(frame, commands, world) if commands else []
-        heading = {r.id: r.theta for r in world.robots if r.team == self.team}
+        pose = {r.id: (r.theta, (r.vx, r.vy)) for r in world.robots if r.team == self.team}
         gain = self.settings.control.motion.kick_gain
-        safe = [relative_kick(c, heading.get(c.id, 0.0), self.settings.field.robot, gain) for c in safe]
+        robot = self.settings.field.robot
+        safe = [relative_kick(c, *pose.get(c.id, (0.0, (0.0, 0.0))), robot, gain) for c in safe]
         sent = {c.id for c in safe}
         for c in safe:
             nav = self.navigators.get(c.id)

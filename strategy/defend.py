@@ -214,7 +214,8 @@ class DefendTeam:
                 it = intents[r.id]
                 x, y = detour((r.x, r.y), (it.x, it.y), (ball.x, ball.y), keep, self.p.detour_share)
                 intents[r.id] = replace(it, x=x, y=y)
-        return [relative_kick(self._steer(r, intents[r.id], on), r.theta, self.field.league.robot) for r in own]
+        robot = self.field.league.robot
+        return [relative_kick(self._steer(r, intents[r.id], on), r.theta, (r.vx, r.vy), robot) for r in own]
 
     def _on_field(self, world: WorldState) -> list[RobotState]:
         """The robots in play (one sent off by a card stands outside the field)."""

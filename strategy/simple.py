@@ -127,7 +127,7 @@ class SimpleTeam:
         elif game.command == RefereeCommand.PENALTY:
             intents = self._penalty(intents, own, world, ball, game.ready, ours, own_sign)
         return [relative_kick(steer(self.team, r.id, r.x, r.y, r.theta, intents[r.id], self.p), r.theta,
-                              self.field.league.robot) for r in own]
+                              (r.vx, r.vy), self.field.league.robot) for r in own]
 
     def _penalty(self, intents: dict[int, Intent], own: list[RobotState], world: WorldState, ball: BallState,
                  ready: bool, ours: bool, own_sign: float) -> dict[int, Intent]:

@@ -119,17 +119,23 @@ def motion_command(robot: RobotState, target: MotionTarget, params: ControlParam
     return RobotCommand(robot.team, robot.id, float(vx), float(vy), float(omega))
 
 
-def relative_kick(cmd: RobotCommand, theta: float, robot: RobotShape, gain: float = 1.0) -> RobotCommand:
+def relative_kick(cmd: RobotCommand, theta: float, velocity: tuple[float, float], robot: RobotShape,
+                  gain: float = 1.0) -> RobotCommand:
     """``cmd`` with its kick (the ball's speed over the ground, as strategy asks it) turned into the
-    kicker's speed relative to the robot, which moves at the command's velocity along its heading
-    ``theta`` (rad): a kicker fires relative to the robot that carries it, so a robot driving onto
-    the ball at 1 m/s that kicks at 6 m/s sends it off at 7 (over the rules' 6.5). A kicker whose
-    ball leaves at ``gain`` of the speed asked (MotionParams ``kick_gain``) is asked that much more,
-    up to the robot's ``max_kick_m_s`` (a gain measured on passes must not send a shot over the rules').
-    Flat kicks; a chip's speed is sent as asked."""
+    kicker's speed relative to the robot heading ``theta`` (rad): a kicker fires relative to the robot
+    that carries it, so a robot driving onto the ball at 1 m/s that kicks at 6 m/s sends it off at 7
+    (over the rules' 6.5). When the kicker fires, the robot moves somewhere between its tracked
+    ``velocity`` (field frame, m/s) and the command's (it speeds up or brakes toward the command
+    within its limits); the faster of the two along the heading is taken off, so the ball never
+    leaves faster than asked (a robot at 1.07 m/s whose command the safety search had just zeroed shot
+    at 6.9 m/s), and a robot driving steadily, the two alike, kicks it off at the speed asked. A
+    kicker whose ball leaves at ``gain`` of the speed asked (MotionParams ``kick_gain``) is asked that
+    much more, up to the robot's ``max_kick_m_s`` (a gain measured on passes must not send a shot
+    over the rules'). Flat kicks; a chip's speed is sent as asked."""
     if cmd.kick_speed <= 0.0 or cmd.chip:
         return cmd
-    forward = cmd.vx * math.cos(theta) + cmd.vy * math.sin(theta)
+    c, s = math.cos(theta), math.sin(theta)
+    forward = max(cmd.vx * c + cmd.vy * s, velocity[0] * c + velocity[1] * s)
     kick = robot.kicker_speed(cmd.kick_speed, forward)
     if gain != 1.0:
         kick = min(max(kick / gain, robot.min_kick_m_s), max(kick, robot.max_kick_m_s))

@@ -48,7 +48,9 @@ def scripted_pass(receiver_at: tuple[float, float], opponent_at: tuple[float, fl
         kick = RobotCommand("blue", 0, vx=drive_m_s if armed else 0.0, kick_speed=kick_m_s if armed else 0.0)
         recorder.report(TeamReport("blue", n, gt.t, (RobotReport(0, "direct", (TARGET[0], 0.0, 0.0), command=kick),),
                                    actions={0: KickPurpose.PASS}, passing=PassReport(0, 1, TARGET, kicked=n > 0)))
-        commands = [relative_kick(kick, 0.0, LEAGUE.robot), RobotCommand("blue", 1, dribbler=1.0)]
+        kicker = next(r for r in gt.robots if r.team == "blue" and r.id == 0)
+        commands = [relative_kick(kick, 0.0, (kicker.vx, kicker.vy), LEAGUE.robot),
+                    RobotCommand("blue", 1, dribbler=1.0)]
         for e in w.step_frame(commands):
             if isinstance(e, Kick):
                 kicked = True

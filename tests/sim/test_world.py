@@ -13,6 +13,7 @@ from cmdragons.geometry import LeagueParams
 from cmdragons.messages import RefereeCommand, RobotCommand
 from sim.referee import Referee
 from sim.referee_params import RefereeParams
+from sim.rules import RulesParams
 from sim.world import (
     BallOut,
     BallParams,
@@ -377,8 +378,9 @@ def test_a_kick_asked_over_the_ground_leaves_at_that_speed_from_a_moving_robot(d
         for _ in range(120):
             cmd = RobotCommand("blue", 0, vx=drive * c, vy=drive * s, kick_speed=asked)
             if relative:
-                cmd = relative_kick(cmd, heading, LEAGUE.robot)
-                assert cmd.kick_speed == pytest.approx(asked - drive)
+                truth = next(r for r in w.ground_truth().robots if r.id == 0)
+                cmd = relative_kick(cmd, heading, (truth.vx, truth.vy), LEAGUE.robot)
+                assert cmd.kick_speed == pytest.approx(asked - drive, abs=1e-3)  # not faster than commanded
             if any(isinstance(e, Kick) for e in w.step_frame([cmd])):
                 speed = ball_speed(w)
                 break
@@ -389,6 +391,66 @@ def test_a_kick_asked_over_the_ground_leaves_at_that_speed_from_a_moving_robot(d
             assert speed == pytest.approx(asked, abs=0.1) and speed < 6.5
         else:
             assert speed == pytest.approx(asked + drive, abs=0.1) and speed > 6.5
+
+
+def kick_from_a_robot_told_to_stop(asked: float, drive: float, stop_gap_m: float) -> tuple[float, float, float]:
+    """Blue 0 drives along +x at ``drive`` m/s toward the ball, its kicker armed at ``asked`` m/s over
+    the ground; once the ball is ``stop_gap_m`` ahead of its front, its command turns to a stop (as the
+    safety search may zero it) with the kick still armed, each kick sent relative to the robot by
+    ``relative_kick`` from the robot's true velocity (as tracked). Returns the ball's true speed the
+    frame it was kicked, the robot's true forward speed then, and how long after the stop was sent
+    the kicker fired (s)."""
+    w = make_world()
+    w.place_robot("blue", 0, 0.0, 0.0, 0.0)
+    w.place_ball(0.6, 0.0)
+    stop_t = None
+    for _ in range(120):
+        truth = next(r for r in w.ground_truth().robots if r.id == 0)
+        gap = float(w.ball_body.position.x) - truth.x - FRONT
+        if stop_t is None and gap <= stop_gap_m:
+            stop_t = w.t
+        cmd = relative_kick(RobotCommand("blue", 0, vx=drive if stop_t is None else 0.0, kick_speed=asked), 0.0,
+                            (truth.vx, truth.vy), LEAGUE.robot)
+        kicks = [e for e in w.step_frame([cmd]) if isinstance(e, Kick)]
+        if kicks:
+            robot = next(r for r in w.ground_truth().robots if r.id == 0)
+            assert stop_t is not None
+            return ball_speed(w), robot.vx, kicks[0].t - stop_t
+    raise AssertionError("no kick")
+
+
+def test_a_shot_from_a_robot_braking_onto_the_ball_never_leaves_faster_than_asked() -> None:
+    """A robot at 1 m/s whose command was zeroed just before its kicker fires still moves at about
+    1 m/s when it kicks: a shot at the fastest kick (field.yaml robot.max_kick_m_s) sent as if the
+    robot stood (its command's velocity) left at 6.9 m/s, over the rules' 6.5; with the robot's own
+    speed taken off it leaves at most at the speed asked (the ball's true speed, within the one frame
+    of sliding, 3 m/s², it may have lost after the kick: 0.06 m/s), under the rules'."""
+    asked = LEAGUE.robot.max_kick_m_s
+    limit = RulesParams().ball_speed_limit_m_s
+    speed, forward, after = kick_from_a_robot_told_to_stop(asked, drive=1.0, stop_gap_m=0.05)
+    assert after >= RobotParams().command_latency_s  # the stop had reached the robot when it kicked ...
+    assert forward > 0.8  # ... but its wheels had not stopped it
+    assert speed <= asked + 0.06 < limit
+    assert speed >= asked - 0.25  # and not much slower: the robot braked at most that much meanwhile
+
+
+@pytest.mark.parametrize(("asked", "drive"), [(3.0, 0.0), (3.0, 1.0), (1.5, 0.5)])
+def test_a_pass_from_a_steady_robot_leaves_at_the_speed_asked(asked: float, drive: float) -> None:
+    """A pass from a robot standing or driving steadily onto the ball (its true velocity, as tracked,
+    equal to its command's) leaves at the speed asked over the ground, within 0.1 m/s (one frame of
+    sliding after the kick, 0.05 m/s, and the robot's speed as it meets the ball)."""
+    w = make_world()
+    w.place_robot("blue", 0, 0.0, 0.0, 0.0)
+    w.place_ball(FRONT + 0.002 + 0.3 * drive, 0.0)
+    speed = None
+    for _ in range(120):
+        truth = next(r for r in w.ground_truth().robots if r.id == 0)
+        cmd = relative_kick(RobotCommand("blue", 0, vx=drive, kick_speed=asked), 0.0, (truth.vx, truth.vy),
+                            LEAGUE.robot)
+        if any(isinstance(e, Kick) for e in w.step_frame([cmd])):
+            speed = ball_speed(w)
+            break
+    assert speed == pytest.approx(asked, abs=0.1)
 
 
 @pytest.mark.parametrize("gain", [0.75, 1.2])
@@ -402,7 +464,7 @@ def test_a_kicker_off_its_gain_is_asked_that_much_more_and_the_ball_leaves_as_as
                   robots_per_team={"blue": 1, "yellow": 0})
         w.place_robot("blue", 0, 0.0, 0.0, 0.0)
         w.place_ball(FRONT + 0.002, 0.0)
-        cmd = relative_kick(RobotCommand("blue", 0, kick_speed=asked), 0.0, LEAGUE.robot, believed)
+        cmd = relative_kick(RobotCommand("blue", 0, kick_speed=asked), 0.0, (0.0, 0.0), LEAGUE.robot, believed)
         assert cmd.kick_speed == pytest.approx(asked / believed)
         for _ in range(6):
             kicks = [e for e in w.step_frame([cmd]) if isinstance(e, Kick)]
@@ -415,9 +477,9 @@ def test_a_kicker_off_its_gain_is_asked_that_much_more_and_the_ball_leaves_as_as
 
 def test_a_gain_never_makes_a_shot_sent_faster_than_the_robots_fastest_kick() -> None:
     robot = LEAGUE.robot
-    shot = relative_kick(RobotCommand("blue", 0, kick_speed=6.0), 0.0, robot, 0.58)
+    shot = relative_kick(RobotCommand("blue", 0, kick_speed=6.0), 0.0, (0.0, 0.0), robot, 0.58)
     assert shot.kick_speed == robot.max_kick_m_s  # not 6 / 0.58 = 10.3: grSim's ball would leave at 8
-    fast = relative_kick(RobotCommand("blue", 0, kick_speed=6.5), 0.0, robot, 0.58)
+    fast = relative_kick(RobotCommand("blue", 0, kick_speed=6.5), 0.0, (0.0, 0.0), robot, 0.58)
     assert fast.kick_speed == 6.5  # a kick asked faster still is not made slower by the cap
 
 
@@ -427,4 +489,4 @@ def test_the_kickers_speed_never_falls_below_its_slowest_and_a_chip_or_no_kick_i
     assert robot.kicker_speed(2.0, -1.0) == 3.0  # backing away: faster by as much
     assert robot.kicker_speed(0.0, 1.0) == 0.0  # no kick stays none
     chip = RobotCommand("blue", 0, vx=1.0, kick_speed=3.0, chip=True)
-    assert relative_kick(chip, 0.0, robot) == chip
+    assert relative_kick(chip, 0.0, (0.0, 0.0), robot) == chip

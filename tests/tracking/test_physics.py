@@ -203,12 +203,10 @@ def test_a_used_value_is_handed_on_again_only_when_it_moved_enough() -> None:
     assert at(6.0, 6.0).in_use() == {}  # back at the configured value: nothing in use
 
 
-def scripted_one_touch(retention: float, seed: int = 1, kicks: int = 8, catch_s: float | None = None) -> Tracker:
+def scripted_one_touch(retention: float, seed: int = 1, kicks: int = 8) -> Tracker:
     """A ball rolled at 2.5 m/s onto the front of a robot at rest facing along +x from 45° to its
     left (or right, in turn), the robot's kicker armed: a one-touch kick at 3 m/s whose kicker keeps
-    ``retention`` of the ball's velocity across the heading. With ``catch_s`` the robot's dribbler
-    catches the ball first and the kicker is armed that long after the ball touched. The tracker
-    hears the commands."""
+    ``retention`` of the ball's velocity across the heading. The tracker hears the commands."""
     latency = 0.03
     league = LeagueParams()
     w = World(league, PhysicsParams(), RobotParams(command_latency_s=latency), BallParams(),
@@ -221,15 +219,11 @@ def scripted_one_touch(retention: float, seed: int = 1, kicks: int = 8, catch_s:
         y = rng.uniform(-1.0, 1.0)
         w.place_robot("blue", 0, -2.0, y, 0.0)
         w.place_ball(-2.0 + front + 0.9, y + side * 0.9, vx=-2.5 / math.sqrt(2.0), vy=-side * 2.5 / math.sqrt(2.0))
-        kicked, touched = False, math.inf
+        kicked = False
         for _ in range(60 * 2):
             snap = w.snapshot()
             tracker.step([detect(snap, rng, sigma=SIGMA)])
-            gap = math.hypot(snap.ball[0] - snap.robots[0][2], snap.ball[1] - snap.robots[0][3])
-            if gap < front + 0.005:
-                touched = min(touched, snap.t)
-            armed = not kicked and (catch_s is None or snap.t >= touched + catch_s)
-            command = RobotCommand("blue", 0, kick_speed=3.0 if armed else 0.0, dribbler=0.0 if catch_s is None else 1.0)
+            command = RobotCommand("blue", 0, kick_speed=0.0 if kicked else 3.0)
             tracker.command_sent([command], snap.t)
             events = w.step_frame([command])
             kicked = kicked or any(isinstance(e, Kick) for e in events)

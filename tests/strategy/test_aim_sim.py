@@ -61,7 +61,7 @@ def test_a_robot_driving_sideways_shoots_at_the_goal_centre(sideways_m_s: float)
         omega = HEADING_GAIN * wrap_angle(intent.theta - r.theta) / dt
         cmd = RobotCommand("blue", 0, vy=sideways_m_s, omega=omega, kick_speed=intent.kick_speed,
                            dribbler=intent.dribbler)
-        if any(isinstance(e, Kick) for e in world.step_frame([relative_kick(cmd, r.theta, shape)])):
+        if any(isinstance(e, Kick) for e in world.step_frame([relative_kick(cmd, r.theta, (r.vx, r.vy), shape)])):
             kicked = world.ground_truth().ball
             break
     assert kicked is not None, "no kick"
@@ -122,7 +122,8 @@ def test_a_robot_driving_sideways_shoots_a_pass_one_touch_at_the_goal_centre(sid
         omega = HEADING_GAIN * wrap_angle(intent.theta - r.theta) / dt
         cmd = RobotCommand("blue", 0, vy=sideways_m_s, omega=omega, kick_speed=intent.kick_speed,
                            dribbler=intent.dribbler)
-        if any(isinstance(e, Kick) for e in world.step_frame([relative_kick(cmd, r.theta, SETTINGS.field.robot)])):
+        sent = relative_kick(cmd, r.theta, (r.vx, r.vy), SETTINGS.field.robot)
+        if any(isinstance(e, Kick) for e in world.step_frame([sent])):
             kicked = world.ground_truth()
             break
     assert kicked is not None, "no kick"
@@ -172,7 +173,8 @@ def test_a_robot_driving_sideways_chips_onto_its_target(sideways_m_s: float) -> 
         last = heading
         cmd = RobotCommand("blue", 0, vy=sideways_m_s, omega=HEADING_GAIN * error / dt + follow,
                            kick_speed=kicker_m_s if armed else 0.0, chip=armed, dribbler=1.0)
-        if any(isinstance(e, Kick) for e in world.step_frame([relative_kick(cmd, r.theta, SETTINGS.field.robot)])):
+        sent = relative_kick(cmd, r.theta, (r.vx, r.vy), SETTINGS.field.robot)
+        if any(isinstance(e, Kick) for e in world.step_frame([sent])):
             kicked = True
             break
     assert kicked, "no chip"

@@ -139,11 +139,16 @@ def vision_goals(messages: Iterable[tuple[str, Any]], pitch: Field) -> dict[Team
     order, the referee's ``referee`` game states among them) its surest ball, across a goal line
     between the posts (:class:`~sim.autoref.BallCrossing`) while the ball is in play; the scorer by
     the sides the referee gave at that moment; one goal until the referee stops play (a ball seen back
-    out of the goal and in again, on the line, is the same goal)."""
+    out of the goal and in again, on the line, is the same goal). The ball must have come from where it
+    was last seen on the field no faster than :data:`_BALL_MAX_M_S`: a stray detection on the field
+    (the ER-Force simulator's, at a robot's front) between two views of a ball lying in a goal is no
+    ball that went in (one left in a goal at half time was counted at the kickoff, the sides changed)."""
     crossing = BallCrossing(pitch)
     game = GameState(0.0)
     goals: dict[Team, int] = {"blue": 0, "yellow": 0}
     scored = False  # a goal counted since play last stopped
+    on_field: tuple[float, float, float] | None = None  # the ball last seen on the field: (t, x, y)
+    reach = pitch.half_length + pitch.league.ball.radius_m
     for topic, m in messages:
         if topic == "referee":
             game = m
@@ -154,13 +159,19 @@ def vision_goals(messages: Iterable[tuple[str, Any]], pitch: Field) -> dict[Team
             continue
         b = max(frame.balls, key=lambda b: b.confidence)
         sign = -1 if game.blue_defends_negative_x else 1
-        seen = crossing.see(frame.t_capture, b.x, b.y, sign, None)
-        if isinstance(seen, Goal) and _in_play(game) and not scored:
+        t = frame.t_capture
+        seen = crossing.see(t, b.x, b.y, sign, None)
+        came = on_field is not None and math.hypot(b.x - on_field[1], b.y - on_field[2]) <= _BALL_MAX_M_S * max(
+            t - on_field[0], 0.0)
+        if isinstance(seen, Goal) and _in_play(game) and not scored and came:
             goals[other(defender_of(b.x, sign))] += 1
             scored = True
+        if abs(b.x) <= reach and abs(b.y) <= pitch.half_width + pitch.league.ball.radius_m:
+            on_field = (t, b.x, b.y)
     return goals
 
 
+_BALL_MAX_M_S = 10.0  # no ball runs faster (the rules allow a kick 6.5 m/s): a longer jump is another detection
 _SAME_FRAME_S = 1e-3  # two clocks' times this near are one frame's (frames 1/60 s apart; times off by float rounding)
 
 

@@ -86,6 +86,26 @@ def test_a_ball_seen_in_the_goal_out_and_in_again_before_the_referee_stops_play_
     assert vision_goals(stream, FIELD) == {"blue": 2, "yellow": 0}
 
 
+def test_a_ball_left_in_a_goal_is_no_goal_at_the_restart_for_a_stray_detection_on_the_field() -> None:
+    """As in an ER-Force row: the ball pushed into the +x goal while play was stopped lay there into the
+    second half; at the kickoff (the sides changed) a stray detection at a robot's front on the field,
+    then the ball in the goal again: no goal (it did not come from the field). The next real goal
+    counts."""
+    stream = [
+        _game(0.0, RefereeCommand.BALL_PLACEMENT),
+        _frame(1.0, 4.3, 0.2), _frame(1.1, PAST_GOAL_X, 0.2),  # pushed in while stopped: no goal
+        _frame(2.0, PAST_GOAL_X, 0.2),
+        _game(3.0, RefereeCommand.STOP, blue_negative=False),
+        _game(3.5, RefereeCommand.KICKOFF, blue_negative=False),
+        _frame(3.50, -1.0, 1.5),  # a stray detection on the field ...
+        _frame(3.52, PAST_GOAL_X, 0.2),  # ... and the ball still in the goal, 5.6 m away a frame later
+        _frame(3.6, PAST_GOAL_X, 0.2),
+        _game(4.0, RefereeCommand.NORMAL, blue_negative=False),
+        _frame(4.5, 0.0, 0.0), _frame(5.0, -4.0, 0.1), _frame(5.1, -PAST_GOAL_X, 0.1),  # blue scores at -x
+    ]
+    assert vision_goals(stream, FIELD) == {"blue": 1, "yellow": 0}
+
+
 def test_goals_in_the_truth_are_counted_at_both_ends_once_each() -> None:
     path = [(0.0, 0.0), (PAST_GOAL_X, 0.2), (PAST_GOAL_X + 0.05, 0.2), (0.0, 0.0), (-PAST_GOAL_X, -0.2),
             (0.0, 0.0), (PAST_GOAL_X, 2.0), (0.0, 0.0)]  # two goals, then out beside the post

@@ -279,10 +279,8 @@ class PhysicsEstimator:
         fit = self._ball_sample(Fact.BALL_ROLL, self._gain)
         if fit is None:
             return
-        t_mid, speed, decel = fit.t_mid, fit.speed, fit.decel
-        rolls = self.samples[Fact.BALL_ROLL]
-        if len(rolls) >= p.min_samples:
-            decel = float(np.median(rolls))
+        t_mid, speed = fit.t_mid, fit.speed
+        decel = self._known(Fact.BALL_ROLL, fit.decel)
         launch = launch_speed(speed, decel, t_mid - t_kick, p.acc_slide_m_s2, p.slide_to_roll_fraction)
         self.samples[Fact.KICK_GAIN].append(launch / asked)
 
@@ -294,12 +292,17 @@ class PhysicsEstimator:
         from the kick); its velocity across the heading less the robot's, over the incoming ball's
         relative to the robot."""
         nx, ny = -math.sin(kick.heading), math.cos(kick.heading)
-        slides = self.samples[Fact.BALL_SLIDE]
-        slide = float(np.median(slides)) if len(slides) >= self.p.min_samples else self.p.acc_slide_m_s2
+        slide = self._known(Fact.BALL_SLIDE, self.p.acc_slide_m_s2)
         launch = fit.speed + slide * max(0.0, fit.t_mid - t_kick)
         across_out = launch * (fit.direction[0] * nx + fit.direction[1] * ny) - (kick.robot_v[0] * nx
                                                                                  + kick.robot_v[1] * ny)
         self.samples[Fact.KICK_RETENTION].append(across_out / _across_in(kick))
+
+    def _known(self, fact: Fact, otherwise: float) -> float:
+        """``fact`` as measured so far (the median of its windows, once they are ``min_samples``), else
+        ``otherwise``: what a window taken back to its kick reckons with."""
+        values = self.samples[fact]
+        return float(np.median(values)) if len(values) >= self.p.min_samples else otherwise
 
     def _ball_sample(self, fact: Fact, window: _Window) -> _Fit | None:
         """The window's deceleration as one sample of ``fact``, and the window's fit (None: too few
